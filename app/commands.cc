@@ -1,0 +1,75 @@
+#include "app/commands.h"
+
+#include <exception>
+#include <iostream>
+
+namespace fresco {
+
+const std::vector<Command>& AllCommands() {
+  static const std::vector<Command> kCommands = {
+      {"run", "paint a project's video onto its model (headless)", RunVerbRun},
+      {"render", "render a (painted or original) glTF model through a camera", RunVerbRender},
+      {"synth", "make a synthetic capture from a glTF scene", RunVerbSynth},
+      {"calib", "calibrate camera intrinsics from board images (mrcal)", RunVerbCalib},
+      {"poses", "bootstrap or verify poses with COLMAP", RunVerbPoses},
+      {"bench", "measure the speed/accuracy trade of pipeline settings", RunVerbBench},
+      {"gui", "the authoring app", RunVerbGui},
+  };
+  return kCommands;
+}
+
+static void PrintMainUsage(std::ostream& out) {
+  out << "usage: fresco VERB [ARGS...]   (fresco VERB --help for a verb's options)\n\nverbs:\n";
+  for (const Command& c : AllCommands()) {
+    out << "  " << c.verb << std::string(8 - std::string(c.verb).size(), ' ') << c.summary
+        << "\n";
+  }
+}
+
+int Dispatch(const std::vector<std::string>& argv) {
+  if (argv.empty()) {
+    PrintMainUsage(std::cerr);
+    return kExitBadInput;
+  }
+  const std::string& verb = argv[0];
+  if (verb == "--help" || verb == "-h" || verb == "help") {
+    PrintMainUsage(std::cout);
+    return kExitOk;
+  }
+  for (const Command& c : AllCommands()) {
+    if (verb != c.verb) continue;
+    try {
+      return c.run(CommandArgs(argv.begin() + 1, argv.end()));
+    } catch (const std::exception& e) {
+      std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";
+      return kExitFailure;
+    }
+  }
+  std::cerr << "fresco: unknown verb '" << verb << "'\n";
+  PrintMainUsage(std::cerr);
+  return kExitBadInput;
+}
+
+int ParseVerbArgs(const std::string& verb, const CommandArgs& argv, const ArgSpec& spec,
+                  Args* args) {
+  std::string error;
+  if (!ParseArgs(argv, spec, args, &error)) return UsageError(verb, spec, error);
+  if (args->help) {
+    std::cout << "usage: " << spec.usage << "\n";
+    if (!spec.help.empty()) std::cout << "\n" << spec.help << "\n";
+    return kExitOk;
+  }
+  return -1;
+}
+
+int UsageError(const std::string& verb, const ArgSpec& spec, const std::string& message) {
+  std::cerr << "fresco " << verb << ": " << message << "\nusage: " << spec.usage << "\n";
+  return kExitBadInput;
+}
+
+int InputError(const Status& status) {
+  std::cerr << "error: " << status.message() << "\n";
+  return kExitBadInput;
+}
+
+}  // namespace fresco

@@ -1,0 +1,25 @@
+// Progress on stderr for long work: a bar redrawn in place when stderr is a terminal, plain
+// lines at every 10 % otherwise (logs stay readable), nothing when quiet.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace fresco {
+
+class Progress {
+ public:
+  Progress(std::string label, int total, bool quiet = false);
+  void Update(int done, const std::string& detail = "");
+  void Finish(const std::string& detail = "");
+
+ private:
+  std::string label_;
+  int total_;
+  bool quiet_;
+  bool tty_;
+  int last_decile_ = -1;
+  std::chrono::steady_clock::time_point start_, last_draw_;
+};
+
+}  // namespace fresco

@@ -1,0 +1,29 @@
+// Verbs whose issues have not landed yet. Each says so plainly and exits 1; each file that
+// implements one of them removes it from here.
+#include <iostream>
+
+#include "app/commands.h"
+
+namespace fresco {
+
+static int NotYet(const std::string& verb, const std::string& issue, const CommandArgs& argv) {
+  ArgSpec spec;
+  spec.usage = "fresco " + verb + " ...";
+  spec.max_positional = 1000;
+  Args args;
+  for (const std::string& a : argv) {
+    if (a == "--help" || a == "-h") {
+      std::cout << "usage: " << spec.usage << "\n\nnot implemented yet (" << issue << ")\n";
+      return kExitOk;
+    }
+  }
+  std::cerr << "fresco " << verb << ": not implemented yet (" << issue << ")\n";
+  return kExitFailure;
+}
+
+int RunVerbCalib(const CommandArgs& a) { return NotYet("calib", "issue 8", a); }
+int RunVerbPoses(const CommandArgs& a) { return NotYet("poses", "issue 9", a); }
+int RunVerbBench(const CommandArgs& a) { return NotYet("bench", "issue 10", a); }
+int RunVerbGui(const CommandArgs& a) { return NotYet("gui", "issue 5", a); }
+
+}  // namespace fresco

@@ -1,0 +1,1 @@
+// The calibration issue (8) fills this library.

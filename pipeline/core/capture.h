@@ -1,0 +1,43 @@
+// A project's inputs loaded and matched: scene, cameras, the video stream and one pose per
+// frame where there is one. Errors name the file and what is wrong (missing file, NaN pose,
+// an image listed in the poses but missing from the video folder, ...).
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/poses.h"
+#include "pipeline/core/project.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/core/status.h"
+#include "pipeline/core/video_source.h"
+
+namespace fresco {
+
+struct Capture {
+  Scene scene;
+  std::map<int, Camera> cameras;        // by CAMERA_ID (a .cameramodel gives id 1)
+  std::vector<PosedImage> poses;        // as read
+  std::vector<PosedImage> truth_poses;  // empty unless the project names truth poses
+  std::unique_ptr<VideoSource> video;
+  // For frame names known up front (folders): frame name -> index into `poses`.
+  std::map<std::string, int> pose_by_name;
+  bool poses_are_tum = false;  // TUM poses match frames in order
+
+  // The pose for a frame (by name for COLMAP, by order for TUM); nullptr when none.
+  const PosedImage* PoseForFrame(const Frame& frame) const;
+  // The camera a pose uses (its CAMERA_ID, or the only camera).
+  const Camera* CameraFor(const PosedImage& pose) const;
+};
+
+struct CaptureLoadOptions {
+  bool load_scene = true;
+  bool open_video = true;
+};
+
+Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture);
+
+}  // namespace fresco

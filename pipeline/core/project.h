@@ -1,0 +1,87 @@
+// The project file (CONTRACT.md): which scene, camera, video and poses, plus every setting
+// of the pipeline, with defaults that work. Parsing is strict: an unknown key, a wrong type
+// or a bad value is an error naming the file and the JSON path of the field. Paths in the
+// file are relative to the folder holding it; Project keeps them as written and resolves
+// them on demand. Saving is atomic (temp file + rename) and load(save(p)) == p.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+enum class SamplingMode { kNearest, kBilinear, kArea };
+
+struct OcclusionOptions {
+  bool enabled = true;
+  // A texel is visible when its depth is within this fraction of the rendered depth
+  // (relative tolerance, scales with depth) plus `tolerance_m`.
+  double tolerance_rel = 0.01;
+  double tolerance_m = 0.002;
+  // Texels seen at more than this angle from the surface normal are not painted.
+  double max_view_angle_deg = 80.0;
+};
+
+struct PipelineOptions {
+  SamplingMode sampling = SamplingMode::kBilinear;
+  double texel_size_m = 0.0;  // base-buffer texel edge in metres; 0 = automatic
+  int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
+  int update_every = 1;       // paint every N-th frame (the paper used 20 with refinement)
+  int max_frames = 0;         // 0 = all frames
+  int threads = 0;            // 0 = all cores
+  bool debug_images = false;  // write per-stage debug images (costs time)
+  OcclusionOptions occlusion;
+};
+
+// Automatic base-buffer grouping (paper §3.6): neighbouring triangles whose normals are
+// within `angle_deg` of the group's seed normal share a buffer.
+struct GroupingEdit {
+  std::string op;             // "merge" | "split" | "move" (see grouping.h)
+  std::vector<int> triangles;
+  std::vector<int> groups;
+  int target_group = -1;
+  double texel_size_m = 0.0;  // per-group override when > 0
+};
+struct GroupingOptions {
+  double angle_deg = 20.0;
+  std::vector<GroupingEdit> edits;
+};
+
+// Ground truth a synthetic capture carries (fresco synth); empty when unknown.
+struct TruthFiles {
+  std::string poses;  // true poses (same format as `poses`)
+};
+
+struct Project {
+  int fresco_version = 1;
+  std::string scene;   // as written in the file
+  std::string camera;
+  std::string video;
+  std::string poses;
+  double time_offset_s = 0.0;  // tracker clock minus video clock (live/TUM matching)
+  PipelineOptions pipeline;
+  GroupingOptions grouping;
+  TruthFiles truth;
+
+  std::string file_path;  // where it was loaded from / saved to (absolute)
+  // Resolves a path as written in the project against the project file's folder.
+  std::string Resolve(const std::string& relative) const;
+};
+
+// Reads and validates the JSON (not the referenced files: see LoadCapture). `overrides` are
+// "KEY=VALUE" strings applied by JSON path before validation (`pipeline.sampling=nearest`).
+// VALUE is parsed as JSON when it parses, otherwise taken as a string.
+Status LoadProject(const std::string& path, const std::vector<std::string>& overrides,
+                   Project* project);
+// Parses a project from text; `name` is used in messages and for resolving paths.
+Status ParseProject(const std::string& text, const std::string& name,
+                    const std::vector<std::string>& overrides, Project* project);
+// Writes the project atomically. Paths stay relative to the new location.
+Status SaveProject(const Project& project, const std::string& path);
+std::string ProjectToJsonText(const Project& project);
+
+std::string SamplingModeName(SamplingMode mode);
+
+}  // namespace fresco

@@ -1,0 +1,87 @@
+// A triangle scene loaded from glTF 2.0 (via tinygltf): all primitives of all nodes of the
+// default scene, flattened into one triangle mesh with node transforms applied. Vertices are
+// stored relative to a local origin (`origin_in_world`) so that map-scale coordinates
+// (~1e6 m) keep their precision: world = local + origin_in_world.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+enum class TextureWrap { kRepeat, kClampToEdge, kMirroredRepeat };
+
+struct Texture {
+  cv::Mat rgba;  // CV_8UC4, sRGB values, row 0 = top of the image (glTF UV v = 0)
+  TextureWrap wrap_s = TextureWrap::kRepeat;
+  TextureWrap wrap_t = TextureWrap::kRepeat;
+  std::string name;
+};
+
+struct Material {
+  Eigen::Vector4d base_color_factor = Eigen::Vector4d::Ones();  // RGBA, linear factor
+  int base_color_texture = -1;  // index into Scene::textures, -1 for none
+  bool double_sided = false;
+  std::string name;
+};
+
+struct TriangleMesh {
+  std::vector<Eigen::Vector3d> vertices;       // local coordinates, metres
+  std::vector<Eigen::Vector3i> triangles;      // vertex indices, counter-clockwise = front
+  std::vector<std::array<Eigen::Vector2f, 3>> uvs;  // TEXCOORD_0 per corner (zeros if absent)
+  std::vector<int> material;                   // per triangle, index into Scene::materials
+  std::vector<bool> has_uv;                    // per triangle
+
+  int NumTriangles() const { return static_cast<int>(triangles.size()); }
+  Eigen::Vector3d Corner(int tri, int k) const { return vertices[triangles[tri][k]]; }
+  // Unit normal (counter-clockwise winding), zero for a degenerate triangle.
+  Eigen::Vector3d Normal(int tri) const;
+  double Area(int tri) const;
+};
+
+// For each triangle, the triangles sharing each of its edges (edge k = corner k -> k+1).
+// Vertices are welded by position (within `weld_tolerance_m`) first, so glTF meshes that
+// duplicate vertices for UV seams are still connected. Non-manifold edges (3+ triangles)
+// list every other triangle on the edge.
+struct MeshAdjacency {
+  std::vector<std::array<std::vector<int>, 3>> edge_neighbours;  // (T, 3) lists
+  std::vector<int> welded_vertex;  // (V) canonical vertex index after welding
+};
+MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m = 1e-6);
+
+struct Scene {
+  TriangleMesh mesh;
+  std::vector<Material> materials;  // at least one (a default white material)
+  std::vector<Texture> textures;
+  Eigen::Vector3d origin_in_world = Eigen::Vector3d::Zero();
+  std::string source_path;
+
+  Eigen::Vector3d LocalFromWorld(const Eigen::Vector3d& p) const { return p - origin_in_world; }
+  Eigen::Vector3d WorldFromLocal(const Eigen::Vector3d& p) const { return p + origin_in_world; }
+  // Axis-aligned bounds of the vertices, local coordinates.
+  void Bounds(Eigen::Vector3d* min_corner, Eigen::Vector3d* max_corner) const;
+};
+
+struct SceneLoadOptions {
+  // Drop triangles with area below this (m^2): degenerate triangles paint nothing.
+  double min_triangle_area_m2 = 1e-14;
+  // Local origin: the centre of the bounding box when true, (0,0,0) when false.
+  bool recentre = true;
+};
+
+// Loads `.gltf` (with its .bin and images) or `.glb`. Errors name the file and what is wrong
+// (missing file, parse error, out-of-range indices, no triangles).
+Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, Scene* scene);
+
+// Writes `scene` as glTF 2.0 (`.gltf` + `.bin` + one PNG per texture beside it), atomically
+// per file. Geometry is written in world coordinates relative to origin via a node
+// translation, so map-scale scenes keep precision.
+Status SaveGltfScene(const Scene& scene, const std::string& path);
+
+}  // namespace fresco

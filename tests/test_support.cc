@@ -1,0 +1,93 @@
+#include "tests/test_support.h"
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+namespace fresco::testing {
+namespace fs = std::filesystem;
+
+std::string SharedDataDir() {
+  const char* env = std::getenv("FRESCO_SHARED_DATA");
+  const std::string dir = env ? env : "";
+  if (dir.empty() || !fs::is_directory(dir)) return "";
+  return fs::canonical(dir).string();
+}
+
+std::string SourceDir() {
+  const char* env = std::getenv("FRESCO_SOURCE_DIR");
+  return env ? env : ".";
+}
+
+namespace {
+std::vector<std::string>& TempDirs() {
+  static std::vector<std::string> dirs;
+  return dirs;
+}
+void RemoveTempDirs() {
+  if (std::getenv("FRESCO_KEEP_TEST_FILES")) return;
+  std::error_code ec;
+  for (const auto& d : TempDirs()) fs::remove_all(d, ec);
+}
+}  // namespace
+
+std::string MakeTempDir(const std::string& tag) {
+  static std::once_flag once;
+  std::call_once(once, [] { std::atexit(RemoveTempDirs); });
+  std::string pattern = (fs::temp_directory_path() / ("fresco-" + tag + "-XXXXXX")).string();
+  char* made = mkdtemp(pattern.data());
+  if (!made) throw std::runtime_error("mkdtemp failed for " + pattern);
+  TempDirs().push_back(made);
+  return made;
+}
+
+void WriteText(const std::string& path, const std::string& text) {
+  fs::create_directories(fs::path(path).parent_path());
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+
+CommandResult RunFresco(const std::vector<std::string>& args) {
+  const char* env = std::getenv("FRESCO_BINARY");
+  const std::string binary = env ? env : "build/app/fresco";
+  const std::string dir = MakeTempDir("cmd");
+  const std::string out_path = dir + "/stdout", err_path = dir + "/stderr";
+  CommandResult result;
+  pid_t pid = fork();
+  if (pid == 0) {
+    int out_fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int null_fd = open("/dev/null", O_RDONLY);
+    dup2(out_fd, 1);
+    dup2(err_fd, 2);
+    dup2(null_fd, 0);
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(binary.c_str()));
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    execv(binary.c_str(), argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.out = ReadText(out_path);
+  result.err = ReadText(err_path);
+  return result;
+}
+
+}  // namespace fresco::testing
