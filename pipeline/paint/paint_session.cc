@@ -1,1 +1,262 @@
-// TODO
+#include "pipeline/paint/paint_session.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/render/renderer.h"
+
+namespace fresco {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+bool SameCamera(const Camera& a, const Camera& b) {
+  return a.width == b.width && a.height == b.height && a.Params() == b.Params() &&
+         a.model == b.model;
+}
+
+cv::Mat DepthDebugImage(const cv::Mat& depth) {
+  cv::Mat finite = depth.clone();
+  cv::Mat mask = depth < 1e30f;
+  double lo = 0, hi = 1;
+  cv::minMaxLoc(depth, &lo, &hi, nullptr, nullptr, mask);
+  finite.setTo(hi, ~mask);
+  cv::Mat gray;
+  finite.convertTo(gray, CV_8U, hi > lo ? -255.0 / (hi - lo) : 0, hi > lo ? 255.0 * hi / (hi - lo) : 0);
+  cv::Mat colour;
+  cv::applyColorMap(gray, colour, cv::COLORMAP_VIRIDIS);
+  colour.setTo(cv::Scalar(0, 0, 0), ~mask);
+  return colour;
+}
+
+}  // namespace
+
+double AutomaticTexelSize(const Scene& scene, const Camera& camera,
+                          const std::vector<Rigid3d>& cam_from_world) {
+  Eigen::Vector3d lo, hi;
+  scene.Bounds(&lo, &hi);
+  const Eigen::Vector3d centre_world = scene.WorldFromLocal(0.5 * (lo + hi));
+  std::vector<double> dist;
+  for (const Rigid3d& pose : cam_from_world) dist.push_back((pose * centre_world).norm());
+  double d = (hi - lo).norm() * 0.5;
+  if (!dist.empty()) {
+    std::nth_element(dist.begin(), dist.begin() + dist.size() / 2, dist.end());
+    d = dist[dist.size() / 2];
+  }
+  const double f = camera.fx > 0 ? 0.5 * (camera.fx + camera.fy) : 500.0;
+  return std::max(d / f, 1e-6);
+}
+
+Status PaintSession::Create(const PaintSessionInputs& inputs,
+                            std::unique_ptr<PaintSession>* session) {
+  std::unique_ptr<PaintSession> s(new PaintSession());
+  s->scene_ = inputs.scene;
+  s->options_ = inputs.pipeline;
+  const TriangleMesh& mesh = inputs.scene->mesh;
+  if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
+  s->texel_size_m_ = inputs.pipeline.texel_size_m > 0
+                         ? inputs.pipeline.texel_size_m
+                         : (inputs.typical_camera ? AutomaticTexelSize(*inputs.scene,
+                                                                       *inputs.typical_camera,
+                                                                       inputs.expected_poses)
+                                                  : 0.01);
+  const MeshAdjacency adjacency = ComputeAdjacency(mesh);
+  Grouping grouping = ComputeGrouping(mesh, adjacency, inputs.grouping.angle_deg);
+  FRESCO_RETURN_IF_ERROR(
+      ApplyGroupingEdits(inputs.grouping.edits, mesh.NumTriangles(), &grouping));
+  BaseBufferOptions buffer_options;
+  buffer_options.texel_size_m = s->texel_size_m_;
+  buffer_options.max_buffer_texels = inputs.pipeline.max_buffer_texels;
+  s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
+  s->painted_.resize(s->set_.buffers.size());
+  s->warped_.resize(s->set_.buffers.size());
+  for (size_t b = 0; b < s->set_.buffers.size(); ++b)
+    InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
+  s->triangle_normals_.resize(mesh.NumTriangles());
+  for (int t = 0; t < mesh.NumTriangles(); ++t)
+    s->triangle_normals_[t] = mesh.Normal(t).cast<float>();
+  *session = std::move(s);
+  return Status::Ok();
+}
+
+const Rasterizer& PaintSession::RasterizerFor(const Camera& camera) {
+  for (auto& [cam, raster] : rasterizers_)
+    if (SameCamera(cam, camera)) return *raster;
+  RasterOptions options;
+  options.near_m = 1e-3;
+  rasterizers_.emplace_back(camera, std::make_unique<Rasterizer>(camera, options));
+  return *rasterizers_.back().second;
+}
+
+void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
+                              const Rigid3d& cam_from_world, FrameReport* report) {
+  const auto frame_start = std::chrono::steady_clock::now();
+  report->frame = frame.index;
+  report->name = frame.name;
+  report->stages.clear();
+  const int frame_number = frames_seen_++;
+  if (options_.update_every > 1 && frame_number % options_.update_every != 0) {
+    report->painted = false;
+    report->skipped_reason = "update_every";
+    return;
+  }
+  const bool debug = options_.debug_images;
+  const Rigid3d cam_from_local = CamFromLocal(*scene_, cam_from_world);
+
+  // 1. depth
+  auto start = std::chrono::steady_clock::now();
+  StageReport depth_report;
+  depth_report.name = "depth";
+  RasterOutput raster;
+  if (options_.occlusion.enabled) {
+    RasterizerFor(camera).Rasterize(scene_->mesh, cam_from_local, &raster);
+    depth_ = raster.depth;
+    depth_report.metrics["surface_pixels"] = cv::countNonZero(raster.triangle_id >= 0);
+    if (debug) depth_report.images["depth"] = DepthDebugImage(depth_);
+  }
+  depth_report.wall_ms = MsSince(start);
+  report->stages.push_back(std::move(depth_report));
+
+  // 2. warp
+  start = std::chrono::steady_clock::now();
+  StageReport warp_report;
+  warp_report.name = "warp";
+  FrameView view;
+  view.camera = &camera;
+  view.cam_from_local = cam_from_local;
+  view.centre_local = cam_from_local.Centre();
+  view.frame_bgr = &frame.bgr;
+  view.depth = options_.occlusion.enabled ? &depth_ : nullptr;
+  if (options_.sampling == SamplingMode::kArea) {
+    view.pyramid.push_back(frame.bgr);
+    while (view.pyramid.size() < 6 && view.pyramid.back().cols > 16) {
+      cv::Mat down;
+      cv::pyrDown(view.pyramid.back(), down);
+      view.pyramid.push_back(down);
+    }
+  }
+  WarpOptions warp_options;
+  warp_options.sampling = options_.sampling;
+  warp_options.occlusion = options_.occlusion;
+  long long in_view = 0, visible = 0, occluded = 0, grazing = 0, buffers_seen = 0;
+  std::vector<bool> seen(set_.buffers.size(), false);
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    const BaseBuffer& buffer = set_.buffers[b];
+    // Cull buffers entirely behind the camera.
+    bool any_in_front = false;
+    for (int c = 0; c < 8 && !any_in_front; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? buffer.bounds_max.x() : buffer.bounds_min.x(),
+                                   (c & 2) ? buffer.bounds_max.y() : buffer.bounds_min.y(),
+                                   (c & 4) ? buffer.bounds_max.z() : buffer.bounds_min.z());
+      any_in_front = (cam_from_local * corner).z() > warp_options.near_m;
+    }
+    if (!any_in_front) continue;
+    WarpFrameToBuffer(buffer, triangle_normals_, view, warp_options, &warped_[b]);
+    in_view += warped_[b].in_view;
+    visible += warped_[b].visible;
+    occluded += warped_[b].occluded;
+    grazing += warped_[b].grazing;
+    if (warped_[b].visible > 0) {
+      seen[b] = true;
+      ++buffers_seen;
+      if (debug) {
+        warp_report.images["warped_b" + std::to_string(b)] = warped_[b].bgr.clone();
+        warp_report.images["visible_b" + std::to_string(b)] = warped_[b].valid.clone();
+      }
+    }
+  }
+  warp_report.metrics["texels_in_view"] = static_cast<double>(in_view);
+  warp_report.metrics["texels_visible"] = static_cast<double>(visible);
+  warp_report.metrics["texels_occluded"] = static_cast<double>(occluded);
+  warp_report.metrics["texels_grazing"] = static_cast<double>(grazing);
+  warp_report.metrics["buffers_seen"] = static_cast<double>(buffers_seen);
+  warp_report.wall_ms = MsSince(start);
+  report->stages.push_back(std::move(warp_report));
+
+  // 3. paint
+  start = std::chrono::steady_clock::now();
+  StageReport paint_report;
+  paint_report.name = "paint";
+  long long written = 0, rejected = 0;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!seen[b]) continue;
+    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], cv::Mat(),
+                                               options_.update, options_.quality_slack,
+                                               &painted_[b]);
+    written += stats.written;
+    rejected += stats.rejected;
+    if (debug) paint_report.images["painted_b" + std::to_string(b)] = painted_[b].bgra.clone();
+  }
+  paint_report.metrics["texels_written"] = static_cast<double>(written);
+  paint_report.metrics["texels_kept_sharper"] = static_cast<double>(rejected);
+  paint_report.metrics["coverage"] = Coverage();
+  paint_report.wall_ms = MsSince(start);
+  report->stages.push_back(std::move(paint_report));
+  report->painted = true;
+  report->total_ms = MsSince(frame_start);
+}
+
+long long PaintSession::NumSurfaceTexels() const {
+  long long n = 0;
+  for (const auto& b : set_.buffers) n += b.num_surface_texels;
+  return n;
+}
+
+long long PaintSession::NumPaintedSurfaceTexels() const {
+  long long n = 0;
+  for (const auto& p : painted_) n += p.painted_surface_texels;
+  return n;
+}
+
+double PaintSession::Coverage() const {
+  const long long total = NumSurfaceTexels();
+  return total > 0 ? static_cast<double>(NumPaintedSurfaceTexels()) / total : 0.0;
+}
+
+Scene PaintSession::PaintedScene() const {
+  Scene out;
+  out.origin_in_world = scene_->origin_in_world;
+  out.source_path = scene_->source_path;
+  out.mesh = scene_->mesh;
+  const TriangleMesh& mesh = scene_->mesh;
+  out.mesh.uvs.assign(mesh.NumTriangles(), {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(),
+                                            Eigen::Vector2f::Zero()});
+  out.mesh.has_uv.assign(mesh.NumTriangles(), false);
+  out.mesh.material.assign(mesh.NumTriangles(), 0);
+  // Material 0: triangles in no buffer (never painted): transparent.
+  Material unpainted;
+  unpainted.name = "unpainted";
+  unpainted.base_color_factor = Eigen::Vector4d(1, 1, 1, 0);
+  out.materials.push_back(unpainted);
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    const BaseBuffer& buffer = set_.buffers[b];
+    Texture texture;
+    texture.name = "buffer_" + std::to_string(b);
+    cv::cvtColor(painted_[b].bgra, texture.rgba, cv::COLOR_BGRA2RGBA);
+    texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
+    out.textures.push_back(texture);
+    Material material;
+    material.name = texture.name;
+    material.base_color_texture = static_cast<int>(b);
+    material.double_sided = false;
+    out.materials.push_back(material);
+    for (int t : buffer.triangles) {
+      out.mesh.material[t] = static_cast<int>(b) + 1;
+      out.mesh.has_uv[t] = true;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d q = buffer.TexelCoords(mesh.Corner(t, k));
+        out.mesh.uvs[t][k] = Eigen::Vector2f(static_cast<float>(q.x() / buffer.width),
+                                             static_cast<float>(q.y() / buffer.height));
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace fresco

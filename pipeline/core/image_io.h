@@ -1,0 +1,18 @@
+// Image files: atomic writes (temp file beside the target, then rename) with the format
+// chosen by the target's extension, and reads whose errors name the file.
+#pragma once
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+// Writes `image` to `path` (format by extension: .png, .jpg, ...), atomically.
+Status WriteImageAtomic(const std::string& path, const cv::Mat& image);
+// Reads an image (cv::IMREAD_UNCHANGED by default); a missing or undecodable file is an error.
+Status ReadImage(const std::string& path, cv::Mat* image, int flags = -1);
+
+}  // namespace fresco

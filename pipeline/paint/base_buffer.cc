@@ -1,0 +1,231 @@
+#include "pipeline/paint/base_buffer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+namespace fresco {
+namespace {
+
+// Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
+Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + ab * (d1 / (d1 - d3));
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + ac * (d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+void ChooseAxes(const Eigen::Vector3d& normal, BaseBuffer* buffer) {
+  // Image "down" follows world down (glTF +Y up) on walls; on floors and ceilings +Z.
+  Eigen::Vector3d down(0, -1, 0);
+  Eigen::Vector3d v = down - normal * normal.dot(down);
+  if (v.norm() < 0.3) {
+    const Eigen::Vector3d z(0, 0, 1);
+    v = z - normal * normal.dot(z);
+  }
+  buffer->normal = normal;
+  buffer->axis_v = v.normalized();
+  buffer->axis_u = normal.cross(buffer->axis_v).normalized();
+}
+
+struct PlaneCoords {
+  double a_min = 1e300, a_max = -1e300, b_min = 1e300, b_max = -1e300;
+};
+
+// Builds one buffer; triangles whose projection folds over others are returned in `folded`.
+BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
+                    double texel_size_m, const BaseBufferOptions& options,
+                    std::vector<int>* folded) {
+  BaseBuffer buffer;
+  buffer.triangles = triangles;
+  BaseBufferGroup tmp;
+  tmp.triangles = triangles;
+  ChooseAxes(GroupNormal(mesh, tmp), &buffer);
+  const Eigen::Vector3d anchor = mesh.Corner(triangles[0], 0);
+  PlaneCoords pc;
+  buffer.bounds_min = Eigen::Vector3d::Constant(1e300);
+  buffer.bounds_max = Eigen::Vector3d::Constant(-1e300);
+  for (int t : triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = mesh.Corner(t, k);
+      buffer.bounds_min = buffer.bounds_min.cwiseMin(p);
+      buffer.bounds_max = buffer.bounds_max.cwiseMax(p);
+      const double a = (p - anchor).dot(buffer.axis_u), b = (p - anchor).dot(buffer.axis_v);
+      pc.a_min = std::min(pc.a_min, a), pc.a_max = std::max(pc.a_max, a);
+      pc.b_min = std::min(pc.b_min, b), pc.b_max = std::max(pc.b_max, b);
+    }
+  }
+  const int gutter = options.gutter_texels;
+  double s = texel_size_m;
+  auto dims = [&](double size, int* w, int* h) {
+    *w = static_cast<int>(std::ceil((pc.a_max - pc.a_min) / size)) + 2 * gutter + 1;
+    *h = static_cast<int>(std::ceil((pc.b_max - pc.b_min) / size)) + 2 * gutter + 1;
+  };
+  int w = 0, h = 0;
+  dims(s, &w, &h);
+  for (int iter = 0; iter < 8 && static_cast<double>(w) * h > options.max_buffer_texels; ++iter) {
+    s *= std::sqrt(static_cast<double>(w) * h / options.max_buffer_texels) * 1.01;
+    dims(s, &w, &h);
+  }
+  buffer.texel_size_m = s;
+  buffer.width = w;
+  buffer.height = h;
+  buffer.origin = anchor + (pc.a_min - gutter * s) * buffer.axis_u +
+                  (pc.b_min - gutter * s) * buffer.axis_v;
+
+  const Eigen::Vector3d& n = buffer.normal;
+  std::vector<int32_t> owner(static_cast<size_t>(w) * h, -1);
+  std::vector<Eigen::Vector3f> point(static_cast<size_t>(w) * h);
+  std::vector<bool> is_folded(mesh.NumTriangles(), false);
+  auto plane_point = [&](int i, int j) {
+    return buffer.origin + ((i + 0.5) * s) * buffer.axis_u + ((j + 0.5) * s) * buffer.axis_v;
+  };
+  for (int t : triangles) {
+    const Eigen::Vector3d nt = mesh.Normal(t);
+    if (nt.dot(n) < 1e-3) {  // edge-on or back-facing in this projection: cannot serve it
+      is_folded[t] = true;
+      continue;
+    }
+    Eigen::Vector2d q[3];
+    for (int k = 0; k < 3; ++k) q[k] = buffer.TexelCoords(mesh.Corner(t, k));
+    const double area2 = (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
+    if (std::abs(area2) < 1e-18) continue;
+    const double sign = area2 > 0 ? 1.0 : -1.0;
+    const int i0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+    const int i1 = std::min(w - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+    const int j0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+    const int j1 = std::min(h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+    const Eigen::Vector3d A = mesh.Corner(t, 0);
+    const double denom = n.dot(nt);
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        const Eigen::Vector2d c(i + 0.5, j + 0.5);
+        bool inside = true;
+        for (int k = 0; k < 3 && inside; ++k) {
+          const Eigen::Vector2d e = q[(k + 1) % 3] - q[k], r = c - q[k];
+          inside = sign * (e.x() * r.y() - e.y() * r.x()) >= 0;
+        }
+        if (!inside) continue;
+        const Eigen::Vector3d pp = plane_point(i, j);
+        const Eigen::Vector3d m = pp + n * ((A - pp).dot(nt) / denom);
+        const size_t idx = static_cast<size_t>(j) * w + i;
+        if (owner[idx] >= 0) {
+          // Shared edge: same point. Different point: the projection folds here.
+          if ((point[idx].cast<double>() - m).norm() > 0.5 * s) is_folded[t] = true;
+          continue;
+        }
+        owner[idx] = t;
+        point[idx] = m.cast<float>();
+      }
+    }
+  }
+  for (int t : triangles)
+    if (is_folded[t]) folded->push_back(t);
+  if (!folded->empty()) {
+    // Drop folded triangles' texels; they go to another buffer.
+    for (size_t idx = 0; idx < owner.size(); ++idx)
+      if (owner[idx] >= 0 && is_folded[owner[idx]]) owner[idx] = -1;
+  }
+  std::vector<uint8_t> surface(owner.size(), 0);
+  for (size_t idx = 0; idx < owner.size(); ++idx) surface[idx] = owner[idx] >= 0;
+
+  // Gutter: dilate ownership ring by ring; a gutter texel takes the closest point on the
+  // neighbouring texel's triangle.
+  for (int ring = 0; ring < gutter; ++ring) {
+    std::vector<int32_t> next = owner;
+    for (int j = 0; j < h; ++j) {
+      for (int i = 0; i < w; ++i) {
+        const size_t idx = static_cast<size_t>(j) * w + i;
+        if (owner[idx] >= 0) continue;
+        int best = -1;
+        for (int dj = -1; dj <= 1 && best < 0; ++dj)
+          for (int di = -1; di <= 1 && best < 0; ++di) {
+            const int ii = i + di, jj = j + dj;
+            if (ii < 0 || jj < 0 || ii >= w || jj >= h) continue;
+            best = owner[static_cast<size_t>(jj) * w + ii];
+          }
+        if (best < 0) continue;
+        next[idx] = best;
+        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(best, 0),
+                                            mesh.Corner(best, 1), mesh.Corner(best, 2))
+                         .cast<float>();
+      }
+    }
+    owner.swap(next);
+  }
+  for (size_t idx = 0; idx < owner.size(); ++idx) {
+    if (owner[idx] < 0) continue;
+    buffer.texel_index.push_back(static_cast<int32_t>(idx));
+    buffer.point.push_back(point[idx]);
+    buffer.triangle.push_back(owner[idx]);
+    buffer.on_surface.push_back(surface[idx]);
+    buffer.num_surface_texels += surface[idx];
+  }
+  return buffer;
+}
+
+}  // namespace
+
+Eigen::Vector2d BaseBuffer::TexelCoords(const Eigen::Vector3d& local_point) const {
+  const Eigen::Vector3d d = local_point - origin;
+  return Eigen::Vector2d(d.dot(axis_u) / texel_size_m, d.dot(axis_v) / texel_size_m);
+}
+
+BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& grouping,
+                               const BaseBufferOptions& options) {
+  BaseBufferSet set;
+  std::deque<BaseBufferGroup> pending(grouping.groups.begin(), grouping.groups.end());
+  while (!pending.empty()) {
+    BaseBufferGroup group = pending.front();
+    pending.pop_front();
+    if (group.triangles.empty()) continue;
+    const double s = group.texel_size_m > 0 ? group.texel_size_m : options.texel_size_m;
+    std::vector<int> folded;
+    BaseBuffer buffer = BuildOne(mesh, group.triangles, s, options, &folded);
+    if (!folded.empty()) {
+      if (folded.size() == group.triangles.size()) {
+        // Nothing in this group can be served by its own mean plane (e.g. opposite
+        // normals): split in halves so the recursion ends.
+        if (folded.size() == 1) continue;  // degenerate: never painted
+        BaseBufferGroup a = group, b = group;
+        a.triangles.assign(folded.begin(), folded.begin() + folded.size() / 2);
+        b.triangles.assign(folded.begin() + folded.size() / 2, folded.end());
+        pending.push_back(a);
+        pending.push_back(b);
+        ++set.folds_split;
+        continue;
+      }
+      std::vector<int> kept;
+      std::set_difference(group.triangles.begin(), group.triangles.end(), folded.begin(),
+                          folded.end(), std::back_inserter(kept));
+      group.triangles = kept;
+      buffer.triangles = kept;
+      BaseBufferGroup rest = group;
+      rest.triangles = folded;
+      pending.push_back(rest);
+      ++set.folds_split;
+    }
+    buffer.id = static_cast<int>(set.buffers.size());
+    set.grouping.groups.push_back(group);
+    set.buffers.push_back(std::move(buffer));
+  }
+  set.grouping.RebuildIndex(mesh.NumTriangles());
+  return set;
+}
+
+}  // namespace fresco

@@ -1,0 +1,61 @@
+// Base texture buffers (paper §2, eq. 2): each group of triangles gets a buffer with its
+// own orthographic projection P_b onto the group's mean plane, so texels map one-to-one
+// onto the surface. For every texel the 3D model point M = I_b P_b^-1 and its triangle are
+// computed once, here. Texels just outside the triangles (a gutter of `gutter_texels`) take
+// the closest point on the nearest triangle, so bilinear texture lookups at polygon edges
+// never see unpainted texels. A group whose projection would fold (two triangles on one
+// texel) is split until none does.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pipeline/core/scene.h"
+#include "pipeline/paint/grouping.h"
+
+namespace fresco {
+
+struct BaseBuffer {
+  int id = -1;
+  std::vector<int> triangles;
+  // Plane frame in local coordinates: texel (i, j) has its centre at
+  //   origin + (i + 0.5) * texel_size_m * axis_u + (j + 0.5) * texel_size_m * axis_v.
+  // Looking at the surface from its front, axis_u points right and axis_v down.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_u = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d axis_v = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double texel_size_m = 0.01;
+  int width = 0, height = 0;
+
+  // Texels that map onto the model (structure of arrays, K entries).
+  std::vector<int32_t> texel_index;    // j * width + i
+  std::vector<Eigen::Vector3f> point;  // model point, local coordinates (float is enough)
+  std::vector<int32_t> triangle;       // its triangle
+  std::vector<uint8_t> on_surface;     // 1 inside a triangle, 0 gutter
+  int num_surface_texels = 0;
+  Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();
+
+  int NumTexels() const { return static_cast<int>(texel_index.size()); }
+  // Texel coordinates (continuous, texel centres at i + 0.5) of a local point.
+  Eigen::Vector2d TexelCoords(const Eigen::Vector3d& local_point) const;
+};
+
+struct BaseBufferOptions {
+  double texel_size_m = 0.01;     // default texel size (groups may override)
+  int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels
+  int gutter_texels = 2;
+};
+
+struct BaseBufferSet {
+  std::vector<BaseBuffer> buffers;
+  Grouping grouping;  // after fold-over splits: buffers[g] serves grouping.groups[g]
+  int folds_split = 0;  // groups split because their projection folded
+};
+
+BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& grouping,
+                               const BaseBufferOptions& options);
+
+}  // namespace fresco

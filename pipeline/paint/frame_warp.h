@@ -1,0 +1,52 @@
+// Model-based warping of one frame into a base buffer (paper eq. 1, 3, 4, §3.2, §3.3), fused
+// in one per-texel kernel: project the texel's model point through the frame's camera (full
+// lens model), reject back-facing and grazing views, keep it only if the video camera's
+// depth map agrees with its depth (tolerance scaled with depth and view angle), and sample
+// the frame (nearest, bilinear, or area: bilinear on the pyramid level matching the texel's
+// footprint).
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/project.h"
+#include "pipeline/core/rigid3.h"
+#include "pipeline/paint/base_buffer.h"
+
+namespace fresco {
+
+// What every buffer of one frame shares.
+struct FrameView {
+  const Camera* camera = nullptr;
+  Rigid3d cam_from_local;
+  Eigen::Vector3d centre_local = Eigen::Vector3d::Zero();  // camera centre, local coords
+  const cv::Mat* frame_bgr = nullptr;  // CV_8UC3, camera size
+  const cv::Mat* depth = nullptr;      // CV_32F camera z per pixel, or null (no occlusion)
+  std::vector<cv::Mat> pyramid;        // level 0 = frame; filled for SamplingMode::kArea
+};
+
+struct WarpOptions {
+  SamplingMode sampling = SamplingMode::kBilinear;
+  OcclusionOptions occlusion;
+  double near_m = 1e-3;
+};
+
+// The frame warped into one buffer's texel space (only the buffer's texels are written).
+struct WarpedBuffer {
+  cv::Mat bgr;      // CV_8UC3, buffer size
+  cv::Mat valid;    // CV_8U, 255 where the texel was seen and sampled
+  cv::Mat quality;  // CV_32F, pixels per texel (min(f s cos / z, 1)) where valid
+  int in_view = 0;       // texels that project inside the image, in front, not grazing
+  int visible = 0;       // ... and pass the occlusion test
+  int occluded = 0;
+  int grazing = 0;       // back-facing or beyond max_view_angle
+};
+
+// `triangle_normals`: (T) unit normals of the mesh's triangles, local frame.
+void WarpFrameToBuffer(const BaseBuffer& buffer, const std::vector<Eigen::Vector3f>& triangle_normals,
+                       const FrameView& view, const WarpOptions& options, WarpedBuffer* warped);
+
+}  // namespace fresco

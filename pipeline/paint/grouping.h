@@ -1,0 +1,44 @@
+// Base-buffer grouping (paper §3.6): neighbouring triangles with similar normals share one
+// base texture buffer. Region growing over the mesh's edge adjacency from the largest
+// unassigned triangle; a neighbour joins when its normal is within `angle_deg` of the
+// seed's normal. The result is data: it can be stored in the project, edited (merge, split,
+// move triangles, per-group texel size) and honoured by `fresco run`.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pipeline/core/project.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+struct BaseBufferGroup {
+  std::vector<int> triangles;
+  double texel_size_m = 0.0;  // > 0 overrides the session's texel size for this group
+};
+
+struct Grouping {
+  std::vector<BaseBufferGroup> groups;
+  // (T) group of each triangle, -1 for triangles in no group (never painted).
+  std::vector<int> group_of_triangle;
+
+  void RebuildIndex(int num_triangles);
+};
+
+Grouping ComputeGrouping(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
+                         double angle_deg);
+
+// Applies edits in order. Errors name the edit ("grouping.edits[2]: group 9 does not
+// exist"). Ops: "merge" (groups -> first of them), "split" (triangles leave their group and
+// form a new one), "move" (triangles -> target_group), "texel" (groups get texel_size_m).
+Status ApplyGroupingEdits(const std::vector<GroupingEdit>& edits, int num_triangles,
+                          Grouping* grouping);
+
+// Area-weighted mean unit normal of a group.
+Eigen::Vector3d GroupNormal(const TriangleMesh& mesh, const BaseBufferGroup& group);
+
+}  // namespace fresco

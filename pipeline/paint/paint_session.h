@@ -1,0 +1,82 @@
+// The painting pipeline, stage by stage, behind one facade. Stages in order, per frame:
+//   1. depth   render the model's depth from the video camera (§3.3; renderer's raster path)
+//   2. warp    per texel: project, reject grazing/back-facing, occlusion test, sample
+//              (eq. 1-4, §3.2, §3.3)        -> frame_warp.h
+//   3. paint   update the persistent base buffers (eq. 4, update policy)  -> paint_update.h
+// Set-up (once): grouping (§3.6) -> grouping.h, base buffers and texel model points (eq. 2)
+// -> base_buffer.h. Each stage reports wall time, metrics and (when asked) debug images in a
+// FrameReport that the CLI and the GUI both consume.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/project.h"
+#include "pipeline/core/rigid3.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/core/video_source.h"
+#include "pipeline/paint/base_buffer.h"
+#include "pipeline/paint/frame_warp.h"
+#include "pipeline/paint/paint_update.h"
+#include "pipeline/paint/stage_report.h"
+#include "pipeline/render/rasterizer.h"
+
+namespace fresco {
+
+struct PaintSessionInputs {
+  const Scene* scene = nullptr;
+  PipelineOptions pipeline;
+  GroupingOptions grouping;
+  // Poses (cam_from_world) and cameras the video will bring, used only to choose the
+  // automatic texel size (about one texel per pixel at the typical distance).
+  std::vector<Rigid3d> expected_poses;
+  const Camera* typical_camera = nullptr;
+};
+
+class PaintSession {
+ public:
+  // Groups the mesh, builds the base buffers. Errors name the grouping edit or setting.
+  static Status Create(const PaintSessionInputs& inputs, std::unique_ptr<PaintSession>* session);
+
+  // Paints one frame seen from `cam_from_world` through `camera`. Fills `report`.
+  void PaintFrame(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
+                  FrameReport* report);
+
+  // The scene's geometry with the painted buffers as base-colour textures (alpha 0 where
+  // never painted) and new UVs into them.
+  Scene PaintedScene() const;
+
+  const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
+  const std::vector<PaintedBuffer>& painted() const { return painted_; }
+  const Grouping& grouping() const { return set_.grouping; }
+  int folds_split() const { return set_.folds_split; }
+  long long NumSurfaceTexels() const;
+  long long NumPaintedSurfaceTexels() const;
+  double Coverage() const;
+  double default_texel_size_m() const { return texel_size_m_; }
+
+ private:
+  PaintSession() = default;
+  const Rasterizer& RasterizerFor(const Camera& camera);
+
+  const Scene* scene_ = nullptr;
+  PipelineOptions options_;
+  double texel_size_m_ = 0.0;
+  BaseBufferSet set_;
+  std::vector<PaintedBuffer> painted_;
+  std::vector<WarpedBuffer> warped_;
+  std::vector<Eigen::Vector3f> triangle_normals_;
+  std::vector<std::pair<Camera, std::unique_ptr<Rasterizer>>> rasterizers_;
+  cv::Mat depth_;
+  int frames_seen_ = 0;
+};
+
+// The automatic texel size: median over the poses of (distance from the camera to the
+// scene's centre) / focal length, i.e. about one texel per pixel at the typical distance.
+double AutomaticTexelSize(const Scene& scene, const Camera& camera,
+                          const std::vector<Rigid3d>& cam_from_world);
+
+}  // namespace fresco
