@@ -1,7 +1,293 @@
+// `fresco render MODEL.gltf --camera CAMERA --poses POSES --out DIR [options]`: renders a glTF
+// model through a camera (full lens model) at every pose, one RGBA PNG per pose (CONTRACT.md).
+// Everything is read and checked before the first image is written, so bad input never
+// leaves a partial output; every image is written atomically (temp file + rename).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "app/commands.h"
+#include "app/progress.h"
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/cameramodel_io.h"
+#include "pipeline/core/poses.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/render/renderer.h"
 
 namespace fresco {
 
-int RunVerbRender(const CommandArgs& args) { return kExitFailure; }
+namespace {
+
+namespace fs = std::filesystem;
+
+// width * height * N^2: the renderer needs about 60 bytes per sample (4 GB here).
+constexpr double kMaxSamplesPerImage = 1 << 26;
+
+const char kHelp[] =
+    R"(Renders MODEL (glTF 2.0: .gltf or .glb) through CAMERA at every pose of POSES and writes
+DIR/NAME.png per pose: 8-bit RGBA at the camera's image size, alpha 255 where a surface
+with texture alpha >= 0.5 is seen and 0 elsewhere. Deterministic, CPU only, no display.
+
+  CAMERA   an mrcal .cameramodel or a COLMAP cameras.txt (each image uses its CAMERA_ID;
+           a single camera serves every pose)
+  POSES    a COLMAP images.txt or model folder (NAME from the file, its extension replaced
+           by .png, subfolders created), or a TUM trajectory (%06d.png by order, from 0)
+
+options:
+  --supersample N      N x N rays per pixel, averaged (1..4, default 1)
+  --filter F           texture filter: bilinear (default) or nearest
+  --near M             near clipping plane in metres (default 0.001)
+  --cull-back-faces    do not draw triangles seen from behind
+  --depth              also write DIR/NAME.depth.png: 16-bit camera z in millimetres
+                       (0 = no surface, 65535 = 65.535 m or farther)
+  --ids                also write DIR/NAME.ids.png: 8-bit RGBA, triangle id + 1 as
+                       R + 256 G + 65536 B (0 = no surface), alpha 255 where a surface is seen
+  --quiet              no progress on stderr)";
+
+// DIR-relative output path for a COLMAP image NAME: extension replaced by `suffix`.
+bool OutputName(const std::string& name, const std::string& suffix, std::string* out,
+                std::string* why) {
+  if (name.empty()) {
+    *why = "empty NAME";
+    return false;
+  }
+  const fs::path path(name);
+  if (path.is_absolute()) {
+    *why = "NAME '" + name + "' is an absolute path";
+    return false;
+  }
+  for (const fs::path& part : path) {
+    if (part == "..") {
+      *why = "NAME '" + name + "' leaves the output folder ('..')";
+      return false;
+    }
+  }
+  if (!path.has_filename() || path.filename() == ".") {
+    *why = "NAME '" + name + "' is not a file name";
+    return false;
+  }
+  fs::path stem = path;
+  stem.replace_extension();
+  *out = stem.generic_string() + suffix;
+  return true;
+}
+
+Status WritePng(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> bytes;
+  if (!cv::imencode(".png", image, bytes))
+    return Status::Error(path + ": could not encode the PNG");
+  const fs::path parent = fs::path(path).parent_path();
+  if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
+  return WriteFileAtomic(path, std::string(bytes.begin(), bytes.end()));
+}
+
+cv::Mat DepthMillimetres(const cv::Mat& depth) {
+  cv::Mat out(depth.size(), CV_16U);
+  for (int r = 0; r < depth.rows; ++r) {
+    const float* in = depth.ptr<float>(r);
+    uint16_t* o = out.ptr<uint16_t>(r);
+    for (int c = 0; c < depth.cols; ++c) {
+      if (!std::isfinite(in[c])) {
+        o[c] = 0;  // no surface
+        continue;
+      }
+      const double mm = std::round(static_cast<double>(in[c]) * 1000.0);
+      o[c] = static_cast<uint16_t>(std::clamp(mm, 1.0, 65535.0));  // 0 is "no surface"
+    }
+  }
+  return out;
+}
+
+cv::Mat IdsRgba(const cv::Mat& ids) {
+  cv::Mat out(ids.size(), CV_8UC4, cv::Scalar::all(0));
+  for (int r = 0; r < ids.rows; ++r) {
+    const int* in = ids.ptr<int>(r);
+    cv::Vec4b* o = out.ptr<cv::Vec4b>(r);
+    for (int c = 0; c < ids.cols; ++c) {
+      if (in[c] < 0) continue;
+      const uint32_t v = static_cast<uint32_t>(in[c]) + 1;
+      // Written as BGRA: B holds the high byte so the file's R is the low byte.
+      o[c] = cv::Vec4b(static_cast<uchar>(v >> 16), static_cast<uchar>(v >> 8),
+                       static_cast<uchar>(v), 255);
+    }
+  }
+  return out;
+}
+
+struct Job {
+  const PosedImage* pose;
+  int camera_id;
+  std::string relative;  // output path relative to DIR, without ".png"
+};
+
+}  // namespace
+
+int RunVerbRender(const CommandArgs& args) {
+  ArgSpec spec;
+  spec.usage = "fresco render MODEL.gltf --camera CAMERA --poses POSES --out DIR [options]";
+  spec.help = kHelp;
+  spec.min_positional = 1;
+  spec.max_positional = 1;
+  spec.options = {"--camera", "--poses", "--out", "--supersample", "--filter", "--near"};
+  spec.switches = {"--depth", "--ids", "--cull-back-faces", "--quiet"};
+  spec.required = {"--camera", "--poses", "--out"};
+  Args parsed;
+  int code = ParseVerbArgs("render", args, spec, &parsed);
+  if (code >= 0) return code;
+
+  const std::string model_path = parsed.positional[0];
+  const std::string camera_path = parsed.Get("--camera");
+  const std::string poses_path = parsed.Get("--poses");
+  const std::string out_dir = parsed.Get("--out");
+  if (out_dir.empty()) return UsageError("render", spec, "--out: empty folder name");
+
+  RenderOptions options;
+  std::string error;
+  if (parsed.Has("--supersample")) {
+    if (!ParseInt(parsed.Get("--supersample"), "--supersample", &options.raster.supersample,
+                  &error))
+      return UsageError("render", spec, error);
+    if (options.raster.supersample < 1 || options.raster.supersample > 4)
+      return UsageError("render", spec, "--supersample: must be 1..4");
+  }
+  if (parsed.Has("--filter")) {
+    const std::string filter = parsed.Get("--filter");
+    if (filter == "bilinear") {
+      options.filter = TextureFilter::kBilinear;
+    } else if (filter == "nearest") {
+      options.filter = TextureFilter::kNearest;
+    } else {
+      return UsageError("render", spec, "--filter: '" + filter + "' is not nearest|bilinear");
+    }
+  }
+  if (parsed.Has("--near")) {
+    if (!ParseDouble(parsed.Get("--near"), "--near", &options.raster.near_m, &error))
+      return UsageError("render", spec, error);
+    if (!(options.raster.near_m > 0)) return UsageError("render", spec, "--near: must be > 0");
+  }
+  options.raster.cull_back_faces = parsed.Switch("--cull-back-faces");
+  const bool write_depth = parsed.Switch("--depth");
+  const bool write_ids = parsed.Switch("--ids");
+  const int n = options.raster.supersample;
+
+  // Cameras.
+  std::map<int, Camera> cameras;
+  {
+    const Status read = ReadCameras(camera_path, &cameras);
+    if (!read.ok()) return InputError(read);
+  }
+  if (cameras.empty()) return InputError(Status::Error(camera_path + ": no camera"));
+  for (const auto& [id, camera] : cameras) {
+    const Status valid = camera.Validate(camera_path + ": camera " + std::to_string(id));
+    if (!valid.ok()) return InputError(valid);
+    if (static_cast<double>(camera.width) * camera.height * n * n > kMaxSamplesPerImage) {
+      return InputError(
+          Status::Error(camera_path + ": camera " + std::to_string(id) + ": image size " +
+                        std::to_string(camera.width) + "x" + std::to_string(camera.height) + " x " +
+                        std::to_string(n * n) + " samples per pixel is too large (at most " +
+                        std::to_string(1 << 26) + " samples)"));
+    }
+  }
+
+  // Poses, each matched to its camera and output name.
+  std::vector<PosedImage> poses;
+  bool is_tum = false;
+  {
+    const Status read = ReadPoses(poses_path, &poses, &is_tum);
+    if (!read.ok()) return InputError(read);
+  }
+  if (poses.empty()) return InputError(Status::Error(poses_path + ": no poses"));
+  std::vector<Job> jobs;
+  std::set<std::string> outputs;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const PosedImage& pose = poses[i];
+    const std::string what =
+        poses_path + ": " +
+        (is_tum ? "pose " + std::to_string(i + 1) : "image '" + pose.name + "'");
+    if (!pose.cam_from_world.AllFinite())
+      return InputError(Status::Error(what + ": pose is not finite"));
+    Job job;
+    job.pose = &pose;
+    if (cameras.count(pose.camera_id)) {
+      job.camera_id = pose.camera_id;
+    } else if (cameras.size() == 1) {
+      job.camera_id = cameras.begin()->first;
+    } else {
+      return InputError(Status::Error(what + ": CAMERA_ID " + std::to_string(pose.camera_id) +
+                                      " is not in " + camera_path));
+    }
+    if (is_tum) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%06zu", i);
+      job.relative = name;
+    } else {
+      std::string why;
+      if (!OutputName(pose.name, "", &job.relative, &why))
+        return InputError(Status::Error(what + ": " + why));
+    }
+    if (!outputs.insert(job.relative).second) {
+      return InputError(Status::Error(what + ": output " + job.relative +
+                                      ".png would overwrite another image's"));
+    }
+    jobs.push_back(job);
+  }
+  if (write_depth || write_ids) {
+    for (const Job& job : jobs) {
+      for (const char* suffix : {".depth", ".ids"}) {
+        if (outputs.count(job.relative + suffix)) {
+          return InputError(Status::Error(poses_path + ": output " + job.relative + suffix +
+                                          ".png clashes with an image's output"));
+        }
+      }
+    }
+  }
+
+  // Scene.
+  Scene scene;
+  {
+    const Status loaded = LoadGltfScene(model_path, SceneLoadOptions(), &scene);
+    if (!loaded.ok()) return InputError(loaded);
+  }
+
+  {
+    const Status made = MakeDirectories(out_dir);
+    if (!made.ok()) return InputError(made);
+  }
+
+  std::map<int, std::unique_ptr<Renderer>> renderers;  // by camera id (ray tables)
+  Progress progress("render", static_cast<int>(jobs.size()), parsed.Switch("--quiet"));
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    const Job& job = jobs[i];
+    std::unique_ptr<Renderer>& renderer = renderers[job.camera_id];
+    if (!renderer) renderer = std::make_unique<Renderer>(cameras.at(job.camera_id), options);
+    RenderOutput out;
+    renderer->Render(scene, job.pose->cam_from_world, &out);
+    const std::string base = (fs::path(out_dir) / job.relative).string();
+    cv::Mat bgra;
+    cv::cvtColor(out.rgba, bgra, cv::COLOR_RGBA2BGRA);
+    Status written = WritePng(base + ".png", bgra);
+    if (written.ok() && write_depth)
+      written = WritePng(base + ".depth.png", DepthMillimetres(out.depth));
+    if (written.ok() && write_ids) written = WritePng(base + ".ids.png", IdsRgba(out.triangle_id));
+    if (!written.ok()) {
+      std::cerr << "error: " << written.message() << "\n";
+      return kExitFailure;
+    }
+    progress.Update(static_cast<int>(i + 1), job.relative + ".png");
+  }
+  progress.Finish(std::to_string(jobs.size()) + " images in " + out_dir);
+  return kExitOk;
+}
 
 }  // namespace fresco

@@ -39,7 +39,7 @@ void RemoveTempDirs() {
 
 std::string MakeTempDir(const std::string& tag) {
   static std::once_flag once;
-  std::call_once(once, [] { std::atexit(RemoveTempDirs); });
+  std::call_once(once, [] { TempDirs(); std::atexit(RemoveTempDirs); });  // list outlives it
   std::string pattern = (fs::temp_directory_path() / ("fresco-" + tag + "-XXXXXX")).string();
   char* made = mkdtemp(pattern.data());
   if (!made) throw std::runtime_error("mkdtemp failed for " + pattern);

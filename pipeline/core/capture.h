@@ -25,6 +25,9 @@ struct Capture {
   std::unique_ptr<VideoSource> video;
   // For frame names known up front (folders): frame name -> index into `poses`.
   std::map<std::string, int> pose_by_name;
+  // Pose name without extension -> index into `poses` (-1 when two poses share it): frames
+  // whose extension differs from the listed name ("a.png" listed, "a.jpg" on disk) still match.
+  std::map<std::string, int> pose_by_stem;
   bool poses_are_tum = false;  // TUM poses match frames in order
 
   // The pose for a frame (by name for COLMAP, by order for TUM); nullptr when none.

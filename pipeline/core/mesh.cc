@@ -1,1 +1,167 @@
-// TODO
+// TriangleMesh geometry helpers, scene bounds and edge adjacency (with vertex welding).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+
+#include "pipeline/core/scene.h"
+
+namespace fresco {
+
+Eigen::Vector3d TriangleMesh::Normal(int tri) const {
+  const Eigen::Vector3d a = Corner(tri, 0);
+  const Eigen::Vector3d n = (Corner(tri, 1) - a).cross(Corner(tri, 2) - a);
+  const double length = n.norm();
+  if (!(length > 0.0) || !std::isfinite(length)) return Eigen::Vector3d::Zero();
+  return n / length;
+}
+
+double TriangleMesh::Area(int tri) const {
+  const Eigen::Vector3d a = Corner(tri, 0);
+  return 0.5 * (Corner(tri, 1) - a).cross(Corner(tri, 2) - a).norm();
+}
+
+void Scene::Bounds(Eigen::Vector3d* min_corner, Eigen::Vector3d* max_corner) const {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(kInf);
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-kInf);
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    if (!v.allFinite()) continue;
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  if (!(lo.x() <= hi.x())) {  // no (finite) vertices
+    lo.setZero();
+    hi.setZero();
+  }
+  if (min_corner) *min_corner = lo;
+  if (max_corner) *max_corner = hi;
+}
+
+namespace {
+
+// Union-find over vertex indices; the root of a set is its smallest index.
+class DisjointSets {
+ public:
+  explicit DisjointSets(int n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  int Find(int i) {
+    while (parent_[i] != i) {
+      parent_[i] = parent_[parent_[i]];
+      i = parent_[i];
+    }
+    return i;
+  }
+  void Union(int a, int b) {
+    a = Find(a);
+    b = Find(b);
+    if (a == b) return;
+    if (a < b) std::swap(a, b);
+    parent_[a] = b;
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+struct CellKey {
+  int64_t x, y, z;
+  bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+struct CellKeyHash {
+  size_t operator()(const CellKey& k) const {
+    uint64_t h = static_cast<uint64_t>(k.x) * 0x9E3779B97F4A7C15ull;
+    h ^= static_cast<uint64_t>(k.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
+    h ^= static_cast<uint64_t>(k.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
+    return static_cast<size_t>(h);
+  }
+};
+
+// Canonical vertex per vertex: vertices closer than `tolerance` (transitively) share the
+// smallest index of their group. Hash grid with cell size = tolerance, so only the 27
+// neighbouring cells are searched.
+std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, double tolerance) {
+  const int n = static_cast<int>(vertices.size());
+  DisjointSets sets(n);
+  // Cell size: the tolerance, or a tiny size for exact welding (then only equal positions,
+  // which always share a cell, are within distance 0).
+  const double cell = tolerance > 0.0 ? tolerance : 1e-9;
+  const double tolerance2 = tolerance > 0.0 ? tolerance * tolerance : 0.0;
+  constexpr double kMaxCell = 4e18;
+  auto cell_of = [&](double v) {
+    return static_cast<int64_t>(std::clamp(std::floor(v / cell), -kMaxCell, kMaxCell));
+  };
+  std::unordered_map<CellKey, std::vector<int>, CellKeyHash> grid;
+  grid.reserve(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = vertices[i];
+    if (!p.allFinite()) continue;  // never welded
+    const CellKey key{cell_of(p.x()), cell_of(p.y()), cell_of(p.z())};
+    for (int64_t dx = -1; dx <= 1; ++dx) {
+      for (int64_t dy = -1; dy <= 1; ++dy) {
+        for (int64_t dz = -1; dz <= 1; ++dz) {
+          auto it = grid.find({key.x + dx, key.y + dy, key.z + dz});
+          if (it == grid.end()) continue;
+          for (int j : it->second) {
+            if ((vertices[j] - p).squaredNorm() <= tolerance2) sets.Union(i, j);
+          }
+        }
+      }
+    }
+    grid[key].push_back(i);
+  }
+  std::vector<int> canonical(n);
+  for (int i = 0; i < n; ++i) canonical[i] = sets.Find(i);
+  return canonical;
+}
+
+}  // namespace
+
+MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m) {
+  MeshAdjacency adjacency;
+  adjacency.welded_vertex = WeldVertices(mesh.vertices, weld_tolerance_m);
+  const int num_triangles = mesh.NumTriangles();
+  adjacency.edge_neighbours.resize(num_triangles);
+
+  // Undirected welded edge -> (triangle, edge k) entries.
+  struct EdgeUse {
+    int tri;
+    int k;
+  };
+  std::unordered_map<uint64_t, std::vector<EdgeUse>> edges;
+  edges.reserve(static_cast<size_t>(num_triangles) * 2);
+  const int num_vertices = static_cast<int>(mesh.vertices.size());
+  auto welded = [&](int v) { return v >= 0 && v < num_vertices ? adjacency.welded_vertex[v] : -1; };
+  for (int t = 0; t < num_triangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = welded(mesh.triangles[t][k]);
+      const int b = welded(mesh.triangles[t][(k + 1) % 3]);
+      if (a < 0 || b < 0 || a == b) continue;  // invalid or collapsed edge
+      const uint64_t key =
+          (static_cast<uint64_t>(std::min(a, b)) << 32) | static_cast<uint32_t>(std::max(a, b));
+      edges[key].push_back({t, k});
+    }
+  }
+  for (const auto& [key, uses] : edges) {
+    if (uses.size() < 2) continue;
+    for (const EdgeUse& use : uses) {
+      std::vector<int>& list = adjacency.edge_neighbours[use.tri][use.k];
+      for (const EdgeUse& other : uses) {
+        if (other.tri == use.tri) continue;
+        if (std::find(list.begin(), list.end(), other.tri) == list.end()) {
+          list.push_back(other.tri);
+        }
+      }
+    }
+  }
+  // Deterministic order regardless of hash-map iteration.
+  for (auto& tri_lists : adjacency.edge_neighbours) {
+    for (auto& list : tri_lists) std::sort(list.begin(), list.end());
+  }
+  return adjacency;
+}
+
+}  // namespace fresco

@@ -13,6 +13,9 @@
 namespace fresco {
 
 enum class SamplingMode { kNearest, kBilinear, kArea };
+// kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
+// when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
+enum class UpdatePolicy { kLatest, kQuality };
 
 struct OcclusionOptions {
   bool enabled = true;
@@ -22,41 +25,53 @@ struct OcclusionOptions {
   double tolerance_m = 0.002;
   // Texels seen at more than this angle from the surface normal are not painted.
   double max_view_angle_deg = 80.0;
+
+  bool operator==(const OcclusionOptions&) const = default;
 };
 
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
-  double texel_size_m = 0.0;  // base-buffer texel edge in metres; 0 = automatic
+  double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
   int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
-  int update_every = 1;       // paint every N-th frame (the paper used 20 with refinement)
-  int max_frames = 0;         // 0 = all frames
-  int threads = 0;            // 0 = all cores
-  bool debug_images = false;  // write per-stage debug images (costs time)
+  int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
+  UpdatePolicy update = UpdatePolicy::kQuality;
+  double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
+  int max_frames = 0;          // 0 = all frames
+  int threads = 0;             // 0 = all cores
+  bool debug_images = false;   // write per-stage debug images (costs time)
   OcclusionOptions occlusion;
+
+  bool operator==(const PipelineOptions&) const = default;
 };
 
 // Automatic base-buffer grouping (paper §3.6): neighbouring triangles whose normals are
 // within `angle_deg` of the group's seed normal share a buffer.
 struct GroupingEdit {
-  std::string op;             // "merge" | "split" | "move" (see grouping.h)
+  std::string op;  // "merge" | "split" | "move" (see grouping.h)
   std::vector<int> triangles;
   std::vector<int> groups;
   int target_group = -1;
   double texel_size_m = 0.0;  // per-group override when > 0
+
+  bool operator==(const GroupingEdit&) const = default;
 };
 struct GroupingOptions {
   double angle_deg = 20.0;
   std::vector<GroupingEdit> edits;
+
+  bool operator==(const GroupingOptions&) const = default;
 };
 
 // Ground truth a synthetic capture carries (fresco synth); empty when unknown.
 struct TruthFiles {
   std::string poses;  // true poses (same format as `poses`)
+
+  bool operator==(const TruthFiles&) const = default;
 };
 
 struct Project {
   int fresco_version = 1;
-  std::string scene;   // as written in the file
+  std::string scene;  // as written in the file
   std::string camera;
   std::string video;
   std::string poses;
@@ -67,7 +82,11 @@ struct Project {
 
   std::string file_path;  // where it was loaded from / saved to (absolute)
   // Resolves a path as written in the project against the project file's folder.
+  // Empty stays empty; absolute paths, URLs and "device:N" are returned as written.
   std::string Resolve(const std::string& relative) const;
+
+  // Every field, file_path included.
+  bool operator==(const Project&) const = default;
 };
 
 // Reads and validates the JSON (not the referenced files: see LoadCapture). `overrides` are
@@ -83,5 +102,10 @@ Status SaveProject(const Project& project, const std::string& path);
 std::string ProjectToJsonText(const Project& project);
 
 std::string SamplingModeName(SamplingMode mode);
+// Parses "nearest" | "bilinear" | "area". Returns false for other names.
+bool SamplingModeFromName(const std::string& name, SamplingMode* mode);
+
+// True for names that are not files: URLs ("udp://...", "tcp://...") and "device:N".
+bool IsUrlOrDevice(const std::string& path);
 
 }  // namespace fresco

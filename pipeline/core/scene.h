@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "pipeline/core/status.h"
@@ -32,11 +33,11 @@ struct Material {
 };
 
 struct TriangleMesh {
-  std::vector<Eigen::Vector3d> vertices;       // local coordinates, metres
-  std::vector<Eigen::Vector3i> triangles;      // vertex indices, counter-clockwise = front
+  std::vector<Eigen::Vector3d> vertices;            // local coordinates, metres
+  std::vector<Eigen::Vector3i> triangles;           // vertex indices, counter-clockwise = front
   std::vector<std::array<Eigen::Vector2f, 3>> uvs;  // TEXCOORD_0 per corner (zeros if absent)
-  std::vector<int> material;                   // per triangle, index into Scene::materials
-  std::vector<bool> has_uv;                    // per triangle
+  std::vector<int> material;                        // per triangle, index into Scene::materials
+  std::vector<bool> has_uv;                         // per triangle
 
   int NumTriangles() const { return static_cast<int>(triangles.size()); }
   Eigen::Vector3d Corner(int tri, int k) const { return vertices[triangles[tri][k]]; }
@@ -61,6 +62,10 @@ struct Scene {
   std::vector<Texture> textures;
   Eigen::Vector3d origin_in_world = Eigen::Vector3d::Zero();
   std::string source_path;
+  // Filled by LoadGltfScene (informational; not written by SaveGltfScene).
+  int dropped_degenerate = 0;         // triangles dropped: area < min_triangle_area_m2
+  int skipped_primitives = 0;         // points / lines primitives (not triangles), skipped
+  std::vector<std::string> warnings;  // one line each (tinygltf warnings, skipped parts)
 
   Eigen::Vector3d LocalFromWorld(const Eigen::Vector3d& p) const { return p - origin_in_world; }
   Eigen::Vector3d WorldFromLocal(const Eigen::Vector3d& p) const { return p + origin_in_world; }
@@ -77,11 +82,26 @@ struct SceneLoadOptions {
 
 // Loads `.gltf` (with its .bin and images) or `.glb`. Errors name the file and what is wrong
 // (missing file, parse error, out-of-range indices, no triangles).
+// - Geometry: the default scene (else scene 0, else every root node), node transforms
+//   composed in double; TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN primitives (points and
+//   lines are skipped and counted); u8/u16/u32 indices, strided, normalized and sparse
+//   accessors. Mirroring node transforms get their winding flipped (CCW stays front).
+//   Only vertices used by kept triangles are stored, in accessor order, per primitive.
+// - UVs: the set the material's base colour texture uses (normally TEXCOORD_0), unflipped.
+// - Materials: 1:1 with the file's, plus a default white one ("default") appended when a
+//   primitive has none. Textures: those used as baseColorTexture, in the file's texture
+//   order, decoded to RGBA8 (16-bit images scaled, grey/RGB expanded).
 Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, Scene* scene);
 
 // Writes `scene` as glTF 2.0 (`.gltf` + `.bin` + one PNG per texture beside it), atomically
 // per file. Geometry is written in world coordinates relative to origin via a node
 // translation, so map-scale scenes keep precision.
+// Round trip: LoadGltfScene gives back the same triangles (same order), UVs, materials and
+// texels exactly; vertices are stored as float relative to the origin (exact when they are
+// floats), one vertex set per run of triangles with equal material and UV presence (a vertex
+// with different UVs on different corners is duplicated). With recentre, the reloaded origin
+// is the bounding-box centre. Textures no material uses are written but not loaded back, and
+// an empty texture name comes back as the PNG's file name.
 Status SaveGltfScene(const Scene& scene, const std::string& path);
 
 }  // namespace fresco

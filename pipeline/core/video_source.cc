@@ -1,1 +1,221 @@
-// TODO
+// Video sources, streamed one frame at a time: a folder of images (sorted by file name), a
+// video file (OpenCV's FFmpeg backend), or a live source ("device:N", a stream URL).
+#include "pipeline/core/video_source.h"
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "pipeline/core/project.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kDefaultFolderFps = 30.0;
+
+bool IsImageFile(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  static const char* kExtensions[] = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm"};
+  for (const char* e : kExtensions) {
+    if (ext == e) return true;
+  }
+  return false;
+}
+
+std::string SizeText(const cv::Size& size) {
+  return std::to_string(size.width) + "x" + std::to_string(size.height);
+}
+
+// Any 8-bit image to CV_8UC3 BGR; false for what cannot be converted.
+bool ToBgr8(const cv::Mat& in, cv::Mat* out) {
+  if (in.empty() || in.depth() != CV_8U) return false;
+  switch (in.channels()) {
+    case 3:
+      *out = in;
+      return true;
+    case 1:
+      cv::cvtColor(in, *out, cv::COLOR_GRAY2BGR);
+      return true;
+    case 4:
+      cv::cvtColor(in, *out, cv::COLOR_BGRA2BGR);
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Frames that must all have the first frame's size.
+class SizeCheck {
+ public:
+  Status Check(const cv::Mat& image, const std::string& what) {
+    if (first_size_.area() == 0) {
+      first_size_ = image.size();
+      first_what_ = what;
+      return Status::Ok();
+    }
+    if (image.size() != first_size_) {
+      return Status::Error(what + ": frame size " + SizeText(image.size()) +
+                           " differs from the first frame's " + SizeText(first_size_) + " (" +
+                           first_what_ + ")");
+    }
+    return Status::Ok();
+  }
+
+ private:
+  cv::Size first_size_;
+  std::string first_what_;
+};
+
+class FolderSource : public VideoSource {
+ public:
+  FolderSource(std::string folder, std::vector<std::string> names)
+      : folder_(std::move(folder)), names_(std::move(names)) {}
+
+  bool Next(Frame* frame, Status* status) override {
+    if (next_ >= names_.size()) return false;
+    const std::string& name = names_[next_];
+    const std::string path = (fs::path(folder_) / name).string();
+    cv::Mat bgr;
+    if (!ToBgr8(cv::imread(path, cv::IMREAD_COLOR), &bgr)) {
+      if (status) *status = Status::Error(path + ": cannot decode the image");
+      return false;
+    }
+    const Status size_ok = sizes_.Check(bgr, path);
+    if (!size_ok.ok()) {
+      if (status) *status = size_ok;
+      return false;
+    }
+    frame->index = static_cast<int>(next_);
+    frame->name = name;
+    frame->timestamp_s = next_ / kDefaultFolderFps;
+    frame->bgr = bgr;
+    ++next_;
+    return true;
+  }
+  int FrameCount() const override { return static_cast<int>(names_.size()); }
+  std::vector<std::string> FrameNames() const override { return names_; }
+  double Fps() const override { return kDefaultFolderFps; }
+
+ private:
+  std::string folder_;
+  std::vector<std::string> names_;
+  size_t next_ = 0;
+  SizeCheck sizes_;
+};
+
+// A video file or a live source through cv::VideoCapture.
+class CaptureSource : public VideoSource {
+ public:
+  CaptureSource(std::string what, cv::VideoCapture capture, bool live)
+      : what_(std::move(what)), capture_(std::move(capture)), live_(live) {
+    const double fps = capture_.get(cv::CAP_PROP_FPS);
+    fps_ = std::isfinite(fps) && fps > 0 && fps < 1000 ? fps : kDefaultFolderFps;
+    const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
+    count_ = !live_ && std::isfinite(count) && count > 0 ? static_cast<int>(count) : -1;
+  }
+
+  bool Next(Frame* frame, Status* status) override {
+    cv::Mat image;
+    if (!capture_.read(image) || image.empty()) return false;  // end of the stream
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", index_);
+    cv::Mat bgr;
+    if (!ToBgr8(image, &bgr)) {
+      if (status) *status = Status::Error(what_ + ": frame " + name + ": cannot convert to BGR");
+      return false;
+    }
+    const Status size_ok = sizes_.Check(bgr, what_ + ": frame " + name);
+    if (!size_ok.ok()) {
+      if (status) *status = size_ok;
+      return false;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (index_ == 0) start_ = now;
+    frame->index = index_;
+    frame->name = name;
+    // Live sources: seconds since the first frame on the wall clock; files: index / fps.
+    frame->timestamp_s =
+        live_ ? std::chrono::duration<double>(now - start_).count() : index_ / fps_;
+    frame->bgr = bgr;
+    ++index_;
+    return true;
+  }
+  int FrameCount() const override { return count_; }
+  std::vector<std::string> FrameNames() const override { return {}; }
+  double Fps() const override { return fps_; }
+
+ private:
+  std::string what_;
+  cv::VideoCapture capture_;
+  bool live_;
+  double fps_ = kDefaultFolderFps;
+  int count_ = -1;
+  int index_ = 0;
+  std::chrono::steady_clock::time_point start_;
+  SizeCheck sizes_;
+};
+
+Status OpenFolder(const std::string& path, std::unique_ptr<VideoSource>* source) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (fs::directory_iterator it(path, ec), end; !ec && it != end; it.increment(ec)) {
+    const fs::path& entry = it->path();
+    const std::string name = entry.filename().string();
+    if (name.empty() || name[0] == '.') continue;  // hidden files, atomic-write temp files
+    if (!IsImageFile(entry) || !it->is_regular_file(ec)) continue;
+    names.push_back(name);
+  }
+  if (ec) return Status::Error(path + ": cannot list the folder: " + ec.message());
+  if (names.empty()) {
+    return Status::Error(path +
+                         ": no image frames in the folder (.png .jpg .jpeg .bmp .tif .tiff .ppm)");
+  }
+  std::sort(names.begin(), names.end());
+  *source = std::make_unique<FolderSource>(path, std::move(names));
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* source) {
+  if (path.rfind("device:", 0) == 0) {
+    const std::string number = path.substr(7);
+    if (number.empty() || number.find_first_not_of("0123456789") != std::string::npos) {
+      return Status::Error(path + ": expected device:N with N a camera number");
+    }
+    cv::VideoCapture capture(std::stoi(number));
+    if (!capture.isOpened()) return Status::Error(path + ": cannot open the camera");
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true);
+    return Status::Ok();
+  }
+  if (IsUrlOrDevice(path)) {
+    cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+    if (!capture.isOpened()) {
+      return Status::Error(path + ": cannot open the stream (OpenCV FFmpeg backend)");
+    }
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true);
+    return Status::Ok();
+  }
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return OpenFolder(path, source);
+  if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
+  cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+  if (!capture.isOpened()) {
+    return Status::Error(path + ": cannot open as a video (OpenCV FFmpeg backend)");
+  }
+  *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/false);
+  return Status::Ok();
+}
+
+}  // namespace fresco

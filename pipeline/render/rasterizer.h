@@ -4,6 +4,14 @@
 // stay straight) is tested against the rays of the buckets it covers. Depth comes from the
 // exact ray/plane intersection. This is the depth + triangle-id path the painting pipeline's
 // occlusion stage uses every frame, so it has no colour work in it.
+//
+// Exactness: a sample shows the nearest triangle its ray meets at camera z >= near_m (ties in
+// depth go to the smallest triangle id), the same answer as a brute-force ray cast of the same
+// rays; triangles partly behind the camera draw only their part in front of the near plane.
+// Edge tests are inclusive and watertight (no cracks between triangles sharing an edge).
+// Determinism: parallel over rows of buckets (cv::parallel_for_), each ray owned by one
+// task, so the output is bit-identical whatever the number of threads. Rasterize() is const
+// and may be called from several threads at once.
 #pragma once
 
 #include <memory>
@@ -19,23 +27,29 @@
 namespace fresco {
 
 struct RasterOptions {
-  double near_m = 1e-3;          // near clipping plane (camera z), metres
-  bool cull_back_faces = false;  // glTF single-sided materials may set this per triangle
-  int supersample = 1;           // N x N rays per pixel (N = 1..4)
+  double near_m = 1e-3;  // near clipping plane (camera z), metres
+  // Skip triangles seen from behind (counter-clockwise = front, as in glTF). Applies to every
+  // triangle (per-material single-sidedness is not looked at).
+  bool cull_back_faces = false;
+  // N x N rays per pixel (N = 1..4): sample i of pixel c sits at c + (i + 0.5)/N - 0.5.
+  int supersample = 1;
 };
 
 struct RasterOutput {
   // One sample per ray: (height*N, width*N) when supersampling with N.
-  cv::Mat depth;        // CV_32F camera z (metres), +inf where no surface
+  cv::Mat depth;        // CV_32F camera z (metres; exact ray/plane hit), +inf where no surface
   cv::Mat triangle_id;  // CV_32S, -1 where no surface
   cv::Mat bary;         // CV_32FC2 barycentrics (b1, b2) of corners 1 and 2 (b0 = 1-b1-b2)
 };
 
 class Rasterizer {
  public:
+  // Unprojects every sample once (the ray table: ~4 ms for 640x480 pinhole, ~25 ms with
+  // distortion). Throws std::invalid_argument for a camera without size or bad options.
   Rasterizer(const Camera& camera, const RasterOptions& options);
   ~Rasterizer();
-  // `cam_from_local`: maps the mesh's local coordinates to the camera frame.
+  // `cam_from_local`: maps the mesh's local coordinates to the camera frame. Triangles with
+  // bad indices or non-finite corners are skipped.
   void Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                  RasterOutput* output) const;
   const Camera& camera() const { return camera_; }

@@ -1,10 +1,14 @@
 // Renders a textured scene through a camera: colour (RGBA), depth and triangle id per pixel,
 // at the camera's image size, deterministic and on the CPU. Texture lookup follows glTF:
-// UV (0,0) is the top-left of the image, wrap modes per sampler, base-colour factor times
-// texture. Alpha is 255 where a surface with texture alpha > 0 is seen, 0 elsewhere
-// (unpainted texels of painted buffers have alpha 0, and their colours never bleed into
-// painted neighbours).
+// UV (0,0) is the top-left of the image, texel centres at (i + 0.5) / size, wrap modes per
+// sampler, base-colour factor times texture. Alpha is 255 where a surface with (filtered)
+// alpha >= 0.5 is seen, 0 elsewhere (unpainted texels of painted buffers have alpha 0, and
+// bilinear filtering weights taps by alpha, so their colours never bleed into painted
+// neighbours). With N x N supersampling a pixel's alpha is 255 when the mean of its samples'
+// alphas is >= 0.5, and its colour is the alpha-weighted mean of the samples' colours.
 #pragma once
+
+#include <memory>
 
 #include <opencv2/core.hpp>
 
@@ -24,23 +28,32 @@ struct RenderOptions {
 };
 
 struct RenderOutput {
-  cv::Mat rgba;         // CV_8UC4 (R,G,B,A order), camera size
-  cv::Mat depth;        // CV_32F, camera size (centre sample), +inf where none
-  cv::Mat triangle_id;  // CV_32S, camera size (centre sample), -1 where none
+  cv::Mat rgba;  // CV_8UC4 (R,G,B,A order), camera size
+  // Depth and triangle id at the pixel centres: the centre sample for N = 1 or odd N, a
+  // separate 1x rasterization for even N (no sample of an even grid is at the centre).
+  cv::Mat depth;        // CV_32F, camera size (camera z, metres), +inf where none
+  cv::Mat triangle_id;  // CV_32S, camera size, -1 where none
 };
 
 class Renderer {
  public:
+  // Precomputes the ray table(s) for `camera` (throws std::invalid_argument on bad options).
   Renderer(const Camera& camera, const RenderOptions& options);
+  ~Renderer();
+  // Thread-safe (const): several threads may render with one Renderer.
   void Render(const Scene& scene, const Rigid3d& cam_from_world, RenderOutput* output) const;
   const Rasterizer& rasterizer() const { return rasterizer_; }
+  const RenderOptions& options() const { return options_; }
 
  private:
   RenderOptions options_;
-  Rasterizer rasterizer_;
+  Rasterizer rasterizer_;                          // N x N samples per pixel
+  std::unique_ptr<Rasterizer> centre_rasterizer_;  // 1x, only for even N
 };
 
-// glTF texture lookup at UV with the texture's wrap modes; RGBA in [0,1].
+// glTF texture lookup at UV with the texture's wrap modes; RGBA in [0,1]. Bilinear weights
+// each tap by its alpha (premultiplied) and returns the un-premultiplied colour with the
+// filtered alpha (colour 0 where all taps have alpha 0). An empty texture gives (1,1,1,1).
 Eigen::Vector4d SampleTexture(const Texture& texture, const Eigen::Vector2d& uv,
                               TextureFilter filter);
 

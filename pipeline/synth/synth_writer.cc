@@ -1,0 +1,320 @@
+#include "pipeline/synth/synth_writer.h"
+
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/cameramodel_io.h"
+#include "pipeline/core/poses.h"
+#include "pipeline/core/project.h"
+#include "pipeline/synth/synth_spec.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+// Bumped whenever the renderer of synthetic frames changes what it writes.
+constexpr const char* kSynthFormat = "fresco-synth-1";
+
+class Fnv64 {
+ public:
+  void Add(const void* data, size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) hash_ = (hash_ ^ p[i]) * 0x100000001b3ull;
+  }
+  template <typename T>
+  void AddValue(const T& value) {
+    Add(&value, sizeof(T));
+  }
+  void AddString(const std::string& s) {
+    AddValue(s.size());
+    Add(s.data(), s.size());
+  }
+  std::string Hex() const {
+    char text[17];
+    std::snprintf(text, sizeof(text), "%016llx", static_cast<unsigned long long>(hash_));
+    return text;
+  }
+
+ private:
+  uint64_t hash_ = 0xcbf29ce484222325ull;
+};
+
+// The COLMAP model that holds the same lens (COLMAP has no LENSMODEL_* names).
+Camera ColmapCamera(const Camera& camera) {
+  Camera c = camera;
+  switch (camera.model) {
+    case LensModel::kPinhole:
+      c.model = LensModel::kColmapPinhole;
+      break;
+    case LensModel::kOpenCV4:
+      c.model = LensModel::kColmapOpenCV;
+      break;
+    default:
+      c.model = LensModel::kFullOpenCV;
+      break;
+  }
+  return c;
+}
+
+bool IsImageFile(const fs::path& path) {
+  static const std::set<std::string> kExtensions = {".png", ".jpg",  ".jpeg", ".bmp",
+                                                    ".tif", ".tiff", ".ppm"};
+  std::string ext = path.extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return kExtensions.count(ext) > 0;
+}
+
+Status WriteMoversJson(const std::string& path, const SynthCapture& plan) {
+  json movers = json::array();
+  for (const MoverOptions& m : plan.movers) {
+    json centres = json::array();
+    for (size_t f = 0; f < plan.true_poses.size(); ++f) {
+      const Eigen::Vector3d c = MoverCentreAt(m, static_cast<int>(f));
+      centres.push_back({c.x(), c.y(), c.z()});
+    }
+    movers.push_back({{"shape", MoverShapeName(m.shape)},
+                      {"radius_m", m.radius_m},
+                      {"rgb", {m.rgb[0], m.rgb[1], m.rgb[2]}},
+                      {"start", {m.start.x(), m.start.y(), m.start.z()}},
+                      {"end", {m.end.x(), m.end.y(), m.end.z()}},
+                      {"period_frames", m.period_frames},
+                      {"phase", m.phase},
+                      {"spin_deg_per_frame", m.spin_deg_per_frame},
+                      {"centre_per_frame", centres}});
+  }
+  return WriteFileAtomic(path, json({{"movers", movers}}).dump(1) + "\n");
+}
+
+// The fingerprint of a planned capture: settings, scene, the plan (so that changes to the
+// path, noise or mover code count) and the pixels of frame 0 (changes to the renderer).
+std::string PlanFingerprint(const Scene& scene, const SynthOptions& options,
+                            const SynthCapture& plan) {
+  Fnv64 h;
+  h.AddString(kSynthFormat);
+  SynthOptions o = options;
+  o.threads = 0;  // does not change the output
+  h.AddString(SynthOptionsToJson(o));
+  const TriangleMesh& mesh = scene.mesh;
+  h.AddValue(scene.origin_in_world);
+  for (const Eigen::Vector3d& v : mesh.vertices) h.AddValue(v);
+  for (const Eigen::Vector3i& t : mesh.triangles) h.AddValue(t);
+  for (const auto& uv : mesh.uvs) {
+    for (const Eigen::Vector2f& c : uv) h.AddValue(c);
+  }
+  for (int m : mesh.material) h.AddValue(m);
+  for (const Material& m : scene.materials) {
+    h.AddValue(m.base_color_factor);
+    h.AddValue(m.base_color_texture);
+  }
+  for (const Texture& t : scene.textures) {
+    h.AddValue(t.wrap_s);
+    h.AddValue(t.wrap_t);
+    h.AddValue(t.rgba.rows);
+    h.AddValue(t.rgba.cols);
+    h.AddValue(t.rgba.type());
+    for (int y = 0; y < t.rgba.rows; ++y) h.Add(t.rgba.ptr(y), t.rgba.cols * t.rgba.elemSize());
+  }
+  for (double p : plan.camera.Params()) h.AddValue(p);
+  for (size_t i = 0; i < plan.true_poses.size(); ++i) {
+    for (const PosedImage* image : {&plan.true_poses[i], &plan.given_poses[i]}) {
+      h.AddString(image->name);
+      h.AddValue(image->cam_from_world.rotation.coeffs().eval());
+      h.AddValue(image->cam_from_world.translation);
+    }
+    h.AddValue(plan.exposure_gains[i]);
+  }
+  for (const MoverOptions& m : plan.movers) {
+    h.AddValue(m.shape);
+    h.AddValue(m.radius_m);
+    h.AddValue(m.rgb);
+    h.AddValue(m.start);
+    h.AddValue(m.end);
+    h.AddValue(m.period_frames);
+    h.AddValue(m.phase);
+    h.AddValue(m.spin_deg_per_frame);
+  }
+  if (!plan.true_poses.empty()) {
+    SynthCapture first = plan;
+    first.true_poses.resize(1);
+    first.given_poses.resize(1);
+    first.exposure_gains.resize(1);
+    SynthOptions one = options;
+    one.threads = 1;
+    RenderSynthFrames(scene, one, first, [&](int, const cv::Mat& bgr) {
+      for (int y = 0; y < bgr.rows; ++y) h.Add(bgr.ptr(y), bgr.cols * bgr.elemSize());
+      return Status::Ok();
+    });
+  }
+  return h.Hex();
+}
+
+}  // namespace
+
+std::string SynthFingerprint(const Scene& scene, const SynthOptions& options) {
+  SynthCapture plan;
+  if (!PlanSynthCapture(scene, options, &plan).ok()) return "";
+  return PlanFingerprint(scene, options, plan);
+}
+
+Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const std::string& dir,
+                         const SynthWriteOptions& write_options, SynthWriteResult* result) {
+  SynthWriteResult local;
+  if (!result) result = &local;
+  *result = SynthWriteResult();
+  SynthCapture plan;
+  FRESCO_RETURN_IF_ERROR(PlanSynthCapture(scene, options, &plan));
+  const int frames = static_cast<int>(plan.true_poses.size());
+  result->frames = frames;
+  result->fingerprint = PlanFingerprint(scene, options, plan);
+
+  const fs::path root(dir);
+  const std::string stamp_path = (root / "synth_stamp.txt").string();
+  const std::string project_path = (root / "project.json").string();
+  const std::string stamp = result->fingerprint + "\n";
+  if (write_options.skip_if_current && fs::is_regular_file(project_path) &&
+      fs::is_regular_file(stamp_path)) {
+    std::string existing;
+    if (ReadFileToString(stamp_path, &existing).ok() && existing == stamp) {
+      result->skipped = true;
+      return Status::Ok();
+    }
+  }
+
+  const fs::path frames_dir = root / "frames";
+  for (const char* sub : {"frames", "sparse", "truth"}) {
+    FRESCO_RETURN_IF_ERROR(MakeDirectories((root / sub).string()));
+  }
+  // A folder without project.json is incomplete: remove it (and the stamp) first, so an
+  // interrupted run is never taken for a finished one.
+  std::error_code ec;
+  fs::remove(project_path, ec);
+  fs::remove(stamp_path, ec);
+  // Frames of an earlier, longer capture would be read as video: remove every image that is
+  // not one of this capture's frames.
+  std::set<std::string> names;
+  for (const PosedImage& p : plan.true_poses) names.insert(p.name);
+  for (const auto& entry : fs::directory_iterator(frames_dir, ec)) {
+    if (entry.is_regular_file() && IsImageFile(entry.path()) &&
+        !names.count(entry.path().filename().string())) {
+      fs::remove(entry.path(), ec);
+    }
+  }
+
+  // Frames, streamed.
+  int done = 0;
+  FRESCO_RETURN_IF_ERROR(
+      RenderSynthFrames(scene, options, plan, [&](int index, const cv::Mat& bgr) -> Status {
+        std::vector<uchar> png;
+        const std::string path = (frames_dir / plan.true_poses[index].name).string();
+        if (!cv::imencode(".png", bgr, png, {cv::IMWRITE_PNG_COMPRESSION, 3})) {
+          return Status::Error(path + ": could not encode the frame as PNG");
+        }
+        FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
+        ++done;
+        if (write_options.progress) write_options.progress(done, frames);
+        return Status::Ok();
+      }));
+
+  // Camera and poses.
+  CameraModelFile model_file;
+  model_file.camera = plan.camera;
+  FRESCO_RETURN_IF_ERROR(WriteCameraModel((root / "camera.cameramodel").string(), model_file));
+  ColmapModel given;
+  given.cameras[1] = ColmapCamera(plan.camera);
+  given.images = plan.given_poses;
+  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "sparse").string(), given));
+  ColmapModel truth = given;
+  truth.images = plan.true_poses;
+  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "truth").string(), truth));
+  std::ostringstream exposure;
+  exposure << "# NAME GAIN: the exposure gain applied to each rendered frame\n";
+  exposure.precision(9);
+  for (int i = 0; i < frames; ++i) {
+    exposure << plan.true_poses[i].name << " " << plan.exposure_gains[i] << "\n";
+  }
+  FRESCO_RETURN_IF_ERROR(
+      WriteFileAtomic((root / "truth" / "exposure.txt").string(), exposure.str()));
+  FRESCO_RETURN_IF_ERROR(WriteMoversJson((root / "truth" / "movers.json").string(), plan));
+
+  // The static scene (no movers).
+  FRESCO_RETURN_IF_ERROR(SaveGltfScene(scene, (root / "scene.gltf").string()));
+
+  // Settings, stamp, and the project last.
+  json settings = json::parse(SynthOptionsToJson(options));
+  settings["scene"] =
+      write_options.scene_source.empty() ? "scene.gltf" : write_options.scene_source;
+  settings["fingerprint"] = result->fingerprint;
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic((root / "synth.json").string(), settings.dump(2) + "\n"));
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(stamp_path, stamp));
+  Project project;
+  project.fresco_version = 1;
+  project.scene = "scene.gltf";
+  project.camera = "camera.cameramodel";
+  project.video = "frames/";
+  project.poses = "sparse/images.txt";
+  project.truth.poses = "truth/images.txt";
+  project.file_path = fs::absolute(project_path).lexically_normal().string();
+  return SaveProject(project, project_path);
+}
+
+Status ExportSynthScene(const Scene& scene, const std::vector<std::string>& texture_files,
+                        const std::string& gltf_path) {
+  const fs::path parent = fs::absolute(gltf_path).parent_path();
+  FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
+  FRESCO_RETURN_IF_ERROR(SaveGltfScene(scene, gltf_path));
+  bool any = false;
+  for (const std::string& f : texture_files) any = any || !f.empty();
+  if (!any) return Status::Ok();
+
+  std::string text;
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(gltf_path, &text));
+  json gltf = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (gltf.is_discarded() || !gltf.contains("textures") || !gltf.contains("images")) {
+    return Status::Error(gltf_path + ": written glTF has no textures/images to point at files");
+  }
+  json& textures = gltf["textures"];
+  json& images = gltf["images"];
+  if (textures.size() != scene.textures.size()) {
+    return Status::Error(gltf_path + ": written glTF has " + std::to_string(textures.size()) +
+                         " textures for the scene's " + std::to_string(scene.textures.size()));
+  }
+  std::set<std::string> replaced;
+  for (size_t i = 0; i < texture_files.size() && i < textures.size(); ++i) {
+    if (texture_files[i].empty() || !textures[i].contains("source")) continue;
+    const int source = textures[i]["source"].get<int>();
+    if (source < 0 || source >= static_cast<int>(images.size())) continue;
+    json& image = images[source];
+    if (image.contains("uri")) replaced.insert(image["uri"].get<std::string>());
+    const fs::path file = fs::absolute(texture_files[i]).lexically_normal();
+    image["uri"] = file.lexically_relative(parent).generic_string();
+    std::string ext = file.extension().string();
+    for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    image["mimeType"] = (ext == ".jpg" || ext == ".jpeg") ? "image/jpeg" : "image/png";
+    image.erase("bufferView");
+  }
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(gltf_path, gltf.dump(2) + "\n"));
+  // Remove the PNG copies nothing refers to any more.
+  std::set<std::string> still_used;
+  for (const json& image : images) {
+    if (image.contains("uri")) still_used.insert(image["uri"].get<std::string>());
+  }
+  std::error_code ec;
+  for (const std::string& uri : replaced) {
+    if (!still_used.count(uri) && uri.find("..") == std::string::npos &&
+        uri.find(':') == std::string::npos) {
+      fs::remove(parent / uri, ec);
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace fresco

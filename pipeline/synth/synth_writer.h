@@ -1,0 +1,65 @@
+// Writes a synthetic capture as a project folder that `fresco run DIR/project.json` accepts
+// as is. Frames are rendered and written one at a time (memory does not grow with the
+// capture's length); every file is written atomically, and project.json last, so a folder
+// with a project.json is complete.
+//
+//   DIR/frames/000000.png ...        the video (8-bit sRGB)
+//   DIR/camera.cameramodel           the lens (mrcal)
+//   DIR/sparse/cameras.txt           the lens again (COLMAP: PINHOLE, OPENCV or FULL_OPENCV)
+//   DIR/sparse/images.txt            the given poses (with the requested noise), names =
+//                                    frame files; sparse/points3D.txt is empty
+//   DIR/truth/images.txt             the true poses (+ truth/cameras.txt, points3D.txt)
+//   DIR/truth/exposure.txt           per frame: NAME GAIN
+//   DIR/truth/movers.json            the moving objects and their centre at every frame
+//   DIR/scene.gltf (+ .bin, PNGs)    the static scene, without the movers
+//   DIR/synth.json                   every setting used
+//   DIR/synth_stamp.txt              fingerprint of scene + settings (see skip_if_current)
+//   DIR/project.json                 fresco 1, scene, camera, video, poses, truth.poses
+//
+// DIR/frames/ belongs to the capture: other image files in it (e.g. the frames of an earlier,
+// longer capture) are removed, since the video reader would take them for frames.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/scene.h"
+#include "pipeline/core/status.h"
+#include "pipeline/synth/synthesize.h"
+
+namespace fresco {
+
+struct SynthWriteOptions {
+  // Called after each frame is written: (frames written, total frames).
+  std::function<void(int done, int total)> progress;
+  // When DIR already holds a complete capture of the same scene and settings (same
+  // fingerprint in synth_stamp.txt, and project.json present), write nothing.
+  bool skip_if_current = false;
+  // Where the written scene came from, recorded in synth.json ("builtin:cube-room", a path).
+  std::string scene_source;
+};
+
+struct SynthWriteResult {
+  bool skipped = false;     // skip_if_current found the capture current
+  std::string fingerprint;  // hex
+  int frames = 0;
+};
+
+Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const std::string& dir,
+                         const SynthWriteOptions& write_options,
+                         SynthWriteResult* result = nullptr);
+
+// A 64-bit fingerprint (16 hex digits) of the scene's content (geometry, UVs, materials,
+// texture pixels), every setting that changes the output (not `threads`), the planned
+// camera, poses, gains and movers, and the rendered pixels of frame 0: a change to the code
+// that makes any of them changes it too. "" for invalid options.
+std::string SynthFingerprint(const Scene& scene, const SynthOptions& options);
+
+// Writes just the scene as glTF (SaveGltfScene). Where `texture_files[i]` names the image file
+// scene texture i was made from, the glTF points at that file (relative to the glTF's
+// folder) instead of a re-encoded PNG copy: bundled scenes keep their small JPEGs.
+Status ExportSynthScene(const Scene& scene, const std::vector<std::string>& texture_files,
+                        const std::string& gltf_path);
+
+}  // namespace fresco

@@ -1,0 +1,359 @@
+// The project file: defaults, strict parsing (unknown keys, wrong types, ranges, malformed
+// JSON, duplicate keys), --set overrides, and load(save(p)) == p, also when saved elsewhere.
+#include "pipeline/core/project.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+const char kMinimal[] = R"({
+  "fresco": 1,
+  "scene": "scene.gltf",
+  "camera": "sparse/cameras.txt",
+  "video": "frames/",
+  "poses": "sparse/images.txt"
+})";
+
+// The minimal project with `extra` spliced in as more top-level keys.
+std::string WithExtra(const std::string& extra) {
+  std::string text = kMinimal;
+  text.insert(text.rfind('}'), ", " + extra + "\n");
+  return text;
+}
+
+Status Parse(const std::string& text, Project* project,
+             const std::vector<std::string>& overrides = {}) {
+  return ParseProject(text, "p.json", overrides, project);
+}
+
+std::string ParseError(const std::string& text, const std::vector<std::string>& overrides = {}) {
+  Project project;
+  const Status status = Parse(text, &project, overrides);
+  EXPECT_FALSE(status.ok()) << "parsed without error:\n" << text;
+  return status.message();
+}
+
+// A project with every setting away from its default.
+Project NonDefaultProject() {
+  Project p;
+  p.scene = "models/castle.gltf";
+  p.camera = "calib/camera.cameramodel";
+  p.video = "frames/";
+  p.poses = "sparse/0";
+  p.time_offset_s = -0.125;
+  p.pipeline.sampling = SamplingMode::kArea;
+  p.pipeline.texel_size_m = 0.0123456789012345;
+  p.pipeline.max_buffer_texels = 4096;
+  p.pipeline.update_every = 20;
+  p.pipeline.update = UpdatePolicy::kLatest;
+  p.pipeline.quality_slack = 0.35;
+  p.pipeline.max_frames = 300;
+  p.pipeline.threads = 2;
+  p.pipeline.debug_images = true;
+  p.pipeline.occlusion.enabled = false;
+  p.pipeline.occlusion.tolerance_rel = 0.05;
+  p.pipeline.occlusion.tolerance_m = 0.01;
+  p.pipeline.occlusion.max_view_angle_deg = 75.5;
+  p.grouping.angle_deg = 12.5;
+  GroupingEdit merge;
+  merge.op = "merge";
+  merge.groups = {3, 4, 7};
+  GroupingEdit move;
+  move.op = "move";
+  move.triangles = {10, 11};
+  move.target_group = 2;
+  move.texel_size_m = 0.02;
+  p.grouping.edits = {merge, move};
+  p.truth.poses = "truth/poses.tum";
+  return p;
+}
+
+TEST(ProjectTest, MinimalProjectGetsDefaults) {
+  Project project;
+  ASSERT_TRUE(Parse(kMinimal, &project).ok());
+  EXPECT_EQ(project.fresco_version, 1);
+  EXPECT_EQ(project.scene, "scene.gltf");
+  EXPECT_EQ(project.camera, "sparse/cameras.txt");
+  EXPECT_EQ(project.video, "frames/");
+  EXPECT_EQ(project.poses, "sparse/images.txt");
+  const Project defaults;
+  EXPECT_EQ(project.pipeline, defaults.pipeline);
+  EXPECT_EQ(project.grouping, defaults.grouping);
+  EXPECT_EQ(project.truth, defaults.truth);
+  EXPECT_EQ(project.time_offset_s, 0.0);
+  EXPECT_TRUE(fs::path(project.file_path).is_absolute());
+}
+
+TEST(ProjectTest, SaveThenLoadGivesTheSameProject) {
+  const std::string dir = testing::MakeTempDir("project");
+  Project project = NonDefaultProject();
+  project.file_path = dir + "/project.json";
+  ASSERT_TRUE(SaveProject(project, project.file_path).ok());
+
+  Project loaded;
+  const Status status = LoadProject(project.file_path, {}, &loaded);
+  ASSERT_TRUE(status.ok()) << status.message();
+  // Field by field (operator== covers every field, file_path included) and as text.
+  EXPECT_EQ(loaded.pipeline, project.pipeline);
+  EXPECT_EQ(loaded.pipeline.occlusion, project.pipeline.occlusion);
+  EXPECT_EQ(loaded.grouping, project.grouping);
+  EXPECT_EQ(loaded.truth, project.truth);
+  EXPECT_EQ(loaded.time_offset_s, project.time_offset_s);
+  EXPECT_EQ(loaded, project);
+  EXPECT_EQ(ProjectToJsonText(loaded), ProjectToJsonText(project));
+  // Saving what was loaded changes nothing on disk.
+  const std::string first = testing::ReadText(project.file_path);
+  ASSERT_TRUE(SaveProject(loaded, project.file_path).ok());
+  EXPECT_EQ(testing::ReadText(project.file_path), first);
+}
+
+TEST(ProjectTest, SavedFileListsEverySetting) {
+  const std::string text = ProjectToJsonText(Project());
+  for (const char* key : {"\"fresco\": 1",       "\"scene\"",
+                          "\"time_offset_s\"",   "\"sampling\": \"bilinear\"",
+                          "\"texel_size_m\"",    "\"max_buffer_texels\"",
+                          "\"update_every\": 1", "\"update\": \"quality\"",
+                          "\"quality_slack\"",   "\"max_frames\"",
+                          "\"threads\"",         "\"debug_images\"",
+                          "\"occlusion\"",       "\"tolerance_rel\"",
+                          "\"tolerance_m\"",     "\"max_view_angle_deg\"",
+                          "\"grouping\"",        "\"angle_deg\"",
+                          "\"edits\"",           "\"truth\""}) {
+    EXPECT_THAT(text, HasSubstr(key));
+  }
+  // Pretty: one key per line.
+  EXPECT_THAT(text, HasSubstr("\n  \"pipeline\": {\n"));
+}
+
+TEST(ProjectTest, SavingElsewhereKeepsPathsPointingAtTheSameFiles) {
+  const std::string dir = testing::MakeTempDir("project");
+  Project project = NonDefaultProject();
+  project.file_path = dir + "/a/project.json";
+  project.scene = "/abs/scene.gltf";       // absolute: kept
+  project.video = "udp://127.0.0.1:5000";  // a stream: kept
+  fs::create_directories(dir + "/b/c");
+  const std::string copy_path = dir + "/b/c/copy.json";
+  ASSERT_TRUE(SaveProject(project, copy_path).ok());
+
+  Project copy;
+  ASSERT_TRUE(LoadProject(copy_path, {}, &copy).ok());
+  EXPECT_EQ(copy.camera, "../../a/calib/camera.cameramodel");
+  EXPECT_EQ(copy.poses, "../../a/sparse/0");
+  EXPECT_EQ(copy.truth.poses, "../../a/truth/poses.tum");
+  EXPECT_EQ(copy.scene, "/abs/scene.gltf");
+  EXPECT_EQ(copy.video, "udp://127.0.0.1:5000");
+  for (auto field : {&Project::scene, &Project::camera, &Project::video, &Project::poses}) {
+    EXPECT_EQ(copy.Resolve(copy.*field), project.Resolve(project.*field));
+  }
+  EXPECT_EQ(copy.Resolve(copy.truth.poses), project.Resolve(project.truth.poses));
+  EXPECT_EQ(copy.pipeline, project.pipeline);
+  EXPECT_EQ(copy.grouping, project.grouping);
+}
+
+TEST(ProjectTest, FolderPathsKeepTheirTrailingSlashWhenRebased) {
+  const std::string dir = testing::MakeTempDir("project");
+  Project project = NonDefaultProject();
+  project.file_path = dir + "/a/project.json";
+  fs::create_directories(dir + "/b");
+  ASSERT_TRUE(SaveProject(project, dir + "/b/p.json").ok());
+  Project copy;
+  ASSERT_TRUE(LoadProject(dir + "/b/p.json", {}, &copy).ok());
+  EXPECT_EQ(copy.video, "../a/frames/");
+}
+
+TEST(ProjectTest, ResolveIsRelativeToTheProjectFolder) {
+  Project project;
+  project.file_path = "/data/site/project.json";
+  EXPECT_EQ(project.Resolve("frames/"), "/data/site/frames/");
+  EXPECT_EQ(project.Resolve("../shared/cam.txt"), "/data/shared/cam.txt");
+  EXPECT_EQ(project.Resolve("/abs/x.gltf"), "/abs/x.gltf");
+  EXPECT_EQ(project.Resolve("device:0"), "device:0");
+  EXPECT_EQ(project.Resolve("tcp://localhost:9000"), "tcp://localhost:9000");
+  EXPECT_EQ(project.Resolve(""), "");
+}
+
+TEST(ProjectTest, SaveIsAtomicAndFailsOnAMissingFolder) {
+  const std::string dir = testing::MakeTempDir("project");
+  const Status status = SaveProject(NonDefaultProject(), dir + "/missing/p.json");
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr(dir + "/missing/p.json"));
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+// ---- Bad input. --------------------------------------------------------------------------
+
+TEST(ProjectTest, MissingFileIsNamed) {
+  Project project;
+  const Status status = LoadProject("/nonexistent/p.json", {}, &project);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("/nonexistent/p.json"));
+  EXPECT_THAT(status.message(), HasSubstr("no such file"));
+}
+
+TEST(ProjectTest, MalformedJsonGivesLineAndColumn) {
+  const std::string message = ParseError("{\n  \"fresco\": 1,\n  \"scene\" \"x\"\n}");
+  EXPECT_THAT(message, StartsWith("p.json: line 3, column"));
+  EXPECT_THAT(message, HasSubstr("malformed JSON"));
+  EXPECT_THAT(ParseError("{\"fresco\": 1,}"), StartsWith("p.json: line 1, column"));
+  EXPECT_THAT(ParseError(""), HasSubstr("malformed JSON"));
+}
+
+TEST(ProjectTest, TopLevelMustBeAnObject) {
+  EXPECT_THAT(ParseError("[1, 2]"), HasSubstr("p.json: expected a JSON object"));
+}
+
+TEST(ProjectTest, UnknownKeysAreNamedByTheirPath) {
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"samplig": "area"})")),
+            "p.json: pipeline.samplig: unknown key (did you mean 'sampling'?)");
+  EXPECT_EQ(ParseError(WithExtra(R"("colour": 1)")), "p.json: colour: unknown key");
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"occlusion": {"enable": true}})")),
+              StartsWith("p.json: pipeline.occlusion.enable: unknown key"));
+  EXPECT_THAT(ParseError(WithExtra(R"("grouping": {"edits": [{"op": "merge", "grups": [1]}]})")),
+              StartsWith("p.json: grouping.edits[0].grups: unknown key"));
+}
+
+TEST(ProjectTest, WrongTypesAreNamed) {
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"update_every": "20"})")),
+              StartsWith("p.json: pipeline.update_every: expected an integer, got string"));
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"update_every": 2.5})")),
+            "p.json: pipeline.update_every: expected an integer, got number 2.5");
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"debug_images": 1})")),
+              StartsWith("p.json: pipeline.debug_images: expected true or false"));
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": 3)")),
+              StartsWith("p.json: pipeline: expected an object, got number"));
+  EXPECT_THAT(ParseError(WithExtra(R"("time_offset_s": "0.5")")),
+              StartsWith("p.json: time_offset_s: expected a number, got string"));
+  EXPECT_THAT(ParseError(WithExtra(R"("grouping": {"edits": {}})")),
+              StartsWith("p.json: grouping.edits: expected an array"));
+  EXPECT_THAT(
+      ParseError(WithExtra(R"("grouping": {"edits": [{"op": "merge", "groups": [1, "x"]}]})")),
+      StartsWith("p.json: grouping.edits[0].groups[1]: expected an integer"));
+  std::string text = kMinimal;
+  text.replace(text.find("\"scene.gltf\""), 12, "42");
+  EXPECT_THAT(ParseError(text), StartsWith("p.json: scene: expected a string, got number 42"));
+  // 20.0 is the integer 20.
+  Project project;
+  ASSERT_TRUE(Parse(WithExtra(R"("pipeline": {"update_every": 20.0})"), &project).ok());
+  EXPECT_EQ(project.pipeline.update_every, 20);
+}
+
+TEST(ProjectTest, RequiredKeysAndVersion) {
+  for (const char* key : {"fresco", "scene", "camera", "video", "poses"}) {
+    std::string text = kMinimal;
+    const size_t start = text.find(std::string("\"") + key + "\"");
+    const size_t end = text.find('\n', start);
+    text.erase(start, end - start + 1);
+    if (std::string(key) == "poses") text.replace(text.rfind(','), 1, "");
+    EXPECT_EQ(ParseError(text), std::string("p.json: ") + key + ": missing required key");
+  }
+  std::string v2 = kMinimal;
+  v2.replace(v2.find("\"fresco\": 1"), 11, "\"fresco\": 2");
+  EXPECT_THAT(ParseError(v2), StartsWith("p.json: fresco: unsupported version 2"));
+  std::string empty = kMinimal;
+  empty.replace(empty.find("\"frames/\""), 9, "\"\"");
+  EXPECT_EQ(ParseError(empty), "p.json: video: must not be empty");
+}
+
+TEST(ProjectTest, EnumsAndRangesAreChecked) {
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"sampling": "cubic"})")),
+            "p.json: pipeline.sampling: 'cubic' is not one of \"nearest\", \"bilinear\" or "
+            "\"area\"");
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"update": "newest"})")),
+              StartsWith("p.json: pipeline.update: 'newest' is not one of \"latest\" or "
+                         "\"quality\""));
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"quality_slack": 1.5})")),
+              StartsWith("p.json: pipeline.quality_slack: must be in [0, 1], got 1.5"));
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"update_every": 0})")),
+            "p.json: pipeline.update_every: must be >= 1, got 0");
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"texel_size_m": -0.01})")),
+            "p.json: pipeline.texel_size_m: must be >= 0, got -0.01");
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"occlusion": {"max_view_angle_deg": 95}})")),
+            "p.json: pipeline.occlusion.max_view_angle_deg: must be in (0, 90], got 95");
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"occlusion": {"max_view_angle_deg": 0}})")),
+              HasSubstr("must be in (0, 90]"));
+  EXPECT_THAT(ParseError(WithExtra(R"("grouping": {"angle_deg": 181})")),
+              StartsWith("p.json: grouping.angle_deg: must be in [0, 180]"));
+  EXPECT_THAT(ParseError(WithExtra(R"("grouping": {"edits": [{"op": "glue"}]})")),
+              StartsWith("p.json: grouping.edits[0].op: 'glue' is not one of"));
+  EXPECT_EQ(ParseError(WithExtra(R"("grouping": {"edits": [{"groups": [1]}]})")),
+            "p.json: grouping.edits[0].op: missing required key");
+  EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"threads": 99999999999})")),
+              StartsWith("p.json: pipeline.threads: integer out of range"));
+}
+
+TEST(ProjectTest, DuplicateKeysAreErrors) {
+  EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"update_every": 2, "update_every": 3})")),
+            "p.json: pipeline.update_every: duplicate key");
+  EXPECT_EQ(ParseError(WithExtra(R"("scene": "other.gltf")")), "p.json: scene: duplicate key");
+  EXPECT_EQ(ParseError(WithExtra(
+                R"("grouping": {"edits": [{"op": "merge"}, {"op": "split", "op": "move"}]})")),
+            "p.json: grouping.edits[1].op: duplicate key");
+}
+
+// ---- --set overrides. --------------------------------------------------------------------
+
+TEST(ProjectTest, SetOverridesByJsonPath) {
+  Project project;
+  const Status status =
+      Parse(kMinimal, &project,
+            {"pipeline.sampling=nearest", "pipeline.update_every=20",
+             "pipeline.occlusion.enabled=false", "video=other/frames/", "time_offset_s=0.25",
+             "grouping.edits=[{\"op\": \"split\", \"groups\": [2]}]"});
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(project.pipeline.sampling, SamplingMode::kNearest);
+  EXPECT_EQ(project.pipeline.update_every, 20);
+  EXPECT_FALSE(project.pipeline.occlusion.enabled);
+  EXPECT_EQ(project.video, "other/frames/");
+  EXPECT_EQ(project.time_offset_s, 0.25);
+  ASSERT_EQ(project.grouping.edits.size(), 1u);
+  EXPECT_EQ(project.grouping.edits[0].op, "split");
+  // Into an array element, and overriding what the file says.
+  ASSERT_TRUE(Parse(WithExtra(R"("pipeline": {"update_every": 5}, "grouping": {"edits": )"
+                              R"([{"op": "merge"}]})"),
+                    &project, {"grouping.edits.0.op=move", "pipeline.update_every=7"})
+                  .ok());
+  EXPECT_EQ(project.grouping.edits[0].op, "move");
+  EXPECT_EQ(project.pipeline.update_every, 7);
+}
+
+TEST(ProjectTest, SetErrorsNameTheKey) {
+  EXPECT_EQ(ParseError(kMinimal, {"pipeline.nope=1"}),
+            "p.json: pipeline.nope: unknown key (from --set pipeline.nope=1)");
+  EXPECT_THAT(ParseError(kMinimal, {"nope.deeper=1"}),
+              StartsWith("p.json: nope: unknown key (from --set nope.deeper=1)"));
+  EXPECT_THAT(ParseError(kMinimal, {"pipeline.update_every=often"}),
+              StartsWith("p.json: pipeline.update_every: expected an integer, got string "
+                         "\"often\" (from --set pipeline.update_every=often)"));
+  EXPECT_THAT(ParseError(kMinimal, {"pipeline.update_every"}),
+              StartsWith("p.json: --set pipeline.update_every: expected KEY=VALUE"));
+  EXPECT_THAT(ParseError(kMinimal, {"scene.x=1"}),
+              StartsWith("p.json: --set scene.x=1: scene: is a string"));
+  EXPECT_THAT(ParseError(kMinimal, {"grouping.edits.3.op=merge"}),
+              HasSubstr("grouping.edits: no element '3'"));
+  EXPECT_THAT(ParseError(kMinimal, {"pipeline..sampling=area"}), HasSubstr("empty name"));
+}
+
+TEST(ProjectTest, SamplingModeNames) {
+  for (SamplingMode mode : {SamplingMode::kNearest, SamplingMode::kBilinear, SamplingMode::kArea}) {
+    SamplingMode parsed;
+    ASSERT_TRUE(SamplingModeFromName(SamplingModeName(mode), &parsed));
+    EXPECT_EQ(parsed, mode);
+  }
+  SamplingMode parsed;
+  EXPECT_FALSE(SamplingModeFromName("cubic", &parsed));
+}
+
+}  // namespace
+}  // namespace fresco
