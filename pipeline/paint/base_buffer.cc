@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
+#include <unordered_set>
 
 namespace fresco {
 namespace {
@@ -168,13 +170,29 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     }
     owner.swap(next);
   }
-  for (size_t idx = 0; idx < owner.size(); ++idx) {
-    if (owner[idx] < 0) continue;
-    buffer.texel_index.push_back(static_cast<int32_t>(idx));
-    buffer.point.push_back(point[idx]);
-    buffer.triangle.push_back(owner[idx]);
-    buffer.on_surface.push_back(surface[idx]);
-    buffer.num_surface_texels += surface[idx];
+  const int tile = BaseBuffer::kTileTexels;
+  for (int tj = 0; tj < h; tj += tile) {
+    for (int ti = 0; ti < w; ti += tile) {
+      BaseBuffer::Chunk chunk;
+      chunk.begin = buffer.NumTexels();
+      chunk.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+      chunk.bounds_max = -chunk.bounds_min;
+      for (int j = tj; j < std::min(tj + tile, h); ++j) {
+        for (int i = ti; i < std::min(ti + tile, w); ++i) {
+          const size_t idx = static_cast<size_t>(j) * w + i;
+          if (owner[idx] < 0) continue;
+          buffer.texel_index.push_back(static_cast<int32_t>(idx));
+          buffer.point.push_back(point[idx]);
+          buffer.triangle.push_back(owner[idx]);
+          buffer.on_surface.push_back(surface[idx]);
+          buffer.num_surface_texels += surface[idx];
+          chunk.bounds_min = chunk.bounds_min.cwiseMin(point[idx]);
+          chunk.bounds_max = chunk.bounds_max.cwiseMax(point[idx]);
+        }
+      }
+      chunk.end = buffer.NumTexels();
+      if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
+    }
   }
   return buffer;
 }
@@ -210,9 +228,10 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
         ++set.folds_split;
         continue;
       }
+      const std::unordered_set<int> folded_set(folded.begin(), folded.end());
       std::vector<int> kept;
-      std::set_difference(group.triangles.begin(), group.triangles.end(), folded.begin(),
-                          folded.end(), std::back_inserter(kept));
+      for (int t : group.triangles)
+        if (!folded_set.count(t)) kept.push_back(t);
       group.triangles = kept;
       buffer.triangles = kept;
       BaseBufferGroup rest = group;

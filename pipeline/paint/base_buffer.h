@@ -30,11 +30,21 @@ struct BaseBuffer {
   double texel_size_m = 0.01;
   int width = 0, height = 0;
 
-  // Texels that map onto the model (structure of arrays, K entries).
+  // Texels that map onto the model (structure of arrays, K entries), in tile order: tiles
+  // of kTileTexels x kTileTexels texels, row-major inside a tile, so that a run of texels is
+  // a compact patch of the surface (cache-friendly in the frame, and cullable as a whole).
   std::vector<int32_t> texel_index;    // j * width + i
   std::vector<Eigen::Vector3f> point;  // model point, local coordinates (float is enough)
   std::vector<int32_t> triangle;       // its triangle
   std::vector<uint8_t> on_surface;     // 1 inside a triangle, 0 gutter
+  // (C) consecutive runs of texels, one per non-empty tile, with their bounding boxes
+  // (local coordinates): a frame culls a whole chunk that lies outside its view.
+  struct Chunk {
+    int begin = 0, end = 0;  // [begin, end) into the texel arrays
+    Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();
+  };
+  std::vector<Chunk> chunks;
+  static constexpr int kTileTexels = 16;
   int num_surface_texels = 0;
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();
 

@@ -3,9 +3,10 @@
 // lens model), reject back-facing and grazing views, keep it only if the video camera's
 // depth map agrees with its depth (tolerance scaled with depth and view angle), and sample
 // the frame (nearest, bilinear, or area: bilinear on the pyramid level matching the texel's
-// footprint).
+// footprint). Chunks of texels (base_buffer.h) outside the view frustum are skipped whole.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include <Eigen/Core>
@@ -18,6 +19,16 @@
 
 namespace fresco {
 
+// The image's extent on the normalized (z = 1) plane, slightly enlarged: a point whose
+// x/z or y/z lies outside it cannot land in the image. For distorted lenses it comes from
+// unprojecting the image border; `valid` is false when the border does not unproject (the
+// lens folds inside the image), and then only the near plane culls.
+struct NormalizedBounds {
+  bool valid = false;
+  float x_min = 0, x_max = 0, y_min = 0, y_max = 0;
+};
+NormalizedBounds ComputeNormalizedBounds(const Camera& camera);
+
 // What every buffer of one frame shares.
 struct FrameView {
   const Camera* camera = nullptr;
@@ -26,6 +37,7 @@ struct FrameView {
   const cv::Mat* frame_bgr = nullptr;  // CV_8UC3, camera size
   const cv::Mat* depth = nullptr;      // CV_32F camera z per pixel, or null (no occlusion)
   std::vector<cv::Mat> pyramid;        // level 0 = frame; filled for SamplingMode::kArea
+  NormalizedBounds bounds;             // for chunk culling (computed when not valid)
 };
 
 struct WarpOptions {
@@ -39,10 +51,12 @@ struct WarpedBuffer {
   cv::Mat bgr;      // CV_8UC3, buffer size
   cv::Mat valid;    // CV_8U, 255 where the texel was seen and sampled
   cv::Mat quality;  // CV_32F, pixels per texel (min(f s cos / z, 1)) where valid
-  int in_view = 0;       // texels that project inside the image, in front, not grazing
-  int visible = 0;       // ... and pass the occlusion test
+  int in_view = 0;        // texels that project inside the image, in front, not grazing
+  int visible = 0;        // ... and pass the occlusion test
   int occluded = 0;
-  int grazing = 0;       // back-facing or beyond max_view_angle
+  int grazing = 0;        // back-facing or beyond max_view_angle
+  int chunks_culled = 0;  // chunks of texels skipped whole (outside the view frustum)
+  long long texels_tested = 0;  // texels in chunks that were not culled
 };
 
 // `triangle_normals`: (T) unit normals of the mesh's triangles, local frame.

@@ -85,13 +85,14 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   return Status::Ok();
 }
 
-const Rasterizer& PaintSession::RasterizerFor(const Camera& camera) {
-  for (auto& [cam, raster] : rasterizers_)
-    if (SameCamera(cam, camera)) return *raster;
+const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
+  for (const CameraCache& cache : cameras_)
+    if (SameCamera(cache.camera, camera)) return cache;
   RasterOptions options;
   options.near_m = 1e-3;
-  rasterizers_.emplace_back(camera, std::make_unique<Rasterizer>(camera, options));
-  return *rasterizers_.back().second;
+  cameras_.push_back(CameraCache{camera, std::make_unique<Rasterizer>(camera, options),
+                                 ComputeNormalizedBounds(camera)});
+  return cameras_.back();
 }
 
 void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
@@ -113,12 +114,11 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   auto start = std::chrono::steady_clock::now();
   StageReport depth_report;
   depth_report.name = "depth";
-  RasterOutput raster;
+  const CameraCache& camera_cache = CacheFor(camera);
   if (options_.occlusion.enabled) {
-    RasterizerFor(camera).Rasterize(scene_->mesh, cam_from_local, &raster);
-    depth_ = raster.depth;
-    depth_report.metrics["surface_pixels"] = cv::countNonZero(raster.triangle_id >= 0);
-    if (debug) depth_report.images["depth"] = DepthDebugImage(depth_);
+    camera_cache.rasterizer->Rasterize(scene_->mesh, cam_from_local, &raster_);
+    if (debug) depth_report.metrics["surface_pixels"] = cv::countNonZero(raster_.triangle_id >= 0);
+    if (debug) depth_report.images["depth"] = DepthDebugImage(raster_.depth);
   }
   depth_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(depth_report));
@@ -132,7 +132,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   view.cam_from_local = cam_from_local;
   view.centre_local = cam_from_local.Centre();
   view.frame_bgr = &frame.bgr;
-  view.depth = options_.occlusion.enabled ? &depth_ : nullptr;
+  view.depth = options_.occlusion.enabled ? &raster_.depth : nullptr;
+  view.bounds = camera_cache.bounds;
   if (options_.sampling == SamplingMode::kArea) {
     view.pyramid.push_back(frame.bgr);
     while (view.pyramid.size() < 6 && view.pyramid.back().cols > 16) {
@@ -145,6 +146,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   warp_options.sampling = options_.sampling;
   warp_options.occlusion = options_.occlusion;
   long long in_view = 0, visible = 0, occluded = 0, grazing = 0, buffers_seen = 0;
+  long long tested = 0, chunks_culled = 0;
   std::vector<bool> seen(set_.buffers.size(), false);
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     const BaseBuffer& buffer = set_.buffers[b];
@@ -162,6 +164,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     visible += warped_[b].visible;
     occluded += warped_[b].occluded;
     grazing += warped_[b].grazing;
+    tested += warped_[b].texels_tested;
+    chunks_culled += warped_[b].chunks_culled;
     if (warped_[b].visible > 0) {
       seen[b] = true;
       ++buffers_seen;
@@ -176,6 +180,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   warp_report.metrics["texels_occluded"] = static_cast<double>(occluded);
   warp_report.metrics["texels_grazing"] = static_cast<double>(grazing);
   warp_report.metrics["buffers_seen"] = static_cast<double>(buffers_seen);
+  warp_report.metrics["texels_tested"] = static_cast<double>(tested);
+  warp_report.metrics["chunks_culled"] = static_cast<double>(chunks_culled);
   warp_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(warp_report));
 

@@ -60,7 +60,13 @@ class PaintSession {
 
  private:
   PaintSession() = default;
-  const Rasterizer& RasterizerFor(const Camera& camera);
+  // Per distinct camera: its depth rasterizer and its frustum bounds (built once).
+  struct CameraCache {
+    Camera camera;
+    std::unique_ptr<Rasterizer> rasterizer;
+    NormalizedBounds bounds;
+  };
+  const CameraCache& CacheFor(const Camera& camera);
 
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
@@ -69,8 +75,8 @@ class PaintSession {
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
   std::vector<Eigen::Vector3f> triangle_normals_;
-  std::vector<std::pair<Camera, std::unique_ptr<Rasterizer>>> rasterizers_;
-  cv::Mat depth_;
+  std::vector<CameraCache> cameras_;
+  RasterOutput raster_;  // the current frame's depth and triangle ids (reused)
   int frames_seen_ = 0;
 };
 

@@ -1,5 +1,7 @@
 #include "pipeline/paint/paint_update.h"
 
+#include <algorithm>
+
 namespace fresco {
 
 void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
@@ -15,23 +17,25 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
                              const cv::Mat& mask, UpdatePolicy policy, double quality_slack,
                              PaintedBuffer* painted) {
   PaintUpdateStats stats;
-  const int w = buffer.width;
   const float keep = static_cast<float>(1.0 - quality_slack);
+  const uint8_t* valid = warped.valid.data;
+  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
+  const float* quality = warped.quality.ptr<float>();
+  const uint8_t* skip = mask.empty() ? nullptr : mask.data;
+  cv::Vec4b* dst = painted->bgra.ptr<cv::Vec4b>();
+  float* stored_quality = painted->quality.ptr<float>();
   for (int k = 0; k < buffer.NumTexels(); ++k) {
     const int idx = buffer.texel_index[k];
-    const int i = idx % w, j = idx / w;
-    if (!warped.valid.at<uint8_t>(j, i)) continue;
-    if (!mask.empty() && mask.at<uint8_t>(j, i)) continue;
-    const float q = warped.quality.at<float>(j, i);
-    float& stored_q = painted->quality.at<float>(j, i);
+    if (!valid[idx] || (skip && skip[idx])) continue;
+    const float q = quality[idx];
+    float& stored_q = stored_quality[idx];
     if (policy == UpdatePolicy::kQuality && q < stored_q * keep) {
       ++stats.rejected;
       continue;
     }
-    cv::Vec4b& px = painted->bgra.at<cv::Vec4b>(j, i);
+    cv::Vec4b& px = dst[idx];
     if (px[3] == 0 && buffer.on_surface[k]) ++painted->painted_surface_texels;
-    const cv::Vec3b& src = warped.bgr.at<cv::Vec3b>(j, i);
-    px = cv::Vec4b(src[0], src[1], src[2], 255);
+    px = cv::Vec4b(src[idx][0], src[idx][1], src[idx][2], 255);
     stored_q = policy == UpdatePolicy::kQuality ? std::max(stored_q, q) : q;
     ++stats.written;
   }
