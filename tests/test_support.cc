@@ -22,7 +22,12 @@ std::string SharedDataDir() {
 
 std::string SourceDir() {
   const char* env = std::getenv("FRESCO_SOURCE_DIR");
-  return env ? env : ".";
+  if (env) return env;
+#ifdef FRESCO_TEST_SOURCE_DIR
+  return FRESCO_TEST_SOURCE_DIR;  // as CMake knows it, when run outside CTest
+#else
+  return ".";
+#endif
 }
 
 namespace {
@@ -63,7 +68,11 @@ std::string ReadText(const std::string& path) {
 
 CommandResult RunFresco(const std::vector<std::string>& args) {
   const char* env = std::getenv("FRESCO_BINARY");
+#ifdef FRESCO_TEST_BINARY
+  const std::string binary = env ? env : FRESCO_TEST_BINARY;  // as CMake knows it
+#else
   const std::string binary = env ? env : "build/app/fresco";
+#endif
   const std::string dir = MakeTempDir("cmd");
   const std::string out_path = dir + "/stdout", err_path = dir + "/stderr";
   CommandResult result;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
 
@@ -39,17 +40,40 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
 
 double AutomaticTexelSize(const Scene& scene, const Camera& camera,
                           const std::vector<Rigid3d>& cam_from_world) {
+  const double f = camera.fx > 0 ? 0.5 * (camera.fx + camera.fy) : 500.0;
   Eigen::Vector3d lo, hi;
   scene.Bounds(&lo, &hi);
-  const Eigen::Vector3d centre_world = scene.WorldFromLocal(0.5 * (lo + hi));
-  std::vector<double> dist;
-  for (const Rigid3d& pose : cam_from_world) dist.push_back((pose * centre_world).norm());
-  double d = (hi - lo).norm() * 0.5;
-  if (!dist.empty()) {
-    std::nth_element(dist.begin(), dist.begin() + dist.size() / 2, dist.end());
-    d = dist[dist.size() / 2];
+  if (cam_from_world.empty() || camera.width <= 0 || camera.height <= 0)
+    return std::max(0.5 * (hi - lo).norm() / f, 1e-6);
+  // The depth actually seen: rasterize up to 16 of the poses through the camera scaled down
+  // 8 times, and take the median depth over all surface samples. A pixel covers z / f
+  // metres there: one texel per pixel at the typical distance.
+  const int scale = 8;
+  Camera small = camera;
+  small.width = std::max(1, camera.width / scale);
+  small.height = std::max(1, camera.height / scale);
+  const double sx = static_cast<double>(small.width) / camera.width;
+  const double sy = static_cast<double>(small.height) / camera.height;
+  small.fx *= sx, small.fy *= sy;
+  small.cx = (camera.cx + 0.5) * sx - 0.5, small.cy = (camera.cy + 0.5) * sy - 0.5;
+  std::vector<float> depths;
+  try {
+    const Rasterizer raster(small, RasterOptions());
+    RasterOutput out;
+    const size_t step = std::max<size_t>(1, cam_from_world.size() / 16);
+    for (size_t i = 0; i < cam_from_world.size(); i += step) {
+      raster.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world[i]), &out);
+      for (int y = 0; y < out.depth.rows; ++y)
+        for (int x = 0; x < out.depth.cols; ++x)
+          if (const float z = out.depth.at<float>(y, x); std::isfinite(z)) depths.push_back(z);
+    }
+  } catch (const std::invalid_argument&) {
   }
-  const double f = camera.fx > 0 ? 0.5 * (camera.fx + camera.fy) : 500.0;
+  double d = 0.5 * (hi - lo).norm();
+  if (!depths.empty()) {
+    std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+    d = depths[depths.size() / 2];
+  }
   return std::max(d / f, 1e-6);
 }
 

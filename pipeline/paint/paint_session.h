@@ -80,8 +80,9 @@ class PaintSession {
   int frames_seen_ = 0;
 };
 
-// The automatic texel size: median over the poses of (distance from the camera to the
-// scene's centre) / focal length, i.e. about one texel per pixel at the typical distance.
+// The automatic texel size: the median depth the cameras see (rasterized at a few of the
+// poses) / focal length, i.e. about one texel per pixel at the typical distance. Buffers
+// larger than PipelineOptions::max_buffer_texels get coarser texels (base_buffer.h).
 double AutomaticTexelSize(const Scene& scene, const Camera& camera,
                           const std::vector<Rigid3d>& cam_from_world);
 

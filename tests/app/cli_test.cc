@@ -1,0 +1,204 @@
+// The `fresco` command line as users and outside checks drive it (CONTRACT.md): the
+// dispatcher, --help on every verb, `fresco run` end to end on a small synthetic capture,
+// and bad input: exit 2, one line naming the file, and earlier outputs left as they were.
+#include <algorithm>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::MakeTempDir;
+using testing::ReadText;
+using testing::RunFresco;
+using testing::WriteText;
+
+// The lines of stderr that report an error (progress lines may come before them).
+std::vector<std::string> ErrorLines(const std::string& err) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  while (start < err.size()) {
+    const size_t end = std::min(err.find('\n', start), err.size());
+    const std::string line = err.substr(start, end - start);
+    if (line.rfind("error: ", 0) == 0) lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
+}
+
+TEST(Cli, DispatcherUsageAndUnknownVerb) {
+  const auto none = RunFresco({});
+  EXPECT_EQ(none.exit_code, 2);
+  EXPECT_NE(none.err.find("usage: fresco VERB"), std::string::npos) << none.err;
+  const auto unknown = RunFresco({"paint"});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("unknown verb 'paint'"), std::string::npos) << unknown.err;
+  const auto help = RunFresco({"--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  for (const char* verb : {"run", "render", "synth", "calib", "poses", "bench", "gui"})
+    EXPECT_NE(help.out.find(verb), std::string::npos) << verb;
+}
+
+TEST(Cli, EveryVerbTakesHelp) {
+  for (const char* verb : {"run", "render", "synth", "calib", "poses", "bench", "gui"}) {
+    const auto r = RunFresco({verb, "--help"});
+    EXPECT_EQ(r.exit_code, 0) << verb << ": " << r.err;
+    EXPECT_NE(r.out.find(std::string("fresco ") + verb), std::string::npos) << verb << ": " << r.out;
+  }
+  const auto bad_option = RunFresco({"run", "p.json", "--out", "x", "--bogus"});
+  EXPECT_EQ(bad_option.exit_code, 2);
+  EXPECT_NE(bad_option.err.find("--bogus"), std::string::npos) << bad_option.err;
+}
+
+// A small capture (12 frames, 160x120) made once for the tests below.
+class RunCommandTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    capture_ = new std::string(MakeTempDir("run-cli") + "/capture");
+    const auto r = RunFresco({"synth", "--scene", "builtin:cube-room", "--out", *capture_,
+                              "--frames", "12", "--size", "160x120", "--seed", "2"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  static void TearDownTestSuite() { delete capture_; }
+  static std::string Project() { return *capture_ + "/project.json"; }
+  // A copy of the capture to break.
+  static std::string CopyCapture(const std::string& tag) {
+    const std::string dir = MakeTempDir(tag) + "/capture";
+    fs::copy(*capture_, dir, fs::copy_options::recursive);
+    return dir;
+  }
+  static std::string* capture_;
+};
+std::string* RunCommandTest::capture_ = nullptr;
+
+TEST_F(RunCommandTest, WritesThePaintedModelMetricsAndStageImages) {
+  const std::string out = MakeTempDir("run-out") + "/out";
+  const auto r = RunFresco({"run", Project(), "--out", out, "--set", "pipeline.sampling=nearest",
+                            "--debug-images"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::is_regular_file(out + "/painted.gltf"));
+  ASSERT_TRUE(fs::is_regular_file(out + "/metrics.json"));
+  const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
+  EXPECT_EQ(m["frames"], 12);
+  EXPECT_EQ(m["frames_painted"], 12);
+  EXPECT_GT(m["seconds"].get<double>(), 0.0);
+  EXPECT_GT(m["fps"].get<double>(), 0.0);
+  for (const char* stage : {"depth", "warp", "paint"})
+    EXPECT_TRUE(m["stage_ms"].contains(stage)) << stage;
+  EXPECT_EQ(m["base_buffers"], 6);  // one per face of the room
+  EXPECT_GT(m["texels"].get<long long>(), 10000);
+  EXPECT_GT(m["coverage"].get<double>(), 0.2);
+  EXPECT_LE(m["coverage"].get<double>(), 1.0);
+  // Textures: one PNG per buffer with alpha 0 where never painted and 255 where painted.
+  int textures = 0, transparent = 0, opaque = 0;
+  for (const auto& entry : fs::directory_iterator(out)) {
+    if (entry.path().extension() != ".png") continue;
+    ++textures;
+    const cv::Mat rgba = cv::imread(entry.path().string(), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(rgba.type(), CV_8UC4) << entry.path();
+    for (int y = 0; y < rgba.rows; ++y)
+      for (int x = 0; x < rgba.cols; ++x) {
+        const uchar a = rgba.at<cv::Vec4b>(y, x)[3];
+        transparent += a == 0, opaque += a == 255;
+      }
+  }
+  EXPECT_EQ(textures, 6);
+  EXPECT_GT(transparent, 0);
+  EXPECT_GT(opaque, 0);
+  // Per-stage debug images were asked for.
+  int stage_images = 0;
+  for (const auto& entry : fs::directory_iterator(out + "/stages")) stage_images += entry.is_regular_file();
+  EXPECT_GT(stage_images, 12);
+  // The painted model renders through the capture's camera.
+  const auto render = RunFresco({"render", out + "/painted.gltf", "--camera", *capture_ + "/camera.cameramodel",
+                                 "--poses", *capture_ + "/sparse/images.txt", "--out", out + "/renders"});
+  EXPECT_EQ(render.exit_code, 0) << render.err;
+  EXPECT_TRUE(fs::is_regular_file(out + "/renders/000005.png"));
+}
+
+TEST_F(RunCommandTest, SetOverridesAndUpdateEvery) {
+  const std::string out = MakeTempDir("run-every") + "/out";
+  const auto r = RunFresco({"run", Project(), "--out", out, "--set", "pipeline.update_every=4",
+                            "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;  // --quiet
+  const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
+  EXPECT_EQ(m["frames"], 12);
+  EXPECT_EQ(m["frames_painted"], 3);
+}
+
+// Bad input: exit 2, a one-line message naming the file (and field), and an output folder
+// from an earlier good run left exactly as it was.
+TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
+  const std::string out = MakeTempDir("run-bad") + "/out";
+  ASSERT_EQ(RunFresco({"run", Project(), "--out", out, "--quiet"}).exit_code, 0);
+  const std::string metrics_before = ReadText(out + "/metrics.json");
+  const std::string gltf_before = ReadText(out + "/painted.gltf");
+
+  struct Case {
+    std::string what;
+    std::vector<std::string> args;
+    std::string expect;  // in the message
+  };
+  std::vector<Case> cases;
+  cases.push_back({"missing project", {"run", "/no/such/project.json", "--out", out}, "/no/such/project.json"});
+  {
+    const std::string dir = MakeTempDir("run-json");
+    WriteText(dir + "/project.json", "{\"fresco\": 1, \"scene\": ");
+    cases.push_back({"malformed JSON", {"run", dir + "/project.json", "--out", out}, "project.json"});
+  }
+  cases.push_back({"unknown key by --set",
+                   {"run", Project(), "--out", out, "--set", "pipeline.samplng=nearest"},
+                   "pipeline.samplng"});
+  cases.push_back({"wrong type by --set",
+                   {"run", Project(), "--out", out, "--set", "pipeline.update_every=\"often\""},
+                   "pipeline.update_every"});
+  {
+    const std::string dir = CopyCapture("run-nan");
+    std::string images = ReadText(dir + "/sparse/images.txt");
+    const size_t line = images.find("\n1 ");  // first image line: IMAGE_ID QW ...
+    ASSERT_NE(line, std::string::npos);
+    const size_t qw = line + 3;
+    images.replace(qw, images.find(' ', qw) - qw, "nan");
+    WriteText(dir + "/sparse/images.txt", images);
+    cases.push_back({"NaN in a pose", {"run", dir + "/project.json", "--out", out}, "images.txt"});
+  }
+  {
+    const std::string dir = CopyCapture("run-missing-frame");
+    fs::remove(dir + "/frames/000003.png");
+    cases.push_back({"frame listed in poses but missing", {"run", dir + "/project.json", "--out", out}, "000003"});
+  }
+  {
+    const std::string dir = CopyCapture("run-corrupt-frame");
+    WriteText(dir + "/frames/000005.png", "this is not a PNG");
+    cases.push_back({"corrupt frame", {"run", dir + "/project.json", "--out", out}, "000005.png"});
+  }
+  {
+    const std::string dir = CopyCapture("run-frame-size");
+    cv::imwrite(dir + "/frames/000007.png", cv::Mat(60, 80, CV_8UC3, cv::Scalar(1, 2, 3)));
+    cases.push_back({"frame of the wrong size", {"run", dir + "/project.json", "--out", out}, "000007.png"});
+  }
+  {
+    const std::string dir = CopyCapture("run-missing-scene");
+    fs::remove(dir + "/scene.gltf");
+    cases.push_back({"missing scene", {"run", dir + "/project.json", "--out", out}, "scene.gltf"});
+  }
+  for (const Case& c : cases) {
+    const auto r = RunFresco(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.what << ": " << r.err;
+    const std::vector<std::string> errors = ErrorLines(r.err);
+    ASSERT_EQ(errors.size(), 1u) << c.what << ": " << r.err;
+    EXPECT_NE(errors[0].find(c.expect), std::string::npos) << c.what << ": " << r.err;
+    EXPECT_EQ(ReadText(out + "/metrics.json"), metrics_before) << c.what;
+    EXPECT_EQ(ReadText(out + "/painted.gltf"), gltf_before) << c.what;
+  }
+}
+
+}  // namespace
+}  // namespace fresco
