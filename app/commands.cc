@@ -10,6 +10,7 @@ const std::vector<Command>& AllCommands() {
       {"run", "paint a project's video onto its model (headless)", RunVerbRun},
       {"render", "render a (painted or original) glTF model through a camera", RunVerbRender},
       {"synth", "make a synthetic capture from a glTF scene", RunVerbSynth},
+      {"group", "show, or store in the project, the base-buffer grouping", RunVerbGroup},
       {"calib", "calibrate camera intrinsics from board images (mrcal)", RunVerbCalib},
       {"poses", "bootstrap or verify poses with COLMAP", RunVerbPoses},
       {"bench", "measure the speed/accuracy trade of pipeline settings", RunVerbBench},

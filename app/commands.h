@@ -39,6 +39,7 @@ int InputError(const Status& status);
 
 int RunVerbRun(const CommandArgs& args);
 int RunVerbRender(const CommandArgs& args);
+int RunVerbGroup(const CommandArgs& args);
 int RunVerbSynth(const CommandArgs& args);
 int RunVerbCalib(const CommandArgs& args);
 int RunVerbPoses(const CommandArgs& args);

@@ -11,6 +11,7 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
+#include "app/project_session.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
@@ -73,20 +74,8 @@ int RunVerbRun(const CommandArgs& argv) {
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
   Capture capture;
-  if (Status s = LoadCapture(project, CaptureLoadOptions(), &capture); !s.ok())
-    return InputError(s);
-  if (capture.cameras.empty())
-    return InputError(Status::Error(project.Resolve(project.camera) + ": no camera"));
-
-  PaintSessionInputs inputs;
-  inputs.scene = &capture.scene;
-  inputs.pipeline = project.pipeline;
-  inputs.grouping = project.grouping;
-  inputs.typical_camera = &capture.cameras.begin()->second;
-  for (const PosedImage& p : capture.poses) inputs.expected_poses.push_back(p.cam_from_world);
   std::unique_ptr<PaintSession> session;
-  if (Status s = PaintSession::Create(inputs, &session); !s.ok())
-    return InputError(Status::Error(project.file_path + ": " + s.message()));
+  if (Status s = OpenPaintSession(project, &capture, &session); !s.ok()) return InputError(s);
   if (!quiet) {
     std::fprintf(stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)\n",
                  capture.scene.mesh.NumTriangles(), session->buffers().size(),

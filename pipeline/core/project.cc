@@ -80,7 +80,7 @@ void Fields(PipelineOptions& o, V& v) {
 
 template <class V>
 void Fields(GroupingEdit& e, V& v) {
-  v.Field("op", e.op, {.required = true, .choices = {"merge", "split", "move"}});
+  v.Field("op", e.op, {.required = true, .choices = {"merge", "split", "move", "texel"}});
   v.Field("triangles", e.triangles, {.min = 0});
   v.Field("groups", e.groups, {.min = 0});
   v.Field("target_group", e.target_group, {.min = -1});
@@ -88,8 +88,15 @@ void Fields(GroupingEdit& e, V& v) {
 }
 
 template <class V>
+void Fields(GroupSpec& g, V& v) {
+  v.Field("triangles", g.triangles, {.min = 0});
+  v.Field("texel_size_m", g.texel_size_m, {.min = 0});
+}
+
+template <class V>
 void Fields(GroupingOptions& o, V& v) {
   v.Field("angle_deg", o.angle_deg, {.min = 0, .max = 180});
+  v.List("groups", o.groups);
   v.List("edits", o.edits);
 }
 
@@ -116,9 +123,10 @@ void Fields(Project& p, V& v) {
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 88, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
-static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 32, "see Fields(GroupingOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
+static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 328, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 352, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

@@ -47,7 +47,7 @@ struct PipelineOptions {
 // Automatic base-buffer grouping (paper §3.6): neighbouring triangles whose normals are
 // within `angle_deg` of the group's seed normal share a buffer.
 struct GroupingEdit {
-  std::string op;  // "merge" | "split" | "move" (see grouping.h)
+  std::string op;  // "merge" | "split" | "move" | "texel" (see grouping.h)
   std::vector<int> triangles;
   std::vector<int> groups;
   int target_group = -1;
@@ -55,8 +55,20 @@ struct GroupingEdit {
 
   bool operator==(const GroupingEdit&) const = default;
 };
+// One base-buffer group as stored in the project: its triangles (indices into the scene's
+// triangle list, in glTF order) and an optional texel size of its own.
+struct GroupSpec {
+  std::vector<int> triangles;
+  double texel_size_m = 0.0;  // > 0 overrides the session's texel size for this group
+
+  bool operator==(const GroupSpec&) const = default;
+};
+// The grouping: automatic (region growing with `angle_deg`) unless `groups` is given, in
+// which case exactly those groups are used (triangles in none are never painted); `edits`
+// then apply in order. `fresco group PROJECT.json --save` stores the automatic result.
 struct GroupingOptions {
   double angle_deg = 20.0;
+  std::vector<GroupSpec> groups;
   std::vector<GroupingEdit> edits;
 
   bool operator==(const GroupingOptions&) const = default;

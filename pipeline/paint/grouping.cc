@@ -129,6 +129,31 @@ Status ApplyGroupingEdits(const std::vector<GroupingEdit>& edits, int num_triang
   return Status::Ok();
 }
 
+Status MakeGrouping(const TriangleMesh& mesh, const GroupingOptions& options, Grouping* grouping) {
+  const int num_triangles = mesh.NumTriangles();
+  if (options.groups.empty()) {
+    *grouping = ComputeGrouping(mesh, ComputeAdjacency(mesh), options.angle_deg);
+  } else {
+    grouping->groups.clear();
+    std::vector<int> owner(num_triangles, -1);
+    for (size_t g = 0; g < options.groups.size(); ++g) {
+      const std::string where = "grouping.groups[" + std::to_string(g) + "]";
+      for (int t : options.groups[g].triangles) {
+        if (t < 0 || t >= num_triangles)
+          return Status::Error(where + ": triangle " + std::to_string(t) + " does not exist (" +
+                               std::to_string(num_triangles) + " triangles)");
+        if (owner[t] >= 0)
+          return Status::Error(where + ": triangle " + std::to_string(t) +
+                               " is also in grouping.groups[" + std::to_string(owner[t]) + "]");
+        owner[t] = static_cast<int>(g);
+      }
+      grouping->groups.push_back(options.groups[g]);
+    }
+    RemoveEmptyGroups(grouping, num_triangles);
+  }
+  return ApplyGroupingEdits(options.edits, num_triangles, grouping);
+}
+
 Eigen::Vector3d GroupNormal(const TriangleMesh& mesh, const BaseBufferGroup& group) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int t : group.triangles) sum += mesh.Normal(t) * mesh.Area(t);

@@ -16,10 +16,9 @@
 
 namespace fresco {
 
-struct BaseBufferGroup {
-  std::vector<int> triangles;
-  double texel_size_m = 0.0;  // > 0 overrides the session's texel size for this group
-};
+// A group: its triangles and an optional texel size of its own (> 0 overrides the
+// session's). The same type as stored in the project file.
+using BaseBufferGroup = GroupSpec;
 
 struct Grouping {
   std::vector<BaseBufferGroup> groups;
@@ -31,6 +30,11 @@ struct Grouping {
 
 Grouping ComputeGrouping(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
                          double angle_deg);
+
+// The grouping a project asks for: `options.groups` when given (checked: triangles exist and
+// are in one group at most; errors name "grouping.groups[i]"), else the automatic one; then
+// the edits.
+Status MakeGrouping(const TriangleMesh& mesh, const GroupingOptions& options, Grouping* grouping);
 
 // Applies edits in order. Errors name the edit ("grouping.edits[2]: group 9 does not
 // exist"). Ops: "merge" (groups -> first of them), "split" (triangles leave their group and

@@ -90,10 +90,8 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
                                                                        *inputs.typical_camera,
                                                                        inputs.expected_poses)
                                                   : 0.01);
-  const MeshAdjacency adjacency = ComputeAdjacency(mesh);
-  Grouping grouping = ComputeGrouping(mesh, adjacency, inputs.grouping.angle_deg);
-  FRESCO_RETURN_IF_ERROR(
-      ApplyGroupingEdits(inputs.grouping.edits, mesh.NumTriangles(), &grouping));
+  Grouping grouping;
+  FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, &grouping));
   BaseBufferOptions buffer_options;
   buffer_options.texel_size_m = s->texel_size_m_;
   buffer_options.max_buffer_texels = inputs.pipeline.max_buffer_texels;

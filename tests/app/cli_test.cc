@@ -46,7 +46,7 @@ TEST(Cli, DispatcherUsageAndUnknownVerb) {
 }
 
 TEST(Cli, EveryVerbTakesHelp) {
-  for (const char* verb : {"run", "render", "synth", "calib", "poses", "bench", "gui"}) {
+  for (const char* verb : {"run", "render", "synth", "group", "calib", "poses", "bench", "gui"}) {
     const auto r = RunFresco({verb, "--help"});
     EXPECT_EQ(r.exit_code, 0) << verb << ": " << r.err;
     EXPECT_NE(r.out.find(std::string("fresco ") + verb), std::string::npos) << verb << ": " << r.out;
@@ -131,6 +131,47 @@ TEST_F(RunCommandTest, SetOverridesAndUpdateEvery) {
   const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
   EXPECT_EQ(m["frames"], 12);
   EXPECT_EQ(m["frames_painted"], 3);
+}
+
+// The grouping is data: shown by `fresco group`, stored with --save as explicit groups,
+// edited in the project, and honoured by `fresco run`.
+TEST_F(RunCommandTest, GroupingIsStoredEditedAndHonoured) {
+  const std::string dir = CopyCapture("run-group");
+  const std::string project = dir + "/project.json";
+  const auto shown = RunFresco({"group", project, "--json", dir + "/groups.json"});
+  ASSERT_EQ(shown.exit_code, 0) << shown.err;
+  EXPECT_NE(shown.out.find("6 base buffers for 12 triangles"), std::string::npos) << shown.out;
+  const nlohmann::json table = nlohmann::json::parse(ReadText(dir + "/groups.json"));
+  EXPECT_EQ(table["groups"].size(), 6u);
+  // At 100 degrees neighbouring faces (90 degrees apart) join a group, but no single
+  // projection serves a corner: the groups are split again, and that is reported.
+  const auto coarse = RunFresco({"group", project, "--set", "grouping.angle_deg=100"});
+  EXPECT_EQ(coarse.exit_code, 0) << coarse.err;
+  EXPECT_NE(coarse.out.find("6 base buffers"), std::string::npos) << coarse.out;
+  EXPECT_EQ(coarse.out.find("; 0 groups split"), std::string::npos) << coarse.out;
+
+  ASSERT_EQ(RunFresco({"group", project, "--save"}).exit_code, 0);
+  const nlohmann::json saved = nlohmann::json::parse(ReadText(project));
+  ASSERT_EQ(saved["grouping"]["groups"].size(), 6u);
+  // Stored groups are used as they are: the angle no longer matters.
+  const std::string out = dir + "/out";
+  ASSERT_EQ(RunFresco({"run", project, "--out", out, "--quiet", "--set", "grouping.angle_deg=100"})
+                .exit_code, 0);
+  EXPECT_EQ(nlohmann::json::parse(ReadText(out + "/metrics.json"))["base_buffers"], 6);
+  // Edits on top of the stored groups: group 2 gets its own texel size.
+  const auto edited = RunFresco(
+      {"run", project, "--out", out, "--quiet", "--set",
+       R"(grouping.edits=[{"op": "texel", "groups": [2], "texel_size_m": 0.05}])"});
+  ASSERT_EQ(edited.exit_code, 0) << edited.err;
+  const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
+  int coarse_buffers = 0;
+  for (const auto& b : m["buffers"]) coarse_buffers += std::abs(b["texel_size_m"].get<double>() - 0.05) < 1e-9;
+  EXPECT_EQ(coarse_buffers, 1);
+  // A stored group naming a triangle the scene does not have: exit 2, naming the field.
+  const auto bad = RunFresco({"run", project, "--out", out, "--quiet", "--set",
+                              R"(grouping.groups=[{"triangles": [0, 99]}])"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("grouping.groups[0]: triangle 99"), std::string::npos) << bad.err;
 }
 
 // Bad input: exit 2, a one-line message naming the file (and field), and an output folder

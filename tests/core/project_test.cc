@@ -75,7 +75,12 @@ Project NonDefaultProject() {
   move.triangles = {10, 11};
   move.target_group = 2;
   move.texel_size_m = 0.02;
-  p.grouping.edits = {merge, move};
+  GroupingEdit texel;
+  texel.op = "texel";
+  texel.groups = {1};
+  texel.texel_size_m = 0.005;
+  p.grouping.edits = {merge, move, texel};
+  p.grouping.groups = {GroupSpec{{0, 1, 2}, 0.0}, GroupSpec{{3, 5}, 0.01}};
   p.truth.poses = "truth/poses.tum";
   return p;
 }

@@ -1,0 +1,17 @@
+// Opens a project for painting: loads its capture (scene, cameras, poses; the video is read
+// lazily) and builds the PaintSession (grouping, base buffers). Shared by `fresco run` and
+// `fresco group`. Errors are bad input (exit 2), naming the file and field.
+#pragma once
+
+#include <memory>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/core/project.h"
+#include "pipeline/paint/paint_session.h"
+
+namespace fresco {
+
+Status OpenPaintSession(const Project& project, Capture* capture,
+                        std::unique_ptr<PaintSession>* session);
+
+}  // namespace fresco
