@@ -55,9 +55,9 @@ int RunVerbGroup(const CommandArgs& argv) {
     const BaseBuffer& b = session->buffers()[g];
     double area = 0;
     for (int t : b.triangles) area += mesh.Area(t);
-    std::printf("%5zu %9zu %6.3f, %6.3f, %6.3f %9.3f %9.5f %5dx%-5d %10d\n", g,
-                b.triangles.size(), b.normal.x(), b.normal.y(), b.normal.z(), area,
-                b.texel_size_m, b.width, b.height, b.num_surface_texels);
+    std::printf("%5zu %9zu %6.3f, %6.3f, %6.3f %9.3f %9.5f %5dx%-5d %10d\n", g, b.triangles.size(),
+                b.normal.x(), b.normal.y(), b.normal.z(), area, b.texel_size_m, b.width, b.height,
+                b.num_surface_texels);
     texels += b.num_surface_texels;
     table.push_back({{"group", g},
                      {"triangles", b.triangles.size()},
@@ -70,10 +70,10 @@ int RunVerbGroup(const CommandArgs& argv) {
   }
   int ungrouped = 0;
   for (int owner : session->grouping().group_of_triangle) ungrouped += owner < 0;
-  std::printf("%zu base buffers for %d triangles (%d in no group), %lld texels; %d groups split "
-              "because one projection could not serve them\n",
-              session->buffers().size(), mesh.NumTriangles(), ungrouped, texels,
-              session->folds_split());
+  std::printf(
+      "%zu base buffers for %d triangles (%d in no group), %lld texels; %d groups split "
+      "because one projection could not serve them\n",
+      session->buffers().size(), mesh.NumTriangles(), ungrouped, texels, session->folds_split());
   if (args.Has("--json")) {
     const nlohmann::json out = {{"base_buffers", session->buffers().size()},
                                 {"triangles", mesh.NumTriangles()},

@@ -17,6 +17,7 @@
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
+#include "pipeline/paint/buffer_preview.h"
 #include "pipeline/paint/paint_session.h"
 
 namespace fresco {
@@ -27,8 +28,9 @@ ArgSpec RunSpec() {
   spec.usage = "fresco run PROJECT.json --out DIR [--set KEY=VALUE ...] [--debug-images] [--quiet]";
   spec.help =
       "Replays the project headless: streams its video, paints every frame into the base\n"
-      "buffers, and writes DIR/painted.gltf (+ .bin, PNG textures; alpha 0 = never painted)\n"
-      "and DIR/metrics.json. Outputs are written atomically at the end.\n\n"
+      "buffers, and writes DIR/painted.gltf (+ .bin, PNG textures; alpha 0 = never painted),\n"
+      "DIR/metrics.json and DIR/buffers.png (all painted buffers in one picture). Outputs\n"
+      "are written atomically at the end.\n\n"
       "  --set KEY=VALUE   override a project setting by JSON path, e.g.\n"
       "                    --set pipeline.sampling=nearest --set pipeline.update_every=20\n"
       "  --debug-images    write per-stage debug images under DIR/stages/ (costs time)\n"
@@ -174,6 +176,13 @@ int RunVerbRun(const CommandArgs& argv) {
   // Outputs: painted.gltf (+ .bin + textures), then metrics.json, each atomically.
   const Scene painted = session->PaintedScene();
   if (Status s = SaveGltfScene(painted, out_dir + "/painted.gltf"); !s.ok()) {
+    std::cerr << "error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  // A picture of the painted buffers, for people (alpha 0 as a checkerboard).
+  if (Status s = WriteImageAtomic(out_dir + "/buffers.png",
+                                  BufferContactSheet(session->painted()));
+      !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }

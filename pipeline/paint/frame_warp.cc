@@ -14,8 +14,18 @@ namespace {
 struct Projector {
   float fx, fy, cx, cy, k1, k2, k3, k4, k5, k6, p1, p2, fold_r2;
   explicit Projector(const Camera& c)
-      : fx(c.fx), fy(c.fy), cx(c.cx), cy(c.cy), k1(c.k1), k2(c.k2), k3(c.k3), k4(c.k4),
-        k5(c.k5), k6(c.k6), p1(c.p1), p2(c.p2),
+      : fx(c.fx),
+        fy(c.fy),
+        cx(c.cx),
+        cy(c.cy),
+        k1(c.k1),
+        k2(c.k2),
+        k3(c.k3),
+        k4(c.k4),
+        k5(c.k5),
+        k6(c.k6),
+        p1(c.p1),
+        p2(c.p2),
         fold_r2(std::isfinite(c.fold_r2) ? static_cast<float>(c.fold_r2)
                                          : std::numeric_limits<float>::infinity()) {}
 
@@ -189,9 +199,12 @@ using ChunkKernel = void (*)(const KernelContext&, const BaseBuffer::Chunk&, Cou
 template <bool kDistorted, bool kDepth>
 ChunkKernel SelectForMode(SamplingMode mode) {
   switch (mode) {
-    case SamplingMode::kNearest: return &WarpChunk<kDistorted, SamplingMode::kNearest, kDepth>;
-    case SamplingMode::kArea: return &WarpChunk<kDistorted, SamplingMode::kArea, kDepth>;
-    default: return &WarpChunk<kDistorted, SamplingMode::kBilinear, kDepth>;
+    case SamplingMode::kNearest:
+      return &WarpChunk<kDistorted, SamplingMode::kNearest, kDepth>;
+    case SamplingMode::kArea:
+      return &WarpChunk<kDistorted, SamplingMode::kArea, kDepth>;
+    default:
+      return &WarpChunk<kDistorted, SamplingMode::kBilinear, kDepth>;
   }
 }
 
@@ -229,8 +242,9 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
   return b;
 }
 
-void WarpFrameToBuffer(const BaseBuffer& buffer, const std::vector<Eigen::Vector3f>& triangle_normals,
-                       const FrameView& view, const WarpOptions& options, WarpedBuffer* warped) {
+void WarpFrameToBuffer(const BaseBuffer& buffer,
+                       const std::vector<Eigen::Vector3f>& triangle_normals, const FrameView& view,
+                       const WarpOptions& options, WarpedBuffer* warped) {
   const int w = buffer.width, h = buffer.height;
   if (warped->bgr.rows != h || warped->bgr.cols != w) {
     warped->bgr.create(h, w, CV_8UC3);
@@ -240,30 +254,29 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const std::vector<Eigen::Vector
   warped->valid.setTo(0);
   const Camera& camera = *view.camera;
   const bool use_depth = options.occlusion.enabled && view.depth && !view.depth->empty();
-  KernelContext k{.buffer = &buffer,
-                  .normals = triangle_normals.data(),
-                  .R = view.cam_from_local.RotationMatrix().cast<float>(),
-                  .t = view.cam_from_local.translation.cast<float>(),
-                  .centre = view.centre_local.cast<float>(),
-                  .projector = Projector(camera),
-                  .bounds = view.bounds.valid ? view.bounds : ComputeNormalizedBounds(camera),
-                  .near_m = static_cast<float>(options.near_m),
-                  .cos_max = static_cast<float>(
-                      std::cos(options.occlusion.max_view_angle_deg * M_PI / 180.0)),
-                  .max_u = static_cast<float>(camera.width - 1),
-                  .max_v = static_cast<float>(camera.height - 1),
-                  .focal = static_cast<float>(0.5 * (camera.fx + camera.fy)),
-                  .tol_rel = static_cast<float>(options.occlusion.tolerance_rel),
-                  .tol_abs = static_cast<float>(options.occlusion.tolerance_m),
-                  .slope_px = static_cast<float>(1.5 / (0.5 * (camera.fx + camera.fy))),
-                  .focal_texel =
-                      static_cast<float>(0.5 * (camera.fx + camera.fy) * buffer.texel_size_m),
-                  .frame = view.frame_bgr,
-                  .depth = use_depth ? view.depth : view.frame_bgr,
-                  .pyramid = &view.pyramid,
-                  .out_bgr = warped->bgr.data,
-                  .out_valid = warped->valid.data,
-                  .out_quality = warped->quality.ptr<float>()};
+  KernelContext k{
+      .buffer = &buffer,
+      .normals = triangle_normals.data(),
+      .R = view.cam_from_local.RotationMatrix().cast<float>(),
+      .t = view.cam_from_local.translation.cast<float>(),
+      .centre = view.centre_local.cast<float>(),
+      .projector = Projector(camera),
+      .bounds = view.bounds.valid ? view.bounds : ComputeNormalizedBounds(camera),
+      .near_m = static_cast<float>(options.near_m),
+      .cos_max = static_cast<float>(std::cos(options.occlusion.max_view_angle_deg * M_PI / 180.0)),
+      .max_u = static_cast<float>(camera.width - 1),
+      .max_v = static_cast<float>(camera.height - 1),
+      .focal = static_cast<float>(0.5 * (camera.fx + camera.fy)),
+      .tol_rel = static_cast<float>(options.occlusion.tolerance_rel),
+      .tol_abs = static_cast<float>(options.occlusion.tolerance_m),
+      .slope_px = static_cast<float>(1.5 / (0.5 * (camera.fx + camera.fy))),
+      .focal_texel = static_cast<float>(0.5 * (camera.fx + camera.fy) * buffer.texel_size_m),
+      .frame = view.frame_bgr,
+      .depth = use_depth ? view.depth : view.frame_bgr,
+      .pyramid = &view.pyramid,
+      .out_bgr = warped->bgr.data,
+      .out_valid = warped->valid.data,
+      .out_quality = warped->quality.ptr<float>()};
   const ChunkKernel kernel = SelectKernel(camera.HasDistortion(), use_depth, options.sampling);
   std::atomic<int> in_view{0}, visible{0}, occluded{0}, grazing{0}, culled{0};
   std::atomic<long long> tested{0};

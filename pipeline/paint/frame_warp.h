@@ -34,10 +34,10 @@ struct FrameView {
   const Camera* camera = nullptr;
   Rigid3d cam_from_local;
   Eigen::Vector3d centre_local = Eigen::Vector3d::Zero();  // camera centre, local coords
-  const cv::Mat* frame_bgr = nullptr;  // CV_8UC3, camera size
-  const cv::Mat* depth = nullptr;      // CV_32F camera z per pixel, or null (no occlusion)
-  std::vector<cv::Mat> pyramid;        // level 0 = frame; filled for SamplingMode::kArea
-  NormalizedBounds bounds;             // for chunk culling (computed when not valid)
+  const cv::Mat* frame_bgr = nullptr;                      // CV_8UC3, camera size
+  const cv::Mat* depth = nullptr;  // CV_32F camera z per pixel, or null (no occlusion)
+  std::vector<cv::Mat> pyramid;    // level 0 = frame; filled for SamplingMode::kArea
+  NormalizedBounds bounds;         // for chunk culling (computed when not valid)
 };
 
 struct WarpOptions {
@@ -51,16 +51,17 @@ struct WarpedBuffer {
   cv::Mat bgr;      // CV_8UC3, buffer size
   cv::Mat valid;    // CV_8U, 255 where the texel was seen and sampled
   cv::Mat quality;  // CV_32F, pixels per texel (min(f s cos / z, 1)) where valid
-  int in_view = 0;        // texels that project inside the image, in front, not grazing
-  int visible = 0;        // ... and pass the occlusion test
+  int in_view = 0;  // texels that project inside the image, in front, not grazing
+  int visible = 0;  // ... and pass the occlusion test
   int occluded = 0;
-  int grazing = 0;        // back-facing or beyond max_view_angle
-  int chunks_culled = 0;  // chunks of texels skipped whole (outside the view frustum)
+  int grazing = 0;              // back-facing or beyond max_view_angle
+  int chunks_culled = 0;        // chunks of texels skipped whole (outside the view frustum)
   long long texels_tested = 0;  // texels in chunks that were not culled
 };
 
 // `triangle_normals`: (T) unit normals of the mesh's triangles, local frame.
-void WarpFrameToBuffer(const BaseBuffer& buffer, const std::vector<Eigen::Vector3f>& triangle_normals,
-                       const FrameView& view, const WarpOptions& options, WarpedBuffer* warped);
+void WarpFrameToBuffer(const BaseBuffer& buffer,
+                       const std::vector<Eigen::Vector3f>& triangle_normals, const FrameView& view,
+                       const WarpOptions& options, WarpedBuffer* warped);
 
 }  // namespace fresco

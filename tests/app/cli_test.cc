@@ -49,7 +49,8 @@ TEST(Cli, EveryVerbTakesHelp) {
   for (const char* verb : {"run", "render", "synth", "group", "calib", "poses", "bench", "gui"}) {
     const auto r = RunFresco({verb, "--help"});
     EXPECT_EQ(r.exit_code, 0) << verb << ": " << r.err;
-    EXPECT_NE(r.out.find(std::string("fresco ") + verb), std::string::npos) << verb << ": " << r.out;
+    EXPECT_NE(r.out.find(std::string("fresco ") + verb), std::string::npos)
+        << verb << ": " << r.out;
   }
   const auto bad_option = RunFresco({"run", "p.json", "--out", "x", "--bogus"});
   EXPECT_EQ(bad_option.exit_code, 2);
@@ -79,8 +80,8 @@ std::string* RunCommandTest::capture_ = nullptr;
 
 TEST_F(RunCommandTest, WritesThePaintedModelMetricsAndStageImages) {
   const std::string out = MakeTempDir("run-out") + "/out";
-  const auto r = RunFresco({"run", Project(), "--out", out, "--set", "pipeline.sampling=nearest",
-                            "--debug-images"});
+  const auto r = RunFresco(
+      {"run", Project(), "--out", out, "--set", "pipeline.sampling=nearest", "--debug-images"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   ASSERT_TRUE(fs::is_regular_file(out + "/painted.gltf"));
   ASSERT_TRUE(fs::is_regular_file(out + "/metrics.json"));
@@ -98,7 +99,9 @@ TEST_F(RunCommandTest, WritesThePaintedModelMetricsAndStageImages) {
   // Textures: one PNG per buffer with alpha 0 where never painted and 255 where painted.
   int textures = 0, transparent = 0, opaque = 0;
   for (const auto& entry : fs::directory_iterator(out)) {
-    if (entry.path().extension() != ".png") continue;
+    if (entry.path().extension() != ".png" ||
+        entry.path().filename().string().rfind("painted", 0) != 0)
+      continue;
     ++textures;
     const cv::Mat rgba = cv::imread(entry.path().string(), cv::IMREAD_UNCHANGED);
     ASSERT_EQ(rgba.type(), CV_8UC4) << entry.path();
@@ -109,23 +112,28 @@ TEST_F(RunCommandTest, WritesThePaintedModelMetricsAndStageImages) {
       }
   }
   EXPECT_EQ(textures, 6);
+  // And all of them in one picture for people.
+  const cv::Mat sheet = cv::imread(out + "/buffers.png");
+  EXPECT_GT(sheet.cols, 6 * 40);
   EXPECT_GT(transparent, 0);
   EXPECT_GT(opaque, 0);
   // Per-stage debug images were asked for.
   int stage_images = 0;
-  for (const auto& entry : fs::directory_iterator(out + "/stages")) stage_images += entry.is_regular_file();
+  for (const auto& entry : fs::directory_iterator(out + "/stages"))
+    stage_images += entry.is_regular_file();
   EXPECT_GT(stage_images, 12);
   // The painted model renders through the capture's camera.
-  const auto render = RunFresco({"render", out + "/painted.gltf", "--camera", *capture_ + "/camera.cameramodel",
-                                 "--poses", *capture_ + "/sparse/images.txt", "--out", out + "/renders"});
+  const auto render =
+      RunFresco({"render", out + "/painted.gltf", "--camera", *capture_ + "/camera.cameramodel",
+                 "--poses", *capture_ + "/sparse/images.txt", "--out", out + "/renders"});
   EXPECT_EQ(render.exit_code, 0) << render.err;
   EXPECT_TRUE(fs::is_regular_file(out + "/renders/000005.png"));
 }
 
 TEST_F(RunCommandTest, SetOverridesAndUpdateEvery) {
   const std::string out = MakeTempDir("run-every") + "/out";
-  const auto r = RunFresco({"run", Project(), "--out", out, "--set", "pipeline.update_every=4",
-                            "--quiet"});
+  const auto r =
+      RunFresco({"run", Project(), "--out", out, "--set", "pipeline.update_every=4", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;  // --quiet
   const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
@@ -156,16 +164,18 @@ TEST_F(RunCommandTest, GroupingIsStoredEditedAndHonoured) {
   // Stored groups are used as they are: the angle no longer matters.
   const std::string out = dir + "/out";
   ASSERT_EQ(RunFresco({"run", project, "--out", out, "--quiet", "--set", "grouping.angle_deg=100"})
-                .exit_code, 0);
+                .exit_code,
+            0);
   EXPECT_EQ(nlohmann::json::parse(ReadText(out + "/metrics.json"))["base_buffers"], 6);
   // Edits on top of the stored groups: group 2 gets its own texel size.
-  const auto edited = RunFresco(
-      {"run", project, "--out", out, "--quiet", "--set",
-       R"(grouping.edits=[{"op": "texel", "groups": [2], "texel_size_m": 0.05}])"});
+  const auto edited =
+      RunFresco({"run", project, "--out", out, "--quiet", "--set",
+                 R"(grouping.edits=[{"op": "texel", "groups": [2], "texel_size_m": 0.05}])"});
   ASSERT_EQ(edited.exit_code, 0) << edited.err;
   const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
   int coarse_buffers = 0;
-  for (const auto& b : m["buffers"]) coarse_buffers += std::abs(b["texel_size_m"].get<double>() - 0.05) < 1e-9;
+  for (const auto& b : m["buffers"])
+    coarse_buffers += std::abs(b["texel_size_m"].get<double>() - 0.05) < 1e-9;
   EXPECT_EQ(coarse_buffers, 1);
   // A stored group naming a triangle the scene does not have: exit 2, naming the field.
   const auto bad = RunFresco({"run", project, "--out", out, "--quiet", "--set",
@@ -188,11 +198,13 @@ TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
     std::string expect;  // in the message
   };
   std::vector<Case> cases;
-  cases.push_back({"missing project", {"run", "/no/such/project.json", "--out", out}, "/no/such/project.json"});
+  cases.push_back(
+      {"missing project", {"run", "/no/such/project.json", "--out", out}, "/no/such/project.json"});
   {
     const std::string dir = MakeTempDir("run-json");
     WriteText(dir + "/project.json", "{\"fresco\": 1, \"scene\": ");
-    cases.push_back({"malformed JSON", {"run", dir + "/project.json", "--out", out}, "project.json"});
+    cases.push_back(
+        {"malformed JSON", {"run", dir + "/project.json", "--out", out}, "project.json"});
   }
   cases.push_back({"unknown key by --set",
                    {"run", Project(), "--out", out, "--set", "pipeline.samplng=nearest"},
@@ -213,7 +225,9 @@ TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
   {
     const std::string dir = CopyCapture("run-missing-frame");
     fs::remove(dir + "/frames/000003.png");
-    cases.push_back({"frame listed in poses but missing", {"run", dir + "/project.json", "--out", out}, "000003"});
+    cases.push_back({"frame listed in poses but missing",
+                     {"run", dir + "/project.json", "--out", out},
+                     "000003"});
   }
   {
     const std::string dir = CopyCapture("run-corrupt-frame");
@@ -223,7 +237,8 @@ TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
   {
     const std::string dir = CopyCapture("run-frame-size");
     cv::imwrite(dir + "/frames/000007.png", cv::Mat(60, 80, CV_8UC3, cv::Scalar(1, 2, 3)));
-    cases.push_back({"frame of the wrong size", {"run", dir + "/project.json", "--out", out}, "000007.png"});
+    cases.push_back(
+        {"frame of the wrong size", {"run", dir + "/project.json", "--out", out}, "000007.png"});
   }
   {
     const std::string dir = CopyCapture("run-missing-scene");

@@ -59,17 +59,14 @@ TEST(DefaultProject, PerfectPosesRepaintAtLeast35DbAtFrameAndNovelPoses) {
   std::unique_ptr<PaintSession> session;
   ASSERT_TRUE(PaintSession::Create(inputs, &session).ok());
   FrameReport report;
-  ASSERT_TRUE(RenderSynthFrames(job.scene, job.options, plan,
-                                [&](int index, const cv::Mat& bgr) {
-                                  Frame frame;
-                                  frame.index = index;
-                                  frame.bgr = bgr;
-                                  session->PaintFrame(frame, plan.camera,
-                                                      plan.true_poses[index].cam_from_world,
-                                                      &report);
-                                  return Status::Ok();
-                                })
-                  .ok());
+  ASSERT_TRUE(RenderSynthFrames(job.scene, job.options, plan, [&](int index, const cv::Mat& bgr) {
+                Frame frame;
+                frame.index = index;
+                frame.bgr = bgr;
+                session->PaintFrame(frame, plan.camera, plan.true_poses[index].cam_from_world,
+                                    &report);
+                return Status::Ok();
+              }).ok());
   const Scene painted = session->PaintedScene();
 
   RenderOptions render_options;
@@ -89,9 +86,10 @@ TEST(DefaultProject, PerfectPosesRepaintAtLeast35DbAtFrameAndNovelPoses) {
     beside.translation -= Eigen::Vector3d(0.1, 0.05, 0.0);  // camera moves +x, +y in its frame
     const Rephoto at_between = Rephotograph(renderer, job.scene, painted, between);
     const Rephoto at_beside = Rephotograph(renderer, job.scene, painted, beside);
-    std::printf("frame %3d: %.2f dB (%.1f %% complete); between %.2f dB; beside %.2f dB (%.1f %%)\n",
-                i, at_frame.psnr_db, 100 * at_frame.completeness, at_between.psnr_db,
-                at_beside.psnr_db, 100 * at_beside.completeness);
+    std::printf(
+        "frame %3d: %.2f dB (%.1f %% complete); between %.2f dB; beside %.2f dB (%.1f %%)\n", i,
+        at_frame.psnr_db, 100 * at_frame.completeness, at_between.psnr_db, at_beside.psnr_db,
+        100 * at_beside.completeness);
     EXPECT_GE(at_frame.completeness, 0.95) << "frame " << i;
     EXPECT_GE(at_between.completeness, 0.95) << "between frame " << i << " and the next";
     worst_frame = std::min(worst_frame, at_frame.psnr_db);
@@ -99,9 +97,10 @@ TEST(DefaultProject, PerfectPosesRepaintAtLeast35DbAtFrameAndNovelPoses) {
     sum += at_frame.psnr_db + at_between.psnr_db + at_beside.psnr_db;
     count += 3;
   }
-  std::printf("default project: worst %.2f dB at frame poses, %.2f dB at novel poses, mean %.2f dB; "
-              "coverage %.1f %%\n",
-              worst_frame, worst_novel, sum / count, 100 * session->Coverage());
+  std::printf(
+      "default project: worst %.2f dB at frame poses, %.2f dB at novel poses, mean %.2f dB; "
+      "coverage %.1f %%\n",
+      worst_frame, worst_novel, sum / count, 100 * session->Coverage());
   EXPECT_GE(worst_frame, 35.0);
   EXPECT_GE(worst_novel, 35.0);
 }
