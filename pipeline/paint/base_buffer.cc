@@ -87,8 +87,8 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   buffer.texel_size_m = s;
   buffer.width = w;
   buffer.height = h;
-  buffer.origin = anchor + (pc.a_min - gutter * s) * buffer.axis_u +
-                  (pc.b_min - gutter * s) * buffer.axis_v;
+  buffer.origin =
+      anchor + (pc.a_min - gutter * s) * buffer.axis_u + (pc.b_min - gutter * s) * buffer.axis_v;
 
   const Eigen::Vector3d& n = buffer.normal;
   std::vector<int32_t> owner(static_cast<size_t>(w) * h, -1);
@@ -105,13 +105,18 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     }
     Eigen::Vector2d q[3];
     for (int k = 0; k < 3; ++k) q[k] = buffer.TexelCoords(mesh.Corner(t, k));
-    const double area2 = (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
+    const double area2 =
+        (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
     if (std::abs(area2) < 1e-18) continue;
     const double sign = area2 > 0 ? 1.0 : -1.0;
-    const int i0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
-    const int i1 = std::min(w - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
-    const int j0 = std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
-    const int j1 = std::min(h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+    const int i0 =
+        std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+    const int i1 = std::min(
+        w - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+    const int j0 =
+        std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+    const int j1 = std::min(
+        h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
     const Eigen::Vector3d A = mesh.Corner(t, 0);
     const double denom = n.dot(nt);
     for (int j = j0; j <= j1; ++j) {
@@ -182,7 +187,13 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
           const size_t idx = static_cast<size_t>(j) * w + i;
           if (owner[idx] < 0) continue;
           buffer.texel_index.push_back(static_cast<int32_t>(idx));
-          buffer.point.push_back(point[idx]);
+          const Eigen::Vector3d n = mesh.Normal(owner[idx]);
+          buffer.point_x.push_back(point[idx].x());
+          buffer.point_y.push_back(point[idx].y());
+          buffer.point_z.push_back(point[idx].z());
+          buffer.normal_x.push_back(static_cast<float>(n.x()));
+          buffer.normal_y.push_back(static_cast<float>(n.y()));
+          buffer.normal_z.push_back(static_cast<float>(n.z()));
           buffer.triangle.push_back(owner[idx]);
           buffer.on_surface.push_back(surface[idx]);
           buffer.num_surface_texels += surface[idx];

@@ -33,10 +33,13 @@ struct BaseBuffer {
   // Texels that map onto the model (structure of arrays, K entries), in tile order: tiles
   // of kTileTexels x kTileTexels texels, row-major inside a tile, so that a run of texels is
   // a compact patch of the surface (cache-friendly in the frame, and cullable as a whole).
-  std::vector<int32_t> texel_index;    // j * width + i
-  std::vector<Eigen::Vector3f> point;  // model point, local coordinates (float is enough)
-  std::vector<int32_t> triangle;       // its triangle
-  std::vector<uint8_t> on_surface;     // 1 inside a triangle, 0 gutter
+  std::vector<int32_t> texel_index;  // j * width + i
+  // Model point (local coordinates: float is enough) and the unit normal of its triangle,
+  // as separate arrays so that the per-frame kernel runs several texels per instruction.
+  std::vector<float> point_x, point_y, point_z;
+  std::vector<float> normal_x, normal_y, normal_z;
+  std::vector<int32_t> triangle;    // its triangle
+  std::vector<uint8_t> on_surface;  // 1 inside a triangle, 0 gutter
   // (C) consecutive runs of texels, one per non-empty tile, with their bounding boxes
   // (local coordinates): a frame culls a whole chunk that lies outside its view.
   struct Chunk {
@@ -49,19 +52,21 @@ struct BaseBuffer {
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();
 
   int NumTexels() const { return static_cast<int>(texel_index.size()); }
+  Eigen::Vector3f Point(int k) const { return {point_x[k], point_y[k], point_z[k]}; }
+  Eigen::Vector3f Normal(int k) const { return {normal_x[k], normal_y[k], normal_z[k]}; }
   // Texel coordinates (continuous, texel centres at i + 0.5) of a local point.
   Eigen::Vector2d TexelCoords(const Eigen::Vector3d& local_point) const;
 };
 
 struct BaseBufferOptions {
-  double texel_size_m = 0.01;     // default texel size (groups may override)
+  double texel_size_m = 0.01;       // default texel size (groups may override)
   int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels
   int gutter_texels = 2;
 };
 
 struct BaseBufferSet {
   std::vector<BaseBuffer> buffers;
-  Grouping grouping;  // after fold-over splits: buffers[g] serves grouping.groups[g]
+  Grouping grouping;    // after fold-over splits: buffers[g] serves grouping.groups[g]
   int folds_split = 0;  // groups split because their projection folded
 };
 

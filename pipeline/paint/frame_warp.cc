@@ -76,7 +76,6 @@ struct Counts {
 // Everything the kernel needs, resolved once per buffer and frame.
 struct KernelContext {
   const BaseBuffer* buffer;
-  const Eigen::Vector3f* normals;
   Eigen::Matrix3f R;
   Eigen::Vector3f t, centre;
   Projector projector;
@@ -111,57 +110,166 @@ bool ChunkCulled(const KernelContext& k, const BaseBuffer::Chunk& chunk) {
   return k.bounds.valid && (left == 8 || right == 8 || top == 8 || bottom == 8);
 }
 
-// The kernel works on local copies of everything it reads: its outputs are written through
-// byte pointers, which may alias anything, so fields read through references would be
-// reloaded for every texel.
+// Pass 1, for a chunk of texels at once (SIMD: plain arithmetic over arrays, compiled for
+// AVX2 and for the baseline, chosen at run time): transform, facing test, projection, image
+// bounds, and the occlusion tolerance and quality of each texel. `code`: 0 skip (behind the
+// camera, outside the image, beyond the lens's fold), 1 back-facing or grazing, 2 in view.
+struct ChunkProjection {
+  static constexpr int kMax = BaseBuffer::kTileTexels * BaseBuffer::kTileTexels;
+  float u[kMax], v[kMax], z[kMax], tol[kMax], quality[kMax];
+  // Bilinear footprint: top-left pixel (x0, y0), with x0 + 1 and y0 + 1 inside the image,
+  // and the fractions towards the next pixel.
+  int32_t x0[kMax], y0[kMax];
+  float ax[kMax], ay[kMax];
+  int32_t code[kMax];
+};
+
+template <bool kDistorted>
+__attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext& k,
+                                                            const BaseBuffer& buffer, int begin,
+                                                            int n, ChunkProjection* out) {
+  const float* __restrict X = buffer.point_x.data() + begin;
+  const float* __restrict Y = buffer.point_y.data() + begin;
+  const float* __restrict Z = buffer.point_z.data() + begin;
+  const float* __restrict NX = buffer.normal_x.data() + begin;
+  const float* __restrict NY = buffer.normal_y.data() + begin;
+  const float* __restrict NZ = buffer.normal_z.data() + begin;
+  float* __restrict u = out->u;
+  float* __restrict v = out->v;
+  float* __restrict zo = out->z;
+  float* __restrict tol = out->tol;
+  float* __restrict quality = out->quality;
+  int32_t* __restrict code = out->code;
+  int32_t* __restrict x0 = out->x0;
+  int32_t* __restrict y0 = out->y0;
+  float* __restrict ax = out->ax;
+  float* __restrict ay = out->ay;
+
+  const float r00 = k.R(0, 0), r01 = k.R(0, 1), r02 = k.R(0, 2);
+  const float r10 = k.R(1, 0), r11 = k.R(1, 1), r12 = k.R(1, 2);
+  const float r20 = k.R(2, 0), r21 = k.R(2, 1), r22 = k.R(2, 2);
+  const float tx = k.t.x(), ty = k.t.y(), tz = k.t.z();
+  const float ox = k.centre.x(), oy = k.centre.y(), oz = k.centre.z();
+  const float cos2_max = k.cos_max > 0.0f ? k.cos_max * k.cos_max : 0.0f;
+  const Projector& pr = k.projector;
+  const float fx = pr.fx, fy = pr.fy, cx = pr.cx, cy = pr.cy;
+  const float k1 = pr.k1, k2 = pr.k2, k3 = pr.k3, k4 = pr.k4, k5 = pr.k5, k6 = pr.k6;
+  const float p1 = pr.p1, p2 = pr.p2, fold_r2 = pr.fold_r2;
+  const float near_m = k.near_m, max_u = k.max_u, max_v = k.max_v;
+  // The last position whose bilinear neighbours are all inside (a 1/1024 px clamp at the
+  // right and bottom edges).
+  const float max_u_in = std::max(0.0f, max_u - 1.0f / 1024);
+  const float max_v_in = std::max(0.0f, max_v - 1.0f / 1024);
+  const float tol_rel = k.tol_rel, tol_abs = k.tol_abs, slope_px = k.slope_px;
+  const float focal_texel = k.focal_texel;
+  for (int i = 0; i < n; ++i) {
+    const float px = r00 * X[i] + r01 * Y[i] + r02 * Z[i] + tx;
+    const float py = r10 * X[i] + r11 * Y[i] + r12 * Z[i] + ty;
+    const float pz = r20 * X[i] + r21 * Y[i] + r22 * Z[i] + tz;
+    const float dx = ox - X[i], dy = oy - Y[i], dz = oz - Z[i];
+    const float nd = NX[i] * dx + NY[i] * dy + NZ[i] * dz;
+    const float dd = dx * dx + dy * dy + dz * dz;
+    // Branch-free (bitwise & on 0/1 ints, selects on floats) so that the loop vectorizes.
+    const int front = pz > near_m;
+    const int facing = (nd > 0.0f) & (nd * nd >= cos2_max * dd);
+    const float z_safe = std::max(pz, near_m);
+    const float inv_z = 1.0f / z_safe;
+    const float x = px * inv_z, y = py * inv_z;
+    float uu, vv;
+    int inside_fold = 1;
+    if constexpr (!kDistorted) {
+      uu = fx * x + cx;
+      vv = fy * y + cy;
+    } else {
+      const float r2 = x * x + y * y;
+      const float num = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
+      const float den = 1.0f + r2 * (k4 + r2 * (k5 + r2 * k6));
+      const float f = num / den;
+      const float two_xy = 2.0f * x * y;
+      uu = fx * (x * f + p1 * two_xy + p2 * (r2 + 2.0f * x * x)) + cx;
+      vv = fy * (y * f + p1 * (r2 + 2.0f * y * y) + p2 * two_xy) + cy;
+      inside_fold = r2 <= fold_r2;
+    }
+    const int in_image = (uu >= 0.0f) & (vv >= 0.0f) & (uu <= max_u) & (vv <= max_v) & inside_fold;
+    const int c = front * (1 - facing + 2 * facing * in_image);
+    code[i] = c;
+    u[i] = c == 2 ? uu : 0.0f;  // inside the image wherever pass 2 looks
+    v[i] = c == 2 ? vv : 0.0f;
+    const float uc = std::min(std::max(u[i], 0.0f), max_u_in);
+    const float vc = std::min(std::max(v[i], 0.0f), max_v_in);
+    const int xi = static_cast<int>(uc), yi = static_cast<int>(vc);
+    x0[i] = xi;
+    y0[i] = yi;
+    ax[i] = uc - static_cast<float>(xi);
+    ay[i] = vc - static_cast<float>(yi);
+    zo[i] = pz;
+    // Occlusion tolerance: relative + absolute, plus the depth change across 1.5 pixels at
+    // this slope (tan of the view angle = |n x d| / n.d).
+    const float nd_safe = std::max(nd, 1e-12f);
+    const float tan_view = std::sqrt(std::max(0.0f, dd - nd * nd)) / nd_safe;
+    tol[i] = pz * (tol_rel + slope_px * tan_view) + tol_abs;
+    // Pixels per texel: f s cos(view) / z.
+    quality[i] = std::min(1.0f, focal_texel * nd_safe / (std::sqrt(dd) * z_safe));
+  }
+}
+
+__attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(const KernelContext& k,
+                                                                           const BaseBuffer& buffer,
+                                                                           int begin, int n,
+                                                                           ChunkProjection* out) {
+  ProjectChunkBody<false>(k, buffer, begin, n, out);
+}
+
+__attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
+    const KernelContext& k, const BaseBuffer& buffer, int begin, int n, ChunkProjection* out) {
+  ProjectChunkBody<true>(k, buffer, begin, n, out);
+}
+
+// Pass 2, texel by texel for those in view: the depth test and the sample. Works on local
+// copies of what it reads: its outputs are written through byte pointers, which may alias
+// anything, so fields read through references would be reloaded for every texel.
 template <bool kDistorted, SamplingMode kMode, bool kDepth>
 void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Counts* counts) {
   const KernelContext k = context;
-  const Eigen::Vector3f* const point = k.buffer->point.data();
-  const int32_t* const triangle = k.buffer->triangle.data();
-  const int32_t* const texel_index = k.buffer->texel_index.data();
+  ChunkProjection proj;
+  const int n = chunk.end - chunk.begin;
+  if constexpr (kDistorted)
+    ProjectChunkDistorted(k, *k.buffer, chunk.begin, n, &proj);
+  else
+    ProjectChunkPinhole(k, *k.buffer, chunk.begin, n, &proj);
+
+  const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const float texel_size_m = static_cast<float>(k.buffer->texel_size_m);
   const uint8_t* const frame = k.frame->data;
   const size_t frame_step = k.frame->step[0];
+  const int levels = static_cast<int>(k.pyramid->size());
   const uint8_t* const depth = k.depth->data;
   const size_t depth_step = k.depth->step[0];
-  const int last_col = k.depth->cols - 1, last_row = k.depth->rows - 1;
-  const int levels = static_cast<int>(k.pyramid->size());
-  const float cos2_max = k.cos_max > 0.0f ? k.cos_max * k.cos_max : 0.0f;
   auto depth_at = [&](int x, int y) {
     return reinterpret_cast<const float*>(depth + y * depth_step)[x];
   };
   int in_view = 0, visible = 0, occluded = 0, grazing = 0;
-  for (int i = chunk.begin; i < chunk.end; ++i) {
-    const Eigen::Vector3f X = point[i];
-    const Eigen::Vector3f p = k.R * X + k.t;
-    if (!(p.z() > k.near_m)) continue;
-    // Back-facing or grazing: n.d <= |d| cos_max, tested without a square root.
-    const Eigen::Vector3f d = k.centre - X;
-    const float nd = k.normals[triangle[i]].dot(d);
-    const float dd = d.squaredNorm();
-    if (nd <= 0.0f || nd * nd < cos2_max * dd) {
-      ++grazing;
+  for (int i = 0; i < n; ++i) {
+    const int code = proj.code[i];
+    if (code != 2) {
+      grazing += code == 1;
       continue;
     }
-    float u, v;
-    if (!k.projector.Project<kDistorted>(p, &u, &v)) continue;
-    if (!(u >= 0.0f && v >= 0.0f && u <= k.max_u && v <= k.max_v)) continue;
     ++in_view;
-    const float z = p.z();
+    const float u = proj.u[i], v = proj.v[i], z = proj.z[i];
     if constexpr (kDepth) {
-      // Tolerance: relative + absolute, plus the depth change across 1.5 pixels at this
-      // slope (tan of the view angle = |n x d| / n.d, and nd > 0 here).
-      const float tan_view = std::sqrt(std::max(0.0f, dd - nd * nd)) / nd;
-      const float tol = z * (k.tol_rel + k.slope_px * tan_view) + k.tol_abs;
+      // Scalar: gathers are slow on some CPUs (measured slower here).
+      const float tol = proj.tol[i];
       bool ok;
       if constexpr (kMode == SamplingMode::kNearest) {
         ok = std::abs(depth_at(static_cast<int>(u + 0.5f), static_cast<int>(v + 0.5f)) - z) <= tol;
       } else {
-        const int x0 = static_cast<int>(u), y0 = static_cast<int>(v);
-        const int x1 = std::min(x0 + 1, last_col), y1 = std::min(y0 + 1, last_row);
-        ok = std::abs(depth_at(x0, y0) - z) <= tol && std::abs(depth_at(x1, y0) - z) <= tol &&
-             std::abs(depth_at(x0, y1) - z) <= tol && std::abs(depth_at(x1, y1) - z) <= tol;
+        const float* d0 =
+            reinterpret_cast<const float*>(depth + proj.y0[i] * depth_step) + proj.x0[i];
+        const float* d1 =
+            reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
+        ok = std::abs(d0[0] - z) <= tol && std::abs(d0[1] - z) <= tol &&
+             std::abs(d1[0] - z) <= tol && std::abs(d1[1] - z) <= tol;
       }
       if (!ok) {
         ++occluded;
@@ -176,7 +284,14 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
           frame + static_cast<int>(v + 0.5f) * frame_step + 3 * static_cast<int>(u + 0.5f);
       out[0] = src[0], out[1] = src[1], out[2] = src[2];
     } else if constexpr (kMode == SamplingMode::kBilinear) {
-      SampleBilinear(*k.frame, u, v, out);
+      const uint8_t* r0 = frame + proj.y0[i] * frame_step + 3 * proj.x0[i];
+      const uint8_t* r1 = r0 + frame_step;
+      const float fx = proj.ax[i], fy = proj.ay[i];
+      const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
+                  w11 = fx * fy;
+      for (int c = 0; c < 3; ++c)
+        out[c] = static_cast<uint8_t>(w00 * r0[c] + w10 * r0[3 + c] + w01 * r1[c] +
+                                      w11 * r1[3 + c] + 0.5f);
     } else {
       // Area: bilinear on the pyramid level whose pixels match the texel's footprint.
       const float footprint = k.focal * texel_size_m / z;
@@ -187,8 +302,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
                      (v + 0.5f) * scale - 0.5f, out);
     }
     k.out_valid[idx] = 255;
-    // Pixels per texel: f s cos(view) / z.
-    k.out_quality[idx] = std::min(1.0f, k.focal_texel * nd / (std::sqrt(dd) * z));
+    k.out_quality[idx] = proj.quality[i];
   }
   counts->in_view += in_view, counts->visible += visible;
   counts->occluded += occluded, counts->grazing += grazing;
@@ -242,9 +356,8 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
   return b;
 }
 
-void WarpFrameToBuffer(const BaseBuffer& buffer,
-                       const std::vector<Eigen::Vector3f>& triangle_normals, const FrameView& view,
-                       const WarpOptions& options, WarpedBuffer* warped) {
+void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
+                       WarpedBuffer* warped) {
   const int w = buffer.width, h = buffer.height;
   if (warped->bgr.rows != h || warped->bgr.cols != w) {
     warped->bgr.create(h, w, CV_8UC3);
@@ -256,7 +369,6 @@ void WarpFrameToBuffer(const BaseBuffer& buffer,
   const bool use_depth = options.occlusion.enabled && view.depth && !view.depth->empty();
   KernelContext k{
       .buffer = &buffer,
-      .normals = triangle_normals.data(),
       .R = view.cam_from_local.RotationMatrix().cast<float>(),
       .t = view.cam_from_local.translation.cast<float>(),
       .centre = view.centre_local.cast<float>(),

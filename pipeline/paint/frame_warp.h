@@ -59,9 +59,7 @@ struct WarpedBuffer {
   long long texels_tested = 0;  // texels in chunks that were not culled
 };
 
-// `triangle_normals`: (T) unit normals of the mesh's triangles, local frame.
-void WarpFrameToBuffer(const BaseBuffer& buffer,
-                       const std::vector<Eigen::Vector3f>& triangle_normals, const FrameView& view,
+void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view,
                        const WarpOptions& options, WarpedBuffer* warped);
 
 }  // namespace fresco

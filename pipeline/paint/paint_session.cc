@@ -100,9 +100,6 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
-  s->triangle_normals_.resize(mesh.NumTriangles());
-  for (int t = 0; t < mesh.NumTriangles(); ++t)
-    s->triangle_normals_[t] = mesh.Normal(t).cast<float>();
   *session = std::move(s);
   return Status::Ok();
 }
@@ -181,7 +178,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
       any_in_front = (cam_from_local * corner).z() > warp_options.near_m;
     }
     if (!any_in_front) continue;
-    WarpFrameToBuffer(buffer, triangle_normals_, view, warp_options, &warped_[b]);
+    WarpFrameToBuffer(buffer, view, warp_options, &warped_[b]);
     in_view += warped_[b].in_view;
     visible += warped_[b].visible;
     occluded += warped_[b].occluded;

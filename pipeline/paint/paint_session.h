@@ -74,7 +74,6 @@ class PaintSession {
   BaseBufferSet set_;
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
-  std::vector<Eigen::Vector3f> triangle_normals_;
   std::vector<CameraCache> cameras_;
   RasterOutput raster_;  // the current frame's depth and triangle ids (reused)
   int frames_seen_ = 0;

@@ -23,7 +23,6 @@ struct Fixture {
   Camera camera;
   Rigid3d cam_from_world;
   BaseBufferSet set;
-  std::vector<Eigen::Vector3f> normals;
   cv::Mat frame, depth;
 
   Fixture(int width, int height, LensModel lens, double distance_m) {
@@ -42,7 +41,6 @@ struct Fixture {
     options.texel_size_m = distance_m / camera.fx;  // ~1 texel per pixel
     options.max_buffer_texels = 1 << 24;
     set = BuildBaseBuffers(scene.mesh, g, options);
-    for (int t = 0; t < scene.mesh.NumTriangles(); ++t) normals.push_back(scene.mesh.Normal(t).cast<float>());
     RenderOutput out;
     Renderer(camera, RenderOptions()).Render(scene, cam_from_world, &out);
     cv::cvtColor(out.rgba, frame, cv::COLOR_RGBA2BGR);
@@ -65,7 +63,7 @@ void RunWarp(benchmark::State& state, Fixture& f) {
   long long texels = 0, tested = 0, visible = 0;
   for (auto _ : state) {
     for (const BaseBuffer& b : f.set.buffers) {
-      WarpFrameToBuffer(b, f.normals, view, options, &warped);
+      WarpFrameToBuffer(b, view, options, &warped);
       texels += b.NumTexels();
       tested += warped.texels_tested;
       visible += warped.visible;

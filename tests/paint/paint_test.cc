@@ -131,9 +131,10 @@ TEST(BaseBuffers, TexelPointsLieOnTheSurfaceAndCoverIt) {
     // A 1 m face at 1 cm texels: 100 x 100 texel centres inside.
     EXPECT_NEAR(b.num_surface_texels, 10000, 200);
     for (int k = 0; k < b.NumTexels(); ++k) {
-      const Eigen::Vector3d p = b.point[k].cast<double>();
+      const Eigen::Vector3d p = b.Point(k).cast<double>();
       const Eigen::Vector3d a = scene.mesh.Corner(b.triangle[k], 0);
       EXPECT_NEAR((p - a).dot(scene.mesh.Normal(b.triangle[k])), 0.0, 1e-5);
+      EXPECT_NEAR((b.Normal(k).cast<double>() - scene.mesh.Normal(b.triangle[k])).norm(), 0.0, 1e-6);
     }
   }
 }
@@ -255,7 +256,7 @@ TEST(Painting, OccludedSurfacesAreNotPainted) {
     for (int k = 0; k < buf.NumTexels(); ++k) {
       if (!buf.on_surface[k]) continue;
       Eigen::Vector2d px;
-      const Eigen::Vector3d pc = cam_from_local * buf.point[k].cast<double>();
+      const Eigen::Vector3d pc = cam_from_local * buf.Point(k).cast<double>();
       if (!camera.Project(pc, &px) || px.x() < 1 || px.y() < 1 || px.x() > 158 || px.y() > 118) continue;
       const int id = frame.triangle_id.at<int>(static_cast<int>(std::lround(px.y())),
                                                static_cast<int>(std::lround(px.x())));
