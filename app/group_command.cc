@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
-#include "app/project_session.h"
+#include "pipeline/paint/open_project.h"
 #include "pipeline/core/atomic_file.h"
 
 namespace fresco {

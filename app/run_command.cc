@@ -12,7 +12,7 @@
 
 #include "app/commands.h"
 #include "app/progress.h"
-#include "app/project_session.h"
+#include "pipeline/paint/open_project.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"

@@ -44,7 +44,10 @@ void RemoveTempDirs() {
 
 std::string MakeTempDir(const std::string& tag) {
   static std::once_flag once;
-  std::call_once(once, [] { TempDirs(); std::atexit(RemoveTempDirs); });  // list outlives it
+  std::call_once(once, [] {
+    TempDirs();
+    std::atexit(RemoveTempDirs);
+  });  // list outlives it
   std::string pattern = (fs::temp_directory_path() / ("fresco-" + tag + "-XXXXXX")).string();
   char* made = mkdtemp(pattern.data());
   if (!made) throw std::runtime_error("mkdtemp failed for " + pattern);
@@ -65,7 +68,6 @@ std::string ReadText(const std::string& path) {
   return ss.str();
 }
 
-
 CommandResult RunFresco(const std::vector<std::string>& args) {
   const char* env = std::getenv("FRESCO_BINARY");
 #ifdef FRESCO_TEST_BINARY
@@ -84,11 +86,19 @@ CommandResult RunFresco(const std::vector<std::string>& args) {
     dup2(out_fd, 1);
     dup2(err_fd, 2);
     dup2(null_fd, 0);
+    // "--xvfb" first: run under xvfb-run with a 1600x1000 screen (GUI tests).
+    const bool xvfb = !args.empty() && args[0] == "--xvfb";
+    static const std::string kXvfb = "/usr/bin/xvfb-run", kA = "-a", kS = "-s",
+                             kScreen = "-screen 0 1600x1000x24";
     std::vector<char*> argv;
+    if (xvfb)
+      for (const std::string* a : {&kXvfb, &kA, &kS, &kScreen})
+        argv.push_back(const_cast<char*>(a->c_str()));
     argv.push_back(const_cast<char*>(binary.c_str()));
-    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    for (size_t i = xvfb ? 1 : 0; i < args.size(); ++i)
+      argv.push_back(const_cast<char*>(args[i].c_str()));
     argv.push_back(nullptr);
-    execv(binary.c_str(), argv.data());
+    execv(argv[0], argv.data());
     _exit(127);
   }
   int status = 0;

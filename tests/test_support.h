@@ -26,6 +26,7 @@ struct CommandResult {
   std::string err;  // stderr
 };
 // Runs build/app/fresco with `args` (no shell quoting issues: args are passed as argv).
+// When args[0] is "--xvfb", it runs under /usr/bin/xvfb-run with a 1600x1000 screen.
 CommandResult RunFresco(const std::vector<std::string>& args);
 
 }  // namespace fresco::testing

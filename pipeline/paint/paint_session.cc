@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -189,7 +190,9 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
       seen[b] = true;
       ++buffers_seen;
       if (debug) {
-        warp_report.images["warped_b" + std::to_string(b)] = warped_[b].bgr.clone();
+        cv::Mat warped(warped_[b].bgr.size(), CV_8UC3, cv::Scalar(64, 64, 64));  // unseen: grey
+        warped_[b].bgr.copyTo(warped, warped_[b].valid);
+        warp_report.images["warped_b" + std::to_string(b)] = warped;
         warp_report.images["visible_b" + std::to_string(b)] = warped_[b].valid.clone();
       }
     }
@@ -208,7 +211,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   start = std::chrono::steady_clock::now();
   StageReport paint_report;
   paint_report.name = "paint";
-  long long written = 0, rejected = 0;
+  long long written = 0, rejected = 0, compared = 0;
+  double difference_sum = 0;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!seen[b]) continue;
     const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], cv::Mat(),
@@ -216,10 +220,16 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
                                                &painted_[b]);
     written += stats.written;
     rejected += stats.rejected;
+    compared += stats.compared;
+    difference_sum += stats.abs_grey_difference_sum;
     if (debug) paint_report.images["painted_b" + std::to_string(b)] = painted_[b].bgra.clone();
   }
   paint_report.metrics["texels_written"] = static_cast<double>(written);
   paint_report.metrics["texels_kept_sharper"] = static_cast<double>(rejected);
+  // Mean |grey difference| between this frame and what the buffers held, where both exist:
+  // a cheap misalignment signal (pose error, exposure change, movers), NaN when none.
+  paint_report.metrics["difference_to_buffer"] =
+      compared > 0 ? difference_sum / compared : std::numeric_limits<double>::quiet_NaN();
   paint_report.metrics["coverage"] = Coverage();
   paint_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(paint_report));

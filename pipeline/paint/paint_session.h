@@ -49,6 +49,10 @@ class PaintSession {
   // never painted) and new UVs into them.
   Scene PaintedScene() const;
 
+  // Debug images on or off from the next frame on (the app asks only for frames it shows).
+  void set_debug_images(bool on) { options_.debug_images = on; }
+  const PipelineOptions& options() const { return options_; }
+
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
   const Grouping& grouping() const { return set_.grouping; }

@@ -1,6 +1,7 @@
 #include "pipeline/paint/paint_update.h"
 
 #include <algorithm>
+#include <cstdlib>
 
 namespace fresco {
 
@@ -27,13 +28,19 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
   for (int k = 0; k < buffer.NumTexels(); ++k) {
     const int idx = buffer.texel_index[k];
     if (!valid[idx] || (skip && skip[idx])) continue;
+    cv::Vec4b& px = dst[idx];
+    if (px[3] != 0) {  // compare with what the buffer holds (BT.601 luma, integer weights)
+      const int new_grey = (29 * src[idx][0] + 150 * src[idx][1] + 77 * src[idx][2]) >> 8;
+      const int old_grey = (29 * px[0] + 150 * px[1] + 77 * px[2]) >> 8;
+      stats.abs_grey_difference_sum += std::abs(new_grey - old_grey);
+      ++stats.compared;
+    }
     const float q = quality[idx];
     float& stored_q = stored_quality[idx];
     if (policy == UpdatePolicy::kQuality && q < stored_q * keep) {
       ++stats.rejected;
       continue;
     }
-    cv::Vec4b& px = dst[idx];
     if (px[3] == 0 && buffer.on_surface[k]) ++painted->painted_surface_texels;
     px = cv::Vec4b(src[idx][0], src[idx][1], src[idx][2], 255);
     stored_q = policy == UpdatePolicy::kQuality ? std::max(stored_q, q) : q;

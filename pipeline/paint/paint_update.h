@@ -22,6 +22,10 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted);
 struct PaintUpdateStats {
   int written = 0;   // texels written this frame
   int rejected = 0;  // visible but kept the stored, sharper sample
+  // Misalignment signal: over texels that were already painted and are seen again, the sum
+  // of |grey(new sample) - grey(stored)| (0..255 each) and how many there were.
+  double abs_grey_difference_sum = 0;
+  int compared = 0;
 };
 
 // `mask` (CV_8U, optional): texels to leave alone (e.g. foreground) where non-zero.

@@ -31,6 +31,11 @@ struct FrameReport {
       if (s.name == name) return &s;
     return nullptr;
   }
+  const StageReport* Stage(const std::string& name) const {
+    for (const auto& s : stages)
+      if (s.name == name) return &s;
+    return nullptr;
+  }
 };
 
 }  // namespace fresco

@@ -1,6 +1,6 @@
 // Opens a project for painting: loads its capture (scene, cameras, poses; the video is read
 // lazily) and builds the PaintSession (grouping, base buffers). Shared by `fresco run` and
-// `fresco group`. Errors are bad input (exit 2), naming the file and field.
+// `fresco group` and the app. Errors are bad input (exit 2), naming the file and field.
 #pragma once
 
 #include <memory>

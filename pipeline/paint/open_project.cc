@@ -1,4 +1,4 @@
-#include "app/project_session.h"
+#include "pipeline/paint/open_project.h"
 
 namespace fresco {
 

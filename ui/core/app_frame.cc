@@ -1,0 +1,148 @@
+#include "ui/core/app_frame.h"
+
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+void OpenNow(UiContext& ui, const std::string& path) {
+  if (Status s = ui.state->Open(path); !s.ok()) {
+    ui.state->message = "error: " + s.message();
+    return;
+  }
+  ui.runner->Restart(ui.state->project);
+}
+
+void DrawUnsavedPrompt(UiContext& ui) {
+  AppState& state = *ui.state;
+  const bool waiting = !state.pending_open.empty() || state.pending_quit;
+  if (!waiting) return;
+  auto proceed = [&] {  // quit, or open the other project
+    if (state.pending_quit)
+      ui.request_quit = true;
+    else
+      OpenNow(ui, state.pending_open);
+    state.pending_open.clear();
+    state.pending_quit = false;
+  };
+  if (!state.dirty) {  // nothing to lose
+    proceed();
+    return;
+  }
+  if (!ImGui::IsPopupOpen("Unsaved changes")) ImGui::OpenPopup("Unsaved changes");
+  if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::Text("%s has unsaved changes.", state.project.file_path.c_str());
+    bool go_on = false;
+    if (ImGui::Button("Save")) {
+      if (Status s = state.Save(); !s.ok())
+        state.message = "error: " + s.message();
+      else
+        go_on = true;
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Discard")) {
+      state.dirty = false;
+      go_on = true;
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+      state.pending_open.clear();
+      state.pending_quit = false;
+      ImGui::CloseCurrentPopup();
+    }
+    if (go_on) {
+      ImGui::CloseCurrentPopup();
+      proceed();
+    }
+    ImGui::EndPopup();
+  }
+}
+
+void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  AppState& state = *ui.state;
+  if (!ImGui::BeginMainMenuBar()) return;
+  if (ImGui::BeginMenu("File")) {
+    if (ImGui::MenuItem("Save", "Ctrl+S", false, state.has_project))
+      if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
+    if (ImGui::BeginMenu("Open recent", !state.recent.empty())) {
+      for (const std::string& path : state.recent)
+        if (ImGui::MenuItem(path.c_str())) RequestOpen(ui, path);
+      ImGui::EndMenu();
+    }
+    if (ImGui::MenuItem("Quit", "Ctrl+Q")) state.pending_quit = true;
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("Edit")) {
+    if (ImGui::MenuItem("Undo", "Ctrl+Z", false, !state.undo.empty())) UndoRedo(ui, true);
+    if (ImGui::MenuItem("Redo", "Ctrl+Y", false, !state.redo.empty())) UndoRedo(ui, false);
+    if (ImGui::MenuItem("Apply to the pipeline (restart)", "F5", false, state.has_project))
+      ApplyProject(ui);
+    ImGui::EndMenu();
+  }
+  if (ImGui::BeginMenu("View")) {
+    for (auto& panel : panels) ImGui::MenuItem(panel->Title(), nullptr, &panel->open);
+    ImGui::EndMenu();
+  }
+  const auto& snap = *ui.snapshot;
+  ImGui::Separator();
+  ImGui::Text("frame %d  %s  coverage %.1f%%  %s", snap.frame, snap.status.c_str(),
+              100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
+  ImGui::EndMainMenuBar();
+}
+
+void HandleShortcuts(UiContext& ui) {
+  ImGuiIO& io = ImGui::GetIO();
+  if (io.WantTextInput) return;
+  AppState& state = *ui.state;
+  if (io.KeyCtrl && ImGui::IsKeyPressed('S') && state.has_project)
+    if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
+  if (io.KeyCtrl && ImGui::IsKeyPressed('Z')) UndoRedo(ui, true);
+  if (io.KeyCtrl && ImGui::IsKeyPressed('Y')) UndoRedo(ui, false);
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Space))) {
+    if (ui.snapshot->playing)
+      ui.runner->Pause();
+    else
+      ui.runner->Play();
+  }
+  if (io.KeyCtrl && ImGui::IsKeyPressed('Q')) state.pending_quit = true;
+}
+
+void DrawStatusBar(UiContext& ui) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  ImGui::SetNextWindowPos(ImVec2(0, display.y - 24));
+  ImGui::SetNextWindowSize(ImVec2(display.x, 24));
+  ImGui::Begin("##status", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
+                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
+  ImGui::TextUnformatted(ui.state->message.c_str());
+  ImGui::End();
+}
+
+}  // namespace
+
+void RequestOpen(UiContext& ui, const std::string& path) { ui.state->pending_open = path; }
+
+void UndoRedo(UiContext& ui, bool undo) {
+  const GroupingOptions before = ui.state->project.grouping;
+  const double texel_before = ui.state->project.pipeline.texel_size_m;
+  if (!(undo ? ui.state->Undo() : ui.state->Redo())) return;
+  // A grouping change shows only once the session is rebuilt.
+  if (!(before == ui.state->project.grouping) ||
+      texel_before != ui.state->project.pipeline.texel_size_m)
+    ApplyProject(ui);
+}
+
+void ApplyProject(UiContext& ui) {
+  if (ui.state->has_project) ui.runner->Restart(ui.state->project);
+}
+
+void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  HandleShortcuts(ui);
+  DrawMenuBar(ui, panels);
+  for (auto& panel : panels)
+    if (panel->open) panel->Draw(ui);
+  DrawUnsavedPrompt(ui);
+  DrawStatusBar(ui);
+}
+
+}  // namespace fresco

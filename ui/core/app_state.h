@@ -1,0 +1,62 @@
+// What the user edits in the app: the project (its path, whether it has unsaved changes,
+// undo/redo of its grouping and settings), the recently opened projects, and what is
+// selected. Plain data and file operations, no ImGui and no GL: tests drive it directly.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/project.h"
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+struct AppState {
+  Project project;  // as edited
+  bool has_project = false;
+  bool dirty = false;               // edited since it was opened or saved
+  std::string message;              // the last status or error, shown in the status bar
+  std::vector<std::string> recent;  // most recent first
+  std::string recent_file;          // where `recent` is kept ("" = not kept)
+
+  // Selection (viewport picks and the grouping table).
+  std::set<int> selected_triangles;
+  std::set<int> selected_groups;
+
+  // Actions waiting for the unsaved-changes prompt: a project to open, or quitting.
+  std::string pending_open;
+  bool pending_quit = false;
+
+  // Undo/redo over whole project snapshots (settings and grouping edits).
+  std::vector<Project> undo, redo;
+
+  // Opens a project (errors leave the current one as it was).
+  Status Open(const std::string& path);
+  // Saves atomically to the project's path, or to `path` when given (Save As).
+  Status Save(const std::string& path = "");
+  // Call before changing `project`: records an undo step and marks the project dirty.
+  void BeginEdit();
+  bool Undo();
+  bool Redo();
+
+  void LoadRecent();
+  void AddRecent(const std::string& path);
+};
+
+// Grouping edits as the app makes them: on the groups the current session built (one per
+// base buffer), stored in the project as explicit groups (grouping.groups) so that
+// `fresco run` paints exactly what the app shows. `num_triangles`: the scene's. Errors name
+// the group or triangle.
+Status MergeGroups(const std::vector<GroupSpec>& current, int num_triangles,
+                   const std::set<int>& groups, std::vector<GroupSpec>* result);
+Status SplitTriangles(const std::vector<GroupSpec>& current, int num_triangles,
+                      const std::set<int>& triangles, std::vector<GroupSpec>* result);
+Status MoveTriangles(const std::vector<GroupSpec>& current, int num_triangles,
+                     const std::set<int>& triangles, int target_group,
+                     std::vector<GroupSpec>* result);
+Status SetGroupTexelSize(const std::vector<GroupSpec>& current, int num_triangles,
+                         const std::set<int>& groups, double texel_size_m,
+                         std::vector<GroupSpec>* result);
+
+}  // namespace fresco

@@ -1,0 +1,83 @@
+// The panel framework: every panel is a struct with its own state and a Draw() that starts
+// with `if (!ImGui::Begin(...)) { ImGui::End(); return; }`. Panels read the runner's latest
+// immutable snapshot and edit the AppState; they never call GL: images go through
+// ImageTextures and the 3D view through ViewportRenderer, which the GL app implements and
+// tests replace with null versions. Adding a panel = a new file in ui/panels/ and one line
+// in ui/panels/panel_registry.cc.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <imgui.h>
+#include <opencv2/core.hpp>
+
+#include "ui/core/app_state.h"
+#include "ui/core/pipeline_runner.h"
+
+namespace fresco {
+
+// Textures for images shown in panels, cached by key and re-uploaded when `version` changes.
+// Images: CV_8UC1, CV_8UC3 (BGR) or CV_8UC4 (BGRA).
+class ImageTextures {
+ public:
+  virtual ~ImageTextures() = default;
+  virtual ImTextureID Get(const std::string& key, const cv::Mat& image, uint64_t version) = 0;
+};
+
+// How the 3D viewport looks at the model.
+struct ViewportView {
+  enum class Mode { kPainted, kGroups, kProjected };
+  Mode mode = Mode::kPainted;
+  float yaw_deg = 30, pitch_deg = 25;  // orbit angles
+  float distance_m = 0;                // 0 = fit the model
+  float target[3] = {0, 0, 0};         // orbit centre, world
+  bool target_set = false;
+  bool show_path = true, show_frustum = true;
+};
+
+// Draws the model (painted textures, group colours or the current frame projected onto it),
+// the current camera's frustum and the path into an offscreen image of w x h pixels.
+class ViewportRenderer {
+ public:
+  virtual ~ViewportRenderer() = default;
+  virtual ImTextureID Render(const RunnerSnapshot& snapshot, const AppState& state,
+                             ViewportView* view, int width, int height) = 0;
+  // The triangle under pixel (x, y) of the last Render, -1 for none.
+  virtual int Pick(int x, int y) = 0;
+};
+
+struct UiContext {
+  AppState* state = nullptr;
+  PipelineRunner* runner = nullptr;
+  ImageTextures* textures = nullptr;
+  ViewportRenderer* viewport = nullptr;
+  std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
+  bool request_quit = false;
+};
+
+class Panel {
+ public:
+  virtual ~Panel() = default;
+  virtual const char* Title() const = 0;
+  virtual void Draw(UiContext& ui) = 0;
+  bool open = true;
+  // Where the panel starts, in a 1600 x 1000 window (scaled to the real size).
+  ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);
+};
+
+// Every panel, in menu order (panel_registry.cc).
+std::vector<std::unique_ptr<Panel>> MakePanels();
+
+// Helpers for panels.
+// Starts the panel's window at its default place the first time (scaled to the display).
+bool BeginPanel(Panel& panel);
+// An image scaled to fit `max_width` (0 = the available width), keeping its aspect.
+void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,
+               float max_width = 0);
+// A two-column table of metrics.
+void ShowMetrics(const std::map<std::string, double>& metrics);
+
+}  // namespace fresco

@@ -1,0 +1,276 @@
+#include "ui/core/pipeline_runner.h"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/paint/open_project.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/render/renderer.h"
+
+namespace fresco {
+
+struct PipelineRunner::Session {
+  Project project;
+  Capture capture;
+  std::unique_ptr<PaintSession> paint;
+  std::unique_ptr<Renderer> review;  // half-size renderer for the misalignment review
+  Camera review_camera;
+  int next_frame = 0;  // index of the next frame to read
+  bool ended = false;
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The camera at half size (pixel centres stay on the same rays).
+Camera HalfSize(const Camera& camera) {
+  Camera half = camera;
+  half.width = std::max(1, camera.width / 2);
+  half.height = std::max(1, camera.height / 2);
+  const double sx = static_cast<double>(half.width) / camera.width;
+  const double sy = static_cast<double>(half.height) / camera.height;
+  half.fx *= sx, half.fy *= sy;
+  half.cx = (camera.cx + 0.5) * sx - 0.5, half.cy = (camera.cy + 0.5) * sy - 0.5;
+  return half;
+}
+
+}  // namespace
+
+PipelineRunner::PipelineRunner(const RunnerOptions& options)
+    : options_(options), snapshot_(std::make_shared<RunnerSnapshot>()) {
+  working_.status = "no project";
+  thread_ = std::thread([this] { Loop(); });
+}
+
+PipelineRunner::~PipelineRunner() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.clear();
+  }
+  Post({Command::kQuit, {}, 0});
+  thread_.join();
+}
+
+void PipelineRunner::Post(Command command) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    queue_.push_back(std::move(command));
+  }
+  wake_.notify_all();
+}
+
+void PipelineRunner::Restart(const Project& project) { Post({Command::kRestart, project, 0}); }
+void PipelineRunner::Play() { Post({Command::kPlay, {}, 0}); }
+void PipelineRunner::Pause() { Post({Command::kPause, {}, 0}); }
+void PipelineRunner::Step() { Post({Command::kStep, {}, 0}); }
+void PipelineRunner::Seek(int frame) { Post({Command::kSeek, {}, frame}); }
+
+void PipelineRunner::WaitIdle() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+std::shared_ptr<const RunnerSnapshot> PipelineRunner::Snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return snapshot_;
+}
+
+void PipelineRunner::OpenSession(const Project& project) {
+  session_.reset();
+  const uint64_t geometry_version = working_.geometry_version + 1;
+  working_ = RunnerSnapshot();
+  working_.version = snapshot_->version;
+  working_.geometry_version = geometry_version;
+  auto s = std::make_unique<Session>();
+  s->project = project;
+  if (Status st = OpenPaintSession(project, &s->capture, &s->paint); !st.ok()) {
+    working_.status = "error: " + st.message();
+    return;
+  }
+  auto geometry = std::make_shared<SessionGeometry>();
+  geometry->painted_layout = s->paint->PaintedScene();
+  geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
+  geometry->groups = s->paint->grouping().groups;
+  geometry->buffer_of_triangle = s->paint->grouping().group_of_triangle;
+  for (const BaseBuffer& b : s->paint->buffers())
+    geometry->buffer_texels.push_back(b.num_surface_texels);
+  for (const PosedImage& p : s->capture.poses) geometry->path.push_back(p.cam_from_world);
+  geometry->camera = s->capture.cameras.begin()->second;
+  geometry->num_frames = s->capture.video->FrameCount();
+  geometry->texel_size_m = s->paint->default_texel_size_m();
+  geometry->folds_split = s->paint->folds_split();
+  working_.geometry = geometry;
+  if (options_.misalignment) {
+    s->review_camera = HalfSize(geometry->camera);
+    try {
+      s->review = std::make_unique<Renderer>(s->review_camera, RenderOptions());
+    } catch (const std::exception&) {
+      s->review.reset();
+    }
+  }
+  working_.status = "paused";
+  session_ = std::move(s);
+}
+
+bool PipelineRunner::PaintNext(bool show) {
+  if (!session_ || session_->ended) return false;
+  Session& s = *session_;
+  Frame frame;
+  Status read;
+  if (!s.capture.video->Next(&frame, &read)) {
+    s.ended = true;
+    working_.status = read.ok() ? "end of video" : "error: " + read.message();
+    return false;
+  }
+  ++s.next_frame;
+  working_.frame = frame.index;
+  working_.frame_name = frame.name;
+  const PosedImage* pose = s.capture.PoseForFrame(frame);
+  const Camera* camera = pose ? s.capture.CameraFor(*pose) : nullptr;
+  working_.has_pose =
+      pose && camera && frame.bgr.cols == camera->width && frame.bgr.rows == camera->height;
+  if (show) working_.frame_bgr = frame.bgr.clone();
+  if (!working_.has_pose) {
+    working_.report = FrameReport();
+    working_.report.frame = frame.index;
+    working_.report.skipped_reason = pose ? "frame size differs from the camera" : "no pose";
+    return true;
+  }
+  working_.cam_from_world = pose->cam_from_world;
+  // Review: the painted model, as it stands before this frame, seen from this frame.
+  if (show && s.review && s.paint->NumPaintedSurfaceTexels() > 0) {
+    RenderOutput out;
+    s.review->Render(s.paint->PaintedScene(), pose->cam_from_world, &out);
+    cv::Mat small, rephoto, grey_frame, grey_rephoto, diff;
+    cv::resize(frame.bgr, small, out.rgba.size(), 0, 0, cv::INTER_AREA);
+    cv::cvtColor(out.rgba, rephoto, cv::COLOR_RGBA2BGR);
+    std::vector<cv::Mat> channels;
+    cv::split(out.rgba, channels);
+    const cv::Mat painted_mask = channels[3] == 255;
+    cv::cvtColor(small, grey_frame, cv::COLOR_BGR2GRAY);
+    cv::cvtColor(rephoto, grey_rephoto, cv::COLOR_BGR2GRAY);
+    cv::absdiff(grey_frame, grey_rephoto, diff);
+    diff.setTo(0, ~painted_mask);
+    cv::Mat scaled;
+    diff.convertTo(scaled, CV_8U, 4.0);  // 64 grey levels of difference = full scale
+    cv::applyColorMap(scaled, working_.difference_heat, cv::COLORMAP_INFERNO);
+    working_.difference_heat.setTo(cv::Scalar(40, 40, 40), ~painted_mask);
+    rephoto.setTo(cv::Scalar(40, 40, 40), ~painted_mask);
+    working_.rephoto_bgr = rephoto;
+  } else if (show) {
+    working_.rephoto_bgr.release();
+    working_.difference_heat.release();
+  }
+  s.paint->set_debug_images(show && options_.debug_images);
+  s.paint->PaintFrame(frame, *camera, pose->cam_from_world, &working_.report);
+  if (working_.report.painted) {
+    working_.frames_painted.push_back(frame.index);
+    for (const StageReport& st : working_.report.stages)
+      working_.stage_ms[st.name].push_back(static_cast<float>(st.wall_ms));
+    const StageReport* paint = working_.report.Stage("paint");
+    double diff = std::numeric_limits<double>::quiet_NaN();
+    if (paint && paint->metrics.count("difference_to_buffer"))
+      diff = paint->metrics.at("difference_to_buffer");
+    working_.misalignment.push_back(static_cast<float>(diff));
+  }
+  working_.coverage = s.paint->Coverage();
+  return true;
+}
+
+void PipelineRunner::Publish(bool with_painted) {
+  working_.playing = playing_;
+  if (working_.status.rfind("error", 0) != 0 && working_.status != "end of video")
+    working_.status = playing_ ? "playing" : "paused";
+  if (with_painted && session_) {
+    auto painted = std::make_shared<std::vector<cv::Mat>>();
+    for (const PaintedBuffer& p : session_->paint->painted()) painted->push_back(p.bgra.clone());
+    working_.painted = painted;
+    ++working_.painted_version;
+  }
+  ++working_.version;
+  auto snapshot = std::make_shared<RunnerSnapshot>(working_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_ = snapshot;
+}
+
+void PipelineRunner::Loop() {
+  auto last_publish = Clock::now();
+  for (;;) {
+    Command command{Command::kPause, {}, -1};
+    bool have_command = false;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      busy_ = playing_ || seek_target_ >= 0;
+      if (queue_.empty() && !busy_) idle_.notify_all();
+      wake_.wait(lock, [this] { return !queue_.empty() || playing_ || seek_target_ >= 0; });
+      if (!queue_.empty()) {
+        command = std::move(queue_.front());
+        queue_.pop_front();
+        have_command = true;
+      }
+      busy_ = true;
+    }
+    if (have_command) {
+      switch (command.kind) {
+        case Command::kQuit:
+          return;
+        case Command::kRestart:
+          playing_ = false;
+          seek_target_ = -1;
+          OpenSession(command.project);
+          Publish(true);
+          break;
+        case Command::kPlay:
+          playing_ = session_ != nullptr && !session_->ended;
+          Publish(false);
+          break;
+        case Command::kPause:
+          playing_ = false;
+          Publish(true);
+          break;
+        case Command::kStep:
+          playing_ = false;
+          PaintNext(true);
+          Publish(true);
+          break;
+        case Command::kSeek:
+          playing_ = false;
+          if (session_ && command.frame < session_->next_frame) {
+            const Project project = session_->project;
+            OpenSession(project);
+          }
+          seek_target_ = session_ ? command.frame : -1;
+          if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
+          if (seek_target_ < 0) Publish(true);
+          break;
+      }
+      continue;
+    }
+    if (seek_target_ >= 0) {
+      const bool last = session_->next_frame >= seek_target_;
+      if (!PaintNext(last) || last) {
+        seek_target_ = -1;
+        Publish(true);
+      }
+      continue;
+    }
+    if (playing_) {
+      const bool show =
+          Clock::now() - last_publish >= std::chrono::milliseconds(options_.publish_interval_ms);
+      if (!PaintNext(show)) {
+        playing_ = false;
+        Publish(true);
+      } else if (show) {
+        Publish(true);
+        last_publish = Clock::now();
+      }
+    }
+  }
+}
+
+}  // namespace fresco

@@ -1,0 +1,116 @@
+// The app's painting worker: owns the project's capture and PaintSession on its own thread
+// and publishes immutable snapshots (the latest frame's report, debug images, painted
+// buffers, timings, misalignment) that the panels read. The UI never waits for painting:
+// commands (play, pause, step, seek, restart with new settings) are queued and the worker
+// picks them up between frames. Settings are copied in on Restart, never shared.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/project.h"
+#include "pipeline/core/rigid3.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/paint/stage_report.h"
+
+namespace fresco {
+
+// What does not change while one session paints: the model with its buffers' UVs, and the
+// grouping (one group per base buffer).
+struct SessionGeometry {
+  Scene painted_layout;                 // PaintSession::PaintedScene() of the fresh session
+  std::vector<int> buffer_of_triangle;  // (T) base buffer of each triangle, -1 for none
+  std::vector<GroupSpec> groups;        // one per base buffer, as the session built them
+  std::vector<int> buffer_texels;       // on-surface texels per buffer
+  std::vector<Rigid3d> path;            // cam_from_world of every posed frame, in order
+  Camera camera;                        // the first camera (frustum drawing, preview)
+  int num_frames = 0;                   // frames in the video when known, else -1
+  double texel_size_m = 0;
+  int folds_split = 0;
+};
+
+struct RunnerSnapshot {
+  uint64_t version = 0;  // increases with every publish
+  uint64_t geometry_version = 0;
+  std::shared_ptr<const SessionGeometry> geometry;  // null until a session opened
+  std::string status;                               // "paused", "playing", "error: ..."
+  bool playing = false;
+  int frame = -1;  // index of the frame last painted
+  std::string frame_name;
+  bool has_pose = false;
+  Rigid3d cam_from_world;
+  cv::Mat frame_bgr;                                    // the input frame
+  FrameReport report;                                   // stages with metrics and debug images
+  std::shared_ptr<const std::vector<cv::Mat>> painted;  // per buffer BGRA (alpha 0 = never)
+  uint64_t painted_version = 0;
+  double coverage = 0;
+  // Per painted frame, in order: stage wall times, and the misalignment figure (mean
+  // absolute grey difference between the frame and the painted model rendered into its
+  // view before the frame was painted; NaN where nothing was painted yet).
+  std::vector<int> frames_painted;
+  std::map<std::string, std::vector<float>> stage_ms;
+  std::vector<float> misalignment;
+  // Misalignment review images for the current frame (half size): the painted model
+  // rendered into the frame's view, and the absolute difference as a heat map.
+  cv::Mat rephoto_bgr, difference_heat;
+};
+
+struct RunnerOptions {
+  bool debug_images = true;       // stage debug images for the frames that are shown
+  bool misalignment = true;       // render the painted model into each frame's view
+  int publish_interval_ms = 100;  // while playing, publish at most this often
+};
+
+class PipelineRunner {
+ public:
+  explicit PipelineRunner(const RunnerOptions& options = RunnerOptions());
+  ~PipelineRunner();
+
+  // (Re)opens the project with these settings and starts from frame 0, paused.
+  void Restart(const Project& project);
+  void Play();
+  void Pause();
+  void Step();           // paints the next frame, then pauses
+  void Seek(int frame);  // paints up to `frame` (restarting when it lies behind), pauses
+  // Blocks until the queue is empty and the worker is idle (tests, --screenshot).
+  void WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> Snapshot() const;
+
+ private:
+  struct Command {
+    enum Kind { kRestart, kPlay, kPause, kStep, kSeek, kQuit } kind;
+    Project project;
+    int frame = 0;
+  };
+  struct Session;
+  void Post(Command command);
+  void Loop();
+  bool PaintNext(bool show);  // false at the end of the video or on error
+  void OpenSession(const Project& project);
+  void Publish(bool with_painted);
+
+  RunnerOptions options_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<Command> queue_;
+  bool busy_ = false;
+  std::shared_ptr<const RunnerSnapshot> snapshot_;
+  // Worker-only state.
+  std::unique_ptr<Session> session_;
+  RunnerSnapshot working_;
+  bool playing_ = false;
+  int seek_target_ = -1;
+  std::thread thread_;
+};
+
+}  // namespace fresco

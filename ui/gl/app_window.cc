@@ -1,0 +1,177 @@
+#include "ui/gl/app_window.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_io.h"
+#include "ui/core/app_frame.h"
+#include "ui/gl/gl.h"
+#include "ui/gl/gl_textures.h"
+#include "ui/gl/viewport_gl.h"
+
+namespace fresco {
+namespace {
+
+std::string ConfigDir() {
+  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg && *xdg)
+    return std::string(xdg) + "/fresco";
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return std::string(home) + "/.config/fresco";
+  return "";
+}
+
+// The window's pixels (bottom-up in GL) as a top-down BGR image.
+cv::Mat ReadWindow(int width, int height) {
+  cv::Mat rgba(height, width, CV_8UC4);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadBuffer(GL_BACK);
+  glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data);
+  cv::Mat flipped, bgr;
+  cv::flip(rgba, flipped, 0);
+  cv::cvtColor(flipped, bgr, cv::COLOR_RGBA2BGR);
+  return bgr;
+}
+
+Status WritePanelList(const std::string& path, const std::vector<std::unique_ptr<Panel>>& panels) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& panel : panels) {
+    ImGuiWindow* window = ImGui::FindWindowByName(panel->Title());
+    nlohmann::json entry = {{"title", panel->Title()}, {"open", panel->open}};
+    if (window && panel->open) {
+      entry["x"] = window->Pos.x;
+      entry["y"] = window->Pos.y;
+      entry["width"] = window->Size.x;
+      entry["height"] = window->Size.y;
+      entry["collapsed"] = window->Collapsed;
+    }
+    list.push_back(entry);
+  }
+  return WriteFileAtomic(path, nlohmann::json{{"panels", list}}.dump(2) + "\n");
+}
+
+}  // namespace
+
+int RunGuiApp(const GuiOptions& options) {
+  const bool screenshot = !options.screenshot.empty();
+  AppState state;
+  if (!screenshot) {
+    const std::string config = ConfigDir();
+    if (!config.empty()) state.recent_file = config + "/recent.json";
+    state.LoadRecent();
+  }
+  if (!options.project.empty()) {
+    if (Status s = state.Open(options.project); !s.ok()) {
+      std::fprintf(stderr, "error: %s\n", s.message().c_str());
+      return 2;
+    }
+  }
+  glfwSetErrorCallback([](int code, const char* text) {
+    std::fprintf(stderr, "fresco gui: GLFW error %d: %s\n", code, text);
+  });
+  if (!glfwInit()) {
+    std::fprintf(stderr, "fresco gui: cannot open a window (no display? run under xvfb-run)\n");
+    return 1;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  GLFWwindow* window = glfwCreateWindow(options.width, options.height, "Fresco", nullptr, nullptr);
+  if (!window) {
+    std::fprintf(stderr, "fresco gui: cannot create an OpenGL 3.3 window\n");
+    glfwTerminate();
+    return 1;
+  }
+  glfwMakeContextCurrent(window);
+  glfwSwapInterval(screenshot ? 0 : 1);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  static std::string ini;
+  if (screenshot || ConfigDir().empty()) {
+    io.IniFilename = nullptr;  // screenshots always show the default layout
+  } else {
+    ini = ConfigDir() + "/imgui.ini";
+    io.IniFilename = ini.c_str();
+  }
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+
+  int code = 0;
+  {
+    PipelineRunner runner;
+    GlTextures textures;
+    GlViewport viewport;
+    auto panels = MakePanels();
+    UiContext ui;
+    ui.state = &state;
+    ui.runner = &runner;
+    ui.textures = &textures;
+    ui.viewport = &viewport;
+    if (state.has_project) runner.Restart(state.project);
+    if (screenshot && state.has_project) {
+      runner.Seek(std::max(0, options.frames - 1));
+      runner.WaitIdle();
+    }
+    int frames_drawn = 0;
+    while (true) {
+      glfwPollEvents();
+      if (glfwWindowShouldClose(window)) {
+        glfwSetWindowShouldClose(window, GLFW_FALSE);
+        state.pending_quit = true;
+      }
+      ui.snapshot = runner.Snapshot();
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      if (screenshot) io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);  // no hover effects in pictures
+      ImGui::NewFrame();
+      DrawAppFrame(ui, panels);
+      ImGui::Render();
+      int fb_width = 0, fb_height = 0;
+      glfwGetFramebufferSize(window, &fb_width, &fb_height);
+      glViewport(0, 0, fb_width, fb_height);
+      glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      textures.EndFrame();
+      ++frames_drawn;
+      // Screenshots: a few frames so that windows settle and textures are uploaded.
+      if (screenshot && frames_drawn >= 4) {
+        const cv::Mat pixels = ReadWindow(fb_width, fb_height);
+        Status s = WriteImageAtomic(options.screenshot, pixels);
+        if (s.ok()) s = WritePanelList(options.screenshot + ".json", panels);
+        if (!s.ok()) {
+          std::fprintf(stderr, "error: %s\n", s.message().c_str());
+          code = 1;
+        } else {
+          std::fprintf(stderr, "fresco gui: wrote %s (%dx%d, frame %d)\n",
+                       options.screenshot.c_str(), fb_width, fb_height, ui.snapshot->frame);
+        }
+        break;
+      }
+      glfwSwapBuffers(window);
+      if (ui.request_quit) break;
+    }
+  }
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return code;
+}
+
+}  // namespace fresco

@@ -1,0 +1,20 @@
+// The app's window: GLFW + OpenGL 3.3 core + Dear ImGui (GLFW and OpenGL3 backends), the
+// main loop, and the --screenshot mode that paints N frames, draws every panel and writes
+// the window to a PNG (plus FILE.json listing the panels and where they are).
+#pragma once
+
+#include <string>
+
+namespace fresco {
+
+struct GuiOptions {
+  std::string project;     // "" = start without a project
+  std::string screenshot;  // "" = interactive
+  int frames = 30;         // --screenshot: frames to paint first
+  int width = 1600, height = 1000;
+};
+
+// Returns the process exit code (0 ok, 1 no display / GL failure, 2 bad project).
+int RunGuiApp(const GuiOptions& options);
+
+}  // namespace fresco

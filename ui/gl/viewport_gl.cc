@@ -1,0 +1,472 @@
+#include "ui/gl/viewport_gl.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "pipeline/render/renderer.h"
+#include "ui/gl/gl.h"
+#include "ui/gl/gl_textures.h"
+
+namespace fresco {
+namespace {
+
+const char* kMeshVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec2 uv;
+layout(location = 2) in float group_id;
+layout(location = 3) in float triangle_id;
+layout(location = 4) in vec3 normal;
+layout(location = 5) in float selected;
+uniform mat4 view_projection;
+out vec2 v_uv;
+out vec3 v_position;
+out vec3 v_normal;
+flat out float v_group;
+flat out int v_triangle;
+flat out float v_selected;
+void main() {
+  v_uv = uv;
+  v_position = position;
+  v_normal = normal;
+  v_group = group_id;
+  v_triangle = int(triangle_id + 0.5);
+  v_selected = selected;
+  gl_Position = view_projection * vec4(position, 1.0);
+})";
+
+const char* kMeshFragment = R"(#version 330 core
+in vec2 v_uv;
+in vec3 v_position;
+in vec3 v_normal;
+flat in float v_group;
+flat in int v_triangle;
+flat in float v_selected;
+uniform int mode;            // 0 painted, 1 groups, 2 frame projected
+uniform sampler2D painted;   // this draw's base buffer
+uniform sampler2D frame;     // the current frame
+uniform mat4 frame_from_local;  // pixel * z = K [R|t] x (pinhole part)
+uniform vec2 frame_size;
+uniform vec3 eye;
+layout(location = 0) out vec4 colour;
+layout(location = 1) out int triangle;
+vec3 GroupColour(float g) {
+  float h = fract(g * 0.618034);
+  vec3 k = vec3(0.0, 2.0 / 3.0, 1.0 / 3.0);
+  return clamp(abs(fract(h + k) * 6.0 - 3.0) - 1.0, 0.0, 1.0) * 0.65 + 0.25;
+}
+void main() {
+  float shade = 0.55 + 0.45 * abs(dot(normalize(v_normal), normalize(eye - v_position)));
+  vec3 base = vec3(0.35);
+  if (v_group < 0.0) {
+    base = vec3(0.25);
+  } else if (mode == 1) {
+    base = GroupColour(v_group) * shade;
+  } else if (mode == 0) {
+    vec4 t = texture(painted, v_uv);
+    bool checker = (int(floor(gl_FragCoord.x / 8.0) + floor(gl_FragCoord.y / 8.0)) & 1) == 1;
+    base = t.a > 0.5 ? t.rgb : vec3(checker ? 0.32 : 0.26) * shade;
+  } else {
+    vec4 p = frame_from_local * vec4(v_position, 1.0);
+    vec2 px = p.xy / p.z;
+    if (p.z > 0.0 && px.x >= -0.5 && px.y >= -0.5 && px.x <= frame_size.x - 0.5 &&
+        px.y <= frame_size.y - 0.5)
+      base = texture(frame, (px + 0.5) / frame_size).rgb;
+    else
+      base = vec3(0.3) * shade;
+  }
+  if (v_selected > 0.5) base = mix(base, vec3(1.0, 0.85, 0.1), 0.55);
+  colour = vec4(base, 1.0);
+  triangle = v_triangle;
+})";
+
+const char* kLineVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 rgb;
+uniform mat4 view_projection;
+out vec3 v_rgb;
+void main() {
+  v_rgb = rgb;
+  gl_Position = view_projection * vec4(position, 1.0);
+})";
+
+const char* kLineFragment = R"(#version 330 core
+in vec3 v_rgb;
+layout(location = 0) out vec4 colour;
+layout(location = 1) out int triangle;
+void main() {
+  colour = vec4(v_rgb, 1.0);
+  triangle = -1;
+})";
+
+GLuint Compile(GLenum type, const char* source) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    std::fprintf(stderr, "fresco gui: shader: %s\n", log);
+  }
+  return shader;
+}
+
+GLuint Link(const char* vertex, const char* fragment) {
+  const GLuint program = glCreateProgram();
+  const GLuint vs = Compile(GL_VERTEX_SHADER, vertex), fs = Compile(GL_FRAGMENT_SHADER, fragment);
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  return program;
+}
+
+// Column-major 4x4 for GL.
+using Mat4 = Eigen::Matrix4f;
+
+Mat4 Perspective(float fov_y_rad, float aspect, float near, float far) {
+  const float f = 1.0f / std::tan(fov_y_rad / 2);
+  Mat4 m = Mat4::Zero();
+  m(0, 0) = f / aspect;
+  m(1, 1) = f;
+  m(2, 2) = (far + near) / (near - far);
+  m(2, 3) = 2 * far * near / (near - far);
+  m(3, 2) = -1;
+  return m;
+}
+
+Mat4 LookAt(const Eigen::Vector3f& eye, const Eigen::Vector3f& target, const Eigen::Vector3f& up) {
+  const Eigen::Vector3f f = (target - eye).normalized();
+  const Eigen::Vector3f s = f.cross(up).normalized();
+  const Eigen::Vector3f u = s.cross(f);
+  Mat4 m = Mat4::Identity();
+  m.block<1, 3>(0, 0) = s.transpose();
+  m.block<1, 3>(1, 0) = u.transpose();
+  m.block<1, 3>(2, 0) = -f.transpose();
+  m(0, 3) = -s.dot(eye);
+  m(1, 3) = -u.dot(eye);
+  m(2, 3) = f.dot(eye);
+  return m;
+}
+
+struct Vertex {
+  float position[3];
+  float uv[2];
+  float group;
+  float triangle;
+  float normal[3];
+  float selected;
+};
+
+struct LineVertex {
+  float position[3];
+  float rgb[3];
+};
+
+}  // namespace
+
+struct GlViewport::Impl {
+  GLuint mesh_program = 0, line_program = 0;
+  GLuint vao = 0, vbo = 0, line_vao = 0, line_vbo = 0;
+  GLuint fbo = 0, colour = 0, ids = 0, depth = 0;
+  int width = 0, height = 0;
+  uint64_t geometry_version = ~0ull;
+  std::set<int> selection;
+  // Draw ranges: buffer b's triangles are vertices [first[b], first[b] + count[b]).
+  std::vector<int> first, count;
+  int ungrouped_first = 0, ungrouped_count = 0;
+  GlTextures textures;
+  bool built = false;
+
+  void Build() {
+    mesh_program = Link(kMeshVertex, kMeshFragment);
+    line_program = Link(kLineVertex, kLineFragment);
+    glGenVertexArrays(1, &vao);
+    glGenBuffers(1, &vbo);
+    glBindVertexArray(vao);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    const GLsizei stride = sizeof(Vertex);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, position));
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, uv));
+    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, group));
+    glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, triangle));
+    glVertexAttribPointer(4, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, normal));
+    glVertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, selected));
+    for (int a = 0; a < 6; ++a) glEnableVertexAttribArray(a);
+    glGenVertexArrays(1, &line_vao);
+    glGenBuffers(1, &line_vbo);
+    glBindVertexArray(line_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, line_vbo);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
+                          (void*)offsetof(LineVertex, position));
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
+                          (void*)offsetof(LineVertex, rgb));
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    glBindVertexArray(0);
+    built = true;
+  }
+
+  void Resize(int w, int h) {
+    if (w == width && h == height && fbo) return;
+    if (fbo) {
+      glDeleteFramebuffers(1, &fbo);
+      glDeleteTextures(1, &colour);
+      glDeleteTextures(1, &ids);
+      glDeleteRenderbuffers(1, &depth);
+    }
+    width = w, height = h;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glGenTextures(1, &colour);
+    glBindTexture(GL_TEXTURE_2D, colour);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour, 0);
+    glGenTextures(1, &ids);
+    glBindTexture(GL_TEXTURE_2D, ids);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32I, w, h, 0, GL_RED_INTEGER, GL_INT, nullptr);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT1, GL_TEXTURE_2D, ids, 0);
+    glGenRenderbuffers(1, &depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+  }
+
+  void Upload(const SessionGeometry& geo, const std::set<int>& selected) {
+    const TriangleMesh& mesh = geo.painted_layout.mesh;
+    const int num_buffers = static_cast<int>(geo.groups.size());
+    std::vector<std::vector<int>> by_buffer(num_buffers + 1);
+    for (int t = 0; t < mesh.NumTriangles(); ++t) {
+      const int b =
+          t < static_cast<int>(geo.buffer_of_triangle.size()) ? geo.buffer_of_triangle[t] : -1;
+      by_buffer[b >= 0 ? b : num_buffers].push_back(t);
+    }
+    std::vector<Vertex> vertices;
+    vertices.reserve(3 * mesh.NumTriangles());
+    first.assign(num_buffers, 0);
+    count.assign(num_buffers, 0);
+    for (int b = 0; b <= num_buffers; ++b) {
+      const int start = static_cast<int>(vertices.size());
+      for (int t : by_buffer[b]) {
+        const Eigen::Vector3d n = mesh.Normal(t);
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d p = mesh.Corner(t, k);
+          Vertex v{};
+          v.position[0] = static_cast<float>(p.x());
+          v.position[1] = static_cast<float>(p.y());
+          v.position[2] = static_cast<float>(p.z());
+          if (t < static_cast<int>(mesh.uvs.size())) {
+            v.uv[0] = mesh.uvs[t][k].x();
+            v.uv[1] = mesh.uvs[t][k].y();
+          }
+          v.group = b < num_buffers ? static_cast<float>(b) : -1.0f;
+          v.triangle = static_cast<float>(t);
+          v.normal[0] = static_cast<float>(n.x());
+          v.normal[1] = static_cast<float>(n.y());
+          v.normal[2] = static_cast<float>(n.z());
+          v.selected = selected.count(t) ? 1.0f : 0.0f;
+          vertices.push_back(v);
+        }
+      }
+      if (b < num_buffers) {
+        first[b] = start;
+        count[b] = static_cast<int>(vertices.size()) - start;
+      } else {
+        ungrouped_first = start;
+        ungrouped_count = static_cast<int>(vertices.size()) - start;
+      }
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, vertices.size() * sizeof(Vertex), vertices.data(),
+                 GL_STATIC_DRAW);
+  }
+};
+
+GlViewport::GlViewport() : impl_(std::make_unique<Impl>()) {}
+
+GlViewport::~GlViewport() {
+  if (!impl_->built) return;
+  glDeleteProgram(impl_->mesh_program);
+  glDeleteProgram(impl_->line_program);
+  glDeleteBuffers(1, &impl_->vbo);
+  glDeleteBuffers(1, &impl_->line_vbo);
+  glDeleteVertexArrays(1, &impl_->vao);
+  glDeleteVertexArrays(1, &impl_->line_vao);
+  if (impl_->fbo) {
+    glDeleteFramebuffers(1, &impl_->fbo);
+    glDeleteTextures(1, &impl_->colour);
+    glDeleteTextures(1, &impl_->ids);
+    glDeleteRenderbuffers(1, &impl_->depth);
+  }
+}
+
+ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& state,
+                               ViewportView* view, int width, int height) {
+  Impl& m = *impl_;
+  if (!m.built) m.Build();
+  m.Resize(width, height);
+  const SessionGeometry& geo = *snapshot.geometry;
+  if (m.geometry_version != snapshot.geometry_version || m.selection != state.selected_triangles) {
+    m.Upload(geo, state.selected_triangles);
+    m.geometry_version = snapshot.geometry_version;
+    m.selection = state.selected_triangles;
+  }
+  // The orbit camera, in the scene's local frame; fitted to the model on first use.
+  const Scene& scene = geo.painted_layout;
+  Eigen::Vector3d lo, hi;
+  scene.Bounds(&lo, &hi);
+  const Eigen::Vector3f centre = (0.5 * (lo + hi)).cast<float>();
+  const float radius = std::max(1e-3f, static_cast<float>(0.5 * (hi - lo).norm()));
+  const float fov = 50.0f * static_cast<float>(M_PI) / 180;
+  if (!view->target_set) {
+    for (int k = 0; k < 3; ++k) view->target[k] = centre[k];
+    view->target_set = true;
+  }
+  if (view->distance_m <= 0) view->distance_m = 1.3f * radius / std::sin(fov / 2);
+  const float yaw = view->yaw_deg * static_cast<float>(M_PI) / 180;
+  const float pitch = view->pitch_deg * static_cast<float>(M_PI) / 180;
+  const Eigen::Vector3f target(view->target[0], view->target[1], view->target[2]);
+  const Eigen::Vector3f eye =
+      target + view->distance_m * Eigen::Vector3f(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
+                                                  std::cos(pitch) * std::cos(yaw));
+  const float near = std::max(1e-3f, 0.01f * view->distance_m);
+  const Mat4 view_projection = Perspective(fov, static_cast<float>(width) / height, near,
+                                           10.0f * (view->distance_m + radius)) *
+                               LookAt(eye, target, Eigen::Vector3f::UnitY());
+
+  GLint previous_fbo = 0, previous_viewport[4];
+  glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
+  glGetIntegerv(GL_VIEWPORT, previous_viewport);
+  glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
+  const GLenum outputs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, outputs);
+  glViewport(0, 0, width, height);
+  const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
+  const GLint no_triangle[4] = {-1, -1, -1, -1};
+  glClearBufferfv(GL_COLOR, 0, background);
+  glClearBufferiv(GL_COLOR, 1, no_triangle);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
+
+  // The frame's projection for the preview: pixel * z = K [R|t] x_local (pinhole part).
+  const Rigid3d cam_from_local = CamFromLocal(scene, snapshot.cam_from_world);
+  Eigen::Matrix4f frame_from_local = Eigen::Matrix4f::Zero();
+  const Camera& cam = geo.camera;
+  Eigen::Matrix3d K;
+  K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
+  frame_from_local.block<3, 3>(0, 0) = (K * cam_from_local.RotationMatrix()).cast<float>();
+  frame_from_local.block<3, 1>(0, 3) = (K * cam_from_local.translation).cast<float>();
+  frame_from_local(3, 3) = 1;
+
+  glUseProgram(m.mesh_program);
+  glUniformMatrix4fv(glGetUniformLocation(m.mesh_program, "view_projection"), 1, GL_FALSE,
+                     view_projection.data());
+  glUniformMatrix4fv(glGetUniformLocation(m.mesh_program, "frame_from_local"), 1, GL_FALSE,
+                     frame_from_local.data());
+  glUniform2f(glGetUniformLocation(m.mesh_program, "frame_size"), static_cast<float>(cam.width),
+              static_cast<float>(cam.height));
+  glUniform3f(glGetUniformLocation(m.mesh_program, "eye"), eye.x(), eye.y(), eye.z());
+  glUniform1i(glGetUniformLocation(m.mesh_program, "mode"), static_cast<int>(view->mode));
+  glUniform1i(glGetUniformLocation(m.mesh_program, "painted"), 0);
+  glUniform1i(glGetUniformLocation(m.mesh_program, "frame"), 1);
+  glActiveTexture(GL_TEXTURE1);
+  const bool projected = view->mode == ViewportView::Mode::kProjected && snapshot.has_pose &&
+                         !snapshot.frame_bgr.empty();
+  GLuint frame_texture = 0;
+  if (projected)
+    frame_texture = static_cast<GLuint>(
+        reinterpret_cast<intptr_t>(m.textures.Get("frame", snapshot.frame_bgr, snapshot.version)));
+  glBindTexture(GL_TEXTURE_2D, frame_texture);
+  glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(m.vao);
+  for (size_t b = 0; b < m.first.size(); ++b) {
+    GLuint texture = 0;
+    if (snapshot.painted && b < snapshot.painted->size())
+      texture = static_cast<GLuint>(reinterpret_cast<intptr_t>(m.textures.Get(
+          "buffer/" + std::to_string(b), (*snapshot.painted)[b], snapshot.painted_version)));
+    glBindTexture(GL_TEXTURE_2D, texture);
+    if (m.count[b] > 0) glDrawArrays(GL_TRIANGLES, m.first[b], m.count[b]);
+  }
+  if (m.ungrouped_count > 0) glDrawArrays(GL_TRIANGLES, m.ungrouped_first, m.ungrouped_count);
+
+  // Lines: the path (grey), the current camera's frustum (yellow).
+  std::vector<LineVertex> lines;
+  auto centre_of = [&](const Rigid3d& cam_from_world) {
+    return CamFromLocal(scene, cam_from_world).Centre().cast<float>();
+  };
+  auto add = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, float g, float bl) {
+    lines.push_back({{a.x(), a.y(), a.z()}, {r, g, bl}});
+    lines.push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
+  };
+  if (view->show_path)
+    for (size_t i = 1; i < geo.path.size(); ++i)
+      add(centre_of(geo.path[i - 1]), centre_of(geo.path[i]), 0.6f, 0.6f, 0.65f);
+  if (view->show_frustum && snapshot.has_pose) {
+    const Rigid3d local_from_cam = cam_from_local.Inverse();
+    const float depth = 0.25f * radius;
+    const Eigen::Vector3f c = local_from_cam.translation.cast<float>();
+    Eigen::Vector3f corners[4];
+    const double px[4][2] = {{-0.5, -0.5},
+                             {cam.width - 0.5, -0.5},
+                             {cam.width - 0.5, cam.height - 0.5},
+                             {-0.5, cam.height - 0.5}};
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d ray((px[k][0] - cam.cx) / cam.fx, (px[k][1] - cam.cy) / cam.fy, 1.0);
+      corners[k] = (local_from_cam * (ray * depth)).cast<float>();
+    }
+    for (int k = 0; k < 4; ++k) {
+      add(c, corners[k], 1.0f, 0.85f, 0.1f);
+      add(corners[k], corners[(k + 1) % 4], 1.0f, 0.85f, 0.1f);
+    }
+  }
+  if (!lines.empty()) {
+    glDisable(GL_DEPTH_TEST);  // drawn over the model: a path inside a room stays visible
+    glUseProgram(m.line_program);
+    glUniformMatrix4fv(glGetUniformLocation(m.line_program, "view_projection"), 1, GL_FALSE,
+                       view_projection.data());
+    glBindVertexArray(m.line_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, m.line_vbo);
+    glBufferData(GL_ARRAY_BUFFER, lines.size() * sizeof(LineVertex), lines.data(), GL_STREAM_DRAW);
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size()));
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, previous_fbo);
+  glViewport(previous_viewport[0], previous_viewport[1], previous_viewport[2],
+             previous_viewport[3]);
+  m.textures.EndFrame();
+  return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(m.colour));
+}
+
+int GlViewport::Pick(int x, int y) {
+  Impl& m = *impl_;
+  if (!m.fbo || x < 0 || y < 0 || x >= m.width || y >= m.height) return -1;
+  GLint previous_fbo = 0;
+  glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, m.fbo);
+  glReadBuffer(GL_COLOR_ATTACHMENT1);
+  GLint id = -1;
+  glReadPixels(x, y, 1, 1, GL_RED_INTEGER, GL_INT, &id);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, previous_fbo);
+  return id;
+}
+
+}  // namespace fresco

@@ -1,0 +1,166 @@
+// Grouping editor (paper §3.6): the automatic grouping's angle and texel size with live
+// re-grouping; the groups the session built (one per base buffer); merge, split, move
+// triangles and per-group texel size on the selection (groups here, triangles picked in the
+// 3D view); all undoable, stored in the project as explicit groups and honoured by
+// `fresco run`.
+#include <algorithm>
+
+#include "ui/core/panel.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+class GroupingPanel : public Panel {
+ public:
+  const char* Title() const override { return "Grouping"; }
+
+  void Draw(UiContext& ui) override {
+    if (!BeginPanel(*this)) {
+      ImGui::End();
+      return;
+    }
+    AppState& state = *ui.state;
+    const RunnerSnapshot& snap = *ui.snapshot;
+    if (!state.has_project || !snap.geometry) {
+      ImGui::TextDisabled("no project painting");
+      ImGui::End();
+      return;
+    }
+    const SessionGeometry& geo = *snap.geometry;
+    const int num_triangles = static_cast<int>(geo.buffer_of_triangle.size());
+    const bool explicit_groups = !state.project.grouping.groups.empty();
+    ImGui::TextWrapped("%s: %zu groups for %d triangles (%d split for fold-over)",
+                       explicit_groups ? "stored groups" : "automatic", geo.groups.size(),
+                       num_triangles, geo.folds_split);
+
+    // Automatic grouping parameters: re-group when a slider is released.
+    if (!ImGui::IsAnyItemActive()) {
+      angle_ = static_cast<float>(state.project.grouping.angle_deg);
+      texel_ = static_cast<float>(state.project.pipeline.texel_size_m);
+    }
+    ImGui::SliderFloat("angle deg", &angle_, 0.0f, 90.0f, "%.1f");
+    const bool angle_done = ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::DragFloat("texel m (0 = auto)", &texel_, 0.0005f, 0.0f, 1.0f, "%.4f");
+    const bool texel_done = ImGui::IsItemDeactivatedAfterEdit();
+    if (angle_done || texel_done) {
+      state.BeginEdit();
+      state.project.grouping.angle_deg = angle_;
+      state.project.pipeline.texel_size_m = texel_;
+      if (angle_done) {  // back to the automatic grouping with the new angle
+        state.project.grouping.groups.clear();
+        state.project.grouping.edits.clear();
+      }
+      ApplyProject(ui);
+    }
+    if (explicit_groups && ImGui::Button("Back to automatic")) {
+      state.BeginEdit();
+      state.project.grouping.groups.clear();
+      state.project.grouping.edits.clear();
+      ApplyProject(ui);
+    }
+    if (!explicit_groups && ImGui::Button("Store these groups in the project")) {
+      state.BeginEdit();
+      state.project.grouping.groups = geo.groups;
+      state.project.grouping.edits.clear();
+    }
+
+    // The groups; click to select (ctrl-click adds).
+    if (ImGui::BeginTable(
+            "groups", 4,
+            ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_BordersInnerV,
+            ImVec2(0, 200))) {
+      ImGui::TableSetupColumn("group");
+      ImGui::TableSetupColumn("triangles");
+      ImGui::TableSetupColumn("texels");
+      ImGui::TableSetupColumn("texel m");
+      ImGui::TableHeadersRow();
+      for (size_t g = 0; g < geo.groups.size(); ++g) {
+        ImGui::TableNextRow();
+        ImGui::TableSetColumnIndex(0);
+        const bool selected = state.selected_groups.count(static_cast<int>(g)) > 0;
+        if (ImGui::Selectable(std::to_string(g).c_str(), selected,
+                              ImGuiSelectableFlags_SpanAllColumns)) {
+          if (!ImGui::GetIO().KeyCtrl) state.selected_groups.clear();
+          if (selected && ImGui::GetIO().KeyCtrl)
+            state.selected_groups.erase(static_cast<int>(g));
+          else
+            state.selected_groups.insert(static_cast<int>(g));
+        }
+        ImGui::TableSetColumnIndex(1);
+        ImGui::Text("%zu", geo.groups[g].triangles.size());
+        ImGui::TableSetColumnIndex(2);
+        ImGui::Text("%d", geo.buffer_texels[g]);
+        ImGui::TableSetColumnIndex(3);
+        if (geo.groups[g].texel_size_m > 0)
+          ImGui::Text("%.4f", geo.groups[g].texel_size_m);
+        else
+          ImGui::TextDisabled("default");
+      }
+      ImGui::EndTable();
+    }
+    ImGui::Text("selected: %zu groups, %zu triangles (pick in the 3D view)",
+                state.selected_groups.size(), state.selected_triangles.size());
+    if (ImGui::SmallButton("clear selection")) {
+      state.selected_groups.clear();
+      state.selected_triangles.clear();
+    }
+
+    // Edits on the selection.
+    std::vector<GroupSpec> result;
+    ImGui::BeginDisabled(state.selected_groups.size() < 2);
+    if (ImGui::Button("Merge groups"))
+      Commit(ui, MergeGroups(geo.groups, num_triangles, state.selected_groups, &result), result);
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(state.selected_triangles.empty());
+    if (ImGui::Button("Split triangles"))
+      Commit(ui, SplitTriangles(geo.groups, num_triangles, state.selected_triangles, &result),
+             result);
+    ImGui::SetNextItemWidth(80);
+    ImGui::InputInt("##target", &target_group_);
+    ImGui::SameLine();
+    if (ImGui::Button("Move triangles to group"))
+      Commit(ui,
+             MoveTriangles(geo.groups, num_triangles, state.selected_triangles, target_group_,
+                           &result),
+             result);
+    ImGui::EndDisabled();
+    ImGui::BeginDisabled(state.selected_groups.empty());
+    ImGui::SetNextItemWidth(80);
+    ImGui::InputFloat("##texel", &group_texel_, 0, 0, "%.4f");
+    ImGui::SameLine();
+    if (ImGui::Button("Set texel size (m)"))
+      Commit(ui,
+             SetGroupTexelSize(geo.groups, num_triangles, state.selected_groups, group_texel_,
+                               &result),
+             result);
+    ImGui::EndDisabled();
+    ImGui::End();
+  }
+
+ private:
+  static void Commit(UiContext& ui, const Status& status, const std::vector<GroupSpec>& groups) {
+    AppState& state = *ui.state;
+    if (!status.ok()) {
+      state.message = "error: " + status.message();
+      return;
+    }
+    state.BeginEdit();
+    state.project.grouping.groups = groups;
+    state.project.grouping.edits.clear();
+    state.selected_groups.clear();
+    state.selected_triangles.clear();
+    state.message = "grouping edited: " + std::to_string(groups.size()) + " groups";
+    ApplyProject(ui);
+  }
+
+  float angle_ = 20, texel_ = 0, group_texel_ = 0.01f;
+  int target_group_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Panel> MakeGroupingPanel() { return std::make_unique<GroupingPanel>(); }
+
+}  // namespace fresco

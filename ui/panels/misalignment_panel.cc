@@ -1,0 +1,82 @@
+// Misalignment review: the painted model (as it was before the current frame) rendered into
+// the frame's view, shown against the frame as a blink, an overlay or a heat map of their
+// difference; the per-frame difference along the sequence; the worst frames, one click away.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <imgui.h>
+#include <opencv2/imgproc.hpp>
+
+#include "ui/core/panel.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+class MisalignmentPanel : public Panel {
+ public:
+  const char* Title() const override { return "Misalignment"; }
+
+  void Draw(UiContext& ui) override {
+    if (!BeginPanel(*this)) {
+      ImGui::End();
+      return;
+    }
+    const RunnerSnapshot& snap = *ui.snapshot;
+    ImGui::RadioButton("heat map", &mode_, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("overlay", &mode_, 1);
+    ImGui::SameLine();
+    ImGui::RadioButton("blink", &mode_, 2);
+    if (snap.rephoto_bgr.empty() || snap.frame_bgr.empty()) {
+      ImGui::TextDisabled("(shown for paused or stepped frames once something is painted)");
+    } else if (mode_ == 0) {
+      ShowImage(ui, "misalignment/heat", snap.difference_heat, snap.version);
+    } else {
+      cv::Mat frame;
+      cv::resize(snap.frame_bgr, frame, snap.rephoto_bgr.size(), 0, 0, cv::INTER_AREA);
+      if (mode_ == 1) {
+        cv::Mat overlay;
+        cv::addWeighted(frame, 0.5, snap.rephoto_bgr, 0.5, 0.0, overlay);
+        ShowImage(ui, "misalignment/overlay", overlay, snap.version);
+      } else {
+        const bool show_frame = static_cast<int>(ImGui::GetTime() * 2.0) % 2 == 0;
+        ShowImage(ui, show_frame ? "misalignment/frame" : "misalignment/rephoto",
+                  show_frame ? frame : snap.rephoto_bgr, snap.version);
+        ImGui::TextDisabled(show_frame ? "frame" : "painted model");
+      }
+    }
+    // The difference along the sequence (grey levels, 0..255), and the worst frames.
+    const std::vector<float>& d = snap.misalignment;
+    std::vector<float> plot(d.size());
+    for (size_t i = 0; i < d.size(); ++i) plot[i] = std::isnan(d[i]) ? 0.0f : d[i];
+    ImGui::PlotLines("##difference", plot.data(), static_cast<int>(plot.size()), 0,
+                     "mean |grey difference| to the buffers, per frame", 0.0f, FLT_MAX,
+                     ImVec2(ImGui::GetContentRegionAvail().x, 80));
+    std::vector<size_t> order(d.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return plot[a] > plot[b]; });
+    ImGui::Text("worst frames:");
+    for (size_t k = 0; k < std::min<size_t>(5, order.size()); ++k) {
+      const size_t i = order[k];
+      if (plot[i] <= 0) break;
+      const int frame = snap.frames_painted[i];
+      ImGui::PushID(static_cast<int>(k));
+      if (ImGui::SmallButton("go")) ui.runner->Seek(frame);
+      ImGui::PopID();
+      ImGui::SameLine();
+      ImGui::Text("frame %d: %.2f", frame, plot[i]);
+    }
+    ImGui::End();
+  }
+
+ private:
+  int mode_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Panel> MakeMisalignmentPanel() { return std::make_unique<MisalignmentPanel>(); }
+
+}  // namespace fresco

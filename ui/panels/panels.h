@@ -1,0 +1,31 @@
+// The panels, one factory per file in ui/panels/ (registered in panel_registry.cc), and the
+// app-level actions they share.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "ui/core/panel.h"
+
+namespace fresco {
+
+std::unique_ptr<Panel> MakeProjectPanel();
+std::unique_ptr<Panel> MakePipelinePanel();
+std::unique_ptr<Panel> MakeViewportPanel();
+std::unique_ptr<Panel> MakeGroupingPanel();
+// A stage panel shows one pipeline stage's metrics and debug images for the current frame.
+std::unique_ptr<Panel> MakeStagePanel(const std::string& stage, const std::string& title);
+std::unique_ptr<Panel> MakeInputFramePanel();
+std::unique_ptr<Panel> MakePaintedBuffersPanel();
+std::unique_ptr<Panel> MakeTimingPanel();
+std::unique_ptr<Panel> MakeMisalignmentPanel();
+
+// Opens `path` (after the unsaved-changes prompt when the project has edits; the app frame
+// shows it) and restarts the pipeline on it.
+void RequestOpen(UiContext& ui, const std::string& path);
+// Restarts the pipeline with the project as edited (settings and grouping).
+void ApplyProject(UiContext& ui);
+// Undo (or redo) one edit; restarts the pipeline when the grouping changed.
+void UndoRedo(UiContext& ui, bool undo);
+
+}  // namespace fresco

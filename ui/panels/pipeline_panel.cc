@@ -1,0 +1,106 @@
+// Pipeline: play, pause, step, seek, restart; and the settings of every stage, edited in the
+// project (undoable) and applied by restarting the worker.
+#include <algorithm>
+
+#include "ui/core/panel.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+class PipelinePanel : public Panel {
+ public:
+  const char* Title() const override { return "Pipeline"; }
+
+  void Draw(UiContext& ui) override {
+    if (!BeginPanel(*this)) {
+      ImGui::End();
+      return;
+    }
+    const RunnerSnapshot& snap = *ui.snapshot;
+    AppState& state = *ui.state;
+    ImGui::BeginDisabled(!state.has_project);
+    if (snap.playing) {
+      if (ImGui::Button("Pause")) ui.runner->Pause();
+    } else if (ImGui::Button("Play")) {
+      ui.runner->Play();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Step")) ui.runner->Step();
+    ImGui::SameLine();
+    if (ImGui::Button("Restart")) ApplyProject(ui);
+    const int last = snap.geometry ? std::max(0, snap.geometry->num_frames - 1) : 0;
+    if (!ImGui::IsItemActive()) seek_ = std::max(0, snap.frame);
+    ImGui::SetNextItemWidth(-60);
+    ImGui::SliderInt("##seek", &seek_, 0, last, "frame %d");
+    if (ImGui::IsItemDeactivatedAfterEdit()) ui.runner->Seek(seek_);
+    ImGui::SameLine();
+    ImGui::Text("/ %d", last);
+    ImGui::EndDisabled();
+    ImGui::Text("%s", snap.status.c_str());
+    if (snap.geometry)
+      ImGui::Text("%zu base buffers, texel %.4f m, coverage %.1f %%", snap.geometry->groups.size(),
+                  snap.geometry->texel_size_m, 100.0 * snap.coverage);
+
+    ImGui::Separator();
+    ImGui::TextDisabled("Settings (Apply restarts painting)");
+    if (!ImGui::IsAnyItemActive()) edit_ = state.project.pipeline;
+    PipelineOptions& p = edit_;
+    bool commit = false;
+    auto done = [&] { commit |= ImGui::IsItemDeactivatedAfterEdit(); };
+    const char* sampling[] = {"nearest", "bilinear", "area"};
+    int mode = static_cast<int>(p.sampling);
+    if (ImGui::Combo("sampling", &mode, sampling, 3)) {
+      p.sampling = static_cast<SamplingMode>(mode);
+      commit = true;
+    }
+    float texel = static_cast<float>(p.texel_size_m);
+    if (ImGui::DragFloat("texel size m (0 = auto)", &texel, 0.0005f, 0.0f, 1.0f, "%.4f"))
+      p.texel_size_m = texel;
+    done();
+    ImGui::DragInt("max buffer texels", &p.max_buffer_texels, 4096, 1, 1 << 26);
+    done();
+    const char* policies[] = {"latest", "quality"};
+    int policy = static_cast<int>(p.update);
+    if (ImGui::Combo("update", &policy, policies, 2)) {
+      p.update = static_cast<UpdatePolicy>(policy);
+      commit = true;
+    }
+    float slack = static_cast<float>(p.quality_slack);
+    if (ImGui::SliderFloat("quality slack", &slack, 0.0f, 1.0f)) p.quality_slack = slack;
+    done();
+    ImGui::SliderInt("update every", &p.update_every, 1, 60);
+    done();
+    if (ImGui::Checkbox("occlusion test", &p.occlusion.enabled)) commit = true;
+    float rel = static_cast<float>(p.occlusion.tolerance_rel);
+    if (ImGui::SliderFloat("tolerance (of depth)", &rel, 0.0f, 0.1f, "%.3f"))
+      p.occlusion.tolerance_rel = rel;
+    done();
+    float abs_m = static_cast<float>(p.occlusion.tolerance_m);
+    if (ImGui::SliderFloat("tolerance m", &abs_m, 0.0f, 0.1f, "%.4f"))
+      p.occlusion.tolerance_m = abs_m;
+    done();
+    float angle = static_cast<float>(p.occlusion.max_view_angle_deg);
+    if (ImGui::SliderFloat("max view angle deg", &angle, 1.0f, 90.0f, "%.1f"))
+      p.occlusion.max_view_angle_deg = angle;
+    done();
+    if (commit && !(edit_ == state.project.pipeline)) {
+      state.BeginEdit();
+      state.project.pipeline = edit_;
+    }
+    ImGui::BeginDisabled(!state.has_project);
+    if (ImGui::Button("Apply")) ApplyProject(ui);
+    ImGui::EndDisabled();
+    ImGui::End();
+  }
+
+ private:
+  int seek_ = 0;
+  PipelineOptions edit_;
+};
+
+}  // namespace
+
+std::unique_ptr<Panel> MakePipelinePanel() { return std::make_unique<PipelinePanel>(); }
+
+}  // namespace fresco

@@ -1,0 +1,100 @@
+// 3D view: the model with its live painted textures, the base-buffer groups in distinct
+// colours, or the current frame projected onto the model; the current camera's frustum and
+// the path. Drag to orbit, right-drag to pan, wheel to zoom, click to pick a triangle
+// (shift-click adds to the selection) for the grouping editor.
+#include <algorithm>
+#include <cmath>
+
+#include "ui/core/panel.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+class ViewportPanel : public Panel {
+ public:
+  const char* Title() const override { return "3D view"; }
+
+  void Draw(UiContext& ui) override {
+    if (!BeginPanel(*this)) {
+      ImGui::End();
+      return;
+    }
+    int mode = static_cast<int>(view_.mode);
+    ImGui::RadioButton("painted", &mode, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("groups", &mode, 1);
+    ImGui::SameLine();
+    ImGui::RadioButton("frame projected", &mode, 2);
+    view_.mode = static_cast<ViewportView::Mode>(mode);
+    ImGui::Checkbox("path", &view_.show_path);
+    ImGui::SameLine();
+    ImGui::Checkbox("frustum", &view_.show_frustum);
+    ImGui::SameLine();
+    if (ImGui::SmallButton("reset view")) view_ = ViewportView{view_.mode};
+
+    const ImVec2 avail = ImGui::GetContentRegionAvail();
+    const int w = std::max(16, static_cast<int>(avail.x)),
+              h = std::max(16, static_cast<int>(avail.y));
+    if (!ui.viewport || !ui.snapshot->geometry) {
+      ImGui::TextDisabled("no model");
+      ImGui::End();
+      return;
+    }
+    const ImTextureID image = ui.viewport->Render(*ui.snapshot, *ui.state, &view_, w, h);
+    const ImVec2 origin = ImGui::GetCursorScreenPos();
+    // The offscreen image is bottom-up (OpenGL): flip it.
+    ImGui::Image(image, ImVec2(static_cast<float>(w), static_cast<float>(h)), ImVec2(0, 1),
+                 ImVec2(1, 0));
+    HandleMouse(ui, origin, w, h);
+    ImGui::End();
+  }
+
+ private:
+  void HandleMouse(UiContext& ui, ImVec2 origin, int w, int h) {
+    if (!ImGui::IsItemHovered()) return;
+    ImGuiIO& io = ImGui::GetIO();
+    if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+      view_.yaw_deg -= io.MouseDelta.x * 0.4f;
+      view_.pitch_deg = std::clamp(view_.pitch_deg + io.MouseDelta.y * 0.4f, -89.0f, 89.0f);
+    }
+    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right) ||
+        ImGui::IsMouseDragging(ImGuiMouseButton_Middle)) {
+      // Pan in the view plane, by the distance so a texel-sized drag stays texel-sized.
+      const float yaw = view_.yaw_deg * static_cast<float>(M_PI) / 180,
+                  pitch = view_.pitch_deg * static_cast<float>(M_PI) / 180;
+      const float scale = std::max(view_.distance_m, 0.1f) / h;
+      const float right[3] = {std::cos(yaw), 0, -std::sin(yaw)};
+      const float up[3] = {-std::sin(pitch) * std::sin(yaw), std::cos(pitch),
+                           -std::sin(pitch) * std::cos(yaw)};
+      for (int k = 0; k < 3; ++k)
+        view_.target[k] += (-io.MouseDelta.x * right[k] + io.MouseDelta.y * up[k]) * scale;
+    }
+    if (io.MouseWheel != 0) view_.distance_m *= std::pow(0.9f, io.MouseWheel);
+    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && !dragged_) {
+      const int x = static_cast<int>(io.MousePos.x - origin.x);
+      const int y = h - 1 - static_cast<int>(io.MousePos.y - origin.y);  // GL rows go up
+      const int triangle = ui.viewport->Pick(x, y);
+      AppState& state = *ui.state;
+      if (!io.KeyShift) state.selected_triangles.clear();
+      if (triangle >= 0) {
+        state.selected_triangles.insert(triangle);
+        const auto& of = ui.snapshot->geometry->buffer_of_triangle;
+        state.message = "picked triangle " + std::to_string(triangle) + " (group " +
+                        std::to_string(triangle < static_cast<int>(of.size()) ? of[triangle] : -1) +
+                        ")";
+      }
+    }
+    dragged_ = ImGui::IsMouseDragging(ImGuiMouseButton_Left, 2.0f);
+    (void)w;
+  }
+
+  ViewportView view_;
+  bool dragged_ = false;
+};
+
+}  // namespace
+
+std::unique_ptr<Panel> MakeViewportPanel() { return std::make_unique<ViewportPanel>(); }
+
+}  // namespace fresco
