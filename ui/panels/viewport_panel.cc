@@ -1,7 +1,7 @@
 // 3D view: the model with its live painted textures, the base-buffer groups in distinct
 // colours, or the current frame projected onto the model; the current camera's frustum and
 // the path. Drag to orbit, right-drag to pan, wheel to zoom, click to pick a triangle
-// (shift-click adds to the selection) for the grouping editor.
+// (shift-click adds to the selection; ctrl-click selects its group) for the grouping editor.
 #include <algorithm>
 #include <cmath>
 
@@ -76,14 +76,17 @@ class ViewportPanel : public Panel {
       const int y = h - 1 - static_cast<int>(io.MousePos.y - origin.y);  // GL rows go up
       const int triangle = ui.viewport->Pick(x, y);
       AppState& state = *ui.state;
-      if (!io.KeyShift) state.selected_triangles.clear();
-      if (triangle >= 0) {
-        state.selected_triangles.insert(triangle);
-        const auto& of = ui.snapshot->geometry->buffer_of_triangle;
-        state.message = "picked triangle " + std::to_string(triangle) + " (group " +
-                        std::to_string(triangle < static_cast<int>(of.size()) ? of[triangle] : -1) +
-                        ")";
+      const auto& of = ui.snapshot->geometry->buffer_of_triangle;
+      const int group = triangle >= 0 && triangle < static_cast<int>(of.size()) ? of[triangle] : -1;
+      if (io.KeyCtrl) {  // ctrl-click: the triangle's group, for merging and texel sizes
+        if (group >= 0) state.selected_groups.insert(group);
+      } else {
+        if (!io.KeyShift) state.selected_triangles.clear();
+        if (triangle >= 0) state.selected_triangles.insert(triangle);
       }
+      if (triangle >= 0)
+        state.message = "picked triangle " + std::to_string(triangle) + " (group " +
+                        std::to_string(group) + ")";
     }
     dragged_ = ImGui::IsMouseDragging(ImGuiMouseButton_Left, 2.0f);
     (void)w;
