@@ -54,6 +54,25 @@ const std::vector<std::pair<UpdatePolicy, std::string>>& UpdatePolicyNames() {
   return names;
 }
 
+const std::vector<std::pair<RefineMode, std::string>>& RefineModeNames() {
+  static const std::vector<std::pair<RefineMode, std::string>> names = {
+      {RefineMode::kOff, "off"},
+      {RefineMode::kPaper, "paper"},
+      {RefineMode::kRobust, "robust"},
+  };
+  return names;
+}
+
+const std::vector<std::pair<RefineModelLimit, std::string>>& RefineModelNames() {
+  static const std::vector<std::pair<RefineModelLimit, std::string>> names = {
+      {RefineModelLimit::kTranslation, "translation"},
+      {RefineModelLimit::kSimilarity, "similarity"},
+      {RefineModelLimit::kAffine, "affine"},
+      {RefineModelLimit::kHomography, "homography"},
+  };
+  return names;
+}
+
 // ---- The fields, each listed once. ----------------------------------------------------------
 
 template <class V>
@@ -62,6 +81,19 @@ void Fields(OcclusionOptions& o, V& v) {
   v.Field("tolerance_rel", o.tolerance_rel, {.min = 0});
   v.Field("tolerance_m", o.tolerance_m, {.min = 0});
   v.Field("max_view_angle_deg", o.max_view_angle_deg, {.min = 0, .min_exclusive = true, .max = 90});
+}
+
+template <class V>
+void Fields(RefineOptions& o, V& v) {
+  v.Enum("mode", o.mode, RefineModeNames());
+  v.Enum("max_model", o.max_model, RefineModelNames());
+  v.Field("max_corners", o.max_corners, {.min = 3});
+  v.Field("search_px", o.search_px, {.min = 1});
+  v.Field("window_px", o.window_px, {.min = 1, .max = 64});
+  v.Field("pyramid_levels", o.pyramid_levels, {.min = 0, .max = 8});
+  v.Field("ransac_px", o.ransac_px, {.min = 0, .min_exclusive = true});
+  v.Field("max_scale_change", o.max_scale_change, {.min = 0, .min_exclusive = true, .max = 1});
+  v.Field("min_inliers", o.min_inliers, {.min = 3});
 }
 
 template <class V>
@@ -76,6 +108,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Field("threads", o.threads, {.min = 0});
   v.Field("debug_images", o.debug_images);
   v.Object("occlusion", o.occlusion);
+  v.Object("refine", o.refine);
 }
 
 template <class V>
@@ -121,12 +154,13 @@ void Fields(Project& p, V& v) {
 // A new member must be added to its Fields() above (read and written) and to the test's
 // NonDefaultProject(); then update the size here. (x86-64 Linux sizes.)
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 88, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 48, "see Fields(RefineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 136, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 352, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 400, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

@@ -29,6 +29,25 @@ struct OcclusionOptions {
   bool operator==(const OcclusionOptions&) const = default;
 };
 
+// Texture alignment refinement (paper §3.5, refine_alignment.h).
+enum class RefineMode { kOff, kPaper, kRobust };
+// The most general 2D motion model refinement may choose (model selection picks simpler
+// ones when the evidence does not need more).
+enum class RefineModelLimit { kTranslation, kSimilarity, kAffine, kHomography };
+struct RefineOptions {
+  RefineMode mode = RefineMode::kOff;
+  RefineModelLimit max_model = RefineModelLimit::kHomography;
+  int max_corners = 150;      // corners tracked per buffer and frame
+  int search_px = 12;         // largest correction looked for, texels (else: no correction)
+  int window_px = 7;          // matching window half-size, texels
+  int pyramid_levels = 3;     // coarse-to-fine levels (robust mode)
+  double ransac_px = 1.5;     // inlier threshold, texels
+  double max_scale_change = 0.05;  // a fit that scales or shears more is refused
+  int min_inliers = 10;
+
+  bool operator==(const RefineOptions&) const = default;
+};
+
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
@@ -40,6 +59,7 @@ struct PipelineOptions {
   int threads = 0;             // 0 = all cores
   bool debug_images = false;   // write per-stage debug images (costs time)
   OcclusionOptions occlusion;
+  RefineOptions refine;
 
   bool operator==(const PipelineOptions&) const = default;
 };

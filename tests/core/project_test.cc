@@ -66,6 +66,15 @@ Project NonDefaultProject() {
   p.pipeline.occlusion.tolerance_rel = 0.05;
   p.pipeline.occlusion.tolerance_m = 0.01;
   p.pipeline.occlusion.max_view_angle_deg = 75.5;
+  p.pipeline.refine.mode = RefineMode::kPaper;
+  p.pipeline.refine.max_model = RefineModelLimit::kAffine;
+  p.pipeline.refine.max_corners = 77;
+  p.pipeline.refine.search_px = 9;
+  p.pipeline.refine.window_px = 5;
+  p.pipeline.refine.pyramid_levels = 2;
+  p.pipeline.refine.ransac_px = 0.75;
+  p.pipeline.refine.max_scale_change = 0.02;
+  p.pipeline.refine.min_inliers = 8;
   p.grouping.angle_deg = 12.5;
   GroupingEdit merge;
   merge.op = "merge";

@@ -1,0 +1,393 @@
+#include "pipeline/paint/refine_alignment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+namespace fresco {
+namespace {
+
+cv::Mat Grey(const cv::Mat& image) {
+  cv::Mat grey;
+  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+cv::Point2d Apply(const cv::Matx33d& H, const cv::Point2d& p) {
+  const double w = H(2, 0) * p.x + H(2, 1) * p.y + H(2, 2);
+  return {(H(0, 0) * p.x + H(0, 1) * p.y + H(0, 2)) / w,
+          (H(1, 0) * p.x + H(1, 1) * p.y + H(1, 2)) / w};
+}
+
+double SumSquared(const cv::Matx33d& H, const std::vector<cv::Point2f>& from,
+                  const std::vector<cv::Point2f>& to) {
+  double sum = 0;
+  for (size_t i = 0; i < from.size(); ++i) {
+    const cv::Point2d d = Apply(H, from[i]) - cv::Point2d(to[i]);
+    sum += d.dot(d);
+  }
+  return sum;
+}
+
+int NumParams(MotionModel m) {
+  switch (m) {
+    case MotionModel::kNone:
+      return 0;
+    case MotionModel::kTranslation:
+      return 2;
+    case MotionModel::kSimilarity:
+      return 4;
+    case MotionModel::kAffine:
+      return 6;
+    case MotionModel::kHomography:
+      return 8;
+  }
+  return 0;
+}
+
+// Least squares fit of `model` to the matches (coordinates centred on `centre` for
+// conditioning). Returns false when the system is degenerate.
+bool FitModel(MotionModel model, const std::vector<cv::Point2f>& from,
+              const std::vector<cv::Point2f>& to, const cv::Point2d& centre, cv::Matx33d* H) {
+  const int n = static_cast<int>(from.size());
+  const cv::Matx33d shift(1, 0, -centre.x, 0, 1, -centre.y, 0, 0, 1);
+  const cv::Matx33d unshift(1, 0, centre.x, 0, 1, centre.y, 0, 0, 1);
+  cv::Matx33d M = cv::Matx33d::eye();
+  if (model == MotionModel::kNone) {
+    *H = M;
+    return true;
+  }
+  if (model == MotionModel::kTranslation) {
+    cv::Point2d t(0, 0);
+    for (int i = 0; i < n; ++i) t += cv::Point2d(to[i] - from[i]);
+    M(0, 2) = t.x / n;
+    M(1, 2) = t.y / n;
+    *H = M;
+    return n > 0;
+  }
+  if (model == MotionModel::kHomography) {
+    std::vector<cv::Point2f> a(n), b(n);
+    for (int i = 0; i < n; ++i) {
+      a[i] = from[i] - cv::Point2f(centre);
+      b[i] = to[i] - cv::Point2f(centre);
+    }
+    const cv::Mat h = cv::findHomography(a, b, 0);
+    if (h.empty()) return false;
+    *H = unshift * cv::Matx33d(h) * shift;
+    return true;
+  }
+  // Similarity: x' = a x - b y + tx, y' = b x + a y + ty; affine: six free parameters.
+  const bool similarity = model == MotionModel::kSimilarity;
+  const int k = similarity ? 4 : 6;
+  cv::Mat A(2 * n, k, CV_64F, cv::Scalar(0)), rhs(2 * n, 1, CV_64F);
+  for (int i = 0; i < n; ++i) {
+    const double x = from[i].x - centre.x, y = from[i].y - centre.y;
+    double* r0 = A.ptr<double>(2 * i);
+    double* r1 = A.ptr<double>(2 * i + 1);
+    if (similarity) {
+      r0[0] = x, r0[1] = -y, r0[2] = 1;
+      r1[0] = y, r1[1] = x, r1[3] = 1;
+    } else {
+      r0[0] = x, r0[1] = y, r0[2] = 1;
+      r1[3] = x, r1[4] = y, r1[5] = 1;
+    }
+    rhs.at<double>(2 * i) = to[i].x - centre.x;
+    rhs.at<double>(2 * i + 1) = to[i].y - centre.y;
+  }
+  cv::Mat p;
+  if (!cv::solve(A, rhs, p, cv::DECOMP_SVD)) return false;
+  const double* q = p.ptr<double>();
+  if (similarity)
+    M = cv::Matx33d(q[0], -q[1], q[2], q[1], q[0], q[3], 0, 0, 1);
+  else
+    M = cv::Matx33d(q[0], q[1], q[2], q[3], q[4], q[5], 0, 0, 1);
+  *H = unshift * M * shift;
+  return true;
+}
+
+// The checks a correction must pass; "" when it does.
+std::string Check(const cv::Matx33d& H, const cv::Rect& region, const RefineOptions& options,
+                  double* correction_px) {
+  const cv::Matx22d A(H(0, 0) / H(2, 2), H(0, 1) / H(2, 2), H(1, 0) / H(2, 2), H(1, 1) / H(2, 2));
+  if (cv::determinant(A) <= 0) return "fit would flip the image";
+  cv::Mat w;
+  cv::SVD::compute(cv::Mat(A), w);
+  const double s1 = w.at<double>(0), s2 = w.at<double>(1);
+  const double limit = options.max_scale_change;
+  if (s1 > 1 + limit || s2 < 1 - limit) return "fit would scale or shear the image";
+  *correction_px = 0;
+  const cv::Point2d corners[4] = {{double(region.x), double(region.y)},
+                                  {double(region.br().x), double(region.y)},
+                                  {double(region.br().x), double(region.br().y)},
+                                  {double(region.x), double(region.br().y)}};
+  for (const cv::Point2d& c : corners) {
+    const cv::Point2d m = Apply(H, c);
+    if (!std::isfinite(m.x) || !std::isfinite(m.y)) return "fit is not finite";
+    *correction_px = std::max(*correction_px, cv::norm(m - c));
+  }
+  if (*correction_px > options.search_px) return "correction larger than the search window";
+  return "";
+}
+
+// Matches by the paper: SSD of a (2w+1)^2 template in a +-search window, integer texels.
+void MatchSsd(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overlap,
+              const std::vector<cv::Point2f>& corners, const RefineOptions& options,
+              std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+  const int w = options.window_px, s = options.search_px;
+  const cv::Rect image(0, 0, grey_w.cols, grey_w.rows);
+  for (const cv::Point2f& c : corners) {
+    const cv::Point p(cvRound(c.x), cvRound(c.y));
+    const cv::Rect templ(p.x - w, p.y - w, 2 * w + 1, 2 * w + 1);
+    const cv::Rect search(p.x - w - s, p.y - w - s, 2 * (w + s) + 1, 2 * (w + s) + 1);
+    if ((templ & image) != templ || (search & image) != search) continue;
+    cv::Mat ssd;
+    cv::matchTemplate(grey_b(search), grey_w(templ), ssd, cv::TM_SQDIFF);
+    cv::Point best;
+    cv::minMaxLoc(ssd, nullptr, nullptr, &best);
+    const cv::Point2f found(static_cast<float>(search.x + best.x + w),
+                            static_cast<float>(search.y + best.y + w));
+    if (!overlap.at<uchar>(cvRound(found.y), cvRound(found.x))) continue;
+    from->push_back(cv::Point2f(p));
+    to->push_back(found);
+  }
+}
+
+// Pyramidal Lucas-Kanade (coarse to fine, sub-texel) with a forward-backward check.
+void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overlap,
+             const std::vector<cv::Point2f>& corners, const RefineOptions& options,
+             std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+  if (corners.empty()) return;
+  std::vector<cv::Point2f> forward, backward;
+  std::vector<uchar> ok_f, ok_b;
+  std::vector<float> err;
+  const cv::Size window(2 * options.window_px + 1, 2 * options.window_px + 1);
+  const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
+  cv::calcOpticalFlowPyrLK(grey_w, grey_b, corners, forward, ok_f, err, window,
+                           options.pyramid_levels, stop);
+  cv::calcOpticalFlowPyrLK(grey_b, grey_w, forward, backward, ok_b, err, window,
+                           options.pyramid_levels, stop);
+  for (size_t i = 0; i < corners.size(); ++i) {
+    if (!ok_f[i] || !ok_b[i]) continue;
+    if (cv::norm(backward[i] - corners[i]) > 0.5) continue;  // not the same texture both ways
+    if (cv::norm(forward[i] - corners[i]) > options.search_px) continue;
+    const cv::Point q(cvRound(forward[i].x), cvRound(forward[i].y));
+    if (q.x < 0 || q.y < 0 || q.x >= overlap.cols || q.y >= overlap.rows || !overlap.at<uchar>(q))
+      continue;
+    from->push_back(corners[i]);
+    to->push_back(forward[i]);
+  }
+}
+
+}  // namespace
+
+std::string MotionModelName(MotionModel model) {
+  switch (model) {
+    case MotionModel::kNone:
+      return "none";
+    case MotionModel::kTranslation:
+      return "translation";
+    case MotionModel::kSimilarity:
+      return "similarity";
+    case MotionModel::kAffine:
+      return "affine";
+    case MotionModel::kHomography:
+      return "homography";
+  }
+  return "?";
+}
+
+RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warped_valid,
+                                  const cv::Mat& buffer_bgra, const RefineOptions& options) {
+  RefineEstimate e;
+  if (options.mode == RefineMode::kOff) {
+    e.fallback = "off";
+    return e;
+  }
+  // Where the frame and the painted buffer overlap; work in that region only.
+  std::vector<cv::Mat> channels;
+  cv::split(buffer_bgra, channels);
+  const cv::Mat overlap_full = warped_valid & (channels[3] == 255);
+  e.region = cv::boundingRect(overlap_full);
+  const int min_side = 4 * options.window_px + 2;
+  if (e.region.width < min_side || e.region.height < min_side) {
+    e.fallback = "too little painted overlap";
+    return e;
+  }
+  const cv::Mat overlap = overlap_full(e.region);
+  const cv::Mat grey_w = Grey(warped_bgr(e.region)), grey_b = Grey(buffer_bgra(e.region));
+  cv::Mat corner_mask;
+  cv::erode(overlap, corner_mask, cv::Mat(), cv::Point(-1, -1), options.window_px + 1);
+  std::vector<cv::Point2f> corners;
+  cv::goodFeaturesToTrack(grey_w, corners, options.max_corners, 0.01, options.window_px,
+                          corner_mask, 3, options.mode == RefineMode::kPaper, 0.04);
+  e.corners = static_cast<int>(corners.size());
+  if (e.corners < options.min_inliers) {
+    e.fallback = "too few corners (textureless?)";
+    return e;
+  }
+  std::vector<cv::Point2f> from, to;
+  if (options.mode == RefineMode::kPaper)
+    MatchSsd(grey_w, grey_b, overlap, corners, options, &from, &to);
+  else
+    MatchLk(grey_w, grey_b, overlap, corners, options, &from, &to);
+  e.matches = static_cast<int>(from.size());
+  const cv::Point2f offset(static_cast<float>(e.region.x), static_cast<float>(e.region.y));
+  for (auto& p : from) p += offset;
+  for (auto& p : to) p += offset;
+  e.from = from;
+  e.to = to;
+  e.inlier.assign(from.size(), 1);
+  if (e.matches < options.min_inliers) {
+    e.fallback = "too few matches";
+    return e;
+  }
+  // Collinear (or clustered) corners cannot fix more than a translation reliably.
+  cv::Mat points(static_cast<int>(from.size()), 2, CV_32F, from.data());
+  cv::Mat covariance, mean;
+  cv::calcCovarMatrix(points, covariance, mean,
+                      cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE);
+  cv::Mat eigen;
+  cv::eigen(covariance, eigen);
+  const double spread_min = std::sqrt(std::max(0.0, eigen.at<double>(1)));
+  const double spread_max = std::sqrt(std::max(0.0, eigen.at<double>(0)));
+  if (spread_min < 2.0 || spread_min < 0.05 * spread_max) {
+    e.fallback = "corners (nearly) collinear";
+    return e;
+  }
+  const cv::Point2d centre(mean.at<double>(0), mean.at<double>(1));
+
+  // Inliers: the paper takes every match; the robust mode, RANSAC on the most general model
+  // allowed.
+  std::vector<uchar> inlier(from.size(), 1);
+  const MotionModel most_general =
+      static_cast<MotionModel>(static_cast<int>(options.max_model) + 1);
+  if (options.mode == RefineMode::kRobust) {
+    cv::Mat mask;
+    if (most_general == MotionModel::kHomography)
+      cv::findHomography(from, to, cv::RANSAC, options.ransac_px, mask, 2000, 0.999);
+    else if (most_general == MotionModel::kAffine)
+      cv::estimateAffine2D(from, to, mask, cv::RANSAC, options.ransac_px);
+    else if (most_general == MotionModel::kSimilarity)
+      cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, options.ransac_px);
+    if (!mask.empty()) {
+      for (size_t i = 0; i < inlier.size(); ++i) inlier[i] = mask.at<uchar>(static_cast<int>(i));
+    } else {  // translation: within the threshold of the median displacement
+      std::vector<float> dx, dy;
+      for (size_t i = 0; i < from.size(); ++i)
+        dx.push_back(to[i].x - from[i].x), dy.push_back(to[i].y - from[i].y);
+      std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+      std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
+      const cv::Point2f median(dx[dx.size() / 2], dy[dy.size() / 2]);
+      for (size_t i = 0; i < from.size(); ++i)
+        inlier[i] = cv::norm(to[i] - from[i] - median) <= options.ransac_px;
+    }
+  }
+  std::vector<cv::Point2f> in_from, in_to;
+  for (size_t i = 0; i < from.size(); ++i)
+    if (inlier[i]) in_from.push_back(from[i]), in_to.push_back(to[i]);
+  e.inlier = inlier;
+  e.inliers = static_cast<int>(in_from.size());
+  if (e.inliers < options.min_inliers) {
+    e.fallback = "too few inliers (repeated texture or movers?)";
+    return e;
+  }
+  const double n2 = 2.0 * e.inliers;
+  e.residual_before_px = std::sqrt(SumSquared(cv::Matx33d::eye(), in_from, in_to) / e.inliers);
+
+  // The model: the paper's affine, or the one BIC prefers among those allowed.
+  cv::Matx33d best_H = cv::Matx33d::eye();
+  MotionModel best = MotionModel::kNone;
+  if (options.mode == RefineMode::kPaper) {
+    if (!FitModel(MotionModel::kAffine, in_from, in_to, centre, &best_H)) {
+      e.fallback = "degenerate fit";
+      return e;
+    }
+    best = MotionModel::kAffine;
+  } else {
+    // BIC with a noise floor (0.05 texel) so that exact data does not favour a model by log(0).
+    double best_bic = std::numeric_limits<double>::infinity();
+    for (int m = 0; m <= static_cast<int>(most_general); ++m) {
+      const MotionModel model = static_cast<MotionModel>(m);
+      cv::Matx33d H;
+      if (!FitModel(model, in_from, in_to, centre, &H)) continue;
+      const double rss = SumSquared(H, in_from, in_to);
+      const double bic = n2 * std::log(rss / n2 + 0.05 * 0.05) + NumParams(model) * std::log(n2);
+      e.bic[MotionModelName(model)] = bic;
+      if (bic < best_bic) best_bic = bic, best = model, best_H = H;
+    }
+  }
+  e.model = best;
+  e.residual_after_px = std::sqrt(SumSquared(best_H, in_from, in_to) / e.inliers);
+  if (best == MotionModel::kNone) {
+    e.fallback = "none needed (model selection)";
+    return e;
+  }
+  const std::string problem = Check(best_H, e.region, options, &e.correction_px);
+  if (!problem.empty()) {
+    e.fallback = problem;
+    e.residual_after_px = e.residual_before_px;
+    return e;
+  }
+  e.buffer_from_warped = best_H;
+  e.applied = true;
+  return e;
+}
+
+void ApplyRefinement(const RefineEstimate& estimate, cv::Mat* warped_bgr, cv::Mat* warped_valid,
+                     cv::Mat* warped_quality) {
+  if (!estimate.applied) return;
+  const int margin = static_cast<int>(std::ceil(estimate.correction_px)) + 2;
+  const cv::Rect image(0, 0, warped_bgr->cols, warped_bgr->rows);
+  const cv::Rect roi =
+      cv::Rect(estimate.region.x - margin, estimate.region.y - margin,
+               estimate.region.width + 2 * margin, estimate.region.height + 2 * margin) &
+      image;
+  // dst (ROI coordinates) = shift * buffer_from_warped * src (whole-image coordinates).
+  const cv::Matx33d to_roi =
+      cv::Matx33d(1, 0, -roi.x, 0, 1, -roi.y, 0, 0, 1) * estimate.buffer_from_warped;
+  const cv::Mat M(to_roi);
+  const cv::Mat bgr = warped_bgr->clone(), valid = warped_valid->clone(),
+                quality = warped_quality->clone();
+  cv::Mat out_bgr, out_valid, out_quality;
+  cv::warpPerspective(bgr, out_bgr, M, roi.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::warpPerspective(valid, out_valid, M, roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  cv::warpPerspective(quality, out_quality, M, roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  cv::erode(out_valid, out_valid, cv::Mat());
+  out_bgr.copyTo((*warped_bgr)(roi));
+  out_valid.copyTo((*warped_valid)(roi));
+  out_quality.copyTo((*warped_quality)(roi));
+}
+
+cv::Mat DrawRefinementMatches(const cv::Mat& warped_bgr, const RefineEstimate& estimate) {
+  cv::Mat out = warped_bgr.clone();
+  for (size_t i = 0; i < estimate.from.size(); ++i) {
+    const cv::Scalar colour = estimate.inlier[i] ? cv::Scalar(0, 220, 0) : cv::Scalar(0, 0, 255);
+    // Displacements are small: drawn 5x longer.
+    const cv::Point2f tip = estimate.from[i] + 5.0f * (estimate.to[i] - estimate.from[i]);
+    cv::circle(out, estimate.from[i], 3, colour, 1, cv::LINE_AA);
+    cv::line(out, estimate.from[i], tip, colour, 1, cv::LINE_AA);
+  }
+  cv::rectangle(out, estimate.region, cv::Scalar(255, 200, 0), 1);
+  return out;
+}
+
+cv::Mat ResidualHeatMap(const cv::Mat& warped_bgr, const cv::Mat& warped_valid,
+                        const cv::Mat& buffer_bgra, const cv::Rect& region) {
+  const cv::Rect r = region & cv::Rect(0, 0, warped_bgr.cols, warped_bgr.rows);
+  if (r.empty()) return cv::Mat();
+  std::vector<cv::Mat> channels;
+  cv::split(buffer_bgra(r), channels);
+  const cv::Mat overlap = warped_valid(r) & (channels[3] == 255);
+  cv::Mat diff, scaled, heat;
+  cv::absdiff(Grey(warped_bgr(r)), Grey(buffer_bgra(r)), diff);
+  diff.convertTo(scaled, CV_8U, 4.0);  // 64 grey levels = full scale
+  cv::applyColorMap(scaled, heat, cv::COLORMAP_INFERNO);
+  heat.setTo(cv::Scalar(40, 40, 40), ~overlap);
+  return heat;
+}
+
+}  // namespace fresco

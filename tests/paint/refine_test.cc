@@ -1,0 +1,215 @@
+// Texture alignment refinement (paper §3.5) against known 2D motions: the estimated
+// buffer_from_warped is compared with the motion that made the warped frame, the chosen
+// model with the one the data needs, and the fall-backs with the cases that call for them.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/refine_alignment.h"
+
+namespace fresco {
+namespace {
+
+// A buffer full of texture (blurred noise), all painted.
+cv::Mat TexturedBuffer(int width = 320, int height = 240, unsigned seed = 5) {
+  cv::Mat noise(height, width, CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::UNIFORM, 0, 255);
+  cv::Mat blurred;
+  cv::GaussianBlur(noise, blurred, cv::Size(0, 0), 2.0);
+  cv::normalize(blurred, blurred, 0, 255, cv::NORM_MINMAX);
+  cv::Mat bgra;
+  cv::cvtColor(blurred, bgra, cv::COLOR_BGR2BGRA);
+  return bgra;
+}
+
+// The warped frame: the buffer's content moved by `buffer_from_warped`^-1 (so that the
+// correct refinement is `buffer_from_warped`), valid everywhere it has content.
+struct Warped {
+  cv::Mat bgr, valid, quality;
+};
+Warped MakeWarped(const cv::Mat& buffer_bgra, const cv::Matx33d& buffer_from_warped) {
+  Warped w;
+  cv::Mat bgr;
+  cv::cvtColor(buffer_bgra, bgr, cv::COLOR_BGRA2BGR);
+  // warped(x) = buffer(buffer_from_warped * x)
+  cv::warpPerspective(bgr, w.bgr, cv::Mat(buffer_from_warped), bgr.size(),
+                      cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT);
+  cv::Mat ones(bgr.size(), CV_8U, cv::Scalar(255));
+  cv::warpPerspective(ones, w.valid, cv::Mat(buffer_from_warped), bgr.size(),
+                      cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT);
+  cv::erode(w.valid, w.valid, cv::Mat(), cv::Point(-1, -1), 2);
+  w.quality = cv::Mat(bgr.size(), CV_32F, cv::Scalar(1));
+  return w;
+}
+
+cv::Matx33d Similarity(double angle_deg, double scale, double tx, double ty, cv::Point2d c) {
+  const double a = angle_deg * M_PI / 180, s = scale;
+  // About centre c: x' = s R (x - c) + c + t
+  const double r00 = s * std::cos(a), r01 = -s * std::sin(a), r10 = s * std::sin(a),
+               r11 = s * std::cos(a);
+  return cv::Matx33d(r00, r01, c.x - r00 * c.x - r01 * c.y + tx, r10, r11,
+                     c.y - r10 * c.x - r11 * c.y + ty, 0, 0, 1);
+}
+
+// Largest distance between where two transforms put the points of a rectangle.
+double MaxDifference(const cv::Matx33d& a, const cv::Matx33d& b, const cv::Rect& r) {
+  double worst = 0;
+  for (int y = r.y; y <= r.br().y; y += r.height / 8)
+    for (int x = r.x; x <= r.br().x; x += r.width / 8) {
+      const cv::Vec3d p(x, y, 1), pa = a * p, pb = b * p;
+      worst =
+          std::max(worst, std::hypot(pa[0] / pa[2] - pb[0] / pb[2], pa[1] / pa[2] - pb[1] / pb[2]));
+    }
+  return worst;
+}
+
+RefineOptions Robust() {
+  RefineOptions o;
+  o.mode = RefineMode::kRobust;
+  return o;
+}
+
+TEST(Refine, TranslationIsRecoveredSubTexelAndModelledAsTranslation) {
+  const cv::Mat buffer = TexturedBuffer();
+  const cv::Matx33d truth(1, 0, 1.7, 0, 1, -2.3, 0, 0, 1);
+  const Warped w = MakeWarped(buffer, truth);
+  const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer, Robust());
+  ASSERT_TRUE(e.applied) << e.fallback;
+  EXPECT_EQ(e.model, MotionModel::kTranslation);
+  EXPECT_LT(MaxDifference(e.buffer_from_warped, truth, e.region), 0.1);
+  EXPECT_NEAR(e.residual_before_px, std::hypot(1.7, 2.3), 0.2);
+  EXPECT_LT(e.residual_after_px, 0.1);
+  EXPECT_GE(e.inliers, 50);
+  // Warping again makes the frame agree with the buffer.
+  Warped again{w.bgr.clone(), w.valid.clone(), w.quality.clone()};
+  ApplyRefinement(e, &again.bgr, &again.valid, &again.quality);
+  cv::Mat buffer_bgr, diff_before, diff_after;
+  cv::cvtColor(buffer, buffer_bgr, cv::COLOR_BGRA2BGR);
+  const cv::Rect inner(20, 20, 280, 200);
+  cv::absdiff(w.bgr(inner), buffer_bgr(inner), diff_before);
+  cv::absdiff(again.bgr(inner), buffer_bgr(inner), diff_after);
+  EXPECT_LT(cv::mean(diff_after)[0], 0.3 * cv::mean(diff_before)[0]);
+}
+
+TEST(Refine, ModelSelectionPicksWhatTheMotionNeeds) {
+  const cv::Mat buffer = TexturedBuffer(400, 300);
+  const cv::Point2d c(200, 150);
+  struct Case {
+    cv::Matx33d truth;
+    MotionModel expected;
+  };
+  cv::Matx33d homography = Similarity(0.5, 1.0, 1.0, 0.5, c);
+  homography(2, 0) = 2e-5;
+  homography(2, 1) = -3e-5;
+  const Case cases[] = {
+      {cv::Matx33d::eye(), MotionModel::kNone},
+      {cv::Matx33d(1, 0, 2.5, 0, 1, 1.0, 0, 0, 1), MotionModel::kTranslation},
+      {Similarity(1.0, 1.02, 1.0, -0.5, c), MotionModel::kSimilarity},
+      {cv::Matx33d(1.02, 0.015, -3.0, -0.01, 0.99, 2.0, 0, 0, 1), MotionModel::kAffine},
+      {homography, MotionModel::kHomography},
+  };
+  for (const Case& k : cases) {
+    const Warped w = MakeWarped(buffer, k.truth);
+    const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer, Robust());
+    EXPECT_EQ(MotionModelName(e.model), MotionModelName(k.expected)) << e.fallback;
+    if (k.expected != MotionModel::kNone) {
+      ASSERT_TRUE(e.applied) << MotionModelName(k.expected) << ": " << e.fallback;
+      EXPECT_LT(MaxDifference(e.buffer_from_warped, k.truth, e.region), 0.15)
+          << MotionModelName(k.expected);
+    } else {
+      EXPECT_FALSE(e.applied);
+      EXPECT_EQ(e.fallback, "none needed (model selection)");
+    }
+  }
+}
+
+TEST(Refine, MoversDoNotDragTheRobustFitButDragThePapers) {
+  const cv::Mat buffer = TexturedBuffer(400, 300);
+  const cv::Matx33d truth(1, 0, 1.5, 0, 1, 1.0, 0, 0, 1);
+  Warped w = MakeWarped(buffer, truth);
+  // A "mover": a textured patch in the warped frame that is displaced differently.
+  const cv::Mat other = TexturedBuffer(400, 300, 99);
+  cv::Mat patch;
+  cv::cvtColor(other(cv::Rect(40, 40, 150, 120)), patch, cv::COLOR_BGRA2BGR);
+  patch.copyTo(w.bgr(cv::Rect(44, 43, 150, 120)));
+  cv::Mat buffer_with_mover = buffer.clone();
+  other(cv::Rect(40, 40, 150, 120)).copyTo(buffer_with_mover(cv::Rect(40, 40, 150, 120)));
+  const RefineEstimate robust = EstimateRefinement(w.bgr, w.valid, buffer_with_mover, Robust());
+  ASSERT_TRUE(robust.applied) << robust.fallback;
+  EXPECT_LT(robust.inliers, robust.matches);  // the mover's matches are outliers
+  EXPECT_LT(MaxDifference(robust.buffer_from_warped, truth, robust.region), 0.2);
+  RefineOptions paper;
+  paper.mode = RefineMode::kPaper;
+  const RefineEstimate p = EstimateRefinement(w.bgr, w.valid, buffer_with_mover, paper);
+  ASSERT_TRUE(p.applied) << p.fallback;
+  EXPECT_EQ(p.model, MotionModel::kAffine);
+  EXPECT_GT(MaxDifference(p.buffer_from_warped, truth, p.region),
+            2 * MaxDifference(robust.buffer_from_warped, truth, robust.region));
+}
+
+TEST(Refine, PaperModeRecoversAnIntegerShift) {
+  const cv::Mat buffer = TexturedBuffer();
+  const cv::Matx33d truth(1, 0, 3, 0, 1, -2, 0, 0, 1);
+  const Warped w = MakeWarped(buffer, truth);
+  RefineOptions paper;
+  paper.mode = RefineMode::kPaper;
+  const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer, paper);
+  ASSERT_TRUE(e.applied) << e.fallback;
+  EXPECT_LT(MaxDifference(e.buffer_from_warped, truth, e.region), 0.3);
+}
+
+TEST(Refine, ExtremesFallBackToNoCorrectionAndSaySo) {
+  const cv::Mat buffer = TexturedBuffer(400, 300);
+  // Textureless.
+  const cv::Mat flat(300, 400, CV_8UC4, cv::Scalar(120, 120, 120, 255));
+  Warped w = MakeWarped(flat, cv::Matx33d(1, 0, 1, 0, 1, 1, 0, 0, 1));
+  RefineEstimate e = EstimateRefinement(w.bgr, w.valid, flat, Robust());
+  EXPECT_FALSE(e.applied);
+  EXPECT_EQ(e.fallback, "too few corners (textureless?)");
+  // Texture only along one line: collinear corners.
+  cv::Mat line_only = flat.clone();
+  buffer(cv::Rect(0, 140, 400, 6)).copyTo(line_only(cv::Rect(0, 140, 400, 6)));
+  w = MakeWarped(line_only, cv::Matx33d(1, 0, 1, 0, 1, 0.5, 0, 0, 1));
+  e = EstimateRefinement(w.bgr, w.valid, line_only, Robust());
+  EXPECT_FALSE(e.applied);
+  EXPECT_TRUE(e.fallback == "corners (nearly) collinear" || e.fallback == "too few matches")
+      << e.fallback;
+  // A shift larger than the search window.
+  RefineOptions narrow = Robust();
+  narrow.search_px = 4;
+  w = MakeWarped(buffer, cv::Matx33d(1, 0, 9, 0, 1, 0, 0, 0, 1));
+  e = EstimateRefinement(w.bgr, w.valid, buffer, narrow);
+  EXPECT_FALSE(e.applied);
+  // A fit that would scale the image by 7 %.
+  w = MakeWarped(buffer, Similarity(0, 1.07, 0, 0, cv::Point2d(200, 150)));
+  RefineOptions wide = Robust();
+  wide.search_px = 30;
+  e = EstimateRefinement(w.bgr, w.valid, buffer, wide);
+  EXPECT_FALSE(e.applied);
+  EXPECT_EQ(e.fallback, "fit would scale or shear the image") << e.fallback;
+  // Nothing painted yet.
+  cv::Mat empty = buffer.clone();
+  empty.setTo(cv::Scalar(255, 255, 255, 0));
+  w = MakeWarped(buffer, cv::Matx33d::eye());
+  e = EstimateRefinement(w.bgr, w.valid, empty, Robust());
+  EXPECT_FALSE(e.applied);
+  EXPECT_EQ(e.fallback, "too little painted overlap");
+  // Off.
+  e = EstimateRefinement(w.bgr, w.valid, buffer, RefineOptions());
+  EXPECT_EQ(e.fallback, "off");
+}
+
+TEST(Refine, DebugImagesHaveTheBufferSize) {
+  const cv::Mat buffer = TexturedBuffer();
+  const Warped w = MakeWarped(buffer, cv::Matx33d(1, 0, 1, 0, 1, 1, 0, 0, 1));
+  const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer, Robust());
+  EXPECT_EQ(DrawRefinementMatches(w.bgr, e).size(), w.bgr.size());
+  const cv::Mat heat = ResidualHeatMap(w.bgr, w.valid, buffer, e.region);
+  EXPECT_EQ(heat.size(), e.region.size());
+}
+
+}  // namespace
+}  // namespace fresco
