@@ -100,6 +100,12 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
+  if (inputs.pipeline.background.mode != BackgroundMode::kOff) {
+    s->background_.resize(s->set_.buffers.size());
+    s->background_frame_.resize(s->set_.buffers.size());
+    for (size_t b = 0; b < s->set_.buffers.size(); ++b)
+      s->background_[b].Init(s->set_.buffers[b], inputs.pipeline.background);
+  }
   *session = std::move(s);
   return Status::Ok();
 }
@@ -204,16 +210,22 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   warp_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(warp_report));
 
-  // 3. paint
+  // 3. background
+  if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
+
+  // 4. paint
   start = std::chrono::steady_clock::now();
   StageReport paint_report;
   paint_report.name = "paint";
   long long written = 0, rejected = 0;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!seen[b]) continue;
-    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], cv::Mat(),
-                                               options_.update, options_.quality_slack,
-                                               &painted_[b]);
+    const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
+                             ? cv::Mat()
+                             : background_frame_[b].foreground;
+    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_.update,
+                                               options_.quality_slack, &painted_[b]);
+    if (!background_.empty()) MarkProvisional(background_frame_[b], &painted_[b]);
     written += stats.written;
     rejected += stats.rejected;
     if (debug) paint_report.images["painted_b" + std::to_string(b)] = painted_[b].bgra.clone();
@@ -225,6 +237,47 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(paint_report));
   report->painted = true;
   report->total_ms = MsSince(frame_start);
+}
+
+StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool debug) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "background";
+  float gain = 1.0f;
+  if (options_.background.mode == BackgroundMode::kRobust && options_.background.normalize_gain) {
+    GainHistogram histogram;
+    for (size_t b = 0; b < set_.buffers.size(); ++b)
+      if (seen[b]) background_[b].AccumulateGain(set_.buffers[b], warped_[b], &histogram);
+    gain = histogram.MedianGain();
+  }
+  long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!seen[b]) continue;
+    BackgroundFrame& frame = background_frame_[b];
+    background_[b].Update(set_.buffers[b], warped_[b], gain, debug, &frame);
+    observed += frame.observed, raw += frame.foreground_raw, masked += frame.masked;
+    warming += frame.warming_up, blobs += frame.blobs_removed;
+    if (debug) {
+      const std::string suffix = "_b" + std::to_string(b);
+      report.images["model" + suffix] = background_[b].Image(set_.buffers[b]);
+      report.images["difference" + suffix] = frame.difference;
+      report.images["foreground" + suffix] = frame.foreground;
+    }
+  }
+  report.metrics["gain"] = gain;
+  report.metrics["texels_observed"] = static_cast<double>(observed);
+  report.metrics["texels_foreground_raw"] = static_cast<double>(raw);
+  report.metrics["texels_masked"] = static_cast<double>(masked);
+  report.metrics["masked_fraction"] = observed > 0 ? static_cast<double>(masked) / observed : 0.0;
+  report.metrics["texels_warming_up"] = static_cast<double>(warming);
+  report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
+  report.metrics["blobs_removed"] = static_cast<double>(blobs);
+  report.wall_ms = MsSince(start);
+  return report;
+}
+
+cv::Mat PaintSession::BackgroundImage(size_t b) const {
+  return b < background_.size() ? background_[b].Image(set_.buffers[b]) : cv::Mat();
 }
 
 long long PaintSession::NumSurfaceTexels() const {
