@@ -129,15 +129,18 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
         t.weight[1] = alpha;
         match = 1;
       }
+      bool flipped = false;
       if (t.weight[1] >= t.weight[0]) {  // the candidate now explains more: it is background
         std::swap(t.mean[0], t.mean[1]);
         std::swap(t.weight[0], t.weight[1]);
         t.var4 = ToVar4(min_var);
         match = 1 - match;
+        flipped = t.samples > 0;
       }
       if (t.samples < 65535) ++t.samples;
       foreground = match != 0;
-      warm_up = t.samples < options_.warmup_frames;
+      // A texel whose background just changed holds a stale paint: provisional too.
+      warm_up = t.samples < options_.warmup_frames || flipped;
     } else {
       AverageTexel& t = average_[k];
       if (t.count < options_.training_frames) {  // training: learn, paint provisionally
@@ -237,7 +240,8 @@ cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
         px[c] = cv::saturate_cast<uint8_t>(robust_[k].mean[0][c] * (1.0f / kMeanScale));
     } else if (!average_.empty() && average_[k].count > 0) {
       for (int c = 0; c < 3; ++c)
-        px[c] = cv::saturate_cast<uint8_t>(static_cast<float>(average_[k].sum[c]) / average_[k].count);
+        px[c] =
+            cv::saturate_cast<uint8_t>(static_cast<float>(average_[k].sum[c]) / average_[k].count);
     }
   }
   return image;

@@ -32,9 +32,9 @@ namespace fresco {
 
 // One buffer's segmentation of one frame.
 struct BackgroundFrame {
-  cv::Mat foreground;  // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
-  cv::Mat warming;     // CV_8U, buffer size: 255 = sampled this frame, model still warming up
-  cv::Mat difference;  // CV_8U (debug only): RMS colour distance to the background x 2
+  cv::Mat foreground;      // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
+  cv::Mat warming;         // CV_8U, buffer size: 255 = sampled this frame, model still warming up
+  cv::Mat difference;      // CV_8U (debug only): RMS colour distance to the background x 2
   int observed = 0;        // texels sampled this frame (valid in the warped buffer)
   int foreground_raw = 0;  // ... classified foreground before cleaning
   int masked = 0;          // ... masked after cleaning (small blobs out, margin in)
@@ -45,7 +45,7 @@ struct BackgroundFrame {
 // Histogram of log2(sample / background) grey ratios over all buffers of a frame, for the
 // frame's global gain (exposure) estimate.
 struct GainHistogram {
-  static constexpr int kBins = 512;       // log2 ratio in [-2, 2): 0.0078 per bin (0.5 %)
+  static constexpr int kBins = 512;  // log2 ratio in [-2, 2): 0.0078 per bin (0.5 %)
   std::array<int, kBins> bins = {};
   long long count = 0;
   // The median ratio, or 1 when fewer than `min_samples` samples were seen.

@@ -29,7 +29,8 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
   cv::minMaxLoc(depth, &lo, &hi, nullptr, nullptr, mask);
   finite.setTo(hi, ~mask);
   cv::Mat gray;
-  finite.convertTo(gray, CV_8U, hi > lo ? -255.0 / (hi - lo) : 0, hi > lo ? 255.0 * hi / (hi - lo) : 0);
+  finite.convertTo(gray, CV_8U, hi > lo ? -255.0 / (hi - lo) : 0,
+                   hi > lo ? 255.0 * hi / (hi - lo) : 0);
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_VIRIDIS);
   colour.setTo(cv::Scalar(0, 0, 0), ~mask);
@@ -84,12 +85,12 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->options_ = inputs.pipeline;
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
-  s->texel_size_m_ = inputs.pipeline.texel_size_m > 0
-                         ? inputs.pipeline.texel_size_m
-                         : (inputs.typical_camera ? AutomaticTexelSize(*inputs.scene,
-                                                                       *inputs.typical_camera,
-                                                                       inputs.expected_poses)
-                                                  : 0.01);
+  s->texel_size_m_ =
+      inputs.pipeline.texel_size_m > 0
+          ? inputs.pipeline.texel_size_m
+          : (inputs.typical_camera
+                 ? AutomaticTexelSize(*inputs.scene, *inputs.typical_camera, inputs.expected_poses)
+                 : 0.01);
   Grouping grouping;
   FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, &grouping));
   BaseBufferOptions buffer_options;
@@ -303,8 +304,8 @@ Scene PaintSession::PaintedScene() const {
   out.source_path = scene_->source_path;
   out.mesh = scene_->mesh;
   const TriangleMesh& mesh = scene_->mesh;
-  out.mesh.uvs.assign(mesh.NumTriangles(), {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(),
-                                            Eigen::Vector2f::Zero()});
+  out.mesh.uvs.assign(mesh.NumTriangles(),
+                      {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()});
   out.mesh.has_uv.assign(mesh.NumTriangles(), false);
   out.mesh.material.assign(mesh.NumTriangles(), 0);
   // Material 0: triangles in no buffer (never painted): transparent.
