@@ -73,6 +73,15 @@ const std::vector<std::pair<RefineModelLimit, std::string>>& RefineModelNames() 
   return names;
 }
 
+const std::vector<std::pair<BackgroundMode, std::string>>& BackgroundModeNames() {
+  static const std::vector<std::pair<BackgroundMode, std::string>> names = {
+      {BackgroundMode::kOff, "off"},
+      {BackgroundMode::kAverage, "average"},
+      {BackgroundMode::kRobust, "robust"},
+  };
+  return names;
+}
+
 // ---- The fields, each listed once. ----------------------------------------------------------
 
 template <class V>
@@ -97,6 +106,20 @@ void Fields(RefineOptions& o, V& v) {
 }
 
 template <class V>
+void Fields(BackgroundOptions& o, V& v) {
+  v.Enum("mode", o.mode, BackgroundModeNames());
+  v.Field("training_frames", o.training_frames, {.min = 1, .max = 250});
+  v.Field("average_threshold", o.average_threshold, {.min = 0});
+  v.Field("warmup_frames", o.warmup_frames, {.min = 1});
+  v.Field("window_frames", o.window_frames, {.min = 2, .max = 65535});
+  v.Field("sigma_threshold", o.sigma_threshold, {.min = 0, .min_exclusive = true});
+  v.Field("min_sigma", o.min_sigma, {.min = 0, .min_exclusive = true, .max = 100});
+  v.Field("normalize_gain", o.normalize_gain);
+  v.Field("min_blob_texels", o.min_blob_texels, {.min = 0});
+  v.Field("dilate_texels", o.dilate_texels, {.min = 0, .max = 64});
+}
+
+template <class V>
 void Fields(PipelineOptions& o, V& v) {
   v.Enum("sampling", o.sampling, SamplingNames());
   v.Field("texel_size_m", o.texel_size_m, {.min = 0});
@@ -109,6 +132,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Field("debug_images", o.debug_images);
   v.Object("occlusion", o.occlusion);
   v.Object("refine", o.refine);
+  v.Object("background", o.background);
 }
 
 template <class V>
@@ -155,12 +179,13 @@ void Fields(Project& p, V& v) {
 // NonDefaultProject(); then update the size here. (x86-64 Linux sizes.)
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 48, "see Fields(RefineOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 136, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 192, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 400, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 456, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 
@@ -630,6 +655,13 @@ std::string Rebase(const std::string& path, const fs::path& old_folder,
 
 std::string SamplingModeName(SamplingMode mode) {
   for (const auto& [m, name] : SamplingNames()) {
+    if (m == mode) return name;
+  }
+  return "unknown";
+}
+
+std::string BackgroundModeName(BackgroundMode mode) {
+  for (const auto& [m, name] : BackgroundModeNames()) {
     if (m == mode) return name;
   }
   return "unknown";

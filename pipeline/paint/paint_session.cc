@@ -30,7 +30,8 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
   cv::minMaxLoc(depth, &lo, &hi, nullptr, nullptr, mask);
   finite.setTo(hi, ~mask);
   cv::Mat gray;
-  finite.convertTo(gray, CV_8U, hi > lo ? -255.0 / (hi - lo) : 0, hi > lo ? 255.0 * hi / (hi - lo) : 0);
+  finite.convertTo(gray, CV_8U, hi > lo ? -255.0 / (hi - lo) : 0,
+                   hi > lo ? 255.0 * hi / (hi - lo) : 0);
   cv::Mat colour;
   cv::applyColorMap(gray, colour, cv::COLORMAP_VIRIDIS);
   colour.setTo(cv::Scalar(0, 0, 0), ~mask);
@@ -85,12 +86,12 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->options_ = inputs.pipeline;
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
-  s->texel_size_m_ = inputs.pipeline.texel_size_m > 0
-                         ? inputs.pipeline.texel_size_m
-                         : (inputs.typical_camera ? AutomaticTexelSize(*inputs.scene,
-                                                                       *inputs.typical_camera,
-                                                                       inputs.expected_poses)
-                                                  : 0.01);
+  s->texel_size_m_ =
+      inputs.pipeline.texel_size_m > 0
+          ? inputs.pipeline.texel_size_m
+          : (inputs.typical_camera
+                 ? AutomaticTexelSize(*inputs.scene, *inputs.typical_camera, inputs.expected_poses)
+                 : 0.01);
   Grouping grouping;
   FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, &grouping));
   BaseBufferOptions buffer_options;
@@ -101,6 +102,12 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
+  if (inputs.pipeline.background.mode != BackgroundMode::kOff) {
+    s->background_.resize(s->set_.buffers.size());
+    s->background_frame_.resize(s->set_.buffers.size());
+    for (size_t b = 0; b < s->set_.buffers.size(); ++b)
+      s->background_[b].Init(s->set_.buffers[b], inputs.pipeline.background);
+  }
   *session = std::move(s);
   return Status::Ok();
 }
@@ -207,7 +214,10 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   warp_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(warp_report));
 
-  // 3. paint
+  // 3. background
+  if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
+
+  // 4. paint
   start = std::chrono::steady_clock::now();
   StageReport paint_report;
   paint_report.name = "paint";
@@ -215,9 +225,12 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   double difference_sum = 0;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!seen[b]) continue;
-    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], cv::Mat(),
-                                               options_.update, options_.quality_slack,
-                                               &painted_[b]);
+    const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
+                             ? cv::Mat()
+                             : background_frame_[b].foreground;
+    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_.update,
+                                               options_.quality_slack, &painted_[b]);
+    if (!background_.empty()) MarkProvisional(background_frame_[b], &painted_[b]);
     written += stats.written;
     rejected += stats.rejected;
     compared += stats.compared;
@@ -235,6 +248,47 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(paint_report));
   report->painted = true;
   report->total_ms = MsSince(frame_start);
+}
+
+StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool debug) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "background";
+  float gain = 1.0f;
+  if (options_.background.mode == BackgroundMode::kRobust && options_.background.normalize_gain) {
+    GainHistogram histogram;
+    for (size_t b = 0; b < set_.buffers.size(); ++b)
+      if (seen[b]) background_[b].AccumulateGain(set_.buffers[b], warped_[b], &histogram);
+    gain = histogram.MedianGain();
+  }
+  long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!seen[b]) continue;
+    BackgroundFrame& frame = background_frame_[b];
+    background_[b].Update(set_.buffers[b], warped_[b], gain, debug, &frame);
+    observed += frame.observed, raw += frame.foreground_raw, masked += frame.masked;
+    warming += frame.warming_up, blobs += frame.blobs_removed;
+    if (debug) {
+      const std::string suffix = "_b" + std::to_string(b);
+      report.images["model" + suffix] = background_[b].Image(set_.buffers[b]);
+      report.images["difference" + suffix] = frame.difference;
+      report.images["foreground" + suffix] = frame.foreground;
+    }
+  }
+  report.metrics["gain"] = gain;
+  report.metrics["texels_observed"] = static_cast<double>(observed);
+  report.metrics["texels_foreground_raw"] = static_cast<double>(raw);
+  report.metrics["texels_masked"] = static_cast<double>(masked);
+  report.metrics["masked_fraction"] = observed > 0 ? static_cast<double>(masked) / observed : 0.0;
+  report.metrics["texels_warming_up"] = static_cast<double>(warming);
+  report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
+  report.metrics["blobs_removed"] = static_cast<double>(blobs);
+  report.wall_ms = MsSince(start);
+  return report;
+}
+
+cv::Mat PaintSession::BackgroundImage(size_t b) const {
+  return b < background_.size() ? background_[b].Image(set_.buffers[b]) : cv::Mat();
 }
 
 long long PaintSession::NumSurfaceTexels() const {
@@ -260,8 +314,8 @@ Scene PaintSession::PaintedScene() const {
   out.source_path = scene_->source_path;
   out.mesh = scene_->mesh;
   const TriangleMesh& mesh = scene_->mesh;
-  out.mesh.uvs.assign(mesh.NumTriangles(), {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(),
-                                            Eigen::Vector2f::Zero()});
+  out.mesh.uvs.assign(mesh.NumTriangles(),
+                      {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()});
   out.mesh.has_uv.assign(mesh.NumTriangles(), false);
   out.mesh.material.assign(mesh.NumTriangles(), 0);
   // Material 0: triangles in no buffer (never painted): transparent.

@@ -2,7 +2,10 @@
 //   1. depth   render the model's depth from the video camera (§3.3; renderer's raster path)
 //   2. warp    per texel: project, reject grazing/back-facing, occlusion test, sample
 //              (eq. 1-4, §3.2, §3.3)        -> frame_warp.h
-//   3. paint   update the persistent base buffers (eq. 4, update policy)  -> paint_update.h
+//   3. background  per texel: compare with the texel's background model, mask foreground
+//              (moving objects), learn (§3.4)                            -> background_model.h
+//   4. paint   update the persistent base buffers where not masked (eq. 4, update policy)
+//                                                                         -> paint_update.h
 // Set-up (once): grouping (§3.6) -> grouping.h, base buffers and texel model points (eq. 2)
 // -> base_buffer.h. Each stage reports wall time, metrics and (when asked) debug images in a
 // FrameReport that the CLI and the GUI both consume.
@@ -18,6 +21,7 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/core/video_source.h"
+#include "pipeline/paint/background_model.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_update.h"
@@ -61,6 +65,8 @@ class PaintSession {
   long long NumPaintedSurfaceTexels() const;
   double Coverage() const;
   double default_texel_size_m() const { return texel_size_m_; }
+  // The background model's current estimate of buffer `b` (CV_8UC3; empty when off).
+  cv::Mat BackgroundImage(size_t b) const;
 
  private:
   PaintSession() = default;
@@ -71,6 +77,8 @@ class PaintSession {
     NormalizedBounds bounds;
   };
   const CameraCache& CacheFor(const Camera& camera);
+  // The background stage over the buffers seen this frame (fills background_frame_).
+  StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
 
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
@@ -78,6 +86,8 @@ class PaintSession {
   BaseBufferSet set_;
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
+  std::vector<BufferBackground> background_;       // per buffer (mode != off)
+  std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;
   RasterOutput raster_;  // the current frame's depth and triangle ids (reused)
   int frames_seen_ = 0;

@@ -75,6 +75,16 @@ Project NonDefaultProject() {
   p.pipeline.refine.ransac_px = 0.75;
   p.pipeline.refine.max_scale_change = 0.02;
   p.pipeline.refine.min_inliers = 8;
+  p.pipeline.background.mode = BackgroundMode::kAverage;
+  p.pipeline.background.training_frames = 33;
+  p.pipeline.background.average_threshold = 21.5;
+  p.pipeline.background.warmup_frames = 4;
+  p.pipeline.background.window_frames = 500;
+  p.pipeline.background.sigma_threshold = 2.5;
+  p.pipeline.background.min_sigma = 4.5;
+  p.pipeline.background.normalize_gain = false;
+  p.pipeline.background.min_blob_texels = 40;
+  p.pipeline.background.dilate_texels = 5;
   p.grouping.angle_deg = 12.5;
   GroupingEdit merge;
   merge.op = "merge";
@@ -122,6 +132,7 @@ TEST(ProjectTest, SaveThenLoadGivesTheSameProject) {
   // Field by field (operator== covers every field, file_path included) and as text.
   EXPECT_EQ(loaded.pipeline, project.pipeline);
   EXPECT_EQ(loaded.pipeline.occlusion, project.pipeline.occlusion);
+  EXPECT_EQ(loaded.pipeline.background, project.pipeline.background);
   EXPECT_EQ(loaded.grouping, project.grouping);
   EXPECT_EQ(loaded.truth, project.truth);
   EXPECT_EQ(loaded.time_offset_s, project.time_offset_s);
@@ -144,7 +155,9 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"occlusion\"",       "\"tolerance_rel\"",
                           "\"tolerance_m\"",     "\"max_view_angle_deg\"",
                           "\"grouping\"",        "\"angle_deg\"",
-                          "\"edits\"",           "\"truth\""}) {
+                          "\"edits\"",           "\"truth\"",
+                          "\"background\"",      "\"mode\": \"robust\"",
+                          "\"window_frames\"",   "\"dilate_texels\""}) {
     EXPECT_THAT(text, HasSubstr(key));
   }
   // Pretty: one key per line.

@@ -1,0 +1,254 @@
+#include "pipeline/paint/background_model.h"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <utility>
+
+#include <opencv2/imgproc.hpp>
+
+namespace fresco {
+namespace {
+
+constexpr float kMeanScale = 64.0f;  // fixed point of RobustTexel::mean
+constexpr float kMaxMean = 65535.0f / kMeanScale;
+
+uint16_t ToFixed(float value) {
+  return static_cast<uint16_t>(std::clamp(value, 0.0f, kMaxMean) * kMeanScale + 0.5f);
+}
+
+uint16_t ToVar4(float var) { return static_cast<uint16_t>(std::min(var * 4.0f, 65535.0f) + 0.5f); }
+
+// Mean squared channel difference between a sample and a fixed-point mean.
+float Distance2(const float x[3], const uint16_t mean[3]) {
+  float d = 0;
+  for (int c = 0; c < 3; ++c) {
+    const float e = x[c] - mean[c] * (1.0f / kMeanScale);
+    d += e * e;
+  }
+  return d * (1.0f / 3.0f);
+}
+
+}  // namespace
+
+float GainHistogram::MedianGain(long long min_samples) const {
+  if (count < min_samples) return 1.0f;
+  long long seen = 0;
+  for (int i = 0; i < kBins; ++i) {
+    seen += bins[i];
+    if (2 * seen >= count) return std::exp2(-2.0f + 4.0f * (i + 0.5f) / kBins);
+  }
+  return 1.0f;
+}
+
+// What one chunk of texels found (reduced after the parallel loop: deterministic).
+struct BufferBackground::ChunkStats {
+  int observed = 0, foreground = 0, warming = 0;
+  int x_min = INT_MAX, y_min = INT_MAX, x_max = -1, y_max = -1;  // foreground texels
+};
+
+void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& options) {
+  options_ = options;
+  robust_.clear();
+  average_.clear();
+  if (options.mode == BackgroundMode::kRobust) robust_.assign(buffer.NumTexels(), RobustTexel{});
+  if (options.mode == BackgroundMode::kAverage) average_.assign(buffer.NumTexels(), AverageTexel{});
+  raw_ = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+}
+
+void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
+                                      GainHistogram* histogram) const {
+  if (robust_.empty()) return;
+  const uint8_t* valid = warped.valid.data;
+  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
+  constexpr float kBinsPerLog2 = GainHistogram::kBins / 4.0f;
+  for (int k = 0; k < buffer.NumTexels(); k += 4) {
+    const int idx = buffer.texel_index[k];
+    const RobustTexel& t = robust_[k];
+    if (!valid[idx] || t.samples == 0) continue;
+    const float model = (t.mean[0][0] + t.mean[0][1] + t.mean[0][2]) * (1.0f / kMeanScale);
+    const float sample = static_cast<float>(src[idx][0] + src[idx][1] + src[idx][2]);
+    if (model < 30.0f || sample < 30.0f) continue;  // too dark for a ratio
+    const int bin = static_cast<int>((std::log2(sample / model) + 2.0f) * kBinsPerLog2);
+    ++histogram->bins[std::clamp(bin, 0, GainHistogram::kBins - 1)];
+    ++histogram->count;
+  }
+}
+
+void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
+                                bool debug, const BaseBuffer::Chunk& chunk, ChunkStats* stats,
+                                BackgroundFrame* frame) {
+  const uint8_t* valid = warped.valid.data;
+  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
+  uint8_t* raw = raw_.data;
+  uint8_t* warming = frame->warming.data;
+  uint8_t* difference = debug ? frame->difference.data : nullptr;
+  const bool robust = options_.mode == BackgroundMode::kRobust;
+  const float inv_gain = 1.0f / gain;
+  const float k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
+  const float min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
+  const float threshold = static_cast<float>(options_.average_threshold);
+  const int window = options_.window_frames;
+  for (int k = chunk.begin; k < chunk.end; ++k) {
+    const int idx = buffer.texel_index[k];
+    if (!valid[idx]) {
+      raw[idx] = warming[idx] = 0;
+      continue;
+    }
+    ++stats->observed;
+    const cv::Vec3b s = src[idx];
+    bool foreground = false, warm_up = false;
+    float distance2 = 0;
+    if (robust) {
+      RobustTexel& t = robust_[k];
+      const float x[3] = {s[0] * inv_gain, s[1] * inv_gain, s[2] * inv_gain};
+      const float alpha = 1.0f / static_cast<float>(std::min<int>(t.samples + 1, window));
+      const float var = std::max(t.var4 * 0.25f, min_var);
+      // The sample's mode: the background if close enough, else the candidate, else it
+      // replaces the candidate.
+      int match = -1;
+      distance2 = t.samples > 0 ? Distance2(x, t.mean[0]) : 1e30f;
+      if (distance2 <= k2 * var) {
+        match = 0;
+      } else if (t.weight[1] > 0 && Distance2(x, t.mean[1]) <= k2 * var) {
+        match = 1;
+      }
+      t.weight[0] *= 1.0f - alpha;
+      t.weight[1] *= 1.0f - alpha;
+      if (match >= 0) {
+        float& w = t.weight[match];
+        w += alpha;
+        const float rho = std::min(1.0f, alpha / w);
+        for (int c = 0; c < 3; ++c) {
+          const float m = t.mean[match][c] * (1.0f / kMeanScale);
+          t.mean[match][c] = ToFixed(m + rho * (x[c] - m));
+        }
+        if (match == 0) t.var4 = ToVar4(var + rho * (distance2 - var));
+      } else {
+        for (int c = 0; c < 3; ++c) t.mean[1][c] = ToFixed(x[c]);
+        t.weight[1] = alpha;
+        match = 1;
+      }
+      bool flipped = false;
+      if (t.weight[1] >= t.weight[0]) {  // the candidate now explains more: it is background
+        std::swap(t.mean[0], t.mean[1]);
+        std::swap(t.weight[0], t.weight[1]);
+        t.var4 = ToVar4(min_var);
+        match = 1 - match;
+        flipped = t.samples > 0;
+      }
+      if (t.samples < 65535) ++t.samples;
+      foreground = match != 0;
+      // A texel whose background just changed holds a stale paint: provisional too.
+      warm_up = t.samples < options_.warmup_frames || flipped;
+    } else {
+      AverageTexel& t = average_[k];
+      if (t.count < options_.training_frames) {  // training: learn, paint provisionally
+        for (int c = 0; c < 3; ++c) t.sum[c] += s[c];
+        ++t.count;
+        warm_up = true;
+      } else {
+        float largest = 0;
+        for (int c = 0; c < 3; ++c) {
+          const float e = s[c] - static_cast<float>(t.sum[c]) / t.count;
+          largest = std::max(largest, std::abs(e));
+          distance2 += e * e * (1.0f / 3.0f);
+        }
+        foreground = largest > threshold;
+      }
+    }
+    raw[idx] = foreground ? 255 : 0;
+    warming[idx] = warm_up ? 255 : 0;
+    stats->warming += warm_up;
+    if (difference) difference[idx] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2));
+    if (foreground) {
+      ++stats->foreground;
+      const int x = idx % buffer.width, y = idx / buffer.width;
+      stats->x_min = std::min(stats->x_min, x), stats->x_max = std::max(stats->x_max, x);
+      stats->y_min = std::min(stats->y_min, y), stats->y_max = std::max(stats->y_max, y);
+    }
+  }
+}
+
+void BufferBackground::Clean(const cv::Rect& roi, BackgroundFrame* frame) {
+  cv::Mat raw = raw_(roi);
+  cv::Mat kept = raw;
+  if (options_.min_blob_texels > 1) {
+    cv::Mat labels, stats, centroids;
+    const int n = cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
+    std::vector<uint8_t> keep(n, 0);
+    for (int i = 1; i < n; ++i) {
+      keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= options_.min_blob_texels ? 255 : 0;
+      frame->blobs_removed += keep[i] == 0;
+    }
+    kept = cv::Mat(raw.size(), CV_8U);
+    for (int y = 0; y < raw.rows; ++y) {
+      const int* l = labels.ptr<int>(y);
+      uint8_t* out = kept.ptr<uint8_t>(y);
+      for (int x = 0; x < raw.cols; ++x) out[x] = keep[l[x]];
+    }
+  }
+  cv::Mat out = frame->foreground(roi);
+  if (options_.dilate_texels > 0) {
+    const int r = options_.dilate_texels;
+    cv::dilate(kept, out,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+  } else {
+    kept.copyTo(out);
+  }
+}
+
+void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
+                              bool debug, BackgroundFrame* frame) {
+  *frame = BackgroundFrame{};
+  frame->foreground = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  frame->warming = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  if (debug) frame->difference = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  if (options_.mode == BackgroundMode::kOff) return;
+  std::vector<ChunkStats> stats(buffer.chunks.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(buffer.chunks.size())),
+                    [&](const cv::Range& range) {
+                      for (int c = range.start; c < range.end; ++c)
+                        Classify(buffer, warped, gain, debug, buffer.chunks[c], &stats[c], frame);
+                    });
+  ChunkStats total;
+  for (const ChunkStats& s : stats) {
+    total.observed += s.observed, total.foreground += s.foreground, total.warming += s.warming;
+    total.x_min = std::min(total.x_min, s.x_min), total.x_max = std::max(total.x_max, s.x_max);
+    total.y_min = std::min(total.y_min, s.y_min), total.y_max = std::max(total.y_max, s.y_max);
+  }
+  frame->observed = total.observed;
+  frame->foreground_raw = total.foreground;
+  frame->warming_up = total.warming;
+  if (total.foreground == 0) return;
+  // Clean only around the foreground (the dilation's reach included).
+  const int pad = options_.dilate_texels + 1;
+  const cv::Rect roi = cv::Rect(cv::Point(total.x_min - pad, total.y_min - pad),
+                                cv::Point(total.x_max + pad + 1, total.y_max + pad + 1)) &
+                       cv::Rect(0, 0, buffer.width, buffer.height);
+  Clean(roi, frame);
+  frame->masked = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
+}
+
+cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
+  cv::Mat image = cv::Mat::zeros(buffer.height, buffer.width, CV_8UC3);
+  cv::Vec3b* out = image.ptr<cv::Vec3b>();
+  for (int k = 0; k < buffer.NumTexels(); ++k) {
+    cv::Vec3b& px = out[buffer.texel_index[k]];
+    if (!robust_.empty() && robust_[k].samples > 0) {
+      for (int c = 0; c < 3; ++c)
+        px[c] = cv::saturate_cast<uint8_t>(robust_[k].mean[0][c] * (1.0f / kMeanScale));
+    } else if (!average_.empty() && average_[k].count > 0) {
+      for (int c = 0; c < 3; ++c)
+        px[c] =
+            cv::saturate_cast<uint8_t>(static_cast<float>(average_[k].sum[c]) / average_[k].count);
+    }
+  }
+  return image;
+}
+
+void MarkProvisional(const BackgroundFrame& frame, PaintedBuffer* painted) {
+  if (frame.warming_up > 0) painted->quality.setTo(0.0f, frame.warming);
+}
+
+}  // namespace fresco

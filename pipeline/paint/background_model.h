@@ -1,0 +1,98 @@
+// Background stage (paper §3.4, selective texture painting): a background model per texel of
+// every base buffer, so it works for moving cameras (each frame is first warped into the
+// buffer, which is static relative to the model). Each frame's warped samples are compared
+// with the model; foreground texels (people, cars, the paper's yellow sphere) are masked and
+// the paint stage leaves them alone. Two models (BackgroundOptions::mode):
+//   average  the paper: the linear average of each texel's first `training_frames` samples,
+//            then image subtraction with a fixed threshold (frozen after training).
+//   robust   two colour modes per texel with weights over a sliding window of samples
+//            (Stauffer-Grimson style, two components): the background is the heavier mode,
+//            so a texel converges to what it shows most of the time whatever came first;
+//            foreground beyond `sigma_threshold` times the texel's own noise; every frame is
+//            divided by its global gain (median sample/background ratio: exposure changes).
+// Memory is fixed per texel (robust 24 bytes, average 8), whatever the video's length.
+// Texels still warming up (fewer samples than the model needs) paint provisionally: their
+// stored quality is reset so that the first trusted background sample replaces it.
+// The mask is cleaned: foreground blobs smaller than `min_blob_texels` are dropped (noise),
+// the rest is dilated by `dilate_texels` (anti-aliased edges, shadows, the model's lag).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/project.h"
+#include "pipeline/paint/base_buffer.h"
+#include "pipeline/paint/frame_warp.h"
+#include "pipeline/paint/paint_update.h"
+
+namespace fresco {
+
+// One buffer's segmentation of one frame.
+struct BackgroundFrame {
+  cv::Mat foreground;      // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
+  cv::Mat warming;         // CV_8U, buffer size: 255 = sampled this frame, model still warming up
+  cv::Mat difference;      // CV_8U (debug only): RMS colour distance to the background x 2
+  int observed = 0;        // texels sampled this frame (valid in the warped buffer)
+  int foreground_raw = 0;  // ... classified foreground before cleaning
+  int masked = 0;          // ... masked after cleaning (small blobs out, margin in)
+  int warming_up = 0;      // ... whose model is still warming up (painted provisionally)
+  int blobs_removed = 0;   // foreground blobs smaller than min_blob_texels
+};
+
+// Histogram of log2(sample / background) grey ratios over all buffers of a frame, for the
+// frame's global gain (exposure) estimate.
+struct GainHistogram {
+  static constexpr int kBins = 512;  // log2 ratio in [-2, 2): 0.0078 per bin (0.5 %)
+  std::array<int, kBins> bins = {};
+  long long count = 0;
+  // The median ratio, or 1 when fewer than `min_samples` samples were seen.
+  float MedianGain(long long min_samples = 256) const;
+};
+
+// The background model of one base buffer. Init once, then per frame (optionally)
+// AccumulateGain over all buffers, then Update with the frame's gain.
+class BufferBackground {
+ public:
+  void Init(const BaseBuffer& buffer, const BackgroundOptions& options);
+  // Adds this buffer's samples (every 4th texel with a model) to the gain histogram.
+  void AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
+                      GainHistogram* histogram) const;
+  // Classifies the warped samples, updates the model with them, cleans the mask.
+  // `gain`: the frame's exposure relative to the model (robust mode; 1 = none).
+  void Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
+              BackgroundFrame* frame);
+  // The background estimate (CV_8UC3, buffer size, black where never seen).
+  cv::Mat Image(const BaseBuffer& buffer) const;
+
+  // Per-texel state (by texel number k, not buffer index). Means are fixed point (x 64).
+  struct RobustTexel {
+    uint16_t mean[2][3];  // mode 0 = background, mode 1 = candidate
+    uint16_t var4;        // background noise variance per channel, grey levels^2 x 4
+    uint16_t samples;     // samples seen (saturates at 65535)
+    float weight[2];      // fraction of the recent samples each mode explains
+  };
+  struct AverageTexel {
+    uint16_t sum[3];  // sum of the training samples
+    uint16_t count;   // training samples so far
+  };
+
+ private:
+  struct ChunkStats;
+  void Classify(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
+                const BaseBuffer::Chunk& chunk, ChunkStats* stats, BackgroundFrame* frame);
+  void Clean(const cv::Rect& roi, BackgroundFrame* frame);
+
+  BackgroundOptions options_;
+  std::vector<RobustTexel> robust_;
+  std::vector<AverageTexel> average_;
+  cv::Mat raw_;  // CV_8U: this frame's foreground before cleaning
+};
+
+// Marks texels painted while warming up as provisional (stored quality 0), so that the
+// quality update policy lets the first trusted sample replace them.
+void MarkProvisional(const BackgroundFrame& frame, PaintedBuffer* painted);
+
+}  // namespace fresco

@@ -1,0 +1,346 @@
+// Selective painting (paper §3.4) against ground truth.
+// Synthetic: a hand-held capture inside the room with moving spheres and boxes. For every
+// frame the test knows which pixels show a mover (the movers' triangle ids), warps that
+// mask into the base buffers like the frame, and follows which texels each frame writes:
+// at the end it knows, for every painted texel, whether its colour came from a mover.
+// Real: two static-camera clips (Intel IoT devkit sample videos, CC BY 4.0) painted onto a
+// plane filling the view, so the painted buffer is the learned background image; it is
+// scored against the clips' empty frames with the background-estimation metrics AGE, pEPs
+// and PSNR (grey levels).
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/video_source.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/render/rasterizer.h"
+#include "pipeline/render/renderer.h"
+#include "pipeline/synth/movers.h"
+#include "pipeline/synth/procedural_scenes.h"
+#include "pipeline/synth/synthesize.h"
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+// ---- Synthetic captures with movers. ---------------------------------------------------------
+
+Scene Room() {
+  CubeRoomOptions room;
+  room.procedural_texture_px = 512;
+  Scene scene;
+  EXPECT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  return scene;
+}
+
+SynthOptions MoverCapture(int frames, double exposure_jitter) {
+  SynthOptions o;
+  o.frames = frames;
+  o.width = 320;
+  o.height = 240;
+  o.hfov_deg = 70;
+  o.path = CameraPathKind::kHandheld;
+  o.target = Eigen::Vector3d(0, 1.5, 0);
+  o.radius_m = 0.5;
+  o.height_m = 1.5;
+  o.turns = 0.5;
+  o.look_at_target = false;
+  o.tilt_deg = 20;
+  // The paper's fig. 6: objects moving in front of the walls while the camera looks around.
+  auto mover = [](MoverShape shape, double radius_m, cv::Vec3b rgb, Eigen::Vector3d start,
+                  Eigen::Vector3d end, double period_frames, double phase) {
+    MoverOptions m;
+    m.shape = shape;
+    m.radius_m = radius_m;
+    m.rgb = rgb;
+    m.start = start;
+    m.end = end;
+    m.period_frames = period_frames;
+    m.phase = phase;
+    m.spin_deg_per_frame = shape == MoverShape::kBox ? 4.0 : 0.0;
+    return m;
+  };
+  o.movers = {
+      mover(MoverShape::kSphere, 0.25, {255, 220, 0}, {-1.4, 1.2, 1.3}, {1.4, 1.2, 1.3}, 24, 0),
+      mover(MoverShape::kBox, 0.2, {220, 40, 30}, {1.3, 0.8, -1.4}, {1.3, 0.8, 1.4}, 30, 0.3),
+      mover(MoverShape::kSphere, 0.2, {40, 80, 230}, {-1.3, 1.9, -1.3}, {1.3, 1.9, -1.3}, 20, 0.6),
+      mover(MoverShape::kBox, 0.25, {30, 160, 60}, {-1.3, 0.6, 1.2}, {-1.3, 0.6, -1.2}, 28, 0.1),
+  };
+  o.exposure_jitter = exposure_jitter;
+  o.seed = 5;
+  return o;
+}
+
+struct MoverFigures {
+  long long painted = 0;        // on-surface texels painted at the end
+  long long painted_mover = 0;  // ... whose colour came from a mover
+  // ... of which seen with a mover on them at least as often as without (no per-texel
+  // model can tell those: the limit)
+  long long mover_dominated = 0;
+  long long open = 0;          // on-surface texels seen at least once with no mover on them
+  long long open_painted = 0;  // ... painted at the end
+  double mover_fraction() const { return painted > 0 ? double(painted_mover) / painted : 0.0; }
+  double open_coverage() const { return open > 0 ? double(open_painted) / open : 0.0; }
+  double masked_fraction = 0;  // mean of the background stage's masked_fraction
+};
+
+MoverFigures PaintWithMovers(const Scene& scene, const SynthCapture& capture,
+                             const PipelineOptions& options) {
+  PaintSessionInputs inputs;
+  inputs.scene = &scene;
+  inputs.pipeline = options;
+  inputs.typical_camera = &capture.camera;
+  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
+  std::unique_ptr<PaintSession> session;
+  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  const std::vector<BaseBuffer>& buffers = session->buffers();
+  const size_t nb = buffers.size();
+  // Per buffer: does the stored sample show a mover; was the texel ever seen mover-free;
+  // how often it was seen with and without a mover on it.
+  std::vector<cv::Mat> shows_mover(nb), open(nb), n_mover(nb), n_open(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    shows_mover[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_8U);
+    open[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_8U);
+    n_mover[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_16U);
+    n_open[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_16U);
+  }
+  MoverScene movers(scene, capture.movers);
+  RasterOptions raster_options;
+  raster_options.near_m = 1e-3;
+  const Rasterizer raster(capture.camera, raster_options);
+  WarpOptions warp_options;
+  warp_options.sampling = options.sampling;
+  warp_options.occlusion = options.occlusion;
+  MoverFigures figures;
+  FrameReport report;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
+    const Rigid3d& cam_from_world = capture.true_poses[i].cam_from_world;
+    // Which pixels show a mover (one pixel of margin: the frames are anti-aliased).
+    movers.SetFrame(static_cast<int>(i));
+    RasterOutput with_movers, static_scene;
+    raster.Rasterize(movers.scene().mesh, CamFromLocal(movers.scene(), cam_from_world),
+                     &with_movers);
+    raster.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world), &static_scene);
+    cv::Mat mover_px = with_movers.triangle_id >= movers.FirstMoverTriangle();
+    cv::dilate(mover_px, mover_px, cv::Mat::ones(3, 3, CV_8U));
+    cv::Mat mover_bgr;
+    cv::cvtColor(mover_px, mover_bgr, cv::COLOR_GRAY2BGR);
+    FrameView view;
+    view.camera = &capture.camera;
+    view.cam_from_local = CamFromLocal(scene, cam_from_world);
+    view.centre_local = view.cam_from_local.Centre();
+    view.frame_bgr = &mover_bgr;
+    view.depth = &static_scene.depth;
+    view.bounds = ComputeNormalizedBounds(capture.camera);
+    std::vector<cv::Mat> before(nb);
+    for (size_t b = 0; b < nb; ++b) before[b] = session->painted()[b].bgra.clone();
+    Frame frame;
+    frame.index = static_cast<int>(i);
+    frame.bgr = capture.frames_bgr[i];
+    session->PaintFrame(frame, capture.camera, cam_from_world, &report);
+    if (const StageReport* stage = report.Stage("background"))
+      figures.masked_fraction += stage->metrics.at("masked_fraction") / capture.frames_bgr.size();
+    for (size_t b = 0; b < nb; ++b) {
+      WarpedBuffer warped;
+      WarpFrameToBuffer(buffers[b], view, warp_options, &warped);
+      if (warped.visible == 0) continue;
+      std::vector<cv::Mat> mover_ch;
+      cv::split(warped.bgr, mover_ch);
+      const cv::Mat mover_texel = mover_ch[0] > 0;
+      cv::Mat diff;
+      cv::absdiff(before[b], session->painted()[b].bgra, diff);
+      cv::Mat written;
+      cv::transform(diff, written, cv::Matx14f(1, 1, 1, 1));
+      written = written > 0;
+      mover_texel.copyTo(shows_mover[b], written);
+      open[b].setTo(255, warped.valid & ~mover_texel);
+      cv::add(n_mover[b], 1, n_mover[b], warped.valid & mover_texel);
+      cv::add(n_open[b], 1, n_open[b], warped.valid & ~mover_texel);
+    }
+  }
+  for (size_t b = 0; b < nb; ++b) {
+    const BaseBuffer& buffer = buffers[b];
+    const cv::Vec4b* bgra = session->painted()[b].bgra.ptr<cv::Vec4b>();
+    for (int k = 0; k < buffer.NumTexels(); ++k) {
+      if (!buffer.on_surface[k]) continue;
+      const int idx = buffer.texel_index[k];
+      const bool painted = bgra[idx][3] == 255;
+      figures.painted += painted;
+      figures.painted_mover += painted && shows_mover[b].data[idx];
+      figures.mover_dominated += painted && shows_mover[b].data[idx] &&
+                                 n_mover[b].ptr<uint16_t>()[idx] >= n_open[b].ptr<uint16_t>()[idx];
+      figures.open += open[b].data[idx] != 0;
+      figures.open_painted += painted && open[b].data[idx];
+    }
+  }
+  return figures;
+}
+
+void Print(const char* name, const MoverFigures& f) {
+  std::printf(
+      "%-8s mover texels painted %6.3f %% (%lld of %lld), open texels painted %6.2f %%, "
+      "masked %5.2f %% per frame, dominated %lld\n",
+      name, 100 * f.mover_fraction(), f.painted_mover, f.painted, 100 * f.open_coverage(),
+      100 * f.masked_fraction, f.mover_dominated);
+}
+
+class MoversTest : public ::testing::TestWithParam<double> {};
+
+TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
+  const double exposure_jitter = GetParam();
+  const Scene scene = Room();
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, MoverCapture(150, exposure_jitter), &capture).ok());
+  ASSERT_GE(capture.movers.size(), 3u);
+  PipelineOptions options;
+  std::map<BackgroundMode, MoverFigures> figures;
+  for (BackgroundMode mode :
+       {BackgroundMode::kOff, BackgroundMode::kAverage, BackgroundMode::kRobust}) {
+    options.background.mode = mode;
+    figures[mode] = PaintWithMovers(scene, capture, options);
+    Print(BackgroundModeName(mode).c_str(), figures[mode]);
+  }
+  const MoverFigures& off = figures[BackgroundMode::kOff];
+  const MoverFigures& robust = figures[BackgroundMode::kRobust];
+  // The movers are there: without background learning they are painted on the walls.
+  EXPECT_GT(off.mover_fraction(), 0.02);
+  EXPECT_LT(robust.mover_fraction(), 0.005);
+  EXPECT_LT(robust.mover_fraction(), off.mover_fraction() / 10);
+  // What was ever seen without a mover on it is painted (nearly) as without movers.
+  EXPECT_GE(robust.open_coverage(), 0.99 * off.open_coverage());
+}
+
+INSTANTIATE_TEST_SUITE_P(Exposure, MoversTest, ::testing::Values(0.0, 0.08), [](const auto& info) {
+  return info.param == 0.0 ? std::string("Steady") : std::string("Jitter");
+});
+
+// ---- Real static-camera video. ---------------------------------------------------------------
+
+// The static-camera projects: a plane at 5 m filling the view of a 768 x 432 pinhole
+// camera (f = 500 px) looking at it head-on, one texel (1 cm) per pixel.
+constexpr double kPlaneDistanceM = 5.0;
+constexpr double kFocalPx = 500.0;
+
+struct BackgroundScore {
+  double age = 0;      // mean absolute grey difference
+  double peps = 0;     // fraction of pixels off by more than 20 grey levels
+  double psnr_db = 0;  // grey PSNR
+};
+
+BackgroundScore Score(const cv::Mat& estimate_grey, const cv::Mat& truth_grey) {
+  cv::Mat diff;
+  cv::absdiff(estimate_grey, truth_grey, diff);
+  BackgroundScore s;
+  s.age = cv::mean(diff)[0];
+  s.peps = static_cast<double>(cv::countNonZero(diff > 20)) / diff.total();
+  cv::Mat d;
+  diff.convertTo(d, CV_64F);
+  const double mse = cv::mean(d.mul(d))[0];
+  s.psnr_db = 10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10));
+  return s;
+}
+
+// Paints a clip onto the plane with `mode`; returns the painted plane rendered through the
+// camera (grey) and keeps the grey frames listed in `keep`.
+cv::Mat LearnBackground(const std::string& video, BackgroundMode mode, const std::vector<int>& keep,
+                        std::map<int, cv::Mat>* kept) {
+  std::unique_ptr<VideoSource> source;
+  EXPECT_TRUE(OpenVideoSource(video, &source).ok()) << video;
+  if (!source) return cv::Mat();
+  Frame frame;
+  Status status;
+  EXPECT_TRUE(source->Next(&frame, &status)) << video;
+  const int w = frame.bgr.cols, h = frame.bgr.rows;
+  const Camera camera = Camera::FromParams(LensModel::kPinhole, w, h,
+                                           {kFocalPx, kFocalPx, 0.5 * (w - 1), 0.5 * (h - 1)});
+  const double s = kPlaneDistanceM / kFocalPx;
+  const Scene scene = MakeTexturedPlaneScene(w * s, h * s);
+  // At z = 5 m looking towards -Z (at the plane's front), image y down = world -Y.
+  const Rigid3d cam_from_world(
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())),
+      Eigen::Vector3d(0, 0, kPlaneDistanceM));
+  PaintSessionInputs inputs;
+  inputs.scene = &scene;
+  inputs.pipeline.texel_size_m = s;
+  inputs.pipeline.background.mode = mode;
+  std::unique_ptr<PaintSession> session;
+  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  FrameReport report;
+  do {
+    for (int k : keep)
+      if (frame.index == k) cv::cvtColor(frame.bgr, (*kept)[k], cv::COLOR_BGR2GRAY);
+    session->PaintFrame(frame, camera, cam_from_world, &report);
+  } while (source->Next(&frame, &status));
+  EXPECT_TRUE(status.ok()) << status.message();
+  RenderOptions render_options;
+  render_options.filter = TextureFilter::kNearest;
+  RenderOutput out;
+  Renderer(camera, render_options).Render(session->PaintedScene(), cam_from_world, &out);
+  cv::Mat grey;
+  cv::cvtColor(out.rgba, grey, cv::COLOR_RGBA2GRAY);
+  return grey;
+}
+
+struct ClipCase {
+  const char* file;
+  std::vector<int> empty_frames;  // frames that show the empty scene (the ground truth)
+};
+
+// Scores each model's learned background against the clip's empty frames. Returns the mean
+// score per mode and prints a table.
+std::map<BackgroundMode, BackgroundScore> ScoreClip(const ClipCase& clip) {
+  const std::string video = testing::SharedDataDir() + "/video-intel-static-cam/" + clip.file;
+  std::map<BackgroundMode, BackgroundScore> result;
+  for (BackgroundMode mode :
+       {BackgroundMode::kOff, BackgroundMode::kAverage, BackgroundMode::kRobust}) {
+    std::map<int, cv::Mat> truth;
+    const cv::Mat estimate = LearnBackground(video, mode, clip.empty_frames, &truth);
+    BackgroundScore mean;
+    for (int k : clip.empty_frames) {
+      EXPECT_TRUE(truth.count(k)) << clip.file << " frame " << k;
+      if (!truth.count(k) || estimate.size() != truth[k].size()) continue;
+      const BackgroundScore s = Score(estimate, truth[k]);
+      mean.age += s.age / clip.empty_frames.size();
+      mean.peps += s.peps / clip.empty_frames.size();
+      mean.psnr_db += s.psnr_db / clip.empty_frames.size();
+    }
+    std::printf("%-36s %-8s AGE %6.2f  pEPs %6.2f %%  PSNR %6.2f dB\n", clip.file,
+                BackgroundModeName(mode).c_str(), mean.age, 100 * mean.peps, mean.psnr_db);
+    result[mode] = mean;
+  }
+  return result;
+}
+
+TEST(StaticCamera, CarDetectionRobustModelLearnsTheEmptyParkingLot) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const auto r = ScoreClip({"car-detection.mp4", {0, 53, 161, 268}});
+  const BackgroundScore& robust = r.at(BackgroundMode::kRobust);
+  const BackgroundScore& average = r.at(BackgroundMode::kAverage);
+  // The empty frames differ from each other and from the end of the clip (compression
+  // noise, wet asphalt): about AGE 5.3 whatever the model (README). No car is left behind:
+  // a car left in the estimate costs far more pEPs than 1.2 %, and both models stay at
+  // that floor.
+  EXPECT_LT(robust.age, 6.0);
+  EXPECT_LT(robust.peps, 0.012);
+  EXPECT_GT(robust.psnr_db, 28.5);
+  EXPECT_LT(robust.age, average.age + 0.3);
+}
+
+TEST(StaticCamera, PersonDetectionRobustModelLearnsTheEmptyRoom) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const auto r = ScoreClip({"one-by-one-person-detection.mp4", {0}});
+  const BackgroundScore& robust = r.at(BackgroundMode::kRobust);
+  const BackgroundScore& average = r.at(BackgroundMode::kAverage);
+  // Measured: robust AGE 2.23, pEPs 0.28 %, 37.1 dB; average 2.29, 0.44 %, 36.6 dB. A
+  // person left in the estimate gives pEPs of several per cent (window 300: 7 %).
+  EXPECT_LT(robust.age, 2.6);
+  EXPECT_LT(robust.peps, 0.004);
+  EXPECT_GT(robust.psnr_db, 36.0);
+  EXPECT_LE(robust.peps, average.peps);
+}
+
+}  // namespace
+}  // namespace fresco
