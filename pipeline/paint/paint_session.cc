@@ -214,10 +214,14 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   warp_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(warp_report));
 
-  // 3. background
+  // 3. refine
+  if (options_.refine.mode != RefineMode::kOff)
+    report->stages.push_back(RefineAlignment(seen, debug));
+
+  // 4. background
   if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
 
-  // 4. paint
+  // 5. paint
   start = std::chrono::steady_clock::now();
   StageReport paint_report;
   paint_report.name = "paint";
@@ -248,6 +252,63 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(paint_report));
   report->painted = true;
   report->total_ms = MsSince(frame_start);
+}
+
+StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "refine";
+  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0;
+  double before_sq = 0, after_sq = 0, correction = 0;
+  std::map<std::string, int> models, reasons;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!seen[b] || painted_[b].painted_surface_texels == 0) continue;
+    WarpedBuffer& w = warped_[b];
+    const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, painted_[b].bgra, options_.refine);
+    const std::string suffix = "_b" + std::to_string(b);
+    if (debug && e.inliers > 0)
+      report.images["residual_before" + suffix] =
+          ResidualHeatMap(w.bgr, w.valid, painted_[b].bgra, e.region);
+    ApplyRefinement(e, &w.bgr, &w.valid, &w.quality);
+    corners += e.corners, matches += e.matches, inliers += e.inliers;
+    before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
+    after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
+    if (e.applied) {
+      ++refined;
+      ++models[MotionModelName(e.model)];
+      correction = std::max(correction, e.correction_px);
+    } else {
+      ++fell_back;
+      ++reasons[e.fallback];
+    }
+    if (debug) {
+      report.images["matches" + suffix] = DrawRefinementMatches(w.bgr, e);
+      if (e.inliers > 0)
+        report.images["residual_after" + suffix] =
+            ResidualHeatMap(w.bgr, w.valid, painted_[b].bgra, e.region);
+      report.notes["buffer" + std::to_string(b)] =
+          (e.applied ? MotionModelName(e.model) : "no correction: " + e.fallback) + " (" +
+          std::to_string(e.inliers) + "/" + std::to_string(e.matches) + " inliers)";
+    }
+  }
+  report.metrics["buffers_refined"] = refined;
+  report.metrics["buffers_not_refined"] = fell_back;
+  report.metrics["corners"] = corners;
+  report.metrics["matches"] = matches;
+  report.metrics["inliers"] = inliers;
+  // RMS over all inliers, texels: identity before, the chosen corrections after.
+  report.metrics["residual_before_px"] =
+      inliers > 0 ? std::sqrt(before_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
+  report.metrics["residual_after_px"] =
+      inliers > 0 ? std::sqrt(after_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
+  report.metrics["correction_px"] = correction;
+  for (const auto& [model, n] : models) report.metrics["model_" + model] = n;
+  std::string why;
+  for (const auto& [reason, n] : reasons)
+    why += (why.empty() ? "" : "; ") + reason + " x" + std::to_string(n);
+  if (!why.empty()) report.notes["not refined"] = why;
+  report.wall_ms = MsSince(start);
+  return report;
 }
 
 StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool debug) {

@@ -2,9 +2,11 @@
 //   1. depth   render the model's depth from the video camera (§3.3; renderer's raster path)
 //   2. warp    per texel: project, reject grazing/back-facing, occlusion test, sample
 //              (eq. 1-4, §3.2, §3.3)        -> frame_warp.h
-//   3. background  per texel: compare with the texel's background model, mask foreground
+//   3. refine  per buffer: register the warped frame to what the buffer holds in 2D and
+//              warp it again (§3.5; off unless pipeline.refine.mode)   -> refine_alignment.h
+//   4. background  per texel: compare with the texel's background model, mask foreground
 //              (moving objects), learn (§3.4)                            -> background_model.h
-//   4. paint   update the persistent base buffers where not masked (eq. 4, update policy)
+//   5. paint   update the persistent base buffers where not masked (eq. 4, update policy)
 //                                                                         -> paint_update.h
 // Set-up (once): grouping (§3.6) -> grouping.h, base buffers and texel model points (eq. 2)
 // -> base_buffer.h. Each stage reports wall time, metrics and (when asked) debug images in a
@@ -25,6 +27,7 @@
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_update.h"
+#include "pipeline/paint/refine_alignment.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/render/rasterizer.h"
 
@@ -77,6 +80,8 @@ class PaintSession {
     NormalizedBounds bounds;
   };
   const CameraCache& CacheFor(const Camera& camera);
+  // The refinement stage over the buffers seen this frame (re-warps warped_).
+  StageReport RefineAlignment(const std::vector<bool>& seen, bool debug);
   // The background stage over the buffers seen this frame (fills background_frame_).
   StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
 

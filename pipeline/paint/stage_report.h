@@ -16,6 +16,7 @@ struct StageReport {
   double wall_ms = 0.0;
   std::map<std::string, double> metrics;   // e.g. {"texels_visible", 12345}
   std::map<std::string, cv::Mat> images;   // debug images (BGR or gray), only when asked
+  std::map<std::string, std::string> notes;  // words: chosen model, why no correction, ...
 };
 
 struct FrameReport {
