@@ -1,5 +1,5 @@
 // Every panel of the app, in the View menu's order, with where it starts in a 1600 x 1000
-// window (four columns, nothing overlapping; scaled to the real window): one line each.
+// window (five columns, nothing overlapping; scaled to the real window): one line each.
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -16,17 +16,19 @@ void Add(std::vector<std::unique_ptr<Panel>>* panels, std::unique_ptr<Panel> pan
 
 std::vector<std::unique_ptr<Panel>> MakePanels() {
   std::vector<std::unique_ptr<Panel>> p;
-  Add(&p, MakeProjectPanel(), 0, 20, 330, 200);
-  Add(&p, MakePipelinePanel(), 0, 220, 330, 470);
-  Add(&p, MakeTimingPanel(), 0, 690, 330, 285);
-  Add(&p, MakeInputFramePanel(), 330, 20, 420, 300);
-  Add(&p, MakeStagePanel("depth", "Stage: depth and visibility"), 330, 320, 420, 330);
-  Add(&p, MakeViewportPanel(), 330, 650, 420, 325);
-  Add(&p, MakeStagePanel("warp", "Stage: warp to buffer"), 750, 20, 420, 300);
-  Add(&p, MakeStagePanel("paint", "Stage: paint"), 750, 320, 420, 330);
-  Add(&p, MakeMisalignmentPanel(), 750, 650, 420, 325);
-  Add(&p, MakePaintedBuffersPanel(), 1170, 20, 430, 300);
-  Add(&p, MakeGroupingPanel(), 1170, 320, 430, 655);
+  Add(&p, MakeProjectPanel(), 0, 20, 320, 190);
+  Add(&p, MakePipelinePanel(), 0, 210, 320, 440);
+  Add(&p, MakeTimingPanel(), 0, 650, 320, 325);
+  Add(&p, MakeInputFramePanel(), 320, 20, 320, 280);
+  Add(&p, MakeStagePanel("depth", "Stage: depth and visibility"), 320, 300, 320, 350);
+  Add(&p, MakeViewportPanel(), 320, 650, 320, 325);
+  Add(&p, MakeStagePanel("warp", "Stage: warp to buffer"), 640, 20, 320, 280);
+  Add(&p, MakeStagePanel("background", "Stage: background"), 640, 300, 320, 350);
+  Add(&p, MakeMisalignmentPanel(), 640, 650, 320, 325);
+  Add(&p, MakeStagePanel("refine", "Stage: refine alignment"), 960, 20, 320, 280);
+  Add(&p, MakeStagePanel("paint", "Stage: paint"), 960, 300, 320, 350);
+  Add(&p, MakePaintedBuffersPanel(), 960, 650, 320, 325);
+  Add(&p, MakeGroupingPanel(), 1280, 20, 320, 955);
   return p;
 }
 

@@ -84,6 +84,36 @@ class PipelinePanel : public Panel {
     if (ImGui::SliderFloat("max view angle deg", &angle, 1.0f, 90.0f, "%.1f"))
       p.occlusion.max_view_angle_deg = angle;
     done();
+    ImGui::TextDisabled("refine alignment (§3.5)");
+    const char* refine_modes[] = {"off", "paper", "robust"};
+    int refine = static_cast<int>(p.refine.mode);
+    if (ImGui::Combo("refine", &refine, refine_modes, 3)) {
+      p.refine.mode = static_cast<RefineMode>(refine);
+      commit = true;
+    }
+    const char* models[] = {"translation", "similarity", "affine", "homography"};
+    int model = static_cast<int>(p.refine.max_model);
+    if (ImGui::Combo("most general model", &model, models, 4)) {
+      p.refine.max_model = static_cast<RefineModelLimit>(model);
+      commit = true;
+    }
+    ImGui::SliderInt("search texels", &p.refine.search_px, 1, 64);
+    done();
+    ImGui::SliderInt("window texels", &p.refine.window_px, 1, 32);
+    done();
+    ImGui::SliderInt("corners", &p.refine.max_corners, 3, 1000);
+    done();
+    ImGui::TextDisabled("background (§3.4)");
+    const char* background_modes[] = {"off", "average", "robust"};
+    int background = static_cast<int>(p.background.mode);
+    if (ImGui::Combo("background", &background, background_modes, 3)) {
+      p.background.mode = static_cast<BackgroundMode>(background);
+      commit = true;
+    }
+    ImGui::SliderInt("window frames", &p.background.window_frames, 2, 1000);
+    done();
+    ImGui::SliderInt("training frames", &p.background.training_frames, 1, 250);
+    done();
     if (commit && !(edit_ == state.project.pipeline)) {
       state.BeginEdit();
       state.project.pipeline = edit_;

@@ -25,8 +25,10 @@ class StagePanel : public Panel {
     for (const StageReport& s : snap.report.stages)
       if (s.name == stage_) stage = &s;
     if (!stage) {
-      ImGui::TextDisabled(snap.report.skipped_reason.empty() ? "no frame painted yet"
-                                                             : snap.report.skipped_reason.c_str());
+      ImGui::TextDisabled(
+          "%s", !snap.report.skipped_reason.empty() ? snap.report.skipped_reason.c_str()
+                : snap.report.stages.empty()        ? "no frame painted yet"
+                                             : "stage not running (off in the pipeline settings)");
       ImGui::End();
       return;
     }
@@ -51,6 +53,8 @@ class StagePanel : public Panel {
     } else {
       ImGui::TextDisabled("(debug images appear when paused or stepping)");
     }
+    for (const auto& [key, text] : stage->notes)
+      ImGui::TextWrapped("%s: %s", key.c_str(), text.c_str());
     ShowMetrics(stage->metrics);
     ImGui::End();
   }
