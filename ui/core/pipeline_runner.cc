@@ -177,6 +177,14 @@ bool PipelineRunner::PaintNext(bool show) {
     if (paint && paint->metrics.count("difference_to_buffer"))
       diff = paint->metrics.at("difference_to_buffer");
     working_.misalignment.push_back(static_cast<float>(diff));
+    if (const StageReport* refine = working_.report.Stage("refine")) {
+      const auto value = [&](const char* key) {
+        const auto it = refine->metrics.find(key);
+        return static_cast<float>(it == refine->metrics.end() ? std::nan("") : it->second);
+      };
+      working_.refine_before_px.push_back(value("residual_before_px"));
+      working_.refine_after_px.push_back(value("residual_after_px"));
+    }
   }
   working_.coverage = s.paint->Coverage();
   return true;

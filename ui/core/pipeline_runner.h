@@ -60,6 +60,9 @@ struct RunnerSnapshot {
   std::vector<int> frames_painted;
   std::map<std::string, std::vector<float>> stage_ms;
   std::vector<float> misalignment;
+  // Per painted frame, when the refine stage runs: the inliers' RMS residual before and
+  // after the correction, texels (NaN where nothing was matched).
+  std::vector<float> refine_before_px, refine_after_px;
   // Misalignment review images for the current frame (half size): the painted model
   // rendered into the frame's view, and the absolute difference as a heat map.
   cv::Mat rephoto_bgr, difference_heat;

@@ -54,6 +54,20 @@ class MisalignmentPanel : public Panel {
     ImGui::PlotLines("##difference", plot.data(), static_cast<int>(plot.size()), 0,
                      "mean |grey difference| to the buffers, per frame", 0.0f, FLT_MAX,
                      ImVec2(ImGui::GetContentRegionAvail().x, 80));
+    if (!snap.refine_before_px.empty()) {
+      // The refine stage's residuals along the sequence (0 where nothing was matched).
+      std::vector<float> before(snap.refine_before_px.size()), after(snap.refine_after_px.size());
+      for (size_t i = 0; i < before.size(); ++i)
+        before[i] = std::isnan(snap.refine_before_px[i]) ? 0.0f : snap.refine_before_px[i];
+      for (size_t i = 0; i < after.size(); ++i)
+        after[i] = std::isnan(snap.refine_after_px[i]) ? 0.0f : snap.refine_after_px[i];
+      const float top = before.empty() ? 1.0f : *std::max_element(before.begin(), before.end());
+      ImGui::PlotLines("##refine_before", before.data(), static_cast<int>(before.size()), 0,
+                       "refinement residual before, texels", 0.0f, top,
+                       ImVec2(ImGui::GetContentRegionAvail().x, 50));
+      ImGui::PlotLines("##refine_after", after.data(), static_cast<int>(after.size()), 0, "after",
+                       0.0f, top, ImVec2(ImGui::GetContentRegionAvail().x, 50));
+    }
     std::vector<size_t> order(d.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return plot[a] > plot[b]; });
