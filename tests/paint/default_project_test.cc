@@ -13,35 +13,14 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/synth/synth_spec.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/paint/rephotograph.h"
 #include "tests/test_support.h"
 
 namespace fresco {
 namespace {
 
-struct Rephoto {
-  double psnr_db = 0;
-  double completeness = 0;  // surface pixels of the original the painted model covers
-};
-
-Rephoto Rephotograph(const Renderer& renderer, const Scene& original, const Scene& painted,
-                     const Rigid3d& cam_from_world) {
-  RenderOutput truth, paint;
-  renderer.Render(original, cam_from_world, &truth);
-  renderer.Render(painted, cam_from_world, &paint);
-  std::vector<cv::Mat> t_ch, p_ch;
-  cv::split(truth.rgba, t_ch);
-  cv::split(paint.rgba, p_ch);
-  const cv::Mat surface = t_ch[3] == 255;
-  const cv::Mat both = surface & (p_ch[3] == 255);
-  cv::Mat t_rgb, p_rgb;
-  cv::cvtColor(truth.rgba, t_rgb, cv::COLOR_RGBA2RGB);
-  cv::cvtColor(paint.rgba, p_rgb, cv::COLOR_RGBA2RGB);
-  Rephoto r;
-  r.psnr_db = PsnrDb(t_rgb, p_rgb, both);
-  r.completeness =
-      static_cast<double>(cv::countNonZero(both)) / std::max(1, cv::countNonZero(surface));
-  return r;
-}
+using testing::Rephoto;
+using testing::Rephotograph;
 
 TEST(DefaultProject, PerfectPosesRepaintAtLeast35DbAtFrameAndNovelPoses) {
   SynthJob job;
@@ -69,9 +48,7 @@ TEST(DefaultProject, PerfectPosesRepaintAtLeast35DbAtFrameAndNovelPoses) {
               }).ok());
   const Scene painted = session->PaintedScene();
 
-  RenderOptions render_options;
-  render_options.raster.supersample = 2;  // anti-aliased, as the frames were made
-  const Renderer renderer(plan.camera, render_options);
+  const Renderer renderer = testing::RephotoRenderer(plan.camera);
   const int n = static_cast<int>(plan.true_poses.size());
   double worst_frame = std::numeric_limits<double>::infinity(), worst_novel = worst_frame;
   double sum = 0;

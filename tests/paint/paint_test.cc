@@ -11,6 +11,7 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/paint/rephotograph.h"
 #include "tests/test_support.h"
 
 namespace fresco {
@@ -42,32 +43,11 @@ PaintResult Paint(const Scene& scene, const SynthCapture& capture, PipelineOptio
   return result;
 }
 
-struct Comparison {
-  double psnr_db = 0;
-  double completeness = 0;  // surface pixels of the original that the painted model covers
-};
+using Comparison = testing::Rephoto;
 
 Comparison Compare(const Scene& original, const Scene& painted, const Camera& camera,
                    const Rigid3d& cam_from_world) {
-  RenderOptions options;
-  options.raster.supersample = 2;
-  Renderer renderer(camera, options);
-  RenderOutput truth, paint;
-  renderer.Render(original, cam_from_world, &truth);
-  renderer.Render(painted, cam_from_world, &paint);
-  std::vector<cv::Mat> t_ch, p_ch;
-  cv::split(truth.rgba, t_ch);
-  cv::split(paint.rgba, p_ch);
-  const cv::Mat surface = t_ch[3] == 255;
-  const cv::Mat both = surface & (p_ch[3] == 255);
-  cv::Mat t_rgb, p_rgb;
-  cv::cvtColor(truth.rgba, t_rgb, cv::COLOR_RGBA2RGB);
-  cv::cvtColor(paint.rgba, p_rgb, cv::COLOR_RGBA2RGB);
-  Comparison c;
-  c.psnr_db = PsnrDb(t_rgb, p_rgb, both);
-  c.completeness = static_cast<double>(cv::countNonZero(both)) /
-                   std::max(1, cv::countNonZero(surface));
-  return c;
+  return testing::Rephotograph(testing::RephotoRenderer(camera), original, painted, cam_from_world);
 }
 
 SynthOptions RoomCapture(int frames) {
@@ -134,7 +114,8 @@ TEST(BaseBuffers, TexelPointsLieOnTheSurfaceAndCoverIt) {
       const Eigen::Vector3d p = b.Point(k).cast<double>();
       const Eigen::Vector3d a = scene.mesh.Corner(b.triangle[k], 0);
       EXPECT_NEAR((p - a).dot(scene.mesh.Normal(b.triangle[k])), 0.0, 1e-5);
-      EXPECT_NEAR((b.Normal(k).cast<double>() - scene.mesh.Normal(b.triangle[k])).norm(), 0.0, 1e-6);
+      EXPECT_NEAR((b.Normal(k).cast<double>() - scene.mesh.Normal(b.triangle[k])).norm(), 0.0,
+                  1e-6);
     }
   }
 }
@@ -145,7 +126,8 @@ TEST(BaseBuffers, FoldedGroupIsSplit) {
   Scene scene = MakeTexturedPlaneScene(1.0, 1.0);
   const int n = scene.mesh.NumTriangles();
   const int v0 = static_cast<int>(scene.mesh.vertices.size());
-  for (int v = 0; v < v0; ++v) scene.mesh.vertices.push_back(scene.mesh.vertices[v] + Eigen::Vector3d(0, 0, -0.5));
+  for (int v = 0; v < v0; ++v)
+    scene.mesh.vertices.push_back(scene.mesh.vertices[v] + Eigen::Vector3d(0, 0, -0.5));
   for (int t = 0; t < n; ++t) {
     scene.mesh.triangles.push_back(scene.mesh.triangles[t] + Eigen::Vector3i::Constant(v0));
     scene.mesh.uvs.push_back(scene.mesh.uvs[t]);
@@ -171,7 +153,8 @@ TEST(Painting, PerfectPosesReproduceTheSceneAtFramePosesAndNovelPoses) {
   const PaintResult r = Paint(scene, capture, options);
   EXPECT_EQ(r.session->buffers().size(), 6u);
   for (int i : {0, 11, 23}) {
-    const Comparison c = Compare(scene, r.painted, capture.camera, capture.true_poses[i].cam_from_world);
+    const Comparison c =
+        Compare(scene, r.painted, capture.camera, capture.true_poses[i].cam_from_world);
     EXPECT_GE(c.psnr_db, 30.0) << "frame " << i;
     EXPECT_GE(c.completeness, 0.95) << "frame " << i;
   }
@@ -197,8 +180,9 @@ TEST(Painting, BackFacesAreNotPainted) {
   capture.camera = camera;
   // Camera at z = -2 looking towards +Z (camera z forward = world +Z), y down = world -Y.
   PosedImage pose;
-  pose.cam_from_world = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())),
-                                Eigen::Vector3d(0, 0, 2));
+  pose.cam_from_world =
+      Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ())),
+              Eigen::Vector3d(0, 0, 2));
   capture.true_poses = {pose};
   capture.frames_bgr = {cv::Mat(120, 160, CV_8UC3, cv::Scalar(0, 0, 255))};
   PipelineOptions options;
@@ -218,7 +202,8 @@ TEST(Painting, OccludedSurfacesAreNotPainted) {
   Scene scene = MakeTexturedPlaneScene(4.0, 4.0);  // wall at z = 0 facing +Z
   const Scene cube = MakeTexturedCubeScene(0.6);
   const int v0 = static_cast<int>(scene.mesh.vertices.size());
-  for (const auto& v : cube.mesh.vertices) scene.mesh.vertices.push_back(v + Eigen::Vector3d(0, 0, 1.0));
+  for (const auto& v : cube.mesh.vertices)
+    scene.mesh.vertices.push_back(v + Eigen::Vector3d(0, 0, 1.0));
   const int m0 = static_cast<int>(scene.materials.size());
   const int t0 = static_cast<int>(scene.textures.size());
   for (auto m : cube.materials) {
@@ -236,8 +221,9 @@ TEST(Painting, OccludedSurfacesAreNotPainted) {
   SynthCapture capture;
   capture.camera = camera;
   PosedImage pose;  // at z = 4 looking at -Z: rotate 180 deg about X (y down = world -Y)
-  pose.cam_from_world = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())),
-                                Eigen::Vector3d(0, 0, 4));
+  pose.cam_from_world =
+      Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())),
+              Eigen::Vector3d(0, 0, 4));
   capture.true_poses = {pose};
   RenderOutput frame;
   Renderer(camera, RenderOptions()).Render(scene, pose.cam_from_world, &frame);
@@ -257,11 +243,13 @@ TEST(Painting, OccludedSurfacesAreNotPainted) {
       if (!buf.on_surface[k]) continue;
       Eigen::Vector2d px;
       const Eigen::Vector3d pc = cam_from_local * buf.Point(k).cast<double>();
-      if (!camera.Project(pc, &px) || px.x() < 1 || px.y() < 1 || px.x() > 158 || px.y() > 118) continue;
+      if (!camera.Project(pc, &px) || px.x() < 1 || px.y() < 1 || px.x() > 158 || px.y() > 118)
+        continue;
       const int id = frame.triangle_id.at<int>(static_cast<int>(std::lround(px.y())),
                                                static_cast<int>(std::lround(px.x())));
       const int idx = buf.texel_index[k];
-      const bool painted = r.session->painted()[b].bgra.at<cv::Vec4b>(idx / buf.width, idx % buf.width)[3] == 255;
+      const bool painted =
+          r.session->painted()[b].bgra.at<cv::Vec4b>(idx / buf.width, idx % buf.width)[3] == 255;
       if (id >= 2) {
         ++hidden, hidden_painted += painted;
       } else if (id >= 0) {
@@ -270,7 +258,8 @@ TEST(Painting, OccludedSurfacesAreNotPainted) {
     }
   }
   EXPECT_GT(hidden, 100);
-  EXPECT_LE(hidden_painted, hidden / 50) << hidden_painted << " of " << hidden;  // silhouette ring at most
+  EXPECT_LE(hidden_painted, hidden / 50)
+      << hidden_painted << " of " << hidden;  // silhouette ring at most
   EXPECT_GE(open_painted, open * 95 / 100);
   // Without the depth test the hidden part would be painted: the test can fail.
   options.occlusion.enabled = false;
@@ -315,7 +304,7 @@ TEST(Painting, QualityPolicyKeepsTheSharperSampleLatestTakesTheNewest) {
   const int red_quality = count(quality, 2), blue_quality = count(quality, 0);
   const int red_latest = count(latest, 2), blue_latest = count(latest, 0);
   EXPECT_GT(red_quality, 15000);
-  EXPECT_EQ(red_latest, 0);              // the far frame sees the whole plane: all blue
+  EXPECT_EQ(red_latest, 0);  // the far frame sees the whole plane: all blue
   EXPECT_GT(blue_latest, red_quality);
   EXPECT_EQ(quality.session->NumPaintedSurfaceTexels(), latest.session->NumPaintedSurfaceTexels());
   EXPECT_EQ(red_quality + blue_quality, red_latest + blue_latest);
@@ -336,8 +325,10 @@ TEST(Painting, MapScaleCoordinatesPaintAsWellAsTheOrigin) {
     p.cam_from_world.translation -= p.cam_from_world.rotation * shift;
   const PaintResult far = Paint(far_scene, far_capture, options);
   EXPECT_EQ(far.session->NumPaintedSurfaceTexels(), near.session->NumPaintedSurfaceTexels());
-  const Comparison cn = Compare(scene, near.painted, capture.camera, capture.true_poses[4].cam_from_world);
-  const Comparison cf = Compare(far_scene, far.painted, capture.camera, far_capture.true_poses[4].cam_from_world);
+  const Comparison cn =
+      Compare(scene, near.painted, capture.camera, capture.true_poses[4].cam_from_world);
+  const Comparison cf =
+      Compare(far_scene, far.painted, capture.camera, far_capture.true_poses[4].cam_from_world);
   EXPECT_NEAR(cf.psnr_db, cn.psnr_db, 0.2);
 }
 

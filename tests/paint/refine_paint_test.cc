@@ -16,6 +16,7 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/paint/rephotograph.h"
 
 namespace fresco {
 namespace {
@@ -57,25 +58,12 @@ Painted Paint(const Scene& scene, const SynthCapture& capture, const std::vector
 
 // Mean PSNR of the painted model against the original at the true poses (every 6th frame).
 double MeanPsnr(const Scene& original, const Scene& painted, const SynthCapture& capture) {
-  RenderOptions options;
-  options.raster.supersample = 2;
-  const Renderer renderer(capture.camera, options);
+  const Renderer renderer = testing::RephotoRenderer(capture.camera);
   double sum = 0;
   int n = 0;
-  for (size_t i = 0; i < capture.true_poses.size(); i += 6) {
-    RenderOutput truth, paint;
-    renderer.Render(original, capture.true_poses[i].cam_from_world, &truth);
-    renderer.Render(painted, capture.true_poses[i].cam_from_world, &paint);
-    std::vector<cv::Mat> t, p;
-    cv::split(truth.rgba, t);
-    cv::split(paint.rgba, p);
-    const cv::Mat both = (t[3] == 255) & (p[3] == 255);
-    cv::Mat a, b;
-    cv::cvtColor(truth.rgba, a, cv::COLOR_RGBA2RGB);
-    cv::cvtColor(paint.rgba, b, cv::COLOR_RGBA2RGB);
-    sum += PsnrDb(a, b, both);
-    ++n;
-  }
+  for (size_t i = 0; i < capture.true_poses.size(); i += 6, ++n)
+    sum += testing::Rephotograph(renderer, original, painted, capture.true_poses[i].cam_from_world)
+               .psnr_db;
   return sum / n;
 }
 
