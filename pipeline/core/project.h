@@ -44,6 +44,13 @@ struct RefineOptions {
   double ransac_px = 1.5;     // inlier threshold, texels
   double max_scale_change = 0.05;  // a fit that scales or shears more is refused
   int min_inliers = 10;
+  // Register every Nth frame only (1 = every frame); the others are painted unrefined.
+  int every_n_frames = 1;
+  // Consensus anchoring (refine_anchor.h): move a buffer back by the mean of the corrections
+  // it asked for, once anchor_min_frames agree on a move larger than anchor_step_px texels.
+  bool anchor = true;
+  int anchor_min_frames = 3;
+  double anchor_step_px = 0.1;
 
   bool operator==(const RefineOptions&) const = default;
 };

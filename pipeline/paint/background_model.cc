@@ -56,6 +56,31 @@ void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& o
   raw_ = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
 }
 
+namespace {
+template <class Texel>
+void MoveTexels(const BaseBuffer& buffer, const cv::Mat& field, std::vector<Texel>* texels) {
+  if (texels->empty()) return;
+  std::vector<int> texel_at(static_cast<size_t>(buffer.width) * buffer.height, -1);
+  for (int k = 0; k < buffer.NumTexels(); ++k) texel_at[buffer.texel_index[k]] = k;
+  const std::vector<Texel> old = *texels;
+  for (int k = 0; k < buffer.NumTexels(); ++k) {
+    const int idx = buffer.texel_index[k];
+    const int x = idx % buffer.width, y = idx / buffer.width;
+    const cv::Vec2f f = field.at<cv::Vec2f>(y, x);
+    const int sx = x + static_cast<int>(std::lround(f[0]));
+    const int sy = y + static_cast<int>(std::lround(f[1]));
+    if (sx < 0 || sy < 0 || sx >= buffer.width || sy >= buffer.height) continue;
+    const int from = texel_at[static_cast<size_t>(sy) * buffer.width + sx];
+    if (from >= 0) (*texels)[k] = old[from];
+  }
+}
+}  // namespace
+
+void BufferBackground::Move(const BaseBuffer& buffer, const cv::Mat& field) {
+  MoveTexels(buffer, field, &robust_);
+  MoveTexels(buffer, field, &average_);
+}
+
 void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
                                       GainHistogram* histogram) const {
   if (robust_.empty()) return;

@@ -66,6 +66,9 @@ class BufferBackground {
               BackgroundFrame* frame);
   // The background estimate (CV_8UC3, buffer size, black where never seen).
   cv::Mat Image(const BaseBuffer& buffer) const;
+  // Moves the model with its buffer (refine_anchor.h): the texel at q takes the state of the
+  // texel nearest to q + field(q) (CV_32FC2, at least buffer size), when that is a texel.
+  void Move(const BaseBuffer& buffer, const cv::Mat& field);
 
   // Per-texel state (by texel number k, not buffer index). Means are fixed point (x 64).
   struct RobustTexel {

@@ -99,6 +99,9 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   buffer_options.max_buffer_texels = inputs.pipeline.max_buffer_texels;
   s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
   s->painted_.resize(s->set_.buffers.size());
+  s->anchors_.resize(s->set_.buffers.size());
+  for (size_t b = 0; b < s->set_.buffers.size(); ++b)
+    InitRefineAnchor(s->set_.buffers[b], &s->anchors_[b]);
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
@@ -215,7 +218,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(warp_report));
 
   // 3. refine
-  if (options_.refine.mode != RefineMode::kOff)
+  if (options_.refine.mode != RefineMode::kOff &&
+      frame_number % options_.refine.every_n_frames == 0)
     report->stages.push_back(RefineAlignment(seen, debug));
 
   // 4. background
@@ -258,18 +262,38 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
-  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0;
+  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, moved = 0,
+      unregistered_kept_out = 0;
   double before_sq = 0, after_sq = 0, correction = 0;
   std::map<std::string, int> models, reasons;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!seen[b] || painted_[b].painted_surface_texels == 0) continue;
     WarpedBuffer& w = warped_[b];
-    const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, painted_[b].bgra, options_.refine);
+    RefineEstimate e = EstimateRefinement(w.bgr, w.valid, painted_[b].bgra, options_.refine);
     const std::string suffix = "_b" + std::to_string(b);
     if (debug && e.inliers > 0)
       report.images["residual_before" + suffix] =
           ResidualHeatMap(w.bgr, w.valid, painted_[b].bgra, e.region);
     ApplyRefinement(e, &w.bgr, &w.valid, &w.quality);
+    // A registered frame is a sample of the buffer's offset (refine_anchor.h).
+    if (options_.refine.anchor && e.registered) {
+      cv::Mat field;
+      if (AddAnchorSample(e.buffer_from_warped, e.region, options_.refine, &anchors_[b],
+                          &field)) {
+        MovePaintedBuffer(field, set_.buffers[b], &painted_[b]);
+        MoveWarpedImages(field, &w.bgr, &w.valid, &w.quality);  // registered before the move
+        if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &field))
+          background_[b].Move(set_.buffers[b], field);
+        ++moved;
+      }
+    }
+    if (!e.registered) {
+      // Not registered: it may fill what the buffer lacks but not overwrite registered texels.
+      std::vector<cv::Mat> channels;
+      cv::split(painted_[b].bgra, channels);
+      w.valid.setTo(0, channels[3]);
+      ++unregistered_kept_out;
+    }
     corners += e.corners, matches += e.matches, inliers += e.inliers;
     before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
     after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
@@ -302,6 +326,8 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   report.metrics["residual_after_px"] =
       inliers > 0 ? std::sqrt(after_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
   report.metrics["correction_px"] = correction;
+  report.metrics["buffers_moved"] = moved;
+  report.metrics["buffers_unregistered"] = unregistered_kept_out;  // consensus anchoring moved them this frame
   for (const auto& [model, n] : models) report.metrics["model_" + model] = n;
   std::string why;
   for (const auto& [reason, n] : reasons)

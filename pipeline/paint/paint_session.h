@@ -28,6 +28,7 @@
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/refine_alignment.h"
+#include "pipeline/paint/refine_anchor.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/render/rasterizer.h"
 
@@ -62,6 +63,7 @@ class PaintSession {
 
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
+  const std::vector<RefineAnchor>& anchors() const { return anchors_; }
   const Grouping& grouping() const { return set_.grouping; }
   int folds_split() const { return set_.folds_split; }
   long long NumSurfaceTexels() const;
@@ -91,6 +93,7 @@ class PaintSession {
   BaseBufferSet set_;
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
+  std::vector<RefineAnchor> anchors_;              // per buffer (refinement on)
   std::vector<BufferBackground> background_;       // per buffer (mode != off)
   std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;

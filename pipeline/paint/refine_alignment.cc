@@ -324,6 +324,7 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
   e.residual_after_px = std::sqrt(SumSquared(best_H, in_from, in_to) / e.inliers);
   if (best == MotionModel::kNone) {
     e.fallback = "none needed (model selection)";
+    e.registered = true;
     return e;
   }
   const std::string problem = Check(best_H, e.region, options, &e.correction_px);
@@ -333,7 +334,7 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
     return e;
   }
   e.buffer_from_warped = best_H;
-  e.applied = true;
+  e.applied = e.registered = true;
   return e;
 }
 
@@ -353,7 +354,7 @@ void ApplyRefinement(const RefineEstimate& estimate, cv::Mat* warped_bgr, cv::Ma
   const cv::Mat bgr = warped_bgr->clone(), valid = warped_valid->clone(),
                 quality = warped_quality->clone();
   cv::Mat out_bgr, out_valid, out_quality;
-  cv::warpPerspective(bgr, out_bgr, M, roi.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::warpPerspective(bgr, out_bgr, M, roi.size(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::warpPerspective(valid, out_valid, M, roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
   cv::warpPerspective(quality, out_quality, M, roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
   cv::erode(out_valid, out_valid, cv::Mat());

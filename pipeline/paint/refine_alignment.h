@@ -33,6 +33,7 @@ std::string MotionModelName(MotionModel model);
 
 struct RefineEstimate {
   bool applied = false;  // a correction was estimated and passed every check
+  bool registered = false;  // applied, or the matches showed no correction is needed
   std::string fallback;  // why not, when not ("too few corners", ...)
   MotionModel model = MotionModel::kNone;
   cv::Matx33d buffer_from_warped = cv::Matx33d::eye();
