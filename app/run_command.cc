@@ -1,6 +1,7 @@
 // fresco run PROJECT.json --out DIR [--set KEY=VALUE ...]: replays a project headless,
 // paints every frame, writes DIR/painted.gltf, DIR/metrics.json and (opt-in) DIR/stages/.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <future>
@@ -80,6 +81,8 @@ class FrameReader {
 
 struct StageTotals {
   std::map<std::string, double> ms;
+  // Per stage and metric: sum and count over the frames where it was finite.
+  std::map<std::string, std::map<std::string, std::pair<double, int>>> metrics;
   int frames = 0;
 };
 
@@ -160,7 +163,14 @@ int RunVerbRun(const CommandArgs& argv) {
     session->PaintFrame(frame, *camera, pose->cam_from_world, &report);
     if (report.painted) {
       ++frames_painted;
-      for (const StageReport& st : report.stages) totals.ms[st.name] += st.wall_ms;
+      for (const StageReport& st : report.stages) {
+        totals.ms[st.name] += st.wall_ms;
+        for (const auto& [key, value] : st.metrics) {
+          if (!std::isfinite(value)) continue;
+          auto& [sum, count] = totals.metrics[st.name][key];
+          sum += value, ++count;
+        }
+      }
       if (project.pipeline.debug_images)
         if (Status s = WriteStageImages(stages_dir, report); !s.ok()) return InputError(s);
     }
@@ -197,6 +207,12 @@ int RunVerbRun(const CommandArgs& argv) {
   for (const auto& [name, ms] : totals.ms)
     stage_ms[name] = frames_painted > 0 ? ms / frames_painted : 0.0;
   metrics["stage_ms"] = stage_ms;
+  // Each stage's metrics, averaged over the frames where they were defined.
+  nlohmann::json stage_metrics = nlohmann::json::object();
+  for (const auto& [stage, by_key] : totals.metrics)
+    for (const auto& [key, sum_count] : by_key)
+      stage_metrics[stage][key] = sum_count.first / sum_count.second;
+  metrics["stage_metrics"] = stage_metrics;
   metrics["texels"] = session->NumSurfaceTexels();
   metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
   metrics["coverage"] = session->Coverage();

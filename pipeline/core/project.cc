@@ -103,9 +103,11 @@ void Fields(RefineOptions& o, V& v) {
   v.Field("ransac_px", o.ransac_px, {.min = 0, .min_exclusive = true});
   v.Field("max_scale_change", o.max_scale_change, {.min = 0, .min_exclusive = true, .max = 1});
   v.Field("min_inliers", o.min_inliers, {.min = 3});
+  v.Field("min_correction_px", o.min_correction_px, {.min = 0});
   v.Field("every_n_frames", o.every_n_frames, {.min = 1});
   v.Field("anchor", o.anchor);
-  v.Field("anchor_min_frames", o.anchor_min_frames, {.min = 1});
+  v.Field("anchor_min_frames", o.anchor_min_frames, {.min = 2});
+  v.Field("anchor_window_frames", o.anchor_window_frames, {.min = 0});
   v.Field("anchor_step_px", o.anchor_step_px, {.min = 0});
 }
 
@@ -182,14 +184,14 @@ void Fields(Project& p, V& v) {
 // A new member must be added to its Fields() above (read and written) and to the test's
 // NonDefaultProject(); then update the size here. (x86-64 Linux sizes.)
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 64, "see Fields(RefineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 208, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 224, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 472, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 488, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

@@ -43,13 +43,19 @@ struct RefineOptions {
   int pyramid_levels = 3;     // coarse-to-fine levels (robust mode)
   double ransac_px = 1.5;     // inlier threshold, texels
   double max_scale_change = 0.05;  // a fit that scales or shears more is refused
+  // Corrections smaller than this (largest displacement over the region, texels) are
+  // measured but not applied: registration noise applied frame after frame random-walks
+  // the buffer away from the model.
+  double min_correction_px = 0.25;
   int min_inliers = 10;
-  // Register every Nth frame only (1 = every frame); the others are painted unrefined.
+  // Register every Nth frame only (1 = every frame); the others only fill texels the
+  // buffers lack (unregistered, they would overwrite registered texels with their error).
   int every_n_frames = 1;
   // Consensus anchoring (refine_anchor.h): move a buffer back by the mean of the corrections
   // it asked for, once anchor_min_frames agree on a move larger than anchor_step_px texels.
   bool anchor = true;
   int anchor_min_frames = 3;
+  int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
   double anchor_step_px = 0.1;
 
   bool operator==(const RefineOptions&) const = default;

@@ -58,27 +58,33 @@ void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& o
 
 namespace {
 template <class Texel>
-void MoveTexels(const BaseBuffer& buffer, const cv::Mat& field, std::vector<Texel>* texels) {
+void MoveTexels(const BaseBuffer& buffer, const std::vector<int>& texel_at, const cv::Rect& roi,
+                const cv::Mat& field, std::vector<Texel>* texels) {
   if (texels->empty()) return;
-  std::vector<int> texel_at(static_cast<size_t>(buffer.width) * buffer.height, -1);
-  for (int k = 0; k < buffer.NumTexels(); ++k) texel_at[buffer.texel_index[k]] = k;
-  const std::vector<Texel> old = *texels;
-  for (int k = 0; k < buffer.NumTexels(); ++k) {
-    const int idx = buffer.texel_index[k];
-    const int x = idx % buffer.width, y = idx / buffer.width;
-    const cv::Vec2f f = field.at<cv::Vec2f>(y, x);
-    const int sx = x + static_cast<int>(std::lround(f[0]));
-    const int sy = y + static_cast<int>(std::lround(f[1]));
-    if (sx < 0 || sy < 0 || sx >= buffer.width || sy >= buffer.height) continue;
-    const int from = texel_at[static_cast<size_t>(sy) * buffer.width + sx];
-    if (from >= 0) (*texels)[k] = old[from];
+  std::vector<std::pair<int, Texel>> moved;  // written after all are read
+  for (int y = roi.y; y < roi.br().y; ++y) {
+    const cv::Vec2f* f = field.ptr<cv::Vec2f>(y - roi.y);
+    for (int x = roi.x; x < roi.br().x; ++x) {
+      const int k = texel_at[static_cast<size_t>(y) * buffer.width + x];
+      const int sx = x + static_cast<int>(std::lround(f[x - roi.x][0]));
+      const int sy = y + static_cast<int>(std::lround(f[x - roi.x][1]));
+      if (k < 0 || (sx == x && sy == y)) continue;
+      if (sx < 0 || sy < 0 || sx >= buffer.width || sy >= buffer.height) continue;
+      const int from = texel_at[static_cast<size_t>(sy) * buffer.width + sx];
+      if (from >= 0) moved.emplace_back(k, (*texels)[from]);
+    }
   }
+  for (const auto& [k, texel] : moved) (*texels)[k] = texel;
 }
 }  // namespace
 
-void BufferBackground::Move(const BaseBuffer& buffer, const cv::Mat& field) {
-  MoveTexels(buffer, field, &robust_);
-  MoveTexels(buffer, field, &average_);
+void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field) {
+  if (texel_at_.empty()) {
+    texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
+    for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
+  }
+  MoveTexels(buffer, texel_at_, roi, field, &robust_);
+  MoveTexels(buffer, texel_at_, roi, field, &average_);
 }
 
 void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,

@@ -66,9 +66,10 @@ class BufferBackground {
               BackgroundFrame* frame);
   // The background estimate (CV_8UC3, buffer size, black where never seen).
   cv::Mat Image(const BaseBuffer& buffer) const;
-  // Moves the model with its buffer (refine_anchor.h): the texel at q takes the state of the
-  // texel nearest to q + field(q) (CV_32FC2, at least buffer size), when that is a texel.
-  void Move(const BaseBuffer& buffer, const cv::Mat& field);
+  // Moves the model with its buffer (refine_anchor.h): the texel at q (in `roi`) takes the
+  // state of the texel nearest to q + field(q - roi.tl()) (CV_32FC2, roi size), when there
+  // is one.
+  void Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field);
 
   // Per-texel state (by texel number k, not buffer index). Means are fixed point (x 64).
   struct RobustTexel {
@@ -92,6 +93,7 @@ class BufferBackground {
   std::vector<RobustTexel> robust_;
   std::vector<AverageTexel> average_;
   cv::Mat raw_;  // CV_8U: this frame's foreground before cleaning
+  std::vector<int> texel_at_;  // texel number k by buffer index, -1 for none (built by Move)
 };
 
 // Marks texels painted while warming up as provisional (stored quality 0), so that the

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <mutex>
 
 #include <opencv2/core/utility.hpp>
 
@@ -392,12 +393,15 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
   const ChunkKernel kernel = SelectKernel(camera.HasDistortion(), use_depth, options.sampling);
   std::atomic<int> in_view{0}, visible{0}, occluded{0}, grazing{0}, culled{0};
   std::atomic<long long> tested{0};
+  std::mutex box_mutex;
+  cv::Rect box;
   const int num_chunks = static_cast<int>(buffer.chunks.size());
   const double stripes = std::max(1, std::min(num_chunks, 16 * cv::getNumThreads()));
   cv::parallel_for_(
       cv::Range(0, num_chunks),
       [&](const cv::Range& range) {
         Counts n;
+        int x0 = w, y0 = h, x1 = -1, y1 = -1;  // inclusive bounds of chunks with visible texels
         for (int c = range.start; c < range.end; ++c) {
           const BaseBuffer::Chunk& chunk = buffer.chunks[c];
           if (ChunkCulled(k, chunk)) {
@@ -405,7 +409,17 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
             continue;
           }
           n.tested += chunk.end - chunk.begin;
+          const int visible_before = n.visible;
           kernel(k, chunk, &n);
+          if (n.visible == visible_before) continue;
+          for (int t = chunk.begin; t < chunk.end; ++t) {
+            const int x = buffer.texel_index[t] % w, y = buffer.texel_index[t] / w;
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+          }
+        }
+        if (x1 >= 0) {
+          const std::lock_guard<std::mutex> lock(box_mutex);
+          box |= cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
         }
         in_view += n.in_view, visible += n.visible, occluded += n.occluded;
         grazing += n.grazing, culled += n.culled, tested += n.tested;
@@ -417,6 +431,7 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
   warped->grazing = grazing;
   warped->chunks_culled = culled;
   warped->texels_tested = tested;
+  warped->valid_box = box;
 }
 
 }  // namespace fresco

@@ -57,6 +57,7 @@ struct WarpedBuffer {
   int grazing = 0;              // back-facing or beyond max_view_angle
   int chunks_culled = 0;        // chunks of texels skipped whole (outside the view frustum)
   long long texels_tested = 0;  // texels in chunks that were not culled
+  cv::Rect valid_box;           // bounds every valid texel (empty when none)
 };
 
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view,

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/render/renderer.h"
@@ -218,9 +219,14 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(warp_report));
 
   // 3. refine
-  if (options_.refine.mode != RefineMode::kOff &&
-      frame_number % options_.refine.every_n_frames == 0)
-    report->stages.push_back(RefineAlignment(seen, debug));
+  if (options_.refine.mode != RefineMode::kOff) {
+    if (frame_number % options_.refine.every_n_frames == 0) {
+      report->stages.push_back(RefineAlignment(seen, debug));
+    } else {  // not registered this frame: it only fills what the buffers lack
+      for (size_t b = 0; b < set_.buffers.size(); ++b)
+        if (seen[b]) KeepOutOfPainted(b, warped_[b].valid_box);
+    }
+  }
 
   // 4. background
   if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
@@ -258,42 +264,94 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->total_ms = MsSince(frame_start);
 }
 
+void PaintSession::KeepOutOfPainted(size_t b, const cv::Rect& roi) {
+  if (roi.empty()) return;
+  cv::Mat alpha;
+  cv::extractChannel(painted_[b].bgra(roi), alpha, 3);
+  warped_[b].valid(roi).setTo(0, alpha);
+}
+
+// One buffer's refinement: register, warp again, anchor; what the stage reports about it.
+struct PaintSession::BufferRefinement {
+  RefineEstimate estimate;
+  bool moved = false, kept_out = false;
+  double estimate_ms = 0, rewarp_ms = 0, anchor_ms = 0;
+  std::map<std::string, cv::Mat> images;
+};
+
+void PaintSession::RefineBuffer(size_t b, bool debug, BufferRefinement* r) {
+  WarpedBuffer& w = warped_[b];
+  PaintedBuffer& painted = painted_[b];
+  RefineEstimate& e = r->estimate;
+  auto t0 = std::chrono::steady_clock::now();
+  e = EstimateRefinement(w.bgr, w.valid, painted.bgra, options_.refine, w.valid_box);
+  r->estimate_ms = MsSince(t0);
+  const std::string suffix = "_b" + std::to_string(b);
+  if (debug && e.inliers > 0)
+    r->images["residual_before" + suffix] = ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
+  t0 = std::chrono::steady_clock::now();
+  ApplyRefinement(e, w.valid_box, &w.bgr, &w.valid, &w.quality);
+  r->rewarp_ms = MsSince(t0);
+  t0 = std::chrono::steady_clock::now();
+  // A registered frame is a sample of the buffer's offset (refine_anchor.h).
+  AnchorMove move;
+  std::vector<cv::Point2f> inliers_at;
+  for (size_t i = 0; i < e.to.size(); ++i)
+    if (e.inlier[i]) inliers_at.push_back(e.to[i]);
+  if (options_.refine.anchor && e.registered &&
+      AddAnchorSample(e.buffer_from_warped, inliers_at, options_.refine, &anchors_[b], &move)) {
+    MovePaintedBuffer(move, anchors_[b], &painted);
+    // The frame, registered to the buffer before the move, moves with it.
+    const int margin = static_cast<int>(std::ceil(e.correction_px)) + 2;
+    const cv::Rect within = cv::Rect(w.valid_box.x - margin, w.valid_box.y - margin,
+                                     w.valid_box.width + 2 * margin,
+                                     w.valid_box.height + 2 * margin) &
+                            cv::Rect(0, 0, w.valid.cols, w.valid.rows);
+    MoveWarpedImages(move, within, &w.bgr, &w.valid, &w.quality);
+    if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &move))
+      background_[b].Move(set_.buffers[b], move.roi, move.field);
+    r->moved = true;
+  }
+  r->anchor_ms = MsSince(t0);
+  if (!e.registered && !e.region.empty()) {
+    // Not registered: it may fill what the buffer lacks but not overwrite registered texels
+    // (which all lie in the region: it bounds where the frame and the buffer overlap).
+    KeepOutOfPainted(b, e.region);
+    r->kept_out = true;
+  }
+  if (debug) {
+    r->images["matches" + suffix] = DrawRefinementMatches(w.bgr, e);
+    if (e.inliers > 0)
+      r->images["residual_after" + suffix] = ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
+  }
+}
+
 StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
+  std::vector<size_t> todo;
+  for (size_t b = 0; b < set_.buffers.size(); ++b)
+    if (seen[b] && painted_[b].painted_surface_texels > 0) todo.push_back(b);
+  // Buffers are independent: one per thread.
+  std::vector<BufferRefinement> results(todo.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) RefineBuffer(todo[i], debug, &results[i]);
+  });
+
   int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, moved = 0,
       unregistered_kept_out = 0;
   double before_sq = 0, after_sq = 0, correction = 0;
+  double estimate_ms = 0, rewarp_ms = 0, anchor_ms = 0;
   std::map<std::string, int> models, reasons;
-  for (size_t b = 0; b < set_.buffers.size(); ++b) {
-    if (!seen[b] || painted_[b].painted_surface_texels == 0) continue;
-    WarpedBuffer& w = warped_[b];
-    RefineEstimate e = EstimateRefinement(w.bgr, w.valid, painted_[b].bgra, options_.refine);
-    const std::string suffix = "_b" + std::to_string(b);
-    if (debug && e.inliers > 0)
-      report.images["residual_before" + suffix] =
-          ResidualHeatMap(w.bgr, w.valid, painted_[b].bgra, e.region);
-    ApplyRefinement(e, &w.bgr, &w.valid, &w.quality);
-    // A registered frame is a sample of the buffer's offset (refine_anchor.h).
-    if (options_.refine.anchor && e.registered) {
-      cv::Mat field;
-      if (AddAnchorSample(e.buffer_from_warped, e.region, options_.refine, &anchors_[b],
-                          &field)) {
-        MovePaintedBuffer(field, set_.buffers[b], &painted_[b]);
-        MoveWarpedImages(field, &w.bgr, &w.valid, &w.quality);  // registered before the move
-        if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &field))
-          background_[b].Move(set_.buffers[b], field);
-        ++moved;
-      }
-    }
-    if (!e.registered) {
-      // Not registered: it may fill what the buffer lacks but not overwrite registered texels.
-      std::vector<cv::Mat> channels;
-      cv::split(painted_[b].bgra, channels);
-      w.valid.setTo(0, channels[3]);
-      ++unregistered_kept_out;
-    }
+  for (size_t i = 0; i < todo.size(); ++i) {
+    const RefineEstimate& e = results[i].estimate;
+    report.images.merge(results[i].images);
+    estimate_ms += results[i].estimate_ms;
+    rewarp_ms += results[i].rewarp_ms;
+    anchor_ms += results[i].anchor_ms;
+    moved += results[i].moved;
+    unregistered_kept_out += results[i].kept_out;
     corners += e.corners, matches += e.matches, inliers += e.inliers;
     before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
     after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
@@ -305,15 +363,10 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
       ++fell_back;
       ++reasons[e.fallback];
     }
-    if (debug) {
-      report.images["matches" + suffix] = DrawRefinementMatches(w.bgr, e);
-      if (e.inliers > 0)
-        report.images["residual_after" + suffix] =
-            ResidualHeatMap(w.bgr, w.valid, painted_[b].bgra, e.region);
-      report.notes["buffer" + std::to_string(b)] =
+    if (debug)
+      report.notes["buffer" + std::to_string(todo[i])] =
           (e.applied ? MotionModelName(e.model) : "no correction: " + e.fallback) + " (" +
           std::to_string(e.inliers) + "/" + std::to_string(e.matches) + " inliers)";
-    }
   }
   report.metrics["buffers_refined"] = refined;
   report.metrics["buffers_not_refined"] = fell_back;
@@ -327,7 +380,12 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
       inliers > 0 ? std::sqrt(after_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
   report.metrics["correction_px"] = correction;
   report.metrics["buffers_moved"] = moved;
-  report.metrics["buffers_unregistered"] = unregistered_kept_out;  // consensus anchoring moved them this frame
+  report.metrics["buffers_unregistered"] = unregistered_kept_out;
+  // Thread time summed over the buffers (they run in parallel): corners, matching and
+  // fitting; warping the frame again; consensus and buffer moves.
+  report.metrics["estimate_ms"] = estimate_ms;
+  report.metrics["rewarp_ms"] = rewarp_ms;
+  report.metrics["anchor_ms"] = anchor_ms;  // consensus anchoring moved them this frame
   for (const auto& [model, n] : models) report.metrics["model_" + model] = n;
   std::string why;
   for (const auto& [reason, n] : reasons)

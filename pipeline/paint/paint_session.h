@@ -84,6 +84,10 @@ class PaintSession {
   const CameraCache& CacheFor(const Camera& camera);
   // The refinement stage over the buffers seen this frame (re-warps warped_).
   StageReport RefineAlignment(const std::vector<bool>& seen, bool debug);
+  struct BufferRefinement;
+  // Clears the frame's valid texels of buffer `b` (within `roi`) where the buffer is painted.
+  void KeepOutOfPainted(size_t b, const cv::Rect& roi);
+  void RefineBuffer(size_t b, bool debug, BufferRefinement* result);
   // The background stage over the buffers seen this frame (fills background_frame_).
   StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
 

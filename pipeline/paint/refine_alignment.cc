@@ -166,10 +166,15 @@ void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overla
   std::vector<float> err;
   const cv::Size window(2 * options.window_px + 1, 2 * options.window_px + 1);
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
-  cv::calcOpticalFlowPyrLK(grey_w, grey_b, corners, forward, ok_f, err, window,
-                           options.pyramid_levels, stop);
-  cv::calcOpticalFlowPyrLK(grey_b, grey_w, forward, backward, ok_b, err, window,
-                           options.pyramid_levels, stop);
+  // Both pyramids once, for both directions.
+  std::vector<cv::Mat> pyramid_w, pyramid_b;
+  const int levels_w = cv::buildOpticalFlowPyramid(grey_w, pyramid_w, window, options.pyramid_levels);
+  const int levels_b = cv::buildOpticalFlowPyramid(grey_b, pyramid_b, window, options.pyramid_levels);
+  const int levels = std::min(levels_w, levels_b);
+  cv::calcOpticalFlowPyrLK(pyramid_w, pyramid_b, corners, forward, ok_f, err, window, levels,
+                           stop);
+  cv::calcOpticalFlowPyrLK(pyramid_b, pyramid_w, forward, backward, ok_b, err, window, levels,
+                           stop);
   for (size_t i = 0; i < corners.size(); ++i) {
     if (!ok_f[i] || !ok_b[i]) continue;
     if (cv::norm(backward[i] - corners[i]) > 0.5) continue;  // not the same texture both ways
@@ -201,29 +206,42 @@ std::string MotionModelName(MotionModel model) {
 }
 
 RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warped_valid,
-                                  const cv::Mat& buffer_bgra, const RefineOptions& options) {
+                                  const cv::Mat& buffer_bgra, const RefineOptions& options,
+                                  cv::Rect within) {
   RefineEstimate e;
   if (options.mode == RefineMode::kOff) {
     e.fallback = "off";
     return e;
   }
   // Where the frame and the painted buffer overlap; work in that region only.
-  std::vector<cv::Mat> channels;
-  cv::split(buffer_bgra, channels);
-  const cv::Mat overlap_full = warped_valid & (channels[3] == 255);
-  e.region = cv::boundingRect(overlap_full);
+  if (within.empty()) within = cv::Rect(0, 0, warped_valid.cols, warped_valid.rows);
+  cv::Mat alpha;
+  cv::extractChannel(buffer_bgra(within), alpha, 3);
+  const cv::Mat overlap_within = warped_valid(within) & (alpha == 255);
+  e.region = cv::boundingRect(overlap_within) + within.tl();
   const int min_side = 4 * options.window_px + 2;
   if (e.region.width < min_side || e.region.height < min_side) {
     e.fallback = "too little painted overlap";
     return e;
   }
-  const cv::Mat overlap = overlap_full(e.region);
+  const cv::Mat overlap = overlap_within(e.region - within.tl());
   const cv::Mat grey_w = Grey(warped_bgr(e.region)), grey_b = Grey(buffer_bgra(e.region));
   cv::Mat corner_mask;
   cv::erode(overlap, corner_mask, cv::Mat(), cv::Point(-1, -1), options.window_px + 1);
   std::vector<cv::Point2f> corners;
-  cv::goodFeaturesToTrack(grey_w, corners, options.max_corners, 0.01, options.window_px,
-                          corner_mask, 3, options.mode == RefineMode::kPaper, 0.04);
+  if (options.mode == RefineMode::kPaper) {  // Harris, full resolution
+    cv::goodFeaturesToTrack(grey_w, corners, options.max_corners, 0.01, options.window_px,
+                            corner_mask, 3, options.mode == RefineMode::kPaper, 0.04);
+  } else {
+    // Shi-Tomasi at half resolution (4x fewer texels): the positions only seed the tracker,
+    // which refines them at full resolution.
+    cv::Mat half, half_mask;
+    cv::pyrDown(grey_w, half);
+    cv::resize(corner_mask, half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
+    cv::goodFeaturesToTrack(half, corners, options.max_corners, 0.01,
+                            std::max(1, options.window_px / 2), half_mask, 3, false);
+    for (cv::Point2f& c : corners) c *= 2.0f;
+  }
   e.corners = static_cast<int>(corners.size());
   if (e.corners < options.min_inliers) {
     e.fallback = "too few corners (textureless?)";
@@ -334,25 +352,32 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
     return e;
   }
   e.buffer_from_warped = best_H;
-  e.applied = e.registered = true;
+  e.registered = true;
+  if (e.correction_px < options.min_correction_px) {
+    e.fallback = "none needed (below min_correction_px)";
+    return e;
+  }
+  e.applied = true;
   return e;
 }
 
-void ApplyRefinement(const RefineEstimate& estimate, cv::Mat* warped_bgr, cv::Mat* warped_valid,
-                     cv::Mat* warped_quality) {
+void ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv::Mat* warped_bgr,
+                     cv::Mat* warped_valid, cv::Mat* warped_quality) {
   if (!estimate.applied) return;
   const int margin = static_cast<int>(std::ceil(estimate.correction_px)) + 2;
   const cv::Rect image(0, 0, warped_bgr->cols, warped_bgr->rows);
-  const cv::Rect roi =
-      cv::Rect(estimate.region.x - margin, estimate.region.y - margin,
-               estimate.region.width + 2 * margin, estimate.region.height + 2 * margin) &
-      image;
-  // dst (ROI coordinates) = shift * buffer_from_warped * src (whole-image coordinates).
-  const cv::Matx33d to_roi =
-      cv::Matx33d(1, 0, -roi.x, 0, 1, -roi.y, 0, 0, 1) * estimate.buffer_from_warped;
-  const cv::Mat M(to_roi);
-  const cv::Mat bgr = warped_bgr->clone(), valid = warped_valid->clone(),
-                quality = warped_quality->clone();
+  const cv::Rect box = within.empty() ? image : within;
+  const auto grow = [&](const cv::Rect& r) {
+    return cv::Rect(r.x - margin, r.y - margin, r.width + 2 * margin, r.height + 2 * margin) &
+           image;
+  };
+  const cv::Rect roi = grow(box), source = grow(roi);
+  // dst (roi coordinates) = to_roi * buffer_from_warped * from_source * src (source coordinates).
+  const cv::Matx33d M = cv::Matx33d(1, 0, -roi.x, 0, 1, -roi.y, 0, 0, 1) *
+                        estimate.buffer_from_warped *
+                        cv::Matx33d(1, 0, source.x, 0, 1, source.y, 0, 0, 1);
+  const cv::Mat bgr = (*warped_bgr)(source).clone(), valid = (*warped_valid)(source).clone(),
+                quality = (*warped_quality)(source).clone();
   cv::Mat out_bgr, out_valid, out_quality;
   cv::warpPerspective(bgr, out_bgr, M, roi.size(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::warpPerspective(valid, out_valid, M, roi.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);

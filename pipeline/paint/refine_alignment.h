@@ -36,6 +36,7 @@ struct RefineEstimate {
   bool registered = false;  // applied, or the matches showed no correction is needed
   std::string fallback;  // why not, when not ("too few corners", ...)
   MotionModel model = MotionModel::kNone;
+  // The correction measured (also when too small to apply: registered but not applied).
   cv::Matx33d buffer_from_warped = cv::Matx33d::eye();
   int corners = 0, matches = 0, inliers = 0;
   double residual_before_px = 0;      // RMS over inliers, identity
@@ -49,15 +50,18 @@ struct RefineEstimate {
 };
 
 // `warped_bgr`, `warped_valid`: the frame warped into the buffer (CV_8UC3, CV_8U);
-// `buffer_bgra`: the buffer as painted so far (alpha 255 = painted).
+// `buffer_bgra`: the buffer as painted so far (alpha 255 = painted); `within` (optional):
+// bounds every valid warped texel (WarpedBuffer::valid_box), so that only it is scanned.
 RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warped_valid,
-                                  const cv::Mat& buffer_bgra, const RefineOptions& options);
+                                  const cv::Mat& buffer_bgra, const RefineOptions& options,
+                                  cv::Rect within = cv::Rect());
 
-// Warps the frame's buffer images again with the estimate (bgr bilinear; valid and quality
-// nearest, valid eroded by a texel so that no sample blends with unseen texels). Only the
-// estimate's region (plus margin) is touched.
-void ApplyRefinement(const RefineEstimate& estimate, cv::Mat* warped_bgr, cv::Mat* warped_valid,
-                     cv::Mat* warped_quality);
+// Warps the frame's buffer images again with the estimate (bgr bicubic; valid and quality
+// nearest, valid eroded by a texel so that no sample blends with unseen texels). Only
+// `within` (every valid texel: WarpedBuffer::valid_box; empty = everywhere) plus a margin is
+// touched: the correction applies to the whole frame, also where the buffer is unpainted.
+void ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv::Mat* warped_bgr,
+                     cv::Mat* warped_valid, cv::Mat* warped_quality);
 
 // Debug images: the warped frame with its corners and matches drawn (inliers green,
 // outliers red), and a heat map of |grey difference| between the warped frame and the

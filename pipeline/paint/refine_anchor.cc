@@ -9,6 +9,8 @@ namespace fresco {
 namespace {
 
 constexpr double kSmoothTiles = 1.0;  // the field's smoothing (Gaussian sigma), tiles
+constexpr double kReach = 0.05;       // smoothed sample weight below which nothing moves
+constexpr double kNegligible = 0.0;  // texels: a tile whose mean is smaller does not move
 
 cv::Point2d Apply(const cv::Matx33d& H, double x, double y) {
   const cv::Vec3d q = H * cv::Vec3d(x, y, 1);
@@ -20,24 +22,52 @@ cv::Point2d TileCentre(int tx, int ty) {
   return {(tx + 0.5) * kAnchorTileTexels - 0.5, (ty + 0.5) * kAnchorTileTexels - 0.5};
 }
 
-// The texel-resolution field (CV_32FC2, `size`) from per-tile values (tile centres exact).
-cv::Mat UpsampleField(const cv::Mat& tiles, const cv::Size& size) {
-  cv::Mat tiles32, full;
-  tiles.convertTo(tiles32, CV_32FC2);
-  cv::resize(tiles32, full, cv::Size(tiles.cols, tiles.rows) * kAnchorTileTexels, 0, 0,
-             cv::INTER_LINEAR);
-  return full(cv::Rect(0, 0, size.width, size.height)).clone();
+// The move for per-tile displacements `tiles` (CV_64FC2) that are non-zero only inside
+// `tile_box`: upsampled to texels (bilinear between tile centres), within `buffer_size`.
+AnchorMove MoveFromTiles(const cv::Mat& tiles, cv::Rect tile_box, const cv::Size& buffer_size) {
+  // One tile of border so that the field fades to zero at the box's edge.
+  tile_box = cv::Rect(tile_box.x - 1, tile_box.y - 1, tile_box.width + 2, tile_box.height + 2) &
+             cv::Rect(0, 0, tiles.cols, tiles.rows);
+  cv::Mat crop32, full;
+  tiles(tile_box).convertTo(crop32, CV_32FC2);
+  cv::resize(crop32, full, tile_box.size() * kAnchorTileTexels, 0, 0, cv::INTER_LINEAR);
+  const cv::Rect texels(tile_box.tl() * kAnchorTileTexels, tile_box.size() * kAnchorTileTexels);
+  AnchorMove move;
+  move.roi = texels & cv::Rect(0, 0, buffer_size.width, buffer_size.height);
+  move.field = full(move.roi - texels.tl()).clone();
+  return move;
 }
 
-// Absolute sampling maps for remap: q -> q + field(q).
-void Maps(const cv::Mat& field, cv::Mat* map) {
-  map->create(field.size(), CV_32FC2);
-  for (int y = 0; y < field.rows; ++y) {
-    const cv::Vec2f* f = field.ptr<cv::Vec2f>(y);
-    cv::Vec2f* m = map->ptr<cv::Vec2f>(y);
-    for (int x = 0; x < field.cols; ++x) m[x] = cv::Vec2f(x + f[x][0], y + f[x][1]);
+// Remapping a roi of buffer-sized images by a move, reading only the texels it needs.
+struct MoveMap {
+  cv::Rect roi;     // written
+  cv::Rect source;  // read: roi grown by the largest displacement
+  cv::Mat map;      // CV_32FC2, roi size: where in `source` each texel of roi comes from
+
+  MoveMap(const AnchorMove& move, const cv::Rect& roi_in, const cv::Size& image) : roi(roi_in) {
+    const cv::Mat field = move.field(roi - move.roi.tl());
+    double low = 0, high = 0;
+    cv::minMaxLoc(field.reshape(1), &low, &high);
+    const double largest = std::max(high, -low);
+    const int margin = static_cast<int>(std::ceil(largest)) + 3;  // + bicubic support
+    source = cv::Rect(roi.x - margin, roi.y - margin, roi.width + 2 * margin,
+                      roi.height + 2 * margin) &
+             cv::Rect(0, 0, image.width, image.height);
+    map.create(roi.size(), CV_32FC2);
+    const float dx = static_cast<float>(roi.x - source.x), dy = static_cast<float>(roi.y - source.y);
+    for (int y = 0; y < roi.height; ++y) {
+      const cv::Vec2f* f = field.ptr<cv::Vec2f>(y);
+      cv::Vec2f* m = map.ptr<cv::Vec2f>(y);
+      for (int x = 0; x < roi.width; ++x) m[x] = cv::Vec2f(dx + x + f[x][0], dy + y + f[x][1]);
+    }
   }
-}
+  // The moved roi of `image` (not written back).
+  cv::Mat Moved(const cv::Mat& image, int interpolation, int border) const {
+    cv::Mat out;
+    cv::remap(image(source), out, map, cv::noArray(), interpolation, border);
+    return out;
+  }
+};
 
 }  // namespace
 
@@ -48,18 +78,9 @@ void InitRefineAnchor(const BaseBuffer& buffer, RefineAnchor* anchor) {
   anchor->sum = cv::Mat::zeros(tiles, CV_64FC2);
   anchor->count = cv::Mat::zeros(tiles, CV_64F);
   anchor->background_pending = cv::Mat::zeros(tiles, CV_64FC2);
-}
-
-bool TakeBackgroundMove(RefineAnchor* anchor, cv::Mat* field) {
-  double largest = 0;
-  cv::minMaxLoc(anchor->background_pending.reshape(1), nullptr, &largest);
-  double smallest = 0;
-  cv::minMaxLoc(anchor->background_pending.reshape(1), &smallest);
-  if (std::max(largest, -smallest) < 0.5) return false;
-  *field = UpsampleField(anchor->background_pending,
-                         anchor->background_pending.size() * kAnchorTileTexels);
-  anchor->background_pending.setTo(0);
-  return true;
+  anchor->surface = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  for (int k = 0; k < buffer.NumTexels(); ++k)
+    if (buffer.on_surface[k]) anchor->surface.data[buffer.texel_index[k]] = 255;
 }
 
 double LargestDisplacement(const cv::Matx33d& H, const cv::Rect& region) {
@@ -71,20 +92,30 @@ double LargestDisplacement(const cv::Matx33d& H, const cv::Rect& region) {
   return largest;
 }
 
-bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Rect& region,
-                     const RefineOptions& options, RefineAnchor* anchor, cv::Mat* field) {
+bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const std::vector<cv::Point2f>& at,
+                     const RefineOptions& options, RefineAnchor* anchor, AnchorMove* move) {
   ++anchor->samples;
+  // Tiles where the frame had matches: the correction is measured there, not extrapolated.
+  cv::Mat matched = cv::Mat::zeros(anchor->count.size(), CV_8U);
+  for (const cv::Point2f& p : at) {
+    const int tx = static_cast<int>(p.x) / kAnchorTileTexels;
+    const int ty = static_cast<int>(p.y) / kAnchorTileTexels;
+    if (tx >= 0 && ty >= 0 && tx < matched.cols && ty < matched.rows) matched.at<uchar>(ty, tx) = 1;
+  }
+  // Older samples fade (time constant anchor_window_frames): the buffer drifts a little
+  // as registered frames paint over it, and old samples would not see that.
+  const double keep =
+      options.anchor_window_frames > 0 ? 1.0 - 1.0 / options.anchor_window_frames : 1.0;
   double largest_mean = 0;
   for (int ty = 0; ty < anchor->count.rows; ++ty) {
     for (int tx = 0; tx < anchor->count.cols; ++tx) {
+      if (!matched.at<uchar>(ty, tx)) continue;
       const cv::Point2d c = TileCentre(tx, ty);
-      if (c.x < region.x || c.y < region.y || c.x >= region.br().x || c.y >= region.br().y)
-        continue;
       const cv::Point2d d = Apply(buffer_from_warped, c.x, c.y) - c;
       cv::Vec2d& s = anchor->sum.at<cv::Vec2d>(ty, tx);
       double& n = anchor->count.at<double>(ty, tx);
-      s += cv::Vec2d(d.x, d.y);
-      n += 1;
+      s = s * keep + cv::Vec2d(d.x, d.y);
+      n = n * keep + 1;
       if (n >= options.anchor_min_frames) largest_mean = std::max(largest_mean, cv::norm(s) / n);
     }
   }
@@ -98,57 +129,73 @@ bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Rect& regi
   cv::GaussianBlur(anchor->count, count_smooth, cv::Size(), kSmoothTiles, kSmoothTiles,
                    cv::BORDER_REPLICATE);
   cv::Mat tiles(anchor->count.size(), CV_64FC2, cv::Scalar(0, 0));
+  cv::Rect box;
   for (int ty = 0; ty < tiles.rows; ++ty) {
     for (int tx = 0; tx < tiles.cols; ++tx) {
       const double n = count_smooth.at<double>(ty, tx);
-      if (n < 0.05) continue;
+      if (n < kReach) continue;
       const cv::Vec2d f = sum_smooth.at<cv::Vec2d>(ty, tx) / n;
+      if (cv::norm(f) < kNegligible) continue;
       tiles.at<cv::Vec2d>(ty, tx) = f;
+      box |= cv::Rect(tx, ty, 1, 1);
       largest_mean = std::max(largest_mean, cv::norm(f));
-      // Re-expressed in the moved buffer: each sample there loses the move.
+      // Re-expressed in the moved buffer: each sample d there becomes d - f.
       anchor->sum.at<cv::Vec2d>(ty, tx) -= anchor->count.at<double>(ty, tx) * f;
     }
   }
   anchor->background_pending += tiles;
-  *field = UpsampleField(tiles, cv::Size(anchor->count.cols * kAnchorTileTexels,
-                                         anchor->count.rows * kAnchorTileTexels));
+  *move = MoveFromTiles(tiles, box, anchor->surface.size());
   ++anchor->moves;
   anchor->largest_move_px = std::max(anchor->largest_move_px, largest_mean);
   return true;
 }
 
-void MovePaintedBuffer(const cv::Mat& field_full, const BaseBuffer& buffer,
+bool TakeBackgroundMove(RefineAnchor* anchor, AnchorMove* move) {
+  cv::Rect box;
+  bool due = false;
+  for (int ty = 0; ty < anchor->background_pending.rows; ++ty) {
+    for (int tx = 0; tx < anchor->background_pending.cols; ++tx) {
+      const cv::Vec2d f = anchor->background_pending.at<cv::Vec2d>(ty, tx);
+      if (f[0] == 0 && f[1] == 0) continue;
+      box |= cv::Rect(tx, ty, 1, 1);
+      due = due || std::max(std::abs(f[0]), std::abs(f[1])) >= 0.5;
+    }
+  }
+  if (!due) return false;
+  *move = MoveFromTiles(anchor->background_pending, box, anchor->surface.size());
+  anchor->background_pending.setTo(0);
+  return true;
+}
+
+void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor,
                        PaintedBuffer* painted) {
-  const cv::Mat field = field_full(cv::Rect(0, 0, buffer.width, buffer.height));
-  cv::Mat map, bgra, alpha_source, alpha, quality;
-  Maps(field, &map);
-  cv::remap(painted->bgra, bgra, map, cv::noArray(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  cv::extractChannel(painted->bgra, alpha_source, 3);
-  cv::remap(alpha_source, alpha, map, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  const MoveMap m(move, move.roi, painted->bgra.size());
+  cv::Mat alpha_before, alpha;
+  cv::extractChannel(painted->bgra(m.roi), alpha_before, 3);
+  const int surface_before = cv::countNonZero(alpha_before & anchor.surface(m.roi));
+  cv::extractChannel(painted->bgra(m.source), alpha, 3);
+  cv::remap(alpha, alpha, m.map, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  const cv::Mat bgra = m.Moved(painted->bgra, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   // A texel next to an unpainted one would have blended white into its colour: unpainted.
   cv::erode(alpha, alpha, cv::Mat());
   cv::insertChannel(alpha, bgra, 3);
-  painted->bgra = bgra;
+  bgra.copyTo(painted->bgra(m.roi));
   // What moved was painted in a worse gauge: any later frame may replace it.
-  painted->quality.setTo(0);
-  int surface = 0;
-  for (int k = 0; k < buffer.NumTexels(); ++k)
-    surface += buffer.on_surface[k] && alpha.data[buffer.texel_index[k]] != 0;
-  painted->painted_surface_texels = surface;
+  painted->quality(m.roi).setTo(0);
+  painted->painted_surface_texels +=
+      cv::countNonZero(alpha & anchor.surface(m.roi)) - surface_before;
 }
 
-void MoveWarpedImages(const cv::Mat& field_full, cv::Mat* bgr, cv::Mat* valid,
-                      cv::Mat* quality) {
-  const cv::Mat field = field_full(cv::Rect(0, 0, bgr->cols, bgr->rows));
-  cv::Mat map, out_bgr, out_valid, out_quality;
-  Maps(field, &map);
-  cv::remap(*bgr, out_bgr, map, cv::noArray(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  cv::remap(*valid, out_valid, map, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
-  cv::remap(*quality, out_quality, map, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
-  cv::erode(out_valid, out_valid, cv::Mat());
-  *bgr = out_bgr;
-  *valid = out_valid;
-  *quality = out_quality;
+void MoveWarpedImages(const AnchorMove& move, const cv::Rect& within, cv::Mat* bgr,
+                      cv::Mat* valid, cv::Mat* quality) {
+  const cv::Rect roi = move.roi & within;
+  if (roi.empty()) return;
+  const MoveMap m(move, roi, bgr->size());
+  m.Moved(*bgr, cv::INTER_CUBIC, cv::BORDER_REPLICATE).copyTo((*bgr)(roi));
+  m.Moved(*quality, cv::INTER_NEAREST, cv::BORDER_CONSTANT).copyTo((*quality)(roi));
+  cv::Mat moved = m.Moved(*valid, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  cv::erode(moved, moved, cv::Mat());
+  moved.copyTo((*valid)(roi));
 }
 
 }  // namespace fresco

@@ -76,8 +76,10 @@ Project NonDefaultProject() {
   p.pipeline.refine.max_scale_change = 0.02;
   p.pipeline.refine.min_inliers = 8;
   p.pipeline.refine.every_n_frames = 3;
+  p.pipeline.refine.min_correction_px = 0.5;
   p.pipeline.refine.anchor = false;
   p.pipeline.refine.anchor_min_frames = 6;
+  p.pipeline.refine.anchor_window_frames = 40;
   p.pipeline.refine.anchor_step_px = 0.5;
   p.pipeline.background.mode = BackgroundMode::kAverage;
   p.pipeline.background.training_frames = 33;

@@ -12,6 +12,8 @@
 #include <map>
 
 #include <gtest/gtest.h>
+
+#include "tests/paint/room_capture.h"
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/video_source.h"
@@ -37,15 +39,7 @@ Scene Room() {
 }
 
 SynthOptions MoverCapture(int frames, double exposure_jitter) {
-  SynthOptions o;
-  o.frames = frames;
-  o.width = 320;
-  o.height = 240;
-  o.hfov_deg = 70;
-  o.path = CameraPathKind::kHandheld;
-  o.target = Eigen::Vector3d(0, 1.5, 0);
-  o.radius_m = 0.5;
-  o.height_m = 1.5;
+  SynthOptions o = testing::HandheldRoomCapture(frames, 0.5);
   o.turns = 0.5;
   o.look_at_target = false;
   o.tilt_deg = 20;

@@ -12,6 +12,7 @@
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/paint/rephotograph.h"
+#include "tests/paint/room_capture.h"
 #include "tests/test_support.h"
 
 namespace fresco {
@@ -51,15 +52,7 @@ Comparison Compare(const Scene& original, const Scene& painted, const Camera& ca
 }
 
 SynthOptions RoomCapture(int frames) {
-  SynthOptions o;
-  o.frames = frames;
-  o.width = 320;
-  o.height = 240;
-  o.hfov_deg = 70;
-  o.path = CameraPathKind::kHandheld;
-  o.target = Eigen::Vector3d(0, 1.5, 0);
-  o.radius_m = 0.8;
-  o.height_m = 1.5;
+  SynthOptions o = testing::HandheldRoomCapture(frames, 0.8);
   o.seed = 3;
   return o;
 }

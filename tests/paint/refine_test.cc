@@ -85,7 +85,7 @@ TEST(Refine, TranslationIsRecoveredSubTexelAndModelledAsTranslation) {
   EXPECT_GE(e.inliers, 50);
   // Warping again makes the frame agree with the buffer.
   Warped again{w.bgr.clone(), w.valid.clone(), w.quality.clone()};
-  ApplyRefinement(e, &again.bgr, &again.valid, &again.quality);
+  ApplyRefinement(e, cv::Rect(), &again.bgr, &again.valid, &again.quality);
   cv::Mat buffer_bgr, diff_before, diff_after;
   cv::cvtColor(buffer, buffer_bgr, cv::COLOR_BGRA2BGR);
   const cv::Rect inner(20, 20, 280, 200);

@@ -1,0 +1,11 @@
+// The painting tests' usual capture: a handheld camera (320x240, 70 deg) at 1.5 m height
+// circling the centre of the procedural cube room (MakeCubeRoomScene) at `radius_m`.
+#pragma once
+
+#include "pipeline/synth/synthesize.h"
+
+namespace fresco::testing {
+
+SynthOptions HandheldRoomCapture(int frames, double radius_m);
+
+}  // namespace fresco::testing
