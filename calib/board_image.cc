@@ -4,16 +4,17 @@
 #include <cstdio>
 
 #include <apriltag/apriltag.h>
-#include <apriltag/tag36h11.h>
 #include <opencv2/imgproc.hpp>
+
+#include "calib/kalibr_tag_family.h"
 
 namespace fresco::calib {
 namespace {
 
 constexpr double kMetresPerInch = 0.0254;
-constexpr int kTagBlackBits = 8;  // tag36h11: the black square is 8 bits wide
+constexpr int kTagBlackBits = 10;  // Kalibr tag36h11: the black square is 10 bits wide
 
-// Copies the family's bitmap of `id` (10 x 10 incl. its white bit border) scaled by
+// Copies the family's bitmap of `id` (12 x 12 incl. its white bit border) scaled by
 // `bit_px`, with its black square's top-left at (x0, y0).
 void DrawTag(apriltag_family_t* family, int id, int bit_px, int x0, int y0, cv::Mat* gray) {
   image_u8_t* tag = apriltag_to_image(family, id);
@@ -64,11 +65,11 @@ Status RenderBoardImage(const BoardSpec& spec, double dpi, BoardImage* image) {
   const int width = pattern_w + 2 * margin, height = pattern_h + 2 * margin + label_px;
   out.gray = cv::Mat(height, width, CV_8U, cv::Scalar(255));
   if (spec.kind == BoardKind::kAprilGrid) {
-    apriltag_family_t* family = tag36h11_create();
+    KalibrTagFamily kalibr;
+    apriltag_family_t* family = kalibr.get();
     const int tag_px = kTagBlackBits * unit_px;
     const int pitch_px = tag_px + static_cast<int>(std::lround(spec.spacing * tag_px));
     if (spec.cols * spec.rows > static_cast<int>(family->ncodes)) {
-      tag36h11_destroy(family);
       return Status::Error("--board: " + spec.text + " needs " + std::to_string(spec.cols * spec.rows) +
                            " tags; tag36h11 has " + std::to_string(family->ncodes));
     }
@@ -77,7 +78,6 @@ Status RenderBoardImage(const BoardSpec& spec, double dpi, BoardImage* image) {
       DrawTag(family, id, unit_px, margin + col * pitch_px,
               margin + (spec.rows - 1 - row) * pitch_px, &out.gray);
     }
-    tag36h11_destroy(family);
   } else {
     for (int r = 0; r <= spec.rows; ++r)
       for (int c = 0; c <= spec.cols; ++c)

@@ -5,9 +5,10 @@
 #include <map>
 
 #include <apriltag/apriltag.h>
-#include <apriltag/tag36h11.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "calib/kalibr_tag_family.h"
 
 namespace fresco::calib {
 namespace {
@@ -66,9 +67,9 @@ int RefineHalfWindow(const apriltag_detection_t& det) {
 BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
                                const DetectOptions& options) {
   BoardDetection out;
-  apriltag_family_t* family = tag36h11_create();
+  KalibrTagFamily family;
   apriltag_detector_t* detector = apriltag_detector_create();
-  apriltag_detector_add_family_bits(detector, family, options.max_hamming);
+  apriltag_detector_add_family_bits(detector, family.get(), options.max_hamming);
   detector->quad_decimate = static_cast<float>(options.quad_decimate);
   detector->nthreads = 1;
   detector->refine_edges = 1;
@@ -101,7 +102,6 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   }
   apriltag_detections_destroy(detections);
   apriltag_detector_destroy(detector);
-  tag36h11_destroy(family);
   std::sort(out.corners.begin(), out.corners.end(),
             [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
   if (out.tags == 0) {
