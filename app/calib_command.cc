@@ -1,0 +1,181 @@
+// `fresco calib`: camera intrinsics from images of a board (CONTRACT.md "Calibration").
+//   fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]
+//   fresco calib board BOARD --out BOARD.png [--dpi N]
+// Bad input (a bad board spec, a folder without usable images) is one line on stderr and
+// exit 2; every output is written atomically.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "app/commands.h"
+#include "calib/board_image.h"
+#include "calib/calibrate.h"
+#include "calib/corners_vnl.h"
+#include "calib/pictures.h"
+#include "calib/report.h"
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_io.h"
+
+namespace fresco {
+namespace {
+
+using calib::BoardSpec;
+
+const char kUsage[] =
+    "fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]\n"
+    "       fresco calib board BOARD --out BOARD.png [--dpi N]";
+
+const char kSolveHelp[] =
+    R"(Detects the board in every image of IMAGES_DIR (*.png *.jpg *.jpeg *.bmp *.tif), solves
+the intrinsics with mrcal and writes CAMERA.cameramodel (mrcal's format) and, beside it,
+CAMERA.report.json, CAMERA.residuals.png and CAMERA.coverage.png.
+
+  --board BOARD        chessboard:COLSxROWS:SQUARE_M (inner corners, e.g. chessboard:9x6:0.025)
+                       or aprilgrid:COLSxROWS:TAG_M:SPACING (Kalibr AprilGrid of tag36h11,
+                       e.g. aprilgrid:6x6:0.088:0.3)
+  --model MODEL        auto (default: the simplest model the data supports, every model
+                       tried in the report), pinhole, opencv4, opencv5, opencv8, splined
+  --corners-vnl FILE   also write the detected corners as mrcal's corners.vnl (for
+                       mrcal-calibrate-cameras)
+  --no-pictures        do not write the PNG pictures
+  --no-cross-validation  skip the half-data solves (faster; auto then compares fits only)
+  --no-refine          AprilGrid: keep the apriltag library's corners (no cornerSubPix)
+  --quiet              no summary on stdout)";
+
+const char kBoardHelp[] =
+    R"(Renders a printable board from the apriltag library's own tag36h11 family (AprilGrid)
+or a chessboard, at --dpi (default 300), and writes BOARD.png and BOARD.json (the physical
+size of what is drawn). Print at 100 % scale and check the size with a ruler.)";
+
+int RunSolve(const CommandArgs& argv) {
+  ArgSpec spec;
+  spec.usage = "fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]";
+  spec.help = kSolveHelp;
+  spec.min_positional = 1;
+  spec.max_positional = 1;
+  spec.options = {"--board", "--out", "--model", "--corners-vnl"};
+  spec.switches = {"--no-pictures", "--no-cross-validation", "--no-refine", "--quiet"};
+  spec.required = {"--board", "--out"};
+  Args args;
+  if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
+  calib::CalibrateRequest request;
+  request.images_dir = args.positional[0];
+  if (Status s = calib::ParseBoardSpec(args.Get("--board"), "--board", &request.board); !s.ok())
+    return InputError(s);
+  request.model = args.Get("--model", "auto");
+  bool known = request.model == "auto";
+  for (const std::string& name : calib::LensModelShortNames()) known |= name == request.model;
+  if (!known)
+    return UsageError("calib solve", spec,
+                      "--model: '" + request.model +
+                          "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
+  request.cross_validate = !args.Switch("--no-cross-validation");
+  request.detect.refine_tag_corners = !args.Switch("--no-refine");
+  const std::string out = args.Get("--out");
+  const bool quiet = args.Switch("--quiet");
+
+  calib::CalibrationRun run;
+  if (Status s = calib::DetectViews(request, &run); !s.ok()) {
+    for (const calib::RejectedImage& r : run.rejected)
+      std::cerr << "  rejected " << r.name << ": " << r.reason << "\n";
+    return InputError(s);
+  }
+  if (Status s = calib::SolveViews(request, &run); !s.ok()) {
+    std::cerr << "fresco calib solve: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+  if (!parent.empty())
+    if (Status s = MakeDirectories(parent.string()); !s.ok()) return InputError(s);
+  std::vector<std::string> pictures;
+  if (!args.Switch("--no-pictures")) {
+    const std::string residuals = calib::SiblingPath(out, ".residuals.png");
+    const std::string coverage = calib::SiblingPath(out, ".coverage.png");
+    if (Status s = WriteImageAtomic(residuals, calib::DrawResiduals(run)); !s.ok()) return InputError(s);
+    if (Status s = WriteImageAtomic(coverage, calib::DrawCoverage(run)); !s.ok()) return InputError(s);
+    pictures = {residuals, coverage};
+  }
+  if (args.Has("--corners-vnl"))
+    if (Status s = calib::WriteCornersVnl(args.Get("--corners-vnl"), run.views, request.board); !s.ok())
+      return InputError(s);
+  if (Status s = calib::WriteCalibration(out, request, run, pictures); !s.ok()) return InputError(s);
+
+  for (const std::string& w : run.warnings) std::cerr << "warning: " << w << "\n";
+  if (!quiet) {
+    for (const calib::RejectedImage& r : run.rejected)
+      std::cout << "rejected " << r.name << ": " << r.reason << "\n";
+    for (const calib::ModelTrial& t : run.choice.trials) {
+      char line[256];
+      if (!t.status.ok()) {
+        std::cout << "model " << t.short_name << ": failed: " << t.status.message() << "\n";
+        continue;
+      }
+      std::snprintf(line, sizeof(line),
+                    "model %-8s rms %.4f px  sigma %.4f px  cross-validation %.4f px  %s%s\n",
+                    t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px, t.cross_validation_px,
+                    t.fits ? "fits" : "does not fit", t.supported ? "" : ", halves disagree");
+      std::cout << line;
+    }
+    const calib::SolveResult& fit = run.Chosen().fit;
+    std::cout << "chosen " << run.Chosen().short_name << " (" << run.Chosen().lensmodel << "): fx "
+              << fit.intrinsics[0] << " fy " << fit.intrinsics[1] << " cx " << fit.intrinsics[2]
+              << " cy " << fit.intrinsics[3] << ", rms " << fit.rms_px << " px, "
+              << run.views.size() << " images used, " << run.rejected.size() << " rejected\n";
+    std::cout << "wrote " << out << " and " << calib::SiblingPath(out, ".report.json") << "\n";
+  }
+  return kExitOk;
+}
+
+int RunBoard(const CommandArgs& argv) {
+  ArgSpec spec;
+  spec.usage = "fresco calib board BOARD --out BOARD.png [--dpi N]";
+  spec.help = kBoardHelp;
+  spec.min_positional = 1;
+  spec.max_positional = 1;
+  spec.options = {"--out", "--dpi"};
+  spec.required = {"--out"};
+  Args args;
+  if (int code = ParseVerbArgs("calib board", argv, spec, &args); code >= 0) return code;
+  BoardSpec board;
+  if (Status s = calib::ParseBoardSpec(args.positional[0], "BOARD", &board); !s.ok())
+    return InputError(s);
+  double dpi = 300;
+  std::string error;
+  if (args.Has("--dpi") && !ParseDouble(args.Get("--dpi"), "--dpi", &dpi, &error))
+    return UsageError("calib board", spec, error);
+  calib::BoardImage image;
+  if (Status s = calib::RenderBoardImage(board, dpi, &image); !s.ok()) return InputError(s);
+  const std::string out = args.Get("--out");
+  if (Status s = WriteImageAtomic(out, image.gray); !s.ok()) return InputError(s);
+  char json[1024];
+  std::snprintf(json, sizeof(json),
+                "{\n  \"board\": \"%s\",\n  \"dpi\": %g,\n  \"image_px\": [%d, %d],\n"
+                "  \"image_size_m\": [%.6f, %.6f],\n  \"pattern_size_m\": [%.6f, %.6f],\n"
+                "  \"drawn_square_m\": %.6f,\n  \"drawn_spacing\": %.6f,\n"
+                "  \"family\": \"%s\"\n}\n",
+                board.text.c_str(), dpi, image.gray.cols, image.gray.rows, image.image_width_m,
+                image.image_height_m, image.pattern_width_m, image.pattern_height_m,
+                image.drawn_square_m, image.drawn_spacing,
+                board.kind == calib::BoardKind::kAprilGrid ? "tag36h11" : "chessboard");
+  const std::string sidecar = calib::SiblingPath(out, ".json");
+  if (Status s = WriteFileAtomic(sidecar, json); !s.ok()) return InputError(s);
+  std::cout << image.label << "\nwrote " << out << " (" << image.gray.cols << "x" << image.gray.rows
+            << " px) and " << sidecar << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunVerbCalib(const CommandArgs& argv) {
+  if (argv.empty() || argv[0] == "--help" || argv[0] == "-h") {
+    (argv.empty() ? std::cerr : std::cout) << "usage: " << kUsage << "\n";
+    return argv.empty() ? kExitBadInput : kExitOk;
+  }
+  const CommandArgs rest(argv.begin() + 1, argv.end());
+  if (argv[0] == "solve") return RunSolve(rest);
+  if (argv[0] == "board") return RunBoard(rest);
+  std::cerr << "fresco calib: unknown sub-command '" << argv[0] << "'\nusage: " << kUsage << "\n";
+  return kExitBadInput;
+}
+
+}  // namespace fresco

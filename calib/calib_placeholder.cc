@@ -1,1 +1,0 @@
-// The calibration issue (8) fills this library.

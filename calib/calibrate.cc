@@ -1,0 +1,171 @@
+#include "calib/calibrate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/image_io.h"
+
+namespace fresco::calib {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kMinCoverage = 0.35;    // fraction of the imager's cells
+constexpr double kMinTiltDeg = 20;       // at least one board this far from fronto-parallel
+constexpr double kMaxFocalStdev = 0.01;  // relative 1-sigma on fx
+
+std::string Percent(double fraction) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.0f %%", 100 * fraction);
+  return buffer;
+}
+
+bool IsImage(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
+         ext == ".tiff";
+}
+
+// Correlation of residuals between different corners of the same tag (same coordinate).
+double TagCornerCorrelation(const std::vector<BoardView>& views, const SolveResult& fit) {
+  double sum_products = 0, sum_squares = 0;
+  long pairs = 0, singles = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    const auto& corners = views[v].corners;
+    for (size_t a = 0; a < corners.size(); ++a) {
+      if (fit.views[v].outlier[a]) continue;
+      sum_squares += fit.views[v].residual_px[a].squaredNorm();
+      singles += 2;
+      for (size_t b = a + 1; b < corners.size() && corners[b].id / 4 == corners[a].id / 4; ++b) {
+        if (fit.views[v].outlier[b]) continue;
+        sum_products += fit.views[v].residual_px[a].dot(fit.views[v].residual_px[b]);
+        pairs += 2;
+      }
+    }
+  }
+  if (pairs == 0 || sum_squares <= 0) return 0;
+  return (sum_products / pairs) / (sum_squares / singles);
+}
+
+void CheckCoverage(CalibrationRun* run) {
+  constexpr int kCols = 16, kRows = 12;
+  std::vector<bool> seen(kCols * kRows, false);
+  bool quadrant[2][2] = {{false, false}, {false, false}};
+  for (const BoardView& v : run->views)
+    for (const CornerObservation& c : v.corners) {
+      const int i = std::clamp(static_cast<int>((c.pixel.x() + 0.5) * kCols / run->width), 0, kCols - 1);
+      const int j = std::clamp(static_cast<int>((c.pixel.y() + 0.5) * kRows / run->height), 0, kRows - 1);
+      seen[j * kCols + i] = true;
+      quadrant[j * 2 / kRows][i * 2 / kCols] = true;
+    }
+  run->coverage_fraction = std::count(seen.begin(), seen.end(), true) / double(seen.size());
+  if (run->coverage_fraction < kMinCoverage)
+    run->warnings.push_back("corners cover only " + Percent(run->coverage_fraction) +
+                            " of the imager (16x12 cells): the lens model is extrapolated "
+                            "elsewhere; show the board near the edges and corners");
+  const char* names[2][2] = {{"top-left", "top-right"}, {"bottom-left", "bottom-right"}};
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i)
+      if (!quadrant[j][i])
+        run->warnings.push_back(std::string("no corner observed in the ") + names[j][i] +
+                                " quarter of the imager");
+  run->max_tilt_deg = 0;
+  for (const auto& rt : run->seed.rt_cam_from_board) {
+    const double angle = std::sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
+    if (angle < 1e-12) continue;
+    // Board normal (0,0,1) rotated; tilt = angle between it and the camera's axis.
+    const double kz = rt[2] / angle, c = std::cos(angle);
+    const double nz = c + kz * kz * (1 - c);  // R(2,2) of the Rodrigues rotation
+    run->max_tilt_deg = std::max(run->max_tilt_deg, std::acos(std::min(1.0, std::abs(nz))) * 180 / M_PI);
+  }
+  if (run->max_tilt_deg < kMinTiltDeg)
+    run->warnings.push_back("every board is within " + std::to_string(int(std::ceil(run->max_tilt_deg))) +
+                            " deg of fronto-parallel: the focal length is poorly determined; "
+                            "tilt the board (30-45 deg) in some images");
+}
+
+}  // namespace
+
+Status ListImages(const std::string& dir, std::vector<std::string>* paths) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return Status::Error(dir + ": IMAGES_DIR: not a folder");
+  paths->clear();
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file() && IsImage(entry.path())) paths->push_back(entry.path().string());
+  if (ec) return Status::Error(dir + ": IMAGES_DIR: cannot list (" + ec.message() + ")");
+  std::sort(paths->begin(), paths->end());
+  if (paths->empty())
+    return Status::Error(dir + ": IMAGES_DIR: no image (*.png, *.jpg, *.jpeg, *.bmp, *.tif)");
+  return Status::Ok();
+}
+
+Status DetectViews(const CalibrateRequest& request, CalibrationRun* run) {
+  std::vector<std::string> paths;
+  FRESCO_RETURN_IF_ERROR(ListImages(request.images_dir, &paths));
+  for (const std::string& path : paths) {
+    const std::string name = fs::path(path).filename().string();
+    cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    if (gray.empty()) {
+      run->rejected.push_back({name, "cannot read the image"});
+      continue;
+    }
+    if (run->width == 0) {
+      run->width = gray.cols;
+      run->height = gray.rows;
+    } else if (gray.cols != run->width || gray.rows != run->height) {
+      run->rejected.push_back({name, "size " + std::to_string(gray.cols) + "x" +
+                                         std::to_string(gray.rows) + " differs from the first image's " +
+                                         std::to_string(run->width) + "x" + std::to_string(run->height)});
+      continue;
+    }
+    BoardDetection detection = DetectBoard(gray, request.board, request.detect);
+    if (!detection.found) {
+      run->rejected.push_back({name, detection.reason});
+      continue;
+    }
+    run->views.push_back({name, std::move(detection.corners)});
+  }
+  if (static_cast<int>(run->views.size()) < kMinViews)
+    return Status::Error(request.images_dir + ": IMAGES_DIR: the board (" + request.board.text +
+                         ") was found in " + std::to_string(run->views.size()) + " of " +
+                         std::to_string(paths.size()) + " images; a calibration needs at least " +
+                         std::to_string(kMinViews));
+  return Status::Ok();
+}
+
+Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
+  if (static_cast<int>(run->views.size()) < kMinViews)
+    return Status::Error("a calibration needs at least " + std::to_string(kMinViews) +
+                         " images with a board (got " + std::to_string(run->views.size()) + ")");
+  if (static_cast<int>(run->views.size()) < kFewViews)
+    run->warnings.push_back("only " + std::to_string(run->views.size()) +
+                            " images with a board: use 20 or more for a trustworthy model");
+  FRESCO_RETURN_IF_ERROR(
+      SeedCalibration(run->views, request.board, run->width, run->height, &run->seed));
+  CheckCoverage(run);
+  SelectOptions select;
+  if (request.model != "auto") select.candidates = {request.model};
+  select.cross_validate = request.cross_validate;
+  FRESCO_RETURN_IF_ERROR(FitLensModels(run->views, request.board, run->width, run->height,
+                                       run->seed, select, &run->choice));
+  for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);
+  if (request.board.kind == BoardKind::kAprilGrid) {
+    run->corner_correlation = TagCornerCorrelation(run->views, run->Chosen().fit);
+    run->noise_inflation = std::sqrt(std::max(1.0, 1 + 3 * run->corner_correlation));
+    for (ModelTrial& t : run->choice.trials)
+      for (double& s : t.fit.intrinsics_stdev) s *= run->noise_inflation;
+  }
+  const SolveResult& fit = run->Chosen().fit;
+  if (!fit.intrinsics_stdev.empty() && fit.intrinsics_stdev[0] > kMaxFocalStdev * fit.intrinsics[0])
+    run->warnings.push_back("fx is uncertain: 1-sigma " + Percent(fit.intrinsics_stdev[0] / fit.intrinsics[0]) +
+                            " of its value; add images, tilted boards and full-imager coverage");
+  return Status::Ok();
+}
+
+}  // namespace fresco::calib

@@ -1,0 +1,109 @@
+#include "calib/pictures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <opencv2/imgproc.hpp>
+
+namespace fresco::calib {
+namespace {
+
+cv::Scalar ViewColour(size_t v) {
+  cv::Mat hsv(1, 1, CV_8UC3, cv::Scalar((v * 47) % 180, 200, 220)), bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  const cv::Vec3b c = bgr.at<cv::Vec3b>(0, 0);
+  return cv::Scalar(c[0], c[1], c[2]);
+}
+
+std::string Text(const char* format, double value) {
+  char buffer[96];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+// Scale so that the imager fits in `max_side` pixels.
+double CanvasScale(const CalibrationRun& run, int max_side) {
+  return std::min(1.0, max_side / double(std::max(run.width, run.height)));
+}
+
+}  // namespace
+
+cv::Mat DrawResiduals(const CalibrationRun& run) {
+  const SolveResult& fit = run.Chosen().fit;
+  const double s = CanvasScale(run, 900);
+  const int w = static_cast<int>(run.width * s), h = static_cast<int>(run.height * s);
+  const int bars_h = 200, top = 30;
+  cv::Mat canvas(top + bars_h + h + 40, std::max(w, 400), CV_8UC3, cv::Scalar(255, 255, 255));
+  double max_rms = 1e-9;
+  for (const ViewFit& v : fit.views) max_rms = std::max(max_rms, v.rms_px);
+  const double bar_w = canvas.cols / double(fit.views.size());
+  for (size_t v = 0; v < fit.views.size(); ++v) {
+    const int bh = static_cast<int>(fit.views[v].rms_px / max_rms * (bars_h - 20));
+    cv::rectangle(canvas, cv::Point(int(v * bar_w) + 1, top + bars_h - bh),
+                  cv::Point(int((v + 1) * bar_w) - 1, top + bars_h), ViewColour(v), cv::FILLED);
+    if (fit.views[v].outliers > 0)
+      cv::putText(canvas, std::to_string(fit.views[v].outliers),
+                  cv::Point(int(v * bar_w) + 1, top + bars_h - bh - 3), cv::FONT_HERSHEY_PLAIN, 0.8,
+                  cv::Scalar(0, 0, 255));
+  }
+  cv::putText(canvas,
+              "per-image RMS (max " + Text("%.3f px", max_rms) + "), model " +
+                  run.Chosen().short_name + ", all " + Text("%.3f px", fit.rms_px) +
+                  "; red numbers: outliers",
+              cv::Point(5, 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  const int y0 = top + bars_h + 10;
+  cv::rectangle(canvas, cv::Rect(0, y0, w, h), cv::Scalar(0, 0, 0));
+  const double magnify = 0.1 * w / std::max(3 * fit.rms_px, 1e-3);  // 3 sigma = 10 % of width
+  for (size_t v = 0; v < run.views.size(); ++v)
+    for (size_t k = 0; k < run.views[v].corners.size(); ++k) {
+      const Eigen::Vector2d& q = run.views[v].corners[k].pixel;
+      const Eigen::Vector2d& r = fit.views[v].residual_px[k];
+      const cv::Point a(int(q.x() * s), y0 + int(q.y() * s));
+      const cv::Point b(int(q.x() * s + r.x() * magnify), y0 + int(q.y() * s + r.y() * magnify));
+      cv::line(canvas, a, b, fit.views[v].outlier[k] ? cv::Scalar(0, 0, 255) : ViewColour(v), 1,
+               cv::LINE_AA);
+    }
+  cv::putText(canvas, "residual vectors on the imager, x" + Text("%.0f", magnify / s),
+              cv::Point(5, y0 + h + 25), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1,
+              cv::LINE_AA);
+  return canvas;
+}
+
+cv::Mat DrawCoverage(const CalibrationRun& run) {
+  const SolveResult& fit = run.Chosen().fit;
+  const double s = CanvasScale(run, 900);
+  const int w = static_cast<int>(run.width * s), h = static_cast<int>(run.height * s);
+  cv::Mat canvas(h + 30, w, CV_8UC3, cv::Scalar(255, 255, 255));
+  constexpr int kCols = 16, kRows = 12;
+  std::vector<bool> seen(kCols * kRows, false);
+  for (const BoardView& v : run.views)
+    for (const CornerObservation& c : v.corners) {
+      const int i = std::clamp(int((c.pixel.x() + 0.5) * kCols / run.width), 0, kCols - 1);
+      const int j = std::clamp(int((c.pixel.y() + 0.5) * kRows / run.height), 0, kRows - 1);
+      seen[j * kCols + i] = true;
+    }
+  for (int j = 0; j < kRows; ++j)
+    for (int i = 0; i < kCols; ++i) {
+      const cv::Rect cell(i * w / kCols, j * h / kRows, w / kCols, h / kRows);
+      if (!seen[j * kCols + i]) cv::rectangle(canvas, cell, cv::Scalar(200, 200, 255), cv::FILLED);
+      cv::rectangle(canvas, cell, cv::Scalar(220, 220, 220));
+    }
+  for (size_t v = 0; v < run.views.size(); ++v)
+    for (size_t k = 0; k < run.views[v].corners.size(); ++k) {
+      const cv::Point p(int(run.views[v].corners[k].pixel.x() * s),
+                        int(run.views[v].corners[k].pixel.y() * s));
+      if (fit.views[v].outlier[k])
+        cv::drawMarker(canvas, p, cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 8, 2);
+      else
+        cv::circle(canvas, p, 2, ViewColour(v), cv::FILLED, cv::LINE_AA);
+    }
+  cv::putText(canvas,
+              "coverage " + Text("%.0f %%", 100 * run.coverage_fraction) + " of 16x12 cells, " +
+                  std::to_string(run.views.size()) + " images; shaded: no corner",
+              cv::Point(5, h + 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1,
+              cv::LINE_AA);
+  return canvas;
+}
+
+}  // namespace fresco::calib

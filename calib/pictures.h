@@ -1,0 +1,17 @@
+// Pictures for the operator (OpenCV drawing, PNG):
+// - residuals: per-image RMS bars (outlier counts in red) above the residual vectors of
+//   every corner drawn on the imager, magnified;
+// - coverage: every observed corner on the imager, coloured by image, outliers as red
+//   crosses, over the 16 x 12 cells the coverage figure counts (empty cells shaded).
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "calib/calibrate.h"
+
+namespace fresco::calib {
+
+cv::Mat DrawResiduals(const CalibrationRun& run);
+cv::Mat DrawCoverage(const CalibrationRun& run);
+
+}  // namespace fresco::calib

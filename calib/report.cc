@@ -1,0 +1,142 @@
+#include "calib/report.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/core/atomic_file.h"
+
+extern "C" {
+#include <mrcal/mrcal.h>
+}
+
+namespace fresco::calib {
+namespace {
+
+std::string Number(double value) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+nlohmann::json TrialJson(const ModelTrial& t) {
+  nlohmann::json j;
+  j["model"] = t.short_name;
+  j["lensmodel"] = t.lensmodel;
+  j["ok"] = t.status.ok();
+  if (!t.status.ok()) {
+    j["error"] = t.status.message();
+    return j;
+  }
+  j["num_intrinsics"] = t.fit.intrinsics.size();
+  j["num_states"] = t.fit.num_states;
+  j["rms_px"] = t.fit.rms_px;
+  j["noise_sigma_px"] = t.fit.noise_sigma_px;
+  j["outliers"] = t.fit.outliers;
+  j["cross_validation_px"] = t.cross_validation_px;
+  j["fits"] = t.fits;
+  j["supported"] = t.supported;
+  if (t.fit.intrinsics.size() <= 16) {
+    j["intrinsics"] = t.fit.intrinsics;
+    j["intrinsics_stdev"] = t.fit.intrinsics_stdev;
+  } else {  // splined: the core only
+    j["intrinsics_core"] = std::vector<double>(t.fit.intrinsics.begin(), t.fit.intrinsics.begin() + 4);
+    if (t.fit.intrinsics_stdev.size() >= 4)
+      j["intrinsics_core_stdev"] =
+          std::vector<double>(t.fit.intrinsics_stdev.begin(), t.fit.intrinsics_stdev.begin() + 4);
+  }
+  return j;
+}
+
+}  // namespace
+
+std::string CameraModelText(const std::string& lensmodel, const std::vector<double>& intrinsics,
+                            int width, int height) {
+  std::string text = "# Written by Fresco (fresco calib solve): an mrcal camera model.\n{\n";
+  text += "    'lensmodel':  '" + lensmodel + "',\n\n";
+  text += "    # intrinsics are fx,fy,cx,cy,distortion0,distortion1,....\n";
+  text += "    'intrinsics': [";
+  for (size_t i = 0; i < intrinsics.size(); ++i)
+    text += (i ? ", " : " ") + Number(intrinsics[i]);
+  text += " ],\n\n    # extrinsics are rt_fromref\n";
+  text += "    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],\n\n";
+  text += "    'imagersize': [ " + std::to_string(width) + ", " + std::to_string(height) + " ],\n}\n";
+  return text;
+}
+
+std::string SiblingPath(const std::string& cameramodel_path, const std::string& suffix) {
+  std::filesystem::path path(cameramodel_path);
+  return (path.parent_path() / (path.stem().string() + suffix)).string();
+}
+
+std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& run,
+                       const std::vector<std::string>& pictures) {
+  const ModelTrial& chosen = run.Chosen();
+  const SolveResult& fit = chosen.fit;
+  nlohmann::json j;
+  j["lensmodel"] = chosen.lensmodel;
+  j["model"] = chosen.short_name;
+  j["model_requested"] = request.model;
+  j["intrinsics"] = fit.intrinsics;
+  j["intrinsics_stdev"] = fit.intrinsics_stdev;
+  j["imagersize"] = {run.width, run.height};
+  j["rms_px"] = fit.rms_px;
+  j["noise_sigma_px"] = fit.noise_sigma_px;
+  j["corners_used"] = fit.corners_used;
+  j["corners_rejected_as_outliers"] = fit.outliers;
+  j["board"] = request.board.text;
+  j["board_warp_m"] = fit.board_warp_m;
+  nlohmann::json used = nlohmann::json::array(), per_image = nlohmann::json::array();
+  for (size_t v = 0; v < run.views.size(); ++v) {
+    used.push_back(run.views[v].name);
+    per_image.push_back({{"image", run.views[v].name},
+                         {"corners", run.views[v].corners.size()},
+                         {"outliers", fit.views[v].outliers},
+                         {"rms_px", fit.views[v].rms_px},
+                         {"rt_cam_from_board", fit.views[v].rt_cam_from_board}});
+  }
+  j["images_used"] = used;
+  nlohmann::json rejected = nlohmann::json::array();
+  for (const RejectedImage& r : run.rejected) rejected.push_back({{"image", r.name}, {"reason", r.reason}});
+  j["images_rejected"] = rejected;
+  j["per_image"] = per_image;
+  nlohmann::json tried = nlohmann::json::array();
+  for (const ModelTrial& t : run.choice.trials) tried.push_back(TrialJson(t));
+  j["models_tried"] = tried;
+  j["model_selection"] =
+      "simplest model that fits (noise sigma within 3 % of the best model's) and whose two "
+      "half-data solves agree (cross_validation_px <= max(3 sigma, 0.3 px))";
+  j["seed"] = {{"method", "OpenCV calibrateCamera, k1 k2 only"},
+               {"fx", run.seed.fx}, {"fy", run.seed.fy}, {"cx", run.seed.cx}, {"cy", run.seed.cy},
+               {"k1", run.seed.k1}, {"k2", run.seed.k2}, {"rms_px", run.seed.rms_px}};
+  j["corner_noise"] = {
+      {"tag_corner_correlation", run.corner_correlation},
+      {"uncertainty_inflation", run.noise_inflation},
+      {"method", request.board.kind == BoardKind::kAprilGrid
+                     ? "AprilTag corners of one tag come from one quad fit: the correlation of "
+                       "their residuals rho is measured and every intrinsics_stdev is "
+                       "multiplied by sqrt(1 + 3 rho) (the design effect of 4 correlated corners)"
+                     : "chessboard corners are found independently: no inflation"}};
+  j["coverage_fraction"] = run.coverage_fraction;
+  j["max_board_tilt_deg"] = run.max_tilt_deg;
+  j["warnings"] = run.warnings;
+  j["pictures"] = pictures;
+  return j.dump(2) + "\n";
+}
+
+Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequest& request,
+                        const CalibrationRun& run, const std::vector<std::string>& pictures) {
+  const ModelTrial& chosen = run.Chosen();
+  const std::string text =
+      CameraModelText(chosen.lensmodel, chosen.fit.intrinsics, run.width, run.height);
+  mrcal_cameramodel_t* check = mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
+  if (!check)
+    return Status::Error(cameramodel_path + ": internal error: mrcal cannot read the model to write");
+  mrcal_free_cameramodel(&check);
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(cameramodel_path, text));
+  return WriteFileAtomic(SiblingPath(cameramodel_path, ".report.json"),
+                         ReportJson(request, run, pictures));
+}
+
+}  // namespace fresco::calib

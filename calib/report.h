@@ -1,0 +1,27 @@
+// What `fresco calib solve` writes: the mrcal .cameramodel (any mrcal lens model, numbers at
+// full precision, checked with mrcal's own reader before the file is replaced) and the
+// report JSON beside it (CONTRACT.md fields plus the evidence for the model choice).
+#pragma once
+
+#include <string>
+
+#include "calib/calibrate.h"
+
+namespace fresco::calib {
+
+// The .cameramodel text (mrcal's Python-dict format) for a camera at the reference.
+std::string CameraModelText(const std::string& lensmodel, const std::vector<double>& intrinsics,
+                            int width, int height);
+
+// CAMERA.cameramodel -> CAMERA.report.json (and .residuals.png etc. via `suffix`).
+std::string SiblingPath(const std::string& cameramodel_path, const std::string& suffix);
+
+// Writes the chosen model to `cameramodel_path` and the report beside it, atomically.
+Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequest& request,
+                        const CalibrationRun& run, const std::vector<std::string>& pictures);
+
+// The report as JSON text.
+std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& run,
+                       const std::vector<std::string>& pictures);
+
+}  // namespace fresco::calib

@@ -1,0 +1,310 @@
+// fresco_calib: board specs, synthetic recovery through known cameras (mrcal projection
+// plus Gaussian corner noise), `auto` model choice, real data (opencv-chessboard-stereo,
+// aprilgrid-yac-mocap), the board renderer round trip, and the data traps.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/board_image.h"
+#include "calib/calibrate.h"
+#include "calib/lens_projection.h"
+#include "tests/test_support.h"
+
+namespace fresco::calib {
+namespace {
+
+namespace fs = std::filesystem;
+using fresco::testing::RunFresco;
+
+// Board poses that tilt +-35 deg and sweep the imager: cam_from_board for view v of n.
+std::array<double, 6> SyntheticPose(int v, int n, const BoardSpec& spec, bool centre_only) {
+  const Eigen::Vector2d size = PatternSize_m(spec);
+  const double a = 2 * M_PI * v / n;
+  const double tilt = centre_only ? 0.05 : 0.6;
+  const Eigen::Vector3d r(tilt * std::cos(a), tilt * std::sin(a), 0.1 * std::sin(3 * a));
+  const double spread = centre_only ? 0.0 : 0.09;
+  const Eigen::Vector3d centre_in_cam(spread * std::cos(a + 0.5), spread * std::sin(a + 0.5) * 0.8,
+                                      0.42 + 0.08 * std::cos(2 * a));
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
+  const Eigen::Vector3d board_centre(size.x() / 2, size.y() / 2, 0);
+  const Eigen::Vector3d t = centre_in_cam - R * board_centre;
+  return {r.x(), r.y(), r.z(), t.x(), t.y(), t.z()};
+}
+
+std::vector<BoardView> SyntheticViews(const BoardSpec& spec, const std::string& lensmodel,
+                                      const std::vector<double>& intrinsics, int width, int height,
+                                      int n, double noise_px, bool centre_only = false) {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0, noise_px);
+  std::vector<BoardView> views;
+  for (int v = 0; v < n; ++v) {
+    const auto rt = SyntheticPose(v, n, spec, centre_only);
+    const Eigen::Vector3d r(rt[0], rt[1], rt[2]);
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
+    std::vector<Eigen::Vector3d> points;
+    for (int id = 0; id < spec.NumCorners(); ++id)
+      points.push_back(R * CornerPosition(spec, id) + Eigen::Vector3d(rt[3], rt[4], rt[5]));
+    std::vector<Eigen::Vector2d> q;
+    EXPECT_TRUE(ProjectPoints(lensmodel, intrinsics, points, &q));
+    BoardView view{"view" + std::to_string(v), {}};
+    for (int id = 0; id < spec.NumCorners(); ++id) {
+      if (q[id].x() < 0 || q[id].y() < 0 || q[id].x() > width - 1 || q[id].y() > height - 1) continue;
+      view.corners.push_back({id, q[id] + Eigen::Vector2d(noise(rng), noise(rng))});
+    }
+    views.push_back(view);
+  }
+  return views;
+}
+
+CalibrationRun SolveSynthetic(const std::vector<BoardView>& views, const BoardSpec& spec,
+                              int width, int height, const std::string& model) {
+  CalibrateRequest request;
+  request.board = spec;
+  request.model = model;
+  CalibrationRun run;
+  run.width = width;
+  run.height = height;
+  run.views = views;
+  const Status s = SolveViews(request, &run);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return run;
+}
+
+BoardSpec Spec(const std::string& text) {
+  BoardSpec spec;
+  const Status s = ParseBoardSpec(text, "--board", &spec);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return spec;
+}
+
+TEST(BoardSpecTest, ParsesAndRejectsWithTheField) {
+  const BoardSpec chess = Spec("chessboard:9x6:0.025");
+  EXPECT_EQ(chess.NumCorners(), 54);
+  EXPECT_NEAR(CornerPosition(chess, 10).x(), 0.025, 1e-12);  // row 1, col 1
+  EXPECT_NEAR(CornerPosition(chess, 10).y(), 0.025, 1e-12);
+  BoardSpec spec;
+  for (const char* bad : {"chessboard:9x6", "chessboard:9y6:0.02", "chessboard:1x6:0.02",
+                          "chessboard:9x6:-1", "aprilgrid:6x6:0.088", "aprilgrid:6x6:0.088:0.333",
+                          "circles:4x4:0.1", "aprilgrid:6x6:abc:0.3"}) {
+    const Status s = ParseBoardSpec(bad, "--board", &spec);
+    EXPECT_FALSE(s.ok()) << bad;
+    EXPECT_EQ(s.message().rfind("--board: ", 0), 0u) << s.message();
+    EXPECT_EQ(s.message().find('\n'), std::string::npos);
+  }
+}
+
+TEST(BoardSpecTest, AprilGridFollowsKalibrAndTheYacReference) {
+  // yac's reference detections: tag 7 corner 0 at (0.1144, 0.1144), corner 2 of tag 1 at
+  // (0.2024, 0.088) (aprilgrid-yac-mocap grid0 CSVs).
+  const BoardSpec grid = Spec("aprilgrid:6x6:0.088:0.3");
+  EXPECT_NEAR(CornerPosition(grid, 7 * 4 + 0).x(), 0.1144, 1e-9);
+  EXPECT_NEAR(CornerPosition(grid, 7 * 4 + 0).y(), 0.1144, 1e-9);
+  EXPECT_NEAR(CornerPosition(grid, 1 * 4 + 2).x(), 0.2024, 1e-9);
+  EXPECT_NEAR(CornerPosition(grid, 1 * 4 + 2).y(), 0.088, 1e-9);
+  const BoardGrid g = MakeBoardGrid(grid);
+  EXPECT_EQ(g.width_n, 76);
+  EXPECT_NEAR(g.spacing_m, 0.0088, 1e-12);
+  for (int id = 0; id < grid.NumCorners(); ++id) {  // every corner sits on its grid point
+    const int index = g.grid_index_of_corner[id];
+    EXPECT_NEAR((index % g.width_n) * g.spacing_m, CornerPosition(grid, id).x(), 1e-9);
+    EXPECT_NEAR((index / g.width_n) * g.spacing_m, CornerPosition(grid, id).y(), 1e-9);
+  }
+}
+
+TEST(SyntheticCalibrationTest, PinholeTruthRecoveredAndAutoPicksPinhole) {
+  const BoardSpec spec = Spec("chessboard:10x7:0.03");
+  const std::vector<double> truth = {600, 605, 322, 238};
+  const auto views = SyntheticViews(spec, "LENSMODEL_PINHOLE", truth, 640, 480, 14, 0.2);
+  const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "auto");
+  const SolveResult& fit = run.Chosen().fit;
+  EXPECT_EQ(run.Chosen().short_name, "pinhole");
+  ASSERT_EQ(fit.intrinsics_stdev.size(), 4u);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(fit.intrinsics[i], truth[i], 0.003 * truth[0]) << i;
+    EXPECT_LE(std::abs(fit.intrinsics[i] - truth[i]), 3.5 * fit.intrinsics_stdev[i]) << i;
+  }
+  EXPECT_NEAR(fit.noise_sigma_px, 0.2, 0.03);
+  EXPECT_EQ(run.choice.trials.size(), 5u);
+}
+
+TEST(SyntheticCalibrationTest, StrongDistortionPicksARicherModel) {
+  const BoardSpec spec = Spec("chessboard:10x7:0.03");
+  const std::vector<double> truth = {420, 422, 318, 243, -0.32, 0.12, 0.0008, -0.0005, -0.02,
+                                     0.01, 0.002, 0.001};
+  const auto views = SyntheticViews(spec, "LENSMODEL_OPENCV8", truth, 640, 480, 14, 0.2);
+  const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "auto");
+  const std::string chosen = run.Chosen().short_name;
+  std::cout << "auto chose " << chosen << "\n";
+  EXPECT_NE(chosen, "pinhole");
+  EXPECT_NE(chosen, "splined");
+  EXPECT_FALSE(run.choice.trials[0].fits);  // pinhole leaves systematic residuals
+  const SolveResult& fit = run.Chosen().fit;
+  EXPECT_LT(fit.rms_px, 0.35);
+  // The chosen model projects like the truth wherever the boards were seen.
+  const double diff = ProjectionDifference_px("LENSMODEL_OPENCV8", truth, fit.lensmodel,
+                                              fit.intrinsics, ObservedPixels(views, 640, 480));
+  std::cout << "projection difference to the truth " << diff << " px\n";
+  EXPECT_LT(diff, 0.1);
+  EXPECT_NEAR(fit.intrinsics[0], truth[0], 0.01 * truth[0]);
+}
+
+TEST(SyntheticCalibrationTest, BoardOnlyAtTheCentreWarns) {
+  const BoardSpec spec = Spec("chessboard:5x4:0.02");
+  const auto views = SyntheticViews(spec, "LENSMODEL_PINHOLE", {600, 600, 320, 240}, 640, 480,
+                                    8, 0.2, /*centre_only=*/true);
+  const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "opencv4");
+  std::string all;
+  for (const std::string& w : run.warnings) all += w + "\n";
+  EXPECT_NE(all.find("cover only"), std::string::npos) << all;
+  EXPECT_NE(all.find("fronto-parallel"), std::string::npos) << all;
+  EXPECT_NE(all.find("only 8 images"), std::string::npos) << all;
+}
+
+TEST(BoardImageTest, RenderedAprilGridIsDetectedWithEveryCorner) {
+  const BoardSpec spec = Spec("aprilgrid:3x2:0.04:0.25");
+  BoardImage image;
+  ASSERT_TRUE(RenderBoardImage(spec, 150, &image).ok());
+  EXPECT_NEAR(image.drawn_square_m, 0.04, 0.04 * 0.02);
+  cv::Mat blurred;
+  cv::GaussianBlur(image.gray, blurred, cv::Size(3, 3), 0.8);
+  const BoardDetection detection = DetectBoard(blurred, spec);
+  ASSERT_TRUE(detection.found) << detection.reason;
+  ASSERT_EQ(detection.corners.size(), 24u);
+  // The drawn board is a fronto-parallel view: pixel = margin + board point * px/m, y up.
+  const double px_per_m = 150 / 0.0254;
+  BoardSpec drawn = spec;  // what was drawn: whole pixels per tag bit
+  drawn.square_m = image.drawn_square_m;
+  drawn.spacing = image.drawn_spacing;
+  const Eigen::Vector2d origin = detection.corners[0].pixel;  // tag 0 corner 0
+  for (const CornerObservation& c : detection.corners) {
+    const Eigen::Vector3d p = CornerPosition(drawn, c.id);
+    const Eigen::Vector2d expected = origin + Eigen::Vector2d(p.x(), -p.y()) * px_per_m;
+    EXPECT_NEAR((c.pixel - expected).norm(), 0, 0.5) << c.id;
+  }
+}
+
+TEST(CalibCommandTest, BadInputExitsTwoWithOneLine) {
+  const std::string dir = fresco::testing::MakeTempDir("calib_bad");
+  auto r = RunFresco({"calib", "solve", dir, "--board", "chessboard:9x6", "--out", dir + "/c.cameramodel"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--board"), std::string::npos) << r.err;
+  r = RunFresco({"calib", "solve", dir, "--board", "chessboard:9x6:0.02", "--out", dir + "/c.cameramodel"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("IMAGES_DIR: no image"), std::string::npos) << r.err;
+  // Two images with a board: too few.
+  BoardImage board;
+  ASSERT_TRUE(RenderBoardImage(Spec("chessboard:6x4:0.02"), 100, &board).ok());
+  cv::imwrite(dir + "/a.png", board.gray);
+  cv::imwrite(dir + "/b.png", board.gray);
+  cv::imwrite(dir + "/c.png", cv::Mat(100, 100, CV_8U, cv::Scalar(128)));
+  r = RunFresco({"calib", "solve", dir, "--board", "chessboard:6x4:0.02", "--out", dir + "/c.cameramodel"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("found in 2 of 3 images"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("rejected c.png"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/c.cameramodel"));
+}
+
+TEST(CalibCommandTest, BoardCommandStatesItsSize) {
+  const std::string dir = fresco::testing::MakeTempDir("calib_board");
+  const auto r = RunFresco({"calib", "board", "aprilgrid:6x6:0.088:0.3", "--out", dir + "/b.png", "--dpi", "100"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("pattern 0.6"), std::string::npos) << r.out;
+  const auto j = nlohmann::json::parse(fresco::testing::ReadText(dir + "/b.json"));
+  EXPECT_NEAR(j["pattern_size_m"][0].get<double>(), 0.66, 0.01);  // whole pixels per bit
+}
+
+TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string data = fresco::testing::SharedDataDir() + "/opencv-chessboard-stereo";
+  const std::string dir = fresco::testing::MakeTempDir("calib_chess");
+  fs::create_directories(dir + "/left");
+  for (const auto& e : fs::directory_iterator(data))
+    if (e.path().filename().string().rfind("left", 0) == 0 && e.path().extension() == ".jpg")
+      fs::copy(e.path(), dir + "/left/" + e.path().filename().string());
+  const std::string out = dir + "/left.cameramodel";
+  const auto r = RunFresco({"calib", "solve", dir + "/left", "--board", "chessboard:9x6:0.025",
+                            "--out", out, "--model", "opencv4", "--corners-vnl", dir + "/corners.vnl"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(fresco::testing::ReadText(dir + "/left.report.json"));
+  const double fx = report["intrinsics"][0], fy = report["intrinsics"][1];
+  EXPECT_LT(std::abs(fx - 535.92) / 535.92, 0.005) << fx;  // OpenCV's left_intrinsics.yml
+  EXPECT_LT(std::abs(fy - 535.92) / 535.92, 0.005) << fy;
+  EXPECT_NEAR(report["intrinsics"][2].get<double>(), 342.28, 3.0);
+  EXPECT_NEAR(report["intrinsics"][3].get<double>(), 235.57, 3.0);
+  EXPECT_LT(report["rms_px"].get<double>(), 0.39);
+  EXPECT_EQ(report["images_used"].size(), 13u);
+  EXPECT_EQ(report["lensmodel"], "LENSMODEL_OPENCV4");
+  // mrcal's own reader and, when installed, mrcal-calibrate-cameras on the same corners.
+  if (std::system("/usr/bin/python3 -c 'import mrcal' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-mrcal is absent: mrcal cross-check skipped";
+  const std::string check = "cd " + dir + "/left && mkdir -p ../m && mrcal-calibrate-cameras --corners-cache ../corners.vnl"
+      " --lensmodel LENSMODEL_OPENCV4 --focal 500 --object-spacing 0.025 --object-width-n 9"
+      " --object-height-n 6 --outdir ../m 'left*.jpg' >/dev/null 2>&1 && /usr/bin/python3 -c \""
+      "import mrcal; a=mrcal.cameramodel('" + out + "').intrinsics()[1];"
+      " b=mrcal.cameramodel('../m/camera-0.cameramodel').intrinsics()[1];"
+      " print(*(a-b))\" > ../diff.txt";
+  ASSERT_EQ(std::system(check.c_str()), 0);
+  std::istringstream diff(fresco::testing::ReadText(dir + "/diff.txt"));
+  double d;
+  for (int i = 0; diff >> d; ++i) EXPECT_NEAR(d, 0, i < 4 ? 0.05 : 1e-4) << "intrinsic " << i;
+}
+
+// yac's reference corners for one image: board point (rounded to 0.1 mm) -> pixel.
+std::map<std::pair<int, int>, Eigen::Vector2d> ReadYacCorners(const std::string& csv) {
+  std::map<std::pair<int, int>, Eigen::Vector2d> corners;
+  std::ifstream in(csv);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, ',')) v.push_back(std::stod(field));
+    corners[{int(std::lround(v[7] * 1e4)), int(std::lround(v[8] * 1e4))}] = Eigen::Vector2d(v[5], v[6]);
+  }
+  return corners;
+}
+
+TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string data = fresco::testing::SharedDataDir() + "/aprilgrid-yac-mocap";
+  const BoardSpec spec = Spec("aprilgrid:6x6:0.088:0.3");
+  std::vector<std::string> images;
+  ASSERT_TRUE(ListImages(data + "/cam0/data", &images).ok());
+  std::vector<double> distances;
+  int reference = 0;
+  for (size_t i = 0; i < images.size(); i += 3) {  // every third image: 10 of 30
+    const cv::Mat gray = cv::imread(images[i], cv::IMREAD_GRAYSCALE);
+    const BoardDetection det = DetectBoard(gray, spec);
+    ASSERT_TRUE(det.found) << images[i] << ": " << det.reason;
+    const auto ref = ReadYacCorners(data + "/grid0/cam0/data/" +
+                                    fs::path(images[i]).stem().string() + ".csv");
+    reference += static_cast<int>(ref.size());
+    for (const CornerObservation& c : det.corners) {
+      const Eigen::Vector3d p = CornerPosition(spec, c.id);
+      auto it = ref.find({int(std::lround(p.x() * 1e4)), int(std::lround(p.y() * 1e4))});
+      if (it != ref.end()) distances.push_back((it->second - c.pixel).norm());
+    }
+  }
+  std::sort(distances.begin(), distances.end());
+  const double median = distances[distances.size() / 2];
+  const double p90 = distances[distances.size() * 9 / 10];
+  std::cout << "matched " << distances.size() << " of " << reference << " reference corners; median "
+            << median << " px, p90 " << p90 << " px\n";
+  EXPECT_GT(distances.size(), 0.8 * reference);
+  EXPECT_LT(median, 0.2);
+  EXPECT_LT(p90, 0.4);
+}
+
+}  // namespace
+}  // namespace fresco::calib
