@@ -103,6 +103,19 @@ class PipelinePanel : public Panel {
     done();
     ImGui::SliderInt("corners", &p.refine.max_corners, 3, 1000);
     done();
+    ImGui::SliderInt("refine every N frames", &p.refine.every_n_frames, 1, 30);
+    done();
+    float dead_band = static_cast<float>(p.refine.min_correction_px);
+    if (ImGui::SliderFloat("min correction texels", &dead_band, 0.0f, 2.0f, "%.2f"))
+      p.refine.min_correction_px = dead_band;
+    done();
+    if (ImGui::Checkbox("consensus anchoring", &p.refine.anchor)) commit = true;
+    float step = static_cast<float>(p.refine.anchor_step_px);
+    if (ImGui::SliderFloat("anchor step texels", &step, 0.0f, 2.0f, "%.2f"))
+      p.refine.anchor_step_px = step;
+    done();
+    ImGui::SliderInt("anchor window frames", &p.refine.anchor_window_frames, 0, 1000);
+    done();
     ImGui::TextDisabled("background (§3.4)");
     const char* background_modes[] = {"off", "average", "robust"};
     int background = static_cast<int>(p.background.mode);
