@@ -12,6 +12,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "app/commands.h"
+#include "app/frame_reader.h"
 #include "app/progress.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/core/atomic_file.h"
@@ -43,41 +44,6 @@ ArgSpec RunSpec() {
   spec.required = {"--out"};
   return spec;
 }
-
-// Reads a video source one frame ahead on another thread (decoding a 1280x720 PNG takes
-// about as long as painting it). Next() hands over the frame read in the background and
-// starts reading the one after it.
-class FrameReader {
- public:
-  explicit FrameReader(VideoSource* video) : video_(video) { Start(); }
-  ~FrameReader() {
-    if (pending_.valid()) pending_.wait();
-  }
-  bool Next(Frame* frame, Status* status) {
-    Result r = pending_.get();
-    *status = r.status;
-    if (!r.ok) return false;
-    *frame = std::move(r.frame);
-    Start();
-    return true;
-  }
-
- private:
-  struct Result {
-    bool ok = false;
-    Frame frame;
-    Status status;
-  };
-  void Start() {
-    pending_ = std::async(std::launch::async, [this] {
-      Result r;
-      r.ok = video_->Next(&r.frame, &r.status);
-      return r;
-    });
-  }
-  VideoSource* video_;
-  std::future<Result> pending_;
-};
 
 struct StageTotals {
   std::map<std::string, double> ms;

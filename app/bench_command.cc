@@ -1,0 +1,247 @@
+// `fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...]` (CONTRACT.md): runs the
+// project once per combination of the swept settings and measures speed (fps, per-stage
+// ms) against accuracy. Accuracy needs no ground truth: every `--holdout`-th frame is left
+// out of painting and the painted model, rendered at its pose, is compared with it (virtual
+// rephotography); a synthetic project's true poses add the same comparison at the truth.
+// Writes DIR/bench.json and DIR/pareto.png.
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core/utility.hpp>
+
+#include "app/commands.h"
+#include "app/frame_reader.h"
+#include "app/pareto_plot.h"
+#include "app/progress.h"
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/capture.h"
+#include "pipeline/core/image_io.h"
+#include "pipeline/paint/open_project.h"
+#include "pipeline/paint/rephotography.h"
+
+namespace fresco {
+namespace {
+
+ArgSpec BenchSpec() {
+  ArgSpec spec;
+  spec.usage =
+      "fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...] [--holdout N] [--quiet]";
+  spec.help =
+      "Runs the project once per combination of the swept settings (cartesian product of the\n"
+      "--sweep options; without any, a default sweep that varies one setting at a time from\n"
+      "the project's own: sampling, texel size, occlusion, background model, refinement,\n"
+      "threads) and writes DIR/bench.json (one row per run: settings, fps, stage_ms, accuracy)\n"
+      "and DIR/pareto.png (fps against PSNR, the Pareto front in red).\n\n"
+      "  --sweep KEY=V1,V2  a project setting by JSON path and its values (repeatable)\n"
+      "  --holdout N        every N-th frame is held out of painting and scored (default 10)\n"
+      "  --quiet            no progress on stderr";
+  spec.min_positional = spec.max_positional = 1;
+  spec.options = {"--out", "--holdout"};
+  spec.repeatable = {"--sweep"};
+  spec.switches = {"--quiet"};
+  spec.required = {"--out"};
+  return spec;
+}
+
+// One run's settings: KEY=VALUE overrides, in order.
+using Settings = std::vector<std::pair<std::string, std::string>>;
+
+const std::vector<std::pair<std::string, std::vector<std::string>>>& DefaultSweep() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> sweep = {
+      {"pipeline.sampling", {"nearest", "area"}},
+      {"pipeline.max_buffer_texels", {"262144"}},
+      {"pipeline.occlusion.tolerance_rel", {"0.005", "0.05"}},
+      {"pipeline.background.mode", {"off", "average"}},
+      {"pipeline.refine.mode", {"robust"}},
+      {"pipeline.threads", {"1"}},
+  };
+  return sweep;
+}
+
+Status ParseSweeps(const std::vector<std::string>& sweeps, std::vector<Settings>* runs) {
+  runs->assign(1, Settings());
+  if (sweeps.empty()) {  // one at a time, from the project's own settings (the first run)
+    for (const auto& [key, values] : DefaultSweep())
+      for (const std::string& v : values) runs->push_back({{key, v}});
+    return Status::Ok();
+  }
+  for (const std::string& sweep : sweeps) {
+    const size_t eq = sweep.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == sweep.size())
+      return Status::Error("--sweep '" + sweep + "': expected KEY=V1,V2,...");
+    std::vector<std::string> values;
+    std::stringstream list(sweep.substr(eq + 1));
+    for (std::string v; std::getline(list, v, ',');) {
+      if (v.empty()) return Status::Error("--sweep '" + sweep + "': empty value");
+      values.push_back(v);
+    }
+    std::vector<Settings> product;
+    for (const Settings& run : *runs)
+      for (const std::string& v : values) {
+        Settings s = run;
+        s.emplace_back(sweep.substr(0, eq), v);
+        product.push_back(std::move(s));
+      }
+    *runs = std::move(product);
+  }
+  return Status::Ok();
+}
+
+struct RunResult {
+  nlohmann::json row;
+  ParetoPoint point;
+};
+
+// Paints the project with `settings`, holding out every `holdout`-th frame, and scores.
+Status BenchOne(const std::string& project_path, const Settings& settings, int holdout,
+                RunResult* result) {
+  std::vector<std::string> overrides;
+  std::string label;
+  for (const auto& [key, value] : settings) {
+    overrides.push_back(key + "=" + value);
+    // The key's last two parts ("refine.mode"): short, and not ambiguous.
+    const size_t last = key.rfind('.');
+    const size_t before = last == std::string::npos || last == 0 ? std::string::npos
+                                                                 : key.rfind('.', last - 1);
+    label += (label.empty() ? "" : " ") +
+             (before == std::string::npos ? key : key.substr(before + 1)) + "=" + value;
+  }
+  Project project;
+  FRESCO_RETURN_IF_ERROR(LoadProject(project_path, overrides, &project));
+  const int threads = project.pipeline.threads > 0 ? project.pipeline.threads : -1;
+  cv::setNumThreads(threads);
+  Capture capture;
+  std::unique_ptr<PaintSession> session;
+  FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, &capture, &session));
+
+  struct HeldOut {
+    Frame frame;
+    const PosedImage* pose;
+    const PosedImage* truth;
+  };
+  std::vector<HeldOut> held_out;
+  std::map<std::string, double> stage_ms;
+  int frames = 0, painted = 0;
+  FrameReader reader(capture.video.get());
+  Frame frame;
+  Status read_status;
+  FrameReport report;
+  const auto start = std::chrono::steady_clock::now();
+  while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
+         reader.Next(&frame, &read_status)) {
+    const int index = frames++;
+    const PosedImage* pose = capture.PoseForFrame(frame);
+    if (!pose || !capture.CameraFor(*pose)) continue;
+    if (holdout > 0 && index % holdout == holdout / 2) {
+      const size_t k = pose - capture.poses.data();
+      const PosedImage* truth = k < capture.truth_poses.size() ? &capture.truth_poses[k] : nullptr;
+      held_out.push_back({frame, pose, truth});
+      continue;
+    }
+    session->PaintFrame(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
+    if (!report.painted) continue;
+    ++painted;
+    for (const StageReport& st : report.stages) stage_ms[st.name] += st.wall_ms;
+  }
+  FRESCO_RETURN_IF_ERROR(read_status);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // Accuracy on the held-out frames (at the given poses; at the true poses when known).
+  const Scene scene = session->PaintedScene();
+  double psnr = 0, ncc = 0, completeness = 0, truth_psnr = 0, truth_ncc = 0;
+  int scored = 0, truth_scored = 0;
+  for (const HeldOut& h : held_out) {
+    RenderOptions options;
+    options.raster.supersample = 2;
+    const Renderer renderer(*capture.CameraFor(*h.pose), options);
+    const RephotoScore s = ScoreRephoto(renderer, scene, h.pose->cam_from_world, h.frame.bgr);
+    if (s.pixels > 0) psnr += s.psnr_db, ncc += s.one_minus_ncc, ++scored;
+    completeness += s.completeness;
+    if (h.truth) {
+      const RephotoScore t = ScoreRephoto(renderer, scene, h.truth->cam_from_world, h.frame.bgr);
+      if (t.pixels > 0) truth_psnr += t.psnr_db, truth_ncc += t.one_minus_ncc, ++truth_scored;
+    }
+  }
+  nlohmann::json& row = result->row;
+  row["settings"] = nlohmann::json::object();
+  for (const auto& [key, value] : settings) row["settings"][key] = value;
+  row["frames"] = frames;
+  row["frames_painted"] = painted;
+  row["seconds"] = seconds;
+  row["fps"] = seconds > 0 ? (frames - held_out.size()) / seconds : 0.0;
+  row["stage_ms"] = nlohmann::json::object();
+  for (const auto& [name, ms] : stage_ms) row["stage_ms"][name] = painted > 0 ? ms / painted : 0;
+  row["holdout_frames"] = held_out.size();
+  row["psnr_db"] = scored > 0 ? psnr / scored : 0.0;
+  row["one_minus_ncc"] = scored > 0 ? ncc / scored : 1.0;
+  row["completeness"] = held_out.empty() ? 0.0 : completeness / held_out.size();
+  row["coverage"] = session->Coverage();
+  if (truth_scored > 0) {
+    row["truth"] = {{"psnr_db", truth_psnr / truth_scored},
+                    {"one_minus_ncc", truth_ncc / truth_scored}};
+  }
+  result->point = {row["fps"].get<double>(), row["psnr_db"].get<double>(),
+                   label.empty() ? "project settings" : label};
+  return Status::Ok();
+}
+
+}  // namespace
+
+int RunVerbBench(const CommandArgs& argv) {
+  const ArgSpec spec = BenchSpec();
+  Args args;
+  if (int code = ParseVerbArgs("bench", argv, spec, &args); code >= 0) return code;
+  const std::string project_path = args.positional[0];
+  const std::string out_dir = args.Get("--out");
+  int holdout = 10;
+  std::string error;
+  if (args.Has("--holdout") && !ParseInt(args.Get("--holdout"), "--holdout", &holdout, &error))
+    return InputError(Status::Error(error));
+  if (holdout < 2) return InputError(Status::Error("--holdout: must be >= 2"));
+  std::vector<Settings> runs;
+  if (Status s = ParseSweeps(args.All("--sweep"), &runs); !s.ok()) return InputError(s);
+  // Every run's settings must load before any runs (a typo fails at once, not after an hour).
+  for (const Settings& run : runs) {
+    std::vector<std::string> overrides;
+    for (const auto& [key, value] : run) overrides.push_back(key + "=" + value);
+    Project project;
+    if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return InputError(s);
+  }
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+
+  Progress progress("bench", static_cast<int>(runs.size()), args.Switch("--quiet"));
+  nlohmann::json rows = nlohmann::json::array();
+  std::vector<ParetoPoint> points;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    RunResult result;
+    if (Status s = BenchOne(project_path, runs[i], holdout, &result); !s.ok())
+      return InputError(s);
+    rows.push_back(result.row);
+    points.push_back(result.point);
+    char detail[160];
+    std::snprintf(detail, sizeof detail, "%s: %.1f fps, %.2f dB", result.point.label.c_str(),
+                  result.point.fps, result.point.psnr_db);
+    progress.Update(static_cast<int>(i + 1), detail);
+  }
+  progress.Finish();
+  for (size_t k : ParetoFront(points)) rows[k]["pareto"] = true;
+  if (Status s = WriteFileAtomic(out_dir + "/bench.json", rows.dump(2) + "\n"); !s.ok()) {
+    std::cerr << "error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  const cv::Mat plot = DrawPareto(points, "fresco bench " + project_path);
+  if (Status s = WriteImageAtomic(out_dir + "/pareto.png", plot); !s.ok()) {
+    std::cerr << "error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", runs.size(),
+               out_dir.c_str(), out_dir.c_str());
+  return kExitOk;
+}
+
+}  // namespace fresco

@@ -1,0 +1,25 @@
+// Virtual rephotography (accuracy without ground truth): the painted model is rendered at a
+// frame's pose and compared with the frame itself, where the model's surface is seen and
+// painted. `fresco bench` holds some frames out of painting and scores them this way.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/rigid3.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/render/renderer.h"
+
+namespace fresco {
+
+struct RephotoScore {
+  double psnr_db = 0;
+  double one_minus_ncc = 0;  // 0 = identical up to gain and offset, 1 = uncorrelated
+  double completeness = 0;   // surface pixels that show painted texels
+  int pixels = 0;            // pixels compared
+};
+
+// `frame_bgr`: the photo at `cam_from_world`, the renderer's camera size.
+RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
+                          const Rigid3d& cam_from_world, const cv::Mat& frame_bgr);
+
+}  // namespace fresco
