@@ -29,7 +29,8 @@ namespace {
 ArgSpec BenchSpec() {
   ArgSpec spec;
   spec.usage =
-      "fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...] [--holdout N] [--quiet]";
+      "fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...] [--holdout N]\n"
+      "       [--no-baseline] [--quiet]";
   spec.help =
       "Runs the project once per combination of the swept settings (cartesian product of the\n"
       "--sweep options; without any, a default sweep that varies one setting at a time from\n"
@@ -38,11 +39,13 @@ ArgSpec BenchSpec() {
       "and DIR/pareto.png (fps against PSNR, the Pareto front in red).\n\n"
       "  --sweep KEY=V1,V2  a project setting by JSON path and its values (repeatable)\n"
       "  --holdout N        every N-th frame is held out of painting and scored (default 10)\n"
+      "  --no-baseline      skip the last run, the naive baseline (per frame a full depth\n"
+      "                     render, every texel projected one at a time, cv::remap)\n"
       "  --quiet            no progress on stderr";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--holdout"};
   spec.repeatable = {"--sweep"};
-  spec.switches = {"--quiet"};
+  spec.switches = {"--quiet", "--no-baseline"};
   spec.required = {"--out"};
   return spec;
 }
@@ -96,9 +99,10 @@ struct RunResult {
   ParetoPoint point;
 };
 
-// Paints the project with `settings`, holding out every `holdout`-th frame, and scores.
+// Paints the project with `settings` (or, `naive`, with the naive baseline), holding out
+// every `holdout`-th frame, and scores.
 Status BenchOne(const std::string& project_path, const Settings& settings, int holdout,
-                RunResult* result) {
+                bool naive, RunResult* result) {
   std::vector<std::string> overrides;
   std::string label;
   for (const auto& [key, value] : settings) {
@@ -142,7 +146,10 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
       held_out.push_back({frame, pose, truth});
       continue;
     }
-    session->PaintFrame(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
+    if (naive)
+      session->PaintFrameNaive(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
+    else
+      session->PaintFrame(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
     if (!report.painted) continue;
     ++painted;
     for (const StageReport& st : report.stages) stage_ms[st.name] += st.wall_ms;
@@ -170,6 +177,10 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   nlohmann::json& row = result->row;
   row["settings"] = nlohmann::json::object();
   for (const auto& [key, value] : settings) row["settings"][key] = value;
+  if (naive) {
+    row["baseline"] = "naive";
+    label = "naive baseline";
+  }
   row["frames"] = frames;
   row["frames_painted"] = painted;
   row["seconds"] = seconds;
@@ -214,12 +225,18 @@ int RunVerbBench(const CommandArgs& argv) {
   }
   if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
 
-  Progress progress("bench", static_cast<int>(runs.size()), args.Switch("--quiet"));
+  Progress progress("bench", static_cast<int>(runs.size()) + !args.Switch("--no-baseline"),
+                    args.Switch("--quiet"));
   nlohmann::json rows = nlohmann::json::array();
   std::vector<ParetoPoint> points;
-  for (size_t i = 0; i < runs.size(); ++i) {
+  // The last run: the naive baseline (full depth render + cv::remap per buffer).
+  const bool baseline = !args.Switch("--no-baseline");
+  const size_t total = runs.size() + (baseline ? 1 : 0);
+  for (size_t i = 0; i < total; ++i) {
     RunResult result;
-    if (Status s = BenchOne(project_path, runs[i], holdout, &result); !s.ok())
+    const bool naive = i == runs.size();
+    if (Status s = BenchOne(project_path, naive ? Settings() : runs[i], holdout, naive, &result);
+        !s.ok())
       return InputError(s);
     rows.push_back(result.row);
     points.push_back(result.point);
@@ -239,7 +256,7 @@ int RunVerbBench(const CommandArgs& argv) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
-  std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", runs.size(),
+  std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", total,
                out_dir.c_str(), out_dir.c_str());
   return kExitOk;
 }

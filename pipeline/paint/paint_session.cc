@@ -494,3 +494,49 @@ Scene PaintSession::PaintedScene() const {
 }
 
 }  // namespace fresco
+
+namespace fresco {
+
+// The obvious implementation, for `fresco bench` to compare against: per frame a full
+// depth render, then per buffer every texel projected one by one through the camera
+// (Camera::Project), the depth compared, and the frame resampled with cv::remap.
+void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
+                                   const Rigid3d& cam_from_world, FrameReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  report->frame = frame.index;
+  report->name = frame.name;
+  report->stages.clear();
+  const Rigid3d cam_from_local = CamFromLocal(*scene_, cam_from_world);
+  CacheFor(camera).rasterizer->Rasterize(scene_->mesh, cam_from_local, &raster_);
+  const float tolerance = static_cast<float>(options_.occlusion.tolerance_rel);
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    const BaseBuffer& buffer = set_.buffers[b];
+    cv::Mat map(buffer.height, buffer.width, CV_32FC2, cv::Scalar(-1, -1));
+    WarpedBuffer& w = warped_[b];
+    w.valid = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    w.quality = cv::Mat::ones(buffer.height, buffer.width, CV_32F);
+    for (int k = 0; k < buffer.NumTexels(); ++k) {
+      const Eigen::Vector3d p = cam_from_local * buffer.Point(k).cast<double>();
+      Eigen::Vector2d pixel;
+      if (p.z() <= 0 || !camera.Project(p, &pixel)) continue;
+      const int u = static_cast<int>(std::lround(pixel.x())),
+                v = static_cast<int>(std::lround(pixel.y()));
+      if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
+      const float depth = raster_.depth.at<float>(v, u);
+      if (p.z() > depth * (1 + tolerance) + options_.occlusion.tolerance_m) continue;
+      map.at<cv::Vec2f>(buffer.texel_index[k]) =
+          cv::Vec2f(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()));
+      w.valid.data[buffer.texel_index[k]] = 255;
+    }
+    cv::remap(frame.bgr, w.bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    PaintBuffer(buffer, w, cv::Mat(), UpdatePolicy::kLatest, 0, &painted_[b]);
+  }
+  StageReport all;
+  all.name = "naive";
+  all.wall_ms = MsSince(start);
+  report->stages.push_back(std::move(all));
+  report->painted = true;
+  report->total_ms = all.wall_ms;
+}
+
+}  // namespace fresco

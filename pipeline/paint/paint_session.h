@@ -53,6 +53,11 @@ class PaintSession {
   void PaintFrame(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
                   FrameReport* report);
 
+  // The naive baseline `fresco bench` measures against (paints the same buffers): full
+  // depth render, every texel projected one at a time, cv::remap per buffer, latest wins.
+  void PaintFrameNaive(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
+                       FrameReport* report);
+
   // The scene's geometry with the painted buffers as base-colour textures (alpha 0 where
   // never painted) and new UVs into them.
   Scene PaintedScene() const;

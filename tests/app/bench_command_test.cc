@@ -38,14 +38,15 @@ TEST_F(BenchCommandTest, OneRowPerCombinationScoredOnHeldOutFrames) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("bench:"), std::string::npos) << "progress on stderr";
   const nlohmann::json rows = nlohmann::json::parse(ReadText(out + "/bench.json"));
-  ASSERT_EQ(rows.size(), 4u);
+  ASSERT_EQ(rows.size(), 5u);  // 2 x 2 and the naive baseline
+  EXPECT_EQ(rows[4]["baseline"], "naive");
   int on_front = 0;
   for (const auto& row : rows) {
-    EXPECT_EQ(row["settings"].size(), 2u);
+    EXPECT_EQ(row["settings"].size(), row.contains("baseline") ? 0u : 2u);
     EXPECT_EQ(row["holdout_frames"], 4);  // frames 2, 7, 12, 17 of 20
     EXPECT_EQ(row["frames_painted"], 16);
     EXPECT_GT(row["fps"].get<double>(), 0);
-    EXPECT_TRUE(row["stage_ms"].contains("warp"));
+    EXPECT_TRUE(row["stage_ms"].contains(row.contains("baseline") ? "naive" : "warp"));
     EXPECT_GT(row["completeness"].get<double>(), 0.5);
     EXPECT_LE(row["completeness"].get<double>(), 1.0);
     // The held-out frames were rendered at the true poses: scored there, the painted model
