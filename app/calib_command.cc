@@ -4,14 +4,11 @@
 // Bad input (a bad board spec, a folder without usable images) is one line on stderr and
 // exit 2; every output is written atomically.
 #include <cstdio>
-#include <filesystem>
 #include <iostream>
 
 #include "app/commands.h"
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
-#include "calib/corners_vnl.h"
-#include "calib/pictures.h"
 #include "calib/report.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/image_io.h"
@@ -84,21 +81,11 @@ int RunSolve(const CommandArgs& argv) {
     std::cerr << "fresco calib solve: " << s.message() << "\n";
     return kExitFailure;
   }
-  const std::filesystem::path parent = std::filesystem::path(out).parent_path();
-  if (!parent.empty())
-    if (Status s = MakeDirectories(parent.string()); !s.ok()) return InputError(s);
-  std::vector<std::string> pictures;
-  if (!args.Switch("--no-pictures")) {
-    const std::string residuals = calib::SiblingPath(out, ".residuals.png");
-    const std::string coverage = calib::SiblingPath(out, ".coverage.png");
-    if (Status s = WriteImageAtomic(residuals, calib::DrawResiduals(run)); !s.ok()) return InputError(s);
-    if (Status s = WriteImageAtomic(coverage, calib::DrawCoverage(run)); !s.ok()) return InputError(s);
-    pictures = {residuals, coverage};
-  }
-  if (args.Has("--corners-vnl"))
-    if (Status s = calib::WriteCornersVnl(args.Get("--corners-vnl"), run.views, request.board); !s.ok())
-      return InputError(s);
-  if (Status s = calib::WriteCalibration(out, request, run, pictures); !s.ok()) return InputError(s);
+  calib::CalibrationOutputs outputs;
+  outputs.pictures = !args.Switch("--no-pictures");
+  outputs.corners_vnl = args.Get("--corners-vnl");
+  if (Status s = calib::WriteCalibrationOutputs(out, request, run, outputs); !s.ok())
+    return InputError(s);
 
   for (const std::string& w : run.warnings) std::cerr << "warning: " << w << "\n";
   if (!quiet) {

@@ -1,11 +1,13 @@
-// fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]: the authoring
-// app (ui/). With --screenshot it paints N frames (default 30), draws every panel, writes the
+// fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]
+//            [--calib-images DIR --board BOARD [--model MODEL]]: the authoring app (ui/). With --screenshot it paints N frames (default 30), draws every panel, writes the
 // window to FILE.png (and FILE.png.json: the panels and where they are) and exits 0; it
 // needs a display (xvfb-run works).
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
 #include "app/commands.h"
+#include "calib/model_select.h"
 #include "pipeline/core/project.h"
 #ifdef FRESCO_HAVE_GUI
 #include "ui/gl/app_window.h"
@@ -15,16 +17,23 @@ namespace fresco {
 
 int RunVerbGui(const CommandArgs& argv) {
   ArgSpec spec;
-  spec.usage = "fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]";
+  spec.usage =
+      "fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]\n"
+      "           [--calib-images DIR --board BOARD [--model MODEL]]";
   spec.help =
       "The authoring app: 3D view, grouping editor, pipeline control, stage panels, timing and\n"
       "misalignment review (Dear ImGui + GLFW + OpenGL 3.3; needs a display).\n\n"
       "  --screenshot FILE  paint N frames, draw every panel, write the window to FILE (PNG)\n"
       "                     and FILE.json (the panels and their places), then exit\n"
       "  --frames N         frames to paint before the screenshot (default 30)\n"
-      "  --size WxH         window size (default 1600x1000)";
+      "  --size WxH         window size (default 1600x1000)\n"
+      "  --calib-images DIR open the Calibration panel on DIR and detect the board in its\n"
+      "                     images (with --screenshot: detect and solve before the shot)\n"
+      "  --board BOARD      the board for --calib-images (as `fresco calib solve --board`)\n"
+      "  --model MODEL      lens model for --calib-images: auto (default), pinhole, opencv4,\n"
+      "                     opencv5, opencv8, splined";
   spec.max_positional = 1;
-  spec.options = {"--screenshot", "--frames", "--size"};
+  spec.options = {"--screenshot", "--frames", "--size", "--calib-images", "--board", "--model"};
   Args args;
   if (int code = ParseVerbArgs("gui", argv, spec, &args); code >= 0) return code;
 #ifdef FRESCO_HAVE_GUI
@@ -42,8 +51,24 @@ int RunVerbGui(const CommandArgs& argv) {
        options.width < 320 || options.height < 240))
     return UsageError("gui", spec,
                       "--size: expected WxH of at least 320x240, got " + args.Get("--size"));
-  if (!options.screenshot.empty() && options.project.empty())
-    return UsageError("gui", spec, "--screenshot needs a PROJECT.json");
+  options.calib_images = args.Get("--calib-images");
+  options.calib_board = args.Get("--board");
+  options.calib_model = args.Get("--model", "auto");
+  if (options.calib_images.empty() && (args.Has("--board") || args.Has("--model")))
+    return UsageError("gui", spec, "--board and --model go with --calib-images");
+  if (!options.calib_images.empty()) {
+    calib::BoardSpec board;
+    if (!args.Has("--board")) return UsageError("gui", spec, "--calib-images needs --board");
+    if (Status s = calib::ParseBoardSpec(options.calib_board, "--board", &board); !s.ok())
+      return InputError(s);
+    const auto& names = calib::LensModelShortNames();
+    if (options.calib_model != "auto" &&
+        std::find(names.begin(), names.end(), options.calib_model) == names.end())
+      return UsageError("gui", spec, "--model: '" + options.calib_model +
+                                         "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
+  }
+  if (!options.screenshot.empty() && options.project.empty() && options.calib_images.empty())
+    return UsageError("gui", spec, "--screenshot needs a PROJECT.json or --calib-images");
   if (!options.project.empty()) {  // bad input is exit 2 before any window opens
     Project project;
     if (Status s = LoadProject(options.project, {}, &project); !s.ok()) return InputError(s);

@@ -15,8 +15,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr double kMinCoverage = 0.35;    // fraction of the imager's cells
-constexpr double kMinTiltDeg = 20;       // at least one board this far from fronto-parallel
 constexpr double kMaxFocalStdev = 0.01;  // relative 1-sigma on fx
 
 std::string Percent(double fraction) {
@@ -54,17 +52,11 @@ double TagCornerCorrelation(const std::vector<BoardView>& views, const SolveResu
 }
 
 void CheckCoverage(CalibrationRun* run) {
-  constexpr int kCols = 16, kRows = 12;
-  std::vector<bool> seen(kCols * kRows, false);
   bool quadrant[2][2] = {{false, false}, {false, false}};
   for (const BoardView& v : run->views)
-    for (const CornerObservation& c : v.corners) {
-      const int i = std::clamp(static_cast<int>((c.pixel.x() + 0.5) * kCols / run->width), 0, kCols - 1);
-      const int j = std::clamp(static_cast<int>((c.pixel.y() + 0.5) * kRows / run->height), 0, kRows - 1);
-      seen[j * kCols + i] = true;
-      quadrant[j * 2 / kRows][i * 2 / kCols] = true;
-    }
-  run->coverage_fraction = std::count(seen.begin(), seen.end(), true) / double(seen.size());
+    for (const CornerObservation& c : v.corners)
+      quadrant[(c.pixel.y() + 0.5) * 2 >= run->height][(c.pixel.x() + 0.5) * 2 >= run->width] = true;
+  run->coverage_fraction = CoverageFraction(run->views, run->width, run->height);
   if (run->coverage_fraction < kMinCoverage)
     run->warnings.push_back("corners cover only " + Percent(run->coverage_fraction) +
                             " of the imager (16x12 cells): the lens model is extrapolated "
@@ -75,15 +67,7 @@ void CheckCoverage(CalibrationRun* run) {
       if (!quadrant[j][i])
         run->warnings.push_back(std::string("no corner observed in the ") + names[j][i] +
                                 " quarter of the imager");
-  run->max_tilt_deg = 0;
-  for (const auto& rt : run->seed.rt_cam_from_board) {
-    const double angle = std::sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
-    if (angle < 1e-12) continue;
-    // Board normal (0,0,1) rotated; tilt = angle between it and the camera's axis.
-    const double kz = rt[2] / angle, c = std::cos(angle);
-    const double nz = c + kz * kz * (1 - c);  // R(2,2) of the Rodrigues rotation
-    run->max_tilt_deg = std::max(run->max_tilt_deg, std::acos(std::min(1.0, std::abs(nz))) * 180 / M_PI);
-  }
+  run->max_tilt_deg = MaxTiltDeg(run->seed);
   if (run->max_tilt_deg < kMinTiltDeg)
     run->warnings.push_back("every board is within " + std::to_string(int(std::ceil(run->max_tilt_deg))) +
                             " deg of fronto-parallel: the focal length is poorly determined; "
@@ -91,6 +75,62 @@ void CheckCoverage(CalibrationRun* run) {
 }
 
 }  // namespace
+
+std::vector<bool> CoverageCells(const std::vector<BoardView>& views, int width, int height) {
+  std::vector<bool> seen(kCoverageCols * kCoverageRows, false);
+  if (width <= 0 || height <= 0) return seen;
+  for (const BoardView& v : views)
+    for (const CornerObservation& c : v.corners) {
+      const int i = std::clamp(static_cast<int>((c.pixel.x() + 0.5) * kCoverageCols / width), 0, kCoverageCols - 1);
+      const int j = std::clamp(static_cast<int>((c.pixel.y() + 0.5) * kCoverageRows / height), 0, kCoverageRows - 1);
+      seen[j * kCoverageCols + i] = true;
+    }
+  return seen;
+}
+
+double CoverageFraction(const std::vector<BoardView>& views, int width, int height) {
+  const std::vector<bool> seen = CoverageCells(views, width, height);
+  return std::count(seen.begin(), seen.end(), true) / double(seen.size());
+}
+
+double MaxTiltDeg(const CalibrationSeed& seed) {
+  double max_tilt = 0;
+  for (const auto& rt : seed.rt_cam_from_board) {
+    const double angle = std::sqrt(rt[0] * rt[0] + rt[1] * rt[1] + rt[2] * rt[2]);
+    if (angle < 1e-12) continue;
+    // Board normal (0,0,1) rotated; tilt = angle between it and the camera's axis.
+    const double kz = rt[2] / angle, c = std::cos(angle);
+    const double nz = c + kz * kz * (1 - c);  // R(2,2) of the Rodrigues rotation
+    max_tilt = std::max(max_tilt, std::acos(std::min(1.0, std::abs(nz))) * 180 / M_PI);
+  }
+  return max_tilt;
+}
+
+DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, int height,
+                              const CalibrationSeed* seed) {
+  DataReadiness r;
+  r.views = static_cast<int>(views.size());
+  r.coverage_fraction = CoverageFraction(views, width, height);
+  if (seed && !seed->rt_cam_from_board.empty()) r.max_tilt_deg = MaxTiltDeg(*seed);
+  if (r.views < kMinViews)
+    r.reasons.push_back(std::to_string(r.views) + " images with a board: a solve needs " +
+                        std::to_string(kMinViews));
+  else if (r.views < kFewViews)
+    r.reasons.push_back(std::to_string(r.views) + " images with a board: " +
+                        std::to_string(kFewViews) + " or more for a trustworthy model");
+  if (r.coverage_fraction < kMinCoverage)
+    r.reasons.push_back("corners cover " + Percent(r.coverage_fraction) + " of the imager (want " +
+                        Percent(kMinCoverage) + "): show the board near edges and corners");
+  if (r.max_tilt_deg < 0)
+    r.reasons.push_back("board tilt not known yet (needs " + std::to_string(kMinViews) + " views)");
+  else if (r.max_tilt_deg < kMinTiltDeg)
+    r.reasons.push_back("most tilted board " + std::to_string(int(std::round(r.max_tilt_deg))) +
+                        " deg (want " + std::to_string(int(kMinTiltDeg)) + "): tilt the board");
+  r.level = r.views < kMinViews    ? DataReadiness::Level::kRed
+            : r.reasons.empty()    ? DataReadiness::Level::kGreen
+                                   : DataReadiness::Level::kYellow;
+  return r;
+}
 
 Status ListImages(const std::string& dir, std::vector<std::string>* paths) {
   std::error_code ec;
@@ -105,32 +145,37 @@ Status ListImages(const std::string& dir, std::vector<std::string>* paths) {
   return Status::Ok();
 }
 
+bool DetectImage(const std::string& path, const CalibrateRequest& request, CalibrationRun* run,
+                 BoardDetection* detection_out) {
+  const std::string name = fs::path(path).filename().string();
+  cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (gray.empty()) {
+    run->rejected.push_back({name, "cannot read the image"});
+    return false;
+  }
+  if (run->width == 0) {
+    run->width = gray.cols;
+    run->height = gray.rows;
+  } else if (gray.cols != run->width || gray.rows != run->height) {
+    run->rejected.push_back({name, "size " + std::to_string(gray.cols) + "x" +
+                                       std::to_string(gray.rows) + " differs from the first image's " +
+                                       std::to_string(run->width) + "x" + std::to_string(run->height)});
+    return false;
+  }
+  BoardDetection detection = DetectBoard(gray, request.board, request.detect);
+  if (detection_out) *detection_out = detection;
+  if (!detection.found) {
+    run->rejected.push_back({name, detection.reason});
+    return false;
+  }
+  run->views.push_back({name, std::move(detection.corners)});
+  return true;
+}
+
 Status DetectViews(const CalibrateRequest& request, CalibrationRun* run) {
   std::vector<std::string> paths;
   FRESCO_RETURN_IF_ERROR(ListImages(request.images_dir, &paths));
-  for (const std::string& path : paths) {
-    const std::string name = fs::path(path).filename().string();
-    cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
-    if (gray.empty()) {
-      run->rejected.push_back({name, "cannot read the image"});
-      continue;
-    }
-    if (run->width == 0) {
-      run->width = gray.cols;
-      run->height = gray.rows;
-    } else if (gray.cols != run->width || gray.rows != run->height) {
-      run->rejected.push_back({name, "size " + std::to_string(gray.cols) + "x" +
-                                         std::to_string(gray.rows) + " differs from the first image's " +
-                                         std::to_string(run->width) + "x" + std::to_string(run->height)});
-      continue;
-    }
-    BoardDetection detection = DetectBoard(gray, request.board, request.detect);
-    if (!detection.found) {
-      run->rejected.push_back({name, detection.reason});
-      continue;
-    }
-    run->views.push_back({name, std::move(detection.corners)});
-  }
+  for (const std::string& path : paths) DetectImage(path, request, run);
   if (static_cast<int>(run->views.size()) < kMinViews)
     return Status::Error(request.images_dir + ": IMAGES_DIR: the board (" + request.board.text +
                          ") was found in " + std::to_string(run->views.size()) + " of " +

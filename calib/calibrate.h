@@ -49,10 +49,40 @@ Status ListImages(const std::string& dir, std::vector<std::string>* paths);
 // than kMinViews images with a board.
 Status DetectViews(const CalibrateRequest& request, CalibrationRun* run);
 
+// One image of DetectViews: adds it to run->views or run->rejected (with the reason).
+// `detection` (optional) receives what was found. Returns whether the image was used.
+bool DetectImage(const std::string& path, const CalibrateRequest& request, CalibrationRun* run,
+                 BoardDetection* detection = nullptr);
+
 // Everything after detection.
 Status SolveViews(const CalibrateRequest& request, CalibrationRun* run);
 
 constexpr int kMinViews = 3;
 constexpr int kFewViews = 10;
+constexpr double kMinCoverage = 0.35;  // fraction of the imager's 16 x 12 cells
+constexpr double kMinTiltDeg = 20;     // at least one board this far from fronto-parallel
+
+// The imager's kCoverageCols x kCoverageRows cells holding a corner of some view (row-major),
+// and their fraction.
+constexpr int kCoverageCols = 16, kCoverageRows = 12;
+std::vector<bool> CoverageCells(const std::vector<BoardView>& views, int width, int height);
+double CoverageFraction(const std::vector<BoardView>& views, int width, int height);
+// Largest board tilt from fronto-parallel over the seed's board poses (degrees).
+double MaxTiltDeg(const CalibrationSeed& seed);
+
+// "Is this enough data yet?", while images are added: red below kMinViews (no solve
+// possible), yellow when a classic trap remains (fewer than kFewViews views, coverage below
+// kMinCoverage, no board tilted kMinTiltDeg), green otherwise. One reason per trap.
+struct DataReadiness {
+  enum class Level { kRed, kYellow, kGreen };
+  Level level = Level::kRed;
+  int views = 0;
+  double coverage_fraction = 0;
+  double max_tilt_deg = -1;  // -1: unknown (no seed yet)
+  std::vector<std::string> reasons;
+};
+// `seed`: board poses for the tilt (null = tilt unknown, which keeps the light yellow).
+DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, int height,
+                              const CalibrationSeed* seed);
 
 }  // namespace fresco::calib

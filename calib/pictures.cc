@@ -71,18 +71,12 @@ cv::Mat DrawResiduals(const CalibrationRun& run) {
 }
 
 cv::Mat DrawCoverage(const CalibrationRun& run) {
-  const SolveResult& fit = run.Chosen().fit;
+  const SolveResult* fit = run.choice.chosen >= 0 ? &run.Chosen().fit : nullptr;
   const double s = CanvasScale(run, 900);
   const int w = static_cast<int>(run.width * s), h = static_cast<int>(run.height * s);
   cv::Mat canvas(h + 30, w, CV_8UC3, cv::Scalar(255, 255, 255));
-  constexpr int kCols = 16, kRows = 12;
-  std::vector<bool> seen(kCols * kRows, false);
-  for (const BoardView& v : run.views)
-    for (const CornerObservation& c : v.corners) {
-      const int i = std::clamp(int((c.pixel.x() + 0.5) * kCols / run.width), 0, kCols - 1);
-      const int j = std::clamp(int((c.pixel.y() + 0.5) * kRows / run.height), 0, kRows - 1);
-      seen[j * kCols + i] = true;
-    }
+  constexpr int kCols = kCoverageCols, kRows = kCoverageRows;
+  const std::vector<bool> seen = CoverageCells(run.views, run.width, run.height);
   for (int j = 0; j < kRows; ++j)
     for (int i = 0; i < kCols; ++i) {
       const cv::Rect cell(i * w / kCols, j * h / kRows, w / kCols, h / kRows);
@@ -93,16 +87,44 @@ cv::Mat DrawCoverage(const CalibrationRun& run) {
     for (size_t k = 0; k < run.views[v].corners.size(); ++k) {
       const cv::Point p(int(run.views[v].corners[k].pixel.x() * s),
                         int(run.views[v].corners[k].pixel.y() * s));
-      if (fit.views[v].outlier[k])
+      if (fit && fit->views[v].outlier[k])
         cv::drawMarker(canvas, p, cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 8, 2);
       else
         cv::circle(canvas, p, 2, ViewColour(v), cv::FILLED, cv::LINE_AA);
     }
   cv::putText(canvas,
-              "coverage " + Text("%.0f %%", 100 * run.coverage_fraction) + " of 16x12 cells, " +
+              "coverage " + Text("%.0f %%", 100 * CoverageFraction(run.views, run.width, run.height)) + " of 16x12 cells, " +
                   std::to_string(run.views.size()) + " images; shaded: no corner",
               cv::Point(5, h + 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1,
               cv::LINE_AA);
+  return canvas;
+}
+
+cv::Mat DrawDetections(const cv::Mat& image, const std::vector<CornerObservation>& corners,
+                       const ViewFit* fit) {
+  cv::Mat canvas;
+  if (image.channels() == 1)
+    cv::cvtColor(image, canvas, cv::COLOR_GRAY2BGR);
+  else
+    canvas = image.clone();
+  const int r = std::max(3, canvas.cols / 160);
+  for (size_t k = 0; k + 1 < corners.size(); ++k)  // the detection order, as OpenCV draws it
+    cv::line(canvas, cv::Point(int(corners[k].pixel.x()), int(corners[k].pixel.y())),
+             cv::Point(int(corners[k + 1].pixel.x()), int(corners[k + 1].pixel.y())),
+             cv::Scalar(255, 160, 0), 1, cv::LINE_AA);
+  for (size_t k = 0; k < corners.size(); ++k) {
+    const cv::Point p(int(corners[k].pixel.x()), int(corners[k].pixel.y()));
+    if (fit && fit->outlier[k])
+      cv::drawMarker(canvas, p, cv::Scalar(0, 0, 255), cv::MARKER_CROSS, 3 * r, 2);
+    else
+      cv::circle(canvas, p, r, k == 0 ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 220, 0), 2, cv::LINE_AA);
+  }
+  const std::string label = std::to_string(corners.size()) + " corners" +
+                            (fit ? ", RMS " + Text("%.3f px", fit->rms_px) : std::string());
+  cv::putText(canvas, label, cv::Point(8, 24), cv::FONT_HERSHEY_SIMPLEX, 0.7, cv::Scalar(0, 0, 0), 3,
+              cv::LINE_AA);
+  cv::putText(canvas, label, cv::Point(8, 24), cv::FONT_HERSHEY_SIMPLEX, 0.7,
+              cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
   return canvas;
 }
 

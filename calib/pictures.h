@@ -12,6 +12,10 @@
 namespace fresco::calib {
 
 cv::Mat DrawResiduals(const CalibrationRun& run);
-cv::Mat DrawCoverage(const CalibrationRun& run);
+cv::Mat DrawCoverage(const CalibrationRun& run);  // before the solve too (no outliers then)
+// One image with its detected corners (first corner red, detection order joined; outliers
+// of `fit` as red crosses when given) and the corner count / RMS.
+cv::Mat DrawDetections(const cv::Mat& image, const std::vector<CornerObservation>& corners,
+                       const ViewFit* fit = nullptr);
 
 }  // namespace fresco::calib

@@ -5,7 +5,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calib/corners_vnl.h"
+#include "calib/pictures.h"
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_io.h"
 
 extern "C" {
 #include <mrcal/mrcal.h>
@@ -137,6 +140,23 @@ Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequ
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(cameramodel_path, text));
   return WriteFileAtomic(SiblingPath(cameramodel_path, ".report.json"),
                          ReportJson(request, run, pictures));
+}
+
+Status WriteCalibrationOutputs(const std::string& cameramodel_path, const CalibrateRequest& request,
+                               const CalibrationRun& run, const CalibrationOutputs& outputs) {
+  const std::filesystem::path parent = std::filesystem::path(cameramodel_path).parent_path();
+  if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
+  std::vector<std::string> pictures;
+  if (outputs.pictures) {
+    const std::string residuals = SiblingPath(cameramodel_path, ".residuals.png");
+    const std::string coverage = SiblingPath(cameramodel_path, ".coverage.png");
+    FRESCO_RETURN_IF_ERROR(WriteImageAtomic(residuals, DrawResiduals(run)));
+    FRESCO_RETURN_IF_ERROR(WriteImageAtomic(coverage, DrawCoverage(run)));
+    pictures = {residuals, coverage};
+  }
+  if (!outputs.corners_vnl.empty())
+    FRESCO_RETURN_IF_ERROR(WriteCornersVnl(outputs.corners_vnl, run.views, request.board));
+  return WriteCalibration(cameramodel_path, request, run, pictures);
 }
 
 }  // namespace fresco::calib

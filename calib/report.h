@@ -20,6 +20,16 @@ std::string SiblingPath(const std::string& cameramodel_path, const std::string& 
 Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequest& request,
                         const CalibrationRun& run, const std::vector<std::string>& pictures);
 
+// Everything `fresco calib solve --out` writes (the CLI and the app share it): the folder,
+// CAMERA.residuals.png and CAMERA.coverage.png (unless !pictures), the corners as mrcal's
+// corners.vnl when `corners_vnl` is set, then the .cameramodel and the report.
+struct CalibrationOutputs {
+  bool pictures = true;
+  std::string corners_vnl;  // "" = none
+};
+Status WriteCalibrationOutputs(const std::string& cameramodel_path, const CalibrateRequest& request,
+                               const CalibrationRun& run, const CalibrationOutputs& outputs);
+
 // The report as JSON text.
 std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& run,
                        const std::vector<std::string>& pictures);

@@ -11,9 +11,12 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "calib/report.h"
 #include "tests/test_support.h"
 #include "ui/core/app_frame.h"
+#include "ui/core/calibration_runner.h"
 #include "ui/core/panel.h"
+#include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
@@ -90,10 +93,12 @@ TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   runner.WaitIdle();
   NullTextures textures;
   NullViewport viewport;
-  UiContext ui{&state, &runner, &textures, &viewport, nullptr, false};
+  CalibrationRunner calibration;  // no folder: the Calibration panel shows its inputs
+  UiContext ui{&state, &runner, &calibration, &textures, &viewport, nullptr, false};
   ImGuiHeadless imgui;
   auto panels = MakePanels();
   ASSERT_GE(panels.size(), 11u);
+  for (auto& panel : panels) panel->open = true;
   for (int i = 0; i < 3; ++i) {
     ui.snapshot = runner.Snapshot();
     imgui.Frame(ui, panels);
@@ -252,6 +257,10 @@ TEST(UiScreenshot, XvfbScreenshotShowsEveryPanel) {
   ASSERT_GE(list["panels"].size(), 11u);
   for (const auto& panel : list["panels"]) {
     const std::string title = panel["title"];
+    if (title == kCalibrationPanelTitle) {  // closed without --calib-images
+      EXPECT_FALSE(panel["open"].get<bool>());
+      continue;
+    }
     ASSERT_TRUE(panel["open"].get<bool>()) << title;
     ASSERT_TRUE(panel.contains("width")) << title;
     EXPECT_FALSE(panel["collapsed"].get<bool>()) << title;
@@ -264,6 +273,104 @@ TEST(UiScreenshot, XvfbScreenshotShowsEveryPanel) {
     cv::meanStdDev(image(inside), mean, stddev);
     EXPECT_GT(stddev[0] + stddev[1] + stddev[2], 10.0) << title << ": an empty panel";
   }
+}
+
+// The left images of opencv-chessboard-stereo (the folder also holds the right ones).
+std::string ChessboardLeftImages() {
+  static const std::string dir = [] {
+    const std::string data = fresco::testing::SharedDataDir() + "/opencv-chessboard-stereo";
+    const std::string d = MakeTempDir("ui-calib") + "/left";
+    fs::create_directories(d);
+    for (const auto& e : fs::directory_iterator(data))
+      if (e.path().filename().string().rfind("left", 0) == 0 && e.path().extension() == ".jpg")
+        fs::copy(e.path(), d + "/" + e.path().filename().string());
+    return d;
+  }();
+  return dir;
+}
+
+// The calibration worker: detections arrive image by image, the light turns from red once
+// kMinViews boards are seen, the solve picks the requested model, Save writes what the CLI does.
+TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  calib::CalibrateRequest request;
+  request.images_dir = ChessboardLeftImages();
+  ASSERT_TRUE(calib::ParseBoardSpec("chessboard:9x6:0.025", "board", &request.board).ok());
+  request.model = "opencv4";
+  CalibrationRunner runner;
+  runner.Detect(request);
+  runner.WaitIdle();
+  auto snap = runner.Snapshot();
+  EXPECT_EQ(snap->images.size(), 13u);
+  EXPECT_EQ(snap->images_done, 13);
+  EXPECT_EQ(snap->run.views.size(), 13u);
+  EXPECT_FALSE(snap->solved);
+  EXPECT_NE(snap->readiness.level, calib::DataReadiness::Level::kRed);
+  EXPECT_GT(snap->readiness.max_tilt_deg, 0);  // seeded from the detections
+  EXPECT_FALSE(snap->coverage_picture.empty());
+  runner.Solve();
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  ASSERT_TRUE(snap->solved) << snap->status;
+  EXPECT_EQ(snap->run.Chosen().short_name, "opencv4");
+  EXPECT_LT(std::abs(snap->run.Chosen().fit.intrinsics[0] - 535.92) / 535.92, 0.005);
+  EXPECT_FALSE(snap->residuals_picture.empty());
+  const std::string out = MakeTempDir("ui-calib-save") + "/cam/left.cameramodel";
+  runner.Save(out);
+  runner.WaitIdle();
+  EXPECT_EQ(runner.Snapshot()->saved_path, out) << runner.Snapshot()->status;
+  EXPECT_TRUE(fs::exists(out));
+  EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".report.json")));
+  EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".coverage.png")));
+}
+
+TEST(CalibrationRunner, MissingFolderIsAnError) {
+  calib::CalibrateRequest request;
+  request.images_dir = "/no/such/folder";
+  ASSERT_TRUE(calib::ParseBoardSpec("chessboard:9x6:0.025", "board", &request.board).ok());
+  CalibrationRunner runner;
+  runner.Detect(request);
+  runner.WaitIdle();
+  EXPECT_EQ(runner.Snapshot()->status.rfind("error: /no/such/folder", 0), 0u)
+      << runner.Snapshot()->status;
+  EXPECT_EQ(runner.Snapshot()->readiness.level, calib::DataReadiness::Level::kRed);
+}
+
+// `fresco gui --calib-images DIR --board B --screenshot X.png` detects and solves before the
+// shot; X.png.json lists the Calibration panel, open, with the solved model.
+TEST(UiScreenshot, XvfbCalibrationPanelShowsTheSolvedModel) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (apt-get install xvfb xauth): skipped";
+  const std::string shot = MakeTempDir("ui-calib-shot") + "/calib.png";
+  const auto r = RunFresco({"--xvfb", "gui", "--calib-images", ChessboardLeftImages(), "--board",
+                            "chessboard:9x6:0.025", "--model", "opencv4", "--screenshot", shot});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(cv::imread(shot).empty());
+  const nlohmann::json list = nlohmann::json::parse(ReadText(shot + ".json"));
+  int found = 0;
+  for (const auto& panel : list["panels"]) {
+    if (panel["title"] != kCalibrationPanelTitle) continue;
+    ++found;
+    ASSERT_TRUE(panel["open"].get<bool>());
+    EXPECT_FALSE(panel["collapsed"].get<bool>());
+    const auto& state = panel["state"];
+    EXPECT_EQ(state["model"], "opencv4") << state.dump();
+    EXPECT_EQ(state["lensmodel"], "LENSMODEL_OPENCV4");
+    EXPECT_EQ(state["views"], "13");
+    EXPECT_EQ(state["rejected"], "0");
+    EXPECT_LT(std::stod(state["rms_px"].get<std::string>()), 0.39);
+    EXPECT_NEAR(std::stod(state["fx"].get<std::string>()), 535.92, 0.005 * 535.92);
+  }
+  EXPECT_EQ(found, 1);
+}
+
+TEST(UiCli, CalibImagesNeedsAValidBoard) {
+  auto r = RunFresco({"gui", "--calib-images", "/tmp", "--board", "chessboard:9x"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  r = RunFresco({"gui", "--calib-images", "/tmp"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("--board"), std::string::npos) << r.err;
 }
 
 }  // namespace

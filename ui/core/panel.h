@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "ui/core/app_state.h"
+#include "ui/core/calibration_runner.h"
 #include "ui/core/pipeline_runner.h"
 
 namespace fresco {
@@ -52,6 +53,7 @@ class ViewportRenderer {
 struct UiContext {
   AppState* state = nullptr;
   PipelineRunner* runner = nullptr;
+  CalibrationRunner* calibration = nullptr;
   ImageTextures* textures = nullptr;
   ViewportRenderer* viewport = nullptr;
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
@@ -63,6 +65,8 @@ class Panel {
   virtual ~Panel() = default;
   virtual const char* Title() const = 0;
   virtual void Draw(UiContext& ui) = 0;
+  // What the panel shows, for `fresco gui --screenshot`'s FILE.json (name -> value).
+  virtual std::map<std::string, std::string> Report() const { return {}; }
   bool open = true;
   // Where the panel starts, in a 1600 x 1000 window (scaled to the real size).
   ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);

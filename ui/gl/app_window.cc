@@ -17,6 +17,7 @@
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/image_io.h"
 #include "ui/core/app_frame.h"
+#include "ui/panels/panels.h"
 #include "ui/gl/gl.h"
 #include "ui/gl/gl_textures.h"
 #include "ui/gl/viewport_gl.h"
@@ -49,6 +50,7 @@ Status WritePanelList(const std::string& path, const std::vector<std::unique_ptr
   for (const auto& panel : panels) {
     ImGuiWindow* window = ImGui::FindWindowByName(panel->Title());
     nlohmann::json entry = {{"title", panel->Title()}, {"open", panel->open}};
+    if (const auto report = panel->Report(); !report.empty()) entry["state"] = report;
     if (window && panel->open) {
       entry["x"] = window->Pos.x;
       entry["y"] = window->Pos.y;
@@ -59,6 +61,25 @@ Status WritePanelList(const std::string& path, const std::vector<std::unique_ptr
     list.push_back(entry);
   }
   return WriteFileAtomic(path, nlohmann::json{{"panels", list}}.dump(2) + "\n");
+}
+
+// Opens the calibration panel on the folder; screenshots show the solved calibration.
+void StartCalibration(const GuiOptions& options, CalibrationRunner* calibration,
+                      std::vector<std::unique_ptr<Panel>>* panels) {
+  calib::CalibrateRequest request;
+  request.images_dir = options.calib_images;
+  request.model = options.calib_model;
+  if (Status s = calib::ParseBoardSpec(options.calib_board, "--board", &request.board); !s.ok()) {
+    std::fprintf(stderr, "error: %s\n", s.message().c_str());
+    return;
+  }
+  for (auto& panel : *panels)
+    if (std::string(panel->Title()) == kCalibrationPanelTitle) panel->open = true;
+  calibration->Detect(request);
+  if (options.screenshot.empty()) return;
+  calibration->WaitIdle();
+  calibration->Solve();
+  calibration->WaitIdle();
 }
 
 }  // namespace
@@ -113,12 +134,14 @@ int RunGuiApp(const GuiOptions& options) {
   int code = 0;
   {
     PipelineRunner runner;
+    CalibrationRunner calibration;
     GlTextures textures;
     GlViewport viewport;
     auto panels = MakePanels();
     UiContext ui;
     ui.state = &state;
     ui.runner = &runner;
+    ui.calibration = &calibration;
     ui.textures = &textures;
     ui.viewport = &viewport;
     if (state.has_project) runner.Restart(state.project);
@@ -126,6 +149,7 @@ int RunGuiApp(const GuiOptions& options) {
       runner.Seek(std::max(0, options.frames - 1));
       runner.WaitIdle();
     }
+    if (!options.calib_images.empty()) StartCalibration(options, &calibration, &panels);
     int frames_drawn = 0;
     while (true) {
       glfwPollEvents();

@@ -12,6 +12,8 @@ struct GuiOptions {
   std::string screenshot;  // "" = interactive
   int frames = 30;         // --screenshot: frames to paint first
   int width = 1600, height = 1000;
+  // Calibration panel: a folder to detect at start (--screenshot also solves before the shot).
+  std::string calib_images, calib_board, calib_model = "auto";
 };
 
 // Returns the process exit code (0 ok, 1 no display / GL failure, 2 bad project).

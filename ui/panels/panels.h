@@ -19,6 +19,10 @@ std::unique_ptr<Panel> MakeInputFramePanel();
 std::unique_ptr<Panel> MakePaintedBuffersPanel();
 std::unique_ptr<Panel> MakeTimingPanel();
 std::unique_ptr<Panel> MakeMisalignmentPanel();
+// Calibration (issue 8): a window over columns 2-5, closed until opened from the View menu
+// or by `fresco gui --calib-images`.
+std::unique_ptr<Panel> MakeCalibrationPanel();
+inline constexpr const char* kCalibrationPanelTitle = "Calibration";
 
 // Opens `path` (after the unsaved-changes prompt when the project has edits; the app frame
 // shows it) and restarts the pipeline on it.

@@ -1,0 +1,165 @@
+#include "ui/core/calibration_runner.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "calib/pictures.h"
+#include "calib/report.h"
+
+namespace fresco {
+
+CalibrationRunner::CalibrationRunner()
+    : snapshot_(std::make_shared<CalibrationSnapshot>()), thread_([this] { Loop(); }) {}
+
+CalibrationRunner::~CalibrationRunner() {
+  cancel_ = true;
+  Post(Command::kQuit);
+  thread_.join();
+}
+
+void CalibrationRunner::Detect(const calib::CalibrateRequest& request) {
+  cancel_ = true;  // the worker drops a detection under way
+  Post(Command::kDetect, request);
+}
+void CalibrationRunner::Solve() { Post(Command::kSolve); }
+void CalibrationRunner::Save(const std::string& path) { Post(Command::kSave, {}, path); }
+
+void CalibrationRunner::Post(Command::Kind kind, const calib::CalibrateRequest& request,
+                             const std::string& path) {
+  Command command;
+  command.kind = kind;
+  command.request = request;
+  command.path = path;
+  std::lock_guard<std::mutex> lock(mutex_);
+  queue_.push_back(std::move(command));
+  wake_.notify_one();
+}
+
+void CalibrationRunner::WaitIdle() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  idle_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+std::shared_ptr<const CalibrationSnapshot> CalibrationRunner::Snapshot() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return snapshot_;
+}
+
+void CalibrationRunner::Publish() {
+  ++working_.version;
+  auto copy = std::make_shared<const CalibrationSnapshot>(working_);
+  std::lock_guard<std::mutex> lock(mutex_);
+  snapshot_ = std::move(copy);
+}
+
+void CalibrationRunner::Loop() {
+  while (true) {
+    Command command;
+    bool superseded = false;  // only the newest detection matters
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      busy_ = false;
+      if (queue_.empty()) idle_.notify_all();
+      wake_.wait(lock, [this] { return !queue_.empty(); });
+      command = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+      for (const Command& later : queue_) superseded |= later.kind == Command::kDetect;
+      if (command.kind == Command::kDetect && !superseded) cancel_ = false;
+    }
+    if (command.kind == Command::kQuit) return;
+    if (command.kind == Command::kDetect && superseded) continue;
+    working_.busy = true;
+    if (command.kind == Command::kDetect) RunDetect(command.request);
+    if (command.kind == Command::kSolve) RunSolve();
+    if (command.kind == Command::kSave) RunSave(command.path);
+    working_.busy = false;
+    Publish();
+  }
+}
+
+void CalibrationRunner::UpdateReadiness() {
+  const calib::CalibrationRun& run = working_.run;
+  calib::CalibrationSeed seed;
+  const bool seeded =
+      working_.solved ||
+      (static_cast<int>(run.views.size()) >= calib::kMinViews &&
+       calib::SeedCalibration(run.views, working_.request.board, run.width, run.height, &seed).ok());
+  working_.readiness = calib::AssessReadiness(run.views, run.width, run.height,
+                                              working_.solved ? &run.seed : seeded ? &seed : nullptr);
+  if (!run.views.empty()) working_.coverage_picture = calib::DrawCoverage(run);
+}
+
+void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
+  const uint64_t version = working_.version;
+  working_ = CalibrationSnapshot();
+  working_.version = version;
+  working_.has_request = true;
+  working_.request = request;
+  working_.busy = true;
+  std::vector<std::string> paths;
+  if (Status s = calib::ListImages(request.images_dir, &paths); !s.ok()) {
+    working_.status = "error: " + s.message();
+    return;
+  }
+  for (const std::string& path : paths) {
+    CalibrationImage image;
+    image.path = path;
+    image.name = std::filesystem::path(path).filename().string();
+    working_.images.push_back(image);
+  }
+  UpdateReadiness();
+  for (CalibrationImage& image : working_.images) {
+    working_.status = "detecting " + std::to_string(working_.images_done + 1) + "/" +
+                      std::to_string(working_.images.size());
+    Publish();
+    if (cancel_) return;
+    image.used = calib::DetectImage(image.path, request, &working_.run);
+    image.done = true;
+    if (image.used)
+      image.view = static_cast<int>(working_.run.views.size()) - 1;
+    else
+      image.reason = working_.run.rejected.back().reason;
+    ++working_.images_done;
+    UpdateReadiness();
+  }
+  working_.status = "detected: board in " + std::to_string(working_.run.views.size()) + " of " +
+                    std::to_string(working_.images.size()) + " images";
+}
+
+void CalibrationRunner::RunSolve() {
+  if (!working_.has_request) return;
+  working_.status = "solving (" + working_.request.model + ")";
+  Publish();
+  calib::CalibrationRun run = working_.run;  // detections kept if the solve fails
+  run.choice = {};
+  run.warnings.clear();
+  if (Status s = calib::SolveViews(working_.request, &run); !s.ok()) {
+    working_.status = "error: " + s.message();
+    return;
+  }
+  working_.run = std::move(run);
+  working_.solved = true;
+  working_.residuals_picture = calib::DrawResiduals(working_.run);
+  UpdateReadiness();
+  const calib::ModelTrial& chosen = working_.run.Chosen();
+  char line[160];
+  std::snprintf(line, sizeof(line), "solved: %s, rms %.3f px", chosen.short_name.c_str(),
+                chosen.fit.rms_px);
+  working_.status = line;
+}
+
+void CalibrationRunner::RunSave(const std::string& path) {
+  if (!working_.solved) {
+    working_.status = "error: solve before saving";
+    return;
+  }
+  if (Status s = calib::WriteCalibrationOutputs(path, working_.request, working_.run, {}); !s.ok()) {
+    working_.status = "error: " + s.message();
+    return;
+  }
+  working_.saved_path = path;
+  working_.status = "saved " + path + " and " + calib::SiblingPath(path, ".report.json");
+}
+
+}  // namespace fresco

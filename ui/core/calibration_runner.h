@@ -1,0 +1,83 @@
+// The app's calibration worker: on its own thread, lists the images of a folder and detects
+// the board image by image (a snapshot after each, so the panel's "enough data yet?" light
+// follows the detections), solves on request (calib::SolveViews) and saves the .cameramodel,
+// report and pictures with the CLI's code (calib::WriteCalibrationOutputs). Headless.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "calib/calibrate.h"
+
+namespace fresco {
+
+struct CalibrationImage {
+  std::string path, name;
+  bool done = false;    // detection ran
+  bool used = false;    // the board was found: run.views[view]
+  int view = -1;
+  std::string reason;   // why rejected
+};
+
+struct CalibrationSnapshot {
+  uint64_t version = 0;   // increases with every publish
+  std::string status;     // "", "detecting 3/13", "detected", "solving", "solved", "error: ..."
+  bool busy = false;
+  bool has_request = false;
+  calib::CalibrateRequest request;
+  std::vector<CalibrationImage> images;  // by name, as listed
+  int images_done = 0;
+  calib::CalibrationRun run;             // views and rejected; after a solve, everything
+  bool solved = false;
+  calib::DataReadiness readiness;
+  cv::Mat coverage_picture;              // every detection so far
+  cv::Mat residuals_picture;             // after a solve
+  std::string saved_path;                // the last .cameramodel written
+};
+
+class CalibrationRunner {
+ public:
+  CalibrationRunner();
+  ~CalibrationRunner();
+
+  // Starts over on this folder and board (a detection under way stops after its image).
+  void Detect(const calib::CalibrateRequest& request);
+  void Solve();  // on the views detected so far, with the request's model
+  void Save(const std::string& cameramodel_path);
+  void WaitIdle();  // tests, --screenshot
+  std::shared_ptr<const CalibrationSnapshot> Snapshot() const;
+
+ private:
+  struct Command {
+    enum Kind { kDetect, kSolve, kSave, kQuit } kind = kQuit;
+    calib::CalibrateRequest request;
+    std::string path;
+  };
+  void Post(Command::Kind kind, const calib::CalibrateRequest& request = {},
+            const std::string& path = "");
+  void Loop();
+  void RunDetect(const calib::CalibrateRequest& request);
+  void RunSolve();
+  void RunSave(const std::string& path);
+  void UpdateReadiness();
+  void Publish();
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_, idle_;
+  std::deque<Command> queue_;
+  bool busy_ = false;
+  std::atomic<bool> cancel_{false};
+  std::shared_ptr<const CalibrationSnapshot> snapshot_;
+  CalibrationSnapshot working_;  // worker only
+  std::thread thread_;
+};
+
+}  // namespace fresco
