@@ -21,7 +21,6 @@ static int NotYet(const std::string& verb, const std::string& issue, const Comma
   return kExitFailure;
 }
 
-int RunVerbPoses(const CommandArgs& a) { return NotYet("poses", "issue 9", a); }
 int RunVerbBench(const CommandArgs& a) { return NotYet("bench", "issue 10", a); }
 
 }  // namespace fresco
