@@ -146,7 +146,9 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
   if (!IsUrlOrDevice(project.poses)) {  // live poses (tcp://) arrive while running
     FRESCO_RETURN_IF_ERROR(
         ReadPoses(project.Resolve(project.poses), &result.poses, &result.poses_are_tum));
-    if (result.poses.empty()) return Status::Error(project.poses + ": holds no poses");
+    if (result.poses.empty() && options.require_poses) {
+      return Status::Error(project.poses + ": holds no poses");
+    }
   } else {
     result.poses_are_tum = true;
   }

@@ -39,6 +39,9 @@ struct Capture {
 struct CaptureLoadOptions {
   bool load_scene = true;
   bool open_video = true;
+  // When false, a poses file that holds no poses is accepted (`fresco poses bootstrap` makes
+  // the poses for such a project).
+  bool require_poses = true;
 };
 
 Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture);

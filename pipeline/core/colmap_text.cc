@@ -265,6 +265,21 @@ Status ReadColmapModel(const std::string& folder, ColmapModel* model) {
   return Status::Ok();
 }
 
+Status ColmapCameraParams(const Camera& source, const std::string& what,
+                          std::string* model_name, std::vector<double>* params) {
+  Camera camera = source;
+  camera.model = ColmapEquivalent(source.model);
+  if (!IsColmapModel(camera.model)) {
+    return Status::Error(what + ": lens model " + LensModelName(source.model) +
+                         " has no COLMAP equivalent");
+  }
+  camera.cx += kColmapPixelShift;
+  camera.cy += kColmapPixelShift;
+  *model_name = LensModelName(camera.model);
+  *params = camera.Params();
+  return Status::Ok();
+}
+
 Status WriteColmapCameras(const std::string& path, const std::map<int, Camera>& cameras) {
   std::string out =
       "# Camera list with one line of data per camera:\n"
@@ -272,17 +287,13 @@ Status WriteColmapCameras(const std::string& path, const std::map<int, Camera>& 
       "# Number of cameras: " +
       std::to_string(cameras.size()) + "\n";
   for (const auto& [camera_id, source] : cameras) {
-    Camera camera = source;
-    camera.model = ColmapEquivalent(source.model);
-    if (!IsColmapModel(camera.model)) {
-      return Status::Error(path + ": camera " + std::to_string(camera_id) + ": lens model " +
-                           LensModelName(source.model) + " has no COLMAP equivalent");
-    }
-    camera.cx += kColmapPixelShift;
-    camera.cy += kColmapPixelShift;
-    out += std::to_string(camera_id) + " " + LensModelName(camera.model) + " " +
-           std::to_string(camera.width) + " " + std::to_string(camera.height);
-    for (double p : camera.Params()) text::AppendField(&out, FormatDouble(p));
+    std::string model_name;
+    std::vector<double> params;
+    FRESCO_RETURN_IF_ERROR(ColmapCameraParams(
+        source, path + ": camera " + std::to_string(camera_id), &model_name, &params));
+    out += std::to_string(camera_id) + " " + model_name + " " + std::to_string(source.width) +
+           " " + std::to_string(source.height);
+    for (double p : params) text::AppendField(&out, FormatDouble(p));
     out += "\n";
   }
   return WriteFileAtomic(path, out);

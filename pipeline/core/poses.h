@@ -46,6 +46,11 @@ Status ReadColmapImages(const std::string& path, std::vector<PosedImage>* images
 Status ReadColmapPoints(const std::string& path, std::vector<Point3D>* points);
 // `folder` holds cameras.txt, images.txt and (optionally) points3D.txt.
 Status ReadColmapModel(const std::string& folder, ColmapModel* model);
+// The COLMAP model name and parameters (COLMAP order and pixel convention, principal point
+// shifted by +0.5) for `camera`; mrcal models map to their COLMAP equivalent. `what` names
+// the camera in the error when there is none.
+Status ColmapCameraParams(const Camera& camera, const std::string& what,
+                          std::string* model_name, std::vector<double>* params);
 Status WriteColmapCameras(const std::string& path, const std::map<int, Camera>& cameras);
 Status WriteColmapImages(const std::string& path, const std::vector<PosedImage>& images);
 Status WriteColmapPoints(const std::string& path, const std::vector<Point3D>& points);

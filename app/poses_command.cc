@@ -1,0 +1,321 @@
+// `fresco poses verify|bootstrap`: runs COLMAP on a project's frames (its intrinsics held
+// fixed) and either judges the project's poses against it (verify.json, verify.png) or
+// writes poses from it, aligned to the scene, with a new project pointing at them.
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/progress.h"
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/poses.h"
+#include "pipeline/core/project.h"
+#include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/project_colmap.h"
+#include "pipeline/poses/verify.h"
+#include "pipeline/poses/verify_report.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* kVerb = "poses";
+
+const char* kColmapOptionsHelp =
+    "COLMAP options (both subcommands):\n"
+    "  --every N            use every Nth frame (default 1)\n"
+    "  --max-frames N       at most N frames (default: all)\n"
+    "  --max-image-size PX  downscale images to this longest side for SIFT (default: COLMAP's\n"
+    "                       3200); keypoints are scaled back, intrinsics stay the project's\n"
+    "  --matcher M          auto (default: exhaustive up to 60 images, else sequential),\n"
+    "                       exhaustive or sequential (loop detection off: no vocab tree)\n"
+    "  --scene-size-m M     scene size for the position threshold (default: the diagonal of\n"
+    "                       the scene's bounding box)\n"
+    "  --colmap PROGRAM     the colmap program (default: `colmap` on PATH)\n"
+    "  --threads N          threads for COLMAP (default: all cores)\n"
+    "  --quiet              no progress on stderr\n"
+    "The COLMAP workspace is DIR/colmap/: its exact commands in commands.txt, each step's\n"
+    "log in logs/, the reconstruction in sparse/ and sparse_txt/.";
+
+ArgSpec PosesArgSpec(const std::string& sub) {
+  ArgSpec spec;
+  spec.min_positional = 2;
+  spec.max_positional = 2;
+  spec.options = {"--out",        "--every",  "--max-frames", "--max-image-size", "--matcher",
+                  "--scene-size-m", "--colmap", "--threads"};
+  spec.switches = {"--quiet"};
+  spec.required = {"--out"};
+  if (sub == "verify") {
+    spec.usage = "fresco poses verify PROJECT.json --out DIR [OPTIONS...]";
+    spec.options.insert({"--rotation-threshold-deg", "--position-threshold", "--window"});
+    spec.help = std::string(
+                    "Runs COLMAP on the project's frames, aligns its reconstruction to the\n"
+                    "project's poses (robust similarity; locally over windows of neighbouring\n"
+                    "frames on long sequences) and writes DIR/verify.json (per frame:\n"
+                    "rotation_error_deg, position_error_m, flagged; registered; thresholds;\n"
+                    "alignment) and DIR/verify.png (both errors along the sequence).\n"
+                    "  --rotation-threshold-deg X  flag above X degrees (default 0.5)\n"
+                    "  --position-threshold F      flag above F x scene size (default 0.01)\n"
+                    "  --window N                  local alignment over N frames (default 40;\n"
+                    "                              0 = one global alignment)\n") +
+                kColmapOptionsHelp;
+  } else {
+    spec.usage =
+        "fresco poses bootstrap PROJECT.json --out DIR [--control-points FILE] [OPTIONS...]";
+    spec.options.insert({"--control-points", "--inlier-position", "--inlier-rotation-deg"});
+    spec.help = std::string(
+                    "Runs COLMAP on the project's frames and writes poses for every registered\n"
+                    "frame, aligned to the scene: DIR/sparse/{cameras,images,points3D}.txt and\n"
+                    "DIR/project.json (the input project pointing at them; the input is never\n"
+                    "overwritten), DIR/bootstrap.json (alignment, registered frames).\n"
+                    "  --control-points FILE     align with >= 3 known world points instead of\n"
+                    "                            the project's poses. One per line:\n"
+                    "                            NAME X Y Z IMAGE U V [IMAGE U V ...]\n"
+                    "                            (metres; pixels, (0,0) = centre of top-left)\n"
+                    "  --inlier-position F       given poses within F x scene size support the\n"
+                    "                            alignment (default 0.02)\n"
+                    "  --inlier-rotation-deg X   ...and within X degrees (default 2)\n") +
+                kColmapOptionsHelp;
+  }
+  return spec;
+}
+
+int PositiveDoubleOption(const Args& args, const ArgSpec& spec, const std::string& option,
+                         double* value) {
+  if (!args.Has(option)) return -1;
+  std::string error;
+  if (!ParseDouble(args.Get(option), option, value, &error)) {
+    return UsageError(kVerb, spec, error);
+  }
+  if (!(*value >= 0)) return UsageError(kVerb, spec, option + ": must be >= 0");
+  return -1;
+}
+
+int IntOption(const Args& args, const ArgSpec& spec, const std::string& option, int min,
+              int* value) {
+  if (!args.Has(option)) return -1;
+  std::string error;
+  if (!ParseInt(args.Get(option), option, value, &error)) return UsageError(kVerb, spec, error);
+  if (*value < min) {
+    return UsageError(kVerb, spec, option + ": must be >= " + std::to_string(min));
+  }
+  return -1;
+}
+
+// Parses the COLMAP options and runs COLMAP on the project. Returns -1 on success, else the
+// exit code (after printing the error).
+int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project,
+                   const std::string& out_dir, ProjectColmap* result) {
+  ProjectColmapOptions options;
+  options.out_dir = (fs::path(out_dir) / "colmap").string();
+  int code = -1;
+  if ((code = IntOption(args, spec, "--every", 1, &options.every_n_frames)) >= 0) return code;
+  if ((code = IntOption(args, spec, "--max-frames", 0, &options.max_frames)) >= 0) return code;
+  if ((code = IntOption(args, spec, "--max-image-size", 0, &options.colmap.max_image_size)) >= 0)
+    return code;
+  if ((code = IntOption(args, spec, "--threads", 0, &options.colmap.threads)) >= 0) return code;
+  if ((code = PositiveDoubleOption(args, spec, "--scene-size-m", &options.scene_size_m)) >= 0)
+    return code;
+  const std::string matcher = args.Get("--matcher", "auto");
+  if (matcher == "auto") {
+    options.colmap.matcher = ColmapMatcher::kAuto;
+  } else if (matcher == "exhaustive") {
+    options.colmap.matcher = ColmapMatcher::kExhaustive;
+  } else if (matcher == "sequential") {
+    options.colmap.matcher = ColmapMatcher::kSequential;
+  } else {
+    return UsageError(kVerb, spec, "--matcher: expected auto, exhaustive or sequential, got '" +
+                                       matcher + "'");
+  }
+  options.colmap.program = args.Get("--colmap");
+  if (FindColmap(options.colmap.program).empty()) {
+    std::cerr << "error: " << (options.colmap.program.empty() ? "colmap" : options.colmap.program)
+              << ": program not found on PATH (install Debian's `colmap` package, or pass "
+                 "--colmap PATH)\n";
+    return kExitFailure;
+  }
+  const bool quiet = args.Switch("--quiet");
+  Progress progress("colmap", 5, quiet);
+  options.colmap.progress = [&](const std::string& step, int index, int total) {
+    if (!quiet && index < total) progress.Update(index, step);
+  };
+  bool bad_input = false;
+  const Status status = RunColmapOnProject(project, options, result, &bad_input);
+  if (!status.ok()) {
+    if (bad_input) return InputError(status);
+    std::cerr << "error: " << status.message() << "\n";
+    return kExitFailure;
+  }
+  char detail[120];
+  std::snprintf(detail, sizeof(detail), "%d of %d frames registered, %.1f s",
+                result->run.registered, static_cast<int>(result->frames.size()),
+                result->run.seconds);
+  progress.Finish(detail);
+  return -1;
+}
+
+int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
+              const std::string& out_dir) {
+  VerifyOptions options;
+  int code = -1;
+  if ((code = PositiveDoubleOption(args, spec, "--rotation-threshold-deg",
+                                   &options.rotation_threshold_deg)) >= 0)
+    return code;
+  if ((code = PositiveDoubleOption(args, spec, "--position-threshold",
+                                   &options.position_threshold_rel)) >= 0)
+    return code;
+  if ((code = IntOption(args, spec, "--window", 0, &options.window_frames)) >= 0) return code;
+  if (Status s = options.Check(); !s.ok()) return UsageError(kVerb, spec, s.message());
+
+  ProjectColmap colmap;
+  if ((code = RunColmapStage(args, spec, project, out_dir, &colmap)) >= 0) return code;
+  std::vector<VerifyFrameInput> inputs;
+  for (const ProjectColmapFrame& f : colmap.frames) {
+    inputs.push_back({f.name, f.given ? &f.given->cam_from_world : nullptr,
+                      f.colmap ? &f.colmap->cam_from_world : nullptr});
+  }
+  VerifyResult result;
+  if (Status s = VerifyPoses(inputs, colmap.scene_size_m, options, &result); !s.ok()) {
+    std::cerr << "error: " << project.poses << ": " << s.message() << "\n";
+    return kExitFailure;
+  }
+  const Status written =
+      WriteVerifyReport(result, colmap.run, (fs::path(out_dir) / "verify.json").string(),
+                        (fs::path(out_dir) / "verify.png").string());
+  if (!written.ok()) {
+    std::cerr << "error: " << written.message() << "\n";
+    return kExitFailure;
+  }
+  std::cout << "verify: " << result.compared << " frames compared (" << result.registered
+            << " registered by COLMAP), " << result.flagged << " flagged; median error of the "
+            << "others " << result.median_rotation_error_deg << " deg, "
+            << result.median_position_error_m << " m\n"
+            << "wrote " << (fs::path(out_dir) / "verify.json").string() << "\n";
+  return kExitOk;
+}
+
+int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
+                 const std::string& out_dir) {
+  double inlier_position_rel = 0.02, inlier_rotation_deg = 2.0;
+  int code = -1;
+  if ((code = PositiveDoubleOption(args, spec, "--inlier-position", &inlier_position_rel)) >= 0)
+    return code;
+  if ((code = PositiveDoubleOption(args, spec, "--inlier-rotation-deg", &inlier_rotation_deg)) >=
+      0)
+    return code;
+  const fs::path new_project_path = fs::absolute(fs::path(out_dir) / "project.json");
+  if (fs::absolute(project.file_path).lexically_normal() == new_project_path.lexically_normal()) {
+    return UsageError(kVerb, spec, "--out: would overwrite the input project " + project.file_path);
+  }
+  std::vector<ControlPoint> control_points;
+  const std::string control_file = args.Get("--control-points");
+  if (!control_file.empty()) {
+    if (Status s = ReadControlPoints(control_file, &control_points); !s.ok()) {
+      return InputError(s);
+    }
+  }
+
+  ProjectColmap colmap;
+  if ((code = RunColmapStage(args, spec, project, out_dir, &colmap)) >= 0) return code;
+  nlohmann::json report;
+  Sim3d world_from_colmap;
+  if (!control_points.empty()) {
+    ControlPointFit fit;
+    if (Status s = AlignWithControlPoints(control_points, control_file, colmap.run.model,
+                                          colmap.camera, &fit);
+        !s.ok()) {
+      std::cerr << "error: " << s.message() << "\n";
+      return kExitFailure;
+    }
+    world_from_colmap = fit.world_from_colmap;
+    report["aligned_with"] = "control_points";
+    report["control_point_residual_m"] = fit.residual_m;
+  } else {
+    std::vector<PosePair> pairs;
+    for (const ProjectColmapFrame& f : colmap.frames) {
+      if (f.given && f.colmap) {
+        pairs.push_back({f.name, f.given->cam_from_world, f.colmap->cam_from_world});
+      }
+    }
+    PoseAlignmentOptions align;
+    align.inlier_position_m = inlier_position_rel * colmap.scene_size_m;
+    align.inlier_rotation_deg = inlier_rotation_deg;
+    PoseAlignment alignment;
+    if (pairs.size() < 3) {
+      std::cerr << "error: " << project.poses << ": only " << pairs.size()
+                << " registered frames have a given pose: give --control-points to place "
+                   "COLMAP's reconstruction in the scene\n";
+      return kExitFailure;
+    }
+    if (Status s = AlignColmapToPoses(pairs, align, &alignment); !s.ok()) {
+      std::cerr << "error: " << project.poses << ": " << s.message() << "\n";
+      return kExitFailure;
+    }
+    world_from_colmap = alignment.world_from_colmap;
+    report["aligned_with"] = "given_poses";
+    report["inliers"] = alignment.num_inliers;
+    report["compared"] = pairs.size();
+  }
+  ColmapModel model = TransformModel(colmap.run.model, world_from_colmap);
+  model.cameras = {{1, colmap.camera}};
+  for (PosedImage& image : model.images) image.camera_id = 1;
+  const fs::path sparse = fs::path(out_dir) / "sparse";
+  Project out = project;
+  out.poses = fs::absolute(sparse / "images.txt").string();
+  Status s = MakeDirectories(sparse.string());
+  if (s.ok()) s = WriteColmapModel(sparse.string(), model);
+  if (s.ok()) s = SaveProject(out, new_project_path.string());
+  std::vector<std::string> missing;
+  for (const ProjectColmapFrame& f : colmap.frames) {
+    if (!f.colmap) missing.push_back(f.name);
+  }
+  const Sim3d& w = world_from_colmap;
+  report["scale"] = w.scale;
+  report["world_from_colmap"] = {
+      {"scale", w.scale},
+      {"rotation_wxyz", {w.rotation.w(), w.rotation.x(), w.rotation.y(), w.rotation.z()}},
+      {"translation_m", {w.translation.x(), w.translation.y(), w.translation.z()}}};
+  report["frames"] = colmap.frames.size();
+  report["registered"] = colmap.run.registered;
+  report["not_registered"] = missing;
+  report["colmap_seconds"] = colmap.run.seconds;
+  report["project"] = new_project_path.string();
+  if (s.ok()) s = WriteFileAtomic((fs::path(out_dir) / "bootstrap.json").string(), report.dump(2));
+  if (!s.ok()) {
+    std::cerr << "error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  std::cout << "bootstrap: " << colmap.run.registered << " of " << colmap.frames.size()
+            << " frames posed (" << report["aligned_with"].get<std::string>() << ")\n"
+            << "wrote " << new_project_path.string() << "\n";
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunVerbPoses(const CommandArgs& argv) {
+  const std::string sub = argv.empty() ? "" : argv[0];
+  if (sub != "verify" && sub != "bootstrap") {
+    const bool help = sub == "--help" || sub == "-h";
+    (help ? std::cout : std::cerr)
+        << (help ? "" : "fresco poses: expected 'verify' or 'bootstrap'\n")
+        << "usage: fresco poses verify PROJECT.json --out DIR [OPTIONS...]\n"
+        << "       fresco poses bootstrap PROJECT.json --out DIR [--control-points FILE] "
+           "[OPTIONS...]\n"
+        << "(fresco poses verify --help, fresco poses bootstrap --help for the options)\n";
+    return help ? kExitOk : kExitBadInput;
+  }
+  const ArgSpec spec = PosesArgSpec(sub);
+  Args args;
+  if (int code = ParseVerbArgs(kVerb, argv, spec, &args); code >= 0) return code;
+  Project project;
+  if (Status s = LoadProject(args.positional[1], {}, &project); !s.ok()) return InputError(s);
+  const std::string out_dir = args.Get("--out");
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  return sub == "verify" ? RunVerify(args, spec, project, out_dir)
+                         : RunBootstrap(args, spec, project, out_dir);
+}
+
+}  // namespace fresco

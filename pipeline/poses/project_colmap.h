@@ -1,0 +1,46 @@
+// COLMAP on a project's frames: the frames as image files (a folder video is used in place;
+// a video file's frames are exported to OUT/images/), the project's single camera held
+// fixed, and each frame's given pose (if any) and COLMAP pose (if registered) side by side.
+// The first stage of both `fresco poses verify` and `fresco poses bootstrap`.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/core/project.h"
+#include "pipeline/poses/colmap_runner.h"
+
+namespace fresco {
+
+struct ProjectColmapOptions {
+  std::string out_dir;  // the COLMAP workspace: OUT/database.db, sparse/, logs/, ...
+  int every_n_frames = 1;  // use every Nth frame only
+  int max_frames = 0;      // 0 = all (after every_n_frames)
+  // Scene size (metres) used for thresholds; 0 = the diagonal of the scene's bounding box
+  // (the scene is then loaded).
+  double scene_size_m = 0.0;
+  ColmapRunOptions colmap;  // workspace, image_path, image_names, camera are filled in
+};
+
+struct ProjectColmapFrame {
+  std::string name;   // image file name, as COLMAP knows it
+  const PosedImage* given = nullptr;   // into ProjectColmap::capture.poses
+  const PosedImage* colmap = nullptr;  // into ProjectColmap::run.model.images
+};
+
+struct ProjectColmap {
+  Capture capture;
+  Camera camera;
+  double scene_size_m = 0.0;
+  std::vector<ProjectColmapFrame> frames;  // in sequence order
+  ColmapRunResult run;
+};
+
+// Loads the project's capture, writes the frames when needed and runs COLMAP. Input errors
+// (project, camera, video) come back as is; COLMAP errors are prefixed with "colmap".
+Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
+                          ProjectColmap* result, bool* bad_input);
+
+}  // namespace fresco

@@ -1,0 +1,22 @@
+// Runs an external program (no shell) with its stdout and stderr appended to a log file,
+// and finds programs on PATH. Used to drive the `colmap` command-line program.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+// Runs argv[0] (looked up on PATH when it holds no '/') with argv[1..]; waits for it.
+// `exit_code` gets its exit status (128 + signal when killed). Error only when it could not
+// be started at all (the message names the program and the log).
+Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path,
+                  int* exit_code);
+
+// The absolute path of `name` on PATH (or `name` itself when it holds a '/' and is
+// executable); "" when not found.
+std::string FindProgram(const std::string& name);
+
+}  // namespace fresco

@@ -1,0 +1,118 @@
+#include "pipeline/poses/verify.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace fresco {
+namespace {
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  return values[mid];
+}
+
+}  // namespace
+
+Status VerifyOptions::Check() const {
+  if (!(rotation_threshold_deg > 0)) return Status::Error("rotation_threshold_deg: must be > 0");
+  if (!(position_threshold_rel > 0)) return Status::Error("position_threshold_rel: must be > 0");
+  if (window_frames < 0) return Status::Error("window_frames: must be >= 0");
+  if (window_frames > 0 && window_frames < 5) {
+    return Status::Error("window_frames: must be 0 or >= 5");
+  }
+  if (!(inlier_fraction > 0 && inlier_fraction <= 1)) {
+    return Status::Error("inlier_fraction: must be in (0, 1]");
+  }
+  return Status::Ok();
+}
+
+Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
+                   const VerifyOptions& options, VerifyResult* result) {
+  FRESCO_RETURN_IF_ERROR(options.Check());
+  if (!(scene_size_m > 0)) return Status::Error("scene size: must be > 0");
+  VerifyResult out;
+  out.scene_size_m = scene_size_m;
+  out.rotation_threshold_deg = options.rotation_threshold_deg;
+  out.position_threshold_m = options.position_threshold_rel * scene_size_m;
+
+  std::vector<PosePair> pairs;
+  std::vector<int> frame_of_pair;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    FrameVerdict v;
+    v.name = frames[i].name;
+    v.has_given = frames[i].given_cam_from_world != nullptr;
+    v.registered = frames[i].colmap_cam_from_colmap != nullptr;
+    if (v.registered) ++out.registered;
+    if (v.has_given && v.registered) {
+      pairs.push_back({v.name, *frames[i].given_cam_from_world, *frames[i].colmap_cam_from_colmap});
+      frame_of_pair.push_back(static_cast<int>(i));
+    }
+    out.frames.push_back(v);
+  }
+  out.compared = static_cast<int>(pairs.size());
+
+  PoseAlignmentOptions align;
+  align.inlier_position_m = options.inlier_fraction * out.position_threshold_m;
+  align.inlier_rotation_deg = options.inlier_fraction * options.rotation_threshold_deg;
+  align.seed = options.seed;
+  PoseAlignment global;
+  FRESCO_RETURN_IF_ERROR(AlignColmapToPoses(pairs, align, &global));
+  out.world_from_colmap = global.world_from_colmap;
+  out.global_inliers = global.num_inliers;
+
+  const int n = static_cast<int>(pairs.size());
+  const bool local = options.window_frames > 0 && n > options.window_frames;
+  std::map<int, PoseAlignment> fits;  // by window start
+  for (int k = 0; k < n; ++k) {
+    int begin = 0, end = n;
+    if (local) {
+      begin = std::clamp(k - options.window_frames / 2, 0, n - options.window_frames);
+      end = begin + options.window_frames;
+    }
+    if (!fits.count(begin)) {
+      if (!local) {
+        fits[begin] = global;
+      } else {
+        const std::vector<PosePair> window(pairs.begin() + begin, pairs.begin() + end);
+        PoseAlignment fit;
+        // A window whose centres are degenerate (a camera standing still) uses the global fit.
+        if (!AlignColmapToPoses(window, align, &fit).ok()) {
+          fit = global;
+          fit.inliers.assign(global.inliers.begin() + begin, global.inliers.begin() + end);
+        }
+        fits[begin] = fit;
+      }
+    }
+    const PoseAlignment& fit = fits[begin];
+    const PoseError e = ComparePose(pairs[k], fit.world_from_colmap);
+    FrameVerdict& v = out.frames[frame_of_pair[k]];
+    v.rotation_error_deg = e.rotation_deg;
+    v.position_error_m = e.position_m;
+    v.inlier = fit.inliers[k - begin];
+    v.flagged = e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
+  }
+  out.windows = static_cast<int>(fits.size());
+  std::vector<double> rotations, positions;
+  for (const FrameVerdict& v : out.frames) {
+    if (!v.has_given || !v.registered) continue;
+    if (v.flagged) {
+      ++out.flagged;
+      continue;
+    }
+    rotations.push_back(v.rotation_error_deg);
+    positions.push_back(v.position_error_m);
+    out.max_unflagged_rotation_error_deg =
+        std::max(out.max_unflagged_rotation_error_deg, v.rotation_error_deg);
+    out.max_unflagged_position_error_m =
+        std::max(out.max_unflagged_position_error_m, v.position_error_m);
+  }
+  out.median_rotation_error_deg = Median(rotations);
+  out.median_position_error_m = Median(positions);
+  *result = std::move(out);
+  return Status::Ok();
+}
+
+}  // namespace fresco

@@ -1,0 +1,69 @@
+// Verification of given poses against an independent COLMAP reconstruction (CONTRACT.md,
+// `fresco poses verify`): COLMAP's poses are aligned to the given ones (pose_alignment.h),
+// globally, or locally (a window of neighbouring frames) on long sequences whose
+// reconstruction drifts in scale, and each frame's rotation and position disagreement is
+// compared with thresholds. Pure computation: no files (verify_report.h writes them).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/core/status.h"
+#include "pipeline/poses/pose_alignment.h"
+
+namespace fresco {
+
+struct VerifyOptions {
+  // A frame is flagged when its rotation disagrees by more than this...
+  double rotation_threshold_deg = 0.5;
+  // ...or its camera centre by more than this fraction of the scene size.
+  double position_threshold_rel = 0.01;
+  // Local alignment: each frame is judged by a similarity fitted to the `window_frames`
+  // registered frames around it (in sequence order); one global fit when the sequence has
+  // no more registered frames than that. 0 = always global.
+  int window_frames = 40;
+  // Frames within these fractions of the thresholds support the alignment fit.
+  double inlier_fraction = 0.5;
+  unsigned seed = 1;
+
+  Status Check() const;
+};
+
+struct FrameVerdict {
+  std::string name;
+  bool has_given = false;   // the project gives a pose for it
+  bool registered = false;  // COLMAP registered it
+  double rotation_error_deg = 0.0;  // when both
+  double position_error_m = 0.0;
+  bool flagged = false;
+  bool inlier = false;  // supported the (global or its local) alignment
+};
+
+struct VerifyResult {
+  std::vector<FrameVerdict> frames;  // in sequence order
+  int registered = 0;                // frames COLMAP registered
+  int compared = 0;                  // frames with both poses
+  int flagged = 0;
+  double scene_size_m = 0.0;
+  double rotation_threshold_deg = 0.0;
+  double position_threshold_m = 0.0;
+  // The global alignment (all compared frames) and its support.
+  Sim3d world_from_colmap;
+  int global_inliers = 0;
+  int windows = 1;  // distinct local fits (1 = global only)
+  // Statistics of the unflagged frames (how well COLMAP and the poses agree).
+  double median_rotation_error_deg = 0.0, max_unflagged_rotation_error_deg = 0.0;
+  double median_position_error_m = 0.0, max_unflagged_position_error_m = 0.0;
+};
+
+// One entry per frame of the sequence, in order.
+struct VerifyFrameInput {
+  std::string name;
+  const Rigid3d* given_cam_from_world = nullptr;   // nullptr: no given pose
+  const Rigid3d* colmap_cam_from_colmap = nullptr;  // nullptr: not registered
+};
+
+Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
+                   const VerifyOptions& options, VerifyResult* result);
+
+}  // namespace fresco

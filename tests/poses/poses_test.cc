@@ -1,0 +1,268 @@
+// Unit tests of pipeline/poses without COLMAP: similarity estimation (exact, robust against
+// outliers, degenerate input), the alignment of a reconstruction to given poses and the
+// verification flags (injected errors on chosen frames), control-point alignment, the
+// control-point file reader.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/pose_alignment.h"
+#include "pipeline/poses/similarity.h"
+#include "pipeline/poses/verify.h"
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+using testing::MakeTempDir;
+using testing::WriteText;
+
+Sim3d SomeSimilarity() {
+  Sim3d s;
+  s.scale = 3.7;
+  s.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(0.8, Eigen::Vector3d(1, 2, -0.5).normalized()));
+  s.translation = Eigen::Vector3d(10.0, -4.0, 2.5);
+  return s;
+}
+
+double RotationErrorDeg(const Sim3d& a, const Sim3d& b) {
+  return RotationDifferenceDeg(a.rotation, b.rotation);
+}
+
+std::vector<Eigen::Vector3d> RandomPoints(int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) points.emplace_back(u(rng), u(rng), u(rng));
+  return points;
+}
+
+TEST(Similarity, RecoversAKnownTransformExactly) {
+  const Sim3d truth = SomeSimilarity();
+  const auto src = RandomPoints(10, 1);
+  std::vector<Eigen::Vector3d> dst;
+  for (const auto& p : src) dst.push_back(truth * p);
+  Sim3d fit;
+  ASSERT_TRUE(EstimateSimilarity(src, dst, "test", &fit).ok());
+  EXPECT_NEAR(fit.scale, truth.scale, 1e-9);
+  EXPECT_LT(RotationErrorDeg(fit, truth), 1e-7);
+  EXPECT_LT((fit.translation - truth.translation).norm(), 1e-8);
+  // The inverse maps back.
+  EXPECT_LT((fit.Inverse() * dst[3] - src[3]).norm(), 1e-9);
+}
+
+TEST(Similarity, RobustFitIgnoresOutliersThatBendLeastSquares) {
+  const Sim3d truth = SomeSimilarity();
+  const auto src = RandomPoints(30, 2);
+  std::vector<Eigen::Vector3d> dst;
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  for (const auto& p : src) dst.push_back(truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  // 9 of 30 (30 %) are wrong by 1..3 m.
+  for (int i = 0; i < 30; i += 3) dst[i] += Eigen::Vector3d(1.0 + i * 0.07, -2.0, 0.5);
+  Sim3d plain;
+  ASSERT_TRUE(EstimateSimilarity(src, dst, "test", &plain).ok());
+  EXPECT_GT((plain.translation - truth.translation).norm(), 0.3);  // bent
+  RobustSimilarityOptions options;
+  options.inlier_threshold = 0.02;
+  RobustSimilarityResult robust;
+  ASSERT_TRUE(EstimateSimilarityRobust(src, dst, options, "test", &robust).ok());
+  EXPECT_EQ(robust.num_inliers, 20);
+  for (int i = 0; i < 30; ++i) EXPECT_EQ(robust.inliers[i], i % 3 != 0) << i;
+  EXPECT_NEAR(robust.dst_from_src.scale, truth.scale, 0.002);
+  EXPECT_LT(RotationErrorDeg(robust.dst_from_src, truth), 0.05);
+  EXPECT_LT((robust.dst_from_src.translation - truth.translation).norm(), 0.01);
+  EXPECT_LT(robust.rms_inlier_error, 0.005);
+}
+
+TEST(Similarity, CollinearAndTooFewPointsAreErrors) {
+  std::vector<Eigen::Vector3d> line = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}};
+  Sim3d fit;
+  const Status collinear = EstimateSimilarity(line, line, "centres", &fit);
+  EXPECT_FALSE(collinear.ok());
+  EXPECT_NE(collinear.message().find("collinear"), std::string::npos) << collinear.message();
+  const Status few = EstimateSimilarity({line[0], line[1]}, {line[0], line[1]}, "centres", &fit);
+  EXPECT_FALSE(few.ok());
+  EXPECT_NE(few.message().find("at least 3"), std::string::npos) << few.message();
+}
+
+// A camera sequence (cam_from_world) on a wobbly arc looking at the origin.
+std::vector<Rigid3d> ArcPoses(int n) {
+  std::vector<Rigid3d> poses;
+  for (int i = 0; i < n; ++i) {
+    const double a = 0.05 * i;
+    const Eigen::Vector3d centre(3.0 * std::cos(a), 0.3 * std::sin(3.0 * a), 3.0 * std::sin(a));
+    const Eigen::Vector3d z = (-centre).normalized();
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z).normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    Eigen::Matrix3d world_from_cam;
+    world_from_cam << x, y, z;
+    poses.push_back(Rigid3d::FromMatrix(world_from_cam, centre).Inverse());
+  }
+  return poses;
+}
+
+// COLMAP's view of `truth`: the same cameras in a frame `colmap_from_world` away.
+Rigid3d InColmapFrame(const Rigid3d& cam_from_world, const Sim3d& world_from_colmap) {
+  // cam_from_colmap = cam_from_world o world_from_colmap (with the scale on the centre).
+  const Eigen::Quaterniond rotation = cam_from_world.rotation * world_from_colmap.rotation;
+  const Eigen::Vector3d centre = world_from_colmap.Inverse() * cam_from_world.Centre();
+  return Rigid3d(rotation, -(rotation * centre));
+}
+
+Rigid3d Perturbed(const Rigid3d& cam_from_world, double rotation_deg, double position_m,
+                  const Eigen::Vector3d& axis) {
+  const Eigen::Quaterniond dq(Eigen::AngleAxisd(rotation_deg * M_PI / 180.0, axis.normalized()));
+  const Eigen::Quaterniond rotation = (dq * cam_from_world.rotation).normalized();
+  const Eigen::Vector3d centre = cam_from_world.Centre() + position_m * axis.normalized();
+  return Rigid3d(rotation, -(rotation * centre));
+}
+
+TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
+  const int n = 40;
+  const auto truth = ArcPoses(n);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  std::vector<Rigid3d> given = truth, colmap;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> small(0.0, 1.0);
+  for (int i = 0; i < n; ++i) {
+    // COLMAP's own error: ~0.03 deg, ~1 mm.
+    const Rigid3d noisy =
+        Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
+                  Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    colmap.push_back(InColmapFrame(noisy, world_from_colmap));
+  }
+  const double scene_size_m = 6.0;  // position threshold 6 cm at 1 %
+  // Errors: 1 deg (5), 2 % of the scene (12), both (20), a 1.2 deg roll about the view (31).
+  given[5] = Perturbed(truth[5], 1.0, 0.0, Eigen::Vector3d(0, 1, 0));
+  given[12] = Perturbed(truth[12], 0.0, 0.02 * scene_size_m, Eigen::Vector3d(1, 1, 0));
+  given[20] = Perturbed(truth[20], 1.0, 0.02 * scene_size_m, Eigen::Vector3d(0, 0, 1));
+  given[31] = Perturbed(truth[31], 1.2, 0.0, truth[31].rotation.conjugate() * Eigen::Vector3d::UnitZ());
+  std::vector<VerifyFrameInput> inputs;
+  for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &given[i], &colmap[i]});
+  inputs[37].colmap_cam_from_colmap = nullptr;  // not registered
+  for (int window : {0, 16}) {
+    VerifyOptions options;
+    options.window_frames = window;
+    VerifyResult result;
+    ASSERT_TRUE(VerifyPoses(inputs, scene_size_m, options, &result).ok());
+    EXPECT_EQ(result.registered, n - 1);
+    EXPECT_EQ(result.compared, n - 1);
+    EXPECT_EQ(result.windows, window == 0 ? 1 : n - 1 - 16 + 1);
+    for (int i = 0; i < n; ++i) {
+      const bool injected = i == 5 || i == 12 || i == 20 || i == 31;
+      EXPECT_EQ(result.frames[i].flagged, injected) << "frame " << i << " window " << window;
+    }
+    EXPECT_EQ(result.flagged, 4);
+    EXPECT_NEAR(result.frames[5].rotation_error_deg, 1.0, 0.15);
+    EXPECT_NEAR(result.frames[12].position_error_m, 0.12, 0.01);
+    EXPECT_NEAR(result.world_from_colmap.scale, world_from_colmap.scale, 0.01);
+    EXPECT_LT(result.max_unflagged_rotation_error_deg, 0.2);
+    EXPECT_LT(result.max_unflagged_position_error_m, 0.01);
+  }
+}
+
+TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
+  // The reconstruction's scale drifts from 1 to 1.6 along the sequence (as on long walks):
+  // each step between cameras is reconstructed with the scale of its time.
+  const int n = 60;
+  const auto truth = ArcPoses(n);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  std::vector<Rigid3d> colmap;
+  Eigen::Vector3d centre_in_colmap = world_from_colmap.Inverse() * truth[0].Centre();
+  for (int i = 0; i < n; ++i) {
+    if (i > 0) {
+      const double drift = 1.0 + 0.6 * i / (n - 1);
+      centre_in_colmap += drift * (world_from_colmap.rotation.conjugate() *
+                                   (truth[i].Centre() - truth[i - 1].Centre())) /
+                          world_from_colmap.scale;
+    }
+    const Eigen::Quaterniond rotation = truth[i].rotation * world_from_colmap.rotation;
+    colmap.push_back(Rigid3d(rotation, -(rotation * centre_in_colmap)));
+  }
+  std::vector<VerifyFrameInput> inputs;
+  for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &truth[i], &colmap[i]});
+  VerifyOptions options;
+  options.window_frames = 0;
+  VerifyResult global, local;
+  ASSERT_TRUE(VerifyPoses(inputs, 6.0, options, &global).ok());
+  EXPECT_GT(global.flagged, 10);
+  options.window_frames = 10;
+  ASSERT_TRUE(VerifyPoses(inputs, 6.0, options, &local).ok());
+  EXPECT_EQ(local.flagged, 0);
+}
+
+TEST(ControlPoints, TriangulatedPointsAlignTheReconstruction) {
+  const auto truth = ArcPoses(20);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  Camera camera = Camera::FromParams(LensModel::kOpenCV4, 640, 480,
+                                     {500, 500, 319.5, 239.5, -0.1, 0.02, 0.001, -0.001});
+  ColmapModel model;
+  for (int i = 0; i < 20; ++i) {
+    PosedImage image;
+    image.image_id = i + 1;
+    image.camera_id = 1;
+    image.name = "f" + std::to_string(i) + ".png";
+    image.cam_from_world = InColmapFrame(truth[i], world_from_colmap);
+    model.images.push_back(image);
+  }
+  std::vector<ControlPoint> points;
+  const std::vector<Eigen::Vector3d> world = {{0.3, 0.2, -0.1}, {-0.4, -0.2, 0.3}, {0.1, 0.5, 0.4},
+                                              {-0.2, 0.1, -0.5}};
+  for (size_t k = 0; k < world.size(); ++k) {
+    ControlPoint p;
+    p.name = "p" + std::to_string(k);
+    p.point_in_world = world[k];
+    for (int i : {2, 9, 17}) {
+      Eigen::Vector2d pixel;
+      ASSERT_TRUE(camera.Project(truth[i] * world[k], &pixel));
+      p.observations.push_back({model.images[i].name, pixel});
+    }
+    points.push_back(p);
+  }
+  ControlPointFit fit;
+  ASSERT_TRUE(AlignWithControlPoints(points, "cp.txt", model, camera, &fit).ok());
+  EXPECT_NEAR(fit.world_from_colmap.scale, world_from_colmap.scale, 1e-6);
+  EXPECT_LT(RotationErrorDeg(fit.world_from_colmap, world_from_colmap), 1e-5);
+  for (double r : fit.residual_m) EXPECT_LT(r, 1e-6);
+  // The model moved into the world gives back the true poses.
+  const ColmapModel moved = TransformModel(model, fit.world_from_colmap);
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_LT(RotationDifferenceDeg(moved.images[i].cam_from_world.rotation, truth[i].rotation),
+              1e-5);
+    EXPECT_LT((moved.images[i].cam_from_world.Centre() - truth[i].Centre()).norm(), 1e-6);
+  }
+  // A point seen in one registered image only cannot be triangulated.
+  points[1].observations.resize(1);
+  const Status one = AlignWithControlPoints(points, "cp.txt", model, camera, &fit);
+  EXPECT_FALSE(one.ok());
+  EXPECT_NE(one.message().find("p1"), std::string::npos) << one.message();
+}
+
+TEST(ControlPoints, FileIsReadAndBadLinesAreNamed) {
+  const std::string dir = MakeTempDir("control-points");
+  WriteText(dir + "/ok.txt",
+            "# name X Y Z image u v ...\n"
+            "a 1 2 3 f0.png 10 20 f1.png 11.5 21\n"
+            "b 0 0 1 f0.png 30 40 f2.png 31 41 f3.png 32 42  # comment\n"
+            "\n"
+            "c -1 0.5 2 f1.png 1 2 f2.png 3 4\n");
+  std::vector<ControlPoint> points;
+  ASSERT_TRUE(ReadControlPoints(dir + "/ok.txt", &points).ok());
+  ASSERT_EQ(points.size(), 3u);
+  EXPECT_EQ(points[1].observations.size(), 3u);
+  EXPECT_EQ(points[0].observations[1].image, "f1.png");
+  EXPECT_DOUBLE_EQ(points[0].observations[1].pixel.x(), 11.5);
+  EXPECT_DOUBLE_EQ(points[2].point_in_world.x(), -1.0);
+  WriteText(dir + "/bad.txt", "a 1 2 3 f0.png 10 20\nb 1 x 3 f0.png 10 20\nc 1 2 3 f 1 2\n");
+  const Status bad = ReadControlPoints(dir + "/bad.txt", &points);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("bad.txt:2: Y"), std::string::npos) << bad.message();
+  WriteText(dir + "/few.txt", "a 1 2 3 f0.png 10 20\n");
+  EXPECT_FALSE(ReadControlPoints(dir + "/few.txt", &points).ok());
+}
+
+}  // namespace
+}  // namespace fresco
