@@ -163,14 +163,16 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   double psnr = 0, ncc = 0, completeness = 0, truth_psnr = 0, truth_ncc = 0;
   int scored = 0, truth_scored = 0;
   for (const HeldOut& h : held_out) {
-    RenderOptions options;
-    options.raster.supersample = 2;
-    const Renderer renderer(*capture.CameraFor(*h.pose), options);
+    const Renderer renderer(*capture.CameraFor(*h.pose), RenderOptions());
     const RephotoScore s = ScoreRephoto(renderer, scene, h.pose->cam_from_world, h.frame.bgr);
     if (s.pixels > 0) psnr += s.psnr_db, ncc += s.one_minus_ncc, ++scored;
     completeness += s.completeness;
     if (h.truth) {
-      const RephotoScore t = ScoreRephoto(renderer, scene, h.truth->cam_from_world, h.frame.bgr);
+      const bool same =
+          h.truth->cam_from_world.rotation.coeffs() == h.pose->cam_from_world.rotation.coeffs() &&
+          h.truth->cam_from_world.translation == h.pose->cam_from_world.translation;
+      const RephotoScore t =
+          same ? s : ScoreRephoto(renderer, scene, h.truth->cam_from_world, h.frame.bgr);
       if (t.pixels > 0) truth_psnr += t.psnr_db, truth_ncc += t.one_minus_ncc, ++truth_scored;
     }
   }

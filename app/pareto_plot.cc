@@ -65,17 +65,43 @@ cv::Mat DrawPareto(const std::vector<ParetoPoint>& points, const std::string& ti
     cv::line(image, to_pixel(points[front[k - 1]].fps, points[front[k - 1]].psnr_db),
              to_pixel(points[front[k]].fps, points[front[k]].psnr_db), cv::Scalar(0, 0, 220), 2,
              cv::LINE_AA);
-  for (size_t i = 0; i < points.size(); ++i) {
+  // Labels: the front's first, then the others; a label that would overlap one already
+  // drawn becomes the point's row number in bench.json ("#3").
+  std::vector<size_t> order = front;
+  for (size_t i = 0; i < points.size(); ++i)
+    if (std::find(front.begin(), front.end(), i) == front.end()) order.push_back(i);
+  std::vector<cv::Rect> placed;
+  for (size_t i : order) {
     const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
     const cv::Point at = to_pixel(points[i].fps, points[i].psnr_db);
-    cv::circle(image, at, 5, on_front ? cv::Scalar(0, 0, 220) : cv::Scalar(120, 120, 120),
-               cv::FILLED, cv::LINE_AA);
-    int baseline = 0;
-    const cv::Size size =
-        cv::getTextSize(points[i].label, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
-    const bool fits_right = at.x + 8 + size.width < width - 4;
-    text(points[i].label, at + cv::Point(fits_right ? 8 : -8 - size.width, -6), 0.4,
-         on_front ? cv::Scalar(0, 0, 160) : cv::Scalar(90, 90, 90));
+    const cv::Scalar colour = on_front ? cv::Scalar(0, 0, 220) : cv::Scalar(120, 120, 120);
+    cv::circle(image, at, 5, colour, cv::FILLED, cv::LINE_AA);
+    // The full label to the right (or left) of the point; if that overlaps a label already
+    // drawn, the row number at the first free place around the point.
+    char number[24];
+    std::snprintf(number, sizeof number, "#%zu", i);
+    const std::string candidates[2] = {points[i].label, number};
+    bool drawn = false;
+    for (const std::string& label : candidates) {
+      int baseline = 0;
+      const cv::Size size = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
+      const bool fits_right = at.x + 8 + size.width < width - 4;
+      const cv::Point offsets[4] = {{fits_right ? 8 : -8 - size.width, -6},
+                                    {fits_right ? 8 : -8 - size.width, 16},
+                                    {-8 - size.width, -6},
+                                    {-8 - size.width, 16}};
+      for (int k = 0; k < (label == number ? 4 : 1) && !drawn; ++k) {
+        const cv::Point origin = at + offsets[k];
+        const cv::Rect box(origin.x, origin.y - size.height, size.width, size.height + baseline);
+        if (std::any_of(placed.begin(), placed.end(),
+                        [&](const cv::Rect& r) { return (r & box).area() > 0; }))
+          continue;
+        placed.push_back(box);
+        text(label, origin, 0.4, on_front ? cv::Scalar(0, 0, 160) : cv::Scalar(90, 90, 90));
+        drawn = true;
+      }
+      if (drawn) break;
+    }
   }
   return image;
 }
