@@ -14,6 +14,7 @@
 #include "pipeline/poses/bootstrap.h"
 #include "pipeline/poses/run_process.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 
 namespace fresco {
@@ -21,6 +22,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::MakeTempDir;
+using testing::Perturbed;
 using testing::ReadText;
 using testing::RunFresco;
 using testing::WriteText;
@@ -36,14 +38,6 @@ constexpr double kRoomDiagonalM = 6.4031;  // the 4 x 3 x 4 m room's bounding-bo
 // Frames with injected errors: 1 deg, 2 % of the scene size, and both.
 const std::set<int> kRotated = {6, 21};
 const std::set<int> kMoved = {13, 21};
-
-Rigid3d Perturbed(const Rigid3d& cam_from_world, double rotation_deg, double position_m,
-                  const Eigen::Vector3d& axis) {
-  const Eigen::Quaterniond dq(Eigen::AngleAxisd(rotation_deg * M_PI / 180.0, axis.normalized()));
-  const Eigen::Quaterniond rotation = (dq * cam_from_world.rotation).normalized();
-  const Eigen::Vector3d centre = cam_from_world.Centre() + position_m * axis.normalized();
-  return Rigid3d(rotation, -(rotation * centre));
-}
 
 class PosesColmapTest : public ::testing::Test {
  protected:

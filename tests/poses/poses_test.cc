@@ -11,12 +11,14 @@
 #include "pipeline/poses/pose_alignment.h"
 #include "pipeline/poses/similarity.h"
 #include "pipeline/poses/verify.h"
+#include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 
 namespace fresco {
 namespace {
 
 using testing::MakeTempDir;
+using testing::Perturbed;
 using testing::WriteText;
 
 Sim3d SomeSimilarity() {
@@ -109,14 +111,6 @@ Rigid3d InColmapFrame(const Rigid3d& cam_from_world, const Sim3d& world_from_col
   // cam_from_colmap = cam_from_world o world_from_colmap (with the scale on the centre).
   const Eigen::Quaterniond rotation = cam_from_world.rotation * world_from_colmap.rotation;
   const Eigen::Vector3d centre = world_from_colmap.Inverse() * cam_from_world.Centre();
-  return Rigid3d(rotation, -(rotation * centre));
-}
-
-Rigid3d Perturbed(const Rigid3d& cam_from_world, double rotation_deg, double position_m,
-                  const Eigen::Vector3d& axis) {
-  const Eigen::Quaterniond dq(Eigen::AngleAxisd(rotation_deg * M_PI / 180.0, axis.normalized()));
-  const Eigen::Quaterniond rotation = (dq * cam_from_world.rotation).normalized();
-  const Eigen::Vector3d centre = cam_from_world.Centre() + position_m * axis.normalized();
   return Rigid3d(rotation, -(rotation * centre));
 }
 
