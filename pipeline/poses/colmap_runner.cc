@@ -131,7 +131,10 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
     std::vector<std::string> argv = {program};
     argv.insert(argv.end(), step.args.begin(), step.args.end());
     std::string line;
-    for (const std::string& a : argv) line += (line.empty() ? "" : " ") + Quote(a);
+    for (const std::string& a : argv) {
+      if (!line.empty()) line += ' ';
+      line += Quote(a);
+    }
     std::string commands;
     ReadFileToString((ws / "commands.txt").string(), &commands);  // absent the first time
     FRESCO_RETURN_IF_ERROR(WriteFileAtomic((ws / "commands.txt").string(), commands + line + "\n"));

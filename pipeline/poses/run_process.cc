@@ -20,8 +20,10 @@ std::string FindProgram(const std::string& name) {
   std::stringstream path(path_env ? path_env : "/usr/local/bin:/usr/bin:/bin");
   std::string folder;
   while (std::getline(path, folder, ':')) {
-    if (folder.empty()) folder = ".";
-    const std::string candidate = folder + "/" + name;
+    if (folder.empty()) folder.assign(1, '.');  // (not = ".": GCC 12 -Wrestrict noise)
+    std::string candidate = folder;
+    candidate += '/';
+    candidate += name;
     if (access(candidate.c_str(), X_OK) == 0) return candidate;
   }
   return "";
