@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -162,8 +163,12 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   const Scene scene = session->PaintedScene();
   double psnr = 0, ncc = 0, completeness = 0, truth_psnr = 0, truth_ncc = 0;
   int scored = 0, truth_scored = 0;
+  std::map<const Camera*, std::unique_ptr<Renderer>> renderers;  // ray tables built once
   for (const HeldOut& h : held_out) {
-    const Renderer renderer(*capture.CameraFor(*h.pose), RenderOptions());
+    const Camera* camera = capture.CameraFor(*h.pose);
+    std::unique_ptr<Renderer>& cached = renderers[camera];
+    if (!cached) cached = std::make_unique<Renderer>(*camera, RenderOptions());
+    const Renderer& renderer = *cached;
     const RephotoScore s = ScoreRephoto(renderer, scene, h.pose->cam_from_world, h.frame.bgr);
     if (s.pixels > 0) psnr += s.psnr_db, ncc += s.one_minus_ncc, ++scored;
     completeness += s.completeness;

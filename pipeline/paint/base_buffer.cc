@@ -180,6 +180,8 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     for (int ti = 0; ti < w; ti += tile) {
       BaseBuffer::Chunk chunk;
       chunk.begin = buffer.NumTexels();
+      chunk.x0 = ti, chunk.y0 = tj, chunk.x1 = std::min(ti + tile, w),
+      chunk.y1 = std::min(tj + tile, h);
       chunk.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
       chunk.bounds_max = -chunk.bounds_min;
       for (int j = tj; j < std::min(tj + tile, h); ++j) {

@@ -44,6 +44,7 @@ struct BaseBuffer {
   // (local coordinates): a frame culls a whole chunk that lies outside its view.
   struct Chunk {
     int begin = 0, end = 0;  // [begin, end) into the texel arrays
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the tile's texels: columns [x0, x1), rows [y0, y1)
     Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();
   };
   std::vector<Chunk> chunks;

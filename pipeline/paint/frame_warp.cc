@@ -401,7 +401,7 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
       cv::Range(0, num_chunks),
       [&](const cv::Range& range) {
         Counts n;
-        int x0 = w, y0 = h, x1 = -1, y1 = -1;  // inclusive bounds of chunks with visible texels
+        cv::Rect range_box;  // the tiles of the chunks with visible texels
         for (int c = range.start; c < range.end; ++c) {
           const BaseBuffer::Chunk& chunk = buffer.chunks[c];
           if (ChunkCulled(k, chunk)) {
@@ -411,15 +411,12 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
           n.tested += chunk.end - chunk.begin;
           const int visible_before = n.visible;
           kernel(k, chunk, &n);
-          if (n.visible == visible_before) continue;
-          for (int t = chunk.begin; t < chunk.end; ++t) {
-            const int x = buffer.texel_index[t] % w, y = buffer.texel_index[t] / w;
-            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-          }
+          if (n.visible > visible_before)
+            range_box |= cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0, chunk.y1 - chunk.y0);
         }
-        if (x1 >= 0) {
+        if (!range_box.empty()) {
           const std::lock_guard<std::mutex> lock(box_mutex);
-          box |= cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1);
+          box |= range_box;
         }
         in_view += n.in_view, visible += n.visible, occluded += n.occluded;
         grazing += n.grazing, culled += n.culled, tested += n.tested;

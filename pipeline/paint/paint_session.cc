@@ -493,10 +493,6 @@ Scene PaintSession::PaintedScene() const {
   return out;
 }
 
-}  // namespace fresco
-
-namespace fresco {
-
 // The obvious implementation, for `fresco bench` to compare against: per frame a full
 // depth render, then per buffer every texel projected one by one through the camera
 // (Camera::Project), the depth compared, and the frame resampled with cv::remap.
