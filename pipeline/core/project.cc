@@ -106,6 +106,7 @@ void Fields(RefineOptions& o, V& v) {
   v.Field("min_correction_px", o.min_correction_px, {.min = 0});
   v.Field("every_n_frames", o.every_n_frames, {.min = 1});
   v.Field("anchor", o.anchor);
+  v.Field("pose", o.pose);
   v.Field("anchor_min_frames", o.anchor_min_frames, {.min = 2});
   v.Field("anchor_window_frames", o.anchor_window_frames, {.min = 0});
   v.Field("anchor_step_px", o.anchor_step_px, {.min = 0});
@@ -133,6 +134,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Field("update_every", o.update_every, {.min = 1});
   v.Enum("update", o.update, UpdatePolicyNames());
   v.Field("quality_slack", o.quality_slack, {.min = 0, .max = 1});
+  v.Field("update_weight", o.update_weight, {.min = 0.01, .max = 1});
   v.Field("max_frames", o.max_frames, {.min = 0});
   v.Field("threads", o.threads, {.min = 0});
   v.Field("debug_images", o.debug_images);
@@ -186,12 +188,12 @@ void Fields(Project& p, V& v) {
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 224, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 232, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 488, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 496, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

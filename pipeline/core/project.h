@@ -54,6 +54,9 @@ struct RefineOptions {
   // Consensus anchoring (refine_anchor.h): move a buffer back by the mean of the corrections
   // it asked for, once anchor_min_frames agree on a move larger than anchor_step_px texels.
   bool anchor = true;
+  // Correct the frame's pose from the matches of every buffer together, and derive each
+  // buffer's correction from it (refine_pose.h), instead of one homography per buffer.
+  bool pose = false;
   int anchor_min_frames = 3;
   int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
   double anchor_step_px = 0.1;
@@ -105,6 +108,9 @@ struct PipelineOptions {
   int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
   UpdatePolicy update = UpdatePolicy::kQuality;
   double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
+  // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
+  // below 1 = running average, which averages out the frames' residual misalignment).
+  double update_weight = 1.0;
   int max_frames = 0;          // 0 = all frames
   int threads = 0;             // 0 = all cores
   bool debug_images = false;   // write per-stage debug images (costs time)

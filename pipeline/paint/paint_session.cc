@@ -219,6 +219,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->stages.push_back(std::move(warp_report));
 
   // 3. refine
+  frame_camera_ = &camera;
+  frame_cam_from_local_ = cam_from_local;
   if (options_.refine.mode != RefineMode::kOff) {
     if (frame_number % options_.refine.every_n_frames == 0) {
       report->stages.push_back(RefineAlignment(seen, debug));
@@ -242,8 +244,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
                              ? cv::Mat()
                              : background_frame_[b].foreground;
-    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_.update,
-                                               options_.quality_slack, &painted_[b]);
+    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
     if (!background_.empty()) MarkProvisional(background_frame_[b], &painted_[b]);
     written += stats.written;
     rejected += stats.rejected;
@@ -279,17 +280,24 @@ struct PaintSession::BufferRefinement {
   std::map<std::string, cv::Mat> images;
 };
 
-void PaintSession::RefineBuffer(size_t b, bool debug, BufferRefinement* r) {
+void PaintSession::EstimateBuffer(size_t b, bool debug, BufferRefinement* r) {
+  const WarpedBuffer& w = warped_[b];
+  const PaintedBuffer& painted = painted_[b];
+  RefineEstimate& e = r->estimate;
+  const auto t0 = std::chrono::steady_clock::now();
+  e = EstimateRefinement(w.bgr, w.valid, painted.bgra, options_.refine, w.valid_box);
+  r->estimate_ms = MsSince(t0);
+  if (debug && e.inliers > 0)
+    r->images["residual_before_b" + std::to_string(b)] =
+        ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
+}
+
+void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   WarpedBuffer& w = warped_[b];
   PaintedBuffer& painted = painted_[b];
   RefineEstimate& e = r->estimate;
-  auto t0 = std::chrono::steady_clock::now();
-  e = EstimateRefinement(w.bgr, w.valid, painted.bgra, options_.refine, w.valid_box);
-  r->estimate_ms = MsSince(t0);
   const std::string suffix = "_b" + std::to_string(b);
-  if (debug && e.inliers > 0)
-    r->images["residual_before" + suffix] = ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
-  t0 = std::chrono::steady_clock::now();
+  auto t0 = std::chrono::steady_clock::now();
   ApplyRefinement(e, w.valid_box, &w.bgr, &w.valid, &w.quality);
   r->rewarp_ms = MsSince(t0);
   t0 = std::chrono::steady_clock::now();
@@ -326,17 +334,76 @@ void PaintSession::RefineBuffer(size_t b, bool debug, BufferRefinement* r) {
   }
 }
 
+void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
+                                      const std::vector<size_t>& fresh,
+                                      std::vector<BufferRefinement>* results, StageReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<PoseMatch> matches;
+  for (size_t i = 0; i < todo.size(); ++i)
+    AppendPoseMatches(set_.buffers[todo[i]], *frame_camera_, frame_cam_from_local_,
+                      (*results)[i].estimate, &matches);
+  const PoseCorrection pose =
+      EstimatePoseCorrection(matches, *frame_camera_, frame_cam_from_local_, options_.refine);
+  report->metrics["pose_matches"] = pose.matches;
+  report->metrics["pose_inliers"] = pose.inliers;
+  report->metrics["pose_residual_before_px"] = pose.residual_before_px;
+  report->metrics["pose_residual_after_px"] = pose.residual_after_px;
+  report->metrics["pose_rotation_deg"] =
+      Rigid3d::AxisAngleFromQuaternion(pose.delta.rotation).norm() * 180.0 / M_PI;
+  report->metrics["pose_translation_m"] = pose.delta.translation.norm();
+  report->metrics["pose_model_" + pose.model] = 1;
+  report->notes["pose"] = pose.applied ? pose.model : "no pose correction: " + pose.fallback;
+  if (!pose.applied) return;  // the buffers keep their own 2D estimates
+  const Rigid3d corrected = pose.delta * frame_cam_from_local_;
+  results->resize(todo.size() + fresh.size());
+  for (size_t i = 0; i < results->size(); ++i) {
+    const size_t b = i < todo.size() ? todo[i] : fresh[i - todo.size()];
+    RefineEstimate& e = (*results)[i].estimate;
+    const cv::Rect& box = warped_[b].valid_box;
+    cv::Matx33d H;
+    if (!BufferCorrectionFromPose(set_.buffers[b], *frame_camera_, frame_cam_from_local_,
+                                  corrected, box, &H)) {
+      continue;  // keeps its own estimate
+    }
+    e.buffer_from_warped = H;
+    e.model = MotionModel::kHomography;
+    e.registered = true;
+    e.correction_px = LargestDisplacement(H, box);
+    e.applied = e.correction_px >= options_.refine.min_correction_px;
+    e.fallback = e.applied ? "" : "none needed (below min_correction_px)";
+    double sum_sq = 0;
+    int n = 0;
+    for (size_t k = 0; k < e.from.size(); ++k) {
+      if (!e.inlier[k]) continue;
+      const cv::Vec3d q = H * cv::Vec3d(e.from[k].x, e.from[k].y, 1);
+      sum_sq += std::pow(q[0] / q[2] - e.to[k].x, 2) + std::pow(q[1] / q[2] - e.to[k].y, 2);
+      ++n;
+    }
+    e.residual_after_px = n > 0 ? std::sqrt(sum_sq / n) : 0;
+  }
+  report->metrics["pose_ms"] = MsSince(start);
+}
+
 StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
-  std::vector<size_t> todo;
-  for (size_t b = 0; b < set_.buffers.size(); ++b)
+  std::vector<size_t> todo, fresh;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (seen[b] && painted_[b].painted_surface_texels > 0) todo.push_back(b);
+    else if (seen[b]) fresh.push_back(b);
+  }
   // Buffers are independent: one per thread.
   std::vector<BufferRefinement> results(todo.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) RefineBuffer(todo[i], debug, &results[i]);
+    for (int i = range.start; i < range.end; ++i) EstimateBuffer(todo[i], debug, &results[i]);
+  });
+  if (options_.refine.pose) {
+    CorrectThroughPose(todo, fresh, &results, &report);
+    if (results.size() > todo.size()) todo.insert(todo.end(), fresh.begin(), fresh.end());
+  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) FinishBuffer(todo[i], debug, &results[i]);
   });
 
   int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, moved = 0,
@@ -505,6 +572,8 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
   const Rigid3d cam_from_local = CamFromLocal(*scene_, cam_from_world);
   CacheFor(camera).rasterizer->Rasterize(scene_->mesh, cam_from_local, &raster_);
   const float tolerance = static_cast<float>(options_.occlusion.tolerance_rel);
+  PipelineOptions latest_wins;
+  latest_wins.update = UpdatePolicy::kLatest;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     const BaseBuffer& buffer = set_.buffers[b];
     cv::Mat map(buffer.height, buffer.width, CV_32FC2, cv::Scalar(-1, -1));
@@ -525,7 +594,7 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
       w.valid.data[buffer.texel_index[k]] = 255;
     }
     cv::remap(frame.bgr, w.bgr, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
-    PaintBuffer(buffer, w, cv::Mat(), UpdatePolicy::kLatest, 0, &painted_[b]);
+    PaintBuffer(buffer, w, cv::Mat(), latest_wins, &painted_[b]);
   }
   StageReport all;
   all.name = "naive";

@@ -29,6 +29,7 @@
 #include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/refine_alignment.h"
 #include "pipeline/paint/refine_anchor.h"
+#include "pipeline/paint/refine_pose.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/render/rasterizer.h"
 
@@ -92,7 +93,14 @@ class PaintSession {
   struct BufferRefinement;
   // Clears the frame's valid texels of buffer `b` (within `roi`) where the buffer is painted.
   void KeepOutOfPainted(size_t b, const cv::Rect& roi);
-  void RefineBuffer(size_t b, bool debug, BufferRefinement* result);
+  // Registers the frame's warped buffer `b` to what it holds (fills result->estimate).
+  void EstimateBuffer(size_t b, bool debug, BufferRefinement* result);
+  // Applies the estimate: warps again, anchors, keeps unregistered frames out.
+  void FinishBuffer(size_t b, bool debug, BufferRefinement* result);
+  // Replaces the buffers' estimates by what one correction of the frame's pose implies
+  // (refine_pose.h); `fresh`: buffers seen but never painted, which get it too.
+  void CorrectThroughPose(const std::vector<size_t>& todo, const std::vector<size_t>& fresh,
+                          std::vector<BufferRefinement>* results, StageReport* report);
   // The background stage over the buffers seen this frame (fills background_frame_).
   StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
 
@@ -107,6 +115,8 @@ class PaintSession {
   std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;
   RasterOutput raster_;  // the current frame's depth and triangle ids (reused)
+  const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
+  Rigid3d frame_cam_from_local_;
   int frames_seen_ = 0;
 };
 

@@ -1,6 +1,7 @@
 #include "pipeline/paint/paint_update.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 
 namespace fresco {
@@ -15,10 +16,13 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
 }
 
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
-                             const cv::Mat& mask, UpdatePolicy policy, double quality_slack,
+                             const cv::Mat& mask, const PipelineOptions& options,
                              PaintedBuffer* painted) {
   PaintUpdateStats stats;
-  const float keep = static_cast<float>(1.0 - quality_slack);
+  const UpdatePolicy policy = options.update;
+  const float keep = static_cast<float>(1.0 - options.quality_slack);
+  // Fixed point: the new sample's weight out of 256 (256 = replace).
+  const int weight = std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
   const uint8_t* valid = warped.valid.data;
   const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
   const float* quality = warped.quality.ptr<float>();
@@ -42,7 +46,11 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
       continue;
     }
     if (px[3] == 0 && buffer.on_surface[k]) ++painted->painted_surface_texels;
-    px = cv::Vec4b(src[idx][0], src[idx][1], src[idx][2], 255);
+    if (px[3] == 0 || weight == 256) {
+      px = cv::Vec4b(src[idx][0], src[idx][1], src[idx][2], 255);
+    } else {
+      for (int c = 0; c < 3; ++c) px[c] = static_cast<uint8_t>((px[c] * (256 - weight) + src[idx][c] * weight + 128) >> 8);
+    }
     stored_q = policy == UpdatePolicy::kQuality ? std::max(stored_q, q) : q;
     ++stats.written;
   }

@@ -30,7 +30,7 @@ struct PaintUpdateStats {
 
 // `mask` (CV_8U, optional): texels to leave alone (e.g. foreground) where non-zero.
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
-                             const cv::Mat& mask, UpdatePolicy policy, double quality_slack,
+                             const cv::Mat& mask, const PipelineOptions& options,
                              PaintedBuffer* painted);
 
 }  // namespace fresco

@@ -59,6 +59,7 @@ Project NonDefaultProject() {
   p.pipeline.update_every = 20;
   p.pipeline.update = UpdatePolicy::kLatest;
   p.pipeline.quality_slack = 0.35;
+  p.pipeline.update_weight = 0.4;
   p.pipeline.max_frames = 300;
   p.pipeline.threads = 2;
   p.pipeline.debug_images = true;
@@ -78,6 +79,7 @@ Project NonDefaultProject() {
   p.pipeline.refine.every_n_frames = 3;
   p.pipeline.refine.min_correction_px = 0.5;
   p.pipeline.refine.anchor = false;
+  p.pipeline.refine.pose = true;
   p.pipeline.refine.anchor_min_frames = 6;
   p.pipeline.refine.anchor_window_frames = 40;
   p.pipeline.refine.anchor_step_px = 0.5;
@@ -156,7 +158,7 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"time_offset_s\"",   "\"sampling\": \"bilinear\"",
                           "\"texel_size_m\"",    "\"max_buffer_texels\"",
                           "\"update_every\": 1", "\"update\": \"quality\"",
-                          "\"quality_slack\"",   "\"max_frames\"",
+                          "\"quality_slack\"",   "\"update_weight\"", "\"max_frames\"",
                           "\"threads\"",         "\"debug_images\"",
                           "\"occlusion\"",       "\"tolerance_rel\"",
                           "\"tolerance_m\"",     "\"max_view_angle_deg\"",

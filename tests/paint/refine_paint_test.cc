@@ -6,7 +6,8 @@
 // buffer is registered to the one painted at the true poses (misalignment, texels).
 // Registration alone makes the frames agree with the buffer but inherits (and random-walks)
 // the buffer's offset; anchoring removes most of it. The target is >= 80 % of the
-// PSNR the noise costs; measured 79 % (README), held here at >= 75 %.
+// PSNR the noise costs: per-buffer homographies reach 80 % (README), held here at >= 75 %;
+// correcting the frame's pose from all buffers' matches reaches 86 %, held at >= 80 %.
 #include <cstdio>
 
 #include <gtest/gtest.h>
@@ -76,6 +77,8 @@ TEST_F(RefinePainting, AnchoredRobustRefinementRecoversMostOfThePsnrLostToPoseNo
   const Row paper = Measure("paper, anchored", noisy_poses, options, noisy_psnr);
   options.refine.mode = RefineMode::kRobust;
   const Row robust = Measure("robust, anchored (default)", noisy_poses, options, noisy_psnr);
+  options.refine.pose = true;
+  const Row pose = Measure("robust, anchored, pose", noisy_poses, options, noisy_psnr);
 
   EXPECT_GT(perfect_psnr_ - noisy_psnr, 5.0);  // the noise costs something: the test can fail
   EXPECT_GE(robust.recovered, 0.75);
@@ -83,6 +86,11 @@ TEST_F(RefinePainting, AnchoredRobustRefinementRecoversMostOfThePsnrLostToPoseNo
   EXPECT_GT(robust.psnr, paper.psnr + 2.0);
   EXPECT_LT(robust.misalignment, 0.6 * noisy.misalignment);
   EXPECT_LT(robust.painted.refine_after_px, 0.5 * robust.painted.refine_before_px);
+  // One pose correction per frame from every buffer's matches (refine_pose.h) does better
+  // than one homography per buffer: measured 86 % (seeds 12, 13: 85 %, 84 %).
+  EXPECT_GE(pose.recovered, 0.80);
+  EXPECT_GT(pose.psnr, robust.psnr + 0.3);
+  EXPECT_LT(pose.misalignment, robust.misalignment);
 }
 
 // Refinement must not damage a capture whose poses are right: registration noise applied
@@ -95,6 +103,12 @@ TEST_F(RefinePainting, CorrectPosesStayCorrectWithRefinementOn) {
                           perfect_psnr_ - 1);
   EXPECT_GT(row.psnr, perfect_psnr_ - 0.3);
   EXPECT_LT(row.misalignment, 0.3);
+  options.refine.pose = true;
+  const Row pose = Measure("perfect poses, robust, pose", scenario_->capture.true_poses, options,
+                           perfect_psnr_ - 1);
+  EXPECT_GT(pose.psnr, perfect_psnr_ - 0.3);
+  EXPECT_LT(pose.misalignment, 0.3);
+  options.refine.pose = false;
   options.refine.min_correction_px = 0;  // without the dead band, the buffers drift
   const Row drifting = Measure("perfect poses, no dead band", scenario_->capture.true_poses,
                                options, perfect_psnr_ - 1);

@@ -10,14 +10,15 @@
 
 namespace fresco::testing {
 
-Status MakeRefineScenario(int frames, double pose_noise_deg, RefineScenario* scenario) {
+Status MakeRefineScenario(int frames, double pose_noise_deg, RefineScenario* scenario,
+                          int seed) {
   CubeRoomOptions room;
   room.procedural_texture_px = 1024;
   FRESCO_RETURN_IF_ERROR(MakeCubeRoomScene(room, &scenario->scene));
   SynthOptions o = HandheldRoomCapture(frames, 0.6);
   o.turns = 0.5;
   o.pose_noise_deg = pose_noise_deg;
-  o.seed = 11;
+  o.seed = seed;
   return SynthesizeCapture(scenario->scene, o, &scenario->capture);
 }
 

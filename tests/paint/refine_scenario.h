@@ -18,7 +18,8 @@ struct RefineScenario {
 };
 
 // `frames` at 30 fps; `pose_noise_deg` RMS rotation noise on the given poses.
-Status MakeRefineScenario(int frames, double pose_noise_deg, RefineScenario* scenario);
+Status MakeRefineScenario(int frames, double pose_noise_deg, RefineScenario* scenario,
+                          int seed = 11);
 
 struct PaintedScenario {
   std::unique_ptr<PaintSession> session;

@@ -69,6 +69,9 @@ class PipelinePanel : public Panel {
     float slack = static_cast<float>(p.quality_slack);
     if (ImGui::SliderFloat("quality slack", &slack, 0.0f, 1.0f)) p.quality_slack = slack;
     done();
+    float weight = static_cast<float>(p.update_weight);
+    if (ImGui::SliderFloat("update weight", &weight, 0.01f, 1.0f, "%.2f")) p.update_weight = weight;
+    done();
     ImGui::SliderInt("update every", &p.update_every, 1, 60);
     done();
     if (ImGui::Checkbox("occlusion test", &p.occlusion.enabled)) commit = true;
@@ -109,6 +112,7 @@ class PipelinePanel : public Panel {
     if (ImGui::SliderFloat("min correction texels", &dead_band, 0.0f, 2.0f, "%.2f"))
       p.refine.min_correction_px = dead_band;
     done();
+    if (ImGui::Checkbox("correct the pose (all buffers)", &p.refine.pose)) commit = true;
     if (ImGui::Checkbox("consensus anchoring", &p.refine.anchor)) commit = true;
     float step = static_cast<float>(p.refine.anchor_step_px);
     if (ImGui::SliderFloat("anchor step texels", &step, 0.0f, 2.0f, "%.2f"))
