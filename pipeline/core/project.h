@@ -56,7 +56,7 @@ struct RefineOptions {
   bool anchor = true;
   // Correct the frame's pose from the matches of every buffer together, and derive each
   // buffer's correction from it (refine_pose.h), instead of one homography per buffer.
-  bool pose = false;
+  bool pose = true;
   int anchor_min_frames = 3;
   int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
   double anchor_step_px = 0.1;

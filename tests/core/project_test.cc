@@ -79,7 +79,7 @@ Project NonDefaultProject() {
   p.pipeline.refine.every_n_frames = 3;
   p.pipeline.refine.min_correction_px = 0.5;
   p.pipeline.refine.anchor = false;
-  p.pipeline.refine.pose = true;
+  p.pipeline.refine.pose = false;
   p.pipeline.refine.anchor_min_frames = 6;
   p.pipeline.refine.anchor_window_frames = 40;
   p.pipeline.refine.anchor_step_px = 0.5;
