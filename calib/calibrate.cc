@@ -16,8 +16,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kMaxFocalStdev = 0.01;  // relative 1-sigma on fx
-constexpr double kYardstickTolerance =
-    0.10;  // a requested model's sigma may exceed opencv8's by 10 %
 
 std::string Percent(double fraction) {
   char buffer[32];
@@ -86,7 +84,8 @@ std::string Pixels(double value) {
 
 // A model named on the command line is not compared with others by `auto`: solve opencv8 as
 // a yardstick and warn when the requested model leaves systematic residuals (its noise sigma
-// well above opencv8's), so that a too-simple model is never silently written.
+// more than kFitTolerance above opencv8's: auto's "does not fit"), so that a too-simple model
+// is never silently written.
 void CheckRequestedModel(const CalibrateRequest& request, CalibrationRun* run) {
   const std::string& model = request.model;
   if (model == "auto" || model == "opencv8" || model == "splined") return;
@@ -99,11 +98,12 @@ void CheckRequestedModel(const CalibrateRequest& request, CalibrationRun* run) {
            .ok())
     return;
   const double sigma = run->Chosen().fit.noise_sigma_px;
-  if (sigma > (1 + kYardstickTolerance) * yardstick.noise_sigma_px)
+  if (sigma > (1 + kFitTolerance) * yardstick.noise_sigma_px)
     run->warnings.push_back("the requested model " + model +
                             " leaves systematic residuals: noise sigma " + Pixels(sigma) +
                             " against " + Pixels(yardstick.noise_sigma_px) +
-                            " with opencv8; use a richer model or --model auto");
+                            " with opencv8 (the fit tolerance is 3 %); use a richer model or "
+                            "--model auto");
 }
 
 void CheckUncertainty(const CalibrateRequest& request, CalibrationRun* run) {
