@@ -25,7 +25,8 @@ const char kUsage[] =
 const char kSolveHelp[] =
     R"(Detects the board in every image of IMAGES_DIR (*.png *.jpg *.jpeg *.bmp *.tif), solves
 the intrinsics with mrcal and writes CAMERA.cameramodel (mrcal's format) and, beside it,
-CAMERA.report.json, CAMERA.residuals.png and CAMERA.coverage.png.
+CAMERA.report.json, CAMERA.residuals.png, CAMERA.coverage.png and CAMERA.uncertainty.png
+(projection uncertainty over the imager at the boards' median range; figures in the report).
 
   --board BOARD        chessboard:COLSxROWS:SQUARE_M (inner corners, e.g. chessboard:9x6:0.025)
                        or aprilgrid:COLSxROWS:TAG_M:SPACING (Kalibr AprilGrid of tag36h11,
@@ -46,7 +47,8 @@ size of what is drawn). Print at 100 % scale and check the size with a ruler.)";
 
 int RunSolve(const CommandArgs& argv) {
   ArgSpec spec;
-  spec.usage = "fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]";
+  spec.usage =
+      "fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]";
   spec.help = kSolveHelp;
   spec.min_positional = 1;
   spec.max_positional = 1;
@@ -108,6 +110,13 @@ int RunSolve(const CommandArgs& argv) {
               << fit.intrinsics[0] << " fy " << fit.intrinsics[1] << " cx " << fit.intrinsics[2]
               << " cy " << fit.intrinsics[3] << ", rms " << fit.rms_px << " px, "
               << run.views.size() << " images used, " << run.rejected.size() << " rejected\n";
+    const calib::UncertaintyMap& u = run.uncertainty;
+    char line[256];
+    std::snprintf(line, sizeof(line),
+                  "projection uncertainty at %.2f m: centre %.3f px, median where observed "
+                  "%.3f px, max %.3f px\n",
+                  u.range_m, u.centre_px, u.median_observed_px, u.max_px);
+    std::cout << line;
     std::cout << "wrote " << out << " and " << calib::SiblingPath(out, ".report.json") << "\n";
   }
   return kExitOk;

@@ -55,7 +55,8 @@ void CheckCoverage(CalibrationRun* run) {
   bool quadrant[2][2] = {{false, false}, {false, false}};
   for (const BoardView& v : run->views)
     for (const CornerObservation& c : v.corners)
-      quadrant[(c.pixel.y() + 0.5) * 2 >= run->height][(c.pixel.x() + 0.5) * 2 >= run->width] = true;
+      quadrant[(c.pixel.y() + 0.5) * 2 >= run->height][(c.pixel.x() + 0.5) * 2 >= run->width] =
+          true;
   run->coverage_fraction = CoverageFraction(run->views, run->width, run->height);
   if (run->coverage_fraction < kMinCoverage)
     run->warnings.push_back("corners cover only " + Percent(run->coverage_fraction) +
@@ -69,9 +70,68 @@ void CheckCoverage(CalibrationRun* run) {
                                 " quarter of the imager");
   run->max_tilt_deg = MaxTiltDeg(run->seed);
   if (run->max_tilt_deg < kMinTiltDeg)
-    run->warnings.push_back("every board is within " + std::to_string(int(std::ceil(run->max_tilt_deg))) +
+    run->warnings.push_back("every board is within " +
+                            std::to_string(int(std::ceil(run->max_tilt_deg))) +
                             " deg of fronto-parallel: the focal length is poorly determined; "
                             "tilt the board (30-45 deg) in some images");
+}
+
+std::string Pixels(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3f px", value);
+  return buffer;
+}
+
+// A model named on the command line is not compared with others by `auto`: solve opencv8 as
+// a yardstick and warn when the requested model leaves systematic residuals (its noise sigma
+// more than kFitTolerance above opencv8's: auto's "does not fit"), so that a too-simple model
+// is never silently written.
+void CheckRequestedModel(const CalibrateRequest& request, CalibrationRun* run) {
+  const std::string& model = request.model;
+  if (model == "auto" || model == "opencv8" || model == "splined") return;
+  SolveOptions solve;
+  solve.lensmodel = MrcalLensModelName("opencv8", run->seed, run->width, run->height);
+  solve.compute_uncertainty = false;
+  SolveResult yardstick;
+  if (!SolveIntrinsics(run->views, request.board, run->width, run->height, run->seed, solve,
+                       &yardstick)
+           .ok())
+    return;
+  const double sigma = run->Chosen().fit.noise_sigma_px;
+  if (sigma > (1 + kFitTolerance) * yardstick.noise_sigma_px)
+    run->warnings.push_back("the requested model " + model +
+                            " leaves systematic residuals: noise sigma " + Pixels(sigma) +
+                            " against " + Pixels(yardstick.noise_sigma_px) +
+                            " with opencv8 (the fit tolerance is 3 %); use a richer model or "
+                            "--model auto");
+}
+
+void CheckUncertainty(const CalibrateRequest& request, CalibrationRun* run) {
+  const SolveResult& fit = run->Chosen().fit;
+  std::vector<Eigen::Vector2d> observed;
+  for (const BoardView& v : run->views)
+    for (const CornerObservation& c : v.corners) observed.push_back(c.pixel);
+  const double sigma = fit.noise_sigma_px * run->noise_inflation;
+  const double range = MedianBoardRange_m(fit, request.board);
+  run->uncertainty = ComputeUncertaintyMap(fit, run->width, run->height, range, sigma, observed);
+  run->uncertainty_at_infinity =
+      ComputeUncertaintyMap(fit, run->width, run->height, 0, sigma, observed);
+  const UncertaintyMap& u = run->uncertainty;
+  if (u.max_px < 0) {
+    run->warnings.push_back("projection uncertainty could not be computed");
+    return;
+  }
+  char range_text[32];
+  std::snprintf(range_text, sizeof(range_text), "%.2f m", range);
+  if (u.median_observed_px > kMaxObservedUncertaintyPx)
+    run->warnings.push_back("projection uncertainty at " + std::string(range_text) + " is " +
+                            Pixels(u.median_observed_px) +
+                            " (median) even where boards were seen: add images");
+  if (u.max_px > kMaxUncertaintyPx)
+    run->warnings.push_back("projection uncertainty at " + std::string(range_text) + " reaches " +
+                            Pixels(u.max_px) + " (centre " + Pixels(u.centre_px) +
+                            "): the model is poorly known where no board was seen; show the "
+                            "board there (see the .uncertainty.png picture)");
 }
 
 }  // namespace
@@ -81,8 +141,10 @@ std::vector<bool> CoverageCells(const std::vector<BoardView>& views, int width, 
   if (width <= 0 || height <= 0) return seen;
   for (const BoardView& v : views)
     for (const CornerObservation& c : v.corners) {
-      const int i = std::clamp(static_cast<int>((c.pixel.x() + 0.5) * kCoverageCols / width), 0, kCoverageCols - 1);
-      const int j = std::clamp(static_cast<int>((c.pixel.y() + 0.5) * kCoverageRows / height), 0, kCoverageRows - 1);
+      const int i = std::clamp(static_cast<int>((c.pixel.x() + 0.5) * kCoverageCols / width), 0,
+                               kCoverageCols - 1);
+      const int j = std::clamp(static_cast<int>((c.pixel.y() + 0.5) * kCoverageRows / height), 0,
+                               kCoverageRows - 1);
       seen[j * kCoverageCols + i] = true;
     }
   return seen;
@@ -126,9 +188,9 @@ DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, in
   else if (r.max_tilt_deg < kMinTiltDeg)
     r.reasons.push_back("most tilted board " + std::to_string(int(std::round(r.max_tilt_deg))) +
                         " deg (want " + std::to_string(int(kMinTiltDeg)) + "): tilt the board");
-  r.level = r.views < kMinViews    ? DataReadiness::Level::kRed
-            : r.reasons.empty()    ? DataReadiness::Level::kGreen
-                                   : DataReadiness::Level::kYellow;
+  r.level = r.views < kMinViews ? DataReadiness::Level::kRed
+            : r.reasons.empty() ? DataReadiness::Level::kGreen
+                                : DataReadiness::Level::kYellow;
   return r;
 }
 
@@ -157,9 +219,10 @@ bool DetectImage(const std::string& path, const CalibrateRequest& request, Calib
     run->width = gray.cols;
     run->height = gray.rows;
   } else if (gray.cols != run->width || gray.rows != run->height) {
-    run->rejected.push_back({name, "size " + std::to_string(gray.cols) + "x" +
-                                       std::to_string(gray.rows) + " differs from the first image's " +
-                                       std::to_string(run->width) + "x" + std::to_string(run->height)});
+    run->rejected.push_back(
+        {name, "size " + std::to_string(gray.cols) + "x" + std::to_string(gray.rows) +
+                   " differs from the first image's " + std::to_string(run->width) + "x" +
+                   std::to_string(run->height)});
     return false;
   }
   BoardDetection detection = DetectBoard(gray, request.board, request.detect);
@@ -200,6 +263,7 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   FRESCO_RETURN_IF_ERROR(FitLensModels(run->views, request.board, run->width, run->height,
                                        run->seed, select, &run->choice));
   for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);
+  CheckRequestedModel(request, run);
   if (request.board.kind == BoardKind::kAprilGrid) {
     run->corner_correlation = TagCornerCorrelation(run->views, run->Chosen().fit);
     run->noise_inflation = std::sqrt(std::max(1.0, 1 + 3 * run->corner_correlation));
@@ -207,8 +271,10 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
       for (double& s : t.fit.intrinsics_stdev) s *= run->noise_inflation;
   }
   const SolveResult& fit = run->Chosen().fit;
+  CheckUncertainty(request, run);
   if (!fit.intrinsics_stdev.empty() && fit.intrinsics_stdev[0] > kMaxFocalStdev * fit.intrinsics[0])
-    run->warnings.push_back("fx is uncertain: 1-sigma " + Percent(fit.intrinsics_stdev[0] / fit.intrinsics[0]) +
+    run->warnings.push_back("fx is uncertain: 1-sigma " +
+                            Percent(fit.intrinsics_stdev[0] / fit.intrinsics[0]) +
                             " of its value; add images, tilted boards and full-imager coverage");
   return Status::Ok();
 }

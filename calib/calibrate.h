@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "calib/model_select.h"
+#include "calib/uncertainty.h"
 
 namespace fresco::calib {
 
@@ -38,6 +39,9 @@ struct CalibrationRun {
   double noise_inflation = 1;
   double coverage_fraction = 0;  // imager cells (16 x 12) holding a corner
   double max_tilt_deg = 0;       // largest board tilt from fronto-parallel, over the views
+  // Projection uncertainty of the chosen model over the imager (calib/uncertainty.h), at the
+  // boards' median range and at infinity; sigma is the noise sigma times noise_inflation.
+  UncertaintyMap uncertainty, uncertainty_at_infinity;
 
   const ModelTrial& Chosen() const { return choice.trials[choice.chosen]; }
 };
@@ -61,6 +65,10 @@ constexpr int kMinViews = 3;
 constexpr int kFewViews = 10;
 constexpr double kMinCoverage = 0.35;  // fraction of the imager's 16 x 12 cells
 constexpr double kMinTiltDeg = 20;     // at least one board this far from fronto-parallel
+// Warn when the projection uncertainty at the boards' range exceeds this anywhere on the
+// imager (the worst cell of the map), or kMaxObservedUncertaintyPx where corners were seen.
+constexpr double kMaxUncertaintyPx = 1.0;
+constexpr double kMaxObservedUncertaintyPx = 0.2;
 
 // The imager's kCoverageCols x kCoverageRows cells holding a corner of some view (row-major),
 // and their fraction.

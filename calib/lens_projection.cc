@@ -67,10 +67,21 @@ bool UnprojectPixels(const std::string& lensmodel, const std::vector<double>& in
 
 double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector<double>& a,
                                const std::string& lensmodel_b, const std::vector<double>& b,
-                               const std::vector<Eigen::Vector2d>& pixels) {
+                               const std::vector<Eigen::Vector2d>& all_pixels) {
   const double kNan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<Eigen::Vector3d> all_rays, all_back;
+  if (all_pixels.empty() || !UnprojectPixels(lensmodel_a, a, all_pixels, &all_rays)) return kNan;
+  // Pixels where either model has no valid (un)projection (a strongly distorted model can fold
+  // over near the imager's edge) are left out; fewer than half left: no comparison.
+  std::vector<Eigen::Vector2d> pixels, back;
   std::vector<Eigen::Vector3d> rays;
-  if (pixels.empty() || !UnprojectPixels(lensmodel_a, a, pixels, &rays)) return kNan;
+  if (!ProjectPoints(lensmodel_b, b, all_rays, &back)) return kNan;
+  for (size_t i = 0; i < all_pixels.size(); ++i)
+    if (all_rays[i].allFinite() && all_rays[i].z() > 0 && back[i].allFinite()) {
+      pixels.push_back(all_pixels[i]);
+      rays.push_back(all_rays[i]);
+    }
+  if (2 * pixels.size() < all_pixels.size() || pixels.empty()) return kNan;
   // Residuals for rotation r: project_b(R(r) ray) - pixel.
   auto residuals = [&](const Eigen::Vector3d& r, Eigen::VectorXd* out) {
     const Eigen::Matrix3d R = Rotation(r);

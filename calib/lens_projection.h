@@ -23,6 +23,7 @@ int LensModelParamCount(const std::string& lensmodel);
 // RMS distance (px) between two models of one camera over `pixels`: each pixel unprojected by
 // `a`, rotated by the best-fitting small rotation, projected by `b` (the rotation absorbs the
 // arbitrary camera-frame orientation each solve picks, as mrcal's projection diff does).
+// Pixels either model cannot (un)project are skipped; NaN when more than half are.
 double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector<double>& a,
                                const std::string& lensmodel_b, const std::vector<double>& b,
                                const std::vector<Eigen::Vector2d>& pixels);

@@ -17,10 +17,10 @@ namespace {
 struct Problem {
   mrcal_lensmodel_t lensmodel{};
   std::vector<double> intrinsics;
-  std::vector<mrcal_pose_t> frames;            // board -> camera
+  std::vector<mrcal_pose_t> frames;  // board -> camera
   mrcal_calobject_warp_t warp{};
   std::vector<mrcal_observation_board_t> observations;
-  std::vector<mrcal_point3_t> pool;            // (N, H, W): x, y, weight (< 0: absent/outlier)
+  std::vector<mrcal_point3_t> pool;  // (N, H, W): x, y, weight (< 0: absent/outlier)
   BoardGrid grid;
   int imagersize[2] = {0, 0};
   mrcal_problem_selections_t selections{};
@@ -31,8 +31,8 @@ struct Problem {
     return mrcal_num_states(1, 0, Nframes(), 0, 0, Nframes(), selections, &lensmodel);
   }
   int NumMeasurements() const {
-    return mrcal_num_measurements(Nframes(), 0, grid.width_n, grid.height_n, 1, 0, Nframes(), 0,
-                                  0, selections, &lensmodel);
+    return mrcal_num_measurements(Nframes(), 0, grid.width_n, grid.height_n, 1, 0, Nframes(), 0, 0,
+                                  selections, &lensmodel);
   }
   int MeasurementIndex(int view, int grid_index) const {
     return mrcal_measurement_index_boards(view, Nframes(), 0, grid.width_n, grid.height_n) +
@@ -41,8 +41,7 @@ struct Problem {
 };
 
 bool LensModelFromName(const std::string& name, mrcal_lensmodel_t* lensmodel) {
-  return mrcal_lensmodel_from_name(lensmodel, name.c_str()) &&
-         lensmodel->type >= 0;
+  return mrcal_lensmodel_from_name(lensmodel, name.c_str()) && lensmodel->type >= 0;
 }
 
 mrcal_problem_selections_t Selections(bool core, bool distortions, bool warp, bool regularize,
@@ -89,11 +88,13 @@ bool Evaluate(const Problem& p, const std::vector<double>& intrinsics,
       p.grid.spacing_m, p.grid.width_n, p.grid.height_n, false);
 }
 
-// 1-sigma of each intrinsic parameter: sigma^2 (J^T J)^-1 over the solved state, J by
-// forward differences restricted to `rows` (the inlier board measurements and the
-// regularization terms).
-std::vector<double> IntrinsicsStdev(const Problem& p, const std::vector<int>& rows,
-                                    double sigma_px) {
+// Covariance of the solved state per px^2 of corner noise, mrcal's form (its uncertainty
+// docs): inv(J^T J) J_obs^T J_obs inv(J^T J), J over all `rows` (inlier board measurements,
+// then the regularization terms), J_obs its first `observation_rows` rows (regularization is
+// no noise). J by forward differences of mrcal_optimizer_callback. State: intrinsics, 6 per
+// board pose (r, t), then the 2 warp terms when solved for.
+Eigen::MatrixXd StateCovariance(const Problem& p, const std::vector<int>& rows,
+                                int observation_rows) {
   struct Param {
     int kind, index;  // 0 intrinsics, 1 frame (index*6 + k), 2 warp
   };
@@ -110,9 +111,10 @@ std::vector<double> IntrinsicsStdev(const Problem& p, const std::vector<int>& ro
     std::vector<double> intrinsics = p.intrinsics;
     std::vector<mrcal_pose_t> frames = p.frames;
     mrcal_calobject_warp_t warp = p.warp;
-    double* value = params[c].kind == 0   ? &intrinsics[params[c].index]
-                    : params[c].kind == 1 ? &reinterpret_cast<double*>(frames.data())[params[c].index]
-                                          : &warp.values[params[c].index];
+    double* value = params[c].kind == 0 ? &intrinsics[params[c].index]
+                    : params[c].kind == 1
+                        ? &reinterpret_cast<double*>(frames.data())[params[c].index]
+                        : &warp.values[params[c].index];
     const double h = 1e-6 * std::max(1.0, std::abs(*value));
     *value += h;
     std::vector<double> x1;
@@ -125,11 +127,11 @@ std::vector<double> IntrinsicsStdev(const Problem& p, const std::vector<int>& ro
   const double floor = values.maxCoeff() * 1e-14;
   Eigen::VectorXd inverse = values;
   for (int i = 0; i < inverse.size(); ++i) inverse[i] = values[i] > floor ? 1.0 / values[i] : 0.0;
-  const Eigen::MatrixXd covariance =
+  const Eigen::MatrixXd JtJ_inverse =
       eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
-  std::vector<double> stdev(Nintr);
-  for (int i = 0; i < Nintr; ++i) stdev[i] = sigma_px * std::sqrt(std::max(0.0, covariance(i, i)));
-  return stdev;
+  if (observation_rows >= static_cast<int>(rows.size())) return JtJ_inverse;
+  const Eigen::MatrixXd J_obs = J.topRows(observation_rows);
+  return JtJ_inverse * (J_obs.transpose() * J_obs) * JtJ_inverse;
 }
 
 }  // namespace
@@ -194,8 +196,8 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
     std::copy(core.begin(), core.end(), p.intrinsics.begin());
   }
   const bool has_distortion = p.intrinsics.size() > 4;
-  p.selections = Selections(true, has_distortion, options.optimize_board_warp, true,
-                            options.reject_outliers);
+  p.selections =
+      Selections(true, has_distortion, options.optimize_board_warp, true, options.reject_outliers);
   std::vector<double> x;
   FRESCO_RETURN_IF_ERROR(Optimize(&p, &x));
 
@@ -251,8 +253,8 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
       for (size_t v = 0; v < views.size(); ++v)
         for (size_t k = 0; k < views[v].corners.size(); ++k)
           if (out.views[v].outlier[k]) {
-            const int m =
-                p.MeasurementIndex(static_cast<int>(v), p.grid.grid_index_of_corner[views[v].corners[k].id]);
+            const int m = p.MeasurementIndex(static_cast<int>(v),
+                                             p.grid.grid_index_of_corner[views[v].corners[k].id]);
             out.views[v].residual_px[k] = Eigen::Vector2d(x_all[m], x_all[m + 1]);
           }
   }
@@ -261,10 +263,17 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   const int dof = 2 * out.corners_used - out.num_states;
   out.noise_sigma_px = dof > 0 ? std::sqrt(ssr / dof) : out.rms_px;
   if (options.compute_uncertainty) {
-    const int regularization = mrcal_measurement_index_regularization(
-        p.Nframes(), 0, p.grid.width_n, p.grid.height_n);
+    const int observation_rows = static_cast<int>(rows.size());
+    const int regularization =
+        mrcal_measurement_index_regularization(p.Nframes(), 0, p.grid.width_n, p.grid.height_n);
     for (int m = regularization; m < p.NumMeasurements(); ++m) rows.push_back(m);
-    out.intrinsics_stdev = IntrinsicsStdev(p, rows, out.noise_sigma_px * options.noise_inflation);
+    out.state_covariance_per_px2 = StateCovariance(p, rows, observation_rows);
+    const double sigma = out.noise_sigma_px * options.noise_inflation;
+    for (int i = 0;
+         i < static_cast<int>(out.intrinsics.size()) && i < out.state_covariance_per_px2.rows();
+         ++i)
+      out.intrinsics_stdev.push_back(sigma *
+                                     std::sqrt(std::max(0.0, out.state_covariance_per_px2(i, i))));
   }
   for (double v : out.intrinsics)
     if (!std::isfinite(v)) return Status::Error("mrcal's solve diverged (non-finite intrinsics)");

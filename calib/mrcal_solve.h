@@ -3,10 +3,12 @@
 // mrcal-calibrate-cameras: first the intrinsics core and board poses with the distortion
 // held at its seed (a stereographic core for the splined model), then everything, with the
 // board's warp, mrcal's regularization and mrcal's outlier rejection.
-// The 1-sigma uncertainty of every solved parameter comes from the Gauss-Newton covariance
-// sigma^2 (J^T J)^-1 at the optimum (J by finite differences of mrcal_optimizer_callback over
-// intrinsics, board poses and warp; sigma from the inlier residuals with the degrees of
-// freedom removed), times SolveOptions::noise_inflation for correlated corner noise.
+// The 1-sigma uncertainty of every solved parameter comes from the covariance of the state
+// at the optimum, sigma^2 inv(J^T J) J_obs^T J_obs inv(J^T J) as in mrcal's uncertainty
+// propagation (J by finite differences of mrcal_optimizer_callback over intrinsics, board
+// poses and warp; sigma from the inlier residuals with the degrees of freedom removed), times
+// SolveOptions::noise_inflation for correlated corner noise. calib/uncertainty.h propagates
+// the same covariance to projection uncertainty over the imager.
 #pragma once
 
 #include <array>
@@ -32,10 +34,10 @@ struct SolveOptions {
 };
 
 struct ViewFit {
-  std::array<double, 6> rt_cam_from_board{};   // Rodrigues r, then t (m)
-  std::vector<Eigen::Vector2d> residual_px;    // per corner of the view: projected - observed
-  std::vector<bool> outlier;                   // per corner: rejected by mrcal
-  double rms_px = 0;                           // over the view's inlier corners (2-D)
+  std::array<double, 6> rt_cam_from_board{};  // Rodrigues r, then t (m)
+  std::vector<Eigen::Vector2d> residual_px;   // per corner of the view: projected - observed
+  std::vector<bool> outlier;                  // per corner: rejected by mrcal
+  double rms_px = 0;                          // over the view's inlier corners (2-D)
   int outliers = 0;
 };
 
@@ -43,6 +45,11 @@ struct SolveResult {
   std::string lensmodel;
   std::vector<double> intrinsics;
   std::vector<double> intrinsics_stdev;  // 1-sigma per parameter (empty when not computed)
+  // Covariance of the solved state per px^2 of corner noise (times sigma^2 gives Var):
+  // (Nstate, Nstate) over the intrinsics, then 6 per view (rt_cam_from_board: r, t), then the
+  // 2 warp terms when solved for. mrcal's form: inv(J^T J) J_obs^T J_obs inv(J^T J), so the
+  // regularization terms are not counted as noise. Empty when not computed.
+  Eigen::MatrixXd state_covariance_per_px2;
   std::vector<ViewFit> views;            // same order as the input views
   std::array<double, 2> board_warp_m{};  // mrcal's calobject_warp (x2, y2)
   double rms_px = 0;                     // sqrt(mean |residual|^2) over inlier corners

@@ -44,11 +44,38 @@ nlohmann::json TrialJson(const ModelTrial& t) {
     j["intrinsics"] = t.fit.intrinsics;
     j["intrinsics_stdev"] = t.fit.intrinsics_stdev;
   } else {  // splined: the core only
-    j["intrinsics_core"] = std::vector<double>(t.fit.intrinsics.begin(), t.fit.intrinsics.begin() + 4);
+    j["intrinsics_core"] =
+        std::vector<double>(t.fit.intrinsics.begin(), t.fit.intrinsics.begin() + 4);
     if (t.fit.intrinsics_stdev.size() >= 4)
       j["intrinsics_core_stdev"] =
           std::vector<double>(t.fit.intrinsics_stdev.begin(), t.fit.intrinsics_stdev.begin() + 4);
   }
+  return j;
+}
+
+nlohmann::json UncertaintyFiguresJson(const UncertaintyMap& u) {
+  return {{"range_m", u.range_m},
+          {"centre_px", u.centre_px},
+          {"corners_px", {u.corners_px[0], u.corners_px[1], u.corners_px[2], u.corners_px[3]}},
+          {"max_px", u.max_px},
+          {"median_observed_px", u.median_observed_px}};
+}
+
+nlohmann::json UncertaintyJson(const CalibrationRun& run) {
+  const UncertaintyMap& u = run.uncertainty;
+  nlohmann::json j = UncertaintyFiguresJson(u);
+  j["method"] =
+      "mrcal's projection uncertainty (python3-mrcal 2.2 projection_uncertainty, 'mean frames'), "
+      "on this solve's state covariance sigma^2 inv(JtJ) Jobs^T Jobs inv(JtJ): worst-direction "
+      "1-sigma of the projection of the point seen at each pixel at range_m";
+  j["sigma_px"] = u.sigma_px;
+  j["corners_order"] = "top-left, top-right, bottom-left, bottom-right cells";
+  j["grid_cols"] = u.cols;
+  j["grid_rows"] = u.rows;
+  j["stdev_px"] = u.stdev_px;  // (grid_rows, grid_cols) row-major, at cell centres
+  nlohmann::json inf = UncertaintyFiguresJson(run.uncertainty_at_infinity);
+  inf.erase("range_m");
+  j["at_infinity"] = inf;
   return j;
 }
 
@@ -60,11 +87,11 @@ std::string CameraModelText(const std::string& lensmodel, const std::vector<doub
   text += "    'lensmodel':  '" + lensmodel + "',\n\n";
   text += "    # intrinsics are fx,fy,cx,cy,distortion0,distortion1,....\n";
   text += "    'intrinsics': [";
-  for (size_t i = 0; i < intrinsics.size(); ++i)
-    text += (i ? ", " : " ") + Number(intrinsics[i]);
+  for (size_t i = 0; i < intrinsics.size(); ++i) text += (i ? ", " : " ") + Number(intrinsics[i]);
   text += " ],\n\n    # extrinsics are rt_fromref\n";
   text += "    'extrinsics': [ 0, 0, 0, 0, 0, 0 ],\n\n";
-  text += "    'imagersize': [ " + std::to_string(width) + ", " + std::to_string(height) + " ],\n}\n";
+  text +=
+      "    'imagersize': [ " + std::to_string(width) + ", " + std::to_string(height) + " ],\n}\n";
   return text;
 }
 
@@ -101,7 +128,8 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
   }
   j["images_used"] = used;
   nlohmann::json rejected = nlohmann::json::array();
-  for (const RejectedImage& r : run.rejected) rejected.push_back({{"image", r.name}, {"reason", r.reason}});
+  for (const RejectedImage& r : run.rejected)
+    rejected.push_back({{"image", r.name}, {"reason", r.reason}});
   j["images_rejected"] = rejected;
   j["per_image"] = per_image;
   nlohmann::json tried = nlohmann::json::array();
@@ -111,8 +139,13 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
       "simplest model that fits (noise sigma within 3 % of the best model's) and whose two "
       "half-data solves agree (cross_validation_px <= max(3 sigma, 0.3 px))";
   j["seed"] = {{"method", "OpenCV calibrateCamera, k1 k2 only"},
-               {"fx", run.seed.fx}, {"fy", run.seed.fy}, {"cx", run.seed.cx}, {"cy", run.seed.cy},
-               {"k1", run.seed.k1}, {"k2", run.seed.k2}, {"rms_px", run.seed.rms_px}};
+               {"fx", run.seed.fx},
+               {"fy", run.seed.fy},
+               {"cx", run.seed.cx},
+               {"cy", run.seed.cy},
+               {"k1", run.seed.k1},
+               {"k2", run.seed.k2},
+               {"rms_px", run.seed.rms_px}};
   j["corner_noise"] = {
       {"tag_corner_correlation", run.corner_correlation},
       {"uncertainty_inflation", run.noise_inflation},
@@ -121,6 +154,7 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
                        "their residuals rho is measured and every intrinsics_stdev is "
                        "multiplied by sqrt(1 + 3 rho) (the design effect of 4 correlated corners)"
                      : "chessboard corners are found independently: no inflation"}};
+  j["projection_uncertainty"] = UncertaintyJson(run);
   j["coverage_fraction"] = run.coverage_fraction;
   j["max_board_tilt_deg"] = run.max_tilt_deg;
   j["warnings"] = run.warnings;
@@ -133,9 +167,11 @@ Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequ
   const ModelTrial& chosen = run.Chosen();
   const std::string text =
       CameraModelText(chosen.lensmodel, chosen.fit.intrinsics, run.width, run.height);
-  mrcal_cameramodel_t* check = mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
+  mrcal_cameramodel_t* check =
+      mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
   if (!check)
-    return Status::Error(cameramodel_path + ": internal error: mrcal cannot read the model to write");
+    return Status::Error(cameramodel_path +
+                         ": internal error: mrcal cannot read the model to write");
   mrcal_free_cameramodel(&check);
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(cameramodel_path, text));
   return WriteFileAtomic(SiblingPath(cameramodel_path, ".report.json"),
@@ -153,6 +189,11 @@ Status WriteCalibrationOutputs(const std::string& cameramodel_path, const Calibr
     FRESCO_RETURN_IF_ERROR(WriteImageAtomic(residuals, DrawResiduals(run)));
     FRESCO_RETURN_IF_ERROR(WriteImageAtomic(coverage, DrawCoverage(run)));
     pictures = {residuals, coverage};
+    const cv::Mat uncertainty = DrawUncertainty(run);
+    if (!uncertainty.empty()) {
+      pictures.push_back(SiblingPath(cameramodel_path, ".uncertainty.png"));
+      FRESCO_RETURN_IF_ERROR(WriteImageAtomic(pictures.back(), uncertainty));
+    }
   }
   if (!outputs.corners_vnl.empty())
     FRESCO_RETURN_IF_ERROR(WriteCornersVnl(outputs.corners_vnl, run.views, request.board));

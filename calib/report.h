@@ -21,8 +21,8 @@ Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequ
                         const CalibrationRun& run, const std::vector<std::string>& pictures);
 
 // Everything `fresco calib solve --out` writes (the CLI and the app share it): the folder,
-// CAMERA.residuals.png and CAMERA.coverage.png (unless !pictures), the corners as mrcal's
-// corners.vnl when `corners_vnl` is set, then the .cameramodel and the report.
+// CAMERA.residuals.png, CAMERA.coverage.png and CAMERA.uncertainty.png (unless !pictures), the
+// corners as mrcal's corners.vnl when `corners_vnl` is set, then the .cameramodel and the report.
 struct CalibrationOutputs {
   bool pictures = true;
   std::string corners_vnl;  // "" = none

@@ -6,11 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -18,6 +17,7 @@
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
 #include "calib/lens_projection.h"
+#include "tests/calib/synthetic_boards.h"
 #include "tests/test_support.h"
 
 namespace fresco::calib {
@@ -26,66 +26,11 @@ namespace {
 namespace fs = std::filesystem;
 using fresco::testing::RunFresco;
 
-// Board poses that tilt +-35 deg and sweep the imager: cam_from_board for view v of n.
-std::array<double, 6> SyntheticPose(int v, int n, const BoardSpec& spec, bool centre_only) {
-  const Eigen::Vector2d size = PatternSize_m(spec);
-  const double a = 2 * M_PI * v / n;
-  const double tilt = centre_only ? 0.05 : 0.6;
-  const Eigen::Vector3d r(tilt * std::cos(a), tilt * std::sin(a), 0.1 * std::sin(3 * a));
-  const double spread = centre_only ? 0.0 : 0.09;
-  const Eigen::Vector3d centre_in_cam(spread * std::cos(a + 0.5), spread * std::sin(a + 0.5) * 0.8,
-                                      0.42 + 0.08 * std::cos(2 * a));
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
-  const Eigen::Vector3d board_centre(size.x() / 2, size.y() / 2, 0);
-  const Eigen::Vector3d t = centre_in_cam - R * board_centre;
-  return {r.x(), r.y(), r.z(), t.x(), t.y(), t.z()};
-}
-
-std::vector<BoardView> SyntheticViews(const BoardSpec& spec, const std::string& lensmodel,
-                                      const std::vector<double>& intrinsics, int width, int height,
-                                      int n, double noise_px, bool centre_only = false) {
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0, noise_px);
-  std::vector<BoardView> views;
-  for (int v = 0; v < n; ++v) {
-    const auto rt = SyntheticPose(v, n, spec, centre_only);
-    const Eigen::Vector3d r(rt[0], rt[1], rt[2]);
-    const Eigen::Matrix3d R = Eigen::AngleAxisd(r.norm(), r.normalized()).toRotationMatrix();
-    std::vector<Eigen::Vector3d> points;
-    for (int id = 0; id < spec.NumCorners(); ++id)
-      points.push_back(R * CornerPosition(spec, id) + Eigen::Vector3d(rt[3], rt[4], rt[5]));
-    std::vector<Eigen::Vector2d> q;
-    EXPECT_TRUE(ProjectPoints(lensmodel, intrinsics, points, &q));
-    BoardView view{"view" + std::to_string(v), {}};
-    for (int id = 0; id < spec.NumCorners(); ++id) {
-      if (q[id].x() < 0 || q[id].y() < 0 || q[id].x() > width - 1 || q[id].y() > height - 1) continue;
-      view.corners.push_back({id, q[id] + Eigen::Vector2d(noise(rng), noise(rng))});
-    }
-    views.push_back(view);
-  }
-  return views;
-}
-
-CalibrationRun SolveSynthetic(const std::vector<BoardView>& views, const BoardSpec& spec,
-                              int width, int height, const std::string& model) {
-  CalibrateRequest request;
-  request.board = spec;
-  request.model = model;
-  CalibrationRun run;
-  run.width = width;
-  run.height = height;
-  run.views = views;
-  const Status s = SolveViews(request, &run);
-  EXPECT_TRUE(s.ok()) << s.message();
-  return run;
-}
-
-BoardSpec Spec(const std::string& text) {
-  BoardSpec spec;
-  const Status s = ParseBoardSpec(text, "--board", &spec);
-  EXPECT_TRUE(s.ok()) << s.message();
-  return spec;
-}
+using testing::AllWarnings;
+using testing::SolveSynthetic;
+using testing::Spec;
+using testing::SyntheticCapture;
+using testing::SyntheticViews;
 
 TEST(BoardSpecTest, ParsesAndRejectsWithTheField) {
   const BoardSpec chess = Spec("chessboard:9x6:0.025");
@@ -124,7 +69,9 @@ TEST(BoardSpecTest, AprilGridFollowsKalibrAndTheYacReference) {
 TEST(SyntheticCalibrationTest, PinholeTruthRecoveredAndAutoPicksPinhole) {
   const BoardSpec spec = Spec("chessboard:10x7:0.03");
   const std::vector<double> truth = {600, 605, 322, 238};
-  const auto views = SyntheticViews(spec, "LENSMODEL_PINHOLE", truth, 640, 480, 14, 0.2);
+  SyntheticCapture capture;
+  capture.intrinsics = truth;
+  const auto views = SyntheticViews(spec, capture);
   const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "auto");
   const SolveResult& fit = run.Chosen().fit;
   EXPECT_EQ(run.Chosen().short_name, "pinhole");
@@ -139,9 +86,12 @@ TEST(SyntheticCalibrationTest, PinholeTruthRecoveredAndAutoPicksPinhole) {
 
 TEST(SyntheticCalibrationTest, StrongDistortionPicksARicherModel) {
   const BoardSpec spec = Spec("chessboard:10x7:0.03");
-  const std::vector<double> truth = {420, 422, 318, 243, -0.32, 0.12, 0.0008, -0.0005, -0.02,
-                                     0.01, 0.002, 0.001};
-  const auto views = SyntheticViews(spec, "LENSMODEL_OPENCV8", truth, 640, 480, 14, 0.2);
+  const std::vector<double> truth = {420,    422,     318,   243,  -0.32, 0.12,
+                                     0.0008, -0.0005, -0.02, 0.01, 0.002, 0.001};
+  SyntheticCapture capture;
+  capture.lensmodel = "LENSMODEL_OPENCV8";
+  capture.intrinsics = truth;
+  const auto views = SyntheticViews(spec, capture);
   const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "auto");
   const std::string chosen = run.Chosen().short_name;
   std::cout << "auto chose " << chosen << "\n";
@@ -160,11 +110,13 @@ TEST(SyntheticCalibrationTest, StrongDistortionPicksARicherModel) {
 
 TEST(SyntheticCalibrationTest, BoardOnlyAtTheCentreWarns) {
   const BoardSpec spec = Spec("chessboard:5x4:0.02");
-  const auto views = SyntheticViews(spec, "LENSMODEL_PINHOLE", {600, 600, 320, 240}, 640, 480,
-                                    8, 0.2, /*centre_only=*/true);
+  SyntheticCapture capture;
+  capture.intrinsics = {600, 600, 320, 240};
+  capture.views = 8;
+  capture.placement = testing::Placement::kCentre;
+  const auto views = SyntheticViews(spec, capture);
   const CalibrationRun run = SolveSynthetic(views, spec, 640, 480, "opencv4");
-  std::string all;
-  for (const std::string& w : run.warnings) all += w + "\n";
+  const std::string all = AllWarnings(run);
   EXPECT_NE(all.find("cover only"), std::string::npos) << all;
   EXPECT_NE(all.find("fronto-parallel"), std::string::npos) << all;
   EXPECT_NE(all.find("only 8 images"), std::string::npos) << all;
@@ -195,10 +147,12 @@ TEST(BoardImageTest, RenderedAprilGridIsDetectedWithEveryCorner) {
 
 TEST(CalibCommandTest, BadInputExitsTwoWithOneLine) {
   const std::string dir = fresco::testing::MakeTempDir("calib_bad");
-  auto r = RunFresco({"calib", "solve", dir, "--board", "chessboard:9x6", "--out", dir + "/c.cameramodel"});
+  auto r = RunFresco(
+      {"calib", "solve", dir, "--board", "chessboard:9x6", "--out", dir + "/c.cameramodel"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("--board"), std::string::npos) << r.err;
-  r = RunFresco({"calib", "solve", dir, "--board", "chessboard:9x6:0.02", "--out", dir + "/c.cameramodel"});
+  r = RunFresco(
+      {"calib", "solve", dir, "--board", "chessboard:9x6:0.02", "--out", dir + "/c.cameramodel"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("IMAGES_DIR: no image"), std::string::npos) << r.err;
   // Two images with a board: too few.
@@ -207,7 +161,8 @@ TEST(CalibCommandTest, BadInputExitsTwoWithOneLine) {
   cv::imwrite(dir + "/a.png", board.gray);
   cv::imwrite(dir + "/b.png", board.gray);
   cv::imwrite(dir + "/c.png", cv::Mat(100, 100, CV_8U, cv::Scalar(128)));
-  r = RunFresco({"calib", "solve", dir, "--board", "chessboard:6x4:0.02", "--out", dir + "/c.cameramodel"});
+  r = RunFresco(
+      {"calib", "solve", dir, "--board", "chessboard:6x4:0.02", "--out", dir + "/c.cameramodel"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("found in 2 of 3 images"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("rejected c.png"), std::string::npos) << r.err;
@@ -216,7 +171,8 @@ TEST(CalibCommandTest, BadInputExitsTwoWithOneLine) {
 
 TEST(CalibCommandTest, BoardCommandStatesItsSize) {
   const std::string dir = fresco::testing::MakeTempDir("calib_board");
-  const auto r = RunFresco({"calib", "board", "aprilgrid:6x6:0.088:0.3", "--out", dir + "/b.png", "--dpi", "100"});
+  const auto r = RunFresco(
+      {"calib", "board", "aprilgrid:6x6:0.088:0.3", "--out", dir + "/b.png", "--dpi", "100"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("pattern 0.6"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(fresco::testing::ReadText(dir + "/b.json"));
@@ -232,8 +188,9 @@ TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
     if (e.path().filename().string().rfind("left", 0) == 0 && e.path().extension() == ".jpg")
       fs::copy(e.path(), dir + "/left/" + e.path().filename().string());
   const std::string out = dir + "/left.cameramodel";
-  const auto r = RunFresco({"calib", "solve", dir + "/left", "--board", "chessboard:9x6:0.025",
-                            "--out", out, "--model", "opencv4", "--corners-vnl", dir + "/corners.vnl"});
+  const auto r =
+      RunFresco({"calib", "solve", dir + "/left", "--board", "chessboard:9x6:0.025", "--out", out,
+                 "--model", "opencv4", "--corners-vnl", dir + "/corners.vnl"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto report = nlohmann::json::parse(fresco::testing::ReadText(dir + "/left.report.json"));
   const double fx = report["intrinsics"][0], fy = report["intrinsics"][1];
@@ -247,16 +204,49 @@ TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
   // mrcal's own reader and, when installed, mrcal-calibrate-cameras on the same corners.
   if (std::system("/usr/bin/python3 -c 'import mrcal' 2>/dev/null") != 0)
     GTEST_SKIP() << "python3-mrcal is absent: mrcal cross-check skipped";
-  const std::string check = "cd " + dir + "/left && mkdir -p ../m && mrcal-calibrate-cameras --corners-cache ../corners.vnl"
+  const std::string check =
+      "cd " + dir +
+      "/left && mkdir -p ../m && mrcal-calibrate-cameras --corners-cache ../corners.vnl"
       " --lensmodel LENSMODEL_OPENCV4 --focal 500 --object-spacing 0.025 --object-width-n 9"
       " --object-height-n 6 --outdir ../m 'left*.jpg' >/dev/null 2>&1 && /usr/bin/python3 -c \""
-      "import mrcal; a=mrcal.cameramodel('" + out + "').intrinsics()[1];"
+      "import mrcal; a=mrcal.cameramodel('" +
+      out +
+      "').intrinsics()[1];"
       " b=mrcal.cameramodel('../m/camera-0.cameramodel').intrinsics()[1];"
       " print(*(a-b))\" > ../diff.txt";
   ASSERT_EQ(std::system(check.c_str()), 0);
   std::istringstream diff(fresco::testing::ReadText(dir + "/diff.txt"));
   double d;
   for (int i = 0; diff >> d; ++i) EXPECT_NEAR(d, 0, i < 4 ? 0.05 : 1e-4) << "intrinsic " << i;
+  // Projection uncertainty: ours (report) against mrcal.projection_uncertainty on the
+  // model mrcal-calibrate-cameras wrote (with its optimization_inputs), same pixels (the
+  // centre and the map's corner cells), same range, same corner noise.
+  const auto& u = report["projection_uncertainty"];
+  const double range = u["range_m"], sigma = u["sigma_px"];
+  EXPECT_GT(range, 0.2);
+  std::vector<double> ours = {u["centre_px"].get<double>()};
+  for (const auto& c : u["corners_px"]) ours.push_back(c.get<double>());
+  for (size_t i = 1; i < ours.size(); ++i) EXPECT_GT(ours[i], 10 * ours[0]);
+  EXPECT_TRUE(fs::exists(dir + "/left.uncertainty.png"));
+  const std::string mrcal_uncertainty =
+      "cd " + dir +
+      " && /usr/bin/python3 -c \"import mrcal, numpy as np; m=mrcal.cameramodel("
+      "'m/camera-0.cameramodel'); W,H=m.imagersize(); c=lambda i,n,s: (i+0.5)*s/n-0.5;"
+      " q=np.array([[(W-1)/2,(H-1)/2],[c(0,32,W),c(0,24,H)],[c(31,32,W),c(0,24,H)],"
+      "[c(0,32,W),c(23,24,H)],[c(31,32,W),c(23,24,H)]]);"
+      " v=mrcal.unproject(q,*m.intrinsics(),normalize=True);"
+      " print(*mrcal.projection_uncertainty(v*" +
+      std::to_string(range) +
+      ",m,"
+      "what='worstdirection-stdev',observed_pixel_uncertainty=" +
+      std::to_string(sigma) + "))\" > uncertainty.txt";
+  ASSERT_EQ(std::system(mrcal_uncertainty.c_str()), 0);
+  std::istringstream theirs(fresco::testing::ReadText(dir + "/uncertainty.txt"));
+  for (size_t i = 0; theirs >> d; ++i) {
+    std::cout << "projection uncertainty " << i << ": ours " << ours.at(i) << " px, mrcal " << d
+              << " px\n";
+    EXPECT_NEAR(ours.at(i) / d, 1.0, 0.01) << i;
+  }
 }
 
 // yac's reference corners for one image: board point (rounded to 0.1 mm) -> pixel.
@@ -270,7 +260,8 @@ std::map<std::pair<int, int>, Eigen::Vector2d> ReadYacCorners(const std::string&
     std::stringstream ss(line);
     std::string field;
     while (std::getline(ss, field, ',')) v.push_back(std::stod(field));
-    corners[{int(std::lround(v[7] * 1e4)), int(std::lround(v[8] * 1e4))}] = Eigen::Vector2d(v[5], v[6]);
+    corners[{int(std::lround(v[7] * 1e4)), int(std::lround(v[8] * 1e4))}] =
+        Eigen::Vector2d(v[5], v[6]);
   }
   return corners;
 }
@@ -287,8 +278,8 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
     const cv::Mat gray = cv::imread(images[i], cv::IMREAD_GRAYSCALE);
     const BoardDetection det = DetectBoard(gray, spec);
     ASSERT_TRUE(det.found) << images[i] << ": " << det.reason;
-    const auto ref = ReadYacCorners(data + "/grid0/cam0/data/" +
-                                    fs::path(images[i]).stem().string() + ".csv");
+    const auto ref =
+        ReadYacCorners(data + "/grid0/cam0/data/" + fs::path(images[i]).stem().string() + ".csv");
     reference += static_cast<int>(ref.size());
     for (const CornerObservation& c : det.corners) {
       const Eigen::Vector3d p = CornerPosition(spec, c.id);
@@ -299,8 +290,8 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
   std::sort(distances.begin(), distances.end());
   const double median = distances[distances.size() / 2];
   const double p90 = distances[distances.size() * 9 / 10];
-  std::cout << "matched " << distances.size() << " of " << reference << " reference corners; median "
-            << median << " px, p90 " << p90 << " px\n";
+  std::cout << "matched " << distances.size() << " of " << reference
+            << " reference corners; median " << median << " px, p90 " << p90 << " px\n";
   EXPECT_GT(distances.size(), 0.8 * reference);
   EXPECT_LT(median, 0.2);
   EXPECT_LT(p90, 0.4);

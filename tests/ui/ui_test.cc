@@ -2,6 +2,7 @@
 // backends (no GL), over a real painting worker on a small synthetic capture; the app's
 // project edits (undo/redo, save, grouping edits) and that `fresco run` honours them; and,
 // when xvfb-run is there, a real screenshot of the GL app.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 
@@ -322,6 +323,80 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".report.json")));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".coverage.png")));
+}
+
+// Every third image of aprilgrid-yac-mocap's cam0 (10 of 30): a real Kalibr AprilGrid.
+std::string AprilGridImages() {
+  static const std::string dir = [] {
+    const std::string data = fresco::testing::SharedDataDir() + "/aprilgrid-yac-mocap/cam0/data";
+    const std::string d = MakeTempDir("ui-calib-april") + "/cam0";
+    fs::create_directories(d);
+    std::vector<fs::path> images;
+    for (const auto& e : fs::directory_iterator(data))
+      if (e.path().extension() == ".jpg") images.push_back(e.path());
+    std::sort(images.begin(), images.end());
+    for (size_t i = 0; i < images.size(); i += 3)
+      fs::copy(images[i], d + "/" + images[i].filename().string());
+    return d;
+  }();
+  return dir;
+}
+
+// The same worker and the Calibration panel with an AprilGrid: partial boards detected tag by
+// tag, the solve, and the panel (drawn headless) showing the detections, coverage, residuals
+// and projection-uncertainty pictures and the chosen model.
+TEST(CalibrationRunner, AprilGridDetectsSolvesAndThePanelShowsIt) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  calib::CalibrateRequest request;
+  request.images_dir = AprilGridImages();
+  ASSERT_TRUE(calib::ParseBoardSpec("aprilgrid:6x6:0.088:0.3", "board", &request.board).ok());
+  request.model = "opencv4";
+  request.cross_validate = false;
+  CalibrationRunner runner;
+  runner.Detect(request);
+  runner.WaitIdle();
+  auto snap = runner.Snapshot();
+  ASSERT_EQ(snap->images.size(), 10u);
+  EXPECT_EQ(snap->run.views.size(), 10u) << snap->status;
+  for (const calib::BoardView& v : snap->run.views) {
+    EXPECT_GE(v.corners.size(), 40u) << v.name;  // tags of a 6x6 grid, some boards partial
+    EXPECT_LE(v.corners.size(), 144u) << v.name;
+  }
+  EXPECT_NE(snap->readiness.level, calib::DataReadiness::Level::kRed);
+  runner.Solve();
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  ASSERT_TRUE(snap->solved) << snap->status;
+  const calib::SolveResult& fit = snap->run.Chosen().fit;
+  EXPECT_EQ(fit.lensmodel, "LENSMODEL_OPENCV4");
+  EXPECT_NEAR(fit.intrinsics[0], 610.1, 0.02 * 610.1);  // all 30 images, CLI: 610.13
+  EXPECT_NEAR(fit.intrinsics[2], 325.9, 6.0);
+  EXPECT_LT(fit.rms_px, 0.4);
+  EXPECT_GT(snap->run.uncertainty.centre_px, 0);
+  EXPECT_FALSE(snap->uncertainty_picture.empty());
+
+  NullTextures textures;
+  UiContext ui{nullptr, nullptr, &runner, &textures, nullptr, nullptr, false};
+  ImGuiHeadless imgui;
+  std::unique_ptr<Panel> panel;
+  for (auto& p : MakePanels())
+    if (std::string(p->Title()) == kCalibrationPanelTitle) panel = std::move(p);
+  ASSERT_TRUE(panel);
+  for (int i = 0; i < 3; ++i) {
+    ImGui::NewFrame();
+    ImGui::SetNextWindowSize(ImVec2(900, 2400));
+    panel->Draw(ui);
+    ImGui::Render();
+  }
+  for (const char* key : {"calibration image", "calibration coverage", "calibration residuals",
+                          "calibration uncertainty"})
+    EXPECT_TRUE(textures.keys.count(key)) << key;
+  const auto report = panel->Report();
+  EXPECT_EQ(report.at("model"), "opencv4");
+  EXPECT_EQ(report.at("views"), "10");
+  EXPECT_NEAR(std::stod(report.at("fx")), fit.intrinsics[0], 1e-3);
+  EXPECT_GT(std::stod(report.at("uncertainty_max_px")),
+            std::stod(report.at("uncertainty_centre_px")));
 }
 
 TEST(CalibrationRunner, MissingFolderIsAnError) {

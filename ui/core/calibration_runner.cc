@@ -81,12 +81,14 @@ void CalibrationRunner::Loop() {
 void CalibrationRunner::UpdateReadiness() {
   const calib::CalibrationRun& run = working_.run;
   calib::CalibrationSeed seed;
-  const bool seeded =
-      working_.solved ||
-      (static_cast<int>(run.views.size()) >= calib::kMinViews &&
-       calib::SeedCalibration(run.views, working_.request.board, run.width, run.height, &seed).ok());
+  const bool seeded = working_.solved || (static_cast<int>(run.views.size()) >= calib::kMinViews &&
+                                          calib::SeedCalibration(run.views, working_.request.board,
+                                                                 run.width, run.height, &seed)
+                                              .ok());
   working_.readiness = calib::AssessReadiness(run.views, run.width, run.height,
-                                              working_.solved ? &run.seed : seeded ? &seed : nullptr);
+                                              working_.solved ? &run.seed
+                                              : seeded        ? &seed
+                                                              : nullptr);
   if (!run.views.empty()) working_.coverage_picture = calib::DrawCoverage(run);
 }
 
@@ -141,6 +143,7 @@ void CalibrationRunner::RunSolve() {
   working_.run = std::move(run);
   working_.solved = true;
   working_.residuals_picture = calib::DrawResiduals(working_.run);
+  working_.uncertainty_picture = calib::DrawUncertainty(working_.run);
   UpdateReadiness();
   const calib::ModelTrial& chosen = working_.run.Chosen();
   char line[160];
@@ -154,7 +157,8 @@ void CalibrationRunner::RunSave(const std::string& path) {
     working_.status = "error: solve before saving";
     return;
   }
-  if (Status s = calib::WriteCalibrationOutputs(path, working_.request, working_.run, {}); !s.ok()) {
+  if (Status s = calib::WriteCalibrationOutputs(path, working_.request, working_.run, {});
+      !s.ok()) {
     working_.status = "error: " + s.message();
     return;
   }

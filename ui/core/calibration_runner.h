@@ -21,26 +21,27 @@ namespace fresco {
 
 struct CalibrationImage {
   std::string path, name;
-  bool done = false;    // detection ran
-  bool used = false;    // the board was found: run.views[view]
+  bool done = false;  // detection ran
+  bool used = false;  // the board was found: run.views[view]
   int view = -1;
-  std::string reason;   // why rejected
+  std::string reason;  // why rejected
 };
 
 struct CalibrationSnapshot {
-  uint64_t version = 0;   // increases with every publish
-  std::string status;     // "", "detecting 3/13", "detected", "solving", "solved", "error: ..."
+  uint64_t version = 0;  // increases with every publish
+  std::string status;    // "", "detecting 3/13", "detected", "solving", "solved", "error: ..."
   bool busy = false;
   bool has_request = false;
   calib::CalibrateRequest request;
   std::vector<CalibrationImage> images;  // by name, as listed
   int images_done = 0;
-  calib::CalibrationRun run;             // views and rejected; after a solve, everything
+  calib::CalibrationRun run;  // views and rejected; after a solve, everything
   bool solved = false;
   calib::DataReadiness readiness;
-  cv::Mat coverage_picture;              // every detection so far
-  cv::Mat residuals_picture;             // after a solve
-  std::string saved_path;                // the last .cameramodel written
+  cv::Mat coverage_picture;     // every detection so far
+  cv::Mat residuals_picture;    // after a solve
+  cv::Mat uncertainty_picture;  // after a solve: projection uncertainty map
+  std::string saved_path;       // the last .cameramodel written
 };
 
 class CalibrationRunner {

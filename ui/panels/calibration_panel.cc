@@ -41,7 +41,8 @@ void TrafficLight(const DataReadiness& r) {
   ImGui::Text("%d views (min %d, want %d+)", r.views, calib::kMinViews, calib::kFewViews);
   ImGui::Text("coverage %.0f %% (want %.0f %%), tilt %s (want %.0f)", 100 * r.coverage_fraction,
               100 * calib::kMinCoverage,
-              r.max_tilt_deg < 0 ? "?" : Format("%.0f deg", r.max_tilt_deg).c_str(), calib::kMinTiltDeg);
+              r.max_tilt_deg < 0 ? "?" : Format("%.0f deg", r.max_tilt_deg).c_str(),
+              calib::kMinTiltDeg);
   for (const std::string& reason : r.reasons) ImGui::BulletText("%s", reason.c_str());
 }
 
@@ -65,7 +66,8 @@ class CalibrationPanel : public Panel {
     }
     const auto snap = ui.calibration->Snapshot();
     if (snap->has_request && folder_[0] == 0) TakeInputs(snap->request);
-    if (ImGui::BeginTable("calibration", 3, ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
+    if (ImGui::BeginTable("calibration", 3,
+                          ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
       ImGui::TableSetupColumn("controls", ImGuiTableColumnFlags_WidthStretch, 0.27f);
       ImGui::TableSetupColumn("pictures", ImGuiTableColumnFlags_WidthStretch, 0.35f);
       ImGui::TableSetupColumn("results", ImGuiTableColumnFlags_WidthStretch, 0.38f);
@@ -125,9 +127,10 @@ class CalibrationPanel : public Panel {
     ImGui::EndDisabled();
     DrawSavePopup(ui);
     if (!snap.images.empty())
-      ImGui::ProgressBar(snap.images_done / float(snap.images.size()), ImVec2(-1, 0),
-                         (std::to_string(snap.images_done) + "/" + std::to_string(snap.images.size()) +
-                          " images").c_str());
+      ImGui::ProgressBar(
+          snap.images_done / float(snap.images.size()), ImVec2(-1, 0),
+          (std::to_string(snap.images_done) + "/" + std::to_string(snap.images.size()) + " images")
+              .c_str());
     if (snap.status.rfind("error", 0) == 0)
       ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", snap.status.c_str());
     else
@@ -171,11 +174,14 @@ class CalibrationPanel : public Panel {
     }
     for (int i = 0; i < static_cast<int>(snap.images.size()); ++i) {
       const CalibrationImage& image = snap.images[i];
-      const ImVec4 colour = !image.done ? ImVec4(0.6f, 0.6f, 0.6f, 1)
+      const ImVec4 colour = !image.done  ? ImVec4(0.6f, 0.6f, 0.6f, 1)
                             : image.used ? ImVec4(0.5f, 0.9f, 0.5f, 1)
                                          : ImVec4(1, 0.5f, 0.4f, 1);
-      std::string label = image.name + (!image.done ? "  ..." : image.used ? "  used" : "  rejected");
-      if (image.used) label += " (" + std::to_string(snap.run.views[image.view].corners.size()) + " corners)";
+      std::string label = image.name + (!image.done  ? "  ..."
+                                        : image.used ? "  used"
+                                                     : "  rejected");
+      if (image.used)
+        label += " (" + std::to_string(snap.run.views[image.view].corners.size()) + " corners)";
       ImGui::PushStyleColor(ImGuiCol_Text, colour);
       if (ImGui::Selectable(label.c_str(), selected_ == i)) selected_ = i;
       ImGui::PopStyleColor();
@@ -204,7 +210,9 @@ class CalibrationPanel : public Panel {
         drawn_version_ = snap.version;
       }
       ImGui::Text("%s: %s", image.name.c_str(),
-                  image.used ? "detections" : image.reason.empty() ? "not detected yet" : image.reason.c_str());
+                  image.used             ? "detections"
+                  : image.reason.empty() ? "not detected yet"
+                                         : image.reason.c_str());
       ShowImage(ui, "calibration image", detections_, drawn_version_ * 1000 + shown);
     } else {
       ImGui::TextDisabled("(no image with a board yet)");
@@ -233,6 +241,13 @@ class CalibrationPanel : public Panel {
       ImGui::Separator();
       ImGui::TextUnformatted("Residual vectors (calib solve's residuals picture)");
       ShowImage(ui, "calibration residuals", snap.residuals_picture, snap.version);
+      const calib::UncertaintyMap& u = snap.run.uncertainty;
+      ImGui::Separator();
+      ImGui::Text(
+          "Projection uncertainty at %.2f m: centre %.3f px, where observed %.3f px, max %.3f px",
+          u.range_m, u.centre_px, u.median_observed_px, u.max_px);
+      if (!snap.uncertainty_picture.empty())
+        ShowImage(ui, "calibration uncertainty", snap.uncertainty_picture, snap.version);
     }
   }
 
@@ -250,7 +265,8 @@ class CalibrationPanel : public Panel {
     if (ImGui::IsItemHovered()) {
       const float x = (ImGui::GetIO().MousePos.x - ImGui::GetItemRectMin().x) /
                       std::max(1.0f, ImGui::GetItemRectSize().x);
-      const int v = std::clamp(static_cast<int>(x * rms.size()), 0, static_cast<int>(rms.size()) - 1);
+      const int v =
+          std::clamp(static_cast<int>(x * rms.size()), 0, static_cast<int>(rms.size()) - 1);
       ImGui::SetTooltip("%s: %.3f px, %d outliers", snap.run.views[v].name.c_str(), rms[v],
                         fit.views[v].outliers);
     }
@@ -260,12 +276,13 @@ class CalibrationPanel : public Panel {
     const calib::ModelTrial& chosen = snap.run.Chosen();
     const auto& k = chosen.fit.intrinsics;
     ImGui::Text("Chosen: %s", chosen.lensmodel.c_str());
-    if (k.size() >= 4)
-      ImGui::Text("fx %.2f  fy %.2f  cx %.2f  cy %.2f", k[0], k[1], k[2], k[3]);
+    if (k.size() >= 4) ImGui::Text("fx %.2f  fy %.2f  cx %.2f  cy %.2f", k[0], k[1], k[2], k[3]);
     ImGui::Text("rms %.4f px over %zu images", chosen.fit.rms_px, snap.run.views.size());
-    const ImGuiTableFlags flags = ImGuiTableFlags_RowBg | ImGuiTableFlags_Borders | ImGuiTableFlags_SizingFixedFit;
+    const ImGuiTableFlags flags =
+        ImGuiTableFlags_RowBg | ImGuiTableFlags_Borders | ImGuiTableFlags_SizingFixedFit;
     if (!ImGui::BeginTable("models", 5, flags)) return;
-    for (const char* h : {"model", "rms px", "sigma px", "cross-val px", "verdict"}) ImGui::TableSetupColumn(h);
+    for (const char* h : {"model", "rms px", "sigma px", "cross-val px", "verdict"})
+      ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
     for (int i = 0; i < static_cast<int>(snap.run.choice.trials.size()); ++i) {
       const calib::ModelTrial& t = snap.run.choice.trials[i];
@@ -308,6 +325,8 @@ class CalibrationPanel : public Panel {
       report_["rms_px"] = Format("%.6f", snap.run.Chosen().fit.rms_px);
       report_["fx"] = Format("%.6f", snap.run.Chosen().fit.intrinsics[0]);
       report_["models_tried"] = std::to_string(snap.run.choice.trials.size());
+      report_["uncertainty_centre_px"] = Format("%.6f", snap.run.uncertainty.centre_px);
+      report_["uncertainty_max_px"] = Format("%.6f", snap.run.uncertainty.max_px);
     }
   }
 
