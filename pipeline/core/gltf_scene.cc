@@ -402,7 +402,16 @@ class GltfLoader {
         }
       }
     } else {
-      out->values.assign(acc.count * components, 0.0);  // glTF: no bufferView = zeros
+      // glTF: no bufferView = zeros (then sparse values). Nothing in the file backs them, so
+      // a 200-byte file could ask for gigabytes (a hand-made input run through
+      // tests/fuzz/gltf_fuzz): capped.
+      constexpr size_t kMaxZeroValues = size_t{1} << 24;
+      if (acc.count * components > kMaxZeroValues) {
+        return Error(where + ": count " + std::to_string(acc.count) +
+                     " without a bufferView is too large (at most " +
+                     std::to_string(kMaxZeroValues / components) + ")");
+      }
+      out->values.assign(acc.count * components, 0.0);
     }
     if (acc.sparse.isSparse) {
       const auto& sparse = acc.sparse;
@@ -776,8 +785,8 @@ bool HasGlbMagic(const std::string& bytes) {
 }
 
 // tinygltf reads `extras` and `extensions` values recursively, one stack frame per level:
-// deep nesting ("[[[[...") overflowed the stack (found by tests/fuzz/gltf_fuzz). Real glTF
-// nests about ten levels.
+// deep nesting ("[[[[...") overflowed the stack (a hand-made input run through
+// tests/fuzz/gltf_fuzz). Real glTF nests about ten levels.
 constexpr int kMaxJsonDepth = 128;
 
 // The deepest nesting of arrays and objects in `json` (brackets inside strings do not count).
