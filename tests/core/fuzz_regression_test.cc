@@ -62,7 +62,10 @@ TEST(FuzzRegressionTest, DeeplyNestedGltfJsonIsAnError) {
   }
   // Brackets inside strings do not count, and ordinary nesting still loads (as an empty scene
   // without triangles, which is its own error).
-  const std::string strings = GltfWithExtras("\"" + Nested("[", "]", 1000) + "\\\"[\"");
+  std::string quoted = "\"";  // a string holding brackets (and an escaped quote)
+  quoted += Nested("[", "]", 1000);
+  quoted += "\\\"[\"";
+  const std::string strings = GltfWithExtras(quoted);
   const std::string shallow = GltfWithExtras(Nested("[", "]", 100));
   for (const std::string& json : {strings, shallow}) {
     Scene scene;
