@@ -27,7 +27,10 @@ struct Value {
   enum Kind { kString, kScalar, kList, kDict } kind = kScalar;
   std::string text;                                   // kString: contents; kScalar: token
   std::vector<Value> items;                           // kList
-  std::vector<std::pair<std::string, Value>> fields;  // kDict, in file order
+  // kDict, in file order, each with its `key` (not a vector of pairs: a pair of an
+  // incomplete type is ill-formed, and clang's libstdc++ checks refuse it).
+  std::vector<Value> fields;
+  std::string key;  // a kDict field's name
   int line = 0;
 };
 
@@ -110,7 +113,8 @@ class DictParser {
         ++pos_;
         Value item;
         FRESCO_RETURN_IF_ERROR(ParseValue(&item, depth + 1));
-        value->fields.emplace_back(key.text, std::move(item));
+        item.key = key.text;
+        value->fields.push_back(std::move(item));
         SkipSpace();
         if (Peek(',')) {
           ++pos_;
@@ -160,8 +164,8 @@ class DictParser {
 };
 
 const Value* FindField(const Value& dict, const std::string& key) {
-  for (const auto& [name, value] : dict.fields)
-    if (name == key) return &value;
+  for (const Value& field : dict.fields)
+    if (field.key == key) return &field;
   return nullptr;
 }
 

@@ -126,6 +126,10 @@ Status ParsePointsLine(const std::string& path, const text::Line& line, PosedIma
 Status ReadColmapCameras(const std::string& path, std::map<int, Camera>* cameras) {
   std::string contents;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &contents));
+  return ParseColmapCameras(contents, path, cameras);
+}
+
+Status ParseColmapCameras(const std::string& contents, const std::string& path, std::map<int, Camera>* cameras) {
   std::map<int, Camera> result;
   std::map<int, int> line_of_id;
   for (const text::Line& line : text::SplitLines(contents)) {
@@ -148,6 +152,10 @@ Status ReadColmapCameras(const std::string& path, std::map<int, Camera>* cameras
 Status ReadColmapImages(const std::string& path, std::vector<PosedImage>* images) {
   std::string contents;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &contents));
+  return ParseColmapImages(contents, path, images);
+}
+
+Status ParseColmapImages(const std::string& contents, const std::string& path, std::vector<PosedImage>* images) {
   const std::vector<text::Line> lines = text::SplitLines(contents);
   std::vector<PosedImage> result;
   std::map<int, int> line_of_id;
@@ -197,6 +205,10 @@ Status ReadColmapImages(const std::string& path, std::vector<PosedImage>* images
 Status ReadColmapPoints(const std::string& path, std::vector<Point3D>* points) {
   std::string contents;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &contents));
+  return ParseColmapPoints(contents, path, points);
+}
+
+Status ParseColmapPoints(const std::string& contents, const std::string& path, std::vector<Point3D>* points) {
   std::vector<Point3D> result;
   std::map<long long, int> line_of_id;
   for (const text::Line& line : text::SplitLines(contents)) {

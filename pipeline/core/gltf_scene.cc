@@ -8,11 +8,11 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <tuple>
 
 #include <tiny_gltf.h>
@@ -402,7 +402,16 @@ class GltfLoader {
         }
       }
     } else {
-      out->values.assign(acc.count * components, 0.0);  // glTF: no bufferView = zeros
+      // glTF: no bufferView = zeros (then sparse values). Nothing in the file backs them, so
+      // a 200-byte file could ask for gigabytes (a hand-made input run through
+      // tests/fuzz/gltf_fuzz): capped.
+      constexpr size_t kMaxZeroValues = size_t{1} << 24;
+      if (acc.count * components > kMaxZeroValues) {
+        return Error(where + ": count " + std::to_string(acc.count) +
+                     " without a bufferView is too large (at most " +
+                     std::to_string(kMaxZeroValues / components) + ")");
+      }
+      out->values.assign(acc.count * components, 0.0);
     }
     if (acc.sparse.isSparse) {
       const auto& sparse = acc.sparse;
@@ -771,11 +780,47 @@ class GltfLoader {
   std::vector<char> on_path_;                    // cycle detection
 };
 
-bool HasGlbMagic(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  in.read(magic, 4);
-  return in.gcount() == 4 && std::memcmp(magic, "glTF", 4) == 0;
+bool HasGlbMagic(const std::string& bytes) {
+  return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
+
+// tinygltf reads `extras` and `extensions` values recursively, one stack frame per level:
+// deep nesting ("[[[[...") overflowed the stack (a hand-made input run through
+// tests/fuzz/gltf_fuzz). Real glTF nests about ten levels.
+constexpr int kMaxJsonDepth = 128;
+
+// The deepest nesting of arrays and objects in `json` (brackets inside strings do not count).
+int JsonNestingDepth(std::string_view json) {
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < json.size(); ++i) {
+    const char c = json[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;
+      } else if (c == '"') {
+        in_string = false;
+      }
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return deepest;
+}
+
+// The JSON text of a glTF file: all of it, or a GLB's JSON chunk (empty when the GLB header
+// is broken: tinygltf reports that).
+std::string_view GltfJson(const std::string& bytes, bool binary) {
+  if (!binary) return bytes;
+  uint32_t length = 0;
+  if (bytes.size() < 20) return {};
+  std::memcpy(&length, bytes.data() + 12, 4);
+  if (length > bytes.size() - 20) return {};
+  return std::string_view(bytes).substr(20, length);
 }
 
 }  // namespace
@@ -783,15 +828,35 @@ bool HasGlbMagic(const std::string& path) {
 Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, Scene* scene) {
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return Status::Error(path + ": file not found");
+  std::string bytes;
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &bytes));
+  return ParseGltfScene(bytes, path, fs::path(path).parent_path().string(), options, scene);
+}
+
+Status ParseGltfScene(const std::string& bytes, const std::string& path,
+                      const std::string& base_dir, const SceneLoadOptions& options,
+                      Scene* scene) {
   if (!(options.min_triangle_area_m2 >= 0.0)) {
     return Status::Error(path + ": min_triangle_area_m2 must be >= 0");
+  }
+  if (bytes.size() > std::numeric_limits<unsigned int>::max()) {
+    return Status::Error(path + ": larger than 4 GB, which tinygltf cannot read");
   }
   tinygltf::TinyGLTF io;
   tinygltf::Model model;
   std::string err, warn;
-  const bool binary = HasGlbMagic(path);
-  const bool parsed = binary ? io.LoadBinaryFromFile(&model, &err, &warn, path)
-                             : io.LoadASCIIFromFile(&model, &err, &warn, path);
+  const bool binary = HasGlbMagic(bytes);
+  if (JsonNestingDepth(GltfJson(bytes, binary)) > kMaxJsonDepth) {
+    return Status::Error(path + ": cannot parse " + (binary ? "GLB" : "glTF") +
+                         ": JSON nested more than " + std::to_string(kMaxJsonDepth) +
+                         " levels deep");
+  }
+  const auto length = static_cast<unsigned int>(bytes.size());
+  const bool parsed =
+      binary ? io.LoadBinaryFromMemory(&model, &err, &warn,
+                                       reinterpret_cast<const unsigned char*>(bytes.data()),
+                                       length, base_dir)
+             : io.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
   if (!parsed) {
     std::string why = OneLine(err);
     if (why.empty()) why = OneLine(warn);

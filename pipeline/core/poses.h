@@ -44,6 +44,13 @@ struct ColmapModel {
 Status ReadColmapCameras(const std::string& path, std::map<int, Camera>* cameras);
 Status ReadColmapImages(const std::string& path, std::vector<PosedImage>* images);
 Status ReadColmapPoints(const std::string& path, std::vector<Point3D>* points);
+// The same from text already in memory; `path` names the source in messages.
+Status ParseColmapCameras(const std::string& contents, const std::string& path,
+                          std::map<int, Camera>* cameras);
+Status ParseColmapImages(const std::string& contents, const std::string& path,
+                         std::vector<PosedImage>* images);
+Status ParseColmapPoints(const std::string& contents, const std::string& path,
+                         std::vector<Point3D>* points);
 // `folder` holds cameras.txt, images.txt and (optionally) points3D.txt.
 Status ReadColmapModel(const std::string& folder, ColmapModel* model);
 // The COLMAP model name and parameters (COLMAP order and pixel convention, principal point
@@ -57,6 +64,9 @@ Status WriteColmapPoints(const std::string& path, const std::vector<Point3D>& po
 Status WriteColmapModel(const std::string& folder, const ColmapModel& model);
 
 Status ReadTumTrajectory(const std::string& path, std::vector<PosedImage>* poses);
+// The same from text already in memory; `path` names the source in messages.
+Status ParseTumTrajectory(const std::string& contents, const std::string& path,
+                          std::vector<PosedImage>* poses);
 Status WriteTumTrajectory(const std::string& path, const std::vector<PosedImage>& poses);
 
 // Reads poses from a COLMAP images.txt, a COLMAP model folder, or a TUM file (decided by

@@ -92,6 +92,11 @@ struct SceneLoadOptions {
 //   primitive has none. Textures: those used as baseColorTexture, in the file's texture
 //   order, decoded to RGBA8 (16-bit images scaled, grey/RGB expanded).
 Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, Scene* scene);
+// The same from the file's bytes already in memory (GLB when they start with "glTF", else
+// glTF JSON); relative URIs resolve against `base_dir`, and `path` names the source in
+// messages and becomes Scene::source_path.
+Status ParseGltfScene(const std::string& bytes, const std::string& path,
+                      const std::string& base_dir, const SceneLoadOptions& options, Scene* scene);
 
 // Writes `scene` as glTF 2.0 (`.gltf` + `.bin` + one PNG per texture beside it), atomically
 // per file. Geometry is written in world coordinates relative to origin via a node

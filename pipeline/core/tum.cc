@@ -23,6 +23,11 @@ std::string TumName(int index) {
 Status ReadTumTrajectory(const std::string& path, std::vector<PosedImage>* poses) {
   std::string contents;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &contents));
+  return ParseTumTrajectory(contents, path, poses);
+}
+
+Status ParseTumTrajectory(const std::string& contents, const std::string& path,
+                          std::vector<PosedImage>* poses) {
   std::vector<PosedImage> result;
   for (const text::Line& line : text::SplitLines(contents)) {
     if (text::IsBlankOrComment(line.text)) continue;
