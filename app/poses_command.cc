@@ -34,6 +34,10 @@ const char* kColmapOptionsHelp =
     "  --scene-size-m M     scene size for the position threshold (default: the diagonal of\n"
     "                       the scene's bounding box)\n"
     "  --colmap PROGRAM     the colmap program (default: `colmap` on PATH)\n"
+    "  --colmap-model DIR   do not run COLMAP: use the text model of an earlier run (e.g.\n"
+    "                       OUT/colmap/sparse_txt/0 of `fresco poses verify`)\n"
+    "  --max-features N     at most N SIFT features per image (default: COLMAP's 8192);\n"
+    "                       fewer is faster (matching time grows with N squared)\n"
     "  --threads N          threads for COLMAP (default: all cores)\n"
     "  --quiet              no progress on stderr\n"
     "The COLMAP workspace is DIR/colmap/: its exact commands in commands.txt, each step's\n"
@@ -44,7 +48,7 @@ ArgSpec PosesArgSpec(const std::string& sub) {
   spec.min_positional = 2;
   spec.max_positional = 2;
   spec.options = {"--out",        "--every",  "--max-frames", "--max-image-size", "--matcher",
-                  "--scene-size-m", "--colmap", "--threads"};
+                  "--scene-size-m", "--colmap", "--threads", "--colmap-model", "--max-features"};
   spec.switches = {"--quiet"};
   spec.required = {"--out"};
   if (sub == "verify") {
@@ -116,6 +120,8 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
   if ((code = IntOption(args, spec, "--max-image-size", 0, &options.colmap.max_image_size)) >= 0)
     return code;
   if ((code = IntOption(args, spec, "--threads", 0, &options.colmap.threads)) >= 0) return code;
+  if ((code = IntOption(args, spec, "--max-features", 0, &options.colmap.max_num_features)) >= 0)
+    return code;
   if ((code = PositiveDoubleOption(args, spec, "--scene-size-m", &options.scene_size_m)) >= 0)
     return code;
   const std::string matcher = args.Get("--matcher", "auto");
@@ -130,7 +136,12 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
                                        matcher + "'");
   }
   options.colmap.program = args.Get("--colmap");
-  if (FindColmap(options.colmap.program).empty()) {
+  options.existing_model = args.Get("--colmap-model");
+  if (!options.existing_model.empty() && !fs::is_directory(options.existing_model)) {
+    std::cerr << "error: " << options.existing_model << ": --colmap-model: no such folder\n";
+    return kExitBadInput;
+  }
+  if (options.existing_model.empty() && FindColmap(options.colmap.program).empty()) {
     std::cerr << "error: " << (options.colmap.program.empty() ? "colmap" : options.colmap.program)
               << ": program not found on PATH (install Debian's `colmap` package, or pass "
                  "--colmap PATH)\n";

@@ -22,6 +22,10 @@ struct ProjectColmapOptions {
   // (the scene is then loaded).
   double scene_size_m = 0.0;
   ColmapRunOptions colmap;  // workspace, image_path, image_names, camera are filled in
+  // A COLMAP text model folder from an earlier run (e.g. OUT/colmap/sparse_txt/0 of
+  // `fresco poses verify`) to use instead of running COLMAP; "" = run COLMAP. Its images are
+  // matched to the frames by name.
+  std::string existing_model;
 };
 
 struct ProjectColmapFrame {

@@ -61,7 +61,8 @@ TEST(Similarity, RobustFitIgnoresOutliersThatBendLeastSquares) {
   std::vector<Eigen::Vector3d> dst;
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.002);
-  for (const auto& p : src) dst.push_back(truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  for (const auto& p : src)
+    dst.push_back(truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
   // 9 of 30 (30 %) are wrong by 1..3 m.
   for (int i = 0; i < 30; i += 3) dst[i] += Eigen::Vector3d(1.0 + i * 0.07, -2.0, 0.5);
   Sim3d plain;
@@ -123,9 +124,8 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   std::normal_distribution<double> small(0.0, 1.0);
   for (int i = 0; i < n; ++i) {
     // COLMAP's own error: ~0.03 deg, ~1 mm.
-    const Rigid3d noisy =
-        Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
-                  Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    const Rigid3d noisy = Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
+                                    Eigen::Vector3d(small(rng), small(rng), small(rng)));
     colmap.push_back(InColmapFrame(noisy, world_from_colmap));
   }
   const double scene_size_m = 6.0;  // position threshold 6 cm at 1 %
@@ -133,7 +133,8 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   given[5] = Perturbed(truth[5], 1.0, 0.0, Eigen::Vector3d(0, 1, 0));
   given[12] = Perturbed(truth[12], 0.0, 0.02 * scene_size_m, Eigen::Vector3d(1, 1, 0));
   given[20] = Perturbed(truth[20], 1.0, 0.02 * scene_size_m, Eigen::Vector3d(0, 0, 1));
-  given[31] = Perturbed(truth[31], 1.2, 0.0, truth[31].rotation.conjugate() * Eigen::Vector3d::UnitZ());
+  given[31] =
+      Perturbed(truth[31], 1.2, 0.0, truth[31].rotation.conjugate() * Eigen::Vector3d::UnitZ());
   std::vector<VerifyFrameInput> inputs;
   for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &given[i], &colmap[i]});
   inputs[37].colmap_cam_from_colmap = nullptr;  // not registered
@@ -158,6 +159,39 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   }
 }
 
+TEST(Alignment, PosesSlightlyOffWithinTheThresholdsStopBendingTheFit) {
+  // 30 frames; COLMAP's own error ~0.02 deg, ~1 mm; 6 given poses 4 cm off the same way:
+  // inside the 5 cm inlier threshold, so the first fit takes them in; the adaptive one
+  // (3 x the inliers' median error) leaves them out.
+  const int n = 30;
+  const auto truth = ArcPoses(n);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  std::mt19937 rng(9);
+  std::normal_distribution<double> small(0.0, 1.0);
+  std::vector<PosePair> pairs;
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d noisy = Perturbed(truth[i], 0.02 * small(rng), 0.001 * small(rng),
+                                    Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    const Rigid3d given =
+        i % 5 == 0 ? Perturbed(truth[i], 0.0, 0.04, Eigen::Vector3d(0, 1, 0)) : truth[i];
+    pairs.push_back({std::to_string(i), given, InColmapFrame(noisy, world_from_colmap)});
+  }
+  auto translation_error = [&](const PoseAlignment& a) {
+    return (a.world_from_colmap.translation - world_from_colmap.translation).norm();
+  };
+  PoseAlignmentOptions options;  // 5 cm, 0.5 deg
+  options.adaptive_factor = 0.0;
+  PoseAlignment plain, adaptive;
+  ASSERT_TRUE(AlignColmapToPoses(pairs, options, &plain).ok());
+  EXPECT_EQ(plain.num_inliers, n);
+  EXPECT_GT(translation_error(plain), 0.005);  // bent by the 6 poses
+  options.adaptive_factor = 3.0;
+  ASSERT_TRUE(AlignColmapToPoses(pairs, options, &adaptive).ok());
+  EXPECT_EQ(adaptive.num_inliers, n - 6);
+  for (int i = 0; i < n; ++i) EXPECT_EQ(adaptive.inliers[i], i % 5 != 0) << i;
+  EXPECT_LT(translation_error(adaptive), 0.003);
+}
+
 TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   // The reconstruction's scale drifts from 1 to 1.6 along the sequence (as on long walks):
   // each step between cameras is reconstructed with the scale of its time.
@@ -169,9 +203,10 @@ TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   for (int i = 0; i < n; ++i) {
     if (i > 0) {
       const double drift = 1.0 + 0.6 * i / (n - 1);
-      centre_in_colmap += drift * (world_from_colmap.rotation.conjugate() *
-                                   (truth[i].Centre() - truth[i - 1].Centre())) /
-                          world_from_colmap.scale;
+      centre_in_colmap +=
+          drift *
+          (world_from_colmap.rotation.conjugate() * (truth[i].Centre() - truth[i - 1].Centre())) /
+          world_from_colmap.scale;
     }
     const Eigen::Quaterniond rotation = truth[i].rotation * world_from_colmap.rotation;
     colmap.push_back(Rigid3d(rotation, -(rotation * centre_in_colmap)));
@@ -198,16 +233,16 @@ TEST(ControlPoints, TriangulatedPointsAlignTheReconstruction) {
     PosedImage image;
     image.image_id = i + 1;
     image.camera_id = 1;
-    image.name = "f" + std::to_string(i) + ".png";
+    image.name = std::string("f").append(std::to_string(i)).append(".png");
     image.cam_from_world = InColmapFrame(truth[i], world_from_colmap);
     model.images.push_back(image);
   }
   std::vector<ControlPoint> points;
-  const std::vector<Eigen::Vector3d> world = {{0.3, 0.2, -0.1}, {-0.4, -0.2, 0.3}, {0.1, 0.5, 0.4},
-                                              {-0.2, 0.1, -0.5}};
+  const std::vector<Eigen::Vector3d> world = {
+      {0.3, 0.2, -0.1}, {-0.4, -0.2, 0.3}, {0.1, 0.5, 0.4}, {-0.2, 0.1, -0.5}};
   for (size_t k = 0; k < world.size(); ++k) {
     ControlPoint p;
-    p.name = "p" + std::to_string(k);
+    p.name = std::string("p").append(std::to_string(k));
     p.point_in_world = world[k];
     for (int i : {2, 9, 17}) {
       Eigen::Vector2d pixel;
