@@ -22,7 +22,7 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
   if (options.max_frames < 0) return Status::Error("max_frames: must be >= 0");
   if (options.scene_size_m < 0) return Status::Error("scene_size_m: must be >= 0");
   CaptureLoadOptions load;
-  load.load_scene = options.scene_size_m == 0.0;
+  load.load_scene = options.scene_size_m == 0.0 || options.load_scene;
   load.require_poses = false;
   FRESCO_RETURN_IF_ERROR(LoadCapture(project, load, &result->capture));
   Capture& capture = result->capture;

@@ -181,16 +181,18 @@ TEST_F(PosesColmapTest, BootstrapFromRoughPosesIsCloseToTheTruth) {
   EXPECT_EQ(b["inliers"].get<int>(), kFrames - 3);
 }
 
-// Control points: NAME X Y Z then (IMAGE U V) in 2-3 frames where the point projects.
+// Control points: NAME X Y Z (`written`) then (IMAGE U V) in 2-3 frames where the true
+// point (`world`) projects.
 std::string ControlPointsText(const std::vector<Eigen::Vector3d>& world,
+                              const std::vector<Eigen::Vector3d>& written,
                               const std::vector<PosedImage>& truth, const Camera& camera,
                               int* points) {
   std::string text = "# name X Y Z image u v ...\n";
   *points = 0;
   for (size_t k = 0; k < world.size(); ++k) {
     char head[128];
-    std::snprintf(head, sizeof(head), "p%zu %.6f %.6f %.6f", k, world[k].x(), world[k].y(),
-                  world[k].z());
+    std::snprintf(head, sizeof(head), "p%zu %.6f %.6f %.6f", k, written[k].x(), written[k].y(),
+                  written[k].z());
     std::string line = head;
     int seen = 0;
     for (int i = static_cast<int>(k) % 3; i < kFrames && seen < 3; i += 5) {
@@ -226,7 +228,7 @@ TEST_F(PosesColmapTest, BootstrapFromControlPointsWithoutPoses) {
   const std::vector<Eigen::Vector3d> world = {
       {-1.5, 0.0, -1.0}, {1.5, 0.0, -1.2}, {1.2, 0.0, 1.5}, {-1.0, 1.0, 0.5}, {0.3, 1.5, -0.2}};
   int points = 0;
-  const std::string text = ControlPointsText(world, Truth(), camera, &points);
+  const std::string text = ControlPointsText(world, world, Truth(), camera, &points);
   ASSERT_GE(points, 3) << text;
   WriteText(dir + "/control.txt", text);
   WriteText(dir + "/empty_images.txt", "# no poses\n");
@@ -252,6 +254,39 @@ TEST_F(PosesColmapTest, BootstrapFromControlPointsWithoutPoses) {
   EXPECT_LT(position_m, 0.01 * scene_size_m_);
   std::cout << "bootstrap (control points): max " << rotation_deg << " deg, " << position_m
             << " m\n";
+
+  // Control points measured roughly (each 6-10 cm off): the alignment is off; ICP of
+  // COLMAP's sparse points to the mesh (--refine-mesh) brings it back.
+  std::vector<Eigen::Vector3d> rough = world;
+  for (size_t k = 0; k < rough.size(); ++k) {
+    const double sign = k % 2 ? 1.0 : -1.0;
+    rough[k] += Eigen::Vector3d(0.06 * sign, 0.08, -0.07 * sign);
+  }
+  WriteText(dir + "/rough.txt", ControlPointsText(world, rough, Truth(), camera, &points));
+  double plain_rotation = 0, plain_position = 0, icp_rotation = 0, icp_position = 0;
+  for (const bool icp : {false, true}) {
+    const std::string out = dir + (icp ? "/rough-icp" : "/rough");
+    std::vector<std::string> args = {
+        "poses",       "bootstrap",        dir + "/project.json", "--out",
+        out,           "--control-points", dir + "/rough.txt",    "--colmap-model",
+        ColmapModel(), "--quiet"};
+    if (icp) args.push_back("--refine-mesh");
+    const auto rr = RunFresco(args);
+    ASSERT_EQ(rr.exit_code, 0) << rr.err;
+    BootstrapErrors(out, &posed, icp ? &icp_rotation : &plain_rotation,
+                    icp ? &icp_position : &plain_position);
+  }
+  std::cout << "bootstrap (rough control points): max " << plain_rotation << " deg, "
+            << plain_position << " m; with mesh ICP " << icp_rotation << " deg, " << icp_position
+            << " m\n";
+  EXPECT_GT(plain_position, 0.03);  // the rough points do move it
+  EXPECT_LT(icp_rotation, 0.2);
+  EXPECT_LT(icp_position, 0.01 * scene_size_m_);
+  EXPECT_LT(icp_position, 0.5 * plain_position);
+  const nlohmann::json b = nlohmann::json::parse(ReadText(dir + "/rough-icp/bootstrap.json"));
+  EXPECT_GT(b["mesh_icp"]["pairs"].get<int>(), 1000);
+  EXPECT_LT(b["mesh_icp"]["median_distance_after_m"].get<double>(),
+            b["mesh_icp"]["median_distance_before_m"].get<double>());
 }
 
 TEST(PosesCli, ErrorsAreClear) {

@@ -3,14 +3,17 @@
 // verification flags (injected errors on chosen frames), control-point alignment, the
 // control-point file reader.
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/mesh_icp.h"
 #include "pipeline/poses/pose_alignment.h"
 #include "pipeline/poses/similarity.h"
 #include "pipeline/poses/verify.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 
@@ -221,6 +224,80 @@ TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   options.window_frames = 10;
   ASSERT_TRUE(VerifyPoses(inputs, 6.0, options, &local).ok());
   EXPECT_EQ(local.flagged, 0);
+}
+
+// Points on the blocks scene's surfaces (area-weighted), 2 mm noise, and 10 % outliers up
+// to 1 m off the model (as COLMAP's sparse points: mostly on the model, some not).
+std::vector<Eigen::Vector3d> PointsOnMesh(const Scene& scene, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<double> areas;
+  for (int t = 0; t < scene.mesh.NumTriangles(); ++t) areas.push_back(scene.mesh.Area(t));
+  std::discrete_distribution<int> triangle(areas.begin(), areas.end());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    const int t = triangle(rng);
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const TriangleMesh& m = scene.mesh;
+    Eigen::Vector3d p =
+        scene.WorldFromLocal(m.Corner(t, 0) + a * (m.Corner(t, 1) - m.Corner(t, 0)) +
+                             b * (m.Corner(t, 2) - m.Corner(t, 0)));
+    p += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    if (i % 10 == 0) p += Eigen::Vector3d(u(rng) - 0.5, u(rng), u(rng) - 0.5);
+    points.push_back(p);
+  }
+  return points;
+}
+
+TEST(MeshIcp, PullsASlightlyWrongAlignmentOntoTheModel) {
+  Scene scene;
+  ASSERT_TRUE(MakeBlocksScene(BlocksOptions(), &scene).ok());
+  const Sim3d truth = SomeSimilarity();  // world_from_colmap
+  std::vector<Eigen::Vector3d> in_colmap;
+  for (const Eigen::Vector3d& p : PointsOnMesh(scene, 3000, 4)) {
+    in_colmap.push_back(truth.Inverse() * p);
+  }
+  // Off by 1 deg, 1 % in scale and 5 cm: what a few rough control points give.
+  Sim3d initial = truth;
+  initial.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized())) *
+      truth.rotation;
+  initial.scale *= 1.01;
+  initial.translation += Eigen::Vector3d(0.03, -0.02, 0.035);
+  auto centre_error = [&](const Sim3d& s) {  // worst over the ground's corners and the blocks
+    double worst = 0;
+    for (const Eigen::Vector3d& w :
+         {Eigen::Vector3d(-3, 0, -3), Eigen::Vector3d(3, 1.5, 3), Eigen::Vector3d(0, 1, 0)}) {
+      worst = std::max(worst, (s * (truth.Inverse() * w) - w).norm());
+    }
+    return worst;
+  };
+  EXPECT_GT(centre_error(initial), 0.08);
+  MeshIcpOptions options;
+  options.max_distance_m = 0.2;
+  MeshIcpResult result;
+  ASSERT_TRUE(AlignPointsToMesh(in_colmap, scene, initial, options, &result).ok());
+  EXPECT_LT(RotationErrorDeg(result.world_from_colmap, truth), 0.05);
+  EXPECT_NEAR(result.world_from_colmap.scale / truth.scale, 1.0, 0.001);
+  EXPECT_LT(centre_error(result.world_from_colmap), 0.005);
+  EXPECT_GT(result.median_distance_before_m, 0.02);
+  EXPECT_LT(result.median_distance_after_m, 0.003);
+  std::cout << "mesh ICP: " << result.iterations << " iterations, median distance "
+            << result.median_distance_before_m << " -> " << result.median_distance_after_m
+            << " m\n";
+  EXPECT_GT(result.pairs, 2400);  // most on-model points, few outliers
+  EXPECT_LT(result.pairs, 2950);
+  // Already right: it stays right.
+  ASSERT_TRUE(AlignPointsToMesh(in_colmap, scene, truth, options, &result).ok());
+  EXPECT_LT(centre_error(result.world_from_colmap), 0.003);
+  // No point near the model: a clear error.
+  Sim3d far = truth;
+  far.translation += Eigen::Vector3d(0, 50, 0);
+  const Status none = AlignPointsToMesh(in_colmap, scene, far, options, &result);
+  EXPECT_FALSE(none.ok());
+  EXPECT_NE(none.message().find("near the model"), std::string::npos) << none.message();
 }
 
 TEST(ControlPoints, TriangulatedPointsAlignTheReconstruction) {
