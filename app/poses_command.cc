@@ -12,6 +12,7 @@
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/mesh_icp.h"
 #include "pipeline/poses/project_colmap.h"
 #include "pipeline/poses/verify.h"
 #include "pipeline/poses/verify_report.h"
@@ -34,6 +35,10 @@ const char* kColmapOptionsHelp =
     "  --scene-size-m M     scene size for the position threshold (default: the diagonal of\n"
     "                       the scene's bounding box)\n"
     "  --colmap PROGRAM     the colmap program (default: `colmap` on PATH)\n"
+    "  --colmap-model DIR   do not run COLMAP: use the text model of an earlier run (e.g.\n"
+    "                       OUT/colmap/sparse_txt/0 of `fresco poses verify`)\n"
+    "  --max-features N     at most N SIFT features per image (default: COLMAP's 8192);\n"
+    "                       fewer is faster (matching time grows with N squared)\n"
     "  --threads N          threads for COLMAP (default: all cores)\n"
     "  --quiet              no progress on stderr\n"
     "The COLMAP workspace is DIR/colmap/: its exact commands in commands.txt, each step's\n"
@@ -43,8 +48,9 @@ ArgSpec PosesArgSpec(const std::string& sub) {
   ArgSpec spec;
   spec.min_positional = 2;
   spec.max_positional = 2;
-  spec.options = {"--out",        "--every",  "--max-frames", "--max-image-size", "--matcher",
-                  "--scene-size-m", "--colmap", "--threads"};
+  spec.options = {"--out",          "--every",        "--max-frames", "--max-image-size",
+                  "--matcher",      "--scene-size-m", "--colmap",     "--threads",
+                  "--colmap-model", "--max-features"};
   spec.switches = {"--quiet"};
   spec.required = {"--out"};
   if (sub == "verify") {
@@ -64,20 +70,27 @@ ArgSpec PosesArgSpec(const std::string& sub) {
   } else {
     spec.usage =
         "fresco poses bootstrap PROJECT.json --out DIR [--control-points FILE] [OPTIONS...]";
-    spec.options.insert({"--control-points", "--inlier-position", "--inlier-rotation-deg"});
-    spec.help = std::string(
-                    "Runs COLMAP on the project's frames and writes poses for every registered\n"
-                    "frame, aligned to the scene: DIR/sparse/{cameras,images,points3D}.txt and\n"
-                    "DIR/project.json (the input project pointing at them; the input is never\n"
-                    "overwritten), DIR/bootstrap.json (alignment, registered frames).\n"
-                    "  --control-points FILE     align with >= 3 known world points instead of\n"
-                    "                            the project's poses. One per line:\n"
-                    "                            NAME X Y Z IMAGE U V [IMAGE U V ...]\n"
-                    "                            (metres; pixels, (0,0) = centre of top-left)\n"
-                    "  --inlier-position F       given poses within F x scene size support the\n"
-                    "                            alignment (default 0.02)\n"
-                    "  --inlier-rotation-deg X   ...and within X degrees (default 2)\n") +
-                kColmapOptionsHelp;
+    spec.options.insert({"--control-points", "--inlier-position", "--inlier-rotation-deg",
+                         "--refine-max-distance"});
+    spec.switches.insert("--refine-mesh");
+    spec.help =
+        std::string(
+            "Runs COLMAP on the project's frames and writes poses for every registered\n"
+            "frame, aligned to the scene: DIR/sparse/{cameras,images,points3D}.txt and\n"
+            "DIR/project.json (the input project pointing at them; the input is never\n"
+            "overwritten), DIR/bootstrap.json (alignment, registered frames).\n"
+            "  --control-points FILE     align with >= 3 known world points instead of\n"
+            "                            the project's poses. One per line:\n"
+            "                            NAME X Y Z IMAGE U V [IMAGE U V ...]\n"
+            "                            (metres; pixels, (0,0) = centre of top-left)\n"
+            "  --inlier-position F       given poses within F x scene size support the\n"
+            "                            alignment (default 0.02)\n"
+            "  --inlier-rotation-deg X   ...and within X degrees (default 2)\n"
+            "  --refine-mesh             then refine the alignment by ICP of COLMAP's\n"
+            "                            sparse points to the scene's mesh\n"
+            "                            (point-to-plane, similarity)\n"
+            "  --refine-max-distance F   ICP pairs within F x scene size (default 0.02)\n") +
+        kColmapOptionsHelp;
   }
   return spec;
 }
@@ -116,8 +129,11 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
   if ((code = IntOption(args, spec, "--max-image-size", 0, &options.colmap.max_image_size)) >= 0)
     return code;
   if ((code = IntOption(args, spec, "--threads", 0, &options.colmap.threads)) >= 0) return code;
+  if ((code = IntOption(args, spec, "--max-features", 0, &options.colmap.max_num_features)) >= 0)
+    return code;
   if ((code = PositiveDoubleOption(args, spec, "--scene-size-m", &options.scene_size_m)) >= 0)
     return code;
+  options.load_scene = args.Switch("--refine-mesh");
   const std::string matcher = args.Get("--matcher", "auto");
   if (matcher == "auto") {
     options.colmap.matcher = ColmapMatcher::kAuto;
@@ -126,11 +142,16 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
   } else if (matcher == "sequential") {
     options.colmap.matcher = ColmapMatcher::kSequential;
   } else {
-    return UsageError(kVerb, spec, "--matcher: expected auto, exhaustive or sequential, got '" +
-                                       matcher + "'");
+    return UsageError(kVerb, spec,
+                      "--matcher: expected auto, exhaustive or sequential, got '" + matcher + "'");
   }
   options.colmap.program = args.Get("--colmap");
-  if (FindColmap(options.colmap.program).empty()) {
+  options.existing_model = args.Get("--colmap-model");
+  if (!options.existing_model.empty() && !fs::is_directory(options.existing_model)) {
+    std::cerr << "error: " << options.existing_model << ": --colmap-model: no such folder\n";
+    return kExitBadInput;
+  }
+  if (options.existing_model.empty() && FindColmap(options.colmap.program).empty()) {
     std::cerr << "error: " << (options.colmap.program.empty() ? "colmap" : options.colmap.program)
               << ": program not found on PATH (install Debian's `colmap` package, or pass "
                  "--colmap PATH)\n";
@@ -202,8 +223,11 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
   int code = -1;
   if ((code = PositiveDoubleOption(args, spec, "--inlier-position", &inlier_position_rel)) >= 0)
     return code;
-  if ((code = PositiveDoubleOption(args, spec, "--inlier-rotation-deg", &inlier_rotation_deg)) >=
-      0)
+  if ((code = PositiveDoubleOption(args, spec, "--inlier-rotation-deg", &inlier_rotation_deg)) >= 0)
+    return code;
+  double refine_max_distance_rel = 0.02;
+  if ((code = PositiveDoubleOption(args, spec, "--refine-max-distance",
+                                   &refine_max_distance_rel)) >= 0)
     return code;
   const fs::path new_project_path = fs::absolute(fs::path(out_dir) / "project.json");
   if (fs::absolute(project.file_path).lexically_normal() == new_project_path.lexically_normal()) {
@@ -257,6 +281,25 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
     report["aligned_with"] = "given_poses";
     report["inliers"] = alignment.num_inliers;
     report["compared"] = pairs.size();
+  }
+  if (args.Switch("--refine-mesh")) {
+    MeshIcpOptions icp;
+    icp.max_distance_m = refine_max_distance_rel * colmap.scene_size_m;
+    std::vector<Eigen::Vector3d> points;
+    for (const Point3D& p : colmap.run.model.points) points.push_back(p.xyz);
+    MeshIcpResult refined;
+    if (Status s =
+            AlignPointsToMesh(points, colmap.capture.scene, world_from_colmap, icp, &refined);
+        !s.ok()) {
+      std::cerr << "error: " << project.scene << ": " << s.message() << "\n";
+      return kExitFailure;
+    }
+    world_from_colmap = refined.world_from_colmap;
+    report["mesh_icp"] = {{"pairs", refined.pairs},
+                          {"iterations", refined.iterations},
+                          {"max_distance_m", icp.max_distance_m},
+                          {"median_distance_before_m", refined.median_distance_before_m},
+                          {"median_distance_after_m", refined.median_distance_after_m}};
   }
   ColmapModel model = TransformModel(colmap.run.model, world_from_colmap);
   model.cameras = {{1, colmap.camera}};

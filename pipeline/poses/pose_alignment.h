@@ -2,8 +2,9 @@
 // given poses: a robust similarity world_from_colmap from the camera centres (RANSAC over
 // minimal sets, similarity.h), whose rotation is then refined from the camera orientations
 // (chordal mean of the per-frame world_from_colmap rotations of the inliers, orientation
-// outliers rejected) and its scale and translation refitted with that rotation. Outlier poses
-// (by position or orientation) do not bend the fit. Also the per-frame disagreement of a
+// outliers rejected) and its scale and translation refitted with that rotation, then once
+// more with thresholds from the inliers' own spread. Outlier poses (by position or
+// orientation) do not bend the fit. Also the per-frame disagreement of a
 // given pose with an aligned COLMAP pose.
 #pragma once
 
@@ -30,6 +31,10 @@ struct PoseAlignmentOptions {
   double inlier_rotation_deg = 0.5;
   int iterations = 500;  // RANSAC trials
   unsigned seed = 1;
+  // After the fit (with >= 6 inliers), the thresholds shrink to this many times the
+  // inliers' median errors (but not below 5 % of the thresholds above) and the fit is
+  // redone: poses a little off stop bending it. 0 = off.
+  double adaptive_factor = 3.0;
 
   Status Check() const;
 };

@@ -22,7 +22,7 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
   if (options.max_frames < 0) return Status::Error("max_frames: must be >= 0");
   if (options.scene_size_m < 0) return Status::Error("scene_size_m: must be >= 0");
   CaptureLoadOptions load;
-  load.load_scene = options.scene_size_m == 0.0;
+  load.load_scene = options.scene_size_m == 0.0 || options.load_scene;
   load.require_poses = false;
   FRESCO_RETURN_IF_ERROR(LoadCapture(project, load, &result->capture));
   Capture& capture = result->capture;
@@ -38,8 +38,9 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     capture.scene.Bounds(&lo, &hi);
     result->scene_size_m = (hi - lo).norm();
     if (!(result->scene_size_m > 0)) {
-      return Status::Error(project.scene + ": the scene has no extent (its size sets the "
-                                           "position threshold)");
+      return Status::Error(project.scene +
+                           ": the scene has no extent (its size sets the "
+                           "position threshold)");
     }
   }
 
@@ -67,8 +68,7 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
       f.index = frame.index;
       f.name = frame.name;
       if (fs::path(f.name).extension().empty()) f.name += ".png";
-      FRESCO_RETURN_IF_ERROR(
-          WriteImageAtomic((fs::path(image_path) / f.name).string(), frame.bgr));
+      FRESCO_RETURN_IF_ERROR(WriteImageAtomic((fs::path(image_path) / f.name).string(), frame.bgr));
       frames.push_back(f);
       if (options.max_frames > 0 && static_cast<int>(frames.size()) >= options.max_frames) break;
     }
@@ -94,13 +94,21 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
                          std::to_string(names.size()) + " (after every_n_frames/max_frames)");
   }
 
+  if (!options.existing_model.empty()) {
+    FRESCO_RETURN_IF_ERROR(ReadColmapModel(options.existing_model, &result->run.model));
+    result->run.registered = static_cast<int>(result->run.model.images.size());
+    result->run.models = 1;
+    result->run.program = "(earlier run: " + options.existing_model + ")";
+  } else {
+    *bad_input = false;
+    ColmapRunOptions run = options.colmap;
+    run.workspace = options.out_dir;
+    run.image_path = image_path;
+    run.image_names = names;
+    run.camera = result->camera;
+    FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
+  }
   *bad_input = false;
-  ColmapRunOptions run = options.colmap;
-  run.workspace = options.out_dir;
-  run.image_path = image_path;
-  run.image_names = names;
-  run.camera = result->camera;
-  FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
   std::map<std::string, const PosedImage*> by_name;
   for (const PosedImage& image : result->run.model.images) by_name[image.name] = &image;
   for (ProjectColmapFrame& f : result->frames) {

@@ -21,7 +21,12 @@ struct ProjectColmapOptions {
   // Scene size (metres) used for thresholds; 0 = the diagonal of the scene's bounding box
   // (the scene is then loaded).
   double scene_size_m = 0.0;
+  bool load_scene = false;  // load the scene even when scene_size_m is given (mesh ICP)
   ColmapRunOptions colmap;  // workspace, image_path, image_names, camera are filled in
+  // A COLMAP text model folder from an earlier run (e.g. OUT/colmap/sparse_txt/0 of
+  // `fresco poses verify`) to use instead of running COLMAP; "" = run COLMAP. Its images are
+  // matched to the frames by name.
+  std::string existing_model;
 };
 
 struct ProjectColmapFrame {

@@ -71,13 +71,14 @@ cv::Mat MakeCheckerTexture(int width_px, int height_px, int squares_x, int squar
   return rgba;
 }
 
-cv::Mat MakeFeatureTexture(int width_px, int height_px, unsigned seed) {
-  SynthRandom random(seed, 101);
-  // Background: smooth colour noise, one field per channel.
+namespace {
+
+// Smooth coloured noise (one field per channel) around a random base colour.
+cv::Mat NoiseBackground(int width_px, int height_px, SynthRandom* random) {
   cv::Mat rgba(height_px, width_px, CV_8UC4);
   std::array<cv::Mat, 3> fields;
-  for (auto& f : fields) f = WrappingNoise(width_px, height_px, 6, 6, &random);
-  const cv::Vec3d base(random.Uniform(90, 170), random.Uniform(90, 170), random.Uniform(90, 170));
+  for (auto& f : fields) f = WrappingNoise(width_px, height_px, 6, 6, random);
+  const cv::Vec3d base(random->Uniform(90, 170), random->Uniform(90, 170), random->Uniform(90, 170));
   for (int y = 0; y < height_px; ++y) {
     cv::Vec4b* row = rgba.ptr<cv::Vec4b>(y);
     for (int x = 0; x < width_px; ++x) {
@@ -87,37 +88,65 @@ cv::Mat MakeFeatureTexture(int width_px, int height_px, unsigned seed) {
       row[x][3] = 255;
     }
   }
-  // Shapes with corners: rectangles (filled and outlined), disks, lines, triangles.
-  const double scale = std::min(width_px, height_px);
-  const int shapes = std::max(12, static_cast<int>(width_px * height_px / 1000.0));
+  return rgba;
+}
+
+// `shapes` shapes with corners (rectangles filled and outlined, disks, triangles), each of
+// size Uniform(min_size, max_size) * scale pixels (at least 2), in random colours.
+void DrawShapes(int shapes, double scale, double min_size, double max_size, SynthRandom* random,
+                cv::Mat* rgba) {
+  const int width_px = rgba->cols, height_px = rgba->rows;
   for (int i = 0; i < shapes; ++i) {
-    const cv::Point p(random.UniformInt(0, width_px - 1), random.UniformInt(0, height_px - 1));
-    const int size = std::max(2, static_cast<int>(random.Uniform(0.01, 0.08) * scale));
-    const cv::Scalar colour = RandomColour(&random);
-    switch (random.UniformInt(0, 4)) {
+    const cv::Point p(random->UniformInt(0, width_px - 1), random->UniformInt(0, height_px - 1));
+    const int size = std::max(2, static_cast<int>(random->Uniform(min_size, max_size) * scale));
+    const cv::Scalar colour = RandomColour(random);
+    switch (random->UniformInt(0, 4)) {
       case 0:
       case 1: {
-        const int w = std::max(2, static_cast<int>(size * random.Uniform(0.5, 1.8)));
-        cv::rectangle(rgba, cv::Rect(p.x, p.y, w, size), colour, cv::FILLED);
+        const int w = std::max(2, static_cast<int>(size * random->Uniform(0.5, 1.8)));
+        cv::rectangle(*rgba, cv::Rect(p.x, p.y, w, size), colour, cv::FILLED);
         break;
       }
       case 2:
-        cv::rectangle(rgba, cv::Rect(p.x, p.y, size, size), colour, std::max(1, size / 6));
+        cv::rectangle(*rgba, cv::Rect(p.x, p.y, size, size), colour, std::max(1, size / 6));
         break;
       case 3:
-        cv::circle(rgba, p, size / 2 + 1, colour, cv::FILLED, cv::LINE_AA);
+        cv::circle(*rgba, p, size / 2 + 1, colour, cv::FILLED, cv::LINE_AA);
         break;
       default: {
-        const cv::Point q(p.x + random.UniformInt(-2 * size, 2 * size),
-                          p.y + random.UniformInt(-2 * size, 2 * size));
-        const cv::Point r(p.x + random.UniformInt(-2 * size, 2 * size),
-                          p.y + random.UniformInt(-2 * size, 2 * size));
+        const cv::Point q(p.x + random->UniformInt(-2 * size, 2 * size),
+                          p.y + random->UniformInt(-2 * size, 2 * size));
+        const cv::Point r(p.x + random->UniformInt(-2 * size, 2 * size),
+                          p.y + random->UniformInt(-2 * size, 2 * size));
         std::vector<cv::Point> tri = {p, q, r};
-        cv::fillConvexPoly(rgba, tri, colour, cv::LINE_AA);
+        cv::fillConvexPoly(*rgba, tri, colour, cv::LINE_AA);
         break;
       }
     }
   }
+}
+
+}  // namespace
+
+cv::Mat MakeFeatureTexture(int width_px, int height_px, unsigned seed) {
+  SynthRandom random(seed, 101);
+  cv::Mat rgba = NoiseBackground(width_px, height_px, &random);
+  const double scale = std::min(width_px, height_px);
+  const int shapes = std::max(12, static_cast<int>(width_px * height_px / 1000.0));
+  DrawShapes(shapes, scale, 0.01, 0.08, &random, &rgba);
+  cv::Mat fine = PixelNoise(width_px, height_px, &random);
+  AddNoise(fine, 6.0, &rgba);
+  return rgba;
+}
+
+cv::Mat MakeDenseFeatureTexture(int width_px, int height_px, double min_shape_px,
+                                double max_shape_px, unsigned seed) {
+  SynthRandom random(seed, 102);
+  cv::Mat rgba = NoiseBackground(width_px, height_px, &random);
+  // About three layers of shapes over every pixel: no patch is plain.
+  const double mean_area = 0.6 * std::pow(0.5 * (min_shape_px + max_shape_px), 2);
+  const int shapes = std::max(4, static_cast<int>(3.0 * width_px * height_px / mean_area));
+  DrawShapes(shapes, 1.0, min_shape_px, max_shape_px, &random, &rgba);
   cv::Mat fine = PixelNoise(width_px, height_px, &random);
   AddNoise(fine, 6.0, &rgba);
   return rgba;

@@ -26,6 +26,11 @@ cv::Mat MakeCheckerTexture(int width_px, int height_px, int squares_x, int squar
 // Smooth coloured noise with many sharp-cornered rectangles, disks and lines on it: every
 // region has texture and corners (Harris/refinement find features), no two areas alike.
 cv::Mat MakeFeatureTexture(int width_px, int height_px, unsigned seed);
+// The same kind of shapes, sized in pixels (Uniform(min_shape_px, max_shape_px)) and about
+// three layers deep over the whole image, whatever its size: dense corners at a chosen scale
+// (e.g. textures sized in texels per metre, seen at a known distance).
+cv::Mat MakeDenseFeatureTexture(int width_px, int height_px, double min_shape_px,
+                                double max_shape_px, unsigned seed);
 // A building façade: wall colour with fine noise, a grid of windows (`floors` x `columns`)
 // with frames and sills, a darker plinth. Deterministic for `seed`.
 cv::Mat MakeFacadeTexture(int width_px, int height_px, int floors, int columns, unsigned seed);

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/procedural_scenes.h"
 
 namespace fresco {
@@ -125,11 +126,12 @@ std::string Resolve(const std::string& base_dir, const std::string& path) {
 }
 
 // What the scene is, for scene-dependent defaults.
-enum class SceneKind { kRoom, kStreet, kPlane, kObject };
+enum class SceneKind { kRoom, kStreet, kPlane, kObject, kBlocks };
 struct SceneInfo {
   SceneKind kind = SceneKind::kObject;
   Eigen::Vector3d room_size = Eigen::Vector3d::Zero();
   StreetOptions street;
+  BlocksOptions blocks;
   double plane_w = 0, plane_h = 0;
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();
 };
@@ -246,9 +248,25 @@ Status BuildScene(const json& value, const std::string& file, const std::string&
     info->kind = plane ? SceneKind::kPlane : SceneKind::kObject;
     info->plane_w = w;
     info->plane_h = h;
+  } else if (builtin == "blocks") {
+    BlocksOptions blocks;
+    FRESCO_RETURN_IF_ERROR(r.Number("ground_m", &blocks.ground_m));
+    FRESCO_RETURN_IF_ERROR(r.Int("blocks", &blocks.blocks));
+    FRESCO_RETURN_IF_ERROR(r.Number("area_m", &blocks.area_m));
+    FRESCO_RETURN_IF_ERROR(r.Number("min_size_m", &blocks.min_size_m));
+    FRESCO_RETURN_IF_ERROR(r.Number("max_size_m", &blocks.max_size_m));
+    FRESCO_RETURN_IF_ERROR(r.Number("max_height_m", &blocks.max_height_m));
+    FRESCO_RETURN_IF_ERROR(r.Int("texels_per_m", &blocks.texels_per_m));
+    FRESCO_RETURN_IF_ERROR(r.Unsigned("seed", &blocks.seed));
+    FRESCO_RETURN_IF_ERROR(r.Finish());
+    Status s = MakeBlocksScene(blocks, &job->scene);
+    if (!s.ok()) return Status::Error(file + ": scene: " + s.message());
+    job->texture_files.assign(job->scene.textures.size(), "");
+    info->kind = SceneKind::kBlocks;
+    info->blocks = blocks;
   } else {
-    return r.Error("builtin",
-                   "unknown built-in scene '" + builtin + "' (cube-room, street, plane, cube)");
+    return r.Error("builtin", "unknown built-in scene '" + builtin +
+                                  "' (cube-room, street, plane, cube, blocks)");
   }
   return Status::Ok();
 }
@@ -308,6 +326,22 @@ void SceneDefaults(const SceneInfo& info, CameraPathKind kind, SynthOptions* o) 
       p.look_around_deg = 0.0;
       o->mover_region_min = Eigen::Vector3d(-0.5 * info.plane_w, -0.5 * info.plane_h, 0.1 * s);
       o->mover_region_max = Eigen::Vector3d(0.5 * info.plane_w, 0.5 * info.plane_h, 0.5 * s);
+      break;
+    }
+    case SceneKind::kBlocks: {
+      // Around the cluster of boxes, looking at its middle from above: parallax everywhere.
+      const double g = info.blocks.ground_m;
+      p.target = Eigen::Vector3d(0, 0.3 * info.blocks.max_height_m, 0);
+      p.radius_m = 0.6 * g;
+      p.height_m = 0.5 * g;
+      p.wander_m = 0.04 * g;
+      p.look_at_target = true;
+      p.wobble_deg = 2.0;
+      p.walk_from = Eigen::Vector3d(-0.4 * g, 0.3 * g, 0.7 * g);
+      p.walk_to = Eigen::Vector3d(0.4 * g, 0.3 * g, 0.7 * g);
+      p.look_around_deg = 10.0;
+      o->mover_region_min = Eigen::Vector3d(-0.4 * g, 0.0, -0.4 * g);
+      o->mover_region_max = Eigen::Vector3d(0.4 * g, 0.3 * g, 0.4 * g);
       break;
     }
     case SceneKind::kObject: {

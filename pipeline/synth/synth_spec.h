@@ -9,13 +9,17 @@
 //   {
 //     "fresco_synth": 1,                      // format version (optional)
 //     "scene": "builtin:cube-room" | "builtin:street" | "builtin:plane" | "builtin:cube"
+//              | "builtin:blocks"
 //              | "PATH.gltf"
 //              | {"builtin": "cube-room", "size_m": [4, 3, 4], "seed": 1,
 //                 "textures": {"floor": "a.jpg", ...}, "repeat": {"floor": [2, 2], ...}}
 //              | {"builtin": "street", "length_m": 40, "street_width_m": 10,
 //                 "buildings_per_side": 5, "min_height_m": 6, "max_height_m": 14, "seed": 1}
 //              | {"builtin": "plane", "width_m": 2, "height_m": 2, "texture": "img.png"}
-//              | {"builtin": "cube", "edge_m": 1, "texture": "img.png"},
+//              | {"builtin": "cube", "edge_m": 1, "texture": "img.png"}
+//              | {"builtin": "blocks", "ground_m": 6, "blocks": 7, "area_m": 3,
+//                 "min_size_m": 0.4, "max_size_m": 1.1, "max_height_m": 1.6,
+//                 "texels_per_m": 160, "seed": 1},
 //     "out": "capture",                       // output folder
 //     "frames": 120, "size": [640, 480] (or "640x480"), "lens": "pinhole" | "opencv4" |
 //     "opencv5" | "opencv8", "hfov_deg": 70,

@@ -3,14 +3,17 @@
 // verification flags (injected errors on chosen frames), control-point alignment, the
 // control-point file reader.
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/mesh_icp.h"
 #include "pipeline/poses/pose_alignment.h"
 #include "pipeline/poses/similarity.h"
 #include "pipeline/poses/verify.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 
@@ -61,7 +64,8 @@ TEST(Similarity, RobustFitIgnoresOutliersThatBendLeastSquares) {
   std::vector<Eigen::Vector3d> dst;
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.002);
-  for (const auto& p : src) dst.push_back(truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  for (const auto& p : src)
+    dst.push_back(truth * p + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
   // 9 of 30 (30 %) are wrong by 1..3 m.
   for (int i = 0; i < 30; i += 3) dst[i] += Eigen::Vector3d(1.0 + i * 0.07, -2.0, 0.5);
   Sim3d plain;
@@ -123,9 +127,8 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   std::normal_distribution<double> small(0.0, 1.0);
   for (int i = 0; i < n; ++i) {
     // COLMAP's own error: ~0.03 deg, ~1 mm.
-    const Rigid3d noisy =
-        Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
-                  Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    const Rigid3d noisy = Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
+                                    Eigen::Vector3d(small(rng), small(rng), small(rng)));
     colmap.push_back(InColmapFrame(noisy, world_from_colmap));
   }
   const double scene_size_m = 6.0;  // position threshold 6 cm at 1 %
@@ -133,7 +136,8 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   given[5] = Perturbed(truth[5], 1.0, 0.0, Eigen::Vector3d(0, 1, 0));
   given[12] = Perturbed(truth[12], 0.0, 0.02 * scene_size_m, Eigen::Vector3d(1, 1, 0));
   given[20] = Perturbed(truth[20], 1.0, 0.02 * scene_size_m, Eigen::Vector3d(0, 0, 1));
-  given[31] = Perturbed(truth[31], 1.2, 0.0, truth[31].rotation.conjugate() * Eigen::Vector3d::UnitZ());
+  given[31] =
+      Perturbed(truth[31], 1.2, 0.0, truth[31].rotation.conjugate() * Eigen::Vector3d::UnitZ());
   std::vector<VerifyFrameInput> inputs;
   for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &given[i], &colmap[i]});
   inputs[37].colmap_cam_from_colmap = nullptr;  // not registered
@@ -158,6 +162,39 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   }
 }
 
+TEST(Alignment, PosesSlightlyOffWithinTheThresholdsStopBendingTheFit) {
+  // 30 frames; COLMAP's own error ~0.02 deg, ~1 mm; 6 given poses 4 cm off the same way:
+  // inside the 5 cm inlier threshold, so the first fit takes them in; the adaptive one
+  // (3 x the inliers' median error) leaves them out.
+  const int n = 30;
+  const auto truth = ArcPoses(n);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  std::mt19937 rng(9);
+  std::normal_distribution<double> small(0.0, 1.0);
+  std::vector<PosePair> pairs;
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d noisy = Perturbed(truth[i], 0.02 * small(rng), 0.001 * small(rng),
+                                    Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    const Rigid3d given =
+        i % 5 == 0 ? Perturbed(truth[i], 0.0, 0.04, Eigen::Vector3d(0, 1, 0)) : truth[i];
+    pairs.push_back({std::to_string(i), given, InColmapFrame(noisy, world_from_colmap)});
+  }
+  auto translation_error = [&](const PoseAlignment& a) {
+    return (a.world_from_colmap.translation - world_from_colmap.translation).norm();
+  };
+  PoseAlignmentOptions options;  // 5 cm, 0.5 deg
+  options.adaptive_factor = 0.0;
+  PoseAlignment plain, adaptive;
+  ASSERT_TRUE(AlignColmapToPoses(pairs, options, &plain).ok());
+  EXPECT_EQ(plain.num_inliers, n);
+  EXPECT_GT(translation_error(plain), 0.005);  // bent by the 6 poses
+  options.adaptive_factor = 3.0;
+  ASSERT_TRUE(AlignColmapToPoses(pairs, options, &adaptive).ok());
+  EXPECT_EQ(adaptive.num_inliers, n - 6);
+  for (int i = 0; i < n; ++i) EXPECT_EQ(adaptive.inliers[i], i % 5 != 0) << i;
+  EXPECT_LT(translation_error(adaptive), 0.003);
+}
+
 TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   // The reconstruction's scale drifts from 1 to 1.6 along the sequence (as on long walks):
   // each step between cameras is reconstructed with the scale of its time.
@@ -169,9 +206,10 @@ TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   for (int i = 0; i < n; ++i) {
     if (i > 0) {
       const double drift = 1.0 + 0.6 * i / (n - 1);
-      centre_in_colmap += drift * (world_from_colmap.rotation.conjugate() *
-                                   (truth[i].Centre() - truth[i - 1].Centre())) /
-                          world_from_colmap.scale;
+      centre_in_colmap +=
+          drift *
+          (world_from_colmap.rotation.conjugate() * (truth[i].Centre() - truth[i - 1].Centre())) /
+          world_from_colmap.scale;
     }
     const Eigen::Quaterniond rotation = truth[i].rotation * world_from_colmap.rotation;
     colmap.push_back(Rigid3d(rotation, -(rotation * centre_in_colmap)));
@@ -188,6 +226,80 @@ TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   EXPECT_EQ(local.flagged, 0);
 }
 
+// Points on the blocks scene's surfaces (area-weighted), 2 mm noise, and 10 % outliers up
+// to 1 m off the model (as COLMAP's sparse points: mostly on the model, some not).
+std::vector<Eigen::Vector3d> PointsOnMesh(const Scene& scene, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<double> areas;
+  for (int t = 0; t < scene.mesh.NumTriangles(); ++t) areas.push_back(scene.mesh.Area(t));
+  std::discrete_distribution<int> triangle(areas.begin(), areas.end());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.002);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < n; ++i) {
+    const int t = triangle(rng);
+    double a = u(rng), b = u(rng);
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const TriangleMesh& m = scene.mesh;
+    Eigen::Vector3d p =
+        scene.WorldFromLocal(m.Corner(t, 0) + a * (m.Corner(t, 1) - m.Corner(t, 0)) +
+                             b * (m.Corner(t, 2) - m.Corner(t, 0)));
+    p += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    if (i % 10 == 0) p += Eigen::Vector3d(u(rng) - 0.5, u(rng), u(rng) - 0.5);
+    points.push_back(p);
+  }
+  return points;
+}
+
+TEST(MeshIcp, PullsASlightlyWrongAlignmentOntoTheModel) {
+  Scene scene;
+  ASSERT_TRUE(MakeBlocksScene(BlocksOptions(), &scene).ok());
+  const Sim3d truth = SomeSimilarity();  // world_from_colmap
+  std::vector<Eigen::Vector3d> in_colmap;
+  for (const Eigen::Vector3d& p : PointsOnMesh(scene, 3000, 4)) {
+    in_colmap.push_back(truth.Inverse() * p);
+  }
+  // Off by 1 deg, 1 % in scale and 5 cm: what a few rough control points give.
+  Sim3d initial = truth;
+  initial.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d(1, 2, 3).normalized())) *
+      truth.rotation;
+  initial.scale *= 1.01;
+  initial.translation += Eigen::Vector3d(0.03, -0.02, 0.035);
+  auto centre_error = [&](const Sim3d& s) {  // worst over the ground's corners and the blocks
+    double worst = 0;
+    for (const Eigen::Vector3d& w :
+         {Eigen::Vector3d(-3, 0, -3), Eigen::Vector3d(3, 1.5, 3), Eigen::Vector3d(0, 1, 0)}) {
+      worst = std::max(worst, (s * (truth.Inverse() * w) - w).norm());
+    }
+    return worst;
+  };
+  EXPECT_GT(centre_error(initial), 0.08);
+  MeshIcpOptions options;
+  options.max_distance_m = 0.2;
+  MeshIcpResult result;
+  ASSERT_TRUE(AlignPointsToMesh(in_colmap, scene, initial, options, &result).ok());
+  EXPECT_LT(RotationErrorDeg(result.world_from_colmap, truth), 0.05);
+  EXPECT_NEAR(result.world_from_colmap.scale / truth.scale, 1.0, 0.001);
+  EXPECT_LT(centre_error(result.world_from_colmap), 0.005);
+  EXPECT_GT(result.median_distance_before_m, 0.02);
+  EXPECT_LT(result.median_distance_after_m, 0.003);
+  std::cout << "mesh ICP: " << result.iterations << " iterations, median distance "
+            << result.median_distance_before_m << " -> " << result.median_distance_after_m
+            << " m\n";
+  EXPECT_GT(result.pairs, 2400);  // most on-model points, few outliers
+  EXPECT_LT(result.pairs, 2950);
+  // Already right: it stays right.
+  ASSERT_TRUE(AlignPointsToMesh(in_colmap, scene, truth, options, &result).ok());
+  EXPECT_LT(centre_error(result.world_from_colmap), 0.003);
+  // No point near the model: a clear error.
+  Sim3d far = truth;
+  far.translation += Eigen::Vector3d(0, 50, 0);
+  const Status none = AlignPointsToMesh(in_colmap, scene, far, options, &result);
+  EXPECT_FALSE(none.ok());
+  EXPECT_NE(none.message().find("near the model"), std::string::npos) << none.message();
+}
+
 TEST(ControlPoints, TriangulatedPointsAlignTheReconstruction) {
   const auto truth = ArcPoses(20);
   const Sim3d world_from_colmap = SomeSimilarity();
@@ -198,16 +310,16 @@ TEST(ControlPoints, TriangulatedPointsAlignTheReconstruction) {
     PosedImage image;
     image.image_id = i + 1;
     image.camera_id = 1;
-    image.name = "f" + std::to_string(i) + ".png";
+    image.name = std::string("f").append(std::to_string(i)).append(".png");
     image.cam_from_world = InColmapFrame(truth[i], world_from_colmap);
     model.images.push_back(image);
   }
   std::vector<ControlPoint> points;
-  const std::vector<Eigen::Vector3d> world = {{0.3, 0.2, -0.1}, {-0.4, -0.2, 0.3}, {0.1, 0.5, 0.4},
-                                              {-0.2, 0.1, -0.5}};
+  const std::vector<Eigen::Vector3d> world = {
+      {0.3, 0.2, -0.1}, {-0.4, -0.2, 0.3}, {0.1, 0.5, 0.4}, {-0.2, 0.1, -0.5}};
   for (size_t k = 0; k < world.size(); ++k) {
     ControlPoint p;
-    p.name = "p" + std::to_string(k);
+    p.name = std::string("p").append(std::to_string(k));
     p.point_in_world = world[k];
     for (int i : {2, 9, 17}) {
       Eigen::Vector2d pixel;

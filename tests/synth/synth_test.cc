@@ -16,6 +16,7 @@
 #include "pipeline/core/project.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/render/renderer.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/camera_path.h"
 #include "pipeline/synth/movers.h"
 #include "pipeline/synth/procedural_scenes.h"
@@ -176,6 +177,42 @@ TEST(ProceduralScenes, FacesPointWhereTheyAreSeenFrom) {
   std::vector<cv::Point2f> corners;
   cv::goodFeaturesToTrack(gray, corners, 200, 0.01, 4, cv::noArray(), 3, /*harris=*/true);
   EXPECT_GT(corners.size(), 30u);
+}
+
+TEST(ProceduralScenes, BlocksStandApartEveryFaceItsOwnTexture) {
+  BlocksOptions options;
+  Scene a, b, other;
+  ASSERT_TRUE(MakeBlocksScene(options, &a).ok());
+  ASSERT_TRUE(MakeBlocksScene(options, &b).ok());
+  options.seed = 2;
+  ASSERT_TRUE(MakeBlocksScene(options, &other).ok());
+  // Ground + 7 boxes x 5 faces, two triangles each, one texture per face.
+  ASSERT_EQ(a.mesh.NumTriangles(), 2 * (1 + 5 * 7));
+  EXPECT_EQ(a.textures.size(), 1u + 5 * 7);
+  EXPECT_EQ(a.mesh.vertices, b.mesh.vertices);  // deterministic
+  EXPECT_NE(a.mesh.vertices, other.mesh.vertices);
+  for (size_t i = 1; i < a.textures.size(); ++i) {  // nothing repeats
+    const cv::Mat& t = a.textures[i].rgba;
+    const cv::Mat& u = a.textures[i - 1].rgba;
+    if (t.size() == u.size()) EXPECT_GT(cv::norm(t, u, cv::NORM_L1), 0.0) << i;
+  }
+  // Box footprints (the bottom corners of each box's first side and of its top) do not
+  // overlap, and everything stands on y = 0 within the area.
+  Eigen::Vector3d lo, hi;
+  a.Bounds(&lo, &hi);
+  EXPECT_NEAR(lo.y(), 0.0, 1e-12);
+  EXPECT_LE(hi.y(), options.max_height_m + 1e-9);
+  EXPECT_NEAR(hi.x() - lo.x(), options.ground_m, 1e-9);
+  // Every box face points away from its box: normals of the faces of box k point away from
+  // the box's centre.
+  for (int box = 0; box < 7; ++box) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    const int first = 2 * (1 + 5 * box);
+    for (int t = first; t < first + 10; ++t) centre += a.mesh.Corner(t, 0) / 10.0;
+    for (int t = first; t < first + 10; ++t) {
+      EXPECT_GT(a.mesh.Normal(t).dot(a.mesh.Corner(t, 1) - centre), 0.0) << box << " " << t;
+    }
+  }
 }
 
 TEST(Synthesize, SameSeedSameFramesOtherSeedOtherFrames) {
