@@ -155,9 +155,9 @@ int RunVerbRun(const CommandArgs& argv) {
   if (Interrupted()) {
     progress.Clear();
     std::fprintf(stderr,
-                 "fresco run: interrupted by %s after %d frames; nothing written to %s (outputs "
+                 "fresco run: interrupted by %s after %d frame%s; nothing written to %s (outputs "
                  "of earlier runs there are kept)\n",
-                 InterruptSignalName().c_str(), frames, out_dir.c_str());
+                 InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
     return InterruptExitCode();
   }
   const double seconds =

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -51,6 +52,14 @@ std::vector<std::string> HiddenEntries(const std::string& dir) {
   return hidden;
 }
 
+// The last line of stderr.
+std::string LastLine(const std::string& err) {
+  std::string text = err;
+  while (!text.empty() && text.back() == '\n') text.pop_back();
+  const size_t start = text.rfind('\n');
+  return start == std::string::npos ? text : text.substr(start + 1);
+}
+
 // Starts `fresco args...`, waits until its stderr holds `marker` (it is under way), sends
 // `signal_number`, and waits for it to end.
 CommandResult InterruptWhenUnderWay(const std::vector<std::string>& args, const std::string& marker,
@@ -72,15 +81,9 @@ CommandResult InterruptWhenUnderWay(const std::vector<std::string>& args, const 
   }
   EXPECT_TRUE(under_way) << "no '" << marker << "' on stderr: " << ReadText(command.err_path);
   kill(command.pid, signal_number);
-  return WaitFresco(command);
-}
-
-// The last line of stderr.
-std::string LastLine(const std::string& err) {
-  std::string text = err;
-  while (!text.empty() && text.back() == '\n') text.pop_back();
-  const size_t start = text.rfind('\n');
-  return start == std::string::npos ? text : text.substr(start + 1);
+  const CommandResult result = WaitFresco(command);
+  std::printf("%s\n", LastLine(result.err).c_str());  // the README quotes these
+  return result;
 }
 
 // A small capture (12 frames, 160x120) and a long one (3000 frames: the small one's frames
