@@ -130,6 +130,25 @@ TEST_F(CorruptInputTest, TruncatedFrame) {
   ExpectBadInput(dir, {frame, "truncated PNG"});
 }
 
+// JPEG frames, one cut short (libjpeg would decode it, grey where the data stopped).
+TEST_F(CorruptInputTest, TruncatedJpegFrame) {
+  const std::string dir = Copy("jpeg-truncated");
+  for (int i = 0; i < 12; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frames/%06d", i);
+    const std::string png = dir + name + ".png";
+    ASSERT_TRUE(cv::imwrite(dir + name + ".jpg", cv::imread(png, cv::IMREAD_COLOR)));
+    fs::remove(png);
+  }
+  std::string images = ReadText(dir + "/sparse/images.txt");
+  for (size_t at = images.find(".png"); at != std::string::npos; at = images.find(".png", at))
+    images.replace(at, 4, ".jpg");
+  WriteText(dir + "/sparse/images.txt", images);
+  const std::string frame = dir + "/frames/000006.jpg";
+  fs::resize_file(frame, fs::file_size(frame) * 2 / 3);
+  ExpectBadInput(dir, {frame, "truncated JPEG"});
+}
+
 TEST_F(CorruptInputTest, EmptyVideoFolder) {
   const std::string dir = Copy("frames-empty");
   fs::remove_all(dir + "/frames");
