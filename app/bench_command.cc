@@ -16,6 +16,7 @@
 
 #include "app/commands.h"
 #include "app/frame_reader.h"
+#include "app/interrupt.h"
 #include "app/pareto_plot.h"
 #include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
@@ -42,7 +43,9 @@ ArgSpec BenchSpec() {
       "  --holdout N        every N-th frame is held out of painting and scored (default 10)\n"
       "  --no-baseline      skip the last run, the naive baseline (per frame a full depth\n"
       "                     render, every texel projected one at a time, cv::remap)\n"
-      "  --quiet            no progress on stderr";
+      "  --quiet            no progress on stderr\n\n"
+      "Ctrl-C (or SIGTERM) stops at the next frame, writes nothing, keeps the outputs of\n"
+      "earlier benches and exits 130 (143).";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--holdout"};
   spec.repeatable = {"--sweep"};
@@ -102,16 +105,16 @@ struct RunResult {
 
 // Paints the project with `settings` (or, `naive`, with the naive baseline), holding out
 // every `holdout`-th frame, and scores.
-Status BenchOne(const std::string& project_path, const Settings& settings, int holdout,
-                bool naive, RunResult* result) {
+Status BenchOne(const std::string& project_path, const Settings& settings, int holdout, bool naive,
+                RunResult* result) {
   std::vector<std::string> overrides;
   std::string label;
   for (const auto& [key, value] : settings) {
     overrides.push_back(key + "=" + value);
     // The key's last two parts ("refine.mode"): short, and not ambiguous.
     const size_t last = key.rfind('.');
-    const size_t before = last == std::string::npos || last == 0 ? std::string::npos
-                                                                 : key.rfind('.', last - 1);
+    const size_t before =
+        last == std::string::npos || last == 0 ? std::string::npos : key.rfind('.', last - 1);
     label += (label.empty() ? "" : " ") +
              (before == std::string::npos ? key : key.substr(before + 1)) + "=" + value;
   }
@@ -136,8 +139,10 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   Status read_status;
   FrameReport report;
   const auto start = std::chrono::steady_clock::now();
+  const Status interrupted = Status::Error(project_path + ": interrupted");
   while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
          reader.Next(&frame, &read_status)) {
+    if (Interrupted()) return interrupted;
     const int index = frames++;
     const PosedImage* pose = capture.PoseForFrame(frame);
     if (!pose || !capture.CameraFor(*pose)) continue;
@@ -165,6 +170,7 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   int scored = 0, truth_scored = 0;
   std::map<const Camera*, std::unique_ptr<Renderer>> renderers;  // ray tables built once
   for (const HeldOut& h : held_out) {
+    if (Interrupted()) return interrupted;
     const Camera* camera = capture.CameraFor(*h.pose);
     std::unique_ptr<Renderer>& cached = renderers[camera];
     if (!cached) cached = std::make_unique<Renderer>(*camera, RenderOptions());
@@ -232,6 +238,7 @@ int RunVerbBench(const CommandArgs& argv) {
   }
   if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
 
+  InterruptCatcher interrupt;
   Progress progress("bench", static_cast<int>(runs.size()) + !args.Switch("--no-baseline"),
                     args.Switch("--quiet"));
   nlohmann::json rows = nlohmann::json::array();
@@ -242,9 +249,18 @@ int RunVerbBench(const CommandArgs& argv) {
   for (size_t i = 0; i < total; ++i) {
     RunResult result;
     const bool naive = i == runs.size();
-    if (Status s = BenchOne(project_path, naive ? Settings() : runs[i], holdout, naive, &result);
-        !s.ok())
-      return InputError(s);
+    progress.Update(static_cast<int>(i),
+                    "run " + std::to_string(i + 1) + " of " + std::to_string(total) + " started");
+    const Status s = BenchOne(project_path, naive ? Settings() : runs[i], holdout, naive, &result);
+    if (Interrupted()) {
+      progress.Clear();
+      std::fprintf(stderr,
+                   "fresco bench: interrupted by %s during run %zu of %zu; nothing written to %s "
+                   "(outputs of earlier benches there are kept)\n",
+                   InterruptSignalName().c_str(), i + 1, total, out_dir.c_str());
+      return InterruptExitCode();
+    }
+    if (!s.ok()) return InputError(s);
     rows.push_back(result.row);
     points.push_back(result.point);
     char detail[160];
@@ -265,6 +281,11 @@ int RunVerbBench(const CommandArgs& argv) {
   }
   std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", total,
                out_dir.c_str(), out_dir.c_str());
+  if (Interrupted()) {  // while the outputs were written: they were finished first
+    std::fprintf(stderr, "fresco bench: interrupted by %s while writing; finished writing first\n",
+                 InterruptSignalName().c_str());
+    return InterruptExitCode();
+  }
   return kExitOk;
 }
 

@@ -42,4 +42,10 @@ void Progress::Finish(const std::string& detail) {
                elapsed_s, detail.c_str());
 }
 
+void Progress::Clear() {
+  if (quiet_ || !tty_) return;
+  std::fprintf(stderr, "\r\033[K");
+  std::fflush(stderr);
+}
+
 }  // namespace fresco

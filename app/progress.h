@@ -12,6 +12,8 @@ class Progress {
   Progress(std::string label, int total, bool quiet = false);
   void Update(int done, const std::string& detail = "");
   void Finish(const std::string& detail = "");
+  // Erases the bar (terminal only) so that a message can take its line.
+  void Clear();
 
  private:
   std::string label_;

@@ -13,13 +13,14 @@
 
 #include "app/commands.h"
 #include "app/frame_reader.h"
+#include "app/interrupt.h"
 #include "app/progress.h"
-#include "pipeline/paint/open_project.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
 #include "pipeline/paint/buffer_preview.h"
+#include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
 
 namespace fresco {
@@ -32,7 +33,8 @@ ArgSpec RunSpec() {
       "Replays the project headless: streams its video, paints every frame into the base\n"
       "buffers, and writes DIR/painted.gltf (+ .bin, PNG textures; alpha 0 = never painted),\n"
       "DIR/metrics.json and DIR/buffers.png (all painted buffers in one picture). Outputs\n"
-      "are written atomically at the end.\n\n"
+      "are written atomically at the end; Ctrl-C (or SIGTERM) stops between frames, keeps the\n"
+      "outputs of earlier runs and exits 130 (143).\n\n"
       "  --set KEY=VALUE   override a project setting by JSON path, e.g.\n"
       "                    --set pipeline.sampling=nearest --set pipeline.update_every=20\n"
       "  --debug-images    write per-stage debug images under DIR/stages/ (costs time)\n"
@@ -89,10 +91,13 @@ int RunVerbRun(const CommandArgs& argv) {
                  session->NumSurfaceTexels(), session->default_texel_size_m());
   }
 
-  const std::string stages_dir = out_dir + "/stages";
+  InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)
   if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  // Debug images go to a staging folder that replaces DIR/stages/ only at the end.
+  StagedFolder stages;
   if (project.pipeline.debug_images)
-    if (Status s = MakeDirectories(stages_dir); !s.ok()) return InputError(s);
+    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
+  const std::string& stages_dir = stages.path();
 
   int total = capture.video->FrameCount();
   if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
@@ -107,7 +112,8 @@ int RunVerbRun(const CommandArgs& argv) {
   Status read_status;
   FrameReport report;
   while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
-         reader.Next(&frame, &read_status)) {
+         !Interrupted() && reader.Next(&frame, &read_status)) {
+    if (Interrupted()) break;  // arrived while the frame was read
     ++frames;
     const PosedImage* pose = capture.PoseForFrame(frame);
     if (!pose) {
@@ -116,15 +122,16 @@ int RunVerbRun(const CommandArgs& argv) {
       continue;
     }
     const Camera* camera = capture.CameraFor(*pose);
-    if (!camera) return InputError(Status::Error(project.Resolve(project.poses) + ": image '" +
-                                                 pose->name + "': camera " +
-                                                 std::to_string(pose->camera_id) + " not found"));
+    if (!camera)
+      return InputError(Status::Error(project.Resolve(project.poses) + ": image '" + pose->name +
+                                      "': camera " + std::to_string(pose->camera_id) +
+                                      " not found"));
     if (frame.bgr.cols != camera->width || frame.bgr.rows != camera->height) {
-      return InputError(Status::Error(
-          project.Resolve(project.video) + ": frame '" + frame.name + "' is " +
-          std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
-          " but the camera is " + std::to_string(camera->width) + "x" +
-          std::to_string(camera->height)));
+      return InputError(Status::Error(project.Resolve(project.video) + ": frame '" + frame.name +
+                                      "' is " + std::to_string(frame.bgr.cols) + "x" +
+                                      std::to_string(frame.bgr.rows) + " but the camera is " +
+                                      std::to_string(camera->width) + "x" +
+                                      std::to_string(camera->height)));
     }
     session->PaintFrame(frame, *camera, pose->cam_from_world, &report);
     if (report.painted) {
@@ -145,6 +152,14 @@ int RunVerbRun(const CommandArgs& argv) {
     progress.Update(frames, detail);
   }
   if (!read_status.ok()) return InputError(read_status);
+  if (Interrupted()) {
+    progress.Clear();
+    std::fprintf(stderr,
+                 "fresco run: interrupted by %s after %d frame%s; nothing written to %s (outputs "
+                 "of earlier runs there are kept)\n",
+                 InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
+    return InterruptExitCode();
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   progress.Finish();
@@ -156,8 +171,7 @@ int RunVerbRun(const CommandArgs& argv) {
     return kExitFailure;
   }
   // A picture of the painted buffers, for people (alpha 0 as a checkerboard).
-  if (Status s = WriteImageAtomic(out_dir + "/buffers.png",
-                                  BufferContactSheet(session->painted()));
+  if (Status s = WriteImageAtomic(out_dir + "/buffers.png", BufferContactSheet(session->painted()));
       !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
@@ -201,6 +215,17 @@ int RunVerbRun(const CommandArgs& argv) {
   if (Status s = WriteFileAtomic(out_dir + "/metrics.json", metrics.dump(2) + "\n"); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
+  }
+  if (project.pipeline.debug_images) {
+    if (Status s = stages.Commit(); !s.ok()) {
+      std::cerr << "error: " << s.message() << "\n";
+      return kExitFailure;
+    }
+  }
+  if (Interrupted()) {  // while the outputs were written: they were finished first
+    std::fprintf(stderr, "fresco run: interrupted by %s while writing; finished writing %s first\n",
+                 InterruptSignalName().c_str(), out_dir.c_str());
+    return InterruptExitCode();
   }
   if (!quiet) {
     std::fprintf(stderr,

@@ -1,10 +1,12 @@
 // `fresco synth`: makes a synthetic capture (frames, poses, camera, truth) from a built-in or
 // glTF scene, the paper's simulation experiment. Settings come from a spec file, the
 // command line, or both (the command line wins).
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "app/commands.h"
+#include "app/interrupt.h"
 #include "app/progress.h"
 #include "pipeline/synth/synth_spec.h"
 #include "pipeline/synth/synth_writer.h"
@@ -32,7 +34,8 @@ ArgSpec SynthArgSpec() {
       "  (given poses)  DIR/truth/images.txt (true poses)  DIR/truth/exposure.txt\n"
       "  DIR/truth/movers.json  DIR/scene.gltf (without movers)  DIR/synth.json\n"
       "  DIR/project.json\n"
-      "The same scene and settings (and seed) give the same files.\n"
+      "The same scene and settings (and seed) give the same files. Ctrl-C (or SIGTERM) while\n"
+      "rendering stops, keeps DIR's earlier capture (or none) and exits 130 (143).\n"
       "\n"
       "  SPEC.json           settings file (see pipeline/synth/synth_spec.h); relative paths\n"
       "                      in it resolve against its folder; options below override it\n"
@@ -168,9 +171,23 @@ int RunVerbSynth(const CommandArgs& argv) {
   write_options.skip_if_current = args.Switch("--if-changed");
   write_options.scene_source = job.scene_source;
   Progress progress("synth", job.options.frames);
-  write_options.progress = [&](int done, int total) { progress.Update(done); };
+  int frames_written = 0;
+  write_options.progress = [&](int done, int total) {
+    frames_written = done;
+    progress.Update(done);
+  };
+  write_options.stop = [] { return Interrupted(); };
   SynthWriteResult result;
+  InterruptCatcher interrupt;
   status = WriteSynthCapture(job.scene, job.options, out, write_options, &result);
+  if (Interrupted() && !status.ok()) {
+    progress.Clear();
+    std::fprintf(stderr,
+                 "fresco synth: interrupted by %s after %d of %d frames; %s keeps its earlier "
+                 "capture, if any (nothing of this one was kept)\n",
+                 InterruptSignalName().c_str(), frames_written, job.options.frames, out.c_str());
+    return InterruptExitCode();
+  }
   if (!status.ok()) {
     std::cerr << "fresco synth: " << status.message() << "\n";
     return kExitFailure;
@@ -184,6 +201,11 @@ int RunVerbSynth(const CommandArgs& argv) {
   std::cout << "wrote " << out << ": " << result.frames << " frames " << job.options.width << "x"
             << job.options.height << " of " << job.scene_source << "\n"
             << "run it: fresco run " << (fs::path(out) / "project.json").string() << " --out OUT\n";
+  if (Interrupted()) {  // after the frames: the capture was finished first
+    std::fprintf(stderr, "fresco synth: interrupted by %s while writing; finished %s first\n",
+                 InterruptSignalName().c_str(), out.c_str());
+    return InterruptExitCode();
+  }
   return kExitOk;
 }
 

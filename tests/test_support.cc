@@ -68,7 +68,7 @@ std::string ReadText(const std::string& path) {
   return ss.str();
 }
 
-CommandResult RunFresco(const std::vector<std::string>& args) {
+StartedCommand StartFresco(const std::vector<std::string>& args) {
   const char* env = std::getenv("FRESCO_BINARY");
 #ifdef FRESCO_TEST_BINARY
   const std::string binary = env ? env : FRESCO_TEST_BINARY;  // as CMake knows it
@@ -76,12 +76,13 @@ CommandResult RunFresco(const std::vector<std::string>& args) {
   const std::string binary = env ? env : "build/app/fresco";
 #endif
   const std::string dir = MakeTempDir("cmd");
-  const std::string out_path = dir + "/stdout", err_path = dir + "/stderr";
-  CommandResult result;
+  StartedCommand command;
+  command.out_path = dir + "/stdout";
+  command.err_path = dir + "/stderr";
   pid_t pid = fork();
   if (pid == 0) {
-    int out_fd = open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    int err_fd = open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int out_fd = open(command.out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    int err_fd = open(command.err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     int null_fd = open("/dev/null", O_RDONLY);
     dup2(out_fd, 1);
     dup2(err_fd, 2);
@@ -101,12 +102,22 @@ CommandResult RunFresco(const std::vector<std::string>& args) {
     execv(argv[0], argv.data());
     _exit(127);
   }
+  command.pid = pid;
+  return command;
+}
+
+CommandResult WaitFresco(const StartedCommand& command) {
+  CommandResult result;
   int status = 0;
-  waitpid(pid, &status, 0);
+  waitpid(command.pid, &status, 0);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  result.out = ReadText(out_path);
-  result.err = ReadText(err_path);
+  result.out = ReadText(command.out_path);
+  result.err = ReadText(command.err_path);
   return result;
+}
+
+CommandResult RunFresco(const std::vector<std::string>& args) {
+  return WaitFresco(StartFresco(args));
 }
 
 }  // namespace fresco::testing

@@ -29,11 +29,21 @@ struct CommandResult {
 // When args[0] is "--xvfb", it runs under /usr/bin/xvfb-run with a 1600x1000 screen.
 CommandResult RunFresco(const std::vector<std::string>& args);
 
+// `fresco` started in the background (interrupt tests): its pid and where its stdout and
+// stderr go (readable while it runs).
+struct StartedCommand {
+  int pid = -1;
+  std::string out_path, err_path;
+};
+StartedCommand StartFresco(const std::vector<std::string>& args);
+// Waits for it to end; exit_code is 128 + the signal when a signal ended it.
+CommandResult WaitFresco(const StartedCommand& command);
+
 }  // namespace fresco::testing
 
 // Skips the current test when ../shared/data is absent.
-#define FRESCO_REQUIRE_SHARED_DATA()                                                    \
-  do {                                                                                  \
-    if (::fresco::testing::SharedDataDir().empty())                                     \
-      GTEST_SKIP() << "../shared/data is absent (a user's clone has none): skipped";    \
+#define FRESCO_REQUIRE_SHARED_DATA()                                                 \
+  do {                                                                               \
+    if (::fresco::testing::SharedDataDir().empty())                                  \
+      GTEST_SKIP() << "../shared/data is absent (a user's clone has none): skipped"; \
   } while (0)

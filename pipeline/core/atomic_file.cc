@@ -1,6 +1,7 @@
 #include "pipeline/core/atomic_file.h"
 
 #include <fcntl.h>
+#include <stdio.h>  // renameat2, RENAME_EXCHANGE (glibc >= 2.28)
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -158,6 +159,70 @@ Status MakeDirectories(const std::string& path) {
   if (fs::exists(path, ec)) return Status::Error(path + ": exists and is not a folder");
   fs::create_directories(path, ec);
   if (ec) return Status::Error(path + ": cannot create folder: " + ec.message());
+  return Status::Ok();
+}
+
+StagedFolder::~StagedFolder() {
+  if (staging_.empty() || committed_) return;
+  std::error_code ec;
+  fs::remove_all(staging_, ec);
+}
+
+Status StagedFolder::Open(const std::string& target) {
+  const fs::path path = fs::path(target).lexically_normal();
+  const std::string name = path.filename().string();
+  if (name.empty() || name == "." || name == "..")
+    return Status::Error(target + ": not a folder name");
+  const fs::path parent = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
+  std::error_code ec;
+  if (fs::exists(path, ec) && !fs::is_directory(path, ec))
+    return Status::Error(target + ": exists and is not a folder");
+  // Leftovers of a process killed before it could clean up (SIGKILL, power loss).
+  const std::string prefix = "." + name + ".partial-";
+  for (const auto& entry : fs::directory_iterator(parent, ec)) {
+    const std::string entry_name = entry.path().filename().string();
+    if (entry_name.rfind(prefix, 0) == 0 && entry.is_directory(ec))
+      fs::remove_all(entry.path(), ec);
+  }
+  std::string pattern = (parent / (prefix + "XXXXXX")).string();
+  if (!mkdtemp(pattern.data())) {
+    const int error = errno;
+    return Status::Error(target + ": cannot create a staging folder in " + parent.string() + ": " +
+                         ErrnoText(error));
+  }
+  chmod(pattern.c_str(), 0755);  // mkdtemp makes it 0700
+  target_ = path.string();
+  staging_ = pattern;
+  committed_ = false;
+  return Status::Ok();
+}
+
+Status StagedFolder::Commit() {
+  if (staging_.empty() || committed_) return Status::Error(target_ + ": nothing staged to commit");
+  std::error_code ec;
+  if (!fs::exists(target_, ec)) {
+    if (std::rename(staging_.c_str(), target_.c_str()) != 0) {
+      const int error = errno;
+      return Status::Error(target_ +
+                           ": cannot rename the staging folder to it: " + ErrnoText(error));
+    }
+  } else if (renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) !=
+             0) {
+    // No atomic exchange on this file system: move the old folder aside, then rename.
+    std::string aside = staging_ + "-old";
+    if (std::rename(target_.c_str(), aside.c_str()) != 0 ||
+        std::rename(staging_.c_str(), target_.c_str()) != 0) {
+      const int error = errno;
+      return Status::Error(target_ +
+                           ": cannot replace it with the staging folder: " + ErrnoText(error));
+    }
+    fs::remove_all(aside, ec);
+  }
+  committed_ = true;
+  // After an exchange the staging name holds the earlier folder.
+  fs::remove_all(staging_, ec);
+  SyncFolder(ParentFolder(target_));
   return Status::Ok();
 }
 

@@ -17,4 +17,29 @@ Status ReadFileToString(const std::string& path, std::string* contents);
 // Creates the folder and its parents; error names the folder.
 Status MakeDirectories(const std::string& path);
 
+// A folder filled under a hidden name beside `target` (".NAME.partial-XXXXXX") and swapped
+// in whole by Commit(): until then `target` keeps its earlier content, and a StagedFolder
+// destroyed without Commit() removes what was written into it. So a run that fails or is
+// interrupted half-way leaves the earlier folder (or none), never a mix.
+class StagedFolder {
+ public:
+  StagedFolder() = default;
+  StagedFolder(const StagedFolder&) = delete;
+  StagedFolder& operator=(const StagedFolder&) = delete;
+  ~StagedFolder();  // removes the staging folder unless committed
+
+  // Makes the staging folder (and `target`'s parent). Staging folders of the same target
+  // left by a killed process are removed first. Errors name the folder.
+  Status Open(const std::string& target);
+  // Where to write; "" before Open().
+  const std::string& path() const { return staging_; }
+  // Replaces `target` and everything in it with the staging folder (one atomic exchange
+  // where the file system supports it).
+  Status Commit();
+
+ private:
+  std::string target_, staging_;
+  bool committed_ = false;
+};
+
 }  // namespace fresco

@@ -1,5 +1,7 @@
 #include "pipeline/core/image_io.h"
 
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <vector>
 
@@ -22,14 +24,52 @@ Status WriteImageAtomic(const std::string& path, const cv::Mat& image) {
   return WriteFileAtomic(path, std::string(bytes.begin(), bytes.end()));
 }
 
-Status ReadImage(const std::string& path, cv::Mat* image, int flags) {
-  if (!std::filesystem::exists(path)) return Status::Error(path + ": file not found");
-  try {
-    *image = cv::imread(path, flags);
-  } catch (const cv::Exception& e) {
-    return Status::Error(path + ": could not decode image (" + e.msg + ")");
+namespace {
+
+uint32_t BigEndian32(const unsigned char* p) {
+  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
+}
+
+// Truncated or mangled PNG and JPEG files are caught here, before the decoder sees them:
+// libpng and libjpeg print their own complaints on stderr (the CLI promises one line), and
+// libjpeg decodes a truncated file without failing (grey where the data stopped).
+Status CheckImageBytes(const std::string& path, const std::string& bytes) {
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  const size_t size = bytes.size();
+  static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size >= 8 && std::memcmp(data, kPng, 8) == 0) {
+    // Chunks: length (4), type (4), data (length), CRC (4), up to IEND.
+    for (size_t at = 8;;) {
+      if (at + 12 > size || at + 12 + BigEndian32(data + at) > size) {
+        return Status::Error(path + ": truncated PNG (" + std::to_string(size) +
+                             " bytes; its chunks run past the end of the file)");
+      }
+      if (std::memcmp(data + at + 4, "IEND", 4) == 0) return Status::Ok();
+      at += 12 + BigEndian32(data + at);
+    }
   }
-  if (image->empty()) return Status::Error(path + ": could not decode image");
+  if (size >= 3 && data[0] == 0xff && data[1] == 0xd8 && data[2] == 0xff) {
+    // The end-of-image marker, allowing for padding after it.
+    const size_t from = size > 4096 ? size - 4096 : 2;
+    for (size_t i = size - 1; i > from; --i)
+      if (data[i - 1] == 0xff && data[i] == 0xd9) return Status::Ok();
+    return Status::Error(path + ": truncated JPEG (no end-of-image marker)");
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status ReadImage(const std::string& path, cv::Mat* image, int flags) {
+  std::string bytes;
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &bytes));
+  FRESCO_RETURN_IF_ERROR(CheckImageBytes(path, bytes));
+  try {
+    *image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), flags);
+  } catch (const cv::Exception& e) {
+    return Status::Error(path + ": cannot decode the image (" + e.msg + ")");
+  }
+  if (image->empty()) return Status::Error(path + ": cannot decode the image");
   return Status::Ok();
 }
 

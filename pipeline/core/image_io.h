@@ -12,7 +12,8 @@ namespace fresco {
 
 // Writes `image` to `path` (format by extension: .png, .jpg, ...), atomically.
 Status WriteImageAtomic(const std::string& path, const cv::Mat& image);
-// Reads an image (cv::IMREAD_UNCHANGED by default); a missing or undecodable file is an error.
+// Reads an image (cv::IMREAD_UNCHANGED by default); a missing, truncated (PNG, JPEG) or
+// undecodable file is an error naming it.
 Status ReadImage(const std::string& path, cv::Mat* image, int flags = -1);
 
 }  // namespace fresco

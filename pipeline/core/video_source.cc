@@ -7,12 +7,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <mutex>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
 
 namespace fresco {
@@ -86,8 +89,12 @@ class FolderSource : public VideoSource {
     if (next_ >= names_.size()) return false;
     const std::string& name = names_[next_];
     const std::string path = (fs::path(folder_) / name).string();
-    cv::Mat bgr;
-    if (!ToBgr8(cv::imread(path, cv::IMREAD_COLOR), &bgr)) {
+    cv::Mat image, bgr;
+    if (Status read = ReadImage(path, &image, cv::IMREAD_COLOR); !read.ok()) {
+      if (status) *status = read;
+      return false;
+    }
+    if (!ToBgr8(image, &bgr)) {
       if (status) *status = Status::Error(path + ": cannot decode the image");
       return false;
     }
@@ -127,7 +134,16 @@ class CaptureSource : public VideoSource {
 
   bool Next(Frame* frame, Status* status) override {
     cv::Mat image;
-    if (!capture_.read(image) || image.empty()) return false;  // end of the stream
+    if (!capture_.read(image) || image.empty()) {  // end of the stream
+      // A file that ends well before the frame count its header declares is truncated or
+      // corrupt (one frame of slack: some containers only estimate the count).
+      if (!live_ && count_ > 0 && index_ + 1 < count_ && status) {
+        *status = Status::Error(what_ + ": ends after " + std::to_string(index_) + " of the " +
+                                std::to_string(count_) +
+                                " frames its header declares (truncated or corrupt file)");
+      }
+      return false;
+    }
     char name[32];
     std::snprintf(name, sizeof(name), "%06d.png", index_);
     cv::Mat bgr;
@@ -186,6 +202,14 @@ Status OpenFolder(const std::string& path, std::unique_ptr<VideoSource>* source)
   return Status::Ok();
 }
 
+// FFmpeg logs its complaints about a broken file on stderr, besides the one-line error
+// Fresco gives: keep it quiet unless the user asked for its log (OPENCV_FFMPEG_LOGLEVEL,
+// read by OpenCV when it first uses FFmpeg; -8 is AV_LOG_QUIET).
+void QuietFfmpegLog() {
+  static std::once_flag once;
+  std::call_once(once, [] { setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", /*overwrite=*/0); });
+}
+
 }  // namespace
 
 Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* source) {
@@ -199,6 +223,7 @@ Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* so
     *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true);
     return Status::Ok();
   }
+  QuietFfmpegLog();
   if (IsUrlOrDevice(path)) {
     cv::VideoCapture capture(path, cv::CAP_FFMPEG);
     if (!capture.isOpened()) {

@@ -65,14 +65,6 @@ Camera ColmapCamera(const Camera& camera) {
   return c;
 }
 
-bool IsImageFile(const fs::path& path) {
-  static const std::set<std::string> kExtensions = {".png", ".jpg",  ".jpeg", ".bmp",
-                                                    ".tif", ".tiff", ".ppm"};
-  std::string ext = path.extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return kExtensions.count(ext) > 0;
-}
-
 Status WriteMoversJson(const std::string& path, const SynthCapture& plan) {
   json movers = json::array();
   for (const MoverOptions& m : plan.movers) {
@@ -189,40 +181,38 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
     }
   }
 
-  const fs::path frames_dir = root / "frames";
-  for (const char* sub : {"frames", "sparse", "truth"}) {
+  for (const char* sub : {"sparse", "truth"}) {
     FRESCO_RETURN_IF_ERROR(MakeDirectories((root / sub).string()));
   }
-  // A folder without project.json is incomplete: remove it (and the stamp) first, so an
-  // interrupted run is never taken for a finished one.
-  std::error_code ec;
-  fs::remove(project_path, ec);
-  fs::remove(stamp_path, ec);
-  // Frames of an earlier, longer capture would be read as video: remove every image that is
-  // not one of this capture's frames.
-  std::set<std::string> names;
-  for (const PosedImage& p : plan.true_poses) names.insert(p.name);
-  for (const auto& entry : fs::directory_iterator(frames_dir, ec)) {
-    if (entry.is_regular_file() && IsImageFile(entry.path()) &&
-        !names.count(entry.path().filename().string())) {
-      fs::remove(entry.path(), ec);
-    }
-  }
-
-  // Frames, streamed.
+  // Frames, streamed into a staging folder: the earlier capture stays complete until every
+  // frame is written.
+  StagedFolder frames_dir;
+  FRESCO_RETURN_IF_ERROR(frames_dir.Open((root / "frames").string()));
   int done = 0;
   FRESCO_RETURN_IF_ERROR(
       RenderSynthFrames(scene, options, plan, [&](int index, const cv::Mat& bgr) -> Status {
+        if (write_options.stop && write_options.stop()) {
+          return Status::Error(dir + ": stopped after " + std::to_string(done) + " of " +
+                               std::to_string(frames) + " frames");
+        }
         std::vector<uchar> png;
-        const std::string path = (frames_dir / plan.true_poses[index].name).string();
+        const std::string name = plan.true_poses[index].name;
+        const std::string path = (fs::path(frames_dir.path()) / name).string();
         if (!cv::imencode(".png", bgr, png, {cv::IMWRITE_PNG_COMPRESSION, 3})) {
-          return Status::Error(path + ": could not encode the frame as PNG");
+          return Status::Error((root / "frames" / name).string() +
+                               ": could not encode the frame as PNG");
         }
         FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
         ++done;
         if (write_options.progress) write_options.progress(done, frames);
         return Status::Ok();
       }));
+  // From here on the folder is rewritten: without project.json (and the stamp) it is
+  // incomplete, so a crash is never taken for a finished capture.
+  std::error_code ec;
+  fs::remove(project_path, ec);
+  fs::remove(stamp_path, ec);
+  FRESCO_RETURN_IF_ERROR(frames_dir.Commit());
 
   // Camera and poses.
   CameraModelFile model_file;

@@ -1,7 +1,9 @@
 // Writes a synthetic capture as a project folder that `fresco run DIR/project.json` accepts
 // as is. Frames are rendered and written one at a time (memory does not grow with the
-// capture's length); every file is written atomically, and project.json last, so a folder
-// with a project.json is complete.
+// capture's length) into a staging folder that replaces DIR/frames/ only once every frame
+// is written (StagedFolder); every file is written atomically, and project.json last, so a
+// folder with a project.json is complete, and a write that fails or is stopped while
+// rendering leaves the earlier capture as it was.
 //
 //   DIR/frames/000000.png ...        the video (8-bit sRGB)
 //   DIR/camera.cameramodel           the lens (mrcal)
@@ -16,8 +18,8 @@
 //   DIR/synth_stamp.txt              fingerprint of scene + settings (see skip_if_current)
 //   DIR/project.json                 fresco 1, scene, camera, video, poses, truth.poses
 //
-// DIR/frames/ belongs to the capture: other image files in it (e.g. the frames of an earlier,
-// longer capture) are removed, since the video reader would take them for frames.
+// DIR/frames/ belongs to the capture: it is replaced whole (the frames of an earlier, longer
+// capture would be read as video, and any other file in it goes too).
 #pragma once
 
 #include <functional>
@@ -33,6 +35,9 @@ namespace fresco {
 struct SynthWriteOptions {
   // Called after each frame is written: (frames written, total frames).
   std::function<void(int done, int total)> progress;
+  // Checked before each frame is written; when it returns true the write stops with an
+  // error, the earlier capture in DIR (if any) untouched (e.g. Ctrl-C).
+  std::function<bool()> stop;
   // When DIR already holds a complete capture of the same scene and settings (same
   // fingerprint in synth_stamp.txt, and project.json present), write nothing.
   bool skip_if_current = false;

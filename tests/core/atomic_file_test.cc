@@ -134,5 +134,47 @@ TEST(AtomicFileTest, MakeDirectories) {
   EXPECT_THAT(status.message(), StartsWith(dir + "/file/sub: cannot create folder"));
 }
 
+// A staged folder replaces the target whole at Commit(), and only then; one dropped
+// uncommitted leaves the target (and its parent) as it was, without the staging folder.
+TEST(StagedFolderTest, ReplacesWholeOnCommitAndLeavesNothingOtherwise) {
+  const std::string dir = testing::MakeTempDir("staged");
+  const std::string target = dir + "/frames";
+  fs::create_directories(target);
+  ASSERT_TRUE(WriteFileAtomic(target + "/old.txt", "old").ok());
+  {
+    StagedFolder staged;  // dropped without Commit(): as if interrupted
+    ASSERT_TRUE(staged.Open(target).ok());
+    EXPECT_THAT(staged.path(), StartsWith(dir + "/.frames.partial-"));
+    ASSERT_TRUE(WriteFileAtomic(staged.path() + "/new.txt", "new").ok());
+    EXPECT_TRUE(fs::exists(target + "/old.txt"));
+  }
+  EXPECT_EQ(CountEntries(dir), 1);  // just frames/
+  EXPECT_EQ(CountEntries(target), 1);
+  {
+    StagedFolder staged;
+    ASSERT_TRUE(staged.Open(target).ok());
+    ASSERT_TRUE(WriteFileAtomic(staged.path() + "/new.txt", "new").ok());
+    ASSERT_TRUE(staged.Commit().ok());
+  }
+  EXPECT_EQ(CountEntries(dir), 1);
+  EXPECT_FALSE(fs::exists(target + "/old.txt"));  // the earlier content went whole
+  std::string text;
+  ASSERT_TRUE(ReadFileToString(target + "/new.txt", &text).ok());
+  EXPECT_EQ(text, "new");
+  // A new target, and a stale staging folder left by a killed process.
+  fs::create_directories(dir + "/.stages.partial-stale1");
+  StagedFolder fresh;
+  ASSERT_TRUE(fresh.Open(dir + "/stages").ok());
+  EXPECT_FALSE(fs::exists(dir + "/.stages.partial-stale1"));
+  ASSERT_TRUE(fresh.Commit().ok());
+  EXPECT_TRUE(fs::is_directory(dir + "/stages"));
+  EXPECT_EQ(CountEntries(dir), 2);
+  EXPECT_FALSE(fresh.Commit().ok());  // once only
+  // A file in the way is an error that names it.
+  ASSERT_TRUE(WriteFileAtomic(dir + "/file", "x").ok());
+  StagedFolder blocked;
+  EXPECT_EQ(blocked.Open(dir + "/file").message(), dir + "/file: exists and is not a folder");
+}
+
 }  // namespace
 }  // namespace fresco

@@ -186,6 +186,12 @@ TEST(VideoSourceTest, ReadsARealVideo) {
     EXPECT_EQ(frame.bgr.size(), cv::Size(768, 432));
   }
   EXPECT_EQ(frame.name, "000004.png");
+  // To the end: every frame its header declares, and no "truncated" error (issue 11).
+  int frames = 5;
+  while (source->Next(&frame, &status)) ++frames;
+  EXPECT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(frames, source->FrameCount());
+  EXPECT_EQ(frames, 377);  // ffprobe -count_frames
 }
 
 }  // namespace

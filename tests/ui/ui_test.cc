@@ -138,6 +138,27 @@ TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   EXPECT_EQ(runner.Snapshot()->stage_ms.at("warp").size(), 3u);
 }
 
+// Endless live streams (issue 11): the per-frame histories keep only the latest frames.
+TEST(UiHeadless, PerFrameHistoriesAreBounded) {
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  RunnerOptions options;
+  options.history_frames = 2;
+  options.misalignment = false;
+  PipelineRunner runner(options);
+  runner.Restart(state.project);
+  runner.Seek(11);
+  runner.WaitIdle();
+  const auto snap = runner.Snapshot();
+  EXPECT_EQ(snap->frame, 11);
+  ASSERT_GE(snap->frames_painted.size(), 2u);
+  EXPECT_LT(snap->frames_painted.size(), 4u);
+  EXPECT_EQ(snap->frames_painted.back(), 11);
+  EXPECT_EQ(snap->frames_painted[snap->frames_painted.size() - 2], 10);
+  EXPECT_EQ(snap->misalignment.size(), snap->frames_painted.size());
+  EXPECT_LT(snap->stage_ms.at("warp").size(), 4u);
+}
+
 TEST(UiHeadless, BadProjectIsReportedNotFatal) {
   AppState state;
   const Status s = state.Open("/no/such/project.json");

@@ -1,5 +1,6 @@
 #include "ui/core/pipeline_runner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -24,6 +25,13 @@ struct PipelineRunner::Session {
 };
 
 namespace {
+
+// Drops the oldest half of a per-frame history once it holds 2 * keep entries (amortized
+// O(1) a frame).
+template <typename T>
+void TrimHistory(size_t keep, std::vector<T>* history) {
+  if (history->size() >= 2 * keep) history->erase(history->begin(), history->end() - keep);
+}
 
 using Clock = std::chrono::steady_clock;
 
@@ -185,6 +193,12 @@ bool PipelineRunner::PaintNext(bool show) {
       working_.refine_before_px.push_back(value("residual_before_px"));
       working_.refine_after_px.push_back(value("residual_after_px"));
     }
+    const size_t keep = static_cast<size_t>(std::max(1, options_.history_frames));
+    TrimHistory(keep, &working_.frames_painted);
+    TrimHistory(keep, &working_.misalignment);
+    TrimHistory(keep, &working_.refine_before_px);
+    TrimHistory(keep, &working_.refine_after_px);
+    for (auto& [stage, ms] : working_.stage_ms) TrimHistory(keep, &ms);
   }
   working_.coverage = s.paint->Coverage();
   return true;

@@ -72,6 +72,10 @@ struct RunnerOptions {
   bool debug_images = true;       // stage debug images for the frames that are shown
   bool misalignment = true;       // render the painted model into each frame's view
   int publish_interval_ms = 100;  // while playing, publish at most this often
+  // The per-frame histories (stage_ms, misalignment, ...) keep the last history_frames to
+  // 2 * history_frames painted frames: on an endless live stream neither the app's memory
+  // nor the copy made at each publish grows without bound.
+  int history_frames = 20000;
 };
 
 class PipelineRunner {
