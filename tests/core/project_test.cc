@@ -53,6 +53,17 @@ Project NonDefaultProject() {
   p.video = "frames/";
   p.poses = "sparse/0";
   p.time_offset_s = -0.125;
+  p.live.queue_frames = 9;
+  p.live.open_timeout_s = 2.5;
+  p.live.read_timeout_s = 1.25;
+  p.live.reconnects = 3;
+  p.live.stream_clock = false;
+  p.live.connect_timeout_s = 0.75;
+  p.live.pose_wait_s = 0.2;
+  p.live.max_pose_gap_s = 0.3;
+  p.live.estimate_offset = true;
+  p.live.offset_search_s = 1.5;
+  p.live.offset_window_frames = 40;
   p.pipeline.sampling = SamplingMode::kArea;
   p.pipeline.texel_size_m = 0.0123456789012345;
   p.pipeline.max_buffer_texels = 4096;
