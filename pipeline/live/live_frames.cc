@@ -1,5 +1,6 @@
 #include "pipeline/live/live_frames.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <future>
@@ -7,7 +8,8 @@
 namespace fresco {
 namespace {
 
-// While the offset is estimated, a live source's frames are held up to this many windows.
+// While the offset is estimated, a live source's frames are held up to this many windows
+// (or the queue's capacity when larger).
 constexpr size_t kHoldWindows = 4;
 
 }  // namespace
@@ -144,7 +146,7 @@ bool LiveFrames::FillWindowAndEstimate(Status* status) {
     while (live_ && running.wait_for(std::chrono::milliseconds(0)) != std::future_status::ready) {
       if (!queue_.Pop(&frame, std::chrono::milliseconds(5))) continue;
       held_.push_back(std::move(frame));
-      if (held_.size() > kHoldWindows * window) {
+      if (held_.size() > std::max(kHoldWindows * window, queue_.capacity())) {
         held_.pop_front();
         std::lock_guard<std::mutex> lock(mutex_);
         ++stats_.frames_held_dropped;

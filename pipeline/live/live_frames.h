@@ -11,7 +11,7 @@
 // times, then the stream has ended. With offset estimation on, the first frames are held
 // (at most twice the window) until the poses cover them for every candidate offset, then
 // the offset is estimated on another thread while the frames arriving meanwhile are held
-// too (at most four windows in all: beyond, the oldest are dropped and counted), and the
+// too (at most four windows or queue_frames in all: beyond, the oldest are dropped and counted), and the
 // held frames are handed out first.
 #pragma once
 

@@ -124,7 +124,7 @@ TEST(LiveStreamTest, UdpVideoAndTcpPosesPaintLiveWithTheOffsetEstimated) {
                     {"offset_window_frames", 30},
                     {"open_timeout_s", 30},
                     {"read_timeout_s", 2},
-                    {"queue_frames", 16}}}};
+                    {"queue_frames", 200}}}};
   testing::WriteText(dir + "/live.json", project.dump(2));
   auto run = std::async(std::launch::async, [&] {
     return testing::RunFresco({"run", dir + "/live.json", "--out", dir + "/live_out", "--record",
@@ -152,7 +152,9 @@ TEST(LiveStreamTest, UdpVideoAndTcpPosesPaintLiveWithTheOffsetEstimated) {
   EXPECT_NEAR(estimated, kOffsetS, 1.0 / kFps);
   EXPECT_EQ(l["video_clock"], "stream");
   EXPECT_GE(l["frames_received"].get<int>(), frames - 5);  // loopback UDP loses little
-  EXPECT_LE(l["queue_high_water"].get<int>(), 16);
+  // A queue longer than the capture: nothing is dropped (back-pressure: live_test), so the
+  // comparison with the files below does not depend on the machine's speed.
+  EXPECT_EQ(l["frames_dropped"].get<int>() + l["frames_held_dropped"].get<int>(), 0);
   EXPECT_THAT(l["end_reason"].get<std::string>(), HasSubstr("no frame within"));
   EXPECT_GT(metrics["frames_painted"].get<int>(), frames / 2);
 
