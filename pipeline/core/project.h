@@ -166,6 +166,8 @@ struct LiveOptions {
   double connect_timeout_s = 5.0;  // the pose feed must accept the connection within this
   double pose_wait_s = 0.5;  // a frame waits this long for the tracker to reach its time
   double max_pose_gap_s = 0.5;  // no pose is interpolated between samples further apart
+  // A frame this far before the first pose or after the last still gets one, extrapolated.
+  double max_pose_extrapolate_s = 0.02;
   // Estimate time_offset_s from the first frames (time_offset_estimation.h): candidates
   // within +-offset_search_s of time_offset_s, scored by how well the frames warped with
   // them agree with the buffers they paint.

@@ -26,6 +26,7 @@ Status OpenLiveInputs(const Project& project, const Capture& capture, const Pain
   inputs->camera = &capture.cameras.begin()->second;
   PoseTrackOptions track_options;
   track_options.max_gap_s = project.live.max_pose_gap_s;
+  track_options.max_extrapolate_s = project.live.max_pose_extrapolate_s;
   WaitPoseAtTime pose_at;
   if (IsUrlOrDevice(project.poses)) {
     PoseFeedOptions feed_options;

@@ -61,6 +61,7 @@ Project NonDefaultProject() {
   p.live.connect_timeout_s = 0.75;
   p.live.pose_wait_s = 0.2;
   p.live.max_pose_gap_s = 0.3;
+  p.live.max_pose_extrapolate_s = 0.04;
   p.live.estimate_offset = true;
   p.live.offset_search_s = 1.5;
   p.live.offset_window_frames = 40;

@@ -46,6 +46,28 @@ bool UdpPortBound(int port) {
   return false;
 }
 
+// Runs `fresco run PROJECT --out OUT [extra]` while `ffmpeg` streams the capture's frames
+// to udp://127.0.0.1:PORT (H.264, lossless 4:4:4) at `rate` times their frame rate, once
+// Fresco listens. Returns Fresco's result.
+testing::CommandResult RunWhileStreaming(const std::string& project, const std::string& out,
+                                         const std::vector<std::string>& extra,
+                                         const std::string& frames_dir, int port, double rate) {
+  std::vector<std::string> args = {"run", project, "--out", out, "--quiet"};
+  args.insert(args.end(), extra.begin(), extra.end());
+  auto run = std::async(std::launch::async, [&] { return testing::RunFresco(args); });
+  // Start streaming once Fresco listens (it connects to the tracker first).
+  for (int i = 0; i < 300 && !UdpPortBound(port); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_TRUE(UdpPortBound(port)) << "fresco never opened the stream";
+  const std::string ffmpeg = "ffmpeg -hide_banner -loglevel error -readrate " +
+                             std::to_string(rate) + " -framerate 30 -i " + frames_dir +
+                             "/%06d.png -c:v libx264 -qp 0 -pix_fmt yuv444p -tune zerolatency "
+                             "-g 15 -f mpegts 'udp://127.0.0.1:" +
+                             std::to_string(port) + "?pkt_size=1316'";
+  EXPECT_EQ(std::system(ffmpeg.c_str()), 0);
+  return run.get();
+}
+
 bool HaveFfmpeg() { return std::system("ffmpeg -version >/dev/null 2>&1") == 0; }
 
 Json ReadJson(const std::string& path) { return Json::parse(testing::ReadText(path)); }
@@ -126,21 +148,9 @@ TEST(LiveStreamTest, UdpVideoAndTcpPosesPaintLiveWithTheOffsetEstimated) {
                     {"read_timeout_s", 2},
                     {"queue_frames", 200}}}};
   testing::WriteText(dir + "/live.json", project.dump(2));
-  auto run = std::async(std::launch::async, [&] {
-    return testing::RunFresco({"run", dir + "/live.json", "--out", dir + "/live_out", "--record",
-                               dir + "/recorded", "--quiet"});
-  });
-  // Start streaming once Fresco listens (it connects to the tracker first).
-  for (int i = 0; i < 300 && !UdpPortBound(video_port); ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  ASSERT_TRUE(UdpPortBound(video_port)) << "fresco never opened the stream";
-  const std::string ffmpeg = "ffmpeg -hide_banner -loglevel error -re -framerate 30 -i " + dir +
-                             "/synth/frames/%06d.png -c:v libx264 -qp 0 -pix_fmt yuv444p -tune "
-                             "zerolatency -g 15 -f mpegts "
-                             "'udp://127.0.0.1:" +
-                             std::to_string(video_port) + "?pkt_size=1316'";
-  EXPECT_EQ(std::system(ffmpeg.c_str()), 0);
-  const testing::CommandResult live = run.get();
+  const testing::CommandResult live =
+      RunWhileStreaming(dir + "/live.json", dir + "/live_out", {"--record", dir + "/recorded"},
+                        dir + "/synth/frames", video_port, 1.0);
   tracker.join();
   ASSERT_EQ(live.exit_code, 0) << live.err;
 
@@ -190,6 +200,26 @@ TEST(LiveStreamTest, UdpVideoAndTcpPosesPaintLiveWithTheOffsetEstimated) {
             metrics["frames_painted"]);
   EXPECT_GT(psnr_rec, 45.0);
   EXPECT_GT(common_rec, 0.999);
+
+  // A source faster than the painter: the same frames streamed at 20 times their rate,
+  // poses from the recording's TUM file (matched by time), a queue of 4 frames. Memory
+  // stays bounded by the queue; the frames the painter could not take are counted.
+  project["video"] = "udp://127.0.0.1:" + std::to_string(video_port);
+  project["poses"] = dir + "/recorded/poses.txt";
+  project["live"] = {{"queue_frames", 4}, {"open_timeout_s", 30}, {"read_timeout_s", 2}};
+  testing::WriteText(dir + "/fast.json", project.dump(2));
+  const testing::CommandResult fast = RunWhileStreaming(dir + "/fast.json", dir + "/fast_out", {},
+                                                        dir + "/synth/frames", video_port, 20.0);
+  ASSERT_EQ(fast.exit_code, 0) << fast.err;
+  const Json fast_metrics = ReadJson(dir + "/fast_out/metrics.json");
+  const Json& f = fast_metrics["live"];
+  EXPECT_LE(f["queue_high_water"].get<int>(), 4);
+  EXPECT_EQ(f["frames_delivered"].get<int>() + f["frames_dropped"].get<int>(),
+            f["frames_received"].get<int>());
+  EXPECT_EQ(fast_metrics["frames"], f["frames_delivered"]);
+  std::printf("20x rate, queue 4: %d received, %d painted, %d dropped, queue high water %d\n",
+              f["frames_received"].get<int>(), fast_metrics["frames_painted"].get<int>(),
+              f["frames_dropped"].get<int>(), f["queue_high_water"].get<int>());
 }
 
 TEST(LiveStreamTest, UnreachableSourcesExitTwoNamingTheAddress) {
