@@ -17,21 +17,22 @@ void Progress::Update(int done, const std::string& detail) {
   const double elapsed_s = std::chrono::duration<double>(now - start_).count();
   const double fraction = total_ > 0 ? static_cast<double>(done) / total_ : 0.0;
   if (tty_) {
-    if (done < total_ && now - last_draw_ < std::chrono::milliseconds(100)) return;
+    const bool last = total_ > 0 && done >= total_;  // unknown totals (live): rate-limited too
+    if (!last && now - last_draw_ < std::chrono::milliseconds(100)) return;
     last_draw_ = now;
     const int width = 30;
     const int filled = static_cast<int>(fraction * width);
-    std::fprintf(stderr, "\r%s [%s%s] %d/%d %.1fs %s\033[K", label_.c_str(),
+    std::fprintf(stderr, "\r%s [%s%s] %d/%s %.1fs %s\033[K", label_.c_str(),
                  std::string(filled, '#').c_str(), std::string(width - filled, '.').c_str(), done,
-                 total_, elapsed_s, detail.c_str());
+                 TotalText().c_str(), elapsed_s, detail.c_str());
     std::fflush(stderr);
     return;
   }
   const int decile = total_ > 0 ? static_cast<int>(fraction * 10) : done / 100;
   if (decile == last_decile_) return;
   last_decile_ = decile;
-  std::fprintf(stderr, "%s: %d/%d (%.1fs) %s\n", label_.c_str(), done, total_, elapsed_s,
-               detail.c_str());
+  std::fprintf(stderr, "%s: %d/%s (%.1fs) %s\n", label_.c_str(), done, TotalText().c_str(),
+               elapsed_s, detail.c_str());
 }
 
 void Progress::Finish(const std::string& detail) {

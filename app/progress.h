@@ -9,6 +9,7 @@ namespace fresco {
 
 class Progress {
  public:
+  // `total` < 0: unknown (a live stream), shown as "?".
   Progress(std::string label, int total, bool quiet = false);
   void Update(int done, const std::string& detail = "");
   void Finish(const std::string& detail = "");
@@ -16,6 +17,7 @@ class Progress {
   void Clear();
 
  private:
+  std::string TotalText() const { return total_ < 0 ? std::string("?") : std::to_string(total_); }
   std::string label_;
   int total_;
   bool quiet_;

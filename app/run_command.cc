@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <iostream>
 #include <map>
@@ -22,13 +23,17 @@
 #include "pipeline/paint/buffer_preview.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/live/live_input.h"
+#include "pipeline/live/session_recorder.h"
 
 namespace fresco {
 namespace {
 
 ArgSpec RunSpec() {
   ArgSpec spec;
-  spec.usage = "fresco run PROJECT.json --out DIR [--set KEY=VALUE ...] [--debug-images] [--quiet]";
+  spec.usage =
+      "fresco run PROJECT.json --out DIR [--set KEY=VALUE ...] [--debug-images] [--quiet]\n"
+      "       [--record DIR]";
   spec.help =
       "Replays the project headless: streams its video, paints every frame into the base\n"
       "buffers, and writes DIR/painted.gltf (+ .bin, PNG textures; alpha 0 = never painted),\n"
@@ -38,9 +43,16 @@ ArgSpec RunSpec() {
       "  --set KEY=VALUE   override a project setting by JSON path, e.g.\n"
       "                    --set pipeline.sampling=nearest --set pipeline.update_every=20\n"
       "  --debug-images    write per-stage debug images under DIR/stages/ (costs time)\n"
-      "  --quiet           no progress on stderr";
+      "  --quiet           no progress on stderr\n"
+      "  --record DIR      (live sources) also write the session as a project to replay:\n"
+      "                    DIR/frames/, DIR/poses.txt, DIR/project.json\n\n"
+      "Live sources (README \"Live capture\"): `video` may be device:N or a stream URL\n"
+      "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
+      "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
+      "by time (+ time_offset_s, estimated with live.estimate_offset); the run ends when\n"
+      "the video ends (no frame within live.read_timeout_s). metrics.json gets \"live\".";
   spec.min_positional = spec.max_positional = 1;
-  spec.options = {"--out"};
+  spec.options = {"--out", "--record"};
   spec.repeatable = {"--set"};
   spec.switches = {"--debug-images", "--quiet"};
   spec.required = {"--out"};
@@ -66,6 +78,56 @@ Status WriteStageImages(const std::string& dir, const FrameReport& report) {
   return Status::Ok();
 }
 
+// What the painting loop gets per frame, from files or live sources.
+struct LoopFrame {
+  PosedFrame posed;
+  const Camera* camera = nullptr;
+  std::string pose_name;  // for messages
+};
+using NextLoopFrame = std::function<bool(LoopFrame*, Status*)>;
+
+nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
+  const LiveFramesStats s = live.frames->stats();
+  nlohmann::json j;
+  j["frames_received"] = s.frames_received;
+  j["frames_dropped"] = s.frames_dropped;
+  j["frames_held_dropped"] = s.frames_held_dropped;
+  j["frames_delivered"] = s.frames_delivered;
+  j["frames_without_pose"] = s.frames_without_pose;
+  j["queue_capacity"] = s.queue_capacity;
+  j["queue_high_water"] = s.queue_high_water;
+  j["video_reopens"] = s.video_reopens;
+  j["video_clock"] = s.video_clock;
+  j["end_reason"] = s.end_reason;
+  j["time_offset_s"] = s.time_offset_s;
+  j["offset_estimated"] = s.offset_estimated;
+  if (live.feed) {
+    const PoseFeedStats f = live.feed->stats();
+    j["pose_feed"] = {{"address", live.feed->address()},
+                      {"poses", f.poses},
+                      {"reconnects", f.reconnects},
+                      {"connected", f.connected},
+                      {"seconds_since_last_pose", f.seconds_since_last_pose}};
+  }
+  if (!s.estimate.candidates.empty() || !s.estimate.note.empty()) {
+    nlohmann::json candidates = nlohmann::json::array();
+    for (const TimeOffsetCandidate& c : s.estimate.candidates)
+      candidates.push_back({{"offset_s", c.offset_s},
+                            {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nullptr},
+                            {"frames", c.frames_scored}});
+    j["offset_estimate"] = {{"ok", s.estimate.ok},
+                            {"offset_s", s.estimate.offset_s},
+                            {"score", s.estimate.score},
+                            {"contrast", s.estimate.contrast},
+                            {"frames", s.estimate.frames},
+                            {"seconds", s.estimate.seconds},
+                            {"note", s.estimate.note},
+                            {"candidates", candidates}};
+  }
+  j["recorded_frames"] = recorded;
+  return j;
+}
+
 }  // namespace
 
 int RunVerbRun(const CommandArgs& argv) {
@@ -82,9 +144,26 @@ int RunVerbRun(const CommandArgs& argv) {
   if (args.Switch("--debug-images")) project.pipeline.debug_images = true;
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
+  const bool live = IsLiveProject(project);
+  const std::string record_dir = args.Get("--record");
+  if (!record_dir.empty() && !live)
+    return InputError(Status::Error(std::string("--record: only for live sources (") + project_path +
+                                    " replays files already)"));
   Capture capture;
   std::unique_ptr<PaintSession> session;
-  if (Status s = OpenPaintSession(project, &capture, &session); !s.ok()) return InputError(s);
+  CaptureLoadOptions load_options;
+  load_options.open_video = !live;  // a live video opens after the pose feed connects
+  if (Status s = OpenPaintSession(project, load_options, &capture, &session); !s.ok())
+    return InputError(s);
+  LiveInputs live_inputs;
+  if (live) {
+    if (Status s = OpenLiveInputs(project, capture, *session, !record_dir.empty(), &live_inputs);
+        !s.ok())
+      return InputError(s);
+  }
+  SessionRecorder recorder;
+  if (!record_dir.empty())
+    if (Status s = recorder.Start(record_dir, project); !s.ok()) return InputError(s);
   if (!quiet) {
     std::fprintf(stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)\n",
                  capture.scene.mesh.NumTriangles(), session->buffers().size(),
@@ -99,33 +178,57 @@ int RunVerbRun(const CommandArgs& argv) {
     if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
   const std::string& stages_dir = stages.path();
 
-  int total = capture.video->FrameCount();
+  int total = live ? -1 : capture.video->FrameCount();
   if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
     total = project.pipeline.max_frames;
   Progress progress("painting", total, quiet);
   StageTotals totals;
   int frames = 0, frames_painted = 0, frames_without_pose = 0;
   const auto loop_start = std::chrono::steady_clock::now();
-  // Frames are read and decoded on a second thread, one frame ahead of the painting.
-  FrameReader reader(capture.video.get());
-  Frame frame;
+  NextLoopFrame next;
+  std::unique_ptr<FrameReader> reader;
+  if (live) {
+    next = [&](LoopFrame* f, Status* status) {
+      if (!live_inputs.frames->Next(&f->posed, status)) return false;
+      f->camera = live_inputs.camera;
+      f->pose_name = f->posed.frame.name;
+      return true;
+    };
+  } else {
+    // Frames are read and decoded on a second thread, one frame ahead of the painting.
+    reader = std::make_unique<FrameReader>(capture.video.get());
+    next = [&](LoopFrame* f, Status* status) {
+      if (!reader->Next(&f->posed.frame, status)) return false;
+      const PosedImage* pose = capture.PoseForFrame(f->posed.frame);
+      f->posed.has_pose = pose != nullptr;
+      if (!pose) return true;
+      f->posed.cam_from_world = pose->cam_from_world;
+      f->pose_name = pose->name;
+      f->camera = capture.CameraFor(*pose);
+      if (!f->camera) {
+        *status = Status::Error(project.Resolve(project.poses) + ": image '" + pose->name +
+                                "': camera " + std::to_string(pose->camera_id) + " not found");
+        return false;
+      }
+      return true;
+    };
+  }
+  LoopFrame loop_frame;
+  const Frame& frame = loop_frame.posed.frame;
   Status read_status;
   FrameReport report;
   while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
-         !Interrupted() && reader.Next(&frame, &read_status)) {
+         !Interrupted() && next(&loop_frame, &read_status)) {
     if (Interrupted()) break;  // arrived while the frame was read
     ++frames;
-    const PosedImage* pose = capture.PoseForFrame(frame);
-    if (!pose) {
+    if (live_inputs.feed)
+      if (Status s = live_inputs.feed->error(); !s.ok()) return InputError(s);
+    if (!loop_frame.posed.has_pose) {
       ++frames_without_pose;
       progress.Update(frames);
       continue;
     }
-    const Camera* camera = capture.CameraFor(*pose);
-    if (!camera)
-      return InputError(Status::Error(project.Resolve(project.poses) + ": image '" + pose->name +
-                                      "': camera " + std::to_string(pose->camera_id) +
-                                      " not found"));
+    const Camera* camera = loop_frame.camera;
     if (frame.bgr.cols != camera->width || frame.bgr.rows != camera->height) {
       return InputError(Status::Error(project.Resolve(project.video) + ": frame '" + frame.name +
                                       "' is " + std::to_string(frame.bgr.cols) + "x" +
@@ -133,7 +236,10 @@ int RunVerbRun(const CommandArgs& argv) {
                                       std::to_string(camera->width) + "x" +
                                       std::to_string(camera->height)));
     }
-    session->PaintFrame(frame, *camera, pose->cam_from_world, &report);
+    if (!record_dir.empty())
+      if (Status s = recorder.Add(frame, loop_frame.posed.cam_from_world); !s.ok())
+        return InputError(s);
+    session->PaintFrame(frame, *camera, loop_frame.posed.cam_from_world, &report);
     if (report.painted) {
       ++frames_painted;
       for (const StageReport& st : report.stages) {
@@ -151,6 +257,7 @@ int RunVerbRun(const CommandArgs& argv) {
     std::snprintf(detail, sizeof detail, "coverage %.1f%%", 100.0 * session->Coverage());
     progress.Update(frames, detail);
   }
+  if (live_inputs.frames) live_inputs.frames->Stop();
   if (!read_status.ok()) return InputError(read_status);
   if (Interrupted()) {
     progress.Clear();
@@ -159,6 +266,15 @@ int RunVerbRun(const CommandArgs& argv) {
                  "of earlier runs there are kept)\n",
                  InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
     return InterruptExitCode();
+  }
+  if (live_inputs.feed)
+    if (Status s = live_inputs.feed->error(); !s.ok()) return InputError(s);
+  if (!record_dir.empty()) {
+    const std::vector<TimedPose> tracker =
+        live_inputs.feed ? live_inputs.feed->AllPoses()
+                         : std::vector<TimedPose>(live_inputs.track->samples().begin(),
+                                                  live_inputs.track->samples().end());
+    if (Status s = recorder.Finish(tracker); !s.ok()) return InputError(s);
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
@@ -212,6 +328,7 @@ int RunVerbRun(const CommandArgs& argv) {
                        {"painted", session->painted()[b].painted_surface_texels}});
   }
   metrics["buffers"] = buffers;
+  if (live) metrics["live"] = LiveMetrics(live_inputs, recorder.frames());
   if (Status s = WriteFileAtomic(out_dir + "/metrics.json", metrics.dump(2) + "\n"); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;

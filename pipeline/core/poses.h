@@ -7,6 +7,7 @@
 
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -63,6 +64,10 @@ Status WriteColmapImages(const std::string& path, const std::vector<PosedImage>&
 Status WriteColmapPoints(const std::string& path, const std::vector<Point3D>& points);
 Status WriteColmapModel(const std::string& folder, const ColmapModel& model);
 
+// One TUM line (`timestamp tx ty tz qx qy qz qw`, world_from_cam); blank lines and '#'
+// comments set `is_pose` false. Errors read "SOURCE:LINE: FIELD: what is wrong".
+Status ParseTumLine(const std::string& source, int line_number, std::string_view line,
+                    bool* is_pose, double* timestamp_s, Rigid3d* world_from_cam);
 Status ReadTumTrajectory(const std::string& path, std::vector<PosedImage>* poses);
 // The same from text already in memory; `path` names the source in messages.
 Status ParseTumTrajectory(const std::string& contents, const std::string& path,

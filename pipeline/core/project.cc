@@ -171,6 +171,22 @@ void Fields(TruthFiles& t, V& v) {
 }
 
 template <class V>
+void Fields(LiveOptions& o, V& v) {
+  v.Field("queue_frames", o.queue_frames, {.min = 1, .max = 1000});
+  v.Field("open_timeout_s", o.open_timeout_s, {.min = 0, .min_exclusive = true});
+  v.Field("read_timeout_s", o.read_timeout_s, {.min = 0, .min_exclusive = true});
+  v.Field("reconnects", o.reconnects, {.min = 0});
+  v.Field("stream_clock", o.stream_clock);
+  v.Field("connect_timeout_s", o.connect_timeout_s, {.min = 0});
+  v.Field("pose_wait_s", o.pose_wait_s, {.min = 0});
+  v.Field("max_pose_gap_s", o.max_pose_gap_s, {.min = 0, .min_exclusive = true});
+  v.Field("max_pose_extrapolate_s", o.max_pose_extrapolate_s, {.min = 0});
+  v.Field("estimate_offset", o.estimate_offset);
+  v.Field("offset_search_s", o.offset_search_s, {.min = 0, .min_exclusive = true, .max = 60});
+  v.Field("offset_window_frames", o.offset_window_frames, {.min = 4, .max = 1000});
+}
+
+template <class V>
 void Fields(Project& p, V& v) {
   v.Field("fresco", p.fresco_version, {.required = true});
   v.Field("scene", p.scene, {.required = true, .non_empty = true});
@@ -181,6 +197,7 @@ void Fields(Project& p, V& v) {
   v.Object("pipeline", p.pipeline);
   v.Object("grouping", p.grouping);
   v.Object("truth", p.truth);
+  v.Object("live", p.live);
 }
 
 // A new member must be added to its Fields() above (read and written) and to the test's
@@ -193,7 +210,8 @@ static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(Grou
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 496, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 88, "see Fields(LiveOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 584, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

@@ -158,6 +158,32 @@ struct TruthFiles {
   bool operator==(const TruthFiles&) const = default;
 };
 
+// Live sources (issue 12; pipeline/live/): a camera or stream as `video`, a pose feed
+// (tcp://, udp://, fifo://) as `poses`, matched by time. Ignored for files.
+struct LiveOptions {
+  // Frames waiting between the source and the painter; when painting is slower the oldest
+  // waiting frame is dropped (newest wins) and counted.
+  int queue_frames = 4;
+  double open_timeout_s = 10.0;  // the video stream must start within this
+  // No frame for this long: the stream has ended (after `reconnects` reopen attempts).
+  double read_timeout_s = 3.0;
+  int reconnects = 0;
+  bool stream_clock = true;  // frame times from the stream's timestamps (else arrival)
+  double connect_timeout_s = 5.0;  // the pose feed must accept the connection within this
+  double pose_wait_s = 0.5;  // a frame waits this long for the tracker to reach its time
+  double max_pose_gap_s = 0.5;  // no pose is interpolated between samples further apart
+  // A frame this far before the first pose or after the last still gets one, extrapolated.
+  double max_pose_extrapolate_s = 0.02;
+  // Estimate time_offset_s from the first frames (time_offset_estimation.h): candidates
+  // within +-offset_search_s of time_offset_s, scored by how well the frames warped with
+  // them agree with the buffers they paint.
+  bool estimate_offset = false;
+  double offset_search_s = 0.5;
+  int offset_window_frames = 30;
+
+  bool operator==(const LiveOptions&) const = default;
+};
+
 struct Project {
   int fresco_version = 1;
   std::string scene;  // as written in the file
@@ -168,6 +194,7 @@ struct Project {
   PipelineOptions pipeline;
   GroupingOptions grouping;
   TruthFiles truth;
+  LiveOptions live;
 
   std::string file_path;  // where it was loaded from / saved to (absolute)
   // Resolves a path as written in the project against the project file's folder.

@@ -124,8 +124,9 @@ class FolderSource : public VideoSource {
 // A video file or a live source through cv::VideoCapture.
 class CaptureSource : public VideoSource {
  public:
-  CaptureSource(std::string what, cv::VideoCapture capture, bool live)
-      : what_(std::move(what)), capture_(std::move(capture)), live_(live) {
+  CaptureSource(std::string what, cv::VideoCapture capture, bool live, bool stream_clock)
+      : what_(std::move(what)), capture_(std::move(capture)), live_(live),
+        stream_clock_(stream_clock) {
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     fps_ = std::isfinite(fps) && fps > 0 && fps < 1000 ? fps : kDefaultFolderFps;
     const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
@@ -144,6 +145,7 @@ class CaptureSource : public VideoSource {
       }
       return false;
     }
+    const auto now = std::chrono::steady_clock::now();
     char name[32];
     std::snprintf(name, sizeof(name), "%06d.png", index_);
     cv::Mat bgr;
@@ -156,13 +158,11 @@ class CaptureSource : public VideoSource {
       if (status) *status = size_ok;
       return false;
     }
-    const auto now = std::chrono::steady_clock::now();
     if (index_ == 0) start_ = now;
     frame->index = index_;
     frame->name = name;
-    // Live sources: seconds since the first frame on the wall clock; files: index / fps.
-    frame->timestamp_s =
-        live_ ? std::chrono::duration<double>(now - start_).count() : index_ / fps_;
+    frame->arrival_s = live_ ? std::chrono::duration<double>(now - start_).count() : 0.0;
+    frame->timestamp_s = live_ ? LiveTimestamp(frame->arrival_s) : index_ / fps_;
     frame->bgr = bgr;
     ++index_;
     return true;
@@ -170,11 +170,41 @@ class CaptureSource : public VideoSource {
   int FrameCount() const override { return count_; }
   std::vector<std::string> FrameNames() const override { return {}; }
   double Fps() const override { return fps_; }
+  bool IsLive() const override { return live_; }
+  std::string Clock() const override {
+    return !live_ ? "index" : (use_stream_clock_ ? "stream" : "arrival");
+  }
 
  private:
+  // The stream's presentation time relative to the first frame's, while it is finite and
+  // increasing; otherwise (cameras without timestamps, a stream that restarts) arrival time
+  // from then on.
+  double LiveTimestamp(double arrival_s) {
+    const double pts_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+    if (index_ == 0) {
+      first_pts_ms_ = pts_ms;
+      use_stream_clock_ = stream_clock_ && std::isfinite(pts_ms) && pts_ms >= 0;
+    }
+    if (use_stream_clock_) {
+      const double t = (pts_ms - first_pts_ms_) / 1000.0;
+      if (std::isfinite(t) && (index_ == 0 || t > last_t_)) {
+        last_t_ = t;
+        return t;
+      }
+      use_stream_clock_ = false;
+      arrival_shift_ = last_t_ - arrival_s + 1.0 / fps_;  // continues after the last stamp
+    }
+    return arrival_s + arrival_shift_;
+  }
+
   std::string what_;
   cv::VideoCapture capture_;
   bool live_;
+  bool stream_clock_;
+  bool use_stream_clock_ = false;
+  double first_pts_ms_ = 0.0;
+  double last_t_ = 0.0;
+  double arrival_shift_ = 0.0;
   double fps_ = kDefaultFolderFps;
   int count_ = -1;
   int index_ = 0;
@@ -212,24 +242,39 @@ void QuietFfmpegLog() {
 
 }  // namespace
 
-Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* source) {
+Status OpenVideoSource(const std::string& path, const VideoSourceOptions& options,
+                       std::unique_ptr<VideoSource>* source) {
+  const int open_ms = static_cast<int>(options.open_timeout_s * 1000);
+  const int read_ms = static_cast<int>(options.read_timeout_s * 1000);
   if (path.rfind("device:", 0) == 0) {
     const std::string number = path.substr(7);
-    if (number.empty() || number.find_first_not_of("0123456789") != std::string::npos) {
+    if (number.empty() || number.size() > 4 ||
+        number.find_first_not_of("0123456789") != std::string::npos) {
       return Status::Error(path + ": expected device:N with N a camera number");
     }
-    cv::VideoCapture capture(std::stoi(number));
-    if (!capture.isOpened()) return Status::Error(path + ": cannot open the camera");
-    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true);
+    cv::VideoCapture capture;
+    capture.open(std::stoi(number), cv::CAP_ANY);
+    if (!capture.isOpened()) {
+      return Status::Error(path + ": cannot open the camera (no /dev/video" + number +
+                           ", or it is busy or not a capture device)");
+    }
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true,
+                                              options.stream_clock);
     return Status::Ok();
   }
   QuietFfmpegLog();
   if (IsUrlOrDevice(path)) {
-    cv::VideoCapture capture(path, cv::CAP_FFMPEG);
+    cv::VideoCapture capture(path, cv::CAP_FFMPEG,
+                             {cv::CAP_PROP_OPEN_TIMEOUT_MSEC, open_ms,
+                              cv::CAP_PROP_READ_TIMEOUT_MSEC, read_ms});
     if (!capture.isOpened()) {
-      return Status::Error(path + ": cannot open the stream (OpenCV FFmpeg backend)");
+      return Status::Error(path + ": cannot open the stream within " +
+                           std::to_string(open_ms / 1000.0).substr(0, 4) +
+                           " s (unreachable, nothing sent, or not a format OpenCV's FFmpeg "
+                           "backend reads)");
     }
-    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true);
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true,
+                                              options.stream_clock);
     return Status::Ok();
   }
   std::error_code ec;
@@ -239,8 +284,13 @@ Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* so
   if (!capture.isOpened()) {
     return Status::Error(path + ": cannot open as a video (OpenCV FFmpeg backend)");
   }
-  *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/false);
+  *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/false,
+                                            options.stream_clock);
   return Status::Ok();
+}
+
+Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* source) {
+  return OpenVideoSource(path, VideoSourceOptions(), source);
 }
 
 }  // namespace fresco

@@ -1,5 +1,7 @@
-// Video frames from a folder of images (sorted by file name) or a video file OpenCV reads.
-// Frames are streamed: memory does not grow with the video's length.
+// Video frames from a folder of images (sorted by file name), a video file OpenCV reads, or
+// a live source: a camera ("device:N", V4L2 through OpenCV) or a stream URL OpenCV's FFmpeg
+// backend reads ("udp://127.0.0.1:5000", "rtsp://...", "http://..."). Frames are streamed:
+// memory does not grow with the video's length.
 #pragma once
 
 #include <memory>
@@ -15,7 +17,13 @@ namespace fresco {
 struct Frame {
   int index = -1;        // 0-based position in the stream
   std::string name;      // file name for folders ("000012.png"); "%06d" index for videos
+  // Capture time, seconds, the first frame at 0. Folders: index / 30; files: the stream's
+  // presentation time; live sources: the stream's presentation time when it has one
+  // (VideoSourceOptions::stream_clock), else the arrival time below.
   double timestamp_s = 0.0;
+  // Live sources: when the frame was received, seconds on the steady clock after the first
+  // frame arrived (0 for files).
+  double arrival_s = 0.0;
   cv::Mat bgr;           // CV_8UC3
 };
 
@@ -30,9 +38,26 @@ class VideoSource {
   // Frame names in order when known (folders), else empty.
   virtual std::vector<std::string> FrameNames() const = 0;
   virtual double Fps() const = 0;
+  // A camera or a stream (frames arrive on their own clock; reading may time out).
+  virtual bool IsLive() const { return false; }
+  // Which clock timestamp_s follows: "index" (folders), "stream" or "arrival".
+  virtual std::string Clock() const { return "index"; }
+};
+
+struct VideoSourceOptions {
+  // Live sources: opening (the stream's first packets, probed by FFmpeg) must succeed within
+  // this, and after that a frame must arrive within read_timeout_s, else reading ends.
+  double open_timeout_s = 10.0;
+  double read_timeout_s = 3.0;
+  // Live sources: timestamps from the stream's presentation times (immune to network and
+  // decoding jitter) when the stream has them; false: arrival times.
+  bool stream_clock = true;
 };
 
 // `path`: a folder of images (.png .jpg .jpeg .bmp .tif .tiff .ppm) or a video file.
+// `path` may also be "device:N" or a stream URL (live sources).
+Status OpenVideoSource(const std::string& path, const VideoSourceOptions& options,
+                       std::unique_ptr<VideoSource>* source);
 Status OpenVideoSource(const std::string& path, std::unique_ptr<VideoSource>* source);
 
 }  // namespace fresco

@@ -4,7 +4,12 @@ namespace fresco {
 
 Status OpenPaintSession(const Project& project, Capture* capture,
                         std::unique_ptr<PaintSession>* session) {
-  FRESCO_RETURN_IF_ERROR(LoadCapture(project, CaptureLoadOptions(), capture));
+  return OpenPaintSession(project, CaptureLoadOptions(), capture, session);
+}
+
+Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
+                        Capture* capture, std::unique_ptr<PaintSession>* session) {
+  FRESCO_RETURN_IF_ERROR(LoadCapture(project, load_options, capture));
   if (capture->cameras.empty())
     return Status::Error(project.Resolve(project.camera) + ": no camera");
   PaintSessionInputs inputs;

@@ -13,5 +13,9 @@ namespace fresco {
 
 Status OpenPaintSession(const Project& project, Capture* capture,
                         std::unique_ptr<PaintSession>* session);
+// The same with the capture's load options (e.g. open_video false: a live video is opened
+// later, once the pose feed is connected).
+Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
+                        Capture* capture, std::unique_ptr<PaintSession>* session);
 
 }  // namespace fresco

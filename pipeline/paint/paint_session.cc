@@ -116,6 +116,15 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   return Status::Ok();
 }
 
+void PaintSession::ResetPainting() {
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    InitPaintedBuffer(set_.buffers[b], &painted_[b]);
+    InitRefineAnchor(set_.buffers[b], &anchors_[b]);
+    if (!background_.empty()) background_[b].Init(set_.buffers[b], options_.background);
+  }
+  frames_seen_ = 0;
+}
+
 const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
   for (const CameraCache& cache : cameras_)
     if (SameCamera(cache.camera, camera)) return cache;

@@ -59,6 +59,11 @@ class PaintSession {
   void PaintFrameNaive(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
                        FrameReport* report);
 
+  // Forgets everything painted (buffers, background models, anchors, frame count); the
+  // grouping, buffers' layout and camera caches stay (time_offset_estimation.h repaints
+  // the same frames once per candidate offset).
+  void ResetPainting();
+
   // The scene's geometry with the painted buffers as base-colour textures (alpha 0 where
   // never painted) and new UVs into them.
   Scene PaintedScene() const;

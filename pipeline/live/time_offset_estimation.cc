@@ -1,0 +1,124 @@
+#include "pipeline/live/time_offset_estimation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace fresco {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double MedianInterval(const std::vector<Frame>& frames) {
+  std::vector<double> dt;
+  for (size_t i = 1; i < frames.size(); ++i) {
+    const double d = frames[i].timestamp_s - frames[i - 1].timestamp_s;
+    if (d > 0) dt.push_back(d);
+  }
+  if (dt.empty()) return 1.0 / 30.0;
+  std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+  return dt[dt.size() / 2];
+}
+
+bool Better(const TimeOffsetCandidate& a, const TimeOffsetCandidate& b) {
+  if (!std::isfinite(b.score)) return std::isfinite(a.score);
+  return std::isfinite(a.score) && a.score < b.score;
+}
+
+}  // namespace
+
+PipelineOptions EstimationPipeline(const PipelineOptions& pipeline) {
+  PipelineOptions p = pipeline;
+  p.background.mode = BackgroundMode::kOff;
+  p.refine.mode = RefineMode::kOff;
+  p.update = UpdatePolicy::kLatest;
+  p.update_every = 1;
+  p.debug_images = false;
+  return p;
+}
+
+TimeOffsetCandidate ScoreTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
+                                    const PoseAtTime& pose_at, double offset_s,
+                                    PaintSession* session) {
+  TimeOffsetCandidate c;
+  c.offset_s = offset_s;
+  session->ResetPainting();
+  double sum = 0;
+  FrameReport report;
+  for (const Frame& frame : frames) {
+    Rigid3d cam_from_world;
+    if (!pose_at(frame.timestamp_s + offset_s, &cam_from_world)) continue;
+    session->PaintFrame(frame, camera, cam_from_world, &report);
+    const StageReport* paint = report.Stage("paint");
+    if (!paint) continue;
+    const auto it = paint->metrics.find("difference_to_buffer");
+    if (it == paint->metrics.end() || !std::isfinite(it->second)) continue;
+    sum += it->second;
+    ++c.frames_scored;
+  }
+  c.score = c.frames_scored > 0 ? sum / c.frames_scored : kNaN;
+  return c;
+}
+
+TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
+                                      const PoseAtTime& pose_at, const TimeOffsetOptions& options,
+                                      PaintSession* session) {
+  const auto start = std::chrono::steady_clock::now();
+  TimeOffsetEstimate result;
+  result.offset_s = options.centre_s;
+  result.frames = static_cast<int>(frames.size());
+  const double period = MedianInterval(frames);
+  const double step = options.step_s > 0 ? options.step_s : period;
+  auto score = [&](double offset) {
+    TimeOffsetCandidate c = ScoreTimeOffset(frames, camera, pose_at, offset, session);
+    if (c.frames_scored < options.min_frames) c.score = kNaN;
+    result.candidates.push_back(c);
+    return c;
+  };
+  // Coarse: one frame period over the whole range.
+  const int half = std::max(1, static_cast<int>(std::ceil(options.search_s / step)));
+  TimeOffsetCandidate best;
+  best.score = kNaN;
+  for (int i = -half; i <= half; ++i) {
+    const TimeOffsetCandidate c = score(options.centre_s + i * step);
+    if (Better(c, best)) best = c;
+  }
+  if (!std::isfinite(best.score)) {
+    result.note =
+        "no candidate offset could be scored (too few frames with poses, or the "
+        "frames see none of the model)";
+    result.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+  // Fine: a quarter step around the best.
+  const double fine = step / 4;
+  std::vector<TimeOffsetCandidate> around;
+  for (int i = -4; i <= 4; ++i) {
+    around.push_back(i == 0 ? best : score(best.offset_s + i * fine));
+  }
+  size_t k = 0;
+  for (size_t i = 1; i < around.size(); ++i)
+    if (Better(around[i], around[k])) k = i;
+  double offset = around[k].offset_s;
+  // Parabola through the best fine score and its neighbours.
+  if (k > 0 && k + 1 < around.size() && std::isfinite(around[k - 1].score) &&
+      std::isfinite(around[k + 1].score)) {
+    const double a = around[k - 1].score, b = around[k].score, c = around[k + 1].score;
+    const double curvature = a - 2 * b + c;
+    if (curvature > 0) offset += 0.5 * fine * (a - c) / curvature;
+  }
+  std::vector<double> scores;
+  for (const TimeOffsetCandidate& c : result.candidates)
+    if (std::isfinite(c.score)) scores.push_back(c.score);
+  std::nth_element(scores.begin(), scores.begin() + scores.size() / 2, scores.end());
+  result.ok = true;
+  result.offset_s = offset;
+  result.score = around[k].score;
+  result.contrast = scores[scores.size() / 2] - around[k].score;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace fresco

@@ -1,0 +1,363 @@
+// Live sources (issue 12), on loopback only: pose interpolation against exact motion, the
+// bounded newest-wins queue, back-pressure under a source faster than the painter, pose
+// feeds over TCP/UDP/named pipes (errors, reconnects), and the time-offset estimation on a
+// synthetic capture with a known offset.
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fcntl.h>
+#include <atomic>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "pipeline/core/poses.h"
+#include "pipeline/live/latest_queue.h"
+#include "pipeline/live/live_frames.h"
+#include "pipeline/live/pose_feed.h"
+#include "pipeline/live/pose_track.h"
+#include "pipeline/live/time_offset_estimation.h"
+#include "pipeline/synth/procedural_scenes.h"
+#include "pipeline/synth/synthesize.h"
+#include "tests/live/loopback.h"
+#include "tests/paint/room_capture.h"
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+constexpr double kDeg = M_PI / 180.0;
+
+// A camera turning about a fixed axis at a constant rate and moving along a line at a
+// constant speed: SLERP and linear interpolation are exact for it.
+TimedPose Motion(double t) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 2).normalized();
+  const double angle = 30.0 * kDeg * t;  // 30 deg/s
+  TimedPose p;
+  p.timestamp_s = t;
+  p.world_from_cam = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(angle, axis)),
+                             Eigen::Vector3d(1.0 + 0.5 * t, -2.0, 0.25 * t));
+  return p;
+}
+
+double CentreError(const Rigid3d& cam_from_world, const TimedPose& truth) {
+  return (cam_from_world.Centre() - truth.world_from_cam.translation).norm();
+}
+
+double AngleErrorDeg(const Rigid3d& cam_from_world, const TimedPose& truth) {
+  return RotationDifferenceDeg(cam_from_world.Inverse().rotation, truth.world_from_cam.rotation);
+}
+
+TEST(PoseTrackTest, InterpolatesExactMotionBetweenSamples) {
+  PoseTrack track;
+  for (int i = 0; i <= 10; ++i) track.Add(Motion(0.1 * i));
+  for (double t : {0.0, 0.025, 0.137, 0.5, 0.999, 1.0}) {
+    Rigid3d pose;
+    ASSERT_TRUE(track.At(t, &pose)) << t;
+    EXPECT_LT(CentreError(pose, Motion(t)), 1e-12) << t;
+    EXPECT_LT(AngleErrorDeg(pose, Motion(t)), 1e-6) << t;
+  }
+  // Numbers: half-way between 0.1 s (3 deg) and 0.2 s (6 deg) the camera has turned 4.5 deg
+  // about the axis and its centre is at x = 1.075.
+  Rigid3d pose;
+  ASSERT_TRUE(track.At(0.15, &pose));
+  EXPECT_NEAR(Eigen::AngleAxisd(pose.Inverse().rotation).angle() / kDeg, 4.5, 1e-9);
+  EXPECT_NEAR(pose.Centre().x(), 1.075, 1e-12);
+  EXPECT_NEAR(pose.Centre().z(), 0.0375, 1e-12);
+}
+
+TEST(PoseTrackTest, SlerpTakesTheShortWayAndMidpointsAreExact) {
+  // 0 and 170 deg about z, the second stored as the negated quaternion.
+  TimedPose a, b;
+  a.timestamp_s = 0;
+  b.timestamp_s = 1;
+  b.world_from_cam.rotation =
+      Eigen::Quaterniond(Eigen::AngleAxisd(170 * kDeg, Eigen::Vector3d::UnitZ()));
+  b.world_from_cam.rotation.coeffs() *= -1;
+  const Rigid3d mid = InterpolatePose(a, b, 0.5);
+  const Eigen::AngleAxisd aa(mid.Inverse().rotation);
+  EXPECT_NEAR(aa.angle() / kDeg, 85.0, 1e-9);
+  EXPECT_NEAR(std::abs(aa.axis().z()), 1.0, 1e-12);
+}
+
+TEST(PoseTrackTest, OutOfOrderSamplesGapsAndEnds) {
+  PoseTrackOptions options;
+  options.max_gap_s = 0.25;
+  options.max_extrapolate_s = 0.05;
+  PoseTrack track(options);
+  for (double t : {0.3, 0.1, 0.2, 0.0, 1.0, 1.1}) track.Add(Motion(t));  // gap 0.3 -> 1.0
+  EXPECT_EQ(track.size(), 6u);
+  EXPECT_EQ(track.first_time_s(), 0.0);
+  EXPECT_EQ(track.last_time_s(), 1.1);
+  Rigid3d pose;
+  EXPECT_TRUE(track.At(0.25, &pose));
+  EXPECT_LT(CentreError(pose, Motion(0.25)), 1e-12);
+  EXPECT_FALSE(track.At(0.6, &pose)) << "inside the 0.7 s gap";
+  EXPECT_TRUE(track.At(1.14, &pose)) << "within max_extrapolate_s after the end";
+  EXPECT_LT(CentreError(pose, Motion(1.14)), 1e-12);  // constant motion extrapolates exactly
+  EXPECT_LT(AngleErrorDeg(pose, Motion(1.14)), 1e-6);
+  EXPECT_FALSE(track.At(1.2, &pose));
+  EXPECT_FALSE(track.At(-0.1, &pose));
+  track.Add(Motion(0.2));  // a sample at a time already held replaces it
+  EXPECT_EQ(track.size(), 6u);
+}
+
+TEST(PoseTrackTest, MemoryIsBounded) {
+  PoseTrackOptions options;
+  options.max_samples = 50;
+  PoseTrack track(options);
+  for (int i = 0; i < 1000; ++i) track.Add(Motion(0.01 * i));
+  EXPECT_EQ(track.size(), 50u);
+  EXPECT_NEAR(track.first_time_s(), 9.5, 1e-9);
+}
+
+TEST(LatestQueueTest, NewestWinsAndDropsAreCounted) {
+  LatestQueue<int> queue(3);
+  for (int i = 0; i < 10; ++i) queue.Push(i);
+  EXPECT_EQ(queue.dropped(), 7);
+  EXPECT_EQ(queue.pushed(), 10);
+  EXPECT_EQ(queue.high_water(), 3u);
+  int v = -1;
+  for (int expected : {7, 8, 9}) {
+    ASSERT_TRUE(queue.Pop(&v, std::chrono::milliseconds(0)));
+    EXPECT_EQ(v, expected);
+  }
+  EXPECT_FALSE(queue.Pop(&v, std::chrono::milliseconds(1)));
+  queue.Close();
+  EXPECT_FALSE(queue.Pop(&v));
+}
+
+// A live source that produces `count` 640x480 frames as fast as it can, then ends; it
+// tells when it has produced them all.
+class FastLiveSource : public VideoSource {
+ public:
+  explicit FastLiveSource(int count) : count_(count) {}
+  bool Next(Frame* frame, Status*) override {
+    if (next_ >= count_) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      done_ = true;
+      done_cv_.notify_all();
+      return false;
+    }
+    frame->index = next_;
+    frame->timestamp_s = next_ / 30.0;
+    frame->bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(next_ % 256, 0, 0));
+    ++next_;
+    return true;
+  }
+  int FrameCount() const override { return -1; }
+  std::vector<std::string> FrameNames() const override { return {}; }
+  double Fps() const override { return 30; }
+  bool IsLive() const override { return true; }
+  std::string Clock() const override { return "stream"; }
+  void WaitDone() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    done_cv_.wait(lock, [this] { return done_; });
+  }
+
+ private:
+  int count_;
+  int next_ = 0;
+  std::mutex mutex_;
+  std::condition_variable done_cv_;
+  bool done_ = false;
+};
+
+TEST(LiveFramesTest, ASourceFasterThanThePainterIsDroppedNewestWins) {
+  const int produced = 500;  // 460 MB if nothing were dropped
+  auto source = std::make_unique<FastLiveSource>(produced);
+  FastLiveSource* raw = source.get();
+  LiveOptions options;
+  options.queue_frames = 4;
+  options.pose_wait_s = 0;
+  PoseTrack track;
+  for (int i = 0; i <= produced; ++i) track.Add(Motion(i / 30.0));
+  LiveFrames frames(
+      std::move(source), nullptr,
+      [&](double t, double, Rigid3d* pose) { return track.At(t, pose); }, options, 0.0, nullptr);
+  PosedFrame f;
+  Status status;
+  ASSERT_TRUE(frames.Next(&f, &status));  // the painter takes one frame, then is "slow":
+  raw->WaitDone();                        // the source produces everything meanwhile
+  std::vector<int> delivered = {f.frame.index};
+  while (frames.Next(&f, &status)) {
+    delivered.push_back(f.frame.index);
+    EXPECT_TRUE(f.has_pose);
+    EXPECT_LT(CentreError(f.cam_from_world, Motion(f.frame.timestamp_s)), 1e-9);
+  }
+  EXPECT_TRUE(status.ok()) << status.message();
+  const LiveFramesStats stats = frames.stats();
+  EXPECT_EQ(stats.frames_received, produced);
+  EXPECT_LE(stats.queue_high_water, 4);  // memory bounded by the queue
+  EXPECT_EQ(stats.frames_delivered + stats.frames_dropped, produced);
+  // The painter got the first frame and the newest four.
+  ASSERT_GE(delivered.size(), 5u);
+  EXPECT_EQ(std::vector<int>(delivered.end() - 4, delivered.end()),
+            (std::vector<int>{produced - 4, produced - 3, produced - 2, produced - 1}));
+  EXPECT_GE(stats.frames_dropped, produced - 1 - 4 - 1);
+  EXPECT_THAT(stats.end_reason, HasSubstr("no frame within"));
+}
+
+std::string TumLine(const TimedPose& p) {
+  return testing::TumLine(p.timestamp_s, p.world_from_cam);
+}
+
+TEST(PoseFeedTest, TcpFeedInterpolatesAndReconnects) {
+  testing::PoseServer server;
+  std::string first = "# timestamp tx ty tz qx qy qz qw\n", second;
+  for (int i = 0; i <= 10; ++i) first += TumLine(Motion(0.1 * i));
+  for (int i = 11; i <= 20; ++i) second += TumLine(Motion(0.1 * i));
+  std::thread tracker([&] {
+    server.ServeOnce(first);   // the tracker drops the connection...
+    server.ServeOnce(second);  // ...and comes back: Fresco reconnects
+  });
+  PoseFeedOptions options;
+  options.keep_all = true;
+  std::unique_ptr<PoseFeed> feed;
+  const Status opened = PoseFeed::Open(server.Address(), options, &feed);
+  ASSERT_TRUE(opened.ok()) << opened.message();
+  Rigid3d pose;
+  ASSERT_TRUE(feed->WaitPoseAt(1.55, 10.0, &pose));  // waits for the second connection
+  EXPECT_LT(CentreError(pose, Motion(1.55)), 1e-9);
+  EXPECT_LT(AngleErrorDeg(pose, Motion(1.55)), 1e-6);
+  ASSERT_TRUE(feed->WaitPoseAt(2.0, 10.0, &pose));
+  tracker.join();
+  EXPECT_TRUE(feed->error().ok()) << feed->error().message();
+  EXPECT_EQ(feed->stats().poses, 21);
+  EXPECT_GE(feed->stats().reconnects, 1);
+  EXPECT_EQ(feed->AllPoses().size(), 21u);
+  EXPECT_FALSE(feed->WaitPoseAt(5.0, 0.05, &pose)) << "beyond the track";
+}
+
+TEST(PoseFeedTest, MalformedLineIsAnErrorNamingAddressAndLine) {
+  testing::PoseServer server;
+  std::thread tracker(
+      [&] { server.ServeOnce(TumLine(Motion(0)) + TumLine(Motion(0.1)) + "0.2 1 2 3 0 0 0 x\n"); });
+  std::unique_ptr<PoseFeed> feed;
+  ASSERT_TRUE(PoseFeed::Open(server.Address(), PoseFeedOptions(), &feed).ok());
+  tracker.join();
+  Rigid3d pose;
+  feed->WaitPoseAt(100.0, 10.0, &pose);  // returns once the feed fails
+  EXPECT_THAT(feed->error().message(), StartsWith(server.Address() + ":3: qw: not a number"));
+}
+
+TEST(PoseFeedTest, UnreachableAndMalformedAddressesAreClearErrors) {
+  PoseFeedOptions options;
+  options.connect_timeout_s = 0.2;
+  std::unique_ptr<PoseFeed> feed;
+  const int port = testing::FreeLoopbackPort(SOCK_STREAM);  // nobody listens there
+  const std::string address = "tcp://127.0.0.1:" + std::to_string(port);
+  const Status refused = PoseFeed::Open(address, options, &feed);
+  EXPECT_THAT(refused.message(), StartsWith(address + ": cannot connect: Connection refused"));
+  EXPECT_THAT(PoseFeed::Open("tcp://127.0.0.1", options, &feed).message(),
+              HasSubstr("not a pose feed"));
+  EXPECT_THAT(PoseFeed::Open("fifo:///nonexistent/dir/poses", options, &feed).message(),
+              StartsWith("fifo:///nonexistent/dir/poses: cannot open the named pipe"));
+}
+
+TEST(PoseFeedTest, UdpDatagramsAndNamedPipe) {
+  // UDP: Fresco listens; each datagram carries lines.
+  const int port = testing::FreeLoopbackPort(SOCK_DGRAM);
+  std::unique_ptr<PoseFeed> feed;
+  const std::string address = "udp://127.0.0.1:" + std::to_string(port);
+  ASSERT_TRUE(PoseFeed::Open(address, PoseFeedOptions(), &feed).ok());
+  const int sender = socket(AF_INET, SOCK_DGRAM, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(port);
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  for (int i = 0; i <= 4; ++i) {
+    std::string datagram = TumLine(Motion(0.1 * i));
+    datagram.pop_back();  // the datagram ends the line
+    sendto(sender, datagram.data(), datagram.size(), 0, reinterpret_cast<sockaddr*>(&to),
+           sizeof to);
+  }
+  close(sender);
+  Rigid3d pose;
+  ASSERT_TRUE(feed->WaitPoseAt(0.4, 5.0, &pose));
+  ASSERT_TRUE(feed->PoseAt(0.33, &pose));
+  EXPECT_LT(CentreError(pose, Motion(0.33)), 1e-9);
+
+  // Named pipe: the tracker opens it, writes, closes.
+  const std::string fifo = testing::MakeTempDir("fifo") + "/poses";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  std::unique_ptr<PoseFeed> pipe_feed;
+  ASSERT_TRUE(PoseFeed::Open("fifo://" + fifo, PoseFeedOptions(), &pipe_feed).ok());
+  const int w = open(fifo.c_str(), O_WRONLY);
+  ASSERT_GE(w, 0);
+  std::string text;
+  for (int i = 0; i <= 4; ++i) text += TumLine(Motion(0.1 * i));
+  ASSERT_EQ(write(w, text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  close(w);
+  ASSERT_TRUE(pipe_feed->WaitPoseAt(0.4, 5.0, &pose));
+  EXPECT_LT(CentreError(pose, Motion(0.4)), 1e-9);
+  EXPECT_EQ(pipe_feed->stats().poses, 5);
+}
+
+// The time-offset estimation on a synthetic hand-held capture whose tracker clock runs
+// `offset` ahead of the video's.
+TEST(TimeOffsetTest, RecoversAKnownOffsetWithinAFramePeriod) {
+  CubeRoomOptions room;
+  Scene scene;
+  ASSERT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  SynthOptions o = testing::HandheldRoomCapture(40, 0.6);
+  o.width = 160, o.height = 120, o.supersample = 1;
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
+  const double fps = 30.0, offset = 0.2;
+  PoseTrack track;
+  for (size_t i = 0; i < capture.true_poses.size(); ++i)
+    track.Add(TimedPose{i / fps + offset, capture.true_poses[i].cam_from_world.Inverse()});
+  std::vector<Frame> frames;
+  for (int i = 0; i < 40; ++i) {
+    Frame f;
+    f.index = i;
+    f.timestamp_s = i / fps;
+    f.bgr = capture.frames_bgr[i];
+    Rigid3d unused;
+    // Frames the track covers for every candidate (centre 0, +-0.35 s).
+    if (track.At(f.timestamp_s - 0.35, &unused) && track.At(f.timestamp_s + 0.35, &unused))
+      frames.push_back(f);
+  }
+  ASSERT_GE(frames.size(), 10u);
+  PaintSessionInputs inputs;
+  inputs.scene = &scene;
+  inputs.pipeline = EstimationPipeline(PipelineOptions());
+  inputs.typical_camera = &capture.camera;
+  std::unique_ptr<PaintSession> session;
+  ASSERT_TRUE(PaintSession::Create(inputs, &session).ok());
+  TimeOffsetOptions options;
+  options.centre_s = 0.0;
+  options.search_s = 0.35;
+  const auto pose_at = [&](double t, Rigid3d* pose) { return track.At(t, pose); };
+  const TimeOffsetEstimate estimate =
+      EstimateTimeOffset(frames, capture.camera, pose_at, options, session.get());
+  ASSERT_TRUE(estimate.ok) << estimate.note;
+  EXPECT_NEAR(estimate.offset_s, offset, 1.0 / fps);
+  EXPECT_GT(estimate.contrast, 0.0);
+  // The score at the true offset is lower than one frame period away.
+  const TimeOffsetCandidate at_truth =
+      ScoreTimeOffset(frames, capture.camera, pose_at, offset, session.get());
+  const TimeOffsetCandidate off_by_two =
+      ScoreTimeOffset(frames, capture.camera, pose_at, offset + 2 / fps, session.get());
+  EXPECT_LT(at_truth.score, off_by_two.score);
+  std::printf(
+      "offset estimate %.4f s (truth %.3f, frame period %.4f s), %zu frames, %zu "
+      "candidates, %.2f s; score at truth %.3f, +2 frames %.3f\n",
+      estimate.offset_s, offset, 1 / fps, frames.size(), estimate.candidates.size(),
+      estimate.seconds, at_truth.score, off_by_two.score);
+}
+
+}  // namespace
+}  // namespace fresco

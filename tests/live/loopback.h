@@ -1,0 +1,72 @@
+// Loopback helpers for the live-source tests: a free port on 127.0.0.1 and TUM lines.
+#pragma once
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/core/rigid3.h"
+
+namespace fresco::testing {
+
+// A port on 127.0.0.1 nobody uses right now (SOCK_STREAM or SOCK_DGRAM).
+inline int FreeLoopbackPort(int type) {
+  const int fd = socket(AF_INET, type, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr);
+  socklen_t len = sizeof addr;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  close(fd);
+  return ntohs(addr.sin_port);
+}
+
+// A one-connection-at-a-time TCP server on 127.0.0.1 (ephemeral port) for pose feeds.
+class PoseServer {
+ public:
+  PoseServer() {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    EXPECT_EQ(bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    socklen_t len = sizeof addr;
+    getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len);
+    port_ = ntohs(addr.sin_port);
+    listen(fd_, 4);
+  }
+  ~PoseServer() { close(fd_); }
+  std::string Address() const { return "tcp://127.0.0.1:" + std::to_string(port_); }
+  // Waits for a connection; its socket (-1 on failure).
+  int Accept() { return accept(fd_, nullptr, nullptr); }
+  // Accepts one connection, sends `text`, closes it.
+  void ServeOnce(const std::string& text) {
+    const int c = Accept();
+    ASSERT_GE(c, 0);
+    EXPECT_EQ(send(c, text.data(), text.size(), MSG_NOSIGNAL), static_cast<ssize_t>(text.size()));
+    close(c);
+  }
+
+ private:
+  int fd_ = -1;
+  int port_ = 0;
+};
+
+// "timestamp tx ty tz qx qy qz qw\n" (camera to world), as a tracker sends it.
+inline std::string TumLine(double t, const Rigid3d& world_from_cam) {
+  const Eigen::Quaterniond& q = world_from_cam.rotation;
+  const Eigen::Vector3d& p = world_from_cam.translation;
+  char line[256];
+  std::snprintf(line, sizeof line, "%.9f %.12f %.12f %.12f %.15f %.15f %.15f %.15f\n", t, p.x(),
+                p.y(), p.z(), q.x(), q.y(), q.z(), q.w());
+  return line;
+}
+
+}  // namespace fresco::testing
