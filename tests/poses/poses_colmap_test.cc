@@ -136,7 +136,9 @@ TEST_F(PosesColmapTest, VerifyFlagsEveryInjectedErrorAndNoCleanFrame) {
     EXPECT_EQ(f["name"], SynthFrameName(i));
     const bool injected = kRotated.count(i) || kMoved.count(i);
     EXPECT_EQ(f["flagged"].get<bool>(), injected) << "frame " << i << ": " << f.dump();
-    if (injected) EXPECT_FALSE(f["inlier"].get<bool>()) << i;
+    if (injected) {
+      EXPECT_FALSE(f["inlier"].get<bool>()) << i;
+    }
     if (kRotated.count(i)) {
       EXPECT_NEAR(f["rotation_error_deg"].get<double>(), 1.0, 0.2) << i;
     }

@@ -194,7 +194,9 @@ TEST(ProceduralScenes, BlocksStandApartEveryFaceItsOwnTexture) {
   for (size_t i = 1; i < a.textures.size(); ++i) {  // nothing repeats
     const cv::Mat& t = a.textures[i].rgba;
     const cv::Mat& u = a.textures[i - 1].rgba;
-    if (t.size() == u.size()) EXPECT_GT(cv::norm(t, u, cv::NORM_L1), 0.0) << i;
+    if (t.size() == u.size()) {
+      EXPECT_GT(cv::norm(t, u, cv::NORM_L1), 0.0) << i;
+    }
   }
   // Box footprints (the bottom corners of each box's first side and of its top) do not
   // overlap, and everything stands on y = 0 within the area.
