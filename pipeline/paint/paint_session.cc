@@ -301,6 +301,11 @@ void PaintSession::EstimateBuffer(size_t b, bool debug, BufferRefinement* r) {
         ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
 }
 
+void PaintSession::RefineBuffer(size_t b, bool debug, BufferRefinement* r) {
+  EstimateBuffer(b, debug, r);
+  FinishBuffer(b, debug, r);
+}
+
 void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   WarpedBuffer& w = warped_[b];
   PaintedBuffer& painted = painted_[b];
@@ -380,15 +385,7 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
     e.correction_px = LargestDisplacement(H, box);
     e.applied = e.correction_px >= options_.refine.min_correction_px;
     e.fallback = e.applied ? "" : "none needed (below min_correction_px)";
-    double sum_sq = 0;
-    int n = 0;
-    for (size_t k = 0; k < e.from.size(); ++k) {
-      if (!e.inlier[k]) continue;
-      const cv::Vec3d q = H * cv::Vec3d(e.from[k].x, e.from[k].y, 1);
-      sum_sq += std::pow(q[0] / q[2] - e.to[k].x, 2) + std::pow(q[1] / q[2] - e.to[k].y, 2);
-      ++n;
-    }
-    e.residual_after_px = n > 0 ? std::sqrt(sum_sq / n) : 0;
+    e.residual_after_px = InlierResidualPx(e, H);
   }
   report->metrics["pose_ms"] = MsSince(start);
 }
@@ -404,16 +401,19 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   }
   // Buffers are independent: one per thread.
   std::vector<BufferRefinement> results(todo.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) EstimateBuffer(todo[i], debug, &results[i]);
-  });
-  if (options_.refine.pose) {
+  const auto for_each_buffer = [&](void (PaintSession::*step)(size_t, bool, BufferRefinement*)) {
+    cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
+      for (int i = range.start; i < range.end; ++i) (this->*step)(todo[i], debug, &results[i]);
+    });
+  };
+  if (options_.refine.pose) {  // every buffer's matches first, then one pose for all
+    for_each_buffer(&PaintSession::EstimateBuffer);
     CorrectThroughPose(todo, fresh, &results, &report);
     if (results.size() > todo.size()) todo.insert(todo.end(), fresh.begin(), fresh.end());
+    for_each_buffer(&PaintSession::FinishBuffer);
+  } else {  // each buffer on its own: one pass
+    for_each_buffer(&PaintSession::RefineBuffer);
   }
-  cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) FinishBuffer(todo[i], debug, &results[i]);
-  });
 
   int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, moved = 0,
       unregistered_kept_out = 0;

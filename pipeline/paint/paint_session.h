@@ -102,6 +102,8 @@ class PaintSession {
   void EstimateBuffer(size_t b, bool debug, BufferRefinement* result);
   // Applies the estimate: warps again, anchors, keeps unregistered frames out.
   void FinishBuffer(size_t b, bool debug, BufferRefinement* result);
+  // Both, for one buffer on its own (refine.pose off).
+  void RefineBuffer(size_t b, bool debug, BufferRefinement* result);
   // Replaces the buffers' estimates by what one correction of the frame's pose implies
   // (refine_pose.h); `fresh`: buffers seen but never painted, which get it too.
   void CorrectThroughPose(const std::vector<size_t>& todo, const std::vector<size_t>& fresh,

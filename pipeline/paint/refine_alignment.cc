@@ -205,6 +205,16 @@ std::string MotionModelName(MotionModel model) {
   return "?";
 }
 
+double InlierResidualPx(const RefineEstimate& estimate, const cv::Matx33d& H) {
+  std::vector<cv::Point2f> from, to;
+  for (size_t i = 0; i < estimate.from.size(); ++i) {
+    if (!estimate.inlier[i]) continue;
+    from.push_back(estimate.from[i]);
+    to.push_back(estimate.to[i]);
+  }
+  return from.empty() ? 0 : std::sqrt(SumSquared(H, from, to) / from.size());
+}
+
 RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warped_valid,
                                   const cv::Mat& buffer_bgra, const RefineOptions& options,
                                   cv::Rect within) {

@@ -49,6 +49,9 @@ struct RefineEstimate {
   cv::Rect region;  // where the warped frame and the painted buffer overlap
 };
 
+// RMS distance (texels) between H(from) and `to` over the estimate's inliers; 0 without any.
+double InlierResidualPx(const RefineEstimate& estimate, const cv::Matx33d& H);
+
 // `warped_bgr`, `warped_valid`: the frame warped into the buffer (CV_8UC3, CV_8U);
 // `buffer_bgra`: the buffer as painted so far (alpha 255 = painted); `within` (optional):
 // bounds every valid warped texel (WarpedBuffer::valid_box), so that only it is scanned.

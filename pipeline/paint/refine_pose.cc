@@ -188,7 +188,7 @@ bool BufferCorrectionFromPose(const BaseBuffer& buffer, const Camera& camera,
                               const Rigid3d& given, const Rigid3d& corrected,
                               const cv::Rect& within, cv::Matx33d* buffer_from_warped) {
   if (within.empty()) return false;
-  const Eigen::Vector3d normal = buffer.axis_u.cross(buffer.axis_v);
+  const Eigen::Vector3d& normal = buffer.normal;
   const Eigen::Vector3d centre = given.Centre();
   const Eigen::Quaterniond local_from_cam = given.rotation.conjugate();
   constexpr int kGrid = 5;
