@@ -82,7 +82,6 @@ Status WriteStageImages(const std::string& dir, const FrameReport& report) {
 struct LoopFrame {
   PosedFrame posed;
   const Camera* camera = nullptr;
-  std::string pose_name;  // for messages
 };
 using NextLoopFrame = std::function<bool(LoopFrame*, Status*)>;
 
@@ -113,7 +112,7 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
     nlohmann::json candidates = nlohmann::json::array();
     for (const TimeOffsetCandidate& c : s.estimate.candidates)
       candidates.push_back({{"offset_s", c.offset_s},
-                            {"score", std::isfinite(c.score) ? nlohmann::json(c.score) : nullptr},
+                            {"score", c.score},
                             {"frames", c.frames_scored}});
     j["offset_estimate"] = {{"ok", s.estimate.ok},
                             {"offset_s", s.estimate.offset_s},
@@ -191,7 +190,6 @@ int RunVerbRun(const CommandArgs& argv) {
     next = [&](LoopFrame* f, Status* status) {
       if (!live_inputs.frames->Next(&f->posed, status)) return false;
       f->camera = live_inputs.camera;
-      f->pose_name = f->posed.frame.name;
       return true;
     };
   } else {
@@ -203,7 +201,6 @@ int RunVerbRun(const CommandArgs& argv) {
       f->posed.has_pose = pose != nullptr;
       if (!pose) return true;
       f->posed.cam_from_world = pose->cam_from_world;
-      f->pose_name = pose->name;
       f->camera = capture.CameraFor(*pose);
       if (!f->camera) {
         *status = Status::Error(project.Resolve(project.poses) + ": image '" + pose->name +

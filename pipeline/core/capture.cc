@@ -161,7 +161,7 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
   IndexPoseNames(&result);
 
   if (options.open_video) {
-    FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(project.video), options.video, &result.video));
+    FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(project.video), &result.video));
     FRESCO_RETURN_IF_ERROR(MatchFolderFrames(project, &result));
   }
   *capture = std::move(result);

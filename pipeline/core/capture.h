@@ -42,7 +42,6 @@ struct CaptureLoadOptions {
   // When false, a poses file that holds no poses is accepted (`fresco poses bootstrap` makes
   // the poses for such a project).
   bool require_poses = true;
-  VideoSourceOptions video;  // timeouts and clock of live video sources
 };
 
 Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture);

@@ -45,17 +45,22 @@ bool Resolve(const std::string& host, int port, int socktype, sockaddr_storage* 
   return true;
 }
 
+// A non-blocking socket of `socktype` for host:port, and its address; -1 with `error` set.
+int OpenSocket(const std::string& host, int port, int socktype, sockaddr_storage* addr,
+               socklen_t* len, std::string* error) {
+  int family = 0;
+  if (!Resolve(host, port, socktype, addr, len, &family, error)) return -1;
+  const int fd = socket(family, socktype | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  if (fd < 0) *error = std::string("socket: ") + ErrnoText();
+  return fd;
+}
+
 // Connects with a timeout; returns the fd or -1 with `error` set.
 int ConnectTcp(const std::string& host, int port, double timeout_s, std::string* error) {
   sockaddr_storage addr{};
   socklen_t len = 0;
-  int family = 0;
-  if (!Resolve(host, port, SOCK_STREAM, &addr, &len, &family, error)) return -1;
-  const int fd = socket(family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-  if (fd < 0) {
-    *error = std::string("socket: ") + ErrnoText();
-    return -1;
-  }
+  const int fd = OpenSocket(host, port, SOCK_STREAM, &addr, &len, error);
+  if (fd < 0) return -1;
   if (connect(fd, reinterpret_cast<sockaddr*>(&addr), len) == 0) return fd;
   if (errno != EINPROGRESS) {
     *error = std::string("cannot connect: ") + ErrnoText();
@@ -80,13 +85,8 @@ int ConnectTcp(const std::string& host, int port, double timeout_s, std::string*
 int BindUdp(const std::string& host, int port, std::string* error) {
   sockaddr_storage addr{};
   socklen_t len = 0;
-  int family = 0;
-  if (!Resolve(host, port, SOCK_DGRAM, &addr, &len, &family, error)) return -1;
-  const int fd = socket(family, SOCK_DGRAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-  if (fd < 0) {
-    *error = std::string("socket: ") + ErrnoText();
-    return -1;
-  }
+  const int fd = OpenSocket(host, port, SOCK_DGRAM, &addr, &len, error);
+  if (fd < 0) return -1;
   const int one = 1;
   setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
   if (bind(fd, reinterpret_cast<sockaddr*>(&addr), len) != 0) {

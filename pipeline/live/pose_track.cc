@@ -8,16 +8,10 @@ namespace fresco {
 Rigid3d InterpolatePose(const TimedPose& a, const TimedPose& b, double t) {
   const double span = b.timestamp_s - a.timestamp_s;
   const double u = span > 0 ? (t - a.timestamp_s) / span : 0.0;
-  Eigen::Quaterniond qa = a.world_from_cam.rotation.normalized();
-  Eigen::Quaterniond qb = b.world_from_cam.rotation.normalized();
-  if (qa.dot(qb) < 0) qb.coeffs() = -qb.coeffs();  // the shorter way round
-  Eigen::Quaterniond q;
-  if (u >= 0 && u <= 1) {
-    q = qa.slerp(u, qb);
-  } else {  // extrapolation: the same angular velocity carried on
-    const Eigen::AngleAxisd delta(qa.conjugate() * qb);
-    q = qa * Eigen::Quaterniond(Eigen::AngleAxisd(delta.angle() * u, delta.axis()));
-  }
+  // Eigen's slerp takes the shorter way round and, for u outside [0, 1], carries the same
+  // angular velocity on (extrapolation).
+  const Eigen::Quaterniond q = a.world_from_cam.rotation.normalized().slerp(
+      u, b.world_from_cam.rotation.normalized());
   const Eigen::Vector3d centre = a.world_from_cam.translation +
                                  u * (b.world_from_cam.translation - a.world_from_cam.translation);
   return Rigid3d(q.normalized(), centre).Inverse();
