@@ -86,8 +86,14 @@ int RunSolve(const CommandArgs& argv) {
   calib::CalibrationOutputs outputs;
   outputs.pictures = !args.Switch("--no-pictures");
   outputs.corners_vnl = args.Get("--corners-vnl");
-  if (Status s = calib::WriteCalibrationOutputs(out, request, run, outputs); !s.ok())
+  std::string optimization_inputs_missing;
+  if (Status s =
+          calib::WriteCalibrationOutputs(out, request, run, outputs, &optimization_inputs_missing);
+      !s.ok())
     return InputError(s);
+  if (!optimization_inputs_missing.empty())
+    std::cerr << "warning: " << out << " has no optimization_inputs (mrcal's uncertainty and "
+              << "residual tools need them): " << optimization_inputs_missing << "\n";
 
   for (const std::string& w : run.warnings) std::cerr << "warning: " << w << "\n";
   if (!quiet) {

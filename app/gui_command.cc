@@ -1,9 +1,12 @@
 // fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]
-//            [--calib-images DIR --board BOARD [--model MODEL]]: the authoring app (ui/). With --screenshot it paints N frames (default 30), draws every panel, writes the
+//            [--calib-images DIR --board BOARD [--model MODEL]]
+//            [--poses verify|bootstrap [--poses-out DIR] [--poses-model DIR]]: the authoring
+// app (ui/). With --screenshot it paints N frames (default 30), draws every panel, writes the
 // window to FILE.png (and FILE.png.json: the panels and where they are) and exits 0; it
 // needs a display (xvfb-run works).
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "app/commands.h"
@@ -19,7 +22,8 @@ int RunVerbGui(const CommandArgs& argv) {
   ArgSpec spec;
   spec.usage =
       "fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]\n"
-      "           [--calib-images DIR --board BOARD [--model MODEL]]";
+      "           [--calib-images DIR --board BOARD [--model MODEL]]\n"
+      "           [--poses verify|bootstrap [--poses-out DIR] [--poses-model DIR]]";
   spec.help =
       "The authoring app: 3D view, grouping editor, pipeline control, stage panels, timing and\n"
       "misalignment review (Dear ImGui + GLFW + OpenGL 3.3; needs a display).\n\n"
@@ -31,9 +35,18 @@ int RunVerbGui(const CommandArgs& argv) {
       "                     images (with --screenshot: detect and solve before the shot)\n"
       "  --board BOARD      the board for --calib-images (as `fresco calib solve --board`)\n"
       "  --model MODEL      lens model for --calib-images: auto (default), pinhole, opencv4,\n"
-      "                     opencv5, opencv8, splined";
+      "                     opencv5, opencv8, splined\n"
+      "  --poses verify     open the Poses panel and run COLMAP on the project's frames, as\n"
+      "                     `fresco poses verify` and `bootstrap` (with --screenshot: the run\n"
+      "                     finishes before the shot)\n"
+      "  --poses bootstrap  the same, then apply the bootstrapped poses to the project\n"
+      "  --poses-out DIR    the run's output folder (default PROJECT_DIR/colmap-poses)\n"
+      "  --poses-model DIR  use an earlier COLMAP text model (OUT/colmap/sparse_txt/0) instead\n"
+      "                     of running COLMAP";
   spec.max_positional = 1;
-  spec.options = {"--screenshot", "--frames", "--size", "--calib-images", "--board", "--model"};
+  spec.options = {"--screenshot",   "--frames", "--size",        "--calib-images",
+                  "--board",        "--model",  "--poses",       "--poses-out",
+                  "--poses-model"};
   Args args;
   if (int code = ParseVerbArgs("gui", argv, spec, &args); code >= 0) return code;
 #ifdef FRESCO_HAVE_GUI
@@ -66,6 +79,21 @@ int RunVerbGui(const CommandArgs& argv) {
         std::find(names.begin(), names.end(), options.calib_model) == names.end())
       return UsageError("gui", spec, "--model: '" + options.calib_model +
                                          "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
+  }
+  options.poses = args.Get("--poses");
+  options.poses_out = args.Get("--poses-out");
+  options.poses_model = args.Get("--poses-model");
+  if (args.Has("--poses") && options.poses != "verify" && options.poses != "bootstrap")
+    return UsageError("gui", spec,
+                      std::string("--poses: expected verify or bootstrap, got '") + options.poses +
+                          "'");
+  if (options.poses.empty() && (args.Has("--poses-out") || args.Has("--poses-model")))
+    return UsageError("gui", spec, "--poses-out and --poses-model go with --poses");
+  if (!options.poses.empty() && options.project.empty())
+    return UsageError("gui", spec, "--poses needs a PROJECT.json");
+  if (!options.poses_model.empty() && !std::filesystem::is_directory(options.poses_model)) {
+    std::cerr << "error: " << options.poses_model << ": --poses-model: no such folder\n";
+    return kExitBadInput;
   }
   if (!options.screenshot.empty() && options.project.empty() && options.calib_images.empty())
     return UsageError("gui", spec, "--screenshot needs a PROJECT.json or --calib-images");

@@ -4,15 +4,13 @@
 #include <filesystem>
 #include <iostream>
 
-#include <nlohmann/json.hpp>
-
 #include "app/commands.h"
 #include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "pipeline/poses/bootstrap.h"
-#include "pipeline/poses/mesh_icp.h"
+#include "pipeline/poses/bootstrap_run.h"
 #include "pipeline/poses/project_colmap.h"
 #include "pipeline/poses/verify.h"
 #include "pipeline/poses/verify_report.h"
@@ -192,13 +190,9 @@ int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
 
   ProjectColmap colmap;
   if ((code = RunColmapStage(args, spec, project, out_dir, &colmap)) >= 0) return code;
-  std::vector<VerifyFrameInput> inputs;
-  for (const ProjectColmapFrame& f : colmap.frames) {
-    inputs.push_back({f.name, f.given ? &f.given->cam_from_world : nullptr,
-                      f.colmap ? &f.colmap->cam_from_world : nullptr});
-  }
   VerifyResult result;
-  if (Status s = VerifyPoses(inputs, colmap.scene_size_m, options, &result); !s.ok()) {
+  if (Status s = VerifyPoses(VerifyInputs(colmap), colmap.scene_size_m, options, &result);
+      !s.ok()) {
     std::cerr << "error: " << project.poses << ": " << s.message() << "\n";
     return kExitFailure;
   }
@@ -243,95 +237,22 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
 
   ProjectColmap colmap;
   if ((code = RunColmapStage(args, spec, project, out_dir, &colmap)) >= 0) return code;
-  nlohmann::json report;
-  Sim3d world_from_colmap;
-  if (!control_points.empty()) {
-    ControlPointFit fit;
-    if (Status s = AlignWithControlPoints(control_points, control_file, colmap.run.model,
-                                          colmap.camera, &fit);
-        !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
-    }
-    world_from_colmap = fit.world_from_colmap;
-    report["aligned_with"] = "control_points";
-    report["control_point_residual_m"] = fit.residual_m;
-  } else {
-    std::vector<PosePair> pairs;
-    for (const ProjectColmapFrame& f : colmap.frames) {
-      if (f.given && f.colmap) {
-        pairs.push_back({f.name, f.given->cam_from_world, f.colmap->cam_from_world});
-      }
-    }
-    PoseAlignmentOptions align;
-    align.inlier_position_m = inlier_position_rel * colmap.scene_size_m;
-    align.inlier_rotation_deg = inlier_rotation_deg;
-    PoseAlignment alignment;
-    if (pairs.size() < 3) {
-      std::cerr << "error: " << project.poses << ": only " << pairs.size()
-                << " registered frames have a given pose: give --control-points to place "
-                   "COLMAP's reconstruction in the scene\n";
-      return kExitFailure;
-    }
-    if (Status s = AlignColmapToPoses(pairs, align, &alignment); !s.ok()) {
-      std::cerr << "error: " << project.poses << ": " << s.message() << "\n";
-      return kExitFailure;
-    }
-    world_from_colmap = alignment.world_from_colmap;
-    report["aligned_with"] = "given_poses";
-    report["inliers"] = alignment.num_inliers;
-    report["compared"] = pairs.size();
-  }
-  if (args.Switch("--refine-mesh")) {
-    MeshIcpOptions icp;
-    icp.max_distance_m = refine_max_distance_rel * colmap.scene_size_m;
-    std::vector<Eigen::Vector3d> points;
-    for (const Point3D& p : colmap.run.model.points) points.push_back(p.xyz);
-    MeshIcpResult refined;
-    if (Status s =
-            AlignPointsToMesh(points, colmap.capture.scene, world_from_colmap, icp, &refined);
-        !s.ok()) {
-      std::cerr << "error: " << project.scene << ": " << s.message() << "\n";
-      return kExitFailure;
-    }
-    world_from_colmap = refined.world_from_colmap;
-    report["mesh_icp"] = {{"pairs", refined.pairs},
-                          {"iterations", refined.iterations},
-                          {"max_distance_m", icp.max_distance_m},
-                          {"median_distance_before_m", refined.median_distance_before_m},
-                          {"median_distance_after_m", refined.median_distance_after_m}};
-  }
-  ColmapModel model = TransformModel(colmap.run.model, world_from_colmap);
-  model.cameras = {{1, colmap.camera}};
-  for (PosedImage& image : model.images) image.camera_id = 1;
-  const fs::path sparse = fs::path(out_dir) / "sparse";
-  Project out = project;
-  out.poses = fs::absolute(sparse / "images.txt").string();
-  Status s = MakeDirectories(sparse.string());
-  if (s.ok()) s = WriteColmapModel(sparse.string(), model);
-  if (s.ok()) s = SaveProject(out, new_project_path.string());
-  std::vector<std::string> missing;
-  for (const ProjectColmapFrame& f : colmap.frames) {
-    if (!f.colmap) missing.push_back(f.name);
-  }
-  const Sim3d& w = world_from_colmap;
-  report["scale"] = w.scale;
-  report["world_from_colmap"] = {
-      {"scale", w.scale},
-      {"rotation_wxyz", {w.rotation.w(), w.rotation.x(), w.rotation.y(), w.rotation.z()}},
-      {"translation_m", {w.translation.x(), w.translation.y(), w.translation.z()}}};
-  report["frames"] = colmap.frames.size();
-  report["registered"] = colmap.run.registered;
-  report["not_registered"] = missing;
-  report["colmap_seconds"] = colmap.run.seconds;
-  report["project"] = new_project_path.string();
-  if (s.ok()) s = WriteFileAtomic((fs::path(out_dir) / "bootstrap.json").string(), report.dump(2));
+  BootstrapOptions options;
+  options.control_points = std::move(control_points);
+  options.control_file = control_file;
+  options.inlier_position_rel = inlier_position_rel;
+  options.inlier_rotation_deg = inlier_rotation_deg;
+  options.refine_mesh = args.Switch("--refine-mesh");
+  options.refine_max_distance_rel = refine_max_distance_rel;
+  BootstrapResult result;
+  Status s = BootstrapFromColmap(project, colmap, options, &result);
+  if (s.ok()) s = WriteBootstrap(project, colmap, result, out_dir);
   if (!s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
   std::cout << "bootstrap: " << colmap.run.registered << " of " << colmap.frames.size()
-            << " frames posed (" << report["aligned_with"].get<std::string>() << ")\n"
+            << " frames posed (" << result.aligned_with << ")\n"
             << "wrote " << new_project_path.string() << "\n";
   return kExitOk;
 }

@@ -1,12 +1,21 @@
 #include "calib/mrcal_solve.h"
 
+#include <malloc.h>
+
+#include <climits>
 #include <cmath>
 #include <cstring>
+#include <mutex>
 
 #include <Eigen/Dense>
+// CHOLMOD's compressed-column sparse matrix, which mrcal_optimizer_callback fills with the
+// Jacobian (transposed: Nstate rows, Nmeasurements columns); mrcal.h only declares it.
+#include <suitesparse/cholmod.h>
 
 extern "C" {
 #include <mrcal/mrcal.h>
+// After mrcal.h: _mrcal_num_j_nonzero, the size of the Jacobian mrcal_optimizer_callback fills.
+#include <mrcal/mrcal-internal.h>
 }
 
 namespace fresco::calib {
@@ -37,6 +46,44 @@ struct Problem {
   int MeasurementIndex(int view, int grid_index) const {
     return mrcal_measurement_index_boards(view, Nframes(), 0, grid.width_n, grid.height_n) +
            2 * grid_index;
+  }
+};
+
+// glibc serves allocations above its mmap threshold (at most 32 MiB) with fresh pages from
+// mmap and unmaps them on free. CHOLMOD allocates and frees the transposed Jacobian (mrcal's
+// board grid is 76 x 76 points for a 6x6 AprilGrid, absent points included: 20-80 MB) at every
+// factorization of mrcal's solver, so every iteration faulted those pages in again, which cost
+// more CPU than the factorization (`calib solve --model opencv4` on 10 AprilGrid images: 18.5 s
+// CPU, 6.7 s of it in the kernel; 6.5 s with this). While any solve runs, large blocks stay on
+// the heap and are reused; the last one to finish gives the memory back.
+class ReuseLargeAllocations {
+ public:
+  ReuseLargeAllocations() {
+    std::lock_guard<std::mutex> lock(Mutex());
+    if (Users()++ == 0) {
+      mallopt(M_MMAP_MAX, 0);
+      mallopt(M_TRIM_THRESHOLD, INT_MAX);
+    }
+  }
+  ~ReuseLargeAllocations() {
+    std::lock_guard<std::mutex> lock(Mutex());
+    if (--Users() == 0) {
+      mallopt(M_MMAP_MAX, 65536);  // glibc's defaults
+      mallopt(M_TRIM_THRESHOLD, 128 * 1024);
+      malloc_trim(0);
+    }
+  }
+  ReuseLargeAllocations(const ReuseLargeAllocations&) = delete;
+  ReuseLargeAllocations& operator=(const ReuseLargeAllocations&) = delete;
+
+ private:
+  static std::mutex& Mutex() {
+    static std::mutex mutex;
+    return mutex;
+  }
+  static int& Users() {
+    static int users = 0;
+    return users;
   }
 };
 
@@ -74,54 +121,76 @@ Status Optimize(Problem* p, std::vector<double>* x) {
   return Status::Ok();
 }
 
-// All measurements at the problem's current state (no optimisation).
-bool Evaluate(const Problem& p, const std::vector<double>& intrinsics,
-              const std::vector<mrcal_pose_t>& frames, const mrcal_calobject_warp_t& warp,
-              std::vector<double>* x) {
+// All measurements at the problem's current state (no optimisation), and mrcal's Jacobian
+// when `Jt` is given.
+bool Evaluate(const Problem& p, std::vector<double>* x, cholmod_sparse* Jt = nullptr) {
   std::vector<double> b(p.NumStates());
   x->assign(p.NumMeasurements(), 0.0);
   return mrcal_optimizer_callback(
       b.data(), static_cast<int>(b.size() * sizeof(double)), x->data(),
-      static_cast<int>(x->size() * sizeof(double)), nullptr, intrinsics.data(), nullptr,
-      frames.data(), nullptr, &warp, 1, 0, p.Nframes(), 0, 0, p.observations.data(), nullptr,
+      static_cast<int>(x->size() * sizeof(double)), Jt, p.intrinsics.data(), nullptr,
+      p.frames.data(), nullptr, &p.warp, 1, 0, p.Nframes(), 0, 0, p.observations.data(), nullptr,
       p.Nframes(), 0, p.pool.data(), &p.lensmodel, p.imagersize, p.selections, &p.constants,
       p.grid.spacing_m, p.grid.width_n, p.grid.height_n, false);
+}
+
+// mrcal's analytic Jacobian at the problem's state, over the packed (unitless) state: column
+// m of Jt holds d x[m] / d p for the states it depends on. `scale` (Nstate) converts: b = p *
+// scale, so d x / d b = d x / d p / scale.
+struct Jacobian {
+  std::vector<int> column_start, state;
+  std::vector<double> value, scale;
+};
+
+bool AnalyticJacobian(const Problem& p, Jacobian* jacobian) {
+  const int Nstate = p.NumStates(), Nmeasurements = p.NumMeasurements();
+  const int nonzero =
+      _mrcal_num_j_nonzero(p.Nframes(), 0, p.grid.width_n, p.grid.height_n, 1, 0, p.Nframes(), 0, 0,
+                           p.observations.data(), nullptr, p.selections, &p.lensmodel);
+  jacobian->column_start.assign(Nmeasurements + 1, 0);
+  jacobian->state.assign(nonzero, 0);
+  jacobian->value.assign(nonzero, 0.0);
+  cholmod_sparse Jt{};
+  Jt.nrow = Nstate;
+  Jt.ncol = Nmeasurements;
+  Jt.nzmax = nonzero;
+  Jt.p = jacobian->column_start.data();
+  Jt.i = jacobian->state.data();
+  Jt.x = jacobian->value.data();
+  Jt.sorted = 1;
+  Jt.packed = 1;
+  Jt.itype = CHOLMOD_INT;
+  Jt.xtype = CHOLMOD_REAL;
+  Jt.dtype = CHOLMOD_DOUBLE;
+  std::vector<double> x;
+  if (!Evaluate(p, &x, &Jt)) return false;
+  jacobian->scale.assign(Nstate, 1.0);
+  mrcal_unpack_solver_state_vector(jacobian->scale.data(), 1, 0, p.Nframes(), 0, 0, p.selections,
+                                   &p.lensmodel);
+  return true;
 }
 
 // Covariance of the solved state per px^2 of corner noise, mrcal's form (its uncertainty
 // docs): inv(J^T J) J_obs^T J_obs inv(J^T J), J over all `rows` (inlier board measurements,
 // then the regularization terms), J_obs its first `observation_rows` rows (regularization is
-// no noise). J by forward differences of mrcal_optimizer_callback. State: intrinsics, 6 per
-// board pose (r, t), then the 2 warp terms when solved for.
+// no noise). J is mrcal's own analytic Jacobian (mrcal_optimizer_callback), taken to the
+// unpacked state: intrinsics, 6 per board pose (r, t), then the 2 warp terms when solved for.
 Eigen::MatrixXd StateCovariance(const Problem& p, const std::vector<int>& rows,
                                 int observation_rows) {
-  struct Param {
-    int kind, index;  // 0 intrinsics, 1 frame (index*6 + k), 2 warp
-  };
-  std::vector<Param> params;
-  const int Nintr = static_cast<int>(p.intrinsics.size());
-  for (int i = 0; i < Nintr; ++i) params.push_back({0, i});
-  for (int i = 0; i < p.Nframes() * 6; ++i) params.push_back({1, i});
-  if (p.selections.do_optimize_calobject_warp)
-    for (int i = 0; i < 2; ++i) params.push_back({2, i});
-  std::vector<double> x0;
-  if (!Evaluate(p, p.intrinsics, p.frames, p.warp, &x0)) return {};
-  Eigen::MatrixXd J(rows.size(), params.size());
-  for (size_t c = 0; c < params.size(); ++c) {
-    std::vector<double> intrinsics = p.intrinsics;
-    std::vector<mrcal_pose_t> frames = p.frames;
-    mrcal_calobject_warp_t warp = p.warp;
-    double* value = params[c].kind == 0 ? &intrinsics[params[c].index]
-                    : params[c].kind == 1
-                        ? &reinterpret_cast<double*>(frames.data())[params[c].index]
-                        : &warp.values[params[c].index];
-    const double h = 1e-6 * std::max(1.0, std::abs(*value));
-    *value += h;
-    std::vector<double> x1;
-    if (!Evaluate(p, intrinsics, frames, warp, &x1)) return {};
-    for (size_t r = 0; r < rows.size(); ++r) J(r, c) = (x1[rows[r]] - x0[rows[r]]) / h;
+  Jacobian J;
+  if (!AnalyticJacobian(p, &J)) return {};
+  const int Nstate = static_cast<int>(J.scale.size());
+  Eigen::MatrixXd JtJ_obs = Eigen::MatrixXd::Zero(Nstate, Nstate), JtJ = JtJ_obs;
+  for (size_t r = 0; r < rows.size(); ++r) {
+    Eigen::MatrixXd& sum = static_cast<int>(r) < observation_rows ? JtJ_obs : JtJ;
+    const int begin = J.column_start[rows[r]], end = J.column_start[rows[r] + 1];
+    for (int a = begin; a < end; ++a) {
+      const double ja = J.value[a] / J.scale[J.state[a]];
+      for (int c = begin; c < end; ++c)
+        sum(J.state[a], J.state[c]) += ja * J.value[c] / J.scale[J.state[c]];
+    }
   }
-  const Eigen::MatrixXd JtJ = J.transpose() * J;
+  JtJ += JtJ_obs;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(JtJ);
   const Eigen::VectorXd& values = eigen.eigenvalues();
   const double floor = values.maxCoeff() * 1e-14;
@@ -130,8 +199,7 @@ Eigen::MatrixXd StateCovariance(const Problem& p, const std::vector<int>& rows,
   const Eigen::MatrixXd JtJ_inverse =
       eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
   if (observation_rows >= static_cast<int>(rows.size())) return JtJ_inverse;
-  const Eigen::MatrixXd J_obs = J.topRows(observation_rows);
-  return JtJ_inverse * (J_obs.transpose() * J_obs) * JtJ_inverse;
+  return JtJ_inverse * JtJ_obs * JtJ_inverse;
 }
 
 }  // namespace
@@ -139,6 +207,7 @@ Eigen::MatrixXd StateCovariance(const Problem& p, const std::vector<int>& rows,
 Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
                        int height, const CalibrationSeed& seed, const SolveOptions& options,
                        SolveResult* result) {
+  const ReuseLargeAllocations reuse;
   mrcal_lensmodel_t target;
   if (!LensModelFromName(options.lensmodel, &target))
     return Status::Error("lens model: mrcal does not know '" + options.lensmodel + "'");
@@ -207,6 +276,8 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   out.lensmodel = name;
   out.intrinsics = p.intrinsics;
   out.board_warp_m = {p.warp.x2, p.warp.y2};
+  out.board_warp_solved = options.optimize_board_warp;
+  out.outlier_rejection = options.reject_outliers;
   out.num_states = p.NumStates();
   out.corners_observed = observed;
   double ssr = 0;
@@ -249,7 +320,7 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
       for (const CornerObservation& c : views[v].corners)
         all.pool[v * points_per_view + p.grid.grid_index_of_corner[c.id]].z = 1.0;
     std::vector<double> x_all;
-    if (Evaluate(all, all.intrinsics, all.frames, all.warp, &x_all))
+    if (Evaluate(all, &x_all))
       for (size_t v = 0; v < views.size(); ++v)
         for (size_t k = 0; k < views[v].corners.size(); ++k)
           if (out.views[v].outlier[k]) {

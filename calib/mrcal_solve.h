@@ -5,8 +5,8 @@
 // board's warp, mrcal's regularization and mrcal's outlier rejection.
 // The 1-sigma uncertainty of every solved parameter comes from the covariance of the state
 // at the optimum, sigma^2 inv(J^T J) J_obs^T J_obs inv(J^T J) as in mrcal's uncertainty
-// propagation (J by finite differences of mrcal_optimizer_callback over intrinsics, board
-// poses and warp; sigma from the inlier residuals with the degrees of freedom removed), times
+// propagation (J: mrcal's analytic Jacobian from mrcal_optimizer_callback, over intrinsics,
+// board poses and warp; sigma from the inlier residuals with the degrees of freedom removed), times
 // SolveOptions::noise_inflation for correlated corner noise. calib/uncertainty.h propagates
 // the same covariance to projection uncertainty over the imager.
 #pragma once
@@ -52,6 +52,8 @@ struct SolveResult {
   Eigen::MatrixXd state_covariance_per_px2;
   std::vector<ViewFit> views;            // same order as the input views
   std::array<double, 2> board_warp_m{};  // mrcal's calobject_warp (x2, y2)
+  bool board_warp_solved = false;        // SolveOptions::optimize_board_warp
+  bool outlier_rejection = false;        // SolveOptions::reject_outliers
   double rms_px = 0;                     // sqrt(mean |residual|^2) over inlier corners
   double noise_sigma_px = 0;             // per coordinate: sqrt(SSR / (2 N_inliers - N_state))
   int corners_used = 0;                  // inlier corners

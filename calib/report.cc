@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/corners_vnl.h"
+#include "calib/optimization_inputs.h"
 #include "calib/pictures.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/image_io.h"
@@ -163,23 +164,36 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
 }
 
 Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequest& request,
-                        const CalibrationRun& run, const std::vector<std::string>& pictures) {
+                        const CalibrationRun& run, const std::vector<std::string>& pictures,
+                        std::string* optimization_inputs_missing) {
   const ModelTrial& chosen = run.Chosen();
-  const std::string text =
-      CameraModelText(chosen.lensmodel, chosen.fit.intrinsics, run.width, run.height);
-  mrcal_cameramodel_t* check =
-      mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
-  if (!check)
-    return Status::Error(cameramodel_path +
-                         ": internal error: mrcal cannot read the model to write");
-  mrcal_free_cameramodel(&check);
-  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(cameramodel_path, text));
-  return WriteFileAtomic(SiblingPath(cameramodel_path, ".report.json"),
-                         ReportJson(request, run, pictures));
+  std::string missing;  // why the model has no optimization_inputs
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomicWith(cameramodel_path, [&](const std::string& temp) {
+    std::string text;
+    Status with_inputs = WriteCameraModelWithOptimizationInputs(temp, request, run);
+    if (with_inputs.ok()) with_inputs = ReadFileToString(temp, &text);
+    if (!with_inputs.ok()) {
+      missing = with_inputs.message();
+      text = CameraModelText(chosen.lensmodel, chosen.fit.intrinsics, run.width, run.height);
+    }
+    mrcal_cameramodel_t* check =
+        mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
+    if (!check)
+      return Status::Error(cameramodel_path +
+                           ": internal error: mrcal cannot read the model to write");
+    mrcal_free_cameramodel(&check);
+    return with_inputs.ok() ? Status::Ok() : WriteFileAtomic(temp, text);
+  }));
+  if (optimization_inputs_missing) *optimization_inputs_missing = missing;
+  nlohmann::json report = nlohmann::json::parse(ReportJson(request, run, pictures));
+  report["optimization_inputs"] =
+      missing.empty() ? "written (python3-mrcal)" : "not written: " + missing;
+  return WriteFileAtomic(SiblingPath(cameramodel_path, ".report.json"), report.dump(2) + "\n");
 }
 
 Status WriteCalibrationOutputs(const std::string& cameramodel_path, const CalibrateRequest& request,
-                               const CalibrationRun& run, const CalibrationOutputs& outputs) {
+                               const CalibrationRun& run, const CalibrationOutputs& outputs,
+                               std::string* optimization_inputs_missing) {
   const std::filesystem::path parent = std::filesystem::path(cameramodel_path).parent_path();
   if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
   std::vector<std::string> pictures;
@@ -197,7 +211,7 @@ Status WriteCalibrationOutputs(const std::string& cameramodel_path, const Calibr
   }
   if (!outputs.corners_vnl.empty())
     FRESCO_RETURN_IF_ERROR(WriteCornersVnl(outputs.corners_vnl, run.views, request.board));
-  return WriteCalibration(cameramodel_path, request, run, pictures);
+  return WriteCalibration(cameramodel_path, request, run, pictures, optimization_inputs_missing);
 }
 
 }  // namespace fresco::calib

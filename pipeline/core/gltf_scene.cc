@@ -1,6 +1,6 @@
 // glTF 2.0 scenes. Loading: tinygltf parses the file (and decodes images); everything it
-// does not check (indices, accessor bounds, strides, sparse accessors, finite positions,
-// missing images) is validated here while the node hierarchy is flattened into one
+// does not check (indices, accessor bounds, strides, sparse accessors, finite positions
+// and UVs, missing images) is validated here while the node hierarchy is flattened into one
 // triangle mesh in double precision. Saving: the JSON is written with nlohmann::json, the
 // geometry into one .bin and each texture into its own PNG, every file atomically.
 #include <algorithm>
@@ -280,6 +280,9 @@ class GltfLoader {
     mesh.vertices.resize(world_vertices_.size());
     for (size_t i = 0; i < world_vertices_.size(); ++i) {
       mesh.vertices[i] = world_vertices_[i] - scene_.origin_in_world;
+      if (!mesh.vertices[i].allFinite()) {
+        return Error("vertex " + std::to_string(i) + " is not finite relative to the centre");
+      }
     }
     return FinishMaterials();
   }
@@ -640,10 +643,20 @@ class GltfLoader {
     std::vector<int> new_index(num_vertices, -1);
     std::vector<std::array<uint32_t, 3>> kept;
     kept.reserve(triangles.size());
+    auto uv = [&](uint32_t i) {
+      return Eigen::Vector2f(static_cast<float>(uvs.At(i, 0)), static_cast<float>(uvs.At(i, 1)));
+    };
     for (auto tri : triangles) {
       for (uint32_t v : tri) {
         if (!position(v).allFinite()) {
           return Error(context + ": POSITION " + std::to_string(v) + " is not finite");
+        }
+        if (!(linear * position(v) + translation).allFinite()) {
+          return Error(context + ": POSITION " + std::to_string(v) +
+                       " is not finite after the node transform");
+        }
+        if (has_uv && !uv(v).allFinite()) {  // as float: 1e300 is finite only as a double
+          return Error(context + ": " + uv_name + " " + std::to_string(v) + " is not finite");
         }
       }
       const Eigen::Vector3d e1 = linear * (position(tri[1]) - position(tri[0]));
@@ -668,9 +681,7 @@ class GltfLoader {
       mesh.triangles.emplace_back(new_index[tri[0]], new_index[tri[1]], new_index[tri[2]]);
       std::array<Eigen::Vector2f, 3> corner_uvs;
       for (int k = 0; k < 3; ++k) {
-        corner_uvs[k] = has_uv ? Eigen::Vector2f(static_cast<float>(uvs.At(tri[k], 0)),
-                                                 static_cast<float>(uvs.At(tri[k], 1)))
-                               : Eigen::Vector2f::Zero();
+        corner_uvs[k] = has_uv ? uv(tri[k]) : Eigen::Vector2f::Zero();
       }
       mesh.uvs.push_back(corner_uvs);
       mesh.material.push_back(prim.material);  // -1 = default, resolved in FinishMaterials

@@ -1,8 +1,10 @@
 #include "pipeline/core/image_io.h"
 
+#include <cerrno>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -11,7 +13,10 @@
 
 namespace fresco {
 
-Status WriteImageAtomic(const std::string& path, const cv::Mat& image) {
+namespace {
+
+// The image encoded in the format `path`'s extension names (PNG without one).
+Status EncodeImage(const std::string& path, const cv::Mat& image, std::string* encoded) {
   if (image.empty()) return Status::Error(path + ": empty image");
   const std::string ext = std::filesystem::path(path).extension().string();
   std::vector<uchar> bytes;
@@ -21,7 +26,27 @@ Status WriteImageAtomic(const std::string& path, const cv::Mat& image) {
   } catch (const cv::Exception& e) {
     return Status::Error(path + ": could not encode image (" + e.msg + ")");
   }
-  return WriteFileAtomic(path, std::string(bytes.begin(), bytes.end()));
+  encoded->assign(bytes.begin(), bytes.end());
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteImageAtomic(const std::string& path, const cv::Mat& image) {
+  std::string encoded;
+  FRESCO_RETURN_IF_ERROR(EncodeImage(path, image, &encoded));
+  return WriteFileAtomic(path, encoded);
+}
+
+Status WriteImage(const std::string& path, const cv::Mat& image) {
+  std::string encoded;
+  FRESCO_RETURN_IF_ERROR(EncodeImage(path, image, &encoded));
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) return Status::Error(path + ": cannot open for writing: " + std::strerror(errno));
+  out.write(encoded.data(), static_cast<std::streamsize>(encoded.size()));
+  out.close();
+  if (!out) return Status::Error(path + ": write failed: " + std::strerror(errno));
+  return Status::Ok();
 }
 
 namespace {

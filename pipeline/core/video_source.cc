@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <mutex>
 
+#include <opencv2/core/utils/logger.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -178,13 +179,17 @@ class CaptureSource : public VideoSource {
  private:
   // The stream's presentation time relative to the first frame's, while it is finite and
   // increasing; otherwise (cameras without timestamps, a stream that restarts) arrival time
-  // from then on.
+  // from then on. A stream whose first frame precedes its start time (RTSP: the first RTP
+  // timestamp) has that frame's time clamped to the start by OpenCV, the same as the
+  // second's: the second frame then counts as one frame period after the first.
   double LiveTimestamp(double arrival_s) {
     const double pts_ms = capture_.get(cv::CAP_PROP_POS_MSEC);
     if (index_ == 0) {
       first_pts_ms_ = pts_ms;
       use_stream_clock_ = stream_clock_ && std::isfinite(pts_ms) && pts_ms >= 0;
     }
+    if (use_stream_clock_ && index_ == 1 && pts_ms == first_pts_ms_ && !IsCamera())
+      first_pts_ms_ -= 1000.0 / fps_;
     if (use_stream_clock_) {
       const double t = (pts_ms - first_pts_ms_) / 1000.0;
       if (std::isfinite(t) && (index_ == 0 || t > last_t_)) {
@@ -196,6 +201,8 @@ class CaptureSource : public VideoSource {
     }
     return arrival_s + arrival_shift_;
   }
+
+  bool IsCamera() const { return what_.rfind("device:", 0) == 0; }
 
   std::string what_;
   cv::VideoCapture capture_;
@@ -246,14 +253,22 @@ Status OpenVideoSource(const std::string& path, const VideoSourceOptions& option
                        std::unique_ptr<VideoSource>* source) {
   const int open_ms = static_cast<int>(options.open_timeout_s * 1000);
   const int read_ms = static_cast<int>(options.read_timeout_s * 1000);
+  std::error_code ec;
   if (path.rfind("device:", 0) == 0) {
     const std::string number = path.substr(7);
     if (number.empty() || number.size() > 4 ||
         number.find_first_not_of("0123456789") != std::string::npos) {
       return Status::Error(path + ": expected device:N with N a camera number");
     }
+    // Only the one-line error below: no device, or OpenCV's own warnings silenced.
+    const std::string device = "/dev/video" + number;
     cv::VideoCapture capture;
-    capture.open(std::stoi(number), cv::CAP_ANY);
+    if (fs::exists(device, ec)) {
+      const cv::utils::logging::LogLevel level =
+          cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+      capture.open(std::stoi(number), cv::CAP_V4L2);
+      cv::utils::logging::setLogLevel(level);
+    }
     if (!capture.isOpened()) {
       return Status::Error(path + ": cannot open the camera (no /dev/video" + number +
                            ", or it is busy or not a capture device)");
@@ -277,7 +292,6 @@ Status OpenVideoSource(const std::string& path, const VideoSourceOptions& option
                                               options.stream_clock);
     return Status::Ok();
   }
-  std::error_code ec;
   if (fs::is_directory(path, ec)) return OpenFolder(path, source);
   if (!fs::exists(path, ec)) return Status::Error(path + ": no such file or folder");
   cv::VideoCapture capture(path, cv::CAP_FFMPEG);

@@ -295,6 +295,7 @@ PoseFeedStats PoseFeed::stats() const {
   s.reconnects = reconnects_;
   s.connected = connected_;
   s.seconds_since_last_pose = last_pose_wall_s_ < 0 ? -1 : NowS() - last_pose_wall_s_;
+  s.latest_time_s = track_.empty() ? 0.0 : track_.last_time_s();
   return s;
 }
 
@@ -305,6 +306,14 @@ std::vector<TimedPose> PoseFeed::AllPoses() const {
     return a.timestamp_s < b.timestamp_s;
   });
   return sorted;
+}
+
+std::vector<TimedPose> PoseFeed::PosesBetween(double from_s, double to_s) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<TimedPose> poses;
+  for (const TimedPose& p : track_.samples())
+    if (p.timestamp_s >= from_s && p.timestamp_s <= to_s) poses.push_back(p);
+  return poses;
 }
 
 }  // namespace fresco

@@ -34,6 +34,7 @@ struct PoseFeedStats {
   long long reconnects = 0;  // connections made after the first
   bool connected = false;
   double seconds_since_last_pose = -1;  // -1 before the first
+  double latest_time_s = 0;             // the newest sample's tracker time (0 before the first)
 };
 
 // Parses "tcp://HOST:PORT" / "udp://HOST:PORT" into host and port; false when malformed.
@@ -61,6 +62,10 @@ class PoseFeed {
   PoseFeedStats stats() const;
   // Every pose received (options.keep_all), in time order.
   std::vector<TimedPose> AllPoses() const;
+  // The samples the track still holds (the newest PoseTrackOptions::max_samples) between
+  // tracker times `from_s` and `to_s`, in time order: the tracker's poses over a recording
+  // without keep_all's unbounded memory.
+  std::vector<TimedPose> PosesBetween(double from_s, double to_s) const;
   const std::string& address() const { return address_; }
 
  private:

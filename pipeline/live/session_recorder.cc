@@ -12,13 +12,14 @@ Status SessionRecorder::Start(const std::string& dir, const Project& live_projec
   dir_ = dir;
   project_ = live_project;
   poses_.clear();
-  return MakeDirectories(dir + "/frames");
+  FRESCO_RETURN_IF_ERROR(MakeDirectories(dir));
+  return frames_.Open(dir + "/frames");
 }
 
 Status SessionRecorder::Add(const Frame& frame, const Rigid3d& cam_from_world) {
   char name[32];
   std::snprintf(name, sizeof name, "%06d.png", static_cast<int>(poses_.size()));
-  FRESCO_RETURN_IF_ERROR(WriteImageAtomic(dir_ + "/frames/" + name, frame.bgr));
+  FRESCO_RETURN_IF_ERROR(WriteImage(frames_.path() + "/" + name, frame.bgr));
   PosedImage pose;
   pose.image_id = static_cast<int>(poses_.size());
   pose.name = name;
@@ -29,6 +30,10 @@ Status SessionRecorder::Add(const Frame& frame, const Rigid3d& cam_from_world) {
 }
 
 Status SessionRecorder::Finish(const std::vector<TimedPose>& tracker_poses) {
+  // From here on DIR is rewritten: without project.json it is an incomplete recording, never
+  // an earlier one's project with this one's poses.
+  std::error_code ec;
+  std::filesystem::remove(dir_ + "/project.json", ec);
   FRESCO_RETURN_IF_ERROR(WriteTumTrajectory(dir_ + "/poses.txt", poses_));
   std::vector<PosedImage> tracker;
   for (const TimedPose& p : tracker_poses) {
@@ -38,6 +43,7 @@ Status SessionRecorder::Finish(const std::vector<TimedPose>& tracker_poses) {
     tracker.push_back(pose);
   }
   FRESCO_RETURN_IF_ERROR(WriteTumTrajectory(dir_ + "/tracker_poses.txt", tracker));
+  FRESCO_RETURN_IF_ERROR(frames_.Commit());
   Project replay = project_;
   // Paths resolve against the new folder: absolute for the inputs kept where they are.
   replay.scene = project_.Resolve(project_.scene);

@@ -5,11 +5,15 @@
 // tracker sent, its own clock) and DIR/project.json (the live project's scene, camera and
 // settings with video "frames/", poses "poses.txt", time_offset_s 0 and estimation off).
 // `fresco run DIR/project.json` then replays what was painted live.
+// The frames go, with plain writes, into a staging folder that replaces DIR/frames in
+// Finish (StagedFolder): no fsync and rename per frame on the painting thread, and a run
+// that stops before Finish leaves an earlier recording in DIR as it was.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "pipeline/core/atomic_file.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "pipeline/core/video_source.h"
@@ -19,16 +23,18 @@ namespace fresco {
 
 class SessionRecorder {
  public:
-  // Creates DIR and DIR/frames. Errors name the folder.
+  // Creates DIR and the staging folder for DIR/frames. Errors name the folder.
   Status Start(const std::string& dir, const Project& live_project);
-  // Writes the frame (PNG, atomically) and keeps its pose.
+  // Writes the frame (PNG) into the staging folder and keeps its pose.
   Status Add(const Frame& frame, const Rigid3d& cam_from_world);
-  // Writes poses.txt, tracker_poses.txt and, last, project.json (all atomically).
+  // Removes an earlier DIR/project.json, writes poses.txt and tracker_poses.txt
+  // (atomically), swaps the staged frames in as DIR/frames and, last, writes project.json.
   Status Finish(const std::vector<TimedPose>& tracker_poses);
   int frames() const { return static_cast<int>(poses_.size()); }
 
  private:
   std::string dir_;
+  StagedFolder frames_;
   Project project_;
   std::vector<PosedImage> poses_;
 };

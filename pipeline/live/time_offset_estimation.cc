@@ -78,12 +78,13 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Ca
   };
   // Coarse: one frame period over the whole range.
   const int half = std::max(1, static_cast<int>(std::ceil(options.search_s / step)));
-  TimeOffsetCandidate best;
-  best.score = kNaN;
+  std::vector<TimeOffsetCandidate> coarse;
+  size_t best_at = 0;
   for (int i = -half; i <= half; ++i) {
-    const TimeOffsetCandidate c = score(options.centre_s + i * step);
-    if (Better(c, best)) best = c;
+    coarse.push_back(score(options.centre_s + i * step));
+    if (Better(coarse.back(), coarse[best_at])) best_at = coarse.size() - 1;
   }
+  const TimeOffsetCandidate& best = coarse[best_at];
   if (!std::isfinite(best.score)) {
     result.note =
         "no candidate offset could be scored (too few frames with poses, or the "
@@ -92,11 +93,16 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Ca
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
   }
-  // Fine: a quarter step around the best.
+  // Fine: a quarter step around the best. Its ends (one step away) and centre are coarse
+  // candidates already scored, unless the best is at the end of the coarse range.
   const double fine = step / 4;
   std::vector<TimeOffsetCandidate> around;
   for (int i = -4; i <= 4; ++i) {
-    around.push_back(i == 0 ? best : score(best.offset_s + i * fine));
+    const long coarse_at = static_cast<long>(best_at) + i / 4;
+    if (i % 4 == 0 && coarse_at >= 0 && coarse_at < static_cast<long>(coarse.size()))
+      around.push_back(coarse[coarse_at]);
+    else
+      around.push_back(score(best.offset_s + i * fine));
   }
   size_t k = 0;
   for (size_t i = 1; i < around.size(); ++i)

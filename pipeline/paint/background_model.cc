@@ -54,6 +54,7 @@ void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& o
   if (options.mode == BackgroundMode::kRobust) robust_.assign(buffer.NumTexels(), RobustTexel{});
   if (options.mode == BackgroundMode::kAverage) average_.assign(buffer.NumTexels(), AverageTexel{});
   raw_ = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  raw_set_.assign(buffer.chunks.size(), 0);
 }
 
 namespace {
@@ -93,16 +94,19 @@ void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuff
   const uint8_t* valid = warped.valid.data;
   const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
   constexpr float kBinsPerLog2 = GainHistogram::kBins / 4.0f;
-  for (int k = 0; k < buffer.NumTexels(); k += 4) {
-    const int idx = buffer.texel_index[k];
-    const RobustTexel& t = robust_[k];
-    if (!valid[idx] || t.samples == 0) continue;
-    const float model = (t.mean[0][0] + t.mean[0][1] + t.mean[0][2]) * (1.0f / kMeanScale);
-    const float sample = static_cast<float>(src[idx][0] + src[idx][1] + src[idx][2]);
-    if (model < 30.0f || sample < 30.0f) continue;  // too dark for a ratio
-    const int bin = static_cast<int>((std::log2(sample / model) + 2.0f) * kBinsPerLog2);
-    ++histogram->bins[std::clamp(bin, 0, GainHistogram::kBins - 1)];
-    ++histogram->count;
+  for (const BaseBuffer::Chunk& chunk : buffer.chunks) {
+    if (!warped.MayBeValid(chunk)) continue;
+    for (int k = (chunk.begin + 3) / 4 * 4; k < chunk.end; k += 4) {  // every 4th texel
+      const int idx = buffer.texel_index[k];
+      const RobustTexel& t = robust_[k];
+      if (!valid[idx] || t.samples == 0) continue;
+      const float model = (t.mean[0][0] + t.mean[0][1] + t.mean[0][2]) * (1.0f / kMeanScale);
+      const float sample = static_cast<float>(src[idx][0] + src[idx][1] + src[idx][2]);
+      if (model < 30.0f || sample < 30.0f) continue;  // too dark for a ratio
+      const int bin = static_cast<int>((std::log2(sample / model) + 2.0f) * kBinsPerLog2);
+      ++histogram->bins[std::clamp(bin, 0, GainHistogram::kBins - 1)];
+      ++histogram->count;
+    }
   }
 }
 
@@ -236,11 +240,22 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
   frame->warming = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   if (debug) frame->difference = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   if (options_.mode == BackgroundMode::kOff) return;
+  // Only chunks that may hold valid texels; a skipped chunk's raw foreground from an earlier
+  // frame is cleared (Clean reads raw_ around this frame's foreground).
   std::vector<ChunkStats> stats(buffer.chunks.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(buffer.chunks.size())),
                     [&](const cv::Range& range) {
-                      for (int c = range.start; c < range.end; ++c)
-                        Classify(buffer, warped, gain, debug, buffer.chunks[c], &stats[c], frame);
+                      for (int c = range.start; c < range.end; ++c) {
+                        const BaseBuffer::Chunk& chunk = buffer.chunks[c];
+                        if (warped.MayBeValid(chunk)) {
+                          Classify(buffer, warped, gain, debug, chunk, &stats[c], frame);
+                        } else if (raw_set_[c]) {
+                          raw_(cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0,
+                                        chunk.y1 - chunk.y0))
+                              .setTo(0);
+                        }
+                        raw_set_[c] = stats[c].foreground > 0;
+                      }
                     });
   ChunkStats total;
   for (const ChunkStats& s : stats) {
@@ -278,8 +293,9 @@ cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
   return image;
 }
 
-void MarkProvisional(const BackgroundFrame& frame, PaintedBuffer* painted) {
-  if (frame.warming_up > 0) painted->quality.setTo(0.0f, frame.warming);
+void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
+                     PaintedBuffer* painted) {
+  if (frame.warming_up > 0) painted->quality(valid_box).setTo(0.0f, frame.warming(valid_box));
 }
 
 }  // namespace fresco

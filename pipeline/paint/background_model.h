@@ -93,11 +93,14 @@ class BufferBackground {
   std::vector<RobustTexel> robust_;
   std::vector<AverageTexel> average_;
   cv::Mat raw_;  // CV_8U: this frame's foreground before cleaning
+  std::vector<uint8_t> raw_set_;  // per chunk: raw_ may hold foreground there
   std::vector<int> texel_at_;  // texel number k by buffer index, -1 for none (built by Move)
 };
 
 // Marks texels painted while warming up as provisional (stored quality 0), so that the
-// quality update policy lets the first trusted sample replace them.
-void MarkProvisional(const BackgroundFrame& frame, PaintedBuffer* painted);
+// quality update policy lets the first trusted sample replace them. `valid_box`: bounds the
+// texels sampled this frame (WarpedBuffer::valid_box).
+void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
+                     PaintedBuffer* painted);
 
 }  // namespace fresco

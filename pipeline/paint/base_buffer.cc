@@ -73,17 +73,22 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     }
   }
   const int gutter = options.gutter_texels;
-  double s = texel_size_m;
-  auto dims = [&](double size, int* w, int* h) {
-    *w = static_cast<int>(std::ceil((pc.a_max - pc.a_min) / size)) + 2 * gutter + 1;
-    *h = static_cast<int>(std::ceil((pc.b_max - pc.b_min) / size)) + 2 * gutter + 1;
+  // Texels larger than the group would leave no texel centre on it (never painted): at
+  // least kMinTexelsAcross texels across its longer side.
+  const double extent = std::max(pc.a_max - pc.a_min, pc.b_max - pc.b_min);
+  double s = extent > 0 ? std::min(texel_size_m, extent / kMinTexelsAcross) : texel_size_m;
+  // In double: a tiny texel size would overflow int before the cap applies.
+  double wd = 0, hd = 0;
+  auto dims = [&](double size) {
+    wd = std::ceil((pc.a_max - pc.a_min) / size) + 2 * gutter + 1;
+    hd = std::ceil((pc.b_max - pc.b_min) / size) + 2 * gutter + 1;
   };
-  int w = 0, h = 0;
-  dims(s, &w, &h);
-  for (int iter = 0; iter < 8 && static_cast<double>(w) * h > options.max_buffer_texels; ++iter) {
-    s *= std::sqrt(static_cast<double>(w) * h / options.max_buffer_texels) * 1.01;
-    dims(s, &w, &h);
+  dims(s);
+  for (int iter = 0; iter < 60 && wd * hd > options.max_buffer_texels; ++iter) {
+    s *= std::sqrt(wd * hd / options.max_buffer_texels) * 1.01;
+    dims(s);
   }
+  const int w = static_cast<int>(wd), h = static_cast<int>(hd);
   buffer.texel_size_m = s;
   buffer.width = w;
   buffer.height = h;
@@ -119,6 +124,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
         h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
     const Eigen::Vector3d A = mesh.Corner(t, 0);
     const double denom = n.dot(nt);
+    bool covers_a_centre = false;
     for (int j = j0; j <= j1; ++j) {
       for (int i = i0; i <= i1; ++i) {
         const Eigen::Vector2d c(i + 0.5, j + 0.5);
@@ -128,6 +134,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
           inside = sign * (e.x() * r.y() - e.y() * r.x()) >= 0;
         }
         if (!inside) continue;
+        covers_a_centre = true;
         const Eigen::Vector3d pp = plane_point(i, j);
         const Eigen::Vector3d m = pp + n * ((A - pp).dot(nt) / denom);
         const size_t idx = static_cast<size_t>(j) * w + i;
@@ -138,6 +145,19 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
         }
         owner[idx] = t;
         point[idx] = m.cast<float>();
+      }
+    }
+    if (!covers_a_centre) {
+      // A sliver thinner than a texel: the texel under its centroid, if free, serves it
+      // (at the centroid, which lies on it), so that no triangle goes unpainted.
+      const Eigen::Vector2d c = (q[0] + q[1] + q[2]) / 3.0;
+      const int i = std::clamp(static_cast<int>(std::floor(c.x())), 0, w - 1);
+      const int j = std::clamp(static_cast<int>(std::floor(c.y())), 0, h - 1);
+      const size_t idx = static_cast<size_t>(j) * w + i;
+      if (owner[idx] < 0) {
+        owner[idx] = t;
+        point[idx] = ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0)
+                         .cast<float>();
       }
     }
   }

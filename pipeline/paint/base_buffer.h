@@ -59,6 +59,10 @@ struct BaseBuffer {
   Eigen::Vector2d TexelCoords(const Eigen::Vector3d& local_point) const;
 };
 
+// A group's buffer has at least this many texels across its longer side, whatever the
+// texel size asked for (larger texels would miss the surface).
+inline constexpr int kMinTexelsAcross = 4;
+
 struct BaseBufferOptions {
   double texel_size_m = 0.01;       // default texel size (groups may override)
   int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels

@@ -58,6 +58,13 @@ struct WarpedBuffer {
   int chunks_culled = 0;        // chunks of texels skipped whole (outside the view frustum)
   long long texels_tested = 0;  // texels in chunks that were not culled
   cv::Rect valid_box;           // bounds every valid texel (empty when none)
+
+  // Whether `chunk` may hold valid texels (its tile meets valid_box): later stages skip
+  // the others whole.
+  bool MayBeValid(const BaseBuffer::Chunk& chunk) const {
+    return chunk.x0 < valid_box.br().x && valid_box.x < chunk.x1 &&
+           chunk.y0 < valid_box.br().y && valid_box.y < chunk.y1;
+  }
 };
 
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view,

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include <opencv2/core/utility.hpp>
@@ -254,7 +255,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
                              ? cv::Mat()
                              : background_frame_[b].foreground;
     const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
-    if (!background_.empty()) MarkProvisional(background_frame_[b], &painted_[b]);
+    if (!background_.empty())
+      MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
     written += stats.written;
     rejected += stats.rejected;
     compared += stats.compared;
@@ -312,7 +314,7 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   RefineEstimate& e = r->estimate;
   const std::string suffix = "_b" + std::to_string(b);
   auto t0 = std::chrono::steady_clock::now();
-  ApplyRefinement(e, w.valid_box, &w.bgr, &w.valid, &w.quality);
+  w.valid_box = ApplyRefinement(e, w.valid_box, &w.bgr, &w.valid, &w.quality);
   r->rewarp_ms = MsSince(t0);
   t0 = std::chrono::steady_clock::now();
   // A registered frame is a sample of the buffer's offset (refine_anchor.h).
@@ -330,6 +332,7 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
                                      w.valid_box.height + 2 * margin) &
                             cv::Rect(0, 0, w.valid.cols, w.valid.rows);
     MoveWarpedImages(move, within, &w.bgr, &w.valid, &w.quality);
+    w.valid_box = within;  // valid texels may have moved by up to the margin
     if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &move))
       background_[b].Move(set_.buffers[b], move.roi, move.field);
     r->moved = true;
@@ -399,12 +402,22 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     if (seen[b] && painted_[b].painted_surface_texels > 0) todo.push_back(b);
     else if (seen[b]) fresh.push_back(b);
   }
-  // Buffers are independent: one per thread.
+  // Buffers are independent: one per thread, the largest regions first so that the threads
+  // finish together (longest processing time first).
   std::vector<BufferRefinement> results(todo.size());
   const auto for_each_buffer = [&](void (PaintSession::*step)(size_t, bool, BufferRefinement*)) {
-    cv::parallel_for_(cv::Range(0, static_cast<int>(todo.size())), [&](const cv::Range& range) {
-      for (int i = range.start; i < range.end; ++i) (this->*step)(todo[i], debug, &results[i]);
+    std::vector<int> order(todo.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+      return warped_[todo[a]].valid_box.area() > warped_[todo[b]].valid_box.area();
     });
+    cv::parallel_for_(
+        cv::Range(0, static_cast<int>(order.size())),
+        [&](const cv::Range& range) {
+          for (int i = range.start; i < range.end; ++i)
+            (this->*step)(todo[order[i]], debug, &results[order[i]]);
+        },
+        static_cast<double>(order.size()));
   };
   if (options_.refine.pose) {  // every buffer's matches first, then one pose for all
     for_each_buffer(&PaintSession::EstimateBuffer);
@@ -415,8 +428,8 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     for_each_buffer(&PaintSession::RefineBuffer);
   }
 
-  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, moved = 0,
-      unregistered_kept_out = 0;
+  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, ambiguous = 0,
+      moved = 0, unregistered_kept_out = 0;
   double before_sq = 0, after_sq = 0, correction = 0;
   double estimate_ms = 0, rewarp_ms = 0, anchor_ms = 0;
   std::map<std::string, int> models, reasons;
@@ -428,7 +441,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     anchor_ms += results[i].anchor_ms;
     moved += results[i].moved;
     unregistered_kept_out += results[i].kept_out;
-    corners += e.corners, matches += e.matches, inliers += e.inliers;
+    corners += e.corners, matches += e.matches, inliers += e.inliers, ambiguous += e.ambiguous;
     before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
     after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
     if (e.applied) {
@@ -449,6 +462,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   report.metrics["corners"] = corners;
   report.metrics["matches"] = matches;
   report.metrics["inliers"] = inliers;
+  report.metrics["ambiguous_matches"] = ambiguous;  // dropped: repetitive texture
   // RMS over all inliers, texels: identity before, the chosen corrections after.
   report.metrics["residual_before_px"] =
       inliers > 0 ? std::sqrt(before_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
@@ -588,6 +602,7 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
     cv::Mat map(buffer.height, buffer.width, CV_32FC2, cv::Scalar(-1, -1));
     WarpedBuffer& w = warped_[b];
     w.valid = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    w.valid_box = cv::Rect(0, 0, buffer.width, buffer.height);
     w.quality = cv::Mat::ones(buffer.height, buffer.width, CV_32F);
     for (int k = 0; k < buffer.NumTexels(); ++k) {
       const Eigen::Vector3d p = cam_from_local * buffer.Point(k).cast<double>();

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <vector>
+
+#include <opencv2/core/utility.hpp>
 
 namespace fresco {
 
@@ -15,9 +18,12 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->painted_surface_texels = 0;
 }
 
-PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
-                             const cv::Mat& mask, const PipelineOptions& options,
-                             PaintedBuffer* painted) {
+namespace {
+
+// Texels [begin, end) of one chunk; `newly_painted`: surface texels painted the first time.
+PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warped,
+                             const cv::Mat& mask, const PipelineOptions& options, int begin,
+                             int end, PaintedBuffer* painted, int* newly_painted) {
   PaintUpdateStats stats;
   const UpdatePolicy policy = options.update;
   const float keep = static_cast<float>(1.0 - options.quality_slack);
@@ -29,7 +35,7 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
   const uint8_t* skip = mask.empty() ? nullptr : mask.data;
   cv::Vec4b* dst = painted->bgra.ptr<cv::Vec4b>();
   float* stored_quality = painted->quality.ptr<float>();
-  for (int k = 0; k < buffer.NumTexels(); ++k) {
+  for (int k = begin; k < end; ++k) {
     const int idx = buffer.texel_index[k];
     if (!valid[idx] || (skip && skip[idx])) continue;
     cv::Vec4b& px = dst[idx];
@@ -45,7 +51,7 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
       ++stats.rejected;
       continue;
     }
-    if (px[3] == 0 && buffer.on_surface[k]) ++painted->painted_surface_texels;
+    if (px[3] == 0 && buffer.on_surface[k]) ++*newly_painted;
     if (px[3] == 0 || weight == 256) {
       px = cv::Vec4b(src[idx][0], src[idx][1], src[idx][2], 255);
     } else {
@@ -54,6 +60,46 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
     stored_q = policy == UpdatePolicy::kQuality ? std::max(stored_q, q) : q;
     ++stats.written;
   }
+  return stats;
+}
+
+}  // namespace
+
+PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
+                             const cv::Mat& mask, const PipelineOptions& options,
+                             PaintedBuffer* painted) {
+  PaintUpdateStats stats;
+  int newly_painted = 0;
+  if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
+    stats = PaintTexels(buffer, warped, mask, options, 0, buffer.NumTexels(), painted,
+                        &newly_painted);
+    painted->painted_surface_texels += newly_painted;
+    return stats;
+  }
+  // Chunks write disjoint texels: in parallel, only those that may hold valid texels,
+  // reduced in chunk order (deterministic).
+  const int num_chunks = static_cast<int>(buffer.chunks.size());
+  std::vector<PaintUpdateStats> per_chunk(num_chunks);
+  std::vector<int> newly(num_chunks, 0);
+  cv::parallel_for_(
+      cv::Range(0, num_chunks),
+      [&](const cv::Range& range) {
+        for (int c = range.start; c < range.end; ++c) {
+          const BaseBuffer::Chunk& chunk = buffer.chunks[c];
+          if (!warped.MayBeValid(chunk)) continue;
+          per_chunk[c] = PaintTexels(buffer, warped, mask, options, chunk.begin, chunk.end,
+                                     painted, &newly[c]);
+        }
+      },
+      std::max(1, std::min(num_chunks, 16 * cv::getNumThreads())));
+  for (int c = 0; c < num_chunks; ++c) {
+    stats.written += per_chunk[c].written;
+    stats.rejected += per_chunk[c].rejected;
+    stats.compared += per_chunk[c].compared;
+    stats.abs_grey_difference_sum += per_chunk[c].abs_grey_difference_sum;
+    newly_painted += newly[c];
+  }
+  painted->painted_surface_texels += newly_painted;
   return stats;
 }
 

@@ -133,10 +133,39 @@ std::string Check(const cv::Matx33d& H, const cv::Rect& region, const RefineOpti
   return "";
 }
 
+// Repetitive texture: whether another place of the search window matches the template nearly
+// as well as the best, so that the best (or the tracker's nearest) may be a period off.
+// `ssd`: the template's SSD over the window (TM_SQDIFF), `best` its minimum. Nearly as good:
+// a local minimum at least 2 texels from the best (not a slope of the best's own basin) whose
+// excess over the best is below kAmbiguity of the median excess (what a mismatch costs here).
+constexpr double kAmbiguity = 0.25;
+bool Ambiguous(const cv::Mat& ssd, const cv::Point& best) {
+  const float least = ssd.at<float>(best);
+  std::vector<float> values(ssd.begin<float>(), ssd.end<float>());
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  const double limit = least + kAmbiguity * (values[values.size() / 2] - least);
+  for (int y = 0; y < ssd.rows; ++y) {
+    for (int x = 0; x < ssd.cols; ++x) {
+      const float v = ssd.at<float>(y, x);
+      if (v > limit || std::max(std::abs(x - best.x), std::abs(y - best.y)) < 2) continue;
+      bool minimum = true;
+      for (int dy = -1; dy <= 1 && minimum; ++dy)
+        for (int dx = -1; dx <= 1 && minimum; ++dx) {
+          const cv::Point n(x + dx, y + dy);
+          if (n.x >= 0 && n.y >= 0 && n.x < ssd.cols && n.y < ssd.rows && ssd.at<float>(n) < v)
+            minimum = false;
+        }
+      if (minimum) return true;
+    }
+  }
+  return false;
+}
+
 // Matches by the paper: SSD of a (2w+1)^2 template in a +-search window, integer texels.
+// Ambiguous matches are counted in `ambiguous`, not kept.
 void MatchSsd(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overlap,
               const std::vector<cv::Point2f>& corners, const RefineOptions& options,
-              std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+              std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to, int* ambiguous) {
   const int w = options.window_px, s = options.search_px;
   const cv::Rect image(0, 0, grey_w.cols, grey_w.rows);
   for (const cv::Point2f& c : corners) {
@@ -151,15 +180,42 @@ void MatchSsd(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overl
     const cv::Point2f found(static_cast<float>(search.x + best.x + w),
                             static_cast<float>(search.y + best.y + w));
     if (!overlap.at<uchar>(cvRound(found.y), cvRound(found.x))) continue;
+    if (Ambiguous(ssd, best)) {
+      ++*ambiguous;
+      continue;
+    }
     from->push_back(cv::Point2f(p));
     to->push_back(found);
   }
 }
 
-// Pyramidal Lucas-Kanade (coarse to fine, sub-texel) with a forward-backward check.
+// Whether the template of the corner at `p` matches the buffer ambiguously within the
+// +-search window (clipped to the image).
+bool AmbiguousAt(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Point& p,
+                 const RefineOptions& options) {
+  const int w = options.window_px, s = options.search_px;
+  const cv::Rect image(0, 0, grey_w.cols, grey_w.rows);
+  const cv::Rect templ(p.x - w, p.y - w, 2 * w + 1, 2 * w + 1);
+  const cv::Rect search =
+      cv::Rect(p.x - w - s, p.y - w - s, 2 * (w + s) + 1, 2 * (w + s) + 1) & image;
+  if ((templ & image) != templ) return false;
+  cv::Mat ssd;
+  cv::matchTemplate(grey_b(search), grey_w(templ), ssd, cv::TM_SQDIFF);
+  cv::Point best;
+  cv::minMaxLoc(ssd, nullptr, nullptr, &best);
+  return Ambiguous(ssd, best);
+}
+
+// Pyramidal Lucas-Kanade (coarse to fine, sub-texel) with a forward-backward check. The
+// tracker converges to the nearest copy of a repetitive texture: the template of up to
+// kAmbiguitySamples matches (evenly spread over the tracked ones; each check is a full SSD
+// search) is compared over the search window; ambiguous ones are counted in `ambiguous`
+// (out of `checked`) and not kept.
+constexpr int kAmbiguitySamples = 24;
 void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overlap,
              const std::vector<cv::Point2f>& corners, const RefineOptions& options,
-             std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to) {
+             std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to, int* ambiguous,
+             int* checked) {
   if (corners.empty()) return;
   std::vector<cv::Point2f> forward, backward;
   std::vector<uchar> ok_f, ok_b;
@@ -175,6 +231,7 @@ void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overla
                            stop);
   cv::calcOpticalFlowPyrLK(pyramid_b, pyramid_w, forward, backward, ok_b, err, window, levels,
                            stop);
+  std::vector<size_t> tracked;  // corners the tracker followed both ways into the overlap
   for (size_t i = 0; i < corners.size(); ++i) {
     if (!ok_f[i] || !ok_b[i]) continue;
     if (cv::norm(backward[i] - corners[i]) > 0.5) continue;  // not the same texture both ways
@@ -182,6 +239,22 @@ void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overla
     const cv::Point q(cvRound(forward[i].x), cvRound(forward[i].y));
     if (q.x < 0 || q.y < 0 || q.x >= overlap.cols || q.y >= overlap.rows || !overlap.at<uchar>(q))
       continue;
+    tracked.push_back(i);
+  }
+  const size_t n = tracked.size();
+  const size_t samples = std::min<size_t>(n, kAmbiguitySamples);
+  size_t next_sample = 0;  // sample k is tracked[k * n / samples]
+  for (size_t j = 0; j < n; ++j) {
+    const size_t i = tracked[j];
+    if (next_sample < samples && j == next_sample * n / samples) {
+      ++next_sample;
+      ++*checked;
+      if (AmbiguousAt(grey_w, grey_b, cv::Point(cvRound(corners[i].x), cvRound(corners[i].y)),
+                      options)) {
+        ++*ambiguous;
+        continue;
+      }
+    }
     from->push_back(corners[i]);
     to->push_back(forward[i]);
   }
@@ -258,10 +331,13 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
     return e;
   }
   std::vector<cv::Point2f> from, to;
-  if (options.mode == RefineMode::kPaper)
-    MatchSsd(grey_w, grey_b, overlap, corners, options, &from, &to);
-  else
-    MatchLk(grey_w, grey_b, overlap, corners, options, &from, &to);
+  int checked = 0;  // matches checked for ambiguity
+  if (options.mode == RefineMode::kPaper) {
+    MatchSsd(grey_w, grey_b, overlap, corners, options, &from, &to, &e.ambiguous);
+    checked = e.ambiguous + static_cast<int>(from.size());
+  } else {
+    MatchLk(grey_w, grey_b, overlap, corners, options, &from, &to, &e.ambiguous, &checked);
+  }
   e.matches = static_cast<int>(from.size());
   const cv::Point2f offset(static_cast<float>(e.region.x), static_cast<float>(e.region.y));
   for (auto& p : from) p += offset;
@@ -269,6 +345,13 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
   e.from = from;
   e.to = to;
   e.inlier.assign(from.size(), 1);
+  // Most matches ambiguous: the texture repeats within the search window, and the few left
+  // (near the region's edges, where a copy may lie outside) cannot be told from a period off.
+  if (2 * e.ambiguous > checked) {
+    e.fallback = "repetitive texture: matches ambiguous within the search window";
+    e.inlier.assign(from.size(), 0);  // nor for the pose (refine_pose.h)
+    return e;
+  }
   if (e.matches < options.min_inliers) {
     e.fallback = "too few matches";
     return e;
@@ -371,9 +454,9 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
   return e;
 }
 
-void ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv::Mat* warped_bgr,
-                     cv::Mat* warped_valid, cv::Mat* warped_quality) {
-  if (!estimate.applied) return;
+cv::Rect ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within,
+                         cv::Mat* warped_bgr, cv::Mat* warped_valid, cv::Mat* warped_quality) {
+  if (!estimate.applied) return within;
   const int margin = static_cast<int>(std::ceil(estimate.correction_px)) + 2;
   const cv::Rect image(0, 0, warped_bgr->cols, warped_bgr->rows);
   const cv::Rect box = within.empty() ? image : within;
@@ -396,6 +479,7 @@ void ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv:
   out_bgr.copyTo((*warped_bgr)(roi));
   out_valid.copyTo((*warped_valid)(roi));
   out_quality.copyTo((*warped_quality)(roi));
+  return roi;
 }
 
 cv::Mat DrawRefinementMatches(const cv::Mat& warped_bgr, const RefineEstimate& estimate) {

@@ -11,7 +11,9 @@
 //    by BIC (residual against parameters), so a frame gets only the model it needs.
 // Both fall back to no correction, with the reason, when there are too few or collinear
 // corners, when the fit would shrink, stretch or flip the image, or when the correction is
-// larger than the search window.
+// larger than the search window. Repetitive texture: a match whose template matches nearly as
+// well elsewhere in the search window (a period away) is dropped; when most are, the buffer
+// gets no correction ("repetitive texture: ...") rather than one a period off.
 //
 // Coordinates: texel (column, row) of the buffer; buffer_from_warped maps a position in the
 // warped frame to where it belongs in the buffer (eq. 6, with a homography as the most
@@ -39,6 +41,10 @@ struct RefineEstimate {
   // The correction measured (also when too small to apply: registered but not applied).
   cv::Matx33d buffer_from_warped = cv::Matx33d::eye();
   int corners = 0, matches = 0, inliers = 0;
+  // Matches dropped because another place in the search window matched nearly as well
+  // (repetitive texture: the nearest copy may be a period off). Paper mode checks every
+  // match; robust mode a sample of the tracked ones (kAmbiguitySamples).
+  int ambiguous = 0;
   double residual_before_px = 0;      // RMS over inliers, identity
   double residual_after_px = 0;       // RMS over inliers, chosen model
   double correction_px = 0;           // largest displacement of the region's corners
@@ -63,7 +69,8 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
 // nearest, valid eroded by a texel so that no sample blends with unseen texels). Only
 // `within` (every valid texel: WarpedBuffer::valid_box; empty = everywhere) plus a margin is
 // touched: the correction applies to the whole frame, also where the buffer is unpainted.
-void ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv::Mat* warped_bgr,
+// Returns what now bounds every valid texel (`within`, grown by the margin when applied).
+cv::Rect ApplyRefinement(const RefineEstimate& estimate, const cv::Rect& within, cv::Mat* warped_bgr,
                      cv::Mat* warped_valid, cv::Mat* warped_quality);
 
 // Debug images: the warped frame with its corners and matches drawn (inliers green,

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "pipeline/core/atomic_file.h"
-#include "pipeline/poses/run_process.h"
+#include "pipeline/core/run_process.h"
 
 #ifndef FRESCO_COLMAP_EXECUTABLE
 #define FRESCO_COLMAP_EXECUTABLE ""
@@ -143,7 +143,9 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
     const fs::path log = logs / (prefix + step.name + ".log");
     const auto step_start = std::chrono::steady_clock::now();
     int exit_code = 0;
-    FRESCO_RETURN_IF_ERROR(RunProcess(argv, log.string(), &exit_code));
+    if (options.cancel && *options.cancel) return Status::Error("colmap: cancelled");
+    FRESCO_RETURN_IF_ERROR(RunProcess(argv, log.string(), &exit_code, options.cancel));
+    if (options.cancel && *options.cancel) return Status::Error("colmap: cancelled");
     result->step_seconds.push_back(
         {step.name,
          std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count()});

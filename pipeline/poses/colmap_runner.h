@@ -9,6 +9,7 @@
 //   most registered images is read (ColmapModel, Fresco's (0,0) pixel convention).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -41,6 +42,9 @@ struct ColmapRunOptions {
   int min_registered = 3;    // fewer registered images is an error
   // Called before each step: (step name, index from 0, number of steps).
   std::function<void(const std::string& step, int index, int total)> progress;
+  // When set and it becomes true, the running step is stopped and RunColmap fails with
+  // "colmap: cancelled" (the app's Poses panel).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct ColmapRunResult {

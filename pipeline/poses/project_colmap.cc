@@ -85,6 +85,7 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     lookup.name = folder_names.empty() ? Stem(frames[i].name) : frames[i].name;
     ProjectColmapFrame pf;
     pf.name = frames[i].name;
+    pf.index = frames[i].index;
     pf.given = capture.PoseForFrame(lookup);
     result->frames.push_back(pf);
     names.push_back(frames[i].name);
@@ -116,6 +117,15 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     if (it != by_name.end()) f.colmap = it->second;
   }
   return Status::Ok();
+}
+
+std::vector<VerifyFrameInput> VerifyInputs(const ProjectColmap& colmap) {
+  std::vector<VerifyFrameInput> inputs;
+  for (const ProjectColmapFrame& f : colmap.frames) {
+    inputs.push_back({f.name, f.given ? &f.given->cam_from_world : nullptr,
+                      f.colmap ? &f.colmap->cam_from_world : nullptr});
+  }
+  return inputs;
 }
 
 }  // namespace fresco

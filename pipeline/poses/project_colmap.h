@@ -11,6 +11,7 @@
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
 #include "pipeline/poses/colmap_runner.h"
+#include "pipeline/poses/verify.h"
 
 namespace fresco {
 
@@ -31,6 +32,7 @@ struct ProjectColmapOptions {
 
 struct ProjectColmapFrame {
   std::string name;   // image file name, as COLMAP knows it
+  int index = 0;      // the frame's index in the project's video
   const PosedImage* given = nullptr;   // into ProjectColmap::capture.poses
   const PosedImage* colmap = nullptr;  // into ProjectColmap::run.model.images
 };
@@ -47,5 +49,8 @@ struct ProjectColmap {
 // (project, camera, video) come back as is; COLMAP errors are prefixed with "colmap".
 Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
                           ProjectColmap* result, bool* bad_input);
+
+// The frames as VerifyPoses takes them (pointing into `colmap`).
+std::vector<VerifyFrameInput> VerifyInputs(const ProjectColmap& colmap);
 
 }  // namespace fresco

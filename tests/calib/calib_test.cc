@@ -2,6 +2,7 @@
 // plus Gaussian corner noise), `auto` model choice, real data (opencv-chessboard-stereo,
 // aprilgrid-yac-mocap), the board renderer round trip, and the data traps.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -104,7 +105,10 @@ TEST(SyntheticCalibrationTest, StrongDistortionPicksARicherModel) {
   const double diff = ProjectionDifference_px("LENSMODEL_OPENCV8", truth, fit.lensmodel,
                                               fit.intrinsics, ObservedPixels(views, 640, 480));
   std::cout << "projection difference to the truth " << diff << " px\n";
-  EXPECT_LT(diff, 0.1);
+  // The bound has room for the compiler: GCC -O3 gives 0.050 px, the clang-14 ASan -O1
+  // build of .ci/sanitize 0.117 px (ulp-level differences change which corners mrcal's
+  // outlier rounds throw out: 12, 17, 5, 8, 6 against 12, 6, 5).
+  EXPECT_LT(diff, 0.15);
   EXPECT_NEAR(fit.intrinsics[0], truth[0], 0.01 * truth[0]);
 }
 
@@ -179,6 +183,42 @@ TEST(CalibCommandTest, BoardCommandStatesItsSize) {
   EXPECT_NEAR(j["pattern_size_m"][0].get<double>(), 0.66, 0.01);  // whole pixels per bit
 }
 
+// mrcal.projection_uncertainty (worst direction, python3-mrcal) of MODEL (relative to `dir`,
+// with optimization_inputs) at the centre and the uncertainty map's four corner cells, at
+// `range` m for corner noise `sigma` px: the figures our report gives as centre_px, corners_px.
+std::vector<double> MrcalProjectionUncertainty(const std::string& dir, const std::string& model,
+                                               double range, double sigma) {
+  auto digits = [](double value) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.17g", value);
+    return std::string(text);
+  };
+  const std::string out_txt = model + ".mrcal-uncertainty.txt";
+  const std::string command =
+      "cd " + dir + " && /usr/bin/python3 -c \"import mrcal, numpy as np; m=mrcal.cameramodel('" +
+      model +
+      "'); W,H=m.imagersize(); c=lambda i,n,s: (i+0.5)*s/n-0.5;"
+      " q=np.array([[(W-1)/2,(H-1)/2],[c(0,32,W),c(0,24,H)],[c(31,32,W),c(0,24,H)],"
+      "[c(0,32,W),c(23,24,H)],[c(31,32,W),c(23,24,H)]]);"
+      " v=mrcal.unproject(q,*m.intrinsics(),normalize=True);"
+      " print(*mrcal.projection_uncertainty(v*" +
+      digits(range) + ",m,what='worstdirection-stdev',observed_pixel_uncertainty=" + digits(sigma) +
+      "))\" > '" + out_txt + "'";
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  std::vector<double> values;
+  std::istringstream in(fresco::testing::ReadText(dir + "/" + out_txt));
+  for (double v; in >> v;) values.push_back(v);
+  return values;
+}
+
+// Our report's centre_px and corners_px.
+std::vector<double> ReportedUncertainty(const nlohmann::json& report) {
+  const auto& u = report["projection_uncertainty"];
+  std::vector<double> values = {u["centre_px"].get<double>()};
+  for (const auto& c : u["corners_px"]) values.push_back(c.get<double>());
+  return values;
+}
+
 TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
   FRESCO_REQUIRE_SHARED_DATA();
   const std::string data = fresco::testing::SharedDataDir() + "/opencv-chessboard-stereo";
@@ -224,29 +264,25 @@ TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
   const auto& u = report["projection_uncertainty"];
   const double range = u["range_m"], sigma = u["sigma_px"];
   EXPECT_GT(range, 0.2);
-  std::vector<double> ours = {u["centre_px"].get<double>()};
-  for (const auto& c : u["corners_px"]) ours.push_back(c.get<double>());
+  const std::vector<double> ours = ReportedUncertainty(report);
   for (size_t i = 1; i < ours.size(); ++i) EXPECT_GT(ours[i], 10 * ours[0]);
   EXPECT_TRUE(fs::exists(dir + "/left.uncertainty.png"));
-  const std::string mrcal_uncertainty =
-      "cd " + dir +
-      " && /usr/bin/python3 -c \"import mrcal, numpy as np; m=mrcal.cameramodel("
-      "'m/camera-0.cameramodel'); W,H=m.imagersize(); c=lambda i,n,s: (i+0.5)*s/n-0.5;"
-      " q=np.array([[(W-1)/2,(H-1)/2],[c(0,32,W),c(0,24,H)],[c(31,32,W),c(0,24,H)],"
-      "[c(0,32,W),c(23,24,H)],[c(31,32,W),c(23,24,H)]]);"
-      " v=mrcal.unproject(q,*m.intrinsics(),normalize=True);"
-      " print(*mrcal.projection_uncertainty(v*" +
-      std::to_string(range) +
-      ",m,"
-      "what='worstdirection-stdev',observed_pixel_uncertainty=" +
-      std::to_string(sigma) + "))\" > uncertainty.txt";
-  ASSERT_EQ(std::system(mrcal_uncertainty.c_str()), 0);
-  std::istringstream theirs(fresco::testing::ReadText(dir + "/uncertainty.txt"));
-  for (size_t i = 0; theirs >> d; ++i) {
-    std::cout << "projection uncertainty " << i << ": ours " << ours.at(i) << " px, mrcal " << d
-              << " px\n";
-    EXPECT_NEAR(ours.at(i) / d, 1.0, 0.01) << i;
+  // Against mrcal-calibrate-cameras' model of our corners (its own optimization_inputs).
+  const std::vector<double> theirs =
+      MrcalProjectionUncertainty(dir, "m/camera-0.cameramodel", range, sigma);
+  ASSERT_EQ(theirs.size(), ours.size());
+  for (size_t i = 0; i < theirs.size(); ++i) {
+    std::cout << "projection uncertainty " << i << ": ours " << ours[i] << " px, mrcal "
+              << theirs[i] << " px\n";
+    EXPECT_NEAR(ours[i] / theirs[i], 1.0, 0.01) << i;
   }
+  // Our .cameramodel carries mrcal's optimization_inputs: mrcal's uncertainty runs on it and
+  // gives our figures (same state, same Jacobian: to rounding).
+  EXPECT_EQ(report["optimization_inputs"], "written (python3-mrcal)");
+  const std::vector<double> on_ours =
+      MrcalProjectionUncertainty(dir, "left.cameramodel", range, sigma);
+  ASSERT_EQ(on_ours.size(), ours.size());
+  for (size_t i = 0; i < on_ours.size(); ++i) EXPECT_NEAR(ours[i] / on_ours[i], 1.0, 1e-5) << i;
 }
 
 // yac's reference corners for one image: board point (rounded to 0.1 mm) -> pixel.
@@ -295,6 +331,36 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
   EXPECT_GT(distances.size(), 0.8 * reference);
   EXPECT_LT(median, 0.2);
   EXPECT_LT(p90, 0.4);
+}
+
+// All 30 aprilgrid-yac-mocap images, opencv4 (auto on them takes minutes: README): every
+// image used, the solve converges, a plausible focal length for this 640x480 RealSense colour
+// camera, and mrcal's own uncertainty on our model (its optimization_inputs hold the 76 x 76
+// AprilGrid point grid, absent points marked) gives our figures.
+TEST(RealDataTest, AprilGridAllImagesSolveAndMrcalReadsTheProblem) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string data = fresco::testing::SharedDataDir() + "/aprilgrid-yac-mocap/cam0/data";
+  const std::string dir = fresco::testing::MakeTempDir("calib_april30");
+  const auto r = RunFresco({"calib", "solve", data, "--board", "aprilgrid:6x6:0.088:0.3", "--out",
+                            dir + "/cam0.cameramodel", "--model", "opencv4",
+                            "--no-cross-validation", "--no-pictures"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(fresco::testing::ReadText(dir + "/cam0.report.json"));
+  EXPECT_EQ(report["images_used"].size(), 30u);
+  EXPECT_LT(report["rms_px"].get<double>(), 0.3);
+  const double fx = report["intrinsics"][0], fy = report["intrinsics"][1];
+  EXPECT_GT(fx, 590);
+  EXPECT_LT(fx, 630);
+  EXPECT_NEAR(fy / fx, 1.0, 0.01);
+  if (std::system("/usr/bin/python3 -c 'import mrcal' 2>/dev/null") != 0)
+    GTEST_SKIP() << "python3-mrcal is absent: optimization_inputs not checked";
+  EXPECT_EQ(report["optimization_inputs"], "written (python3-mrcal)");
+  const auto& u = report["projection_uncertainty"];
+  const std::vector<double> ours = ReportedUncertainty(report);
+  const std::vector<double> theirs =
+      MrcalProjectionUncertainty(dir, "cam0.cameramodel", u["range_m"], u["sigma_px"]);
+  ASSERT_EQ(theirs.size(), ours.size());
+  for (size_t i = 0; i < theirs.size(); ++i) EXPECT_NEAR(ours[i] / theirs[i], 1.0, 1e-5) << i;
 }
 
 }  // namespace

@@ -25,6 +25,17 @@ BaseBufferSet PlaneBuffers(const Scene& scene, const BaseBufferOptions& options)
   return BuildBaseBuffers(scene.mesh, g, options);
 }
 
+// The one buffer of a single-plane scene.
+BaseBuffer OnlyBuffer(const Scene& scene, double texel_size_m,
+                      int max_buffer_texels = BaseBufferOptions().max_buffer_texels) {
+  BaseBufferOptions options;
+  options.texel_size_m = texel_size_m;
+  options.max_buffer_texels = max_buffer_texels;
+  const BaseBufferSet set = PlaneBuffers(scene, options);
+  EXPECT_EQ(set.buffers.size(), 1u);
+  return set.buffers.empty() ? BaseBuffer() : set.buffers[0];
+}
+
 // Warps a uniform frame into `buffer` from a camera 3 m from the plane's centre, looking at
 // it from `elevation_deg` above the plane (90 = head-on, < 0 = from behind).
 WarpedBuffer WarpFromElevation(const BaseBuffer& buffer, const Camera& camera,
@@ -44,11 +55,7 @@ WarpedBuffer WarpFromElevation(const BaseBuffer& buffer, const Camera& camera,
 
 TEST(Extremes, GrazingViewsAreNotPaintedAndWouldScoreNearZeroQuality) {
   const Scene scene = MakeTexturedPlaneScene(1.0, 1.0);
-  BaseBufferOptions buffer_options;
-  buffer_options.texel_size_m = 0.01;
-  const BaseBufferSet set = PlaneBuffers(scene, buffer_options);
-  ASSERT_EQ(set.buffers.size(), 1u);
-  const BaseBuffer& buffer = set.buffers[0];
+  const BaseBuffer buffer = OnlyBuffer(scene, 0.01);
   ASSERT_GT(buffer.num_surface_texels, 9000);
   const Camera camera = Camera::FromParams(LensModel::kPinhole, 640, 480, {500, 500, 319.5, 239.5});
   const cv::Mat frame(480, 640, CV_8UC3, cv::Scalar(10, 200, 30));
@@ -118,6 +125,51 @@ TEST(Extremes, TinyAndHugeTexelSizesGiveBoundedBuffersOnTheSurface) {
     for (int k = 0; k < b.NumTexels(); ++k)
       max_off_plane = std::max(max_off_plane, std::abs(b.Point(k).z()));
     EXPECT_LT(max_off_plane, 1e-6) << tiny;
+  }
+}
+
+TEST(Extremes, HugeTexelsAreCappedSoTheSurfaceStillHasTexels) {
+  // Texels larger than the surface would leave no texel centre on it: never painted.
+  const Scene scene = MakeTexturedPlaneScene(1.0, 1.0);
+  for (double huge : {10.0, 1e6, 1e300}) {
+    const BaseBuffer b = OnlyBuffer(scene, huge);
+    EXPECT_LE(b.texel_size_m, 1.0 / kMinTexelsAcross) << huge;
+    EXPECT_GE(b.num_surface_texels, kMinTexelsAcross * kMinTexelsAcross) << huge;
+    for (int k = 0; k < b.NumTexels(); ++k) {
+      EXPECT_LT(std::abs(b.Point(k).z()), 1e-6) << huge;
+      EXPECT_LE(std::abs(b.Point(k).x()), 0.5 + 1e-6) << huge;  // on the plane, not beside it
+      EXPECT_LE(std::abs(b.Point(k).y()), 0.5 + 1e-6) << huge;
+    }
+  }
+}
+
+TEST(Extremes, TexelCountsBeyondTheIntRangeAreCappedNotOverflowed) {
+  // 1 km at 1e-12 m: 1e15 texels across, far beyond int, before the cap brings it down.
+  const Scene scene = MakeTexturedPlaneScene(1000.0, 1000.0);
+  const int cap = 1 << 18;
+  const BaseBuffer b = OnlyBuffer(scene, 1e-12, cap);
+  EXPECT_GT(b.width, 0);
+  EXPECT_GT(b.height, 0);
+  EXPECT_LE(static_cast<long long>(b.width) * b.height, cap);
+  EXPECT_GE(b.texel_size_m, 1000.0 / 512);
+  EXPECT_GE(b.num_surface_texels, 0.9 * cap);
+}
+
+TEST(Extremes, ASliverThinnerThanATexelStillGetsATexelOnIt) {
+  // One triangle 1 m long and 0.1 mm wide, 1 cm texels: no texel centre falls inside it.
+  Scene scene;
+  scene.mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0.5, 1e-4, 0}};
+  scene.mesh.triangles = {{0, 1, 2}};
+  scene.mesh.uvs.resize(1);
+  scene.mesh.material = {0};
+  scene.mesh.has_uv = {false};
+  const BaseBuffer b = OnlyBuffer(scene, 0.01);
+  ASSERT_GE(b.num_surface_texels, 1);
+  for (int k = 0; k < b.NumTexels(); ++k) {
+    if (!b.on_surface[k]) continue;
+    EXPECT_NEAR(b.Point(k).x(), 0.5, 1e-6);  // the centroid
+    EXPECT_NEAR(b.Point(k).y(), 1e-4 / 3, 1e-6);
+    EXPECT_NEAR(b.Point(k).z(), 0, 1e-9);
   }
 }
 

@@ -91,6 +91,22 @@ TEST(FuzzRegressionTest, HugeAccessorWithoutBufferViewIsAnError) {
                         "5592405)"));
 }
 
+// gltf_fuzz (the 10 s run of .ci/sanitize): a GLB whose TEXCOORD_0 holds non-finite floats
+// was accepted, the fuzzer's consistency check (finite UVs) aborted. Now: an error naming the
+// file, the primitive and the attribute.
+TEST(FuzzRegressionTest, NonFiniteUvIsAnError) {
+  std::string bytes;
+  ASSERT_TRUE(
+      ReadFileToString(testing::SourceDir() + "/tests/fuzz/seeds/gltf/found-nonfinite-uv.glb",
+                       &bytes)
+          .ok());
+  Scene scene;
+  const Status status = ParseGltfScene(bytes, "found.glb", "", SceneLoadOptions(), &scene);
+  ASSERT_FALSE(status.ok());
+  EXPECT_THAT(status.message(), HasSubstr("found.glb: mesh "));
+  EXPECT_THAT(status.message(), ::testing::MatchesRegex(".*: TEXCOORD_0 [0-9]+ is not finite"));
+}
+
 // The in-memory readers give what the file readers give.
 TEST(FuzzRegressionTest, InMemoryReadersMatchFileReaders) {
   const std::string source = testing::SourceDir();

@@ -650,6 +650,33 @@ TEST(GltfSceneErrorTest, NanPosition) {
               HasSubstr("nan.gltf: mesh 'Tri' primitive 0: POSITION 1 is not finite"));
 }
 
+// Non-finite UVs (gltf_fuzz found them accepted) and positions that overflow only once the
+// node transform is applied.
+TEST(GltfSceneErrorTest, NonFiniteUvAndTransformedPosition) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(),
+                          std::numeric_limits<float>::infinity()}) {
+    GltfDoc doc;
+    std::vector<float> uv = {0, 0, 1, 0, 0, 1};
+    uv[5] = bad;
+    const int mesh =
+        doc.Mesh("Tri", {{"attributes",
+                          {{"POSITION", doc.Positions(kTriangle)},
+                           {"TEXCOORD_0", doc.Accessor(doc.View(uv), kFloat, 3, "VEC2")}}}});
+    doc.Scene({doc.Node({{"mesh", mesh}})});
+    const std::string path = doc.Write(MakeTempDir("scene"), "nanuv.gltf");
+    EXPECT_THAT(LoadError(path),
+                HasSubstr("nanuv.gltf: mesh 'Tri' primitive 0: TEXCOORD_0 2 is not finite"));
+  }
+  GltfDoc doc;
+  std::vector<float> xyz = kTriangle;
+  for (float& v : xyz) v *= 1e30f;  // finite as float, times 1e300 overflows a double
+  const int mesh = doc.Mesh("Tri", {{"attributes", {{"POSITION", doc.Positions(xyz)}}}});
+  doc.Scene({doc.Node({{"mesh", mesh}, {"scale", {1e300, 1e300, 1e300}}})});
+  const std::string path = doc.Write(MakeTempDir("scene"), "huge.gltf");
+  EXPECT_THAT(LoadError(path), HasSubstr("huge.gltf: mesh 'Tri' primitive 0: POSITION "));
+  EXPECT_THAT(LoadError(path), HasSubstr(" is not finite after the node transform"));
+}
+
 TEST(GltfSceneErrorTest, AccessorOutOfBufferBounds) {
   GltfDoc doc;
   const int view = doc.View(kTriangle);                         // 36 bytes

@@ -1,7 +1,7 @@
 // Live sources (issue 12), on loopback only: pose interpolation against exact motion, the
 // bounded newest-wins queue, back-pressure under a source faster than the painter, pose
-// feeds over TCP/UDP/named pipes (errors, reconnects), and the time-offset estimation on a
-// synthetic capture with a known offset.
+// feeds over TCP/UDP/named pipes (errors, reconnects), the time-offset estimation on a
+// synthetic capture with a known offset, and the session recorder's staged frames.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -9,21 +9,27 @@
 #include <unistd.h>
 
 #include <fcntl.h>
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
+#include <filesystem>
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_io.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/live/latest_queue.h"
 #include "pipeline/live/live_frames.h"
 #include "pipeline/live/pose_feed.h"
 #include "pipeline/live/pose_track.h"
+#include "pipeline/live/session_recorder.h"
 #include "pipeline/live/time_offset_estimation.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
@@ -307,6 +313,61 @@ TEST(PoseFeedTest, UdpDatagramsAndNamedPipe) {
 
 // The time-offset estimation on a synthetic hand-held capture whose tracker clock runs
 // `offset` ahead of the video's.
+// --record: frames are staged and swapped in whole by Finish; a recording that stops before
+// Finish leaves the earlier one in DIR as it was, and nothing of its own.
+TEST(SessionRecorderTest, FramesAppearOnlyWithFinishAndAStoppedRecordingLeavesTheEarlierOne) {
+  namespace fs = std::filesystem;
+  const std::string dir = testing::MakeTempDir("recorder") + "/rec";
+  auto entries = [](const std::string& folder) {
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(folder)) names.push_back(e.path().filename());
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  ASSERT_TRUE(MakeDirectories(dir + "/frames").ok());
+  testing::WriteText(dir + "/frames/old.png", "earlier recording");
+  testing::WriteText(dir + "/project.json", "{}");
+  Project project;
+  project.scene = "/abs/scene.gltf";
+  project.camera = "/abs/camera.cameramodel";
+  Frame frame;
+  frame.bgr = cv::Mat(4, 6, CV_8UC3, cv::Scalar(10, 20, 30));
+  frame.bgr.at<cv::Vec3b>(1, 2) = cv::Vec3b(200, 100, 50);
+  Rigid3d pose;
+  pose.translation = Eigen::Vector3d(1, 2, 3);
+  {
+    SessionRecorder stopped;  // e.g. Ctrl-C: destroyed without Finish
+    ASSERT_TRUE(stopped.Start(dir, project).ok());
+    ASSERT_TRUE(stopped.Add(frame, pose).ok());
+    EXPECT_EQ(entries(dir + "/frames"), std::vector<std::string>{"old.png"});
+  }
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"frames", "project.json"}));
+  EXPECT_EQ(entries(dir + "/frames"), std::vector<std::string>{"old.png"});
+
+  SessionRecorder recorder;
+  ASSERT_TRUE(recorder.Start(dir, project).ok());
+  for (int i = 0; i < 2; ++i) {
+    frame.timestamp_s = 0.5 * i;
+    ASSERT_TRUE(recorder.Add(frame, pose).ok());
+  }
+  EXPECT_EQ(entries(dir + "/frames"), std::vector<std::string>{"old.png"});
+  ASSERT_TRUE(recorder.Finish({Motion(0.0)}).ok());
+  EXPECT_EQ(entries(dir), (std::vector<std::string>{"frames", "poses.txt", "project.json",
+                                                    "tracker_poses.txt"}));
+  EXPECT_EQ(entries(dir + "/frames"), (std::vector<std::string>{"000000.png", "000001.png"}));
+  cv::Mat read;
+  ASSERT_TRUE(ReadImage(dir + "/frames/000001.png", &read).ok());
+  EXPECT_EQ(cv::norm(read, frame.bgr, cv::NORM_INF), 0.0);
+  std::vector<PosedImage> poses;
+  ASSERT_TRUE(ReadTumTrajectory(dir + "/poses.txt", &poses).ok());
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_DOUBLE_EQ(poses[1].timestamp_s, 0.5);
+  EXPECT_NEAR((poses[1].cam_from_world.translation - pose.translation).norm(), 0.0, 1e-9);
+  std::string text;
+  ASSERT_TRUE(ReadFileToString(dir + "/project.json", &text).ok());
+  EXPECT_THAT(text, HasSubstr("\"frames/\""));
+}
+
 TEST(TimeOffsetTest, RecoversAKnownOffsetWithinAFramePeriod) {
   CubeRoomOptions room;
   Scene scene;
@@ -346,6 +407,12 @@ TEST(TimeOffsetTest, RecoversAKnownOffsetWithinAFramePeriod) {
   ASSERT_TRUE(estimate.ok) << estimate.note;
   EXPECT_NEAR(estimate.offset_s, offset, 1.0 / fps);
   EXPECT_GT(estimate.contrast, 0.0);
+  // Every offset is scored once: the fine scan's ends and centre are coarse candidates.
+  for (size_t i = 0; i < estimate.candidates.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      EXPECT_GT(std::abs(estimate.candidates[i].offset_s - estimate.candidates[j].offset_s),
+                1e-9)
+          << "offset " << estimate.candidates[i].offset_s << " scored twice";
   // The score at the true offset is lower than one frame period away.
   const TimeOffsetCandidate at_truth =
       ScoreTimeOffset(frames, capture.camera, pose_at, offset, session.get());

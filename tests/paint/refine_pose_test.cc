@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/paint/refine_pose.h"
+#include "tests/paint/frontal_wall.h"
 
 namespace fresco {
 namespace {
@@ -132,13 +133,7 @@ TEST(RefinePose, OutliersDoNotDragTheFitAndTooFewMatchesFallBack) {
 // a pose change is the warp it stands for: warped texel p (seen through the given pose)
 // shows what the corrected pose puts at q = H p.
 TEST(RefinePose, BufferCorrectionIsTheWarpThePoseChangeMakes) {
-  BaseBuffer buffer;
-  buffer.texel_size_m = 0.01;
-  buffer.width = 200, buffer.height = 150;
-  buffer.origin = Eigen::Vector3d(-1.0, -0.75, 2.5);
-  buffer.axis_u = Eigen::Vector3d::UnitX();
-  buffer.axis_v = Eigen::Vector3d::UnitY();
-  buffer.normal = -Eigen::Vector3d::UnitZ();
+  const BaseBuffer buffer = FrontalWall(200, 150, 0.01, 2.5);
   for (const Camera& camera : {Pinhole(), Distorted()}) {
     const Rigid3d given(Rigid3d::QuaternionFromAxisAngle(Eigen::Vector3d(0.02, -0.03, 0.01)),
                         Eigen::Vector3d(0.05, 0, 0));

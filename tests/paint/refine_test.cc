@@ -8,6 +8,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/refine_alignment.h"
+#include "pipeline/paint/refine_pose.h"
+#include "tests/paint/frontal_wall.h"
 
 namespace fresco {
 namespace {
@@ -83,6 +85,8 @@ TEST(Refine, TranslationIsRecoveredSubTexelAndModelledAsTranslation) {
   EXPECT_NEAR(e.residual_before_px, std::hypot(1.7, 2.3), 0.2);
   EXPECT_LT(e.residual_after_px, 0.1);
   EXPECT_GE(e.inliers, 50);
+  // Texture that does not repeat: few matches dropped as ambiguous (random look-alikes).
+  EXPECT_LT(e.ambiguous, 0.05 * (e.matches + e.ambiguous)) << e.ambiguous << " of " << e.matches;
   // Warping again makes the frame agree with the buffer.
   Warped again{w.bgr.clone(), w.valid.clone(), w.quality.clone()};
   ApplyRefinement(e, cv::Rect(), &again.bgr, &again.valid, &again.quality);
@@ -209,6 +213,126 @@ TEST(Refine, DebugImagesHaveTheBufferSize) {
   EXPECT_EQ(DrawRefinementMatches(w.bgr, e).size(), w.bgr.size());
   const cv::Mat heat = ResidualHeatMap(w.bgr, w.valid, buffer, e.region);
   EXPECT_EQ(heat.size(), e.region.size());
+}
+
+// Repetitive buffers (issue 10): a texture that repeats with a period shorter than the search
+// window matches equally well one period away, so the nearest match may be the wrong one. A
+// shift of 0.6 period puts the wrong copy nearest (0.4 period the other way). Whatever the
+// shift, the estimate must be the true one or none, with the reason: never a whole period off.
+
+// Blurred noise repeated every `period` texels along x (and along y when period.height > 0).
+cv::Mat RepeatedNoise(cv::Size period, int width, int height, unsigned seed) {
+  cv::Mat tile(period.height > 0 ? period.height : height, period.width, CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(tile, cv::RNG::UNIFORM, 0, 255);
+  cv::Mat noise, blurred, bgra;
+  cv::repeat(tile, height / tile.rows + 1, width / tile.cols + 1, noise);
+  cv::GaussianBlur(noise, blurred, cv::Size(0, 0), 1.2);  // of a periodic image: periodic
+  cv::normalize(blurred(cv::Rect(0, 0, width, height)), blurred, 0, 255, cv::NORM_MINMAX);
+  cv::cvtColor(blurred, bgra, cv::COLOR_BGR2BGRA);
+  return bgra;
+}
+
+// Bricks 12 x 6 texels, rows staggered by half a brick, mortar 1 texel: periods (12, 0), (6, 6).
+cv::Mat Bricks(int width, int height) {
+  cv::Mat image(height, width, CV_8UC3, cv::Scalar(70, 80, 90));
+  for (int row = 0; row * 6 < height; ++row)
+    for (int x = (row % 2) * 6 - 12; x < width; x += 12)
+      cv::rectangle(image, cv::Rect(x + 1, row * 6 + 1, 11, 5), cv::Scalar(60, 90, 170), cv::FILLED);
+  cv::Mat blurred, bgra;
+  cv::GaussianBlur(image, blurred, cv::Size(0, 0), 0.7);
+  cv::cvtColor(blurred, bgra, cv::COLOR_BGR2BGRA);
+  return bgra;
+}
+
+const char kAmbiguous[] = "repetitive texture: matches ambiguous within the search window";
+
+RefineOptions WithMode(RefineMode mode) {
+  RefineOptions o;
+  o.mode = mode;
+  return o;
+}
+
+TEST(Refine, RepetitiveTextureIsRegisteredTrulyOrRefusedNeverAPeriodOff) {
+  struct Buffer {
+    const char* name;
+    cv::Mat bgra;
+    double period_x;
+  };
+  const Buffer buffers[] = {
+      {"columns of period 8", RepeatedNoise(cv::Size(8, 0), 320, 240, 11), 8},
+      {"tiles of 10 x 10", RepeatedNoise(cv::Size(10, 10), 320, 240, 12), 10},
+      {"bricks 12 x 6", Bricks(320, 240), 12},
+  };
+  for (const Buffer& buffer : buffers) {
+    for (const RefineMode mode : {RefineMode::kPaper, RefineMode::kRobust}) {
+      // Paper mode matches whole texels: half a texel of rounding on top of the interpolation.
+      const double tolerance = mode == RefineMode::kPaper ? 0.6 : 0.3;
+      for (const double fraction : {0.2, 0.45, 0.6}) {
+        const cv::Matx33d truth(1, 0, fraction * buffer.period_x, 0, 1, 0.4, 0, 0, 1);
+        const Warped w = MakeWarped(buffer.bgra, truth);
+        const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer.bgra, WithMode(mode));
+        const std::string what = std::string(buffer.name) +
+                                 (mode == RefineMode::kPaper ? ", paper" : ", robust") +
+                                 ", shift " + std::to_string(fraction) + " period";
+        if (e.applied) {
+          EXPECT_LT(MaxDifference(e.buffer_from_warped, truth, e.region), tolerance) << what;
+        } else {
+          EXPECT_FALSE(e.registered) << what;  // no sample for the anchor either
+          EXPECT_EQ(e.fallback, kAmbiguous) << what;
+        }
+      }
+    }
+  }
+}
+
+TEST(Refine, RepetitionLongerThanTheSearchWindowIsStillRegistered) {
+  // Period 32: one copy only within +-12 texels of the shift, so nothing is ambiguous.
+  const cv::Mat buffer = RepeatedNoise(cv::Size(32, 32), 320, 240, 13);
+  const cv::Matx33d truth(1, 0, 6.4, 0, 1, -2.2, 0, 0, 1);
+  const Warped w = MakeWarped(buffer, truth);
+  for (const RefineMode mode : {RefineMode::kPaper, RefineMode::kRobust}) {
+    const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, buffer, WithMode(mode));
+    ASSERT_TRUE(e.applied) << e.fallback;
+    EXPECT_LT(MaxDifference(e.buffer_from_warped, truth, e.region),
+              mode == RefineMode::kPaper ? 0.6 : 0.3);
+    EXPECT_EQ(e.ambiguous, 0);
+  }
+}
+
+// The pose path: a 3.2 m x 2.4 m wall at 1 cm texels, 2.5 m in front of the camera, in
+// columns of period 8 texels; the pose is off by a rotation that shifts the wall by 0.2, 0.45
+// and 0.6 period (more towards the sides: perspective). Unchecked, the 0.6 case gave a pose
+// correction (rotation + translation) that put the wall 8.0 texels off: one period.
+TEST(Refine, RepetitiveWallGivesNoPoseCorrectionAPeriodOff) {
+  const BaseBuffer wall = FrontalWall(320, 240, 0.01, 2.5);
+  const Camera camera = Camera::FromParams(LensModel::kPinhole, 320, 240, {228, 228, 159.5, 119.5});
+  const Rigid3d given;
+  const cv::Mat texture = RepeatedNoise(cv::Size(8, 0), wall.width, wall.height, 14);
+  for (const double fraction : {0.2, 0.45, 0.6}) {
+    // About y: 1 rad moves the wall by 2.5 m = 250 texels.
+    const Rigid3d truth(
+        Rigid3d::QuaternionFromAxisAngle(Eigen::Vector3d(0, fraction * 8 / 250.0, 0)),
+        Eigen::Vector3d::Zero());
+    cv::Matx33d H;
+    ASSERT_TRUE(BufferCorrectionFromPose(wall, camera, given, truth * given,
+                                         cv::Rect(0, 0, wall.width, wall.height), &H));
+    const Warped w = MakeWarped(texture, H);
+    const RefineEstimate e = EstimateRefinement(w.bgr, w.valid, texture, Robust());
+    std::vector<PoseMatch> matches;
+    AppendPoseMatches(wall, camera, given, e, &matches);
+    const PoseCorrection pose = EstimatePoseCorrection(matches, camera, given, Robust());
+    if (pose.applied) {  // the wall's correction from the pose: where it puts the texture
+      cv::Matx33d from_pose;
+      ASSERT_TRUE(BufferCorrectionFromPose(wall, camera, given, pose.delta * given,
+                                           cv::Rect(0, 0, wall.width, wall.height), &from_pose));
+      EXPECT_LT(MaxDifference(from_pose, H, cv::Rect(0, 0, wall.width, wall.height)), 0.3)
+          << fraction << ": " << pose.model;
+    } else {
+      EXPECT_FALSE(pose.fallback.empty());
+      EXPECT_EQ(e.fallback, kAmbiguous) << fraction;
+    }
+  }
 }
 
 }  // namespace

@@ -3,8 +3,13 @@
 // project edits (undo/redo, save, grouping edits) and that `fresco run` honours them; and,
 // when xvfb-run is there, a real screenshot of the GL app.
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <imgui.h>
@@ -13,46 +18,28 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/report.h"
+#include "pipeline/core/poses.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/core/run_process.h"
+#include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
+#include "tests/ui/headless_ui.h"
 #include "ui/core/app_frame.h"
 #include "ui/core/calibration_runner.h"
 #include "ui/core/panel.h"
+#include "ui/core/poses_runner.h"
 #include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ImGuiHeadless;
 using testing::MakeTempDir;
+using testing::NullTextures;
+using testing::NullViewport;
 using testing::ReadText;
 using testing::RunFresco;
-
-class NullTextures : public ImageTextures {
- public:
-  ImTextureID Get(const std::string& key, const cv::Mat& image, uint64_t) override {
-    ++requests;
-    keys.insert(key);
-    EXPECT_FALSE(image.empty()) << key;
-    return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(1));
-  }
-  int requests = 0;
-  std::set<std::string> keys;
-};
-
-class NullViewport : public ViewportRenderer {
- public:
-  ImTextureID Render(const RunnerSnapshot& snapshot, const AppState&, ViewportView* view, int w,
-                     int h) override {
-    ++renders;
-    EXPECT_TRUE(snapshot.geometry != nullptr);
-    EXPECT_GT(w, 0);
-    EXPECT_GT(h, 0);
-    view->target_set = true;
-    return reinterpret_cast<ImTextureID>(static_cast<intptr_t>(2));
-  }
-  int Pick(int, int) override { return 0; }
-  int renders = 0;
-};
 
 // A 12-frame capture of the cube room, made once.
 std::string Capture() {
@@ -65,25 +52,6 @@ std::string Capture() {
   }();
   return dir;
 }
-
-struct ImGuiHeadless {
-  ImGuiHeadless() {
-    ImGui::CreateContext();
-    ImGuiIO& io = ImGui::GetIO();
-    io.DisplaySize = ImVec2(1600, 1000);
-    io.DeltaTime = 1.0f / 60;
-    io.IniFilename = nullptr;
-    unsigned char* pixels = nullptr;
-    int w = 0, h = 0;
-    io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);  // a font atlas, no texture upload
-  }
-  ~ImGuiHeadless() { ImGui::DestroyContext(); }
-  void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
-    ImGui::NewFrame();
-    DrawAppFrame(ui, panels);
-    ImGui::Render();
-  }
-};
 
 TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   AppState state;
@@ -279,7 +247,7 @@ TEST(UiScreenshot, XvfbScreenshotShowsEveryPanel) {
   ASSERT_GE(list["panels"].size(), 11u);
   for (const auto& panel : list["panels"]) {
     const std::string title = panel["title"];
-    if (title == kCalibrationPanelTitle) {  // closed without --calib-images
+    if (title == kCalibrationPanelTitle || title == kPosesPanelTitle) {  // closed at first
       EXPECT_FALSE(panel["open"].get<bool>());
       continue;
     }
@@ -403,12 +371,7 @@ TEST(CalibrationRunner, AprilGridDetectsSolvesAndThePanelShowsIt) {
   for (auto& p : MakePanels())
     if (std::string(p->Title()) == kCalibrationPanelTitle) panel = std::move(p);
   ASSERT_TRUE(panel);
-  for (int i = 0; i < 3; ++i) {
-    ImGui::NewFrame();
-    ImGui::SetNextWindowSize(ImVec2(900, 2400));
-    panel->Draw(ui);
-    ImGui::Render();
-  }
+  for (int i = 0; i < 3; ++i) ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(900, 2400));
   for (const char* key : {"calibration image", "calibration coverage", "calibration residuals",
                           "calibration uncertainty"})
     EXPECT_TRUE(textures.keys.count(key)) << key;
@@ -467,6 +430,205 @@ TEST(UiCli, CalibImagesNeedsAValidBoard) {
   r = RunFresco({"gui", "--calib-images", "/tmp"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("--board"), std::string::npos) << r.err;
+}
+
+// The Poses panel's worker with the real `colmap` (skipped when it is not on PATH), on the
+// capture of tests/poses/poses_colmap_test.cc with 10 frames instead of 16 (`builtin:blocks`,
+// a half orbit; exhaustive matching takes a third of the time) whose given poses are wrong on
+// frames 3 and 7 (1 deg) and 5 and 7 (2 % of the scene):
+// the run publishes its COLMAP steps, the table flags exactly those frames, "next flagged"
+// moves the pipeline to each in turn, the bootstrapped poses (close to the truth) are applied
+// as an undoable edit, and `fresco gui --poses bootstrap --poses-model` shows it all under
+// Xvfb. COLMAP runs once here; a second run is cancelled during feature extraction.
+TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
+  if (FindProgram("colmap").empty())
+    GTEST_SKIP() << "`colmap` is not on PATH (Debian package colmap): skipped";
+  constexpr int kFrames = 10;
+  const std::string dir = MakeTempDir("ui-poses");
+  const std::string capture = dir + "/capture";
+  auto r = RunFresco({"synth", "--scene", "builtin:blocks", "--out", capture, "--frames",
+                      std::to_string(kFrames),
+                      "--size", "480x360", "--supersample", "2", "--seed", "3", "--path", "orbit",
+                      "--set", "path.turns=0.5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Scene scene;
+  ASSERT_TRUE(LoadGltfScene(capture + "/scene.gltf", SceneLoadOptions(), &scene).ok());
+  Eigen::Vector3d lo, hi;
+  scene.Bounds(&lo, &hi);
+  const double scene_size_m = (hi - lo).norm();
+  std::vector<PosedImage> truth, given;
+  ASSERT_TRUE(ReadColmapImages(capture + "/truth/images.txt", &truth).ok());
+  ASSERT_EQ(truth.size(), static_cast<size_t>(kFrames));
+  given = truth;
+  const std::set<int> rotated = {3, 7}, moved = {5, 7};
+  for (int i = 0; i < kFrames; ++i)
+    given[i].cam_from_world = testing::Perturbed(
+        truth[i].cam_from_world, rotated.count(i) ? 1.0 : 0.0,
+        moved.count(i) ? 0.02 * scene_size_m : 0.0, Eigen::Vector3d(1, -2, 0.5 + i));
+  ASSERT_TRUE(WriteColmapImages(capture + "/sparse/images.txt", given).ok());
+
+  AppState state;
+  ASSERT_TRUE(state.Open(capture + "/project.json").ok());
+  const Project before = state.project;
+  PipelineRunner runner;
+  runner.Restart(state.project);
+  runner.WaitIdle();
+  PosesRunner poses;
+  PosesRequest request;
+  request.project = state.project;
+  request.out_dir = dir + "/poses";
+  request.colmap.colmap.threads = 2;
+  NullTextures textures;
+  UiContext ui{&state, &runner, nullptr, &textures, nullptr, nullptr, false, &poses};
+  ImGuiHeadless imgui;
+  std::unique_ptr<Panel> panel;
+  for (auto& p : MakePanels())
+    if (std::string(p->Title()) == kPosesPanelTitle) panel = std::move(p);
+  ASSERT_TRUE(panel);
+  EXPECT_FALSE(panel->open);  // opened from the View menu
+  panel->open = true;
+  poses.Run(request);
+  // The UI thread is never blocked: the panel, drawn headless while COLMAP runs, shows the
+  // steps as they come.
+  std::set<std::string> shown;
+  while (true) {
+    const bool busy = poses.Snapshot()->busy || !poses.Snapshot()->has_request;
+    ui.snapshot = runner.Snapshot();
+    ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(1280, 955));
+    shown.insert(panel->Report().at("status"));
+    if (!busy) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  poses.WaitIdle();
+  auto snap = poses.Snapshot();
+  ASSERT_TRUE(snap->verified) << snap->status << " " << snap->verify_error;
+  EXPECT_TRUE(shown.count("colmap 1/4: feature_extractor")) << shown.size();
+  EXPECT_TRUE(shown.count("colmap 3/4: mapper")) << shown.size();
+  EXPECT_EQ(snap->registered, kFrames);
+  ASSERT_EQ(snap->verify.frames.size(), static_cast<size_t>(kFrames));
+  std::set<int> flagged;
+  for (size_t i = 0; i < snap->verify.frames.size(); ++i)
+    if (snap->verify.frames[i].flagged) flagged.insert(snap->frame_index[i]);
+  EXPECT_EQ(flagged, (std::set<int>{3, 5, 7}));
+  for (int i : rotated) EXPECT_NEAR(snap->verify.frames[i].rotation_error_deg, 1.0, 0.2) << i;
+  for (int i : moved)
+    EXPECT_NEAR(snap->verify.frames[i].position_error_m, 0.02 * scene_size_m,
+                0.002 * scene_size_m)
+        << i;
+  EXPECT_TRUE(fs::is_regular_file(dir + "/poses/verify.json"));  // as `fresco poses verify`
+  EXPECT_TRUE(fs::is_regular_file(dir + "/poses/colmap/commands.txt"));
+  // Clean frames agree well inside the thresholds (0.5 deg, 1 % of the scene).
+  EXPECT_LT(snap->verify.max_unflagged_rotation_error_deg, 0.25);
+  EXPECT_LT(snap->verify.max_unflagged_position_error_m, 0.005 * scene_size_m);
+  std::cout << "poses runner: clean frames within " << snap->verify.max_unflagged_rotation_error_deg
+            << " deg, " << snap->verify.max_unflagged_position_error_m << " m; colmap "
+            << snap->colmap_seconds << " s;";
+  for (const auto& [step, seconds] : snap->step_seconds) std::cout << " " << step << " " << seconds;
+  std::cout << "\n";
+
+  // The panel: "next flagged" moves the pipeline to 3, then 5, then 7.
+  for (int i = 0; i < 2; ++i) {
+    ui.snapshot = runner.Snapshot();
+    ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(1280, 955));
+  }
+  EXPECT_EQ(panel->Report().at("flagged_frames"), "3,5,7");
+  EXPECT_EQ(panel->Report().at("registered"), std::to_string(kFrames));
+  for (int expected : {3, 5, 7}) {
+    float x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    std::istringstream(panel->Report().at("next_flagged_button")) >> x0 >> y0 >> x1 >> y1;
+    ASSERT_GT(x1, x0);
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = ImVec2((x0 + x1) / 2, (y0 + y1) / 2);
+    for (bool down : {false, true, false}) {  // hover, press, release: a click
+      io.MouseDown[0] = down;
+      ui.snapshot = runner.Snapshot();
+      ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(1280, 955));
+    }
+    io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);
+    runner.WaitIdle();
+    EXPECT_EQ(runner.Snapshot()->frame, expected);
+    EXPECT_EQ(panel->Report().at("selected_frame"), std::to_string(expected));
+  }
+
+  // Apply: the project points at the bootstrapped poses (an undoable, dirty edit).
+  ASSERT_TRUE(snap->bootstrapped) << snap->bootstrap_error;
+  EXPECT_EQ(snap->aligned_with, "given_poses");
+  EXPECT_FALSE(state.dirty);
+  ASSERT_TRUE(ApplyBootstrappedPoses(*snap, &state).ok());
+  EXPECT_TRUE(state.dirty);
+  EXPECT_EQ(state.project.poses, snap->bootstrap_poses);
+  EXPECT_EQ(fs::canonical(state.project.Resolve(state.project.poses)),
+            fs::canonical(dir + "/poses/sparse/images.txt"));
+  std::vector<PosedImage> bootstrapped;
+  ASSERT_TRUE(ReadColmapImages(state.project.Resolve(state.project.poses), &bootstrapped).ok());
+  ASSERT_EQ(bootstrapped.size(), static_cast<size_t>(kFrames));
+  double worst_deg = 0, worst_m = 0;
+  for (const PosedImage& b : bootstrapped) {
+    const auto t = std::find_if(truth.begin(), truth.end(),
+                                [&](const PosedImage& p) { return p.name == b.name; });
+    ASSERT_NE(t, truth.end()) << b.name;
+    worst_deg = std::max(
+        worst_deg, RotationDifferenceDeg(b.cam_from_world.rotation, t->cam_from_world.rotation));
+    worst_m = std::max(worst_m, (b.cam_from_world.Centre() - t->cam_from_world.Centre()).norm());
+  }
+  EXPECT_LT(worst_deg, 0.2);  // the injected errors are gone
+  EXPECT_LT(worst_m, 0.01 * scene_size_m);
+  std::cout << "bootstrap applied: worst " << worst_deg << " deg, " << worst_m << " m of "
+            << scene_size_m << " m\n";
+  ui.snapshot = runner.Snapshot();
+  ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(1280, 955));
+  EXPECT_EQ(panel->Report().at("applied"), "true");
+  ASSERT_TRUE(state.Undo());
+  EXPECT_EQ(state.project, before);
+  // Another project open: the bootstrap does not apply to it.
+  PosesSnapshot other = *snap;
+  other.request.project.file_path = dir + "/other.json";
+  EXPECT_FALSE(ApplyBootstrappedPoses(other, &state).ok());
+
+  // A second run, cancelled while COLMAP runs.
+  request.out_dir = dir + "/cancelled";
+  poses.Run(request);
+  while (true) {  // until COLMAP runs (or the run ended)
+    const auto s = poses.Snapshot();
+    if (s->request.out_dir == request.out_dir && (s->steps > 0 || !s->busy)) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  poses.Cancel();
+  poses.WaitIdle();
+  EXPECT_EQ(poses.Snapshot()->status, "cancelled");
+  EXPECT_FALSE(poses.Snapshot()->reconstructed);
+
+  // The GL app under Xvfb on the same reconstruction: the panel open with the table.
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) return;
+  const std::string shot = dir + "/poses.png";
+  r = RunFresco({"--xvfb", "gui", capture + "/project.json", "--poses", "bootstrap",
+                 "--poses-out", dir + "/gui", "--poses-model", dir + "/poses/colmap/sparse_txt/0",
+                 "--frames", "5", "--screenshot", shot});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(cv::imread(shot).empty());
+  const nlohmann::json list = nlohmann::json::parse(ReadText(shot + ".json"));
+  int found = 0;
+  for (const auto& p : list["panels"]) {
+    if (p["title"] != kPosesPanelTitle) continue;
+    ++found;
+    ASSERT_TRUE(p["open"].get<bool>());
+    EXPECT_EQ(p["state"]["flagged_frames"], "3,5,7") << p.dump();
+    EXPECT_EQ(p["state"]["applied"], "true") << p.dump();
+  }
+  EXPECT_EQ(found, 1);
+}
+
+TEST(UiCli, PosesNeedsAProjectAndAKnownMode) {
+  auto r = RunFresco({"gui", "--poses", "verify"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("PROJECT"), std::string::npos) << r.err;
+  r = RunFresco({"gui", Capture() + "/project.json", "--poses", "check"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("verify or bootstrap"), std::string::npos) << r.err;
+  r = RunFresco({"gui", Capture() + "/project.json", "--poses", "verify", "--poses-model",
+                 "/no/such/model"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("/no/such/model"), std::string::npos) << r.err;
 }
 
 }  // namespace

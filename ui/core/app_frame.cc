@@ -115,6 +115,10 @@ void DrawStatusBar(UiContext& ui) {
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
   ImGui::TextUnformatted(ui.state->message.c_str());
+  if (const std::string& problem = ui.snapshot->live.problem; !problem.empty()) {
+    ImGui::SameLine();  // a live source that stalled, dropped or ended
+    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "  live: %s", problem.c_str());
+  }
   ImGui::End();
 }
 
@@ -125,10 +129,12 @@ void RequestOpen(UiContext& ui, const std::string& path) { ui.state->pending_ope
 void UndoRedo(UiContext& ui, bool undo) {
   const GroupingOptions before = ui.state->project.grouping;
   const double texel_before = ui.state->project.pipeline.texel_size_m;
+  const std::string poses_before = ui.state->project.poses;
   if (!(undo ? ui.state->Undo() : ui.state->Redo())) return;
-  // A grouping change shows only once the session is rebuilt.
+  // A grouping or poses change (Poses panel) shows only once the session is rebuilt.
   if (!(before == ui.state->project.grouping) ||
-      texel_before != ui.state->project.pipeline.texel_size_m)
+      texel_before != ui.state->project.pipeline.texel_size_m ||
+      poses_before != ui.state->project.poses)
     ApplyProject(ui);
 }
 

@@ -17,6 +17,7 @@
 #include "ui/core/app_state.h"
 #include "ui/core/calibration_runner.h"
 #include "ui/core/pipeline_runner.h"
+#include "ui/core/poses_runner.h"
 
 namespace fresco {
 
@@ -58,6 +59,7 @@ struct UiContext {
   ViewportRenderer* viewport = nullptr;
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
   bool request_quit = false;
+  PosesRunner* poses = nullptr;  // the COLMAP worker (Poses panel)
 };
 
 class Panel {
@@ -78,6 +80,9 @@ std::vector<std::unique_ptr<Panel>> MakePanels();
 // Helpers for panels.
 // Starts the panel's window at its default place the first time (scaled to the display).
 bool BeginPanel(Panel& panel);
+// The same for a large window over other panels (opaque) that shows a worker: false, with
+// the window already ended, when it is collapsed or there is no worker (it says so).
+bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker);
 // An image scaled to fit `max_width` (0 = the available width), keeping its aspect.
 void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,
                float max_width = 0);

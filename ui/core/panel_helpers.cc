@@ -14,6 +14,20 @@ bool BeginPanel(Panel& panel) {
   return ImGui::Begin(panel.Title(), &panel.open);
 }
 
+bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker) {
+  ImGui::SetNextWindowBgAlpha(1.0f);
+  if (!BeginPanel(panel)) {
+    ImGui::End();
+    return false;
+  }
+  if (!has_worker) {
+    ImGui::TextDisabled("(no %s)", worker);
+    ImGui::End();
+    return false;
+  }
+  return true;
+}
+
 void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,
                float max_width) {
   if (image.empty()) {

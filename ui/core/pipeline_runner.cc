@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/capture.h"
+#include "pipeline/live/live_input.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/render/renderer.h"
@@ -18,10 +19,13 @@ struct PipelineRunner::Session {
   Project project;
   Capture capture;
   std::unique_ptr<PaintSession> paint;
-  std::unique_ptr<Renderer> review;  // half-size renderer for the misalignment review
+  std::unique_ptr<LiveSession> live;  // live sources (reads capture and paint: after them)
+  std::unique_ptr<Renderer> review;   // half-size renderer for the misalignment review
   Camera review_camera;
-  int next_frame = 0;  // index of the next frame to read
+  int next_frame = 0;  // index of the next frame to read (live: frames taken so far)
   bool ended = false;
+  std::string end_message;  // the status once ended ("end of video", "error: ...")
+  long long frames_painted = 0;
 };
 
 namespace {
@@ -60,7 +64,7 @@ PipelineRunner::~PipelineRunner() {
     std::lock_guard<std::mutex> lock(mutex_);
     queue_.clear();
   }
-  Post({Command::kQuit, {}, 0});
+  Post({Command::kQuit, {}, 0, {}});
   thread_.join();
 }
 
@@ -72,11 +76,12 @@ void PipelineRunner::Post(Command command) {
   wake_.notify_all();
 }
 
-void PipelineRunner::Restart(const Project& project) { Post({Command::kRestart, project, 0}); }
-void PipelineRunner::Play() { Post({Command::kPlay, {}, 0}); }
-void PipelineRunner::Pause() { Post({Command::kPause, {}, 0}); }
-void PipelineRunner::Step() { Post({Command::kStep, {}, 0}); }
-void PipelineRunner::Seek(int frame) { Post({Command::kSeek, {}, frame}); }
+void PipelineRunner::Restart(const Project& project) { Post({Command::kRestart, project, 0, {}}); }
+void PipelineRunner::Play() { Post({Command::kPlay, {}, 0, {}}); }
+void PipelineRunner::Pause() { Post({Command::kPause, {}, 0, {}}); }
+void PipelineRunner::Step() { Post({Command::kStep, {}, 0, {}}); }
+void PipelineRunner::Seek(int frame) { Post({Command::kSeek, {}, frame, {}}); }
+void PipelineRunner::Record(const std::string& dir) { Post({Command::kRecord, {}, 0, dir}); }
 
 void PipelineRunner::WaitIdle() {
   std::unique_lock<std::mutex> lock(mutex_);
@@ -96,9 +101,27 @@ void PipelineRunner::OpenSession(const Project& project) {
   working_.geometry_version = geometry_version;
   auto s = std::make_unique<Session>();
   s->project = project;
-  if (Status st = OpenPaintSession(project, &s->capture, &s->paint); !st.ok()) {
+  const bool live = IsLiveProject(project);
+  CaptureLoadOptions load_options;
+  load_options.open_video = !live;  // a live video opens after the pose feed connects
+  if (Status st = OpenPaintSession(project, load_options, &s->capture, &s->paint); !st.ok()) {
     working_.status = "error: " + st.message();
     return;
+  }
+  if (live) {
+    LiveStatus& l = working_.live;
+    l.active = true;
+    l.state = "connecting";
+    l.video = project.Resolve(project.video);
+    l.poses = project.Resolve(project.poses);
+    working_.status = "connecting to " + l.video + " and " + l.poses;
+    Publish(false);  // opening waits for the sources (up to their timeouts)
+    if (Status st = LiveSession::Open(project, s->capture, *s->paint, &s->live); !st.ok()) {
+      working_.status = "error: " + st.message();
+      l.state = "error";
+      l.problem = working_.status;
+      return;
+    }
   }
   auto geometry = std::make_shared<SessionGeometry>();
   geometry->painted_layout = s->paint->PaintedScene();
@@ -109,7 +132,7 @@ void PipelineRunner::OpenSession(const Project& project) {
     geometry->buffer_texels.push_back(b.num_surface_texels);
   for (const PosedImage& p : s->capture.poses) geometry->path.push_back(p.cam_from_world);
   geometry->camera = s->capture.cameras.begin()->second;
-  geometry->num_frames = s->capture.video->FrameCount();
+  geometry->num_frames = live ? -1 : s->capture.video->FrameCount();
   geometry->texel_size_m = s->paint->default_texel_size_m();
   geometry->folds_split = s->paint->folds_split();
   working_.geometry = geometry;
@@ -125,35 +148,59 @@ void PipelineRunner::OpenSession(const Project& project) {
   session_ = std::move(s);
 }
 
-bool PipelineRunner::PaintNext(bool show) {
-  if (!session_ || session_->ended) return false;
+PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
+  if (!session_ || session_->ended) return Painted::kEnded;
   Session& s = *session_;
-  Frame frame;
-  Status read;
-  if (!s.capture.video->Next(&frame, &read)) {
-    s.ended = true;
-    working_.status = read.ok() ? "end of video" : "error: " + read.message();
-    return false;
+  PosedFrame posed;
+  const Camera* camera = nullptr;
+  if (s.live) {
+    std::string end;
+    const LiveSession::Poll poll = s.live->Next(options_.live_poll_ms, &posed, &end);
+    if (poll == LiveSession::Poll::kWaiting) return Painted::kWaiting;
+    if (poll == LiveSession::Poll::kEnded) {
+      s.ended = true;
+      s.end_message = end;
+      std::string recorded;
+      if (s.live->recording()) s.live->StopRecording(&recorded);  // errors: in its status
+      return Painted::kEnded;
+    }
+    camera = &s.live->camera();
+  } else {
+    Status read;
+    if (!s.capture.video->Next(&posed.frame, &read)) {
+      s.ended = true;
+      s.end_message = read.ok() ? "end of video" : "error: " + read.message();
+      return Painted::kEnded;
+    }
+    const PosedImage* pose = s.capture.PoseForFrame(posed.frame);
+    camera = pose ? s.capture.CameraFor(*pose) : nullptr;
+    posed.has_pose = pose && camera;
+    if (pose) posed.cam_from_world = pose->cam_from_world;
   }
+  const Frame& frame = posed.frame;
   ++s.next_frame;
   working_.frame = frame.index;
   working_.frame_name = frame.name;
-  const PosedImage* pose = s.capture.PoseForFrame(frame);
-  const Camera* camera = pose ? s.capture.CameraFor(*pose) : nullptr;
   working_.has_pose =
-      pose && camera && frame.bgr.cols == camera->width && frame.bgr.rows == camera->height;
+      posed.has_pose && frame.bgr.cols == camera->width && frame.bgr.rows == camera->height;
   if (show) working_.frame_bgr = frame.bgr.clone();
   if (!working_.has_pose) {
     working_.report = FrameReport();
     working_.report.frame = frame.index;
-    working_.report.skipped_reason = pose ? "frame size differs from the camera" : "no pose";
-    return true;
+    working_.report.skipped_reason =
+        posed.has_pose ? "frame size differs from the camera" : "no pose";
+    return Painted::kFrame;
   }
-  working_.cam_from_world = pose->cam_from_world;
+  if (s.live) {
+    s.live->Record(posed);
+    working_.live_path.push_back(posed.cam_from_world);
+    TrimHistory(RunnerSnapshot::kLivePathFrames, &working_.live_path);
+  }
+  working_.cam_from_world = posed.cam_from_world;
   // Review: the painted model, as it stands before this frame, seen from this frame.
   if (show && s.review && s.paint->NumPaintedSurfaceTexels() > 0) {
     RenderOutput out;
-    s.review->Render(s.paint->PaintedScene(), pose->cam_from_world, &out);
+    s.review->Render(s.paint->PaintedScene(), posed.cam_from_world, &out);
     cv::Mat small, rephoto, grey_frame, grey_rephoto, diff;
     cv::resize(frame.bgr, small, out.rgba.size(), 0, 0, cv::INTER_AREA);
     cv::cvtColor(out.rgba, rephoto, cv::COLOR_RGBA2BGR);
@@ -175,8 +222,9 @@ bool PipelineRunner::PaintNext(bool show) {
     working_.difference_heat.release();
   }
   s.paint->set_debug_images(show && options_.debug_images);
-  s.paint->PaintFrame(frame, *camera, pose->cam_from_world, &working_.report);
+  s.paint->PaintFrame(frame, *camera, posed.cam_from_world, &working_.report);
   if (working_.report.painted) {
+    ++s.frames_painted;
     working_.frames_painted.push_back(frame.index);
     for (const StageReport& st : working_.report.stages)
       working_.stage_ms[st.name].push_back(static_cast<float>(st.wall_ms));
@@ -201,13 +249,30 @@ bool PipelineRunner::PaintNext(bool show) {
     for (auto& [stage, ms] : working_.stage_ms) TrimHistory(keep, &ms);
   }
   working_.coverage = s.paint->Coverage();
-  return true;
+  return Painted::kFrame;
+}
+
+void PipelineRunner::SetRecording(const std::string& dir) {
+  if (!session_ || !session_->live) return;  // the panel offers Record for live sources only
+  LiveSession& live = *session_->live;
+  std::string recorded;
+  if (dir.empty()) {
+    if (live.recording()) live.StopRecording(&recorded);  // errors: in its status
+  } else if (!session_->ended) {
+    live.StartRecording(dir);
+  }
 }
 
 void PipelineRunner::Publish(bool with_painted) {
   working_.playing = playing_;
-  if (working_.status.rfind("error", 0) != 0 && working_.status != "end of video")
-    working_.status = playing_ ? "playing" : "paused";
+  if (session_) {  // without one, the status says why (no project, error, connecting)
+    working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
+    if (session_->live) {
+      working_.live = session_->live->CurrentStatus();
+      working_.live.frames_painted = session_->frames_painted;
+      if (!session_->ended) working_.status += " (live: " + working_.live.state + ")";
+    }
+  }
   if (with_painted && session_) {
     auto painted = std::make_shared<std::vector<cv::Mat>>();
     for (const PaintedBuffer& p : session_->paint->painted()) painted->push_back(p.bgra.clone());
@@ -223,13 +288,18 @@ void PipelineRunner::Publish(bool with_painted) {
 void PipelineRunner::Loop() {
   auto last_publish = Clock::now();
   for (;;) {
-    Command command{Command::kPause, {}, -1};
+    Command command{Command::kPause, {}, -1, {}};
     bool have_command = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       busy_ = playing_ || seek_target_ >= 0;
       if (queue_.empty() && !busy_) idle_.notify_all();
-      wake_.wait(lock, [this] { return !queue_.empty() || playing_ || seek_target_ >= 0; });
+      const auto ready = [this] { return !queue_.empty() || playing_ || seek_target_ >= 0; };
+      // Paused on a live source: wake up now and then to publish the sources' state.
+      if (session_ && session_->live && !session_->ended)
+        wake_.wait_for(lock, std::chrono::milliseconds(options_.publish_interval_ms), ready);
+      else
+        wake_.wait(lock, ready);
       if (!queue_.empty()) {
         command = std::move(queue_.front());
         queue_.pop_front();
@@ -257,12 +327,22 @@ void PipelineRunner::Loop() {
           break;
         case Command::kStep:
           playing_ = false;
+          if (session_ && session_->live) {  // waits for the next frame (as a seek)
+            seek_target_ = session_->ended ? -1 : session_->next_frame;
+            if (seek_target_ < 0) Publish(false);
+            break;
+          }
           PaintNext(true);
           Publish(true);
           break;
+        case Command::kRecord:
+          SetRecording(command.path);
+          Publish(false);
+          break;
         case Command::kSeek:
           playing_ = false;
-          if (session_ && command.frame < session_->next_frame) {
+          // A live source cannot go back: only forward seeks (paint N more frames) apply.
+          if (session_ && !session_->live && command.frame < session_->next_frame) {
             const Project project = session_->project;
             OpenSession(project);
           }
@@ -273,24 +353,32 @@ void PipelineRunner::Loop() {
       }
       continue;
     }
+    const bool due =
+        Clock::now() - last_publish >= std::chrono::milliseconds(options_.publish_interval_ms);
     if (seek_target_ >= 0) {
       const bool last = session_->next_frame >= seek_target_;
-      if (!PaintNext(last) || last) {
+      const Painted painted = PaintNext(last);
+      if (painted == Painted::kEnded || (painted == Painted::kFrame && last)) {
         seek_target_ = -1;
         Publish(true);
+      } else if (painted == Painted::kWaiting && due) {
+        Publish(false);
+        last_publish = Clock::now();
       }
       continue;
     }
     if (playing_) {
-      const bool show =
-          Clock::now() - last_publish >= std::chrono::milliseconds(options_.publish_interval_ms);
-      if (!PaintNext(show)) {
+      const Painted painted = PaintNext(due);
+      if (painted == Painted::kEnded) {
         playing_ = false;
         Publish(true);
-      } else if (show) {
-        Publish(true);
+      } else if (due) {
+        Publish(painted == Painted::kFrame);
         last_publish = Clock::now();
       }
+    } else if (due && session_ && session_->live) {  // paused: the sources' state
+      Publish(false);
+      last_publish = Clock::now();
     }
   }
 }

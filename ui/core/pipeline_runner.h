@@ -3,6 +3,12 @@
 // buffers, timings, misalignment) that the panels read. The UI never waits for painting:
 // commands (play, pause, step, seek, restart with new settings) are queued and the worker
 // picks them up between frames. Settings are copied in on Restart, never shared.
+//
+// A project whose video or poses are live (device:N, udp://..., a TUM pose feed) paints
+// through the same live core as `fresco run` (LiveSession over OpenLiveInputs): the worker
+// waits for frames a little at a time, so it stays responsive and keeps publishing the
+// sources' state (RunnerSnapshot::live) when a source stalls or dies; Record() writes the
+// session as a project to replay.
 #pragma once
 
 #include <atomic>
@@ -22,6 +28,7 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
+#include "ui/core/live_session.h"
 
 namespace fresco {
 
@@ -34,7 +41,7 @@ struct SessionGeometry {
   std::vector<int> buffer_texels;       // on-surface texels per buffer
   std::vector<Rigid3d> path;            // cam_from_world of every posed frame, in order
   Camera camera;                        // the first camera (frustum drawing, preview)
-  int num_frames = 0;                   // frames in the video when known, else -1
+  int num_frames = 0;                   // frames in the video when known, else -1 (live)
   double texel_size_m = 0;
   int folds_split = 0;
 };
@@ -66,6 +73,12 @@ struct RunnerSnapshot {
   // Misalignment review images for the current frame (half size): the painted model
   // rendered into the frame's view, and the absolute difference as a heat map.
   cv::Mat rephoto_bgr, difference_heat;
+  // Live sources (active for a live project): state, counts, offset, recording.
+  LiveStatus live;
+  // The poses of the latest frames painted live (up to 2 * kLivePathFrames): the path the
+  // 3D view draws when the poses come from a feed (geometry->path is empty then).
+  std::vector<Rigid3d> live_path;
+  static constexpr size_t kLivePathFrames = 1000;
 };
 
 struct RunnerOptions {
@@ -76,6 +89,9 @@ struct RunnerOptions {
   // 2 * history_frames painted frames: on an endless live stream neither the app's memory
   // nor the copy made at each publish grows without bound.
   int history_frames = 20000;
+  // Live sources: the worker waits at most this long for a frame before it looks at its
+  // commands again (and publishes the sources' state at least every publish_interval_ms).
+  int live_poll_ms = 50;
 };
 
 class PipelineRunner {
@@ -89,21 +105,29 @@ class PipelineRunner {
   void Pause();
   void Step();           // paints the next frame, then pauses
   void Seek(int frame);  // paints up to `frame` (restarting when it lies behind), pauses
+  // Live projects: records the frames painted from now on (with their poses) to `dir` as
+  // a project to replay (SessionRecorder); "" stops and writes DIR/project.json. A
+  // recording also stops when the live video ends or the project restarts.
+  void Record(const std::string& dir);
   // Blocks until the queue is empty and the worker is idle (tests, --screenshot).
   void WaitIdle();
   std::shared_ptr<const RunnerSnapshot> Snapshot() const;
 
  private:
   struct Command {
-    enum Kind { kRestart, kPlay, kPause, kStep, kSeek, kQuit } kind;
+    enum Kind { kRestart, kPlay, kPause, kStep, kSeek, kRecord, kQuit } kind;
     Project project;
     int frame = 0;
+    std::string path;
   };
+  enum class Painted { kFrame, kWaiting, kEnded };
   struct Session;
   void Post(Command command);
   void Loop();
-  bool PaintNext(bool show);  // false at the end of the video or on error
+  // kWaiting: a live source has no frame yet; kEnded: the end of the video, or an error.
+  Painted PaintNext(bool show);
   void OpenSession(const Project& project);
+  void SetRecording(const std::string& dir);
   void Publish(bool with_painted);
 
   RunnerOptions options_;

@@ -82,6 +82,33 @@ void StartCalibration(const GuiOptions& options, CalibrationRunner* calibration,
   calibration->WaitIdle();
 }
 
+// Opens the Poses panel and runs COLMAP on the project; screenshots show the finished run
+// (and, for "bootstrap", the project using the bootstrapped poses).
+void StartPoses(const GuiOptions& options, UiContext& ui,
+                std::vector<std::unique_ptr<Panel>>* panels) {
+  PosesRequest request;
+  request.project = ui.state->project;
+  request.out_dir =
+      !options.poses_out.empty()
+          ? options.poses_out
+          : (std::filesystem::path(ui.state->project.file_path).parent_path() / "colmap-poses")
+                .string();
+  request.colmap.existing_model = options.poses_model;
+  for (auto& panel : *panels)
+    if (std::string(panel->Title()) == kPosesPanelTitle) panel->open = true;
+  ui.poses->Run(request);
+  if (options.screenshot.empty()) return;
+  ui.poses->WaitIdle();
+  if (options.poses != "bootstrap") return;
+  if (Status s = ApplyBootstrappedPoses(*ui.poses->Snapshot(), ui.state); !s.ok()) {
+    std::fprintf(stderr, "error: %s\n", s.message().c_str());
+    return;
+  }
+  ui.runner->Restart(ui.state->project);
+  ui.runner->Seek(std::max(0, options.frames - 1));
+  ui.runner->WaitIdle();
+}
+
 }  // namespace
 
 int RunGuiApp(const GuiOptions& options) {
@@ -135,6 +162,7 @@ int RunGuiApp(const GuiOptions& options) {
   {
     PipelineRunner runner;
     CalibrationRunner calibration;
+    PosesRunner poses;
     GlTextures textures;
     GlViewport viewport;
     auto panels = MakePanels();
@@ -144,12 +172,14 @@ int RunGuiApp(const GuiOptions& options) {
     ui.calibration = &calibration;
     ui.textures = &textures;
     ui.viewport = &viewport;
+    ui.poses = &poses;
     if (state.has_project) runner.Restart(state.project);
     if (screenshot && state.has_project) {
       runner.Seek(std::max(0, options.frames - 1));
       runner.WaitIdle();
     }
     if (!options.calib_images.empty()) StartCalibration(options, &calibration, &panels);
+    if (!options.poses.empty() && state.has_project) StartPoses(options, ui, &panels);
     int frames_drawn = 0;
     while (true) {
       glfwPollEvents();

@@ -14,6 +14,11 @@ struct GuiOptions {
   int width = 1600, height = 1000;
   // Calibration panel: a folder to detect at start (--screenshot also solves before the shot).
   std::string calib_images, calib_board, calib_model = "auto";
+  // Poses panel: "" (closed), "verify" (run COLMAP and verify at start; --screenshot waits
+  // for it) or "bootstrap" (also apply the bootstrapped poses to the project); the output
+  // folder ("" = PROJECT_DIR/colmap-poses) and an earlier COLMAP text model to use instead of
+  // running COLMAP ("" = run it).
+  std::string poses, poses_out, poses_model;
 };
 
 // Returns the process exit code (0 ok, 1 no display / GL failure, 2 bad project).

@@ -416,8 +416,9 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
     lines.push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
   };
   if (view->show_path)
-    for (size_t i = 1; i < geo.path.size(); ++i)
-      add(centre_of(geo.path[i - 1]), centre_of(geo.path[i]), 0.6f, 0.6f, 0.65f);
+    for (const std::vector<Rigid3d>* path : {&geo.path, &snapshot.live_path})
+      for (size_t i = 1; i < path->size(); ++i)
+        add(centre_of((*path)[i - 1]), centre_of((*path)[i]), 0.6f, 0.6f, 0.65f);
   if (view->show_frustum && snapshot.has_pose) {
     const Rigid3d local_from_cam = cam_from_local.Inverse();
     const float depth = 0.25f * radius;

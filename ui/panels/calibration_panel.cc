@@ -54,16 +54,7 @@ class CalibrationPanel : public Panel {
   std::map<std::string, std::string> Report() const override { return report_; }
 
   void Draw(UiContext& ui) override {
-    ImGui::SetNextWindowBgAlpha(1.0f);  // it lies over other panels
-    if (!BeginPanel(*this)) {
-      ImGui::End();
-      return;
-    }
-    if (!ui.calibration) {
-      ImGui::TextDisabled("(no calibration worker)");
-      ImGui::End();
-      return;
-    }
+    if (!BeginOverlayPanel(*this, ui.calibration != nullptr, "calibration worker")) return;
     const auto snap = ui.calibration->Snapshot();
     if (snap->has_request && folder_[0] == 0) TakeInputs(snap->request);
     if (ImGui::BeginTable("calibration", 3,

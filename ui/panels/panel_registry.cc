@@ -1,6 +1,6 @@
 // Every panel of the app, in the View menu's order, with where it starts in a 1600 x 1000
 // window (five columns, nothing overlapping; scaled to the real window): one line each.
-// Calibration is the exception: a large window over columns 2-5, closed at first.
+// Calibration and Poses are the exceptions: large windows over columns 2-5, closed at first.
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -31,6 +31,7 @@ std::vector<std::unique_ptr<Panel>> MakePanels() {
   Add(&p, MakePaintedBuffersPanel(), 960, 650, 320, 325);
   Add(&p, MakeGroupingPanel(), 1280, 20, 320, 955);
   Add(&p, MakeCalibrationPanel(), 320, 20, 1280, 955);
+  Add(&p, MakePosesPanel(), 320, 20, 1280, 955);
   return p;
 }
 

@@ -23,13 +23,17 @@ std::unique_ptr<Panel> MakeMisalignmentPanel();
 // or by `fresco gui --calib-images`.
 std::unique_ptr<Panel> MakeCalibrationPanel();
 inline constexpr const char* kCalibrationPanelTitle = "Calibration";
+// Poses with COLMAP (issue 9): a window over columns 2-5, closed until opened from the View
+// menu or by `fresco gui --poses`.
+std::unique_ptr<Panel> MakePosesPanel();
+inline constexpr const char* kPosesPanelTitle = "Poses";
 
 // Opens `path` (after the unsaved-changes prompt when the project has edits; the app frame
 // shows it) and restarts the pipeline on it.
 void RequestOpen(UiContext& ui, const std::string& path);
 // Restarts the pipeline with the project as edited (settings and grouping).
 void ApplyProject(UiContext& ui);
-// Undo (or redo) one edit; restarts the pipeline when the grouping changed.
+// Undo (or redo) one edit; restarts the pipeline when the grouping or the poses changed.
 void UndoRedo(UiContext& ui, bool undo);
 
 }  // namespace fresco

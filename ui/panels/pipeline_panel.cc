@@ -1,8 +1,10 @@
-// Pipeline: play, pause, step, seek, restart; and the settings of every stage, edited in the
-// project (undoable) and applied by restarting the worker.
+// Pipeline: play, pause, step, seek, restart; live sources' state and the Record toggle
+// (live_status_section.h); and the settings of every stage, edited in the project
+// (undoable) and applied by restarting the worker.
 #include <algorithm>
 
 #include "ui/core/panel.h"
+#include "ui/panels/live_status_section.h"
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -11,6 +13,7 @@ namespace {
 class PipelinePanel : public Panel {
  public:
   const char* Title() const override { return "Pipeline"; }
+  std::map<std::string, std::string> Report() const override { return live_.report(); }
 
   void Draw(UiContext& ui) override {
     if (!BeginPanel(*this)) {
@@ -29,18 +32,24 @@ class PipelinePanel : public Panel {
     if (ImGui::Button("Step")) ui.runner->Step();
     ImGui::SameLine();
     if (ImGui::Button("Restart")) ApplyProject(ui);
-    const int last = snap.geometry ? std::max(0, snap.geometry->num_frames - 1) : 0;
-    if (!ImGui::IsItemActive()) seek_ = std::max(0, snap.frame);
-    ImGui::SetNextItemWidth(-60);
-    ImGui::SliderInt("##seek", &seek_, 0, last, "frame %d");
-    if (ImGui::IsItemDeactivatedAfterEdit()) ui.runner->Seek(seek_);
-    ImGui::SameLine();
-    ImGui::Text("/ %d", last);
+    if (snap.live.active) {  // a live source has no end to seek to
+      ImGui::SameLine();
+      ImGui::Text("live frame %d", snap.frame);
+    } else {
+      const int last = snap.geometry ? std::max(0, snap.geometry->num_frames - 1) : 0;
+      if (!ImGui::IsItemActive()) seek_ = std::max(0, snap.frame);
+      ImGui::SetNextItemWidth(-60);
+      ImGui::SliderInt("##seek", &seek_, 0, last, "frame %d");
+      if (ImGui::IsItemDeactivatedAfterEdit()) ui.runner->Seek(seek_);
+      ImGui::SameLine();
+      ImGui::Text("/ %d", last);
+    }
     ImGui::EndDisabled();
-    ImGui::Text("%s", snap.status.c_str());
+    ImGui::TextWrapped("%s", snap.status.c_str());
     if (snap.geometry)
       ImGui::Text("%zu base buffers, texel %.4f m, coverage %.1f %%", snap.geometry->groups.size(),
                   snap.geometry->texel_size_m, 100.0 * snap.coverage);
+    live_.Draw(ui, snap.live);
 
     ImGui::Separator();
     ImGui::TextDisabled("Settings (Apply restarts painting)");
@@ -144,6 +153,7 @@ class PipelinePanel : public Panel {
  private:
   int seek_ = 0;
   PipelineOptions edit_;
+  LiveStatusSection live_;
 };
 
 }  // namespace

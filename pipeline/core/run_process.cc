@@ -1,6 +1,7 @@
-#include "pipeline/poses/run_process.h"
+#include "pipeline/core/run_process.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,7 +31,7 @@ std::string FindProgram(const std::string& name) {
 }
 
 Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path,
-                  int* exit_code) {
+                  int* exit_code, const std::atomic<bool>* cancel) {
   if (argv.empty()) return Status::Error("RunProcess: empty command");
   const int log_fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) {
@@ -67,7 +68,23 @@ Status RunProcess(const std::vector<std::string>& argv, const std::string& log_p
   const ssize_t got = read(error_pipe[0], &exec_errno, sizeof(exec_errno));
   close(error_pipe[0]);
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  if (cancel) {
+    // Polled, so that a cancel stops the program within 0.1 s.
+    int polls_since_term = -1;
+    while (true) {
+      const pid_t done = waitpid(pid, &status, WNOHANG);
+      if (done == pid || (done < 0 && errno != EINTR)) break;
+      if (*cancel && polls_since_term < 0) {
+        kill(pid, SIGTERM);
+        polls_since_term = 0;
+      } else if (polls_since_term >= 0 && ++polls_since_term == 20) {
+        kill(pid, SIGKILL);
+      }
+      usleep(100000);
+    }
+  } else {
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
   }
   if (got == static_cast<ssize_t>(sizeof(exec_errno))) {
     return Status::Error(argv[0] + ": cannot run: " + std::strerror(exec_errno));

@@ -2,6 +2,7 @@
 // and finds programs on PATH. Used to drive the `colmap` command-line program.
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -11,9 +12,10 @@ namespace fresco {
 
 // Runs argv[0] (looked up on PATH when it holds no '/') with argv[1..]; waits for it.
 // `exit_code` gets its exit status (128 + signal when killed). Error only when it could not
-// be started at all (the message names the program and the log).
+// be started at all (the message names the program and the log). When `cancel` becomes true
+// while it runs, the program is sent SIGTERM (then SIGKILL after 2 s) and waited for.
 Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path,
-                  int* exit_code);
+                  int* exit_code, const std::atomic<bool>* cancel = nullptr);
 
 // The absolute path of `name` on PATH (or `name` itself when it holds a '/' and is
 // executable); "" when not found.

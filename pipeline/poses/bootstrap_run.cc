@@ -1,0 +1,128 @@
+#include "pipeline/poses/bootstrap_run.h"
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/poses/pose_alignment.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+
+nlohmann::json ReportJson(const ProjectColmap& colmap, const BootstrapResult& result,
+                          const std::string& project_path) {
+  nlohmann::json report;
+  report["aligned_with"] = result.aligned_with;
+  if (result.aligned_with == "control_points") {
+    report["control_point_residual_m"] = result.control_point_residual_m;
+  } else {
+    report["inliers"] = result.inliers;
+    report["compared"] = result.compared;
+  }
+  if (result.refined) {
+    const MeshIcpResult& icp = result.icp;
+    report["mesh_icp"] = {{"pairs", icp.pairs},
+                          {"iterations", icp.iterations},
+                          {"max_distance_m", result.icp_max_distance_m},
+                          {"median_distance_before_m", icp.median_distance_before_m},
+                          {"median_distance_after_m", icp.median_distance_after_m}};
+  }
+  const Sim3d& w = result.world_from_colmap;
+  report["scale"] = w.scale;
+  report["world_from_colmap"] = {
+      {"scale", w.scale},
+      {"rotation_wxyz", {w.rotation.w(), w.rotation.x(), w.rotation.y(), w.rotation.z()}},
+      {"translation_m", {w.translation.x(), w.translation.y(), w.translation.z()}}};
+  report["frames"] = colmap.frames.size();
+  report["registered"] = colmap.run.registered;
+  report["not_registered"] = result.not_registered;
+  report["colmap_seconds"] = colmap.run.seconds;
+  report["project"] = project_path;
+  return report;
+}
+
+}  // namespace
+
+Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
+                           const BootstrapOptions& options, BootstrapResult* result) {
+  *result = BootstrapResult();
+  if (!options.control_points.empty()) {
+    ControlPointFit fit;
+    FRESCO_RETURN_IF_ERROR(AlignWithControlPoints(options.control_points, options.control_file,
+                                                  colmap.run.model, colmap.camera, &fit));
+    result->world_from_colmap = fit.world_from_colmap;
+    result->aligned_with = "control_points";
+    result->control_point_residual_m = fit.residual_m;
+  } else {
+    std::vector<PosePair> pairs;
+    for (const ProjectColmapFrame& f : colmap.frames) {
+      if (f.given && f.colmap) {
+        pairs.push_back({f.name, f.given->cam_from_world, f.colmap->cam_from_world});
+      }
+    }
+    if (pairs.size() < 3) {
+      return Status::Error(project.poses + ": only " + std::to_string(pairs.size()) +
+                           " registered frames have a given pose: give --control-points to "
+                           "place COLMAP's reconstruction in the scene");
+    }
+    PoseAlignmentOptions align;
+    align.inlier_position_m = options.inlier_position_rel * colmap.scene_size_m;
+    align.inlier_rotation_deg = options.inlier_rotation_deg;
+    PoseAlignment alignment;
+    if (Status s = AlignColmapToPoses(pairs, align, &alignment); !s.ok()) {
+      return Status::Error(project.poses + ": " + s.message());
+    }
+    result->world_from_colmap = alignment.world_from_colmap;
+    result->aligned_with = "given_poses";
+    result->inliers = alignment.num_inliers;
+    result->compared = static_cast<int>(pairs.size());
+  }
+  if (options.refine_mesh) {
+    MeshIcpOptions icp;
+    icp.max_distance_m = options.refine_max_distance_rel * colmap.scene_size_m;
+    std::vector<Eigen::Vector3d> points;
+    for (const Point3D& p : colmap.run.model.points) points.push_back(p.xyz);
+    if (Status s = AlignPointsToMesh(points, colmap.capture.scene, result->world_from_colmap, icp,
+                                     &result->icp);
+        !s.ok()) {
+      return Status::Error(project.scene + ": " + s.message());
+    }
+    result->world_from_colmap = result->icp.world_from_colmap;
+    result->refined = true;
+    result->icp_max_distance_m = icp.max_distance_m;
+  }
+  result->model = TransformModel(colmap.run.model, result->world_from_colmap);
+  result->model.cameras = {{1, colmap.camera}};
+  for (PosedImage& image : result->model.images) image.camera_id = 1;
+  for (const ProjectColmapFrame& f : colmap.frames) {
+    if (!f.colmap) result->not_registered.push_back(f.name);
+  }
+  return Status::Ok();
+}
+
+std::string BootstrapPosesPath(const std::string& out_dir) {
+  return fs::absolute(fs::path(out_dir) / "sparse" / "images.txt").string();
+}
+
+Status WriteBootstrap(const Project& project, const ProjectColmap& colmap,
+                      const BootstrapResult& result, const std::string& out_dir) {
+  const fs::path new_project_path = fs::absolute(fs::path(out_dir) / "project.json");
+  if (fs::absolute(project.file_path).lexically_normal() == new_project_path.lexically_normal()) {
+    return Status::Error(out_dir + ": would overwrite the input project " + project.file_path);
+  }
+  const fs::path sparse = fs::path(out_dir) / "sparse";
+  Project out = project;
+  out.poses = BootstrapPosesPath(out_dir);
+  FRESCO_RETURN_IF_ERROR(MakeDirectories(sparse.string()));
+  FRESCO_RETURN_IF_ERROR(WriteColmapModel(sparse.string(), result.model));
+  FRESCO_RETURN_IF_ERROR(SaveProject(out, new_project_path.string()));
+  FRESCO_RETURN_IF_ERROR(
+      WriteFileAtomic((fs::path(out_dir) / "bootstrap.json").string(),
+                      ReportJson(colmap, result, new_project_path.string()).dump(2)));
+  return Status::Ok();
+}
+
+}  // namespace fresco

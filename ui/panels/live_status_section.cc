@@ -1,0 +1,129 @@
+#include "ui/panels/live_status_section.h"  // imgui.h first: imgui_stdlib.h needs it
+
+#include <imgui_stdlib.h>
+
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+const ImVec4 kGood(0.45f, 0.85f, 0.45f, 1.0f);
+const ImVec4 kWarn(1.0f, 0.75f, 0.3f, 1.0f);
+const ImVec4 kBad(1.0f, 0.4f, 0.4f, 1.0f);
+
+ImVec4 StateColour(const std::string& state) {
+  if (state == "receiving") return kGood;
+  if (state == "error" || state == "ended") return kBad;
+  return kWarn;  // connecting, waiting for frames, stalled
+}
+
+// <project folder>/recordings/YYYYMMDD-HHMMSS.
+std::string DefaultRecordDir(const Project& project) {
+  char stamp[32];
+  const std::time_t now = std::time(nullptr);
+  std::tm local{};
+  localtime_r(&now, &local);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &local);
+  const std::filesystem::path folder = std::filesystem::path(project.file_path).parent_path();
+  return (folder / "recordings" / stamp).string();
+}
+
+void WrappedColored(const ImVec4& colour, const std::string& text) {
+  ImGui::PushStyleColor(ImGuiCol_Text, colour);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
+std::string Format(const char* format, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+}  // namespace
+
+void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
+  report_.clear();
+  if (!live.active) return;
+  ImGui::Separator();
+  ImGui::TextDisabled("Live sources");
+  ImGui::Text("video");
+  ImGui::SameLine(60);
+  ImGui::TextColored(StateColour(live.state), "%s", live.state.c_str());
+  ImGui::SameLine();
+  ImGui::TextWrapped("%s", live.video.c_str());
+  ImGui::Text("poses");
+  ImGui::SameLine(60);
+  std::string pose_state = "file";
+  if (live.pose_feed) {
+    pose_state = live.poses_connected ? "connected" : "disconnected";
+    ImGui::TextColored(live.poses_connected ? kGood : kWarn, "%s", pose_state.c_str());
+  } else {
+    ImGui::TextDisabled("file");
+  }
+  ImGui::SameLine();
+  ImGui::TextWrapped("%s", live.poses.c_str());
+  ImGui::Text("frames: %lld received, %lld painted", live.frames_received,
+              live.frames_painted);
+  ImGui::Text("        %lld dropped, %lld without pose", live.frames_dropped,
+              live.frames_without_pose);
+  ImGui::Text("queue: high water %d of %d; clock %s", live.queue_high_water, live.queue_capacity,
+              live.video_clock.c_str());
+  if (live.pose_feed)
+    ImGui::Text("tracker: %lld poses, %lld reconnects", live.poses_received, live.pose_reconnects);
+  const std::string lag = live.pose_lag_known ? Format("%+.3f s", live.pose_lag_s) : "-";
+  ImGui::Text("pose-match lag: %s", lag.c_str());
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip(
+        "the tracker's newest pose time minus the last frame's pose time\n"
+        "(> 0: the tracker is ahead of the video)");
+  std::string offset = Format("%.4f s", live.time_offset_s);
+  if (live.offset_estimating)
+    offset += " (estimating...)";
+  else if (live.offset_estimated)
+    offset += Format(" (estimated, score %.2f)", live.offset_score);
+  else if (!live.offset_note.empty())
+    offset += " (not estimated: " + live.offset_note + ")";
+  else
+    offset += " (as set)";
+  ImGui::TextWrapped("time offset: %s", offset.c_str());
+  if (!live.problem.empty()) WrappedColored(kBad, live.problem);
+
+  // Record toggle: the worker's state is the truth; a click asks it to change.
+  bool recording = live.recording;
+  if (ImGui::Checkbox("Record", &recording)) {
+    if (recording && record_dir_.empty()) record_dir_ = DefaultRecordDir(ui.state->project);
+    ui.runner->Record(recording ? record_dir_ : "");
+    if (recording) record_dir_.clear();  // the next recording gets a fresh default
+  }
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(-1);
+  ImGui::BeginDisabled(live.recording);
+  ImGui::InputTextWithHint("##record", "folder (default: recordings/<time>)", &record_dir_);
+  ImGui::EndDisabled();
+  if (live.recording) {
+    WrappedColored(kBad, "recording: " + std::to_string(live.recorded_frames) + " frames to " +
+                             live.record_dir);
+  } else if (!live.recorded_project.empty()) {
+    ImGui::TextWrapped("recorded %d frames: %s", live.recorded_frames,
+                       live.recorded_project.c_str());
+    if (ImGui::Button("Open the recording")) RequestOpen(ui, live.recorded_project);
+  }
+  if (!live.record_error.empty()) WrappedColored(kBad, "recording failed: " + live.record_error);
+
+  report_["live.state"] = live.state;
+  report_["live.poses_state"] = pose_state;
+  report_["live.frames_received"] = std::to_string(live.frames_received);
+  report_["live.frames_dropped"] = std::to_string(live.frames_dropped);
+  report_["live.frames_painted"] = std::to_string(live.frames_painted);
+  report_["live.pose_lag"] = lag;
+  report_["live.time_offset"] = offset;
+  report_["live.problem"] = live.problem;
+  report_["live.recording"] = live.recording ? live.record_dir : "";
+}
+
+}  // namespace fresco
