@@ -586,6 +586,12 @@ Status ParseJsonText(const std::string& text, const std::string& name, Json* jso
     if (colon != std::string::npos) what = what.substr(colon + 2);
     return Status::Error(name + ": line " + std::to_string(line) + ", column " +
                          std::to_string(column) + ": malformed JSON: " + what);
+  } catch (const Json::exception& e) {
+    // Not a syntax error but a value JSON cannot hold here (e.g. 1e999: "number overflow").
+    std::string what = e.what();
+    const size_t bracket = what.find("] ");
+    if (bracket != std::string::npos) what = what.substr(bracket + 2);
+    return Status::Error(name + ": malformed JSON: " + what);
   }
   if (!finder.duplicate_path.empty()) {
     return Status::Error(name + ": " + finder.duplicate_path + ": duplicate key");

@@ -11,6 +11,7 @@
 
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/poses.h"
+#include "pipeline/core/project.h"
 #include "pipeline/core/scene.h"
 #include "tests/test_support.h"
 
@@ -105,6 +106,23 @@ TEST(FuzzRegressionTest, NonFiniteUvIsAnError) {
   ASSERT_FALSE(status.ok());
   EXPECT_THAT(status.message(), HasSubstr("found.glb: mesh "));
   EXPECT_THAT(status.message(), ::testing::MatchesRegex(".*: TEXCOORD_0 [0-9]+ is not finite"));
+}
+
+// project_fuzz (the 10 s run of .ci/sanitize): a number too large for a double (1e999)
+// made nlohmann throw out_of_range ("number overflow"), not parse_error, so it escaped the
+// project reader and aborted. Now: the one-line malformed-JSON error naming the file.
+TEST(FuzzRegressionTest, NumberOverflowInProjectIsAnError) {
+  for (const std::string& text :
+       {std::string("88888888888e888888888\x9d"), std::string("{\"fresco\": 1e999}"),
+        std::string("{\"fresco\": 1, \"pipeline\": {\"update_every\": -1e400}}")}) {
+    SCOPED_TRACE(text);
+    Project project;
+    const Status status = ParseProject(text, "p.json", {}, &project);
+    ASSERT_FALSE(status.ok());
+    EXPECT_THAT(status.message(), ::testing::StartsWith("p.json: malformed JSON: "));
+    EXPECT_THAT(status.message(), HasSubstr("number overflow"));
+    EXPECT_EQ(status.message().find('\n'), std::string::npos);
+  }
 }
 
 // The in-memory readers give what the file readers give.
