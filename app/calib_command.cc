@@ -106,9 +106,11 @@ int RunSolve(const CommandArgs& argv) {
         continue;
       }
       std::snprintf(line, sizeof(line),
-                    "model %-8s rms %.4f px  sigma %.4f px  cross-validation %.4f px  %s%s\n",
+                    "model %-8s rms %.4f px  sigma %.4f px  cross-validation %.4f px (limit "
+                    "%.4f)  %s%s\n",
                     t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px, t.cross_validation_px,
-                    t.fits ? "fits" : "does not fit", t.supported ? "" : ", halves disagree");
+                    calib::AgreementLimit_px(t), t.fits ? "fits" : "does not fit",
+                    t.supported ? "" : ", halves disagree");
       std::cout << line;
     }
     const calib::SolveResult& fit = run.Chosen().fit;

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/noise_correlation.h"
 #include "pipeline/core/image_io.h"
 
 namespace fresco::calib {
@@ -28,27 +29,6 @@ bool IsImage(const fs::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
   return ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".bmp" || ext == ".tif" ||
          ext == ".tiff";
-}
-
-// Correlation of residuals between different corners of the same tag (same coordinate).
-double TagCornerCorrelation(const std::vector<BoardView>& views, const SolveResult& fit) {
-  double sum_products = 0, sum_squares = 0;
-  long pairs = 0, singles = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    const auto& corners = views[v].corners;
-    for (size_t a = 0; a < corners.size(); ++a) {
-      if (fit.views[v].outlier[a]) continue;
-      sum_squares += fit.views[v].residual_px[a].squaredNorm();
-      singles += 2;
-      for (size_t b = a + 1; b < corners.size() && corners[b].id / 4 == corners[a].id / 4; ++b) {
-        if (fit.views[v].outlier[b]) continue;
-        sum_products += fit.views[v].residual_px[a].dot(fit.views[v].residual_px[b]);
-        pairs += 2;
-      }
-    }
-  }
-  if (pairs == 0 || sum_squares <= 0) return 0;
-  return (sum_products / pairs) / (sum_squares / singles);
 }
 
 void CheckCoverage(CalibrationRun* run) {
@@ -266,7 +246,7 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   CheckRequestedModel(request, run);
   if (request.board.kind == BoardKind::kAprilGrid) {
     run->corner_correlation = TagCornerCorrelation(run->views, run->Chosen().fit);
-    run->noise_inflation = std::sqrt(std::max(1.0, 1 + 3 * run->corner_correlation));
+    run->noise_inflation = TagNoiseInflation(run->corner_correlation);
     for (ModelTrial& t : run->choice.trials)
       for (double& s : t.fit.intrinsics_stdev) s *= run->noise_inflation;
   }

@@ -65,23 +65,26 @@ bool UnprojectPixels(const std::string& lensmodel, const std::vector<double>& in
   return true;
 }
 
-double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector<double>& a,
-                               const std::string& lensmodel_b, const std::vector<double>& b,
-                               const std::vector<Eigen::Vector2d>& all_pixels) {
-  const double kNan = std::numeric_limits<double>::quiet_NaN();
-  std::vector<Eigen::Vector3d> all_rays, all_back;
-  if (all_pixels.empty() || !UnprojectPixels(lensmodel_a, a, all_pixels, &all_rays)) return kNan;
+bool ProjectionDifferences_px(const std::string& lensmodel_a, const std::vector<double>& a,
+                              const std::string& lensmodel_b, const std::vector<double>& b,
+                              const std::vector<Eigen::Vector2d>& all_pixels,
+                              std::vector<int>* compared, std::vector<Eigen::Vector2d>* diffs) {
+  compared->clear();
+  diffs->clear();
+  std::vector<Eigen::Vector3d> all_rays;
+  if (all_pixels.empty() || !UnprojectPixels(lensmodel_a, a, all_pixels, &all_rays)) return false;
   // Pixels where either model has no valid (un)projection (a strongly distorted model can fold
   // over near the imager's edge) are left out; fewer than half left: no comparison.
   std::vector<Eigen::Vector2d> pixels, back;
   std::vector<Eigen::Vector3d> rays;
-  if (!ProjectPoints(lensmodel_b, b, all_rays, &back)) return kNan;
+  if (!ProjectPoints(lensmodel_b, b, all_rays, &back)) return false;
   for (size_t i = 0; i < all_pixels.size(); ++i)
     if (all_rays[i].allFinite() && all_rays[i].z() > 0 && back[i].allFinite()) {
+      compared->push_back(static_cast<int>(i));
       pixels.push_back(all_pixels[i]);
       rays.push_back(all_rays[i]);
     }
-  if (2 * pixels.size() < all_pixels.size() || pixels.empty()) return kNan;
+  if (2 * pixels.size() < all_pixels.size() || pixels.empty()) return false;
   // Residuals for rotation r: project_b(R(r) ray) - pixel.
   auto residuals = [&](const Eigen::Vector3d& r, Eigen::VectorXd* out) {
     const Eigen::Matrix3d R = Rotation(r);
@@ -95,14 +98,14 @@ double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector
   };
   Eigen::Vector3d r = Eigen::Vector3d::Zero();
   Eigen::VectorXd e;
-  if (!residuals(r, &e)) return kNan;
+  if (!residuals(r, &e)) return false;
   for (int iteration = 0; iteration < 8; ++iteration) {  // Gauss-Newton on 3 parameters
     Eigen::MatrixXd J(e.size(), 3);
     for (int k = 0; k < 3; ++k) {
       Eigen::Vector3d rk = r;
       rk[k] += 1e-7;
       Eigen::VectorXd ek;
-      if (!residuals(rk, &ek)) return kNan;
+      if (!residuals(rk, &ek)) return false;
       J.col(k) = (ek - e) / 1e-7;
     }
     const Eigen::Vector3d step = (J.transpose() * J).ldlt().solve(-J.transpose() * e);
@@ -113,7 +116,21 @@ double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector
     e = e_new;
     if (step.norm() < 1e-12) break;
   }
-  return std::sqrt(e.squaredNorm() / pixels.size());
+  diffs->resize(pixels.size());
+  for (size_t i = 0; i < pixels.size(); ++i) (*diffs)[i] = e.segment<2>(2 * i);
+  return true;
+}
+
+double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector<double>& a,
+                               const std::string& lensmodel_b, const std::vector<double>& b,
+                               const std::vector<Eigen::Vector2d>& pixels) {
+  std::vector<int> compared;
+  std::vector<Eigen::Vector2d> diffs;
+  if (!ProjectionDifferences_px(lensmodel_a, a, lensmodel_b, b, pixels, &compared, &diffs))
+    return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0;
+  for (const Eigen::Vector2d& d : diffs) sum += d.squaredNorm();
+  return std::sqrt(sum / diffs.size());
 }
 
 }  // namespace fresco::calib

@@ -27,5 +27,11 @@ int LensModelParamCount(const std::string& lensmodel);
 double ProjectionDifference_px(const std::string& lensmodel_a, const std::vector<double>& a,
                                const std::string& lensmodel_b, const std::vector<double>& b,
                                const std::vector<Eigen::Vector2d>& pixels);
+// The same per pixel: `diffs` (projected by b minus the pixel, after the best rotation) for
+// the pixels `compared` (indices into `pixels`). False where ProjectionDifference_px is NaN.
+bool ProjectionDifferences_px(const std::string& lensmodel_a, const std::vector<double>& a,
+                              const std::string& lensmodel_b, const std::vector<double>& b,
+                              const std::vector<Eigen::Vector2d>& pixels,
+                              std::vector<int>* compared, std::vector<Eigen::Vector2d>* diffs);
 
 }  // namespace fresco::calib

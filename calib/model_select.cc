@@ -6,6 +6,8 @@
 #include <limits>
 
 #include "calib/lens_projection.h"
+#include "calib/noise_correlation.h"
+#include "calib/uncertainty.h"
 
 namespace fresco::calib {
 namespace {
@@ -25,6 +27,43 @@ CalibrationSeed SubsetSeed(const CalibrationSeed& seed, const std::vector<int>& 
   out.rt_cam_from_board.clear();
   for (int i : indices) out.rt_cam_from_board.push_back(seed.rt_cam_from_board[i]);
   return out;
+}
+
+// Solves each half alone and compares their projections over `observed` with what their own
+// uncertainty (at infinity, as the diff fits a rotation only; corner noise times the trial's
+// AprilTag inflation) predicts for two independent solves of a model that fits the lens.
+void CrossValidate(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
+                   int height, const CalibrationSeed& seed, const std::vector<int> (&halves)[2],
+                   const SolveOptions& solve, const std::vector<Eigen::Vector2d>& observed,
+                   ModelTrial* trial) {
+  SolveResult half_fit[2];
+  SolveOptions half = solve;
+  half.compute_uncertainty = true;
+  half.noise_inflation = trial->noise_inflation;
+  for (int h = 0; h < 2; ++h) {
+    std::vector<BoardView> subset;
+    for (int i : halves[h]) subset.push_back(views[i]);
+    if (!SolveIntrinsics(subset, spec, width, height, SubsetSeed(seed, halves[h]), half,
+                         &half_fit[h])
+             .ok())
+      return;
+  }
+  std::vector<int> compared;
+  std::vector<Eigen::Vector2d> diffs;
+  if (!ProjectionDifferences_px(half_fit[0].lensmodel, half_fit[0].intrinsics,
+                                half_fit[1].lensmodel, half_fit[1].intrinsics, observed,
+                                &compared, &diffs))
+    return;
+  double diff_sum = 0;
+  std::vector<Eigen::Vector2d> pixels;
+  for (size_t i = 0; i < compared.size(); ++i) {
+    diff_sum += diffs[i].squaredNorm();
+    pixels.push_back(observed[compared[i]]);
+  }
+  trial->cross_validation_px = std::sqrt(diff_sum / diffs.size());
+  trial->cross_validation_expected_px = ExpectedProjectionDifference_px(
+      half_fit[0], half_fit[0].noise_sigma_px * trial->noise_inflation, half_fit[1],
+      half_fit[1].noise_sigma_px * trial->noise_inflation, pixels);
 }
 
 }  // namespace
@@ -58,6 +97,13 @@ std::string MrcalLensModelName(const std::string& short_name, const CalibrationS
   const int ny = std::max(4, static_cast<int>(std::lround(kSplinedNx * height / double(width))));
   return "LENSMODEL_SPLINED_STEREOGRAPHIC_order=3_Nx=" + std::to_string(kSplinedNx) +
          "_Ny=" + std::to_string(ny) + "_fov_x_deg=" + std::to_string(fov);
+}
+
+double AgreementLimit_px(const ModelTrial& trial) {
+  const double expected = trial.cross_validation_expected_px >= 0
+                              ? trial.cross_validation_expected_px
+                              : trial.fit.noise_sigma_px * trial.noise_inflation;
+  return std::max(kAgreeFactor * expected, kAgreeFloorPx);
 }
 
 std::vector<Eigen::Vector2d> ObservedPixels(const std::vector<BoardView>& views, int width,
@@ -102,34 +148,18 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
     SolveOptions solve = options.solve;
     solve.lensmodel = trial.lensmodel;
     trial.status = SolveIntrinsics(views, spec, width, height, seed, solve, &trial.fit);
-    if (trial.status.ok() && can_cross_validate) {
-      SolveResult half_fit[2];
-      SolveOptions half = solve;
-      half.compute_uncertainty = false;
-      bool ok = true;
-      for (int h = 0; h < 2 && ok; ++h) {
-        std::vector<BoardView> subset;
-        for (int i : halves[h]) subset.push_back(views[i]);
-        ok = SolveIntrinsics(subset, spec, width, height, SubsetSeed(seed, halves[h]), half,
-                             &half_fit[h])
-                 .ok();
-      }
-      if (ok)
-        trial.cross_validation_px =
-            ProjectionDifference_px(half_fit[0].lensmodel, half_fit[0].intrinsics,
-                                    half_fit[1].lensmodel, half_fit[1].intrinsics, observed);
-      if (!std::isfinite(trial.cross_validation_px)) trial.cross_validation_px = -1;
-    }
+    if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid)
+      trial.noise_inflation = TagNoiseInflation(TagCornerCorrelation(views, trial.fit));
+    if (trial.status.ok() && can_cross_validate) CrossValidate(views, spec, width, height, seed,
+                                                               halves, solve, observed, &trial);
     out.trials.push_back(std::move(trial));
   }
   // Supported first: a model whose halves disagree overfits, and its low sigma is no
   // yardstick for the others.
-  const double agree_px_floor = 0.3;
   for (ModelTrial& t : out.trials)
     if (t.status.ok())
-      t.supported = t.cross_validation_px < 0
-                        ? !can_cross_validate
-                        : t.cross_validation_px <= std::max(3 * t.fit.noise_sigma_px, agree_px_floor);
+      t.supported = t.cross_validation_px < 0 ? !can_cross_validate
+                                              : t.cross_validation_px <= AgreementLimit_px(t);
   double best_sigma = std::numeric_limits<double>::infinity();
   int best = -1;
   for (int pass = 0; pass < 2 && best < 0; ++pass)
@@ -142,6 +172,32 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
   if (best < 0) return Status::Error("no lens model could be solved: " + out.trials[0].status.message());
   for (ModelTrial& t : out.trials)
     if (t.status.ok()) t.fits = t.fit.noise_sigma_px <= best_sigma * (1 + kFitTolerance);
+  // A model whose sigma is higher still fits when it projects like the best model within what
+  // the best model itself cannot pin down (its projection uncertainty where boards were seen):
+  // the richer model's gain is then below its own noise.
+  const ModelTrial& yardstick = out.trials[best];
+  double uncertainty_sum = 0;
+  int uncertainty_count = 0;
+  for (const Eigen::Vector2d& pixel : observed) {
+    const double u =
+        ProjectionUncertainty_px(yardstick.fit, pixel, /*range_m=*/0,
+                                 yardstick.fit.noise_sigma_px * yardstick.noise_inflation);
+    if (u < 0 || !std::isfinite(u)) continue;
+    uncertainty_sum += u * u;
+    ++uncertainty_count;
+  }
+  const double best_uncertainty_px =
+      uncertainty_count > 0 ? std::sqrt(uncertainty_sum / uncertainty_count) : -1;
+  for (ModelTrial& t : out.trials) {
+    if (!t.status.ok()) continue;
+    t.best_uncertainty_px = best_uncertainty_px;
+    t.projection_vs_best_px =
+        ProjectionDifference_px(t.fit.lensmodel, t.fit.intrinsics, yardstick.fit.lensmodel,
+                                yardstick.fit.intrinsics, observed);
+    if (!std::isfinite(t.projection_vs_best_px)) t.projection_vs_best_px = -1;
+    if (t.projection_vs_best_px >= 0 && t.projection_vs_best_px <= best_uncertainty_px)
+      t.fits = true;
+  }
   for (size_t i = 0; i < out.trials.size(); ++i)
     if (out.trials[i].fits && out.trials[i].supported) {
       out.chosen = static_cast<int>(i);

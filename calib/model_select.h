@@ -6,9 +6,19 @@
 // models: a model too simple for the lens leaves systematic residuals and a larger sigma.
 // A model is SUPPORTED when cross-validation agrees: the views are split into two halves
 // (even/odd images), each half is solved alone, and the two solutions' projections over the
-// observed part of the imager differ by at most max(3 sigma, 0.3 px) RMS (after the best
-// small rotation, as in mrcal's projection diff). The "best" sigma that FITS compares with is
-// the lowest among the supported models (an overfitting model's low sigma is no yardstick).
+// observed part of the imager (after the best small rotation, as in mrcal's projection diff)
+// differ by at most kAgreeFactor times what the halves' own projection uncertainty predicts
+// for two independent solves, sqrt(u0^2 + u1^2) RMS over the same pixels (at infinity, like
+// the diff), and never less than kAgreeFloorPx. The corner noise behind that uncertainty is
+// the half's sigma times the AprilTag design effect (calib/noise_correlation.h): AprilTag
+// corner errors are correlated, so a rule on sigma alone is too strict on real AprilGrids.
+// A model that misses part of the lens leaves systematic differences beyond its
+// uncertainty; a model richer than the data has large uncertainty, and FITS (above) keeps
+// the simplest. The "best" model that FITS compares with is the one with the lowest sigma
+// among the supported models (an overfitting model's low sigma is no yardstick). A model
+// with a higher sigma still FITS when its projection is within the best model's own
+// projection uncertainty of the best's (RMS over the observed imager, at infinity): the
+// richer model's gain is below what it can pin down itself.
 // `auto` keeps the simplest model that fits and is supported; if none is, the best-fitting
 // one, with a warning.
 #pragma once
@@ -33,6 +43,14 @@ struct ModelTrial {
   Status status;                      // failed solves are reported, not fatal
   SolveResult fit;                    // on all views
   double cross_validation_px = -1;    // RMS diff of the half solves (-1: not computed)
+  // RMS of sqrt(u0^2 + u1^2) over the compared pixels: the diff the halves' own uncertainty
+  // predicts (-1: not computed; the limit then falls back to 3 sigma x inflation).
+  double cross_validation_expected_px = -1;
+  double noise_inflation = 1;         // AprilGrid: sqrt(1 + 3 rho) from this model's residuals
+  // RMS projection difference to the best model (lowest sigma among the supported) over the
+  // observed pixels, and that model's RMS projection uncertainty there (-1: not computed).
+  double projection_vs_best_px = -1;
+  double best_uncertainty_px = -1;
   bool fits = false;
   bool supported = false;
 };
@@ -50,6 +68,11 @@ struct SelectOptions {
 };
 
 constexpr double kFitTolerance = 0.03;  // sigma may exceed the best by 3 %
+constexpr double kAgreeFactor = 3.0;    // halves may differ 3x their predicted difference
+constexpr double kAgreeFloorPx = 0.3;   // differences this small always agree
+
+// The largest cross_validation_px with which `trial` is supported.
+double AgreementLimit_px(const ModelTrial& trial);
 
 Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
                      int height, const CalibrationSeed& seed, const SelectOptions& options,

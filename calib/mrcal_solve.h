@@ -29,7 +29,7 @@ struct SolveOptions {
   bool optimize_board_warp = true;
   bool compute_uncertainty = true;
   // Multiplies sigma in the covariance: > 1 when corner errors are positively correlated
-  // (AprilTag corners of one tag share one quad fit); see calib/noise_correlation.h.
+  // (AprilTag corners of one tag share one quad fit); calib/noise_correlation.h.
   double noise_inflation = 1.0;
 };
 

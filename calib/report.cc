@@ -39,6 +39,11 @@ nlohmann::json TrialJson(const ModelTrial& t) {
   j["noise_sigma_px"] = t.fit.noise_sigma_px;
   j["outliers"] = t.fit.outliers;
   j["cross_validation_px"] = t.cross_validation_px;
+  j["cross_validation_expected_px"] = t.cross_validation_expected_px;
+  j["cross_validation_limit_px"] = AgreementLimit_px(t);
+  j["noise_inflation"] = t.noise_inflation;
+  j["projection_vs_best_px"] = t.projection_vs_best_px;
+  j["best_uncertainty_px"] = t.best_uncertainty_px;
   j["fits"] = t.fits;
   j["supported"] = t.supported;
   if (t.fit.intrinsics.size() <= 16) {
@@ -137,8 +142,12 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
   for (const ModelTrial& t : run.choice.trials) tried.push_back(TrialJson(t));
   j["models_tried"] = tried;
   j["model_selection"] =
-      "simplest model that fits (noise sigma within 3 % of the best model's) and whose two "
-      "half-data solves agree (cross_validation_px <= max(3 sigma, 0.3 px))";
+      "simplest model that fits (noise sigma within 3 % of the best model's, or projection "
+      "within the best model's own projection uncertainty of the best's: projection_vs_best_px "
+      "<= best_uncertainty_px) and whose two "
+      "half-data solves agree: cross_validation_px <= max(3 x cross_validation_expected_px, "
+      "0.3 px), the expected difference being sqrt(u0^2 + u1^2) RMS from the halves' own "
+      "projection uncertainty at infinity (corner noise x the AprilTag inflation)";
   j["seed"] = {{"method", "OpenCV calibrateCamera, k1 k2 only"},
                {"fx", run.seed.fx},
                {"fy", run.seed.fy},

@@ -25,6 +25,19 @@ namespace fresco::calib {
 double ProjectionUncertainty_px(const SolveResult& fit, const Eigen::Vector2d& pixel,
                                 double range_m, double sigma_px);
 
+// dq/d(state) (2 x Nstate, the columns of SolveResult::state_covariance_per_px2) for the point
+// seen at `pixel` at `range_m` (<= 0: at infinity). False when it cannot be computed.
+bool ProjectionGradient(const SolveResult& fit, const Eigen::Vector2d& pixel, double range_m,
+                        Eigen::MatrixXd* G);
+
+// The RMS difference two independent solves `a` and `b` of a lens model that fits would show
+// over `pixels` when compared as ProjectionDifference_px does (at infinity, after the best
+// rotation): sqrt(trace(P (Cov_a + Cov_b) P) / N), P projecting out the rotation. -1 when
+// it cannot be computed.
+double ExpectedProjectionDifference_px(const SolveResult& a, double sigma_a_px,
+                                       const SolveResult& b, double sigma_b_px,
+                                       const std::vector<Eigen::Vector2d>& pixels);
+
 struct UncertaintyMap {
   double range_m = 0;   // distance of the points (<= 0: at infinity)
   double sigma_px = 0;  // corner noise propagated (noise sigma times the correlation inflation)

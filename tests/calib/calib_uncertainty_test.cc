@@ -217,5 +217,66 @@ TEST(DataTrapsTest, ForcedTooSimpleModelWarns) {
   EXPECT_EQ(none.find("systematic"), std::string::npos) << none;
 }
 
+// ---- Cross-validation (model_select.h): the halves' difference against what their own
+// uncertainty predicts. ---------------------------------------------------------------------
+
+// A model that fits the lens: over several noise draws the halves differ about as much as
+// their covariances predict (the rule allows 3x), so it is supported.
+TEST(CrossValidationTest, HalvesDifferAsTheirUncertaintyPredicts) {
+  const BoardSpec spec = Spec("chessboard:10x7:0.03");
+  double sum_ratio = 0;
+  const int kDraws = 6;
+  for (int draw = 0; draw < kDraws; ++draw) {
+    SyntheticCapture truth = MildOpenCV4();
+    truth.seed = 100 + draw;
+    const CalibrationRun run =
+        SolveSynthetic(SyntheticViews(spec, truth), spec, 640, 480, "opencv4", true);
+    const ModelTrial& t = run.choice.trials[0];
+    ASSERT_GT(t.cross_validation_expected_px, 0);
+    const double ratio = t.cross_validation_px / t.cross_validation_expected_px;
+    std::cout << "draw " << draw << ": halves differ " << t.cross_validation_px
+              << " px, predicted " << t.cross_validation_expected_px << " px, ratio " << ratio
+              << "\n";
+    EXPECT_TRUE(t.supported);
+    EXPECT_DOUBLE_EQ(t.noise_inflation, 1.0);  // chessboard corners are independent
+    sum_ratio += ratio;
+  }
+  std::cout << "mean ratio " << sum_ratio / kDraws << "\n";
+  EXPECT_GT(sum_ratio / kDraws, 0.4);
+  EXPECT_LT(sum_ratio / kDraws, 1.6);
+}
+
+// AprilTag-like noise: each tag's 4 corners share a shift (0.2 px) on top of independent
+// noise (0.1 px), so their correlation is 0.8. It is measured from the residuals, the
+// uncertainty is inflated by sqrt(1 + 3 rho), and the true model class is still supported.
+TEST(CrossValidationTest, CorrelatedTagNoiseIsMeasuredAndInflatesTheUncertainty) {
+  const BoardSpec spec = Spec("aprilgrid:6x6:0.088:0.3");
+  SyntheticCapture truth = MildOpenCV4();
+  truth.distance_m = 1.3;
+  truth.noise_px = 0.1;
+  truth.tag_shift_px = 0.2;
+  const double rho = 0.2 * 0.2 / (0.2 * 0.2 + 0.1 * 0.1);
+  const CalibrationRun run =
+      SolveSynthetic(SyntheticViews(spec, truth), spec, 640, 480, "opencv4", true);
+  const ModelTrial& t = run.choice.trials[0];
+  std::cout << "rho " << run.corner_correlation << " (truth " << rho << "), inflation "
+            << t.noise_inflation << ", halves differ " << t.cross_validation_px
+            << " px, predicted " << t.cross_validation_expected_px << " px\n";
+  EXPECT_NEAR(run.corner_correlation, rho, 0.1);
+  EXPECT_NEAR(t.noise_inflation, std::sqrt(1 + 3 * rho), 0.15);
+  EXPECT_NEAR(run.noise_inflation, t.noise_inflation, 1e-9);
+  EXPECT_TRUE(t.supported);
+  // Independent noise of the same variance: no inflation.
+  SyntheticCapture independent = truth;
+  independent.tag_shift_px = 0;
+  independent.noise_px = std::sqrt(0.2 * 0.2 + 0.1 * 0.1);
+  const CalibrationRun plain =
+      SolveSynthetic(SyntheticViews(spec, independent), spec, 640, 480, "opencv4", true);
+  std::cout << "independent: rho " << plain.corner_correlation << ", inflation "
+            << plain.choice.trials[0].noise_inflation << "\n";
+  EXPECT_NEAR(plain.corner_correlation, 0, 0.1);
+  EXPECT_LT(plain.choice.trials[0].noise_inflation, 1.15);
+}
+
 }  // namespace
 }  // namespace fresco::calib

@@ -43,11 +43,15 @@ std::vector<BoardView> SyntheticViews(const BoardSpec& spec, const SyntheticCapt
     std::vector<Eigen::Vector2d> q;
     EXPECT_TRUE(ProjectPoints(capture.lensmodel, capture.intrinsics, points, &q));
     BoardView view{"view" + std::to_string(v), {}};
+    std::normal_distribution<double> shift(0, std::max(capture.tag_shift_px, 1e-300));
+    Eigen::Vector2d tag_shift = Eigen::Vector2d::Zero();
     for (int id = 0; id < spec.NumCorners(); ++id) {
+      if (capture.tag_shift_px > 0 && id % 4 == 0)
+        tag_shift = Eigen::Vector2d(shift(rng), shift(rng));
       if (!(q[id].x() >= 0 && q[id].y() >= 0 && q[id].x() <= capture.width - 1 &&
             q[id].y() <= capture.height - 1))
         continue;
-      view.corners.push_back({id, q[id] + Eigen::Vector2d(noise(rng), noise(rng))});
+      view.corners.push_back({id, q[id] + tag_shift + Eigen::Vector2d(noise(rng), noise(rng))});
     }
     views.push_back(view);
   }

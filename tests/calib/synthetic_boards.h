@@ -24,6 +24,10 @@ struct SyntheticCapture {
   int width = 640, height = 480;
   int views = 14;
   double noise_px = 0.2;
+  // AprilGrid: one shift per tag shared by its 4 corners (the correlated part of AprilTag
+  // corner noise), added to the independent noise_px; corner-to-corner correlation is
+  // tag_shift^2 / (tag_shift^2 + noise^2).
+  double tag_shift_px = 0;
   Placement placement = Placement::kSweep;
   double distance_m = 0.42;  // mean distance of the board's centre
   unsigned seed = 7;

@@ -272,7 +272,7 @@ class CalibrationPanel : public Panel {
     const ImGuiTableFlags flags =
         ImGuiTableFlags_RowBg | ImGuiTableFlags_Borders | ImGuiTableFlags_SizingFixedFit;
     if (!ImGui::BeginTable("models", 5, flags)) return;
-    for (const char* h : {"model", "rms px", "sigma px", "cross-val px", "verdict"})
+    for (const char* h : {"model", "rms px", "sigma px", "halves / limit px", "verdict"})
       ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
     for (int i = 0; i < static_cast<int>(snap.run.choice.trials.size()); ++i) {
@@ -296,7 +296,7 @@ class CalibrationPanel : public Panel {
       if (t.cross_validation_px < 0)
         ImGui::TextDisabled("-");
       else
-        ImGui::Text("%.4f", t.cross_validation_px);
+        ImGui::Text("%.4f / %.4f", t.cross_validation_px, calib::AgreementLimit_px(t));
       ImGui::TableSetColumnIndex(4);
       ImGui::Text("%s%s", t.fits ? "fits" : "does not fit", t.supported ? "" : ", halves disagree");
     }
