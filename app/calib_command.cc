@@ -5,8 +5,10 @@
 // exit 2; every output is written atomically.
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "app/commands.h"
+#include "app/progress.h"
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
 #include "calib/report.h"
@@ -73,6 +75,17 @@ int RunSolve(const CommandArgs& argv) {
   const std::string out = args.Get("--out");
   const bool quiet = args.Switch("--quiet");
 
+  // Progress on stderr: detection image by image, then each solve (auto on 30 AprilGrid
+  // images runs 15 solves over minutes).
+  std::unique_ptr<Progress> detect_progress, solve_progress;
+  request.progress = [&](const std::string& stage, int done, int total, const std::string& what) {
+    std::unique_ptr<Progress>& bar = stage == "detect" ? detect_progress : solve_progress;
+    if (!bar) {
+      if (stage == "solve" && detect_progress) detect_progress->Finish();
+      bar = std::make_unique<Progress>("calib " + stage, total, quiet);
+    }
+    bar->Update(done, what);
+  };
   calib::CalibrationRun run;
   if (Status s = calib::DetectViews(request, &run); !s.ok()) {
     for (const calib::RejectedImage& r : run.rejected)
@@ -83,6 +96,7 @@ int RunSolve(const CommandArgs& argv) {
     std::cerr << "fresco calib solve: " << s.message() << "\n";
     return kExitFailure;
   }
+  if (solve_progress) solve_progress->Finish();
   calib::CalibrationOutputs outputs;
   outputs.pictures = !args.Switch("--no-pictures");
   outputs.corners_vnl = args.Get("--corners-vnl");

@@ -218,7 +218,12 @@ bool DetectImage(const std::string& path, const CalibrateRequest& request, Calib
 Status DetectViews(const CalibrateRequest& request, CalibrationRun* run) {
   std::vector<std::string> paths;
   FRESCO_RETURN_IF_ERROR(ListImages(request.images_dir, &paths));
-  for (const std::string& path : paths) DetectImage(path, request, run);
+  for (size_t i = 0; i < paths.size(); ++i) {
+    if (request.progress)
+      request.progress("detect", static_cast<int>(i), static_cast<int>(paths.size()),
+                       fs::path(paths[i]).filename().string());
+    DetectImage(paths[i], request, run);
+  }
   if (static_cast<int>(run->views.size()) < kMinViews)
     return Status::Error(request.images_dir + ": IMAGES_DIR: the board (" + request.board.text +
                          ") was found in " + std::to_string(run->views.size()) + " of " +
@@ -240,6 +245,10 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   SelectOptions select;
   if (request.model != "auto") select.candidates = {request.model};
   select.cross_validate = request.cross_validate;
+  if (request.progress)
+    select.progress = [&request](int done, int total, const std::string& what) {
+      request.progress("solve", done, total, what);
+    };
   FRESCO_RETURN_IF_ERROR(FitLensModels(run->views, request.board, run->width, run->height,
                                        run->seed, select, &run->choice));
   for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);

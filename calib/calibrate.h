@@ -4,6 +4,7 @@
 // part of the imager never observed, boards never tilted), as warnings.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +20,10 @@ struct CalibrateRequest {
   std::string model = "auto";  // auto or a short name (LensModelShortNames)
   DetectOptions detect;
   bool cross_validate = true;
+  // Optional, for long runs: DetectViews calls it before each image ("detect", image name),
+  // SolveViews before each solve ("solve", model and data); `done` of `total` finished.
+  std::function<void(const std::string& stage, int done, int total, const std::string& what)>
+      progress;
 };
 
 struct RejectedImage {

@@ -35,7 +35,7 @@ CalibrationSeed SubsetSeed(const CalibrationSeed& seed, const std::vector<int>& 
 void CrossValidate(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
                    int height, const CalibrationSeed& seed, const std::vector<int> (&halves)[2],
                    const SolveOptions& solve, const std::vector<Eigen::Vector2d>& observed,
-                   ModelTrial* trial) {
+                   const std::function<void(const std::string&)>& starting, ModelTrial* trial) {
   SolveResult half_fit[2];
   SolveOptions half = solve;
   half.compute_uncertainty = true;
@@ -43,6 +43,8 @@ void CrossValidate(const std::vector<BoardView>& views, const BoardSpec& spec, i
   for (int h = 0; h < 2; ++h) {
     std::vector<BoardView> subset;
     for (int i : halves[h]) subset.push_back(views[i]);
+    starting(trial->short_name + ": half " + std::to_string(h + 1) + " (" +
+             std::to_string(subset.size()) + " images)");
     if (!SolveIntrinsics(subset, spec, width, height, SubsetSeed(seed, halves[h]), half,
                          &half_fit[h])
              .ok())
@@ -139,6 +141,13 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
                            " usable images: too few to cross-validate (need " +
                            std::to_string(2 * kMinViewsPerHalf) + ")");
   const std::vector<Eigen::Vector2d> observed = ObservedPixels(views, width, height);
+  const int total_solves =
+      static_cast<int>(options.candidates.size()) * (can_cross_validate ? 3 : 1);
+  int solves_started = 0;
+  auto starting = [&](const std::string& what) {
+    if (options.progress) options.progress(solves_started, total_solves, what);
+    ++solves_started;
+  };
   for (const std::string& short_name : options.candidates) {
     ModelTrial trial;
     trial.short_name = short_name;
@@ -147,11 +156,12 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
       return Status::Error("--model: unknown lens model '" + short_name + "'");
     SolveOptions solve = options.solve;
     solve.lensmodel = trial.lensmodel;
+    starting(short_name + ": all " + std::to_string(views.size()) + " images");
     trial.status = SolveIntrinsics(views, spec, width, height, seed, solve, &trial.fit);
     if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid)
       trial.noise_inflation = TagNoiseInflation(TagCornerCorrelation(views, trial.fit));
-    if (trial.status.ok() && can_cross_validate) CrossValidate(views, spec, width, height, seed,
-                                                               halves, solve, observed, &trial);
+    if (trial.status.ok() && can_cross_validate)
+      CrossValidate(views, spec, width, height, seed, halves, solve, observed, starting, &trial);
     out.trials.push_back(std::move(trial));
   }
   // Supported first: a model whose halves disagree overfits, and its low sigma is no

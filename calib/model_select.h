@@ -23,6 +23,7 @@
 // one, with a warning.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -61,10 +62,14 @@ struct ModelChoice {
   std::vector<std::string> warnings;
 };
 
+// Called before each solve: `done` of `total` solves finished, `what` the one starting.
+using SolveProgress = std::function<void(int done, int total, const std::string& what)>;
+
 struct SelectOptions {
   std::vector<std::string> candidates = LensModelShortNames();
   SolveOptions solve;                 // lensmodel is set per candidate
   bool cross_validate = true;
+  SolveProgress progress;             // optional
 };
 
 constexpr double kFitTolerance = 0.03;  // sigma may exceed the best by 3 %

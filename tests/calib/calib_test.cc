@@ -241,6 +241,11 @@ TEST(RealDataTest, OpenCVChessboardLeftFocalWithinHalfPercent) {
   EXPECT_LT(report["rms_px"].get<double>(), 0.39);
   EXPECT_EQ(report["images_used"].size(), 13u);
   EXPECT_EQ(report["lensmodel"], "LENSMODEL_OPENCV4");
+  // Progress on stderr (not a terminal: plain lines): every image, then the three solves.
+  EXPECT_NE(r.err.find("calib detect: 0/13 ("), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("calib detect: done in"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(") opencv4: half 2 (6 images)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("calib solve: done in"), std::string::npos) << r.err;
   // mrcal's own reader and, when installed, mrcal-calibrate-cameras on the same corners.
   if (std::system("/usr/bin/python3 -c 'import mrcal' 2>/dev/null") != 0)
     GTEST_SKIP() << "python3-mrcal is absent: mrcal cross-check skipped";

@@ -136,7 +136,13 @@ void CalibrationRunner::RunSolve() {
   calib::CalibrationRun run = working_.run;  // detections kept if the solve fails
   run.choice = {};
   run.warnings.clear();
-  if (Status s = calib::SolveViews(working_.request, &run); !s.ok()) {
+  calib::CalibrateRequest request = working_.request;
+  request.progress = [this](const std::string&, int done, int total, const std::string& what) {
+    working_.status = "solving " + std::to_string(done + 1) + "/" + std::to_string(total) + ": " +
+                      what;
+    Publish();
+  };
+  if (Status s = calib::SolveViews(request, &run); !s.ok()) {
     working_.status = "error: " + s.message();
     return;
   }
