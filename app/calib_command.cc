@@ -119,13 +119,9 @@ int RunSolve(const CommandArgs& argv) {
         std::cout << "model " << t.short_name << ": failed: " << t.status.message() << "\n";
         continue;
       }
-      std::snprintf(line, sizeof(line),
-                    "model %-8s rms %.4f px  sigma %.4f px  cross-validation %.4f px (limit "
-                    "%.4f)  %s%s\n",
-                    t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px, t.cross_validation_px,
-                    calib::AgreementLimit_px(t), t.fits ? "fits" : "does not fit",
-                    t.supported ? "" : ", halves disagree");
-      std::cout << line;
+      std::snprintf(line, sizeof(line), "model %-8s rms %.4f px  sigma %.4f px  ",
+                    t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px);
+      std::cout << line << calib::CrossValidationText(t) << "  " << calib::VerdictText(t) << "\n";
     }
     const calib::SolveResult& fit = run.Chosen().fit;
     std::cout << "chosen " << run.Chosen().short_name << " (" << run.Chosen().lensmodel << "): fx "

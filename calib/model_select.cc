@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "calib/lens_projection.h"
 #include "calib/noise_correlation.h"
@@ -68,6 +70,22 @@ void CrossValidate(const std::vector<BoardView>& views, const BoardSpec& spec, i
       half_fit[1].noise_sigma_px * trial->noise_inflation, pixels);
 }
 
+// RMS over `pixels` of the trial's projection uncertainty at infinity (corner noise times its
+// inflation); -1 when it cannot be computed anywhere.
+double RmsProjectionUncertainty_px(const ModelTrial& trial,
+                                   const std::vector<Eigen::Vector2d>& pixels) {
+  double sum = 0;
+  int count = 0;
+  for (const Eigen::Vector2d& pixel : pixels) {
+    const double u = ProjectionUncertainty_px(trial.fit, pixel, /*range_m=*/0,
+                                              trial.fit.noise_sigma_px * trial.noise_inflation);
+    if (u < 0 || !std::isfinite(u)) continue;
+    sum += u * u;
+    ++count;
+  }
+  return count > 0 ? std::sqrt(sum / count) : -1;
+}
+
 }  // namespace
 
 const std::vector<std::string>& LensModelShortNames() {
@@ -106,6 +124,20 @@ double AgreementLimit_px(const ModelTrial& trial) {
                               ? trial.cross_validation_expected_px
                               : trial.fit.noise_sigma_px * trial.noise_inflation;
   return std::max(kAgreeFactor * expected, kAgreeFloorPx);
+}
+
+std::string CrossValidationText(const ModelTrial& trial) {
+  if (trial.halves_skipped) return "halves not compared (not needed)";
+  if (trial.cross_validation_px < 0) return "halves not compared";
+  return "halves differ " + Fixed(trial.cross_validation_px, 4) + " px (limit " +
+         Fixed(AgreementLimit_px(trial), 4) + ")";
+}
+
+std::string VerdictText(const ModelTrial& trial) {
+  if (!trial.status.ok()) return "failed";
+  std::string text = trial.fits ? "fits" : "does not fit";
+  if (!trial.supported && !trial.halves_skipped) text += ", halves disagree";
+  return text;
 }
 
 std::vector<Eigen::Vector2d> ObservedPixels(const std::vector<BoardView>& views, int width,
@@ -160,59 +192,112 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
     trial.status = SolveIntrinsics(views, spec, width, height, seed, solve, &trial.fit);
     if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid)
       trial.noise_inflation = TagNoiseInflation(TagCornerCorrelation(views, trial.fit));
-    if (trial.status.ok() && can_cross_validate)
-      CrossValidate(views, spec, width, height, seed, halves, solve, observed, starting, &trial);
     out.trials.push_back(std::move(trial));
   }
-  // Supported first: a model whose halves disagree overfits, and its low sigma is no
-  // yardstick for the others.
-  for (ModelTrial& t : out.trials)
-    if (t.status.ok())
-      t.supported = t.cross_validation_px < 0 ? !can_cross_validate
-                                              : t.cross_validation_px <= AgreementLimit_px(t);
-  double best_sigma = std::numeric_limits<double>::infinity();
-  int best = -1;
-  for (int pass = 0; pass < 2 && best < 0; ++pass)
-    for (size_t i = 0; i < out.trials.size(); ++i)
-      if (out.trials[i].status.ok() && (pass == 1 || out.trials[i].supported) &&
-          out.trials[i].fit.noise_sigma_px < best_sigma) {
-        best_sigma = out.trials[i].fit.noise_sigma_px;
-        best = static_cast<int>(i);
+  if (std::none_of(out.trials.begin(), out.trials.end(),
+                   [](const ModelTrial& t) { return t.status.ok(); }))
+    return Status::Error("no lens model could be solved: " + out.trials[0].status.message());
+
+  // The halves are solved only where the choice depends on them (splined's halves are most
+  // of `auto`'s time on an AprilGrid): agree[i] is -1 until model i's halves are compared.
+  const int n = static_cast<int>(out.trials.size());
+  std::vector<int> agree(n, can_cross_validate ? -1 : 1);
+  for (int i = 0; i < n; ++i)
+    if (!out.trials[i].status.ok()) agree[i] = 0;
+  auto compare_halves = [&](int i) {
+    ModelTrial& t = out.trials[i];
+    SolveOptions solve = options.solve;
+    solve.lensmodel = t.lensmodel;
+    CrossValidate(views, spec, width, height, seed, halves, solve, observed, starting, &t);
+    agree[i] = t.cross_validation_px >= 0 && t.cross_validation_px <= AgreementLimit_px(t);
+  };
+  if (options.all_halves)
+    for (int i = 0; i < n; ++i)
+      if (agree[i] < 0) compare_halves(i);
+  std::vector<int> by_sigma;
+  for (int i = 0; i < n; ++i)
+    if (out.trials[i].status.ok()) by_sigma.push_back(i);
+  std::stable_sort(by_sigma.begin(), by_sigma.end(), [&](int a, int b) {
+    return out.trials[a].fit.noise_sigma_px < out.trials[b].fit.noise_sigma_px;
+  });
+  // The yardstick is the supported model with the lowest sigma: any model not yet compared
+  // below the lowest known-supported one may still be it.
+  auto possible_yardsticks = [&] {
+    std::vector<int> possible;
+    for (int i : by_sigma) {
+      if (agree[i] == 0) continue;
+      possible.push_back(i);
+      if (agree[i] == 1) break;
+    }
+    return possible;
+  };
+  std::map<int, double> uncertainty_of;             // yardstick -> RMS projection uncertainty
+  std::map<std::pair<int, int>, double> diff_of;    // (model, yardstick) -> projection diff
+  auto uncertainty = [&](int y) {
+    auto it = uncertainty_of.find(y);
+    if (it == uncertainty_of.end())
+      it = uncertainty_of.emplace(y, RmsProjectionUncertainty_px(out.trials[y], observed)).first;
+    return it->second;
+  };
+  auto projection_diff = [&](int i, int y) {
+    auto it = diff_of.find({i, y});
+    if (it == diff_of.end()) {
+      double d = ProjectionDifference_px(out.trials[i].fit.lensmodel, out.trials[i].fit.intrinsics,
+                                         out.trials[y].fit.lensmodel, out.trials[y].fit.intrinsics,
+                                         observed);
+      it = diff_of.emplace(std::make_pair(i, y), std::isfinite(d) ? d : -1).first;
+    }
+    return it->second;
+  };
+  // FITS against yardstick y: sigma within kFitTolerance of y's, or a projection within y's
+  // own uncertainty of y's (the richer model's gain is then below its own noise).
+  auto fits = [&](int i, int y) {
+    if (out.trials[i].fit.noise_sigma_px <= out.trials[y].fit.noise_sigma_px * (1 + kFitTolerance))
+      return true;
+    const double d = projection_diff(i, y);
+    return d >= 0 && d <= uncertainty(y);
+  };
+  // Simple to rich: the first model that is supported and fits whichever the yardstick turns
+  // out to be. Where that is open, the simplest (cheapest) model whose halves would settle it
+  // is compared, and the search starts again.
+  while (out.chosen < 0) {
+    const std::vector<int> possible = possible_yardsticks();
+    if (possible.empty()) break;  // no model's halves agree
+    int settle = -1;
+    for (int i = 0; i < n && out.chosen < 0 && settle < 0; ++i) {
+      if (agree[i] == 0) continue;
+      int fitting = 0;
+      for (int y : possible) fitting += fits(i, y);
+      if (fitting == 0) continue;  // too simple whichever model is the yardstick
+      if (fitting == static_cast<int>(possible.size()) && agree[i] == 1) {
+        out.chosen = i;
+        break;
       }
-  if (best < 0) return Status::Error("no lens model could be solved: " + out.trials[0].status.message());
-  for (ModelTrial& t : out.trials)
-    if (t.status.ok()) t.fits = t.fit.noise_sigma_px <= best_sigma * (1 + kFitTolerance);
-  // A model whose sigma is higher still fits when it projects like the best model within what
-  // the best model itself cannot pin down (its projection uncertainty where boards were seen):
-  // the richer model's gain is then below its own noise.
-  const ModelTrial& yardstick = out.trials[best];
-  double uncertainty_sum = 0;
-  int uncertainty_count = 0;
-  for (const Eigen::Vector2d& pixel : observed) {
-    const double u =
-        ProjectionUncertainty_px(yardstick.fit, pixel, /*range_m=*/0,
-                                 yardstick.fit.noise_sigma_px * yardstick.noise_inflation);
-    if (u < 0 || !std::isfinite(u)) continue;
-    uncertainty_sum += u * u;
-    ++uncertainty_count;
+      settle = agree[i] < 0 ? i : n;
+      for (int y : possible)
+        if (agree[y] < 0) settle = std::min(settle, y);
+    }
+    if (out.chosen >= 0 || settle < 0 || settle >= n) break;
+    compare_halves(settle);
   }
-  const double best_uncertainty_px =
-      uncertainty_count > 0 ? std::sqrt(uncertainty_sum / uncertainty_count) : -1;
-  for (ModelTrial& t : out.trials) {
-    if (!t.status.ok()) continue;
-    t.best_uncertainty_px = best_uncertainty_px;
-    t.projection_vs_best_px =
-        ProjectionDifference_px(t.fit.lensmodel, t.fit.intrinsics, yardstick.fit.lensmodel,
-                                yardstick.fit.intrinsics, observed);
-    if (!std::isfinite(t.projection_vs_best_px)) t.projection_vs_best_px = -1;
-    if (t.projection_vs_best_px >= 0 && t.projection_vs_best_px <= best_uncertainty_px)
-      t.fits = true;
-  }
-  for (size_t i = 0; i < out.trials.size(); ++i)
-    if (out.trials[i].fits && out.trials[i].supported) {
-      out.chosen = static_cast<int>(i);
+  // Report every model against the yardstick: the lowest-sigma supported model (or, when no
+  // model's halves agree, the lowest-sigma one).
+  int best = -1;
+  for (int i : by_sigma)
+    if (agree[i] == 1) {
+      best = i;
       break;
     }
+  if (best < 0) best = by_sigma.front();
+  for (int i = 0; i < n; ++i) {
+    ModelTrial& t = out.trials[i];
+    if (!t.status.ok()) continue;
+    t.supported = agree[i] == 1;
+    t.halves_skipped = agree[i] < 0;
+    t.fits = fits(i, best);
+    t.projection_vs_best_px = projection_diff(i, best);
+    t.best_uncertainty_px = uncertainty(best);
+  }
   if (out.chosen < 0) {
     out.chosen = best;
     out.warnings.push_back("no model both fits and has halves that agree; kept the best fit, " +

@@ -52,6 +52,8 @@ struct ModelTrial {
   // observed pixels, and that model's RMS projection uncertainty there (-1: not computed).
   double projection_vs_best_px = -1;
   double best_uncertainty_px = -1;
+  // The halves were not solved: the choice did not depend on them (cross_validation_px -1).
+  bool halves_skipped = false;
   bool fits = false;
   bool supported = false;
 };
@@ -70,6 +72,9 @@ struct SelectOptions {
   SolveOptions solve;                 // lensmodel is set per candidate
   bool cross_validate = true;
   SolveProgress progress;             // optional
+  // Solve every model's halves even where the choice does not depend on them (the choice is
+  // the same; the report then has every model's cross-validation).
+  bool all_halves = false;
 };
 
 constexpr double kFitTolerance = 0.03;  // sigma may exceed the best by 3 %
@@ -78,6 +83,10 @@ constexpr double kAgreeFloorPx = 0.3;   // differences this small always agree
 
 // The largest cross_validation_px with which `trial` is supported.
 double AgreementLimit_px(const ModelTrial& trial);
+// For people: "halves differ 0.0908 px (limit 0.8254)", "halves not compared (not needed)"
+// or "halves not compared"; and "fits", "does not fit, halves disagree", ...
+std::string CrossValidationText(const ModelTrial& trial);
+std::string VerdictText(const ModelTrial& trial);
 
 Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
                      int height, const CalibrationSeed& seed, const SelectOptions& options,

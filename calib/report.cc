@@ -41,6 +41,7 @@ nlohmann::json TrialJson(const ModelTrial& t) {
   j["cross_validation_px"] = t.cross_validation_px;
   j["cross_validation_expected_px"] = t.cross_validation_expected_px;
   j["cross_validation_limit_px"] = AgreementLimit_px(t);
+  j["halves_skipped"] = t.halves_skipped;
   j["noise_inflation"] = t.noise_inflation;
   j["projection_vs_best_px"] = t.projection_vs_best_px;
   j["best_uncertainty_px"] = t.best_uncertainty_px;
@@ -147,7 +148,8 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
       "<= best_uncertainty_px) and whose two "
       "half-data solves agree: cross_validation_px <= max(3 x cross_validation_expected_px, "
       "0.3 px), the expected difference being sqrt(u0^2 + u1^2) RMS from the halves' own "
-      "projection uncertainty at infinity (corner noise x the AprilTag inflation)";
+      "projection uncertainty at infinity (corner noise x the AprilTag inflation); halves are "
+      "solved only where the choice depends on them (halves_skipped: it did not)";
   j["seed"] = {{"method", "OpenCV calibrateCamera, k1 k2 only"},
                {"fx", run.seed.fx},
                {"fy", run.seed.fy},

@@ -278,5 +278,38 @@ TEST(CrossValidationTest, CorrelatedTagNoiseIsMeasuredAndInflatesTheUncertainty)
   EXPECT_LT(plain.choice.trials[0].noise_inflation, 1.15);
 }
 
+// `auto` solves a model's halves only where the choice depends on them: the choice, and every
+// verdict it rests on, is the same as with every model's halves solved.
+TEST(CrossValidationTest, SkippingUnneededHalvesChoosesTheSame) {
+  const BoardSpec spec = Spec("chessboard:10x7:0.03");
+  SyntheticCapture pinhole;
+  for (const SyntheticCapture& truth : {pinhole, MildOpenCV4(), HeavyDistortion()}) {
+    SCOPED_TRACE(truth.lensmodel);
+    const auto views = SyntheticViews(spec, truth);
+    CalibrationSeed seed;
+    ASSERT_TRUE(SeedCalibration(views, spec, 640, 480, &seed).ok());
+    SelectOptions lazy, all;
+    all.all_halves = true;
+    int lazy_solves = 0;
+    lazy.progress = [&](int, int, const std::string&) { ++lazy_solves; };
+    ModelChoice a, b;
+    ASSERT_TRUE(FitLensModels(views, spec, 640, 480, seed, lazy, &a).ok());
+    ASSERT_TRUE(FitLensModels(views, spec, 640, 480, seed, all, &b).ok());
+    ASSERT_EQ(a.trials.size(), b.trials.size());
+    std::cout << truth.lensmodel << ": chosen " << a.trials[a.chosen].short_name << " with "
+              << lazy_solves << " solves (all halves: " << 3 * a.trials.size() << ")\n";
+    EXPECT_EQ(a.chosen, b.chosen);
+    EXPECT_LT(lazy_solves, static_cast<int>(3 * a.trials.size()));
+    for (size_t i = 0; i < a.trials.size(); ++i) {
+      EXPECT_FALSE(b.trials[i].halves_skipped);
+      if (a.trials[i].halves_skipped) continue;
+      EXPECT_EQ(a.trials[i].supported, b.trials[i].supported) << a.trials[i].short_name;
+      EXPECT_DOUBLE_EQ(a.trials[i].cross_validation_px, b.trials[i].cross_validation_px);
+    }
+    EXPECT_TRUE(a.trials[a.chosen].supported);
+    EXPECT_FALSE(a.trials[a.chosen].halves_skipped);
+  }
+}
+
 }  // namespace
 }  // namespace fresco::calib

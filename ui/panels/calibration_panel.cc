@@ -294,11 +294,11 @@ class CalibrationPanel : public Panel {
       ImGui::Text("%.4f", t.fit.noise_sigma_px);
       ImGui::TableSetColumnIndex(3);
       if (t.cross_validation_px < 0)
-        ImGui::TextDisabled("-");
+        ImGui::TextDisabled(t.halves_skipped ? "not needed" : "-");
       else
         ImGui::Text("%.4f / %.4f", t.cross_validation_px, calib::AgreementLimit_px(t));
       ImGui::TableSetColumnIndex(4);
-      ImGui::Text("%s%s", t.fits ? "fits" : "does not fit", t.supported ? "" : ", halves disagree");
+      ImGui::TextUnformatted(calib::VerdictText(t).c_str());
     }
     ImGui::EndTable();
   }
