@@ -39,6 +39,8 @@ CAMERA.report.json, CAMERA.residuals.png, CAMERA.coverage.png and CAMERA.uncerta
                        mrcal-calibrate-cameras)
   --no-pictures        do not write the PNG pictures
   --no-cross-validation  skip the half-data solves (faster; auto then compares fits only)
+  --all-halves         solve every model's halves, even where the choice does not depend
+                       on them (same choice, slower; the report then compares all)
   --no-refine          AprilGrid: keep the apriltag library's corners (no cornerSubPix)
   --quiet              no summary on stdout)";
 
@@ -55,7 +57,8 @@ int RunSolve(const CommandArgs& argv) {
   spec.min_positional = 1;
   spec.max_positional = 1;
   spec.options = {"--board", "--out", "--model", "--corners-vnl"};
-  spec.switches = {"--no-pictures", "--no-cross-validation", "--no-refine", "--quiet"};
+  spec.switches = {"--no-pictures", "--no-cross-validation", "--all-halves", "--no-refine",
+                   "--quiet"};
   spec.required = {"--board", "--out"};
   Args args;
   if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
@@ -71,6 +74,7 @@ int RunSolve(const CommandArgs& argv) {
                       "--model: '" + request.model +
                           "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
   request.cross_validate = !args.Switch("--no-cross-validation");
+  request.all_halves = args.Switch("--all-halves");
   request.detect.refine_tag_corners = !args.Switch("--no-refine");
   const std::string out = args.Get("--out");
   const bool quiet = args.Switch("--quiet");

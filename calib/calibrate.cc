@@ -245,6 +245,7 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   SelectOptions select;
   if (request.model != "auto") select.candidates = {request.model};
   select.cross_validate = request.cross_validate;
+  select.all_halves = request.all_halves;
   if (request.progress)
     select.progress = [&request](int done, int total, const std::string& what) {
       request.progress("solve", done, total, what);

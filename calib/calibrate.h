@@ -20,6 +20,7 @@ struct CalibrateRequest {
   std::string model = "auto";  // auto or a short name (LensModelShortNames)
   DetectOptions detect;
   bool cross_validate = true;
+  bool all_halves = false;  // SelectOptions::all_halves
   // Optional, for long runs: DetectViews calls it before each image ("detect", image name),
   // SolveViews before each solve ("solve", model and data); `done` of `total` finished.
   std::function<void(const std::string& stage, int done, int total, const std::string& what)>
