@@ -102,9 +102,20 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   j["offset_estimated"] = s.offset_estimated;
   if (live.feed) {
     const PoseFeedStats f = live.feed->stats();
+    nlohmann::json gaps = nlohmann::json::array();
+    for (const PoseFeedGap& g : f.gaps)  // NaN (no pose on that side) is written as null
+      gaps.push_back({{"last_pose_before_s", g.last_pose_before_s},
+                      {"first_pose_after_s", g.first_pose_after_s},
+                      {"tracker_gap_s", g.tracker_gap_s()},
+                      {"disconnected_s", g.disconnected_s},
+                      {"attempts", g.attempts},
+                      {"reconnected", g.reconnected}});
     j["pose_feed"] = {{"address", live.feed->address()},
                       {"poses", f.poses},
                       {"reconnects", f.reconnects},
+                      {"disconnects", f.disconnects},
+                      {"disconnected_s", f.disconnected_s},
+                      {"gaps", gaps},
                       {"connected", f.connected},
                       {"seconds_since_last_pose", f.seconds_since_last_pose}};
   }

@@ -246,6 +246,157 @@ TEST(PoseFeedTest, TcpFeedInterpolatesAndReconnects) {
   EXPECT_FALSE(feed->WaitPoseAt(5.0, 0.05, &pose)) << "beyond the track";
 }
 
+// A file-like source (read on demand, nothing dropped) of tiny frames at given times.
+class TimedFrameSource : public VideoSource {
+ public:
+  explicit TimedFrameSource(std::vector<double> times_s) : times_s_(std::move(times_s)) {}
+  bool Next(Frame* frame, Status*) override {
+    if (next_ >= times_s_.size()) return false;
+    frame->index = static_cast<int>(next_);
+    frame->timestamp_s = times_s_[next_++];
+    frame->bgr = cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 0, 0));
+    return true;
+  }
+  int FrameCount() const override { return static_cast<int>(times_s_.size()); }
+  std::vector<std::string> FrameNames() const override { return {}; }
+  double Fps() const override { return 10; }
+
+ private:
+  std::vector<double> times_s_;
+  size_t next_ = 0;
+};
+
+// Mid-stream the tracker goes away (its connection and its listening socket close) and comes
+// back on the same port 0.5 s later. The feed reconnects once, reports the gap (tracker time
+// 1.0 s to 2.0 s), and frames after the gap are matched to the tracker's poses again.
+TEST(PoseFeedTest, TrackerGoingAwayMidStreamIsReconnectedAndTheGapReported) {
+  auto server = std::make_unique<testing::PoseServer>();
+  const int port = server->port();
+  const std::string address = server->Address();
+  std::string before, after;
+  for (int i = 0; i <= 10; ++i) before += TumLine(Motion(0.1 * i));  // 0 .. 1.0 s
+  for (int i = 20; i <= 30; ++i) after += TumLine(Motion(0.1 * i));  // 2.0 .. 3.0 s
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool checked = false;
+  std::thread tracker([&] {
+    int c = server->Accept();
+    ASSERT_GE(c, 0);
+    send(c, before.data(), before.size(), MSG_NOSIGNAL);
+    server->Close();  // refused from now on (before the feed sees the connection end)
+    close(c);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    testing::PoseServer again(port);
+    c = again.Accept();
+    ASSERT_GE(c, 0);
+    send(c, after.data(), after.size(), MSG_NOSIGNAL);
+    std::unique_lock<std::mutex> lock(mutex);  // stays connected until the test has checked
+    cv.wait_for(lock, std::chrono::seconds(60), [&] { return checked; });
+    close(c);
+  });
+  PoseFeedOptions options;
+  options.reconnect_interval_s = 0.05;
+  options.reconnect_max_interval_s = 0.2;
+  std::unique_ptr<PoseFeed> feed;
+  const Status opened = PoseFeed::Open(address, options, &feed);
+  ASSERT_TRUE(opened.ok()) << opened.message();
+
+  // The painter's view: a frame every 0.1 s from 0 to 3 s, offset 0, poses from the feed.
+  std::vector<double> times;
+  for (int i = 0; i <= 30; ++i) times.push_back(0.1 * i);
+  LiveOptions live;
+  live.pose_wait_s = 20.0;  // a safety limit: frames wait for the tracker to come back
+  LiveFrames frames(
+      std::make_unique<TimedFrameSource>(times), nullptr,
+      [&](double t, double timeout_s, Rigid3d* pose) {
+        return feed->WaitPoseAt(t, timeout_s, pose);
+      },
+      live, 0.0, nullptr);
+  PosedFrame f;
+  Status status;
+  std::vector<int> with_pose, without_pose;
+  while (frames.Next(&f, &status)) {
+    (f.has_pose ? with_pose : without_pose).push_back(f.frame.index);
+    if (!f.has_pose) continue;
+    EXPECT_LT(CentreError(f.cam_from_world, Motion(f.frame.timestamp_s)), 1e-9) << f.frame.index;
+    EXPECT_LT(AngleErrorDeg(f.cam_from_world, Motion(f.frame.timestamp_s)), 1e-6);
+  }
+  EXPECT_TRUE(status.ok()) << status.message();
+  // Frames 0..10 (before) and 20..30 (after the reconnect) have poses; 11..19 fall in the
+  // 1 s gap (wider than max_gap_s, 0.5 s): none is interpolated across it.
+  std::vector<int> expected_with, expected_without;
+  for (int i = 0; i <= 30; ++i)
+    (i <= 10 || i >= 20 ? expected_with : expected_without).push_back(i);
+  EXPECT_EQ(with_pose, expected_with);
+  EXPECT_EQ(without_pose, expected_without);
+  EXPECT_EQ(frames.stats().frames_without_pose, 9);
+  Rigid3d pose;
+  ASSERT_TRUE(feed->WaitPoseAt(2.55, 1.0, &pose));
+  EXPECT_LT(CentreError(pose, Motion(2.55)), 1e-9);
+
+  const PoseFeedStats stats = feed->stats();
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    checked = true;
+  }
+  cv.notify_all();
+  tracker.join();
+  EXPECT_TRUE(feed->error().ok()) << feed->error().message();
+  EXPECT_EQ(stats.reconnects, 1);
+  EXPECT_EQ(stats.disconnects, 1);
+  EXPECT_TRUE(stats.connected);
+  EXPECT_EQ(stats.poses, 22);
+  ASSERT_EQ(stats.gaps.size(), 1u);
+  const PoseFeedGap& gap = stats.gaps[0];
+  EXPECT_TRUE(gap.reconnected);
+  EXPECT_NEAR(gap.last_pose_before_s, 1.0, 1e-9);
+  EXPECT_NEAR(gap.first_pose_after_s, 2.0, 1e-9);
+  EXPECT_NEAR(gap.tracker_gap_s(), 1.0, 1e-9);
+  EXPECT_GT(gap.disconnected_s, 0.0);
+  EXPECT_GE(gap.attempts, 2) << "refused at least once while the tracker was away";
+  EXPECT_EQ(stats.disconnected_s, gap.disconnected_s);
+  std::printf("reconnected after %d attempts, %.3f s disconnected; tracker gap %.3f s\n",
+              gap.attempts, gap.disconnected_s, gap.tracker_gap_s());
+}
+
+// A tracker that never comes back: the backoff gives up after reconnect_give_up_s with an
+// error naming the address, and a frame waiting for a pose is released by it.
+TEST(PoseFeedTest, ATrackerThatNeverComesBackEndsTheFeedWithAnError) {
+  auto server = std::make_unique<testing::PoseServer>();
+  const std::string address = server->Address();
+  std::thread tracker([&] {
+    const int c = server->Accept();
+    const std::string line = TumLine(Motion(0.0));
+    send(c, line.data(), line.size(), MSG_NOSIGNAL);
+    server->Close();
+    close(c);
+  });
+  PoseFeedOptions options;
+  options.reconnect_interval_s = 0.02;
+  options.reconnect_max_interval_s = 0.1;
+  options.reconnect_give_up_s = 0.3;
+  std::unique_ptr<PoseFeed> feed;
+  ASSERT_TRUE(PoseFeed::Open(address, options, &feed).ok());
+  tracker.join();
+  Rigid3d pose;
+  EXPECT_FALSE(feed->WaitPoseAt(1.0, 30.0, &pose));  // returns once the feed gives up
+  EXPECT_THAT(feed->error().message(),
+              StartsWith(address + ": the tracker went away and did not come back within 0.3 s"));
+  EXPECT_THAT(feed->error().message(), HasSubstr("Connection refused"));
+  const PoseFeedStats stats = feed->stats();
+  EXPECT_EQ(stats.reconnects, 0);
+  EXPECT_EQ(stats.disconnects, 1);
+  EXPECT_FALSE(stats.connected);
+  ASSERT_EQ(stats.gaps.size(), 1u);
+  EXPECT_FALSE(stats.gaps[0].reconnected);
+  EXPECT_EQ(stats.gaps[0].last_pose_before_s, 0.0);
+  EXPECT_TRUE(std::isnan(stats.gaps[0].first_pose_after_s));
+  EXPECT_GE(stats.gaps[0].disconnected_s, 0.3);
+  // Backoff: 0.02, 0.04, 0.08, 0.1, 0.1 ... apart: a handful of attempts, not hundreds.
+  EXPECT_GE(stats.gaps[0].attempts, 2);
+  EXPECT_LE(stats.gaps[0].attempts, 10);
+}
+
 TEST(PoseFeedTest, MalformedLineIsAnErrorNamingAddressAndLine) {
   testing::PoseServer server;
   std::thread tracker(

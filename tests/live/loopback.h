@@ -31,18 +31,29 @@ inline int FreeLoopbackPort(int type) {
 // A one-connection-at-a-time TCP server on 127.0.0.1 (ephemeral port) for pose feeds.
 class PoseServer {
  public:
-  PoseServer() {
+  // Listens on `port` (0: an ephemeral one). SO_REUSEADDR: a server can listen again on the
+  // port of one that closed.
+  explicit PoseServer(int port = 0) {
     fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    const int one = 1;
+    setsockopt(fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
     sockaddr_in addr{};
     addr.sin_family = AF_INET;
     addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    EXPECT_EQ(bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    addr.sin_port = htons(port);
+    EXPECT_EQ(bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0) << "port " << port;
     socklen_t len = sizeof addr;
     getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len);
     port_ = ntohs(addr.sin_port);
     listen(fd_, 4);
   }
-  ~PoseServer() { close(fd_); }
+  ~PoseServer() { Close(); }
+  // Stops listening: connections are refused until a server listens on the port again.
+  void Close() {
+    if (fd_ >= 0) close(fd_);
+    fd_ = -1;
+  }
+  int port() const { return port_; }
   std::string Address() const { return "tcp://127.0.0.1:" + std::to_string(port_); }
   // Waits for a connection; its socket (-1 on failure).
   int Accept() { return accept(fd_, nullptr, nullptr); }

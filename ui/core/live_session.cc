@@ -164,6 +164,11 @@ LiveStatus LiveSession::CurrentStatus() {
     st.poses_connected = p.connected;
     st.poses_received = p.poses;
     st.pose_reconnects = p.reconnects;
+    st.pose_gap_known = !p.gaps.empty();
+    if (st.pose_gap_known) {
+      st.pose_gap_tracker_s = p.gaps.back().tracker_gap_s();
+      st.pose_gap_disconnected_s = p.gaps.back().disconnected_s;
+    }
     st.seconds_since_pose = p.seconds_since_last_pose;
     st.pose_lag_known = delivered_any_ && p.poses > 0;
     if (st.pose_lag_known) st.pose_lag_s = p.latest_time_s - last_pose_time_s_;

@@ -43,6 +43,10 @@ struct LiveStatus {
   bool pose_feed = false;  // poses from a feed (else a TUM file)
   bool poses_connected = false;
   long long poses_received = 0, pose_reconnects = 0;
+  // The last disconnection of the pose feed: tracker time it spans (NaN until the first
+  // pose after it) and wall seconds without a connection; valid when pose_gap_known.
+  bool pose_gap_known = false;
+  double pose_gap_tracker_s = 0, pose_gap_disconnected_s = 0;
   double seconds_since_pose = -1;
   // Pose-match lag: the newest tracker sample's time minus the pose time of the last frame
   // delivered (frame time + offset), seconds; > 0: the tracker is ahead of the video.
