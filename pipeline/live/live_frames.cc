@@ -14,6 +14,20 @@ constexpr size_t kHoldWindows = 4;
 
 }  // namespace
 
+std::string LiveFrames::EndReason(bool timed_out, bool signals_end, long long frames) const {
+  char reason[200];
+  if (!timed_out) {
+    std::snprintf(reason, sizeof reason, "the stream ended after %lld frames", frames);
+  } else {
+    std::snprintf(reason, sizeof reason, "stalled: no frame within %.1f s after %lld frames%s",
+                  options_.read_timeout_s, frames,
+                  signals_end ? ""
+                              : " (the protocol does not signal the end of a stream: it "
+                                "ended or stalled)");
+  }
+  return reason;
+}
+
 LiveFrames::LiveFrames(std::unique_ptr<VideoSource> video, VideoOpener reopen,
                        WaitPoseAtTime pose_at, const LiveOptions& options, double time_offset_s,
                        OffsetEstimator estimator)
@@ -66,6 +80,8 @@ void LiveFrames::CaptureLoop() {
       stats_.end_reason = status.message();
       break;
     }
+    const bool timed_out = video_->TimedOut();
+    const bool signals_end = video_->SignalsEnd();
     if (stats_.video_reopens < options_.reconnects && reopen_ && !stop_) {
       ++stats_.video_reopens;
       std::unique_ptr<VideoSource> again;
@@ -75,11 +91,7 @@ void LiveFrames::CaptureLoop() {
       }
       continue;
     }
-    char reason[160];
-    std::snprintf(reason, sizeof reason,
-                  "no frame within %.1f s after %lld frames (the stream ended or stalled)",
-                  options_.read_timeout_s, stats_.frames_received);
-    stats_.end_reason = reason;
+    stats_.end_reason = EndReason(timed_out, signals_end, stats_.frames_received);
     break;
   }
   queue_.Close();

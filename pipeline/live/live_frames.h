@@ -7,12 +7,12 @@
 // A live video (camera, stream) is read on its own thread into a bounded queue: when the
 // painter is slower than the stream, the oldest waiting frames are dropped and counted, and
 // memory stays bounded. A file video is read directly (nothing is dropped). When the video
-// stops delivering (no frame within its read timeout) it is reopened up to `reconnects`
-// times, then the stream has ended. With offset estimation on, the first frames are held
-// (at most twice the window) until the poses cover them for every candidate offset, then
-// the offset is estimated on another thread while the frames arriving meanwhile are held
-// too (at most four windows or queue_frames in all: beyond, the oldest are dropped and counted), and the
-// held frames are handed out first.
+// stops delivering (its end, or no frame within its read timeout) it is reopened up to
+// `reconnects` times, then the stream has ended (end_reason tells which of the two). With offset
+// estimation on, the first frames are held (at most twice the window) until the poses cover them
+// for every candidate offset, then the offset is estimated on another thread while the frames
+// arriving meanwhile are held too (at most four windows or queue_frames in all: beyond, the oldest
+// are dropped and counted), and the held frames are handed out first.
 #pragma once
 
 #include <deque>
@@ -81,6 +81,9 @@ class LiveFrames {
   bool Pull(Frame* frame, Status* status);  // the next frame from the queue or the file
   bool FillWindowAndEstimate(Status* status);
   bool Usable(const Frame& frame) const;
+  // Why the live video ended: "the stream ended after N frames" when the source said so,
+  // "stalled: no frame within X s after N frames" when reading timed out.
+  std::string EndReason(bool timed_out, bool signals_end, long long frames) const;
 
   std::unique_ptr<VideoSource> video_;
   VideoOpener reopen_;
