@@ -134,6 +134,20 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
                             {"note", s.estimate.note},
                             {"candidates", candidates}};
   }
+  if (!s.offset_track.empty()) {
+    nlohmann::json track = nlohmann::json::array();
+    for (const OffsetTrackPoint& p : s.offset_track)
+      track.push_back({{"window_start_s", p.window_start_s},
+                       {"time_s", p.time_s},
+                       {"frames", p.frames},
+                       {"offset_s", p.offset_s},
+                       {"score", p.score},
+                       {"current_score", p.current_score},
+                       {"ok", p.ok},
+                       {"applied", p.applied},
+                       {"seconds", p.seconds}});
+    j["offset_track"] = track;
+  }
   j["recorded_frames"] = recorded;
   return j;
 }

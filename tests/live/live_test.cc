@@ -577,5 +577,109 @@ TEST(TimeOffsetTest, RecoversAKnownOffsetWithinAFramePeriod) {
       estimate.seconds, at_truth.score, off_by_two.score);
 }
 
+// Offset tracking: the tracker's clock jumps 0.1 s ahead halfway through a hand-held capture
+// (offset 0.2 s for frames 0..59, 0.3 s from frame 60 on), poses sent over TCP. The offset
+// is estimated on the first window, then again every 15 frames over the last 30: once a
+// window lies after the step, the offset in use follows it within one frame period; before
+// the step, re-estimations agree with the offset in use and are not applied.
+TEST(TimeOffsetTest, TrackingFollowsAStepInTheOffset) {
+  CubeRoomOptions room;
+  Scene scene;
+  ASSERT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  const int n = 120, step_at = 60;
+  const double fps = 30.0, before = 0.2, after = 0.3, step_s = step_at / fps;
+  SynthOptions o = testing::HandheldRoomCapture(n, 0.6);
+  o.width = 160, o.height = 120, o.supersample = 1;
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
+  std::string lines;
+  for (int i = 0; i < n; ++i)
+    lines += testing::TumLine(i / fps + (i < step_at ? before : after),
+                              capture.true_poses[i].cam_from_world.Inverse());
+  testing::PoseServer server;
+  std::thread tracker([&] { server.ServeOnce(lines); });
+  std::unique_ptr<PoseFeed> feed;
+  ASSERT_TRUE(PoseFeed::Open(server.Address(), PoseFeedOptions(), &feed).ok());
+  Rigid3d unused;
+  ASSERT_TRUE(feed->WaitPoseAt((n - 1) / fps + after, 30.0, &unused));  // every pose is in
+  tracker.join();
+
+  // A file-like source: tracking waits for each re-estimation (reproducible).
+  class CaptureSource : public VideoSource {
+   public:
+    explicit CaptureSource(const SynthCapture& c) : c_(c) {}
+    bool Next(Frame* f, Status*) override {
+      if (next_ >= c_.frames_bgr.size()) return false;
+      f->index = static_cast<int>(next_);
+      f->timestamp_s = next_ / 30.0;
+      f->bgr = c_.frames_bgr[next_++];
+      return true;
+    }
+    int FrameCount() const override { return static_cast<int>(c_.frames_bgr.size()); }
+    std::vector<std::string> FrameNames() const override { return {}; }
+    double Fps() const override { return 30; }
+
+   private:
+    const SynthCapture& c_;
+    size_t next_ = 0;
+  };
+  LiveOptions live;
+  live.pose_wait_s = 0;
+  live.estimate_offset = true;
+  live.offset_search_s = 0.35;
+  live.offset_window_frames = 30;
+  live.track_offset = true;
+  live.offset_track_every_frames = 15;
+  live.offset_track_search_s = 0.15;
+  live.offset_track_min_gain = 0.1;
+  LiveFrames frames(
+      std::make_unique<CaptureSource>(capture), nullptr,
+      [&](double t, double, Rigid3d* pose) { return feed->PoseAt(t, pose); }, live, 0.0,
+      MakeTimeOffsetEstimator(&scene, capture.camera, PipelineOptions(), GroupingOptions(), 0.0,
+                              TimeOffsetOptions()));
+  PosedFrame f;
+  Status status;
+  std::vector<double> used(n, std::nan(""));  // the offset each frame was matched with
+  while (frames.Next(&f, &status)) used[f.frame.index] = f.pose_time_s - f.frame.timestamp_s;
+  ASSERT_TRUE(status.ok()) << status.message();
+  const LiveFramesStats stats = frames.stats();
+  ASSERT_TRUE(stats.offset_estimated) << stats.estimate.note;
+  EXPECT_NEAR(stats.estimate.offset_s, before, 1.0 / fps);
+
+  double follows_from_s = -1;  // end of the first window wholly after the step
+  int applied_after = 0;
+  for (const OffsetTrackPoint& p : stats.offset_track) {
+    std::printf("window %.3f..%.3f s (%d frames): estimate %.4f s, score %.3f vs %.3f%s\n",
+                p.window_start_s, p.time_s, p.frames, p.offset_s, p.score, p.current_score,
+                p.applied ? " applied" : "");
+    EXPECT_TRUE(p.ok);
+    if (p.time_s < step_s) {  // wholly before the step
+      EXPECT_NEAR(p.offset_s, before, 1.0 / fps);
+      EXPECT_FALSE(p.applied) << "no better offset before the step";
+    } else if (p.window_start_s >= step_s) {  // wholly after
+      EXPECT_NEAR(p.offset_s, after, 1.0 / fps);
+      if (follows_from_s < 0) follows_from_s = p.time_s;
+    }
+    if (p.applied) ++applied_after;
+  }
+  ASSERT_GE(stats.offset_track.size(), 5u);
+  ASSERT_GT(follows_from_s, 0) << "no window after the step";
+  EXPECT_GE(applied_after, 1);
+  EXPECT_NEAR(stats.time_offset_s, after, 1.0 / fps);
+  // Every frame before the step was matched at the first offset; every frame from the end of
+  // the first window after the step on, at the new one.
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(used[i])) continue;  // no pose (beyond the track's end)
+    if (i < step_at) {
+      EXPECT_NEAR(used[i], before, 1.0 / fps) << "frame " << i;
+    }
+    if (i / fps >= follows_from_s) {
+      EXPECT_NEAR(used[i], after, 1.0 / fps) << "frame " << i;
+    }
+  }
+  std::printf("final offset %.4f s (truth %.3f), %zu re-estimations\n", stats.time_offset_s, after,
+              stats.offset_track.size());
+}
+
 }  // namespace
 }  // namespace fresco

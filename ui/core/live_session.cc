@@ -152,6 +152,11 @@ LiveStatus LiveSession::CurrentStatus() {
       project_.live.estimate_offset && f.estimate.candidates.empty() && f.estimate.note.empty();
   st.offset_score = f.estimate.score;
   st.offset_note = f.estimate.note;
+  st.offset_track_points = static_cast<int>(f.offset_track.size());
+  if (!f.offset_track.empty()) {
+    st.offset_track_last_s = f.offset_track.back().offset_s;
+    st.offset_track_last_applied = f.offset_track.back().applied;
+  }
   const double now = NowS();
   if (f.frames_received != last_received_) {
     last_received_ = f.frames_received;

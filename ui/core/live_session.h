@@ -58,6 +58,11 @@ struct LiveStatus {
   bool offset_estimated = false;
   double offset_score = 0;  // mean |grey difference| at the estimate
   std::string offset_note;
+  // Offset tracking (live.track_offset): re-estimations so far, and the last one's estimate
+  // and whether it replaced the offset in use.
+  int offset_track_points = 0;
+  double offset_track_last_s = 0;
+  bool offset_track_last_applied = false;
   std::string end_reason;
   // Recording (the Record toggle).
   bool recording = false;

@@ -98,6 +98,9 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
   else
     offset += " (as set)";
   ImGui::TextWrapped("time offset: %s", offset.c_str());
+  if (live.offset_track_points > 0)
+    ImGui::Text("tracked: %d re-estimates, last %.4f s (%s)", live.offset_track_points,
+                live.offset_track_last_s, live.offset_track_last_applied ? "applied" : "kept");
   if (!live.problem.empty()) WrappedColored(kBad, live.problem);
 
   // Record toggle: the worker's state is the truth; a click asks it to change.
