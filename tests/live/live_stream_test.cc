@@ -376,6 +376,53 @@ TEST(LiveStreamTest, HttpStreamEndIsToldApartFromAStall) {
   server.get();  // exits 1: its client went away (nothing to check)
 }
 
+// `fresco run` with a tracker that goes away mid-session: it sends the poses of frames
+// 0..39, closes its connection and its listening socket, and 0.5 s later listens again on
+// the same port and sends frames 60..89 (it lost track meanwhile). The feed reconnects
+// once; the frames whose pose time falls in the gap get no pose, every other frame is
+// painted, and metrics.json reports the gap in tracker time.
+TEST(LiveStreamTest, PaintingGoesOnAfterTheTrackerReconnects) {
+  const std::string dir = testing::MakeTempDir("live_reconnect");
+  const int frames = 90, lost_from = 40, back_at = 60;
+  const std::vector<PosedImage> truth = testing::MakeStreamCapture(dir + "/synth", frames);
+  ASSERT_EQ(truth.size(), static_cast<size_t>(frames));
+  auto line = [&](int i) {
+    return testing::TumLine(i / kFps + kOffsetS, truth[i].cam_from_world.Inverse());
+  };
+  std::string first, second;
+  for (int i = 0; i < lost_from; ++i) first += line(i);
+  for (int i = back_at; i < frames; ++i) second += line(i);
+  testing::DroppingTracker tracker(first, second, 500);
+  // The capture's frames from their folder (read on demand) and the poses from the tracker,
+  // the offset as set: frame i at tracker time i / 30 + 0.2, exactly a sample's time.
+  Json project =
+      testing::StreamProjectFrom(dir + "/synth", dir + "/synth/frames", tracker.Address());
+  project["time_offset_s"] = kOffsetS;
+  project["live"] = {{"pose_wait_s", 30}, {"connect_timeout_s", 30}};  // safety limits
+  testing::WriteText(dir + "/live.json", project.dump(2));
+  const testing::CommandResult run =
+      testing::RunFresco({"run", dir + "/live.json", "--out", dir + "/out", "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json metrics = ReadJson(dir + "/out/metrics.json");
+  const Json& l = metrics["live"];
+  const Json& feed = l["pose_feed"];
+  std::printf("reconnect: %s; painted %d of %d\n", feed.dump().c_str(),
+              metrics["frames_painted"].get<int>(), metrics["frames"].get<int>());
+  EXPECT_EQ(metrics["frames"].get<int>(), frames);
+  EXPECT_EQ(l["frames_without_pose"].get<int>(), back_at - lost_from);
+  EXPECT_EQ(metrics["frames_painted"].get<int>(), frames - (back_at - lost_from));
+  EXPECT_EQ(feed["reconnects"].get<int>(), 1);
+  EXPECT_EQ(feed["disconnects"].get<int>(), 1);
+  EXPECT_EQ(feed["poses"].get<int>(), frames - (back_at - lost_from));
+  ASSERT_EQ(feed["gaps"].size(), 1u);
+  const Json& gap = feed["gaps"][0];
+  EXPECT_TRUE(gap["reconnected"].get<bool>());
+  EXPECT_NEAR(gap["last_pose_before_s"].get<double>(), (lost_from - 1) / kFps + kOffsetS, 1e-6);
+  EXPECT_NEAR(gap["first_pose_after_s"].get<double>(), back_at / kFps + kOffsetS, 1e-6);
+  EXPECT_NEAR(gap["tracker_gap_s"].get<double>(), (back_at - lost_from + 1) / kFps, 1e-6);
+  EXPECT_GT(gap["disconnected_s"].get<double>(), 0.0);
+}
+
 TEST(LiveStreamTest, UnreachableSourcesExitTwoNamingTheAddress) {
   const std::string dir = testing::MakeTempDir("live_errors");
   testing::WriteText(dir + "/camera.txt", "1 PINHOLE 32 24 30 30 16 12\n");
