@@ -50,7 +50,8 @@ ArgSpec RunSpec() {
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
       "by time (+ time_offset_s, estimated with live.estimate_offset); the run ends when\n"
-      "the video ends (no frame within live.read_timeout_s). metrics.json gets \"live\".";
+      "the video ends (its stream ends, or no frame within live.read_timeout_s; the\n"
+      "\"live\" object in metrics.json says which in end_reason).";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--record"};
   spec.repeatable = {"--set"};
