@@ -250,6 +250,7 @@ bool LiveFrames::Next(PosedFrame* out, Status* status) {
     frame = std::move(held_.front());
     held_.pop_front();
   } else if (!Pull(&frame, status)) {
+    if (tracking_.valid()) FinishTracking();  // the series reports every re-estimation
     return false;
   }
   if (options_.track_offset && estimator_) TrackOffset(frame);
