@@ -298,7 +298,18 @@ class OneShotHttpServer {
   std::thread thread_;
 };
 
-// Reads an HTTP stream to its end through LiveFrames (no poses); its stats.
+// DIR/s.ts: 30 frames of FFmpeg's test pattern (160x120, H.264 lossless, MPEG-TS); "" when
+// the `ffmpeg` program fails.
+std::string ThirtyFrameStream(const std::string& dir) {
+  const std::string ts = dir + "/s.ts";
+  const std::string command =
+      "timeout 60 ffmpeg -hide_banner -loglevel error -f lavfi -i testsrc=size=160x120:rate=30 "
+      "-frames:v 30 -c:v libx264 -qp 0 -tune zerolatency -g 15 -f mpegts " +
+      ts;
+  return std::system(command.c_str()) == 0 ? ts : "";
+}
+
+// Reads a stream to its end through LiveFrames (no poses, read timeout 1 s); its stats.
 LiveFramesStats ReadStreamToTheEnd(const std::string& url) {
   VideoSourceOptions video_options;
   video_options.open_timeout_s = 30;  // safety limits
@@ -329,14 +340,8 @@ LiveFramesStats ReadStreamToTheEnd(const std::string& url) {
 TEST(LiveStreamTest, HttpStreamEndIsToldApartFromAStall) {
   if (!testing::HaveFfmpeg())
     GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
-  const std::string dir = testing::MakeTempDir("live_end");
-  const std::string ts = dir + "/s.ts";
-  ASSERT_EQ(std::system(("timeout 60 ffmpeg -hide_banner -loglevel error -f lavfi -i "
-                         "testsrc=size=160x120:rate=30 -frames:v 30 -c:v libx264 -qp 0 "
-                         "-tune zerolatency -g 15 -f mpegts " +
-                         ts)
-                            .c_str()),
-            0);
+  const std::string ts = ThirtyFrameStream(testing::MakeTempDir("live_end"));
+  ASSERT_FALSE(ts.empty());
   const std::string body = testing::ReadText(ts);
   ASSERT_GT(body.size(), 1000u);
   {
@@ -374,6 +379,44 @@ TEST(LiveStreamTest, HttpStreamEndIsToldApartFromAStall) {
   EXPECT_EQ(stalled.end_reason, "stalled: no frame within 1.0 s after " +
                                     std::to_string(stalled.frames_received) + " frames");
   server.get();  // exits 1: its client went away (nothing to check)
+}
+
+// RTSP (Fresco listens, ffmpeg pushes over TCP): a pusher that finishes tears the session
+// down (the stream ended); one whose input goes silent keeps it open (a stall).
+TEST(LiveStreamTest, RtspStreamEndIsToldApartFromAStall) {
+  if (!testing::HaveFfmpeg())
+    GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
+  const std::string ts = ThirtyFrameStream(testing::MakeTempDir("live_rtsp_end"));
+  ASSERT_FALSE(ts.empty());
+  // Probing limited to 0.1 s of stream: by default FFmpeg probes up to 5 s, more than the
+  // silent pusher sends before it stalls (the open would return only at its teardown).
+  setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_flags;listen|analyzeduration;100000", 1);
+  struct Unset {
+    ~Unset() { unsetenv("OPENCV_FFMPEG_CAPTURE_OPTIONS"); }
+  } unset;  // also when an assertion returns early
+  for (const bool stall : {false, true}) {
+    const int port = testing::FreeLoopbackPort(SOCK_STREAM);
+    const std::string url = "rtsp://127.0.0.1:" + std::to_string(port) + "/live";
+    auto reading = std::async(std::launch::async, [&] { return ReadStreamToTheEnd(url); });
+    ASSERT_TRUE(testing::WaitTcpPortListening(port));
+    const std::string push = "(cat " + ts + (stall ? "; sleep 6" : "") +
+                             ") | timeout 60 ffmpeg -hide_banner -loglevel error -probesize 32 "
+                             "-analyzeduration 0 -f mpegts -i - -c copy -f rtsp "
+                             "-rtsp_transport tcp " +
+                             url;
+    auto pusher = std::async(std::launch::async, [&] { return std::system(push.c_str()); });
+    const LiveFramesStats s = reading.get();
+    pusher.get();
+    std::printf("rtsp, %s pusher: %lld frames, \"%s\"\n", stall ? "silent" : "finishing",
+                s.frames_received, s.end_reason.c_str());
+    if (stall) {
+      EXPECT_GE(s.frames_received, 20);
+      EXPECT_EQ(s.end_reason, "stalled: no frame within 1.0 s after " +
+                                  std::to_string(s.frames_received) + " frames");
+    } else {
+      EXPECT_EQ(s.end_reason, "the stream ended after 30 frames");
+    }
+  }
 }
 
 // `fresco run` with a tracker that goes away mid-session: it sends the poses of frames
