@@ -50,7 +50,8 @@ ArgSpec RunSpec() {
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
       "by time (+ time_offset_s, estimated with live.estimate_offset); the run ends when\n"
-      "the video ends (no frame within live.read_timeout_s). metrics.json gets \"live\".";
+      "the video ends (its stream ends, or no frame within live.read_timeout_s; the\n"
+      "\"live\" object in metrics.json says which in end_reason).";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--record"};
   spec.repeatable = {"--set"};
@@ -102,9 +103,20 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   j["offset_estimated"] = s.offset_estimated;
   if (live.feed) {
     const PoseFeedStats f = live.feed->stats();
+    nlohmann::json gaps = nlohmann::json::array();
+    for (const PoseFeedGap& g : f.gaps)  // NaN (no pose on that side) is written as null
+      gaps.push_back({{"last_pose_before_s", g.last_pose_before_s},
+                      {"first_pose_after_s", g.first_pose_after_s},
+                      {"tracker_gap_s", g.tracker_gap_s()},
+                      {"disconnected_s", g.disconnected_s},
+                      {"attempts", g.attempts},
+                      {"reconnected", g.reconnected}});
     j["pose_feed"] = {{"address", live.feed->address()},
                       {"poses", f.poses},
                       {"reconnects", f.reconnects},
+                      {"disconnects", f.disconnects},
+                      {"disconnected_s", f.disconnected_s},
+                      {"gaps", gaps},
                       {"connected", f.connected},
                       {"seconds_since_last_pose", f.seconds_since_last_pose}};
   }
@@ -122,6 +134,20 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
                             {"seconds", s.estimate.seconds},
                             {"note", s.estimate.note},
                             {"candidates", candidates}};
+  }
+  if (!s.offset_track.empty()) {
+    nlohmann::json track = nlohmann::json::array();
+    for (const OffsetTrackPoint& p : s.offset_track)
+      track.push_back({{"window_start_s", p.window_start_s},
+                       {"time_s", p.time_s},
+                       {"frames", p.frames},
+                       {"offset_s", p.offset_s},
+                       {"score", p.score},
+                       {"current_score", p.current_score},
+                       {"ok", p.ok},
+                       {"applied", p.applied},
+                       {"seconds", p.seconds}});
+    j["offset_track"] = track;
   }
   j["recorded_frames"] = recorded;
   return j;

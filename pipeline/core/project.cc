@@ -178,12 +178,18 @@ void Fields(LiveOptions& o, V& v) {
   v.Field("reconnects", o.reconnects, {.min = 0});
   v.Field("stream_clock", o.stream_clock);
   v.Field("connect_timeout_s", o.connect_timeout_s, {.min = 0});
+  v.Field("pose_reconnect_give_up_s", o.pose_reconnect_give_up_s, {.min = 0});
   v.Field("pose_wait_s", o.pose_wait_s, {.min = 0});
   v.Field("max_pose_gap_s", o.max_pose_gap_s, {.min = 0, .min_exclusive = true});
   v.Field("max_pose_extrapolate_s", o.max_pose_extrapolate_s, {.min = 0});
   v.Field("estimate_offset", o.estimate_offset);
   v.Field("offset_search_s", o.offset_search_s, {.min = 0, .min_exclusive = true, .max = 60});
   v.Field("offset_window_frames", o.offset_window_frames, {.min = 4, .max = 1000});
+  v.Field("track_offset", o.track_offset);
+  v.Field("offset_track_every_frames", o.offset_track_every_frames, {.min = 1, .max = 100000});
+  v.Field("offset_track_search_s", o.offset_track_search_s,
+          {.min = 0, .min_exclusive = true, .max = 60});
+  v.Field("offset_track_min_gain", o.offset_track_min_gain, {.min = 0, .max = 1});
 }
 
 template <class V>
@@ -210,8 +216,8 @@ static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(Grou
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
-static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 88, "see Fields(LiveOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 584, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 616, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

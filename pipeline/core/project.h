@@ -170,6 +170,9 @@ struct LiveOptions {
   int reconnects = 0;
   bool stream_clock = true;  // frame times from the stream's timestamps (else arrival)
   double connect_timeout_s = 5.0;  // the pose feed must accept the connection within this
+  // A pose feed that drops is reconnected with backoff; no connection for this long (wall
+  // seconds) ends it with an error (0: keep trying).
+  double pose_reconnect_give_up_s = 60.0;
   double pose_wait_s = 0.5;  // a frame waits this long for the tracker to reach its time
   double max_pose_gap_s = 0.5;  // no pose is interpolated between samples further apart
   // A frame this far before the first pose or after the last still gets one, extrapolated.
@@ -180,6 +183,15 @@ struct LiveOptions {
   bool estimate_offset = false;
   double offset_search_s = 0.5;
   int offset_window_frames = 30;
+  // Track the offset during the session: every offset_track_every_frames frames, estimate it
+  // again on the last offset_window_frames frames, candidates within +-offset_track_search_s
+  // of the offset in use; the new estimate replaces it only when its score is at least
+  // offset_track_min_gain (a fraction) lower than the score of the offset in use on the same
+  // frames.
+  bool track_offset = false;
+  int offset_track_every_frames = 30;
+  double offset_track_search_s = 0.15;
+  double offset_track_min_gain = 0.1;
 
   bool operator==(const LiveOptions&) const = default;
 };

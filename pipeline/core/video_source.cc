@@ -125,9 +125,13 @@ class FolderSource : public VideoSource {
 // A video file or a live source through cv::VideoCapture.
 class CaptureSource : public VideoSource {
  public:
-  CaptureSource(std::string what, cv::VideoCapture capture, bool live, bool stream_clock)
-      : what_(std::move(what)), capture_(std::move(capture)), live_(live),
-        stream_clock_(stream_clock) {
+  CaptureSource(std::string what, cv::VideoCapture capture, bool live,
+                const VideoSourceOptions& options)
+      : what_(std::move(what)),
+        capture_(std::move(capture)),
+        live_(live),
+        stream_clock_(options.stream_clock),
+        read_timeout_s_(options.read_timeout_s) {
     const double fps = capture_.get(cv::CAP_PROP_FPS);
     fps_ = std::isfinite(fps) && fps > 0 && fps < 1000 ? fps : kDefaultFolderFps;
     const double count = capture_.get(cv::CAP_PROP_FRAME_COUNT);
@@ -136,7 +140,20 @@ class CaptureSource : public VideoSource {
 
   bool Next(Frame* frame, Status* status) override {
     cv::Mat image;
-    if (!capture_.read(image) || image.empty()) {  // end of the stream
+    const auto read_start = std::chrono::steady_clock::now();
+    timed_out_ = false;
+    const bool read = capture_.read(image) && !image.empty();
+    const double read_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
+    const double previous_read_s = last_read_s_;
+    last_read_s_ = read_s;
+    if (!read) {  // end of the stream
+      // OpenCV tells neither why a read failed nor whether its read timeout fired. Only the
+      // timeout makes a read last that long; when it fires, FFmpeg may still return a frame it
+      // held (that read lasted the timeout) and then fails every read at once. FFmpeg reports
+      // the end of a stream at once.
+      timed_out_ =
+          live_ && std::max(read_s, previous_read_s) >= kTimedOutFraction * read_timeout_s_;
       // A file that ends well before the frame count its header declares is truncated or
       // corrupt (one frame of slack: some containers only estimate the count).
       if (!live_ && count_ > 0 && index_ + 1 < count_ && status) {
@@ -172,6 +189,8 @@ class CaptureSource : public VideoSource {
   std::vector<std::string> FrameNames() const override { return {}; }
   double Fps() const override { return fps_; }
   bool IsLive() const override { return live_; }
+  bool TimedOut() const override { return timed_out_; }
+  bool SignalsEnd() const override { return what_.rfind("udp://", 0) != 0; }
   std::string Clock() const override {
     return !live_ ? "index" : (use_stream_clock_ ? "stream" : "arrival");
   }
@@ -207,7 +226,13 @@ class CaptureSource : public VideoSource {
   std::string what_;
   cv::VideoCapture capture_;
   bool live_;
+  // A failed read that lasted this fraction of the read timeout timed out.
+  static constexpr double kTimedOutFraction = 0.9;
+
   bool stream_clock_;
+  double read_timeout_s_;
+  bool timed_out_ = false;
+  double last_read_s_ = 0.0;  // how long the last read took
   bool use_stream_clock_ = false;
   double first_pts_ms_ = 0.0;
   double last_t_ = 0.0;
@@ -273,8 +298,7 @@ Status OpenVideoSource(const std::string& path, const VideoSourceOptions& option
       return Status::Error(path + ": cannot open the camera (no /dev/video" + number +
                            ", or it is busy or not a capture device)");
     }
-    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true,
-                                              options.stream_clock);
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true, options);
     return Status::Ok();
   }
   QuietFfmpegLog();
@@ -288,8 +312,7 @@ Status OpenVideoSource(const std::string& path, const VideoSourceOptions& option
                            " s (unreachable, nothing sent, or not a format OpenCV's FFmpeg "
                            "backend reads)");
     }
-    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true,
-                                              options.stream_clock);
+    *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/true, options);
     return Status::Ok();
   }
   if (fs::is_directory(path, ec)) return OpenFolder(path, source);
@@ -298,8 +321,7 @@ Status OpenVideoSource(const std::string& path, const VideoSourceOptions& option
   if (!capture.isOpened()) {
     return Status::Error(path + ": cannot open as a video (OpenCV FFmpeg backend)");
   }
-  *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/false,
-                                            options.stream_clock);
+  *source = std::make_unique<CaptureSource>(path, std::move(capture), /*live=*/false, options);
   return Status::Ok();
 }
 

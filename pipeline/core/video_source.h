@@ -42,6 +42,13 @@ class VideoSource {
   virtual bool IsLive() const { return false; }
   // Which clock timestamp_s follows: "index" (folders), "stream" or "arrival".
   virtual std::string Clock() const { return "index"; }
+  // Live sources: the last Next() returned false because no frame came within the read
+  // timeout (a stall, or a stream that ends without saying so, like UDP), not because the
+  // source reported its end (an HTTP or RTSP server that finished, a file's end).
+  virtual bool TimedOut() const { return false; }
+  // False for a protocol that carries no end of stream (UDP): a sender that finished and one
+  // that stalled both time out.
+  virtual bool SignalsEnd() const { return true; }
 };
 
 struct VideoSourceOptions {

@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <future>
+#include <limits>
 
 namespace fresco {
 namespace {
@@ -13,6 +15,20 @@ namespace {
 constexpr size_t kHoldWindows = 4;
 
 }  // namespace
+
+std::string LiveFrames::EndReason(bool timed_out, bool signals_end, long long frames) const {
+  char reason[200];
+  if (!timed_out) {
+    std::snprintf(reason, sizeof reason, "the stream ended after %lld frames", frames);
+  } else {
+    std::snprintf(reason, sizeof reason, "stalled: no frame within %.1f s after %lld frames%s",
+                  options_.read_timeout_s, frames,
+                  signals_end ? ""
+                              : " (the protocol does not signal the end of a stream: it "
+                                "ended or stalled)");
+  }
+  return reason;
+}
 
 LiveFrames::LiveFrames(std::unique_ptr<VideoSource> video, VideoOpener reopen,
                        WaitPoseAtTime pose_at, const LiveOptions& options, double time_offset_s,
@@ -66,6 +82,8 @@ void LiveFrames::CaptureLoop() {
       stats_.end_reason = status.message();
       break;
     }
+    const bool timed_out = video_->TimedOut();
+    const bool signals_end = video_->SignalsEnd();
     if (stats_.video_reopens < options_.reconnects && reopen_ && !stop_) {
       ++stats_.video_reopens;
       std::unique_ptr<VideoSource> again;
@@ -75,11 +93,7 @@ void LiveFrames::CaptureLoop() {
       }
       continue;
     }
-    char reason[160];
-    std::snprintf(reason, sizeof reason,
-                  "no frame within %.1f s after %lld frames (the stream ended or stalled)",
-                  options_.read_timeout_s, stats_.frames_received);
-    stats_.end_reason = reason;
+    stats_.end_reason = EndReason(timed_out, signals_end, stats_.frames_received);
     break;
   }
   queue_.Close();
@@ -103,11 +117,68 @@ bool LiveFrames::Pull(Frame* frame, Status* status) {
   return true;
 }
 
-bool LiveFrames::Usable(const Frame& frame) const {
-  const double t = frame.timestamp_s + stats_.time_offset_s;
+bool LiveFrames::Usable(const Frame& frame, double search_s) const {
+  double offset;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    offset = stats_.time_offset_s;
+  }
+  const double t = frame.timestamp_s + offset;
   Rigid3d unused;
-  return pose_at_(t - options_.offset_search_s, 0.0, &unused) &&
-         pose_at_(t + options_.offset_search_s, 0.0, &unused);
+  return pose_at_(t - search_s, 0.0, &unused) && pose_at_(t + search_s, 0.0, &unused);
+}
+
+void LiveFrames::TrackOffset(const Frame& frame) {
+  if (tracking_.valid() &&
+      tracking_.wait_for(std::chrono::milliseconds(0)) == std::future_status::ready)
+    FinishTracking();
+  const size_t window = static_cast<size_t>(options_.offset_window_frames);
+  recent_.push_back(frame);
+  recent_.back().bgr = frame.bgr.clone();  // the painter may write into its copy
+  while (recent_.size() > window) recent_.pop_front();
+  ++since_tracked_;
+  if (since_tracked_ < options_.offset_track_every_frames || tracking_.valid()) return;
+  std::vector<Frame> usable;
+  for (const Frame& f : recent_)
+    if (Usable(f, options_.offset_track_search_s)) usable.push_back(f);
+  if (usable.size() < std::max<size_t>(4, window / 2)) return;  // the poses lag: next frame
+  since_tracked_ = 0;
+  tracking_point_ = OffsetTrackPoint();
+  tracking_point_.window_start_s = usable.front().timestamp_s;
+  tracking_point_.time_s = usable.back().timestamp_s;
+  tracking_point_.frames = static_cast<int>(usable.size());
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    tracking_point_.offset_s = stats_.time_offset_s;  // the centre, until the estimate
+  }
+  const PoseAtTime pose_at = [this](double t, Rigid3d* pose) { return pose_at_(t, 0.0, pose); };
+  tracking_ = std::async(std::launch::async, [this, usable = std::move(usable), pose_at,
+                                              centre = tracking_point_.offset_s] {
+    return estimator_(usable, pose_at, centre, options_.offset_track_search_s);
+  });
+  if (!live_) FinishTracking();
+}
+
+void LiveFrames::FinishTracking() {
+  const TimeOffsetEstimate e = tracking_.get();
+  OffsetTrackPoint p = tracking_point_;
+  const double centre_s = p.offset_s;
+  p.current_score = std::numeric_limits<double>::quiet_NaN();
+  for (const TimeOffsetCandidate& c : e.candidates)
+    if (c.offset_s == centre_s) p.current_score = c.score;
+  p.ok = e.ok;
+  p.seconds = e.seconds;
+  if (e.ok) {
+    p.offset_s = e.offset_s;
+    p.score = e.score;
+  }
+  p.applied = e.ok && std::isfinite(p.current_score) &&
+              e.score < (1.0 - options_.offset_track_min_gain) * p.current_score;
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (p.applied) stats_.time_offset_s = p.offset_s;
+  stats_.offset_track.push_back(p);
+  if (stats_.offset_track.size() > kMaxOffsetTrackPoints)
+    stats_.offset_track.erase(stats_.offset_track.begin());
 }
 
 bool LiveFrames::FillWindowAndEstimate(Status* status) {
@@ -142,7 +213,9 @@ bool LiveFrames::FillWindowAndEstimate(Status* status) {
     // Estimate on another thread; meanwhile a live source's frames keep being held (up to
     // kHoldWindows windows, oldest dropped and counted beyond) instead of overflowing the
     // queue.
-    auto running = std::async(std::launch::async, [&] { return estimator_(usable, pose_at); });
+    auto running = std::async(std::launch::async, [&] {
+      return estimator_(usable, pose_at, stats_.time_offset_s, options_.offset_search_s);
+    });
     while (live_ && running.wait_for(std::chrono::milliseconds(0)) != std::future_status::ready) {
       if (!queue_.Pop(&frame, std::chrono::milliseconds(5))) continue;
       held_.push_back(std::move(frame));
@@ -177,8 +250,10 @@ bool LiveFrames::Next(PosedFrame* out, Status* status) {
     frame = std::move(held_.front());
     held_.pop_front();
   } else if (!Pull(&frame, status)) {
+    if (tracking_.valid()) FinishTracking();  // the series reports every re-estimation
     return false;
   }
+  if (options_.track_offset && estimator_) TrackOffset(frame);
   double offset;
   {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -205,7 +280,8 @@ OffsetEstimator MakeTimeOffsetEstimator(const Scene* scene, const Camera& camera
                                         const PipelineOptions& pipeline,
                                         const GroupingOptions& grouping, double texel_size_m,
                                         const TimeOffsetOptions& options) {
-  return [=](const std::vector<Frame>& window, const PoseAtTime& pose_at) {
+  return [=](const std::vector<Frame>& window, const PoseAtTime& pose_at, double centre_s,
+             double search_s) {
     PaintSessionInputs inputs;
     inputs.scene = scene;
     inputs.pipeline = EstimationPipeline(pipeline);
@@ -213,13 +289,16 @@ OffsetEstimator MakeTimeOffsetEstimator(const Scene* scene, const Camera& camera
     inputs.grouping = grouping;
     inputs.typical_camera = &camera;
     std::unique_ptr<PaintSession> session;
+    TimeOffsetOptions around = options;
+    around.centre_s = centre_s;
+    around.search_s = search_s;
     TimeOffsetEstimate failed;
-    failed.offset_s = options.centre_s;
+    failed.offset_s = centre_s;
     if (Status s = PaintSession::Create(inputs, &session); !s.ok()) {
       failed.note = s.message();
       return failed;
     }
-    return EstimateTimeOffset(window, camera, pose_at, options, session.get());
+    return EstimateTimeOffset(window, camera, pose_at, around, session.get());
   };
 }
 

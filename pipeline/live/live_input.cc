@@ -31,6 +31,7 @@ Status OpenLiveInputs(const Project& project, const Capture& capture, const Pain
   if (IsUrlOrDevice(project.poses)) {
     PoseFeedOptions feed_options;
     feed_options.connect_timeout_s = project.live.connect_timeout_s;
+    feed_options.reconnect_give_up_s = project.live.pose_reconnect_give_up_s;
     feed_options.track = track_options;
     feed_options.keep_all = keep_tracker_poses;
     FRESCO_RETURN_IF_ERROR(PoseFeed::Open(project.poses, feed_options, &inputs->feed));
@@ -59,10 +60,8 @@ Status OpenLiveInputs(const Project& project, const Capture& capture, const Pain
     return OpenVideoSource(video_path, video_options, again);
   };
   OffsetEstimator estimator;
-  if (project.live.estimate_offset) {
-    TimeOffsetOptions offset_options;
-    offset_options.centre_s = project.time_offset_s;
-    offset_options.search_s = project.live.offset_search_s;
+  if (project.live.estimate_offset || project.live.track_offset) {
+    TimeOffsetOptions offset_options;  // centre and range: given per estimation
     estimator =
         MakeTimeOffsetEstimator(&capture.scene, *inputs->camera, project.pipeline, project.grouping,
                                 session.default_texel_size_m(), offset_options);

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <string_view>
 
@@ -181,26 +182,65 @@ bool PoseFeed::Reconnect() {
     std::lock_guard<std::mutex> lock(mutex_);
     connected_ = false;
     partial_line_.clear();
+    ++disconnects_;
+    PoseFeedGap gap;
+    if (!track_.empty()) gap.last_pose_before_s = track_.last_time_s();
+    gaps_.push_back(gap);
+    if (gaps_.size() > kMaxReportedGaps) gaps_.pop_front();
+    disconnected_since_s_ = NowS();
+    awaiting_first_after_ = false;
   }
   if (!options_.reconnect) {
     Fail(Status::Error(address_ + ": the tracker closed the connection"));
     return false;
   }
+  return ConnectWithBackoff();
+}
+
+bool PoseFeed::ConnectWithBackoff() {
+  double interval_s = std::max(0.01, options_.reconnect_interval_s);
+  int attempts = 0;
+  std::string error;
   while (!stop_) {
-    std::string error;
+    ++attempts;
     if (kind_ == 2) {
       fd_ = open(fifo_path_.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+      if (fd_ < 0) error = "cannot open the named pipe: " + ErrnoText();
     } else {
-      fd_ = ConnectTcp(host_, port_, options_.reconnect_interval_s, &error);
+      fd_ = ConnectTcp(host_, port_, std::min(interval_s, 1.0), &error);
     }
+    const double now = NowS();
+    std::unique_lock<std::mutex> lock(mutex_);
+    PoseFeedGap& gap = gaps_.back();
+    gap.attempts = attempts;
+    gap.disconnected_s = now - disconnected_since_s_;
     if (fd_ >= 0) {
-      std::lock_guard<std::mutex> lock(mutex_);
+      gap.reconnected = true;
+      disconnected_total_s_ += gap.disconnected_s;
+      disconnected_since_s_ = -1;
+      awaiting_first_after_ = true;
       connected_ = true;
       ++reconnects_;
       return true;
     }
-    std::this_thread::sleep_for(
-        std::chrono::milliseconds(static_cast<int>(options_.reconnect_interval_s * 1000)));
+    if (options_.reconnect_give_up_s > 0 && gap.disconnected_s >= options_.reconnect_give_up_s) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    ": the tracker went away and did not come back within %.1f s (%d attempts; "
+                    "last: ",
+                    options_.reconnect_give_up_s, attempts);
+      disconnected_total_s_ += gap.disconnected_s;
+      disconnected_since_s_ = -1;
+      lock.unlock();
+      Fail(Status::Error(address_ + text + error + ")"));
+      return false;
+    }
+    lock.unlock();
+    const double give_up_in_s = options_.reconnect_give_up_s > 0
+                                    ? options_.reconnect_give_up_s - gap.disconnected_s
+                                    : interval_s;
+    std::this_thread::sleep_for(std::chrono::duration<double>(std::min(interval_s, give_up_in_s)));
+    interval_s = std::min(2 * interval_s, std::max(options_.reconnect_max_interval_s, 0.01));
   }
   return false;
 }
@@ -264,6 +304,10 @@ void PoseFeed::Consume(const char* data, size_t size, bool datagram) {
       std::lock_guard<std::mutex> lock(mutex_);
       track_.Add(pose);
       if (options_.keep_all) all_.push_back(pose);
+      if (awaiting_first_after_ && !gaps_.empty()) {
+        gaps_.back().first_pose_after_s = pose.timestamp_s;
+        awaiting_first_after_ = false;
+      }
       ++poses_;
       last_pose_wall_s_ = NowS();
     }
@@ -296,6 +340,13 @@ PoseFeedStats PoseFeed::stats() const {
   s.connected = connected_;
   s.seconds_since_last_pose = last_pose_wall_s_ < 0 ? -1 : NowS() - last_pose_wall_s_;
   s.latest_time_s = track_.empty() ? 0.0 : track_.last_time_s();
+  s.disconnects = disconnects_;
+  s.gaps.assign(gaps_.begin(), gaps_.end());
+  s.disconnected_s = disconnected_total_s_;
+  if (disconnected_since_s_ >= 0 && !s.gaps.empty()) {  // a drop that lasts
+    s.gaps.back().disconnected_s = NowS() - disconnected_since_s_;
+    s.disconnected_s += s.gaps.back().disconnected_s;
+  }
   return s;
 }
 

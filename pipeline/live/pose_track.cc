@@ -40,6 +40,10 @@ bool PoseTrack::At(double t, Rigid3d* cam_from_world) const {
   if (t > last_time_s() + options_.max_extrapolate_s) return false;
   auto later = std::lower_bound(samples_.begin(), samples_.end(), t,
                                 [](const TimedPose& s, double x) { return s.timestamp_s < x; });
+  if (later != samples_.end() && later->timestamp_s == t) {  // a sample's own time (even
+    *cam_from_world = later->world_from_cam.Inverse();       // next to a gap)
+    return true;
+  }
   if (later == samples_.begin()) ++later;  // before the first: extrapolate back
   if (later == samples_.end()) --later;    // after the last: extrapolate on
   const TimedPose& b = *later;

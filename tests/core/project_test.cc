@@ -65,6 +65,11 @@ Project NonDefaultProject() {
   p.live.estimate_offset = true;
   p.live.offset_search_s = 1.5;
   p.live.offset_window_frames = 40;
+  p.live.pose_reconnect_give_up_s = 12.5;
+  p.live.track_offset = true;
+  p.live.offset_track_every_frames = 45;
+  p.live.offset_track_search_s = 0.25;
+  p.live.offset_track_min_gain = 0.2;
   p.pipeline.sampling = SamplingMode::kArea;
   p.pipeline.texel_size_m = 0.0123456789012345;
   p.pipeline.max_buffer_texels = 4096;

@@ -11,12 +11,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <future>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -26,6 +28,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/poses.h"
+#include "pipeline/core/video_source.h"
+#include "pipeline/live/live_frames.h"
 #include "tests/live/loopback.h"
 #include "tests/live/stream_support.h"
 #include "tests/test_support.h"
@@ -169,7 +173,10 @@ TEST(LiveStreamTest, UdpVideoAndTcpPosesPaintLiveWithTheOffsetEstimated) {
   const Json metrics = PaintStreamAndCompare(dir, url, sender_at(1.0, kUdpPadFrames),
                                              kUdpMinPsnrDb, {"--record", dir + "/recorded"});
   ASSERT_FALSE(metrics.is_null());
-  EXPECT_THAT(metrics["live"]["end_reason"].get<std::string>(), HasSubstr("no frame within"));
+  // UDP carries no end of stream: the sender finishing looks like a stall.
+  EXPECT_THAT(metrics["live"]["end_reason"].get<std::string>(),
+              HasSubstr("stalled: no frame within 2.0 s after 150 frames (the protocol does not "
+                        "signal the end of a stream"));
 
   // The recording replays as a normal project, to what was painted live.
   const Json recorded_project = ReadJson(dir + "/recorded/project.json");
@@ -217,7 +224,9 @@ TEST(LiveStreamTest, HttpVideoServedByFfmpegPaintsLikeTheFiles) {
   const Sender sender{testing::FfmpegStreamCommand(dir + "/synth/frames", url, 1.0, kHttpPadFrames,
                                                    "-listen 1 -listen_timeout 60000"),
                       /*sender_first=*/true, [port] { return testing::WaitTcpPortListening(port); }};
-  PaintStreamAndCompare(dir, url, sender, kHttpMinPsnrDb);
+  const Json metrics = PaintStreamAndCompare(dir, url, sender, kHttpMinPsnrDb);
+  ASSERT_FALSE(metrics.is_null());
+  EXPECT_EQ(metrics["live"]["end_reason"], "the stream ended after 150 frames");
 }
 
 // RTSP: Fresco listens (OpenCV's FFmpeg backend told `rtsp_flags=listen` through
@@ -234,8 +243,227 @@ TEST(LiveStreamTest, RtspVideoPushedByFfmpegPaintsLikeTheFiles) {
                       /*sender_first=*/false,
                       [port] { return testing::WaitTcpPortListening(port); }};
   setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_flags;listen", 1);
-  PaintStreamAndCompare(dir, url, sender, kRtspMinPsnrDb);
+  const Json metrics = PaintStreamAndCompare(dir, url, sender, kRtspMinPsnrDb);
   unsetenv("OPENCV_FFMPEG_CAPTURE_OPTIONS");
+  ASSERT_FALSE(metrics.is_null());
+  EXPECT_EQ(metrics["live"]["end_reason"], "the stream ended after 150 frames");
+}
+
+// An HTTP server for one client: sends the response headers and `body`, then closes the
+// connection (`close_at_end`: the stream ended) or keeps it open sending nothing (a stalled
+// server) until the reader has finished.
+class OneShotHttpServer {
+ public:
+  OneShotHttpServer(std::string body, bool close_at_end)
+      : body_(std::move(body)), close_at_end_(close_at_end) {
+    thread_ = std::thread([this] { Serve(); });
+  }
+  ~OneShotHttpServer() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      released_ = true;
+    }
+    released_cv_.notify_all();
+    thread_.join();
+  }
+  std::string Url() const { return "http://127.0.0.1:" + std::to_string(server_.port()) + "/s.ts"; }
+
+ private:
+  void Serve() {
+    const int c = server_.Accept();
+    if (c < 0) return;
+    std::string request;
+    char buffer[1024];
+    while (request.find("\r\n\r\n") == std::string::npos) {
+      const ssize_t n = recv(c, buffer, sizeof buffer, 0);
+      if (n <= 0) break;
+      request.append(buffer, n);
+    }
+    const std::string head = "HTTP/1.1 200 OK\r\nContent-Type: video/mp2t\r\n\r\n";
+    send(c, head.data(), head.size(), MSG_NOSIGNAL);
+    send(c, body_.data(), body_.size(), MSG_NOSIGNAL);
+    if (!close_at_end_) {  // stall: connected, silent (a safety limit of 60 s)
+      std::unique_lock<std::mutex> lock(mutex_);
+      released_cv_.wait_for(lock, std::chrono::seconds(60), [this] { return released_; });
+    }
+    close(c);
+  }
+
+  testing::PoseServer server_;  // any TCP listener
+  std::string body_;
+  bool close_at_end_;
+  std::mutex mutex_;
+  std::condition_variable released_cv_;
+  bool released_ = false;
+  std::thread thread_;
+};
+
+// DIR/s.ts: 30 frames of FFmpeg's test pattern (160x120, H.264 lossless, MPEG-TS); "" when
+// the `ffmpeg` program fails.
+std::string ThirtyFrameStream(const std::string& dir) {
+  const std::string ts = dir + "/s.ts";
+  const std::string command =
+      "timeout 60 ffmpeg -hide_banner -loglevel error -f lavfi -i testsrc=size=160x120:rate=30 "
+      "-frames:v 30 -c:v libx264 -qp 0 -tune zerolatency -g 15 -f mpegts " +
+      ts;
+  return std::system(command.c_str()) == 0 ? ts : "";
+}
+
+// Reads a stream to its end through LiveFrames (no poses, read timeout 1 s); its stats.
+LiveFramesStats ReadStreamToTheEnd(const std::string& url) {
+  VideoSourceOptions video_options;
+  video_options.open_timeout_s = 30;  // safety limits
+  video_options.read_timeout_s = 1.0;
+  std::unique_ptr<VideoSource> video;
+  const Status opened = OpenVideoSource(url, video_options, &video);
+  EXPECT_TRUE(opened.ok()) << opened.message();
+  if (!opened.ok()) return LiveFramesStats();
+  LiveOptions options;
+  options.queue_frames = 100;  // more than the stream: nothing dropped
+  options.read_timeout_s = video_options.read_timeout_s;
+  options.pose_wait_s = 0;
+  LiveFrames frames(
+      std::move(video), nullptr, [](double, double, Rigid3d*) { return false; }, options, 0.0,
+      nullptr);
+  PosedFrame f;
+  Status status;
+  while (frames.Next(&f, &status)) {
+  }
+  EXPECT_TRUE(status.ok()) << status.message();
+  return frames.stats();
+}
+
+// A stream whose server finishes is reported as ended; one whose server stops sending but
+// keeps the connection is reported as stalled (after the read timeout): a plain HTTP server
+// (no Content-Length, closes or goes silent) and the `ffmpeg` program serving HTTP from a
+// pipe whose writer goes silent (the shape of a camera encoder that hangs).
+TEST(LiveStreamTest, HttpStreamEndIsToldApartFromAStall) {
+  if (!testing::HaveFfmpeg())
+    GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
+  const std::string ts = ThirtyFrameStream(testing::MakeTempDir("live_end"));
+  ASSERT_FALSE(ts.empty());
+  const std::string body = testing::ReadText(ts);
+  ASSERT_GT(body.size(), 1000u);
+  {
+    OneShotHttpServer server(body, /*close_at_end=*/true);
+    const LiveFramesStats ended = ReadStreamToTheEnd(server.Url());
+    EXPECT_EQ(ended.frames_received, 30);
+    EXPECT_EQ(ended.end_reason, "the stream ended after 30 frames");
+  }
+  {
+    OneShotHttpServer server(body, /*close_at_end=*/false);
+    const LiveFramesStats stalled = ReadStreamToTheEnd(server.Url());
+    std::printf("stalled server: %lld frames, \"%s\"\n", stalled.frames_received,
+                stalled.end_reason.c_str());
+    EXPECT_GE(stalled.frames_received, 28);  // the demuxer may hold the last frame back
+    EXPECT_LE(stalled.frames_received, 30);
+    EXPECT_EQ(stalled.end_reason, "stalled: no frame within 1.0 s after " +
+                                      std::to_string(stalled.frames_received) + " frames");
+  }
+  // ffmpeg serves what it reads from a pipe that stays open and silent for 6 s after the
+  // frames (probing limited so that it listens at once).
+  const int port = testing::FreeLoopbackPort(SOCK_STREAM);
+  const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/s.ts";
+  const std::string serve = "(cat " + ts +
+                            "; sleep 6) | timeout 60 ffmpeg -hide_banner -loglevel error "
+                            "-probesize 32 -analyzeduration 0 -f mpegts -i - -c copy -f mpegts "
+                            "-listen 1 " +
+                            url;
+  auto server = std::async(std::launch::async, [&] { return std::system(serve.c_str()); });
+  ASSERT_TRUE(testing::WaitTcpPortListening(port));
+  const LiveFramesStats stalled = ReadStreamToTheEnd(url);
+  std::printf("stalled ffmpeg server: %lld frames, \"%s\"\n", stalled.frames_received,
+              stalled.end_reason.c_str());
+  EXPECT_GE(stalled.frames_received, 20);
+  EXPECT_LE(stalled.frames_received, 30);
+  EXPECT_EQ(stalled.end_reason, "stalled: no frame within 1.0 s after " +
+                                    std::to_string(stalled.frames_received) + " frames");
+  server.get();  // exits 1: its client went away (nothing to check)
+}
+
+// RTSP (Fresco listens, ffmpeg pushes over TCP): a pusher that finishes tears the session
+// down (the stream ended); one whose input goes silent keeps it open (a stall).
+TEST(LiveStreamTest, RtspStreamEndIsToldApartFromAStall) {
+  if (!testing::HaveFfmpeg())
+    GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
+  const std::string ts = ThirtyFrameStream(testing::MakeTempDir("live_rtsp_end"));
+  ASSERT_FALSE(ts.empty());
+  // Probing limited to 0.1 s of stream: by default FFmpeg probes up to 5 s, more than the
+  // silent pusher sends before it stalls (the open would return only at its teardown).
+  setenv("OPENCV_FFMPEG_CAPTURE_OPTIONS", "rtsp_flags;listen|analyzeduration;100000", 1);
+  struct Unset {
+    ~Unset() { unsetenv("OPENCV_FFMPEG_CAPTURE_OPTIONS"); }
+  } unset;  // also when an assertion returns early
+  for (const bool stall : {false, true}) {
+    const int port = testing::FreeLoopbackPort(SOCK_STREAM);
+    const std::string url = "rtsp://127.0.0.1:" + std::to_string(port) + "/live";
+    auto reading = std::async(std::launch::async, [&] { return ReadStreamToTheEnd(url); });
+    ASSERT_TRUE(testing::WaitTcpPortListening(port));
+    const std::string push = "(cat " + ts + (stall ? "; sleep 6" : "") +
+                             ") | timeout 60 ffmpeg -hide_banner -loglevel error -probesize 32 "
+                             "-analyzeduration 0 -f mpegts -i - -c copy -f rtsp "
+                             "-rtsp_transport tcp " +
+                             url;
+    auto pusher = std::async(std::launch::async, [&] { return std::system(push.c_str()); });
+    const LiveFramesStats s = reading.get();
+    pusher.get();
+    std::printf("rtsp, %s pusher: %lld frames, \"%s\"\n", stall ? "silent" : "finishing",
+                s.frames_received, s.end_reason.c_str());
+    if (stall) {
+      EXPECT_GE(s.frames_received, 20);
+      EXPECT_EQ(s.end_reason, "stalled: no frame within 1.0 s after " +
+                                  std::to_string(s.frames_received) + " frames");
+    } else {
+      EXPECT_EQ(s.end_reason, "the stream ended after 30 frames");
+    }
+  }
+}
+
+// `fresco run` with a tracker that goes away mid-session: it sends the poses of frames
+// 0..39, closes its connection and its listening socket, and 0.5 s later listens again on
+// the same port and sends frames 60..89 (it lost track meanwhile). The feed reconnects
+// once; the frames whose pose time falls in the gap get no pose, every other frame is
+// painted, and metrics.json reports the gap in tracker time.
+TEST(LiveStreamTest, PaintingGoesOnAfterTheTrackerReconnects) {
+  const std::string dir = testing::MakeTempDir("live_reconnect");
+  const int frames = 90, lost_from = 40, back_at = 60;
+  const std::vector<PosedImage> truth = testing::MakeStreamCapture(dir + "/synth", frames);
+  ASSERT_EQ(truth.size(), static_cast<size_t>(frames));
+  auto line = [&](int i) {
+    return testing::TumLine(i / kFps + kOffsetS, truth[i].cam_from_world.Inverse());
+  };
+  std::string first, second;
+  for (int i = 0; i < lost_from; ++i) first += line(i);
+  for (int i = back_at; i < frames; ++i) second += line(i);
+  testing::DroppingTracker tracker(first, second, 500);
+  // The capture's frames from their folder (read on demand) and the poses from the tracker,
+  // the offset as set: frame i at tracker time i / 30 + 0.2, exactly a sample's time.
+  Json project =
+      testing::StreamProjectFrom(dir + "/synth", dir + "/synth/frames", tracker.Address());
+  project["time_offset_s"] = kOffsetS;
+  project["live"] = {{"pose_wait_s", 30}, {"connect_timeout_s", 30}};  // safety limits
+  testing::WriteText(dir + "/live.json", project.dump(2));
+  const testing::CommandResult run =
+      testing::RunFresco({"run", dir + "/live.json", "--out", dir + "/out", "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json metrics = ReadJson(dir + "/out/metrics.json");
+  const Json& l = metrics["live"];
+  const Json& feed = l["pose_feed"];
+  std::printf("reconnect: %s; painted %d of %d\n", feed.dump().c_str(),
+              metrics["frames_painted"].get<int>(), metrics["frames"].get<int>());
+  EXPECT_EQ(metrics["frames"].get<int>(), frames);
+  EXPECT_EQ(l["frames_without_pose"].get<int>(), back_at - lost_from);
+  EXPECT_EQ(metrics["frames_painted"].get<int>(), frames - (back_at - lost_from));
+  EXPECT_EQ(feed["reconnects"].get<int>(), 1);
+  EXPECT_EQ(feed["disconnects"].get<int>(), 1);
+  EXPECT_EQ(feed["poses"].get<int>(), frames - (back_at - lost_from));
+  ASSERT_EQ(feed["gaps"].size(), 1u);
+  const Json& gap = feed["gaps"][0];
+  EXPECT_TRUE(gap["reconnected"].get<bool>());
+  EXPECT_NEAR(gap["last_pose_before_s"].get<double>(), (lost_from - 1) / kFps + kOffsetS, 1e-6);
+  EXPECT_NEAR(gap["first_pose_after_s"].get<double>(), back_at / kFps + kOffsetS, 1e-6);
+  EXPECT_NEAR(gap["tracker_gap_s"].get<double>(), (back_at - lost_from + 1) / kFps, 1e-6);
+  EXPECT_GT(gap["disconnected_s"].get<double>(), 0.0);
 }
 
 TEST(LiveStreamTest, UnreachableSourcesExitTwoNamingTheAddress) {

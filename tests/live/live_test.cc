@@ -212,7 +212,7 @@ TEST(LiveFramesTest, ASourceFasterThanThePainterIsDroppedNewestWins) {
   EXPECT_EQ(std::vector<int>(delivered.end() - 4, delivered.end()),
             (std::vector<int>{produced - 4, produced - 3, produced - 2, produced - 1}));
   EXPECT_GE(stats.frames_dropped, produced - 1 - 4 - 1);
-  EXPECT_THAT(stats.end_reason, HasSubstr("no frame within"));
+  EXPECT_EQ(stats.end_reason, "the stream ended after 500 frames");  // the source said so
 }
 
 std::string TumLine(const TimedPose& p) {
@@ -244,6 +244,132 @@ TEST(PoseFeedTest, TcpFeedInterpolatesAndReconnects) {
   EXPECT_GE(feed->stats().reconnects, 1);
   EXPECT_EQ(feed->AllPoses().size(), 21u);
   EXPECT_FALSE(feed->WaitPoseAt(5.0, 0.05, &pose)) << "beyond the track";
+}
+
+// A file-like source (read on demand, nothing dropped) of tiny frames at given times.
+class TimedFrameSource : public VideoSource {
+ public:
+  explicit TimedFrameSource(std::vector<double> times_s) : times_s_(std::move(times_s)) {}
+  bool Next(Frame* frame, Status*) override {
+    if (next_ >= times_s_.size()) return false;
+    frame->index = static_cast<int>(next_);
+    frame->timestamp_s = times_s_[next_++];
+    frame->bgr = cv::Mat(8, 8, CV_8UC3, cv::Scalar(0, 0, 0));
+    return true;
+  }
+  int FrameCount() const override { return static_cast<int>(times_s_.size()); }
+  std::vector<std::string> FrameNames() const override { return {}; }
+  double Fps() const override { return 10; }
+
+ private:
+  std::vector<double> times_s_;
+  size_t next_ = 0;
+};
+
+// Mid-stream the tracker goes away (its connection and its listening socket close) and comes
+// back on the same port 0.5 s later. The feed reconnects once, reports the gap (tracker time
+// 1.0 s to 2.0 s), and frames after the gap are matched to the tracker's poses again.
+TEST(PoseFeedTest, TrackerGoingAwayMidStreamIsReconnectedAndTheGapReported) {
+  std::string before, after;
+  for (int i = 0; i <= 10; ++i) before += TumLine(Motion(0.1 * i));  // 0 .. 1.0 s
+  for (int i = 20; i <= 30; ++i) after += TumLine(Motion(0.1 * i));  // 2.0 .. 3.0 s
+  testing::DroppingTracker tracker(before, after, 500);
+  const std::string address = tracker.Address();
+  PoseFeedOptions options;
+  options.reconnect_interval_s = 0.05;
+  options.reconnect_max_interval_s = 0.2;
+  std::unique_ptr<PoseFeed> feed;
+  const Status opened = PoseFeed::Open(address, options, &feed);
+  ASSERT_TRUE(opened.ok()) << opened.message();
+
+  // The painter's view: a frame every 0.1 s from 0 to 3 s, offset 0, poses from the feed.
+  std::vector<double> times;
+  for (int i = 0; i <= 30; ++i) times.push_back(0.1 * i);
+  LiveOptions live;
+  live.pose_wait_s = 20.0;  // a safety limit: frames wait for the tracker to come back
+  LiveFrames frames(
+      std::make_unique<TimedFrameSource>(times), nullptr,
+      [&](double t, double timeout_s, Rigid3d* pose) {
+        return feed->WaitPoseAt(t, timeout_s, pose);
+      },
+      live, 0.0, nullptr);
+  PosedFrame f;
+  Status status;
+  std::vector<int> with_pose, without_pose;
+  while (frames.Next(&f, &status)) {
+    (f.has_pose ? with_pose : without_pose).push_back(f.frame.index);
+    if (!f.has_pose) continue;
+    EXPECT_LT(CentreError(f.cam_from_world, Motion(f.frame.timestamp_s)), 1e-9) << f.frame.index;
+    EXPECT_LT(AngleErrorDeg(f.cam_from_world, Motion(f.frame.timestamp_s)), 1e-6);
+  }
+  EXPECT_TRUE(status.ok()) << status.message();
+  // Frames 0..10 (before) and 20..30 (after the reconnect) have poses; 11..19 fall in the
+  // 1 s gap (wider than max_gap_s, 0.5 s): none is interpolated across it.
+  std::vector<int> expected_with, expected_without;
+  for (int i = 0; i <= 30; ++i)
+    (i <= 10 || i >= 20 ? expected_with : expected_without).push_back(i);
+  EXPECT_EQ(with_pose, expected_with);
+  EXPECT_EQ(without_pose, expected_without);
+  EXPECT_EQ(frames.stats().frames_without_pose, 9);
+  Rigid3d pose;
+  ASSERT_TRUE(feed->WaitPoseAt(2.55, 1.0, &pose));
+  EXPECT_LT(CentreError(pose, Motion(2.55)), 1e-9);
+
+  const PoseFeedStats stats = feed->stats();  // before the tracker goes away again
+  EXPECT_TRUE(feed->error().ok()) << feed->error().message();
+  EXPECT_EQ(stats.reconnects, 1);
+  EXPECT_EQ(stats.disconnects, 1);
+  EXPECT_TRUE(stats.connected);
+  EXPECT_EQ(stats.poses, 22);
+  ASSERT_EQ(stats.gaps.size(), 1u);
+  const PoseFeedGap& gap = stats.gaps[0];
+  EXPECT_TRUE(gap.reconnected);
+  EXPECT_NEAR(gap.last_pose_before_s, 1.0, 1e-9);
+  EXPECT_NEAR(gap.first_pose_after_s, 2.0, 1e-9);
+  EXPECT_NEAR(gap.tracker_gap_s(), 1.0, 1e-9);
+  EXPECT_GT(gap.disconnected_s, 0.0);
+  EXPECT_GE(gap.attempts, 2) << "refused at least once while the tracker was away";
+  EXPECT_EQ(stats.disconnected_s, gap.disconnected_s);
+  std::printf("reconnected after %d attempts, %.3f s disconnected; tracker gap %.3f s\n",
+              gap.attempts, gap.disconnected_s, gap.tracker_gap_s());
+}
+
+// A tracker that never comes back: the backoff gives up after reconnect_give_up_s with an
+// error naming the address, and a frame waiting for a pose is released by it.
+TEST(PoseFeedTest, ATrackerThatNeverComesBackEndsTheFeedWithAnError) {
+  auto server = std::make_unique<testing::PoseServer>();
+  const std::string address = server->Address();
+  std::thread tracker([&] {
+    const int c = server->Accept();
+    const std::string line = TumLine(Motion(0.0));
+    send(c, line.data(), line.size(), MSG_NOSIGNAL);
+    server->Close();
+    close(c);
+  });
+  PoseFeedOptions options;
+  options.reconnect_interval_s = 0.02;
+  options.reconnect_max_interval_s = 0.1;
+  options.reconnect_give_up_s = 0.3;
+  std::unique_ptr<PoseFeed> feed;
+  ASSERT_TRUE(PoseFeed::Open(address, options, &feed).ok());
+  tracker.join();
+  Rigid3d pose;
+  EXPECT_FALSE(feed->WaitPoseAt(1.0, 30.0, &pose));  // returns once the feed gives up
+  EXPECT_THAT(feed->error().message(),
+              StartsWith(address + ": the tracker went away and did not come back within 0.3 s"));
+  EXPECT_THAT(feed->error().message(), HasSubstr("Connection refused"));
+  const PoseFeedStats stats = feed->stats();
+  EXPECT_EQ(stats.reconnects, 0);
+  EXPECT_EQ(stats.disconnects, 1);
+  EXPECT_FALSE(stats.connected);
+  ASSERT_EQ(stats.gaps.size(), 1u);
+  EXPECT_FALSE(stats.gaps[0].reconnected);
+  EXPECT_EQ(stats.gaps[0].last_pose_before_s, 0.0);
+  EXPECT_TRUE(std::isnan(stats.gaps[0].first_pose_after_s));
+  EXPECT_GE(stats.gaps[0].disconnected_s, 0.3);
+  // Backoff: 0.02, 0.04, 0.08, 0.1, 0.1 ... apart: a handful of attempts, not hundreds.
+  EXPECT_GE(stats.gaps[0].attempts, 2);
+  EXPECT_LE(stats.gaps[0].attempts, 10);
 }
 
 TEST(PoseFeedTest, MalformedLineIsAnErrorNamingAddressAndLine) {
@@ -424,6 +550,110 @@ TEST(TimeOffsetTest, RecoversAKnownOffsetWithinAFramePeriod) {
       "candidates, %.2f s; score at truth %.3f, +2 frames %.3f\n",
       estimate.offset_s, offset, 1 / fps, frames.size(), estimate.candidates.size(),
       estimate.seconds, at_truth.score, off_by_two.score);
+}
+
+// Offset tracking: the tracker's clock jumps 0.1 s ahead halfway through a hand-held capture
+// (offset 0.2 s for frames 0..59, 0.3 s from frame 60 on), poses sent over TCP. The offset
+// is estimated on the first window, then again every 15 frames over the last 30: once a
+// window lies after the step, the offset in use follows it within one frame period; before
+// the step, re-estimations agree with the offset in use and are not applied.
+TEST(TimeOffsetTest, TrackingFollowsAStepInTheOffset) {
+  CubeRoomOptions room;
+  Scene scene;
+  ASSERT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  const int n = 120, step_at = 60;
+  const double fps = 30.0, before = 0.2, after = 0.3, step_s = step_at / fps;
+  SynthOptions o = testing::HandheldRoomCapture(n, 0.6);
+  o.width = 160, o.height = 120, o.supersample = 1;
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
+  std::string lines;
+  for (int i = 0; i < n; ++i)
+    lines += testing::TumLine(i / fps + (i < step_at ? before : after),
+                              capture.true_poses[i].cam_from_world.Inverse());
+  testing::PoseServer server;
+  std::thread tracker([&] { server.ServeOnce(lines); });
+  std::unique_ptr<PoseFeed> feed;
+  ASSERT_TRUE(PoseFeed::Open(server.Address(), PoseFeedOptions(), &feed).ok());
+  Rigid3d unused;
+  ASSERT_TRUE(feed->WaitPoseAt((n - 1) / fps + after, 30.0, &unused));  // every pose is in
+  tracker.join();
+
+  // A file-like source: tracking waits for each re-estimation (reproducible).
+  class CaptureSource : public VideoSource {
+   public:
+    explicit CaptureSource(const SynthCapture& c) : c_(c) {}
+    bool Next(Frame* f, Status*) override {
+      if (next_ >= c_.frames_bgr.size()) return false;
+      f->index = static_cast<int>(next_);
+      f->timestamp_s = next_ / 30.0;
+      f->bgr = c_.frames_bgr[next_++];
+      return true;
+    }
+    int FrameCount() const override { return static_cast<int>(c_.frames_bgr.size()); }
+    std::vector<std::string> FrameNames() const override { return {}; }
+    double Fps() const override { return 30; }
+
+   private:
+    const SynthCapture& c_;
+    size_t next_ = 0;
+  };
+  LiveOptions live;
+  live.pose_wait_s = 0;
+  live.estimate_offset = true;
+  live.offset_search_s = 0.35;
+  live.offset_window_frames = 30;
+  live.track_offset = true;
+  live.offset_track_every_frames = 15;
+  live.offset_track_search_s = 0.15;
+  live.offset_track_min_gain = 0.1;
+  LiveFrames frames(
+      std::make_unique<CaptureSource>(capture), nullptr,
+      [&](double t, double, Rigid3d* pose) { return feed->PoseAt(t, pose); }, live, 0.0,
+      MakeTimeOffsetEstimator(&scene, capture.camera, PipelineOptions(), GroupingOptions(), 0.0,
+                              TimeOffsetOptions()));
+  PosedFrame f;
+  Status status;
+  std::vector<double> used(n, std::nan(""));  // the offset each frame was matched with
+  while (frames.Next(&f, &status)) used[f.frame.index] = f.pose_time_s - f.frame.timestamp_s;
+  ASSERT_TRUE(status.ok()) << status.message();
+  const LiveFramesStats stats = frames.stats();
+  ASSERT_TRUE(stats.offset_estimated) << stats.estimate.note;
+  EXPECT_NEAR(stats.estimate.offset_s, before, 1.0 / fps);
+
+  double follows_from_s = -1;  // end of the first window wholly after the step
+  int applied_after = 0;
+  for (const OffsetTrackPoint& p : stats.offset_track) {
+    std::printf("window %.3f..%.3f s (%d frames): estimate %.4f s, score %.3f vs %.3f%s\n",
+                p.window_start_s, p.time_s, p.frames, p.offset_s, p.score, p.current_score,
+                p.applied ? " applied" : "");
+    EXPECT_TRUE(p.ok);
+    if (p.time_s < step_s) {  // wholly before the step
+      EXPECT_NEAR(p.offset_s, before, 1.0 / fps);
+      EXPECT_FALSE(p.applied) << "no better offset before the step";
+    } else if (p.window_start_s >= step_s) {  // wholly after
+      EXPECT_NEAR(p.offset_s, after, 1.0 / fps);
+      if (follows_from_s < 0) follows_from_s = p.time_s;
+    }
+    if (p.applied) ++applied_after;
+  }
+  ASSERT_GE(stats.offset_track.size(), 5u);
+  ASSERT_GT(follows_from_s, 0) << "no window after the step";
+  EXPECT_GE(applied_after, 1);
+  EXPECT_NEAR(stats.time_offset_s, after, 1.0 / fps);
+  // Every frame before the step was matched at the first offset; every frame from the end of
+  // the first window after the step on, at the new one.
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(used[i])) continue;  // no pose (beyond the track's end)
+    if (i < step_at) {
+      EXPECT_NEAR(used[i], before, 1.0 / fps) << "frame " << i;
+    }
+    if (i / fps >= follows_from_s) {
+      EXPECT_NEAR(used[i], after, 1.0 / fps) << "frame " << i;
+    }
+  }
+  std::printf("final offset %.4f s (truth %.3f), %zu re-estimations\n", stats.time_offset_s, after,
+              stats.offset_track.size());
 }
 
 }  // namespace

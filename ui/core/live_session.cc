@@ -152,6 +152,11 @@ LiveStatus LiveSession::CurrentStatus() {
       project_.live.estimate_offset && f.estimate.candidates.empty() && f.estimate.note.empty();
   st.offset_score = f.estimate.score;
   st.offset_note = f.estimate.note;
+  st.offset_track_points = static_cast<int>(f.offset_track.size());
+  if (!f.offset_track.empty()) {
+    st.offset_track_last_s = f.offset_track.back().offset_s;
+    st.offset_track_last_applied = f.offset_track.back().applied;
+  }
   const double now = NowS();
   if (f.frames_received != last_received_) {
     last_received_ = f.frames_received;
@@ -164,6 +169,11 @@ LiveStatus LiveSession::CurrentStatus() {
     st.poses_connected = p.connected;
     st.poses_received = p.poses;
     st.pose_reconnects = p.reconnects;
+    st.pose_gap_known = !p.gaps.empty();
+    if (st.pose_gap_known) {
+      st.pose_gap_tracker_s = p.gaps.back().tracker_gap_s();
+      st.pose_gap_disconnected_s = p.gaps.back().disconnected_s;
+    }
     st.seconds_since_pose = p.seconds_since_last_pose;
     st.pose_lag_known = delivered_any_ && p.poses > 0;
     if (st.pose_lag_known) st.pose_lag_s = p.latest_time_s - last_pose_time_s_;

@@ -43,6 +43,10 @@ struct LiveStatus {
   bool pose_feed = false;  // poses from a feed (else a TUM file)
   bool poses_connected = false;
   long long poses_received = 0, pose_reconnects = 0;
+  // The last disconnection of the pose feed: tracker time it spans (NaN until the first
+  // pose after it) and wall seconds without a connection; valid when pose_gap_known.
+  bool pose_gap_known = false;
+  double pose_gap_tracker_s = 0, pose_gap_disconnected_s = 0;
   double seconds_since_pose = -1;
   // Pose-match lag: the newest tracker sample's time minus the pose time of the last frame
   // delivered (frame time + offset), seconds; > 0: the tracker is ahead of the video.
@@ -54,6 +58,11 @@ struct LiveStatus {
   bool offset_estimated = false;
   double offset_score = 0;  // mean |grey difference| at the estimate
   std::string offset_note;
+  // Offset tracking (live.track_offset): re-estimations so far, and the last one's estimate
+  // and whether it replaced the offset in use.
+  int offset_track_points = 0;
+  double offset_track_last_s = 0;
+  bool offset_track_last_applied = false;
   std::string end_reason;
   // Recording (the Record toggle).
   bool recording = false;

@@ -2,6 +2,7 @@
 
 #include <imgui_stdlib.h>
 
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -75,6 +76,12 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
               live.video_clock.c_str());
   if (live.pose_feed)
     ImGui::Text("tracker: %lld poses, %lld reconnects", live.poses_received, live.pose_reconnects);
+  if (live.pose_feed && live.pose_gap_known) {
+    const std::string span = std::isfinite(live.pose_gap_tracker_s)
+                                 ? Format("%.3f s of tracker time", live.pose_gap_tracker_s)
+                                 : std::string("tracker time not known yet");
+    ImGui::Text("last gap: %.2f s disconnected, %s", live.pose_gap_disconnected_s, span.c_str());
+  }
   const std::string lag = live.pose_lag_known ? Format("%+.3f s", live.pose_lag_s) : "-";
   ImGui::Text("pose-match lag: %s", lag.c_str());
   if (ImGui::IsItemHovered())
@@ -91,6 +98,9 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
   else
     offset += " (as set)";
   ImGui::TextWrapped("time offset: %s", offset.c_str());
+  if (live.offset_track_points > 0)
+    ImGui::Text("tracked: %d re-estimates, last %.4f s (%s)", live.offset_track_points,
+                live.offset_track_last_s, live.offset_track_last_applied ? "applied" : "kept");
   if (!live.problem.empty()) WrappedColored(kBad, live.problem);
 
   // Record toggle: the worker's state is the truth; a click asks it to change.
