@@ -8,7 +8,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/noise_correlation.h"
 #include "pipeline/core/image_io.h"
 
 namespace fresco::calib {
@@ -255,8 +254,8 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);
   CheckRequestedModel(request, run);
   if (request.board.kind == BoardKind::kAprilGrid) {
-    run->corner_correlation = TagCornerCorrelation(run->views, run->Chosen().fit);
-    run->noise_inflation = TagNoiseInflation(run->corner_correlation);
+    run->corner_correlation = run->Chosen().corner_correlation;
+    run->noise_inflation = run->Chosen().noise_inflation;
     for (ModelTrial& t : run->choice.trials)
       for (double& s : t.fit.intrinsics_stdev) s *= run->noise_inflation;
   }

@@ -190,8 +190,10 @@ Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec,
     solve.lensmodel = trial.lensmodel;
     starting(short_name + ": all " + std::to_string(views.size()) + " images");
     trial.status = SolveIntrinsics(views, spec, width, height, seed, solve, &trial.fit);
-    if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid)
-      trial.noise_inflation = TagNoiseInflation(TagCornerCorrelation(views, trial.fit));
+    if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid) {
+      trial.corner_correlation = TagCornerCorrelation(views, trial.fit);
+      trial.noise_inflation = TagNoiseInflation(trial.corner_correlation);
+    }
     out.trials.push_back(std::move(trial));
   }
   if (std::none_of(out.trials.begin(), out.trials.end(),

@@ -47,7 +47,8 @@ struct ModelTrial {
   // RMS of sqrt(u0^2 + u1^2) over the compared pixels: the diff the halves' own uncertainty
   // predicts (-1: not computed; the limit then falls back to 3 sigma x inflation).
   double cross_validation_expected_px = -1;
-  double noise_inflation = 1;         // AprilGrid: sqrt(1 + 3 rho) from this model's residuals
+  double corner_correlation = 0;      // AprilGrid: rho of this model's tag-corner residuals
+  double noise_inflation = 1;         // AprilGrid: sqrt(1 + 3 rho)
   // RMS projection difference to the best model (lowest sigma among the supported) over the
   // observed pixels, and that model's RMS projection uncertainty there (-1: not computed).
   double projection_vs_best_px = -1;
