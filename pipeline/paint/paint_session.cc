@@ -157,9 +157,11 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   depth_report.name = "depth";
   const CameraCache& camera_cache = CacheFor(camera);
   if (options_.occlusion.enabled) {
-    camera_cache.rasterizer->Rasterize(scene_->mesh, cam_from_local, &raster_);
-    if (debug) depth_report.metrics["surface_pixels"] = cv::countNonZero(raster_.triangle_id >= 0);
-    if (debug) depth_report.images["depth"] = DepthDebugImage(raster_.depth);
+    camera_cache.rasterizer->RasterizeDepth(scene_->mesh, cam_from_local, &depth_);
+    if (debug)
+      depth_report.metrics["surface_pixels"] =
+          cv::countNonZero(depth_ < std::numeric_limits<float>::infinity());
+    if (debug) depth_report.images["depth"] = DepthDebugImage(depth_);
   }
   depth_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(depth_report));
@@ -173,7 +175,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   view.cam_from_local = cam_from_local;
   view.centre_local = cam_from_local.Centre();
   view.frame_bgr = &frame.bgr;
-  view.depth = options_.occlusion.enabled ? &raster_.depth : nullptr;
+  view.depth = options_.occlusion.enabled ? &depth_ : nullptr;
   view.bounds = camera_cache.bounds;
   if (options_.sampling == SamplingMode::kArea) {
     view.pyramid.push_back(frame.bgr);
@@ -254,7 +256,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
                              ? cv::Mat()
                              : background_frame_[b].foreground;
-    const PaintUpdateStats stats = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
+    const PaintUpdateStats stats =
+        PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
     if (!background_.empty())
       MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
     written += stats.written;
@@ -327,10 +330,10 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
     MovePaintedBuffer(move, anchors_[b], &painted);
     // The frame, registered to the buffer before the move, moves with it.
     const int margin = static_cast<int>(std::ceil(e.correction_px)) + 2;
-    const cv::Rect within = cv::Rect(w.valid_box.x - margin, w.valid_box.y - margin,
-                                     w.valid_box.width + 2 * margin,
-                                     w.valid_box.height + 2 * margin) &
-                            cv::Rect(0, 0, w.valid.cols, w.valid.rows);
+    const cv::Rect within =
+        cv::Rect(w.valid_box.x - margin, w.valid_box.y - margin, w.valid_box.width + 2 * margin,
+                 w.valid_box.height + 2 * margin) &
+        cv::Rect(0, 0, w.valid.cols, w.valid.rows);
     MoveWarpedImages(move, within, &w.bgr, &w.valid, &w.quality);
     w.valid_box = within;  // valid texels may have moved by up to the margin
     if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &move))
@@ -347,7 +350,8 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   if (debug) {
     r->images["matches" + suffix] = DrawRefinementMatches(w.bgr, e);
     if (e.inliers > 0)
-      r->images["residual_after" + suffix] = ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
+      r->images["residual_after" + suffix] =
+          ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
   }
 }
 
@@ -378,8 +382,8 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
     RefineEstimate& e = (*results)[i].estimate;
     const cv::Rect& box = warped_[b].valid_box;
     cv::Matx33d H;
-    if (!BufferCorrectionFromPose(set_.buffers[b], *frame_camera_, frame_cam_from_local_,
-                                  corrected, box, &H)) {
+    if (!BufferCorrectionFromPose(set_.buffers[b], *frame_camera_, frame_cam_from_local_, corrected,
+                                  box, &H)) {
       continue;  // keeps its own estimate
     }
     e.buffer_from_warped = H;
@@ -399,8 +403,10 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   report.name = "refine";
   std::vector<size_t> todo, fresh;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
-    if (seen[b] && painted_[b].painted_surface_texels > 0) todo.push_back(b);
-    else if (seen[b]) fresh.push_back(b);
+    if (seen[b] && painted_[b].painted_surface_texels > 0)
+      todo.push_back(b);
+    else if (seen[b])
+      fresh.push_back(b);
   }
   // Buffers are independent: one per thread, the largest regions first so that the threads
   // finish together (longest processing time first).
@@ -428,8 +434,8 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     for_each_buffer(&PaintSession::RefineBuffer);
   }
 
-  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, ambiguous = 0,
-      moved = 0, unregistered_kept_out = 0;
+  int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, ambiguous = 0, moved = 0,
+      unregistered_kept_out = 0;
   double before_sq = 0, after_sq = 0, correction = 0;
   double estimate_ms = 0, rewarp_ms = 0, anchor_ms = 0;
   std::map<std::string, int> models, reasons;
@@ -593,7 +599,7 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
   report->name = frame.name;
   report->stages.clear();
   const Rigid3d cam_from_local = CamFromLocal(*scene_, cam_from_world);
-  CacheFor(camera).rasterizer->Rasterize(scene_->mesh, cam_from_local, &raster_);
+  CacheFor(camera).rasterizer->RasterizeDepth(scene_->mesh, cam_from_local, &depth_);
   const float tolerance = static_cast<float>(options_.occlusion.tolerance_rel);
   PipelineOptions latest_wins;
   latest_wins.update = UpdatePolicy::kLatest;
@@ -611,7 +617,7 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
       const int u = static_cast<int>(std::lround(pixel.x())),
                 v = static_cast<int>(std::lround(pixel.y()));
       if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
-      const float depth = raster_.depth.at<float>(v, u);
+      const float depth = depth_.at<float>(v, u);
       if (p.z() > depth * (1 + tolerance) + options_.occlusion.tolerance_m) continue;
       map.at<cv::Vec2f>(buffer.texel_index[k]) =
           cv::Vec2f(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()));

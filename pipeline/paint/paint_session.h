@@ -121,7 +121,7 @@ class PaintSession {
   std::vector<BufferBackground> background_;       // per buffer (mode != off)
   std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;
-  RasterOutput raster_;  // the current frame's depth and triangle ids (reused)
+  cv::Mat depth_;  // the current frame's depth map from the video camera (reused)
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;
   int frames_seen_ = 0;

@@ -211,8 +211,9 @@ bool PolygonSlabRange(const TriangleSetup& s, double ylo, double yhi, double* xl
 
 }  // namespace
 
-void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                           RasterOutput* output) const {
+template <class Record>
+void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                          const Record& record) const {
   const RayTable& t = *rays_;
   const double near_m = options_.near_m;
   const bool cull = options_.cull_back_faces;
@@ -287,25 +288,6 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
     }
   }
 
-  // Per-sample results (sample order), in a per-thread scratch buffer reused across calls
-  // (no page faults per frame). Each sample is written only by the task owning its bucket.
-  struct RayHit {
-    double inv_depth;  // 1/z of the nearest hit so far, 0 when none
-    int id;            // its triangle, -1 when none
-    float b1, b2;      // its barycentrics
-  };
-  // Large grids (> 64 MB of hits) use a buffer of their own, released after the call.
-  thread_local std::vector<RayHit> scratch;
-  std::vector<RayHit> large;
-  std::vector<RayHit>& buffer = t.by_sample.size() * sizeof(RayHit) > (64u << 20) ? large : scratch;
-  buffer.resize(t.by_sample.size());
-  RayHit* hits = buffer.data();
-  const double inv_near = 1.0 / near_m;
-  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
-    std::fill(hits + static_cast<size_t>(range.start) * t.width,
-              hits + static_cast<size_t>(range.end) * t.width, RayHit{0.0, -1, 0.f, 0.f});
-  });
-
   cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
     for (int row = range.start; row < range.end; ++row) {
       const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
@@ -326,21 +308,6 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
         const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
         const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
         const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
-        // Records a hit of ray k at inverse depth inv_z when it is the nearest so far (ties:
-        // smallest id), with z >= near_m.
-        auto record = [&](int k, float x, float y, double inv_z) {
-          RayHit& h = hits[t.sample[k]];
-          if (!(inv_z > h.inv_depth || (inv_z == h.inv_depth && tri < h.id))) return;
-          if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
-          const float w0 = e00 * x + e01 * y + e02;
-          const float w1 = e10 * x + e11 * y + e12;
-          const float w2 = e20 * x + e21 * y + e22;
-          const float sum = w0 + w1 + w2;
-          h.inv_depth = inv_z;
-          h.id = tri;
-          h.b1 = sum > 0.f ? std::max(w1, 0.f) / sum : 0.f;
-          h.b2 = sum > 0.f ? std::max(w2, 0.f) / sum : 0.f;
-        };
         for (int col = col0; col <= col1; ++col) {
           const int bucket = row * t.cols + col;
           const int begin = t.bucket_start[bucket], end = t.bucket_start[bucket + 1];
@@ -365,7 +332,7 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
           if (inside) {
             for (int k = begin; k < end; ++k) {
               const float x = t.xs[k], y = t.ys[k];
-              record(k, x, y, ia * x + ib * y + ic);
+              record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
             }
             continue;
           }
@@ -375,12 +342,52 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
             const float w1 = e10 * x + e11 * y + e12;
             const float w2 = e20 * x + e21 * y + e22;
             if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
-            record(k, x, y, ia * x + ib * y + ic);
+            record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
           }
         }
       }
     }
   });
+}
+
+void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                           RasterOutput* output) const {
+  const RayTable& t = *rays_;
+  // Per-sample results (sample order), in a per-thread scratch buffer reused across calls
+  // (no page faults per frame). Each sample is written only by the task owning its bucket.
+  struct RayHit {
+    double inv_depth;  // 1/z of the nearest hit so far, 0 when none
+    int id;            // its triangle, -1 when none
+    float b1, b2;      // its barycentrics
+  };
+  // Large grids (> 64 MB of hits) use a buffer of their own, released after the call.
+  thread_local std::vector<RayHit> scratch;
+  std::vector<RayHit> large;
+  std::vector<RayHit>& buffer = t.by_sample.size() * sizeof(RayHit) > (64u << 20) ? large : scratch;
+  buffer.resize(t.by_sample.size());
+  RayHit* hits = buffer.data();
+  const double inv_near = 1.0 / options_.near_m;
+  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
+    std::fill(hits + static_cast<size_t>(range.start) * t.width,
+              hits + static_cast<size_t>(range.end) * t.width, RayHit{0.0, -1, 0.f, 0.f});
+  });
+
+  // Records a hit of triangle `tri` on sample `sample` at inverse depth inv_z when it is the
+  // nearest so far (ties: smallest id), with z >= near_m.
+  Traverse(mesh, cam_from_local,
+           [&](int tri, int sample, float x, float y, double inv_z, const TriangleSetup& s) {
+             RayHit& h = hits[sample];
+             if (!(inv_z > h.inv_depth || (inv_z == h.inv_depth && tri < h.id))) return;
+             if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
+             const float w0 = s.edge[0][0] * x + s.edge[0][1] * y + s.edge[0][2];
+             const float w1 = s.edge[1][0] * x + s.edge[1][1] * y + s.edge[1][2];
+             const float w2 = s.edge[2][0] * x + s.edge[2][1] * y + s.edge[2][2];
+             const float sum = w0 + w1 + w2;
+             h.inv_depth = inv_z;
+             h.id = tri;
+             h.b1 = sum > 0.f ? std::max(w1, 0.f) / sum : 0.f;
+             h.b2 = sum > 0.f ? std::max(w2, 0.f) / sum : 0.f;
+           });
 
   // Outputs in sample order.
   output->depth.create(t.height, t.width, CV_32F);
@@ -399,6 +406,31 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
         ids[c] = h[c].id;
         bary[c] = cv::Vec2f(h[c].b1, h[c].b2);
       }
+    }
+  });
+}
+
+void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                                cv::Mat* depth) const {
+  const RayTable& t = *rays_;
+  depth->create(t.height, t.width, CV_32F);
+  // Inverse depth in place (0: no hit), then depth. The nearest hit is the largest float
+  // inverse depth: a maximum, so the result does not depend on the visiting order.
+  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r) std::fill_n(depth->ptr<float>(r), t.width, 0.0f);
+  });
+  float* inv = depth->ptr<float>();
+  const double inv_near = 1.0 / options_.near_m;
+  Traverse(mesh, cam_from_local,
+           [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
+             const float inv_zf = static_cast<float>(inv_z);
+             if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near) inv[sample] = inv_zf;
+           });
+  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r) {
+      float* d = depth->ptr<float>(r);
+      for (int c = 0; c < t.width; ++c)
+        d[c] = d[c] > 0.0f ? 1.0f / d[c] : std::numeric_limits<float>::infinity();
     }
   });
 }

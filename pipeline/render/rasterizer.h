@@ -52,6 +52,10 @@ class Rasterizer {
   // bad indices or non-finite corners are skipped.
   void Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                  RasterOutput* output) const;
+  // Depth only (CV_32F, as RasterOutput::depth): what the occlusion test needs, without the
+  // triangle ids and barycentrics (a quarter of the memory traffic).
+  void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                      cv::Mat* depth) const;
   const Camera& camera() const { return camera_; }
   const RasterOptions& options() const { return options_; }
   // Normalized ray (x, y) of sample (col, row) in the supersampled grid; NaN if the lens
@@ -60,6 +64,11 @@ class Rasterizer {
 
  private:
   struct RayTable;
+  // Sets up the triangles and calls record(tri, sample, x, y, inv_z, setup) for every ray
+  // inside a triangle at inverse depth inv_z (near plane not yet checked).
+  template <class Record>
+  void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                const Record& record) const;
   Camera camera_;
   RasterOptions options_;
   std::unique_ptr<RayTable> rays_;

@@ -370,6 +370,50 @@ TEST(RasterizerTest, TrianglesCrossingTheCameraPlaneMatchBruteForce) {
   }
 }
 
+// The depth-only path (what the painting's occlusion test uses) gives the full path's depth
+// to float rounding of 1/z, including where triangles cross the near plane and through a
+// distorted lens; both are +inf exactly where no surface is.
+void ExpectDepthOnlyMatchesFull(const Camera& camera, const TriangleMesh& mesh, double near_m) {
+  RasterOptions options;
+  options.near_m = near_m;
+  const Rasterizer rasterizer(camera, options);
+  RasterOutput full;
+  rasterizer.Rasterize(mesh, Rigid3d(), &full);
+  cv::Mat depth;
+  rasterizer.RasterizeDepth(mesh, Rigid3d(), &depth);
+  ASSERT_EQ(depth.type(), CV_32F);
+  ASSERT_EQ(depth.size(), full.depth.size());
+  int hits = 0, differ = 0;
+  for (int r = 0; r < depth.rows; ++r) {
+    for (int c = 0; c < depth.cols; ++c) {
+      const float a = full.depth.at<float>(r, c), b = depth.at<float>(r, c);
+      ASSERT_EQ(std::isinf(a), std::isinf(b)) << "sample " << c << "," << r;
+      if (std::isinf(a)) continue;
+      ++hits;
+      differ += std::abs(a - b) > 1e-6f * a;
+    }
+  }
+  EXPECT_GT(hits, depth.rows * depth.cols / 5);
+  EXPECT_EQ(differ, 0);
+}
+
+TEST(RasterizerTest, DepthOnlyMatchesFullRaster) {
+  TriangleMesh crossing;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> xy(-4.0, 4.0), z(-3.0, 6.0);
+  for (int i = 0; i < 40; ++i)
+    AddTriangle(&crossing, {xy(rng), xy(rng), z(rng)}, {xy(rng), xy(rng), z(rng)},
+                {xy(rng), xy(rng), z(rng)});
+  for (const double near_m : {1e-3, 0.5})
+    ExpectDepthOnlyMatchesFull(PinholeCamera(160, 120, 100.0), crossing, near_m);
+  TriangleMesh grid;
+  AddGrid(&grid, Eigen::Vector3d(-2.5, -2.0, 3.0), Eigen::Vector3d(1.0, 0.0, 0.35).normalized(),
+          Eigen::Vector3d(0.0, 1.0, 0.2).normalized(), 10, 8, 0.5);
+  AddGrid(&grid, Eigen::Vector3d(-0.3, -0.3, 2.0), Eigen::Vector3d::UnitX(),
+          Eigen::Vector3d::UnitY(), 2, 2, 0.3);
+  ExpectDepthOnlyMatchesFull(DistortedCamera(), grid, 1e-3);
+}
+
 TEST(RasterizerTest, BackFaceCulling) {
   const Camera camera = PinholeCamera(100, 80, 100.0);
   TriangleMesh mesh;
