@@ -7,10 +7,10 @@
 #include <sstream>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/cameramodel_io.h"
+#include "pipeline/core/png_encode.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "pipeline/synth/synth_spec.h"
@@ -22,7 +22,7 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 // Bumped whenever the renderer of synthetic frames changes what it writes.
-constexpr const char* kSynthFormat = "fresco-synth-1";
+constexpr const char* kSynthFormat = "fresco-synth-2";  // 2: frames as fast-decoding PNG
 
 class Fnv64 {
  public:
@@ -195,13 +195,11 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
           return Status::Error(dir + ": stopped after " + std::to_string(done) + " of " +
                                std::to_string(frames) + " frames");
         }
-        std::vector<uchar> png;
+        std::vector<uint8_t> png;
         const std::string name = plan.true_poses[index].name;
         const std::string path = (fs::path(frames_dir.path()) / name).string();
-        if (!cv::imencode(".png", bgr, png, {cv::IMWRITE_PNG_COMPRESSION, 3})) {
-          return Status::Error((root / "frames" / name).string() +
-                               ": could not encode the frame as PNG");
-        }
+        if (Status s = EncodeFastDecodingPng(bgr, &png); !s.ok())
+          return Status::Error((root / "frames" / name).string() + ": " + s.message());
         FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
         ++done;
         if (write_options.progress) write_options.progress(done, frames);

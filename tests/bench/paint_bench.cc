@@ -4,11 +4,15 @@
 //                          kernel): the kernel's own throughput
 //   BM_WarpKernelCloseUp   the camera close to the wall, seeing ~40 % of it: chunk culling
 //                          skips the rest, so texels of the buffer per second is higher
+//   BM_DepthRaster         the occlusion stage's depth map, depth only and full
+//   BM_DecodeFrame         decoding one PNG frame, as written by `fresco synth` and before
 //   build/tests/paint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/core/png_encode.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/render/rasterizer.h"
@@ -34,8 +38,7 @@ struct Fixture {
     cam_from_world = Rigid3d(Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()) *
                                                 Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY())),
                              Eigen::Vector3d(0, 0, distance_m));
-    cam_from_world.translation =
-        -(cam_from_world.rotation * Eigen::Vector3d(0.3, 0.1, distance_m));
+    cam_from_world.translation = -(cam_from_world.rotation * Eigen::Vector3d(0.3, 0.1, distance_m));
     const Grouping g = ComputeGrouping(scene.mesh, ComputeAdjacency(scene.mesh), 20.0);
     BaseBufferOptions options;
     options.texel_size_m = distance_m / camera.fx;  // ~1 texel per pixel
@@ -82,22 +85,85 @@ void BM_WarpKernel(benchmark::State& state) {
   static Fixture* distorted = new Fixture(1280, 720, LensModel::kOpenCV5, 3.8);
   RunWarp(state, state.range(1) ? *distorted : *pinhole);
 }
-BENCHMARK(BM_WarpKernel)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames({"threads", "distorted"})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_WarpKernel)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "distorted"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_WarpKernelCloseUp(benchmark::State& state) {
   static Fixture* pinhole = new Fixture(1280, 720, LensModel::kPinhole, 2.5);
   static Fixture* distorted = new Fixture(1280, 720, LensModel::kOpenCV5, 2.5);
   RunWarp(state, state.range(1) ? *distorted : *pinhole);
 }
-BENCHMARK(BM_WarpKernelCloseUp)->ArgsProduct({{1, 2}, {0, 1}})->ArgNames({"threads", "distorted"})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_WarpKernelCloseUp)
+    ->ArgsProduct({{1, 2}, {0, 1}})
+    ->ArgNames({"threads", "distorted"})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
+// depth_only 1: RasterizeDepth (the painting's occlusion stage); 0: depth, ids, barycentrics.
 void BM_DepthRaster(benchmark::State& state) {
   static Fixture* f = new Fixture(1280, 720, LensModel::kPinhole, 3.8);
   Rasterizer raster(f->camera, RasterOptions());
   RasterOutput out;
-  for (auto _ : state) raster.Rasterize(f->scene.mesh, CamFromLocal(f->scene, f->cam_from_world), &out);
+  const Rigid3d cam_from_local = CamFromLocal(f->scene, f->cam_from_world);
+  for (auto _ : state) {
+    if (state.range(0))
+      raster.RasterizeDepth(f->scene.mesh, cam_from_local, &out.depth);
+    else
+      raster.Rasterize(f->scene.mesh, cam_from_local, &out);
+  }
 }
-BENCHMARK(BM_DepthRaster)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DepthRaster)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("depth_only")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Decoding one 1280x720 frame (one thread, cv::imdecode), as `fresco run` does for every
+// frame of a capture: fast 1: written by EncodeFastDecodingPng (what `fresco synth` writes);
+// 0: OpenCV's encoder at compression 3 (what it wrote before). The frame: the procedural cube
+// room seen from its middle, at an angle (four textured faces in view).
+void BM_DecodeFrame(benchmark::State& state) {
+  static const cv::Mat frame = [] {
+    Scene scene;
+    if (!MakeCubeRoomScene(CubeRoomOptions(), &scene).ok()) return cv::Mat();
+    const Camera camera = Camera::FromParams(LensModel::kPinhole, 1280, 720,
+                                             {914.0, 914.0, 639.5, 359.5});
+    // World y up; the camera looks level along world +z turned 40 deg, 10 deg down.
+    const Eigen::Quaterniond world_from_cam =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())) *
+        Eigen::Quaterniond(Eigen::AngleAxisd(-0.17, Eigen::Vector3d::UnitX())) *
+        Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()));
+    const Eigen::Vector3d centre(0.2, 1.5, -0.3);
+    const Rigid3d cam_from_world(world_from_cam.conjugate(),
+                                 -(world_from_cam.conjugate() * centre));
+    RenderOutput out;
+    Renderer(camera, RenderOptions()).Render(scene, cam_from_world, &out);
+    cv::Mat bgr;
+    cv::cvtColor(out.rgba, bgr, cv::COLOR_RGBA2BGR);
+    return bgr;
+  }();
+  std::vector<uint8_t> png;
+  if (frame.empty()) state.SkipWithError("no cube room");
+  if (state.range(0)) {
+    if (!EncodeFastDecodingPng(frame, &png).ok()) state.SkipWithError("encoding failed");
+  } else {
+    cv::imencode(".png", frame, png, {cv::IMWRITE_PNG_COMPRESSION, 3});
+  }
+  cv::setNumThreads(1);
+  for (auto _ : state) benchmark::DoNotOptimize(cv::imdecode(png, cv::IMREAD_COLOR));
+  cv::setNumThreads(-1);
+  state.counters["bytes"] = static_cast<double>(png.size());
+}
+BENCHMARK(BM_DecodeFrame)
+    ->Arg(0)
+    ->Arg(1)
+    ->ArgName("fast")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace fresco
