@@ -413,6 +413,7 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
 void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                                 cv::Mat* depth) const {
   const RayTable& t = *rays_;
+  if (!depth->isContinuous()) depth->release();  // rays index the samples as one array
   depth->create(t.height, t.width, CV_32F);
   // Inverse depth in place (0: no hit), then depth. The nearest hit is the largest float
   // inverse depth: a maximum, so the result does not depend on the visiting order.

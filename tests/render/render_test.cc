@@ -379,8 +379,11 @@ void ExpectDepthOnlyMatchesFull(const Camera& camera, const TriangleMesh& mesh, 
   const Rasterizer rasterizer(camera, options);
   RasterOutput full;
   rasterizer.Rasterize(mesh, Rigid3d(), &full);
-  cv::Mat depth;
+  // Given a view into a larger image (rows not contiguous): replaced by an image of its own.
+  cv::Mat larger(camera.height + 2, camera.width + 3, CV_32F, cv::Scalar(-1));
+  cv::Mat depth = larger(cv::Rect(1, 1, camera.width, camera.height));
   rasterizer.RasterizeDepth(mesh, Rigid3d(), &depth);
+  ASSERT_TRUE(depth.isContinuous());
   ASSERT_EQ(depth.type(), CV_32F);
   ASSERT_EQ(depth.size(), full.depth.size());
   int hits = 0, differ = 0;
