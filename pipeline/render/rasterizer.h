@@ -2,8 +2,9 @@
 // precomputed once per camera (Camera::Unproject), bucketed in normalized (z=1) coordinates,
 // and each triangle (clipped to the near plane, projected to the z=1 plane where its edges
 // stay straight) is tested against the rays of the buckets it covers. Depth comes from the
-// exact ray/plane intersection. This is the depth + triangle-id path the painting pipeline's
-// occlusion stage uses every frame, so it has no colour work in it.
+// exact ray/plane intersection. No colour work: the renderer shades from the triangle ids and
+// barycentrics, and the painting pipeline's occlusion stage takes the depth alone
+// (RasterizeDepth) every frame.
 //
 // Exactness: a sample shows the nearest triangle its ray meets at camera z >= near_m (ties in
 // depth go to the smallest triangle id), the same answer as a brute-force ray cast of the same
@@ -53,7 +54,8 @@ class Rasterizer {
   void Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                  RasterOutput* output) const;
   // Depth only (CV_32F, as RasterOutput::depth): what the occlusion test needs, without the
-  // triangle ids and barycentrics (a quarter of the memory traffic).
+  // triangle ids and barycentrics (4 bytes per ray instead of a 24-byte hit record and three
+  // output images: 1.25 against 3.00 ms at 1280x720, paint_bench BM_DepthRaster).
   void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                       cv::Mat* depth) const;
   const Camera& camera() const { return camera_; }
