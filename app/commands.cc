@@ -20,7 +20,8 @@ const std::vector<Command>& AllCommands() {
 }
 
 static void PrintMainUsage(std::ostream& out) {
-  out << "usage: fresco VERB [ARGS...]   (fresco VERB --help for a verb's options)\n\nverbs:\n";
+  out << "usage: fresco VERB [ARGS...]   (fresco VERB --help for a verb's options;\n"
+         "       fresco --version prints the version)\n\nverbs:\n";
   for (const Command& c : AllCommands()) {
     out << "  " << c.verb << std::string(8 - std::string(c.verb).size(), ' ') << c.summary
         << "\n";
@@ -35,6 +36,10 @@ int Dispatch(const std::vector<std::string>& argv) {
   const std::string& verb = argv[0];
   if (verb == "--help" || verb == "-h" || verb == "help") {
     PrintMainUsage(std::cout);
+    return kExitOk;
+  }
+  if (verb == "--version" || verb == "version") {
+    std::cout << "fresco " << FRESCO_VERSION << "\n";
     return kExitOk;
   }
   for (const Command& c : AllCommands()) {

@@ -20,7 +20,7 @@
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
-#include "pipeline/paint/buffer_preview.h"
+#include "pipeline/paint/charts.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/live/live_input.h"
@@ -36,10 +36,10 @@ ArgSpec RunSpec() {
       "       [--record DIR]";
   spec.help =
       "Replays the project headless: streams its video, paints every frame into the base\n"
-      "buffers, and writes DIR/painted.gltf (+ .bin, PNG textures; alpha 0 = never painted),\n"
-      "DIR/metrics.json and DIR/buffers.png (all painted buffers in one picture). Outputs\n"
-      "are written atomically at the end; Ctrl-C (or SIGTERM) stops between frames, keeps the\n"
-      "outputs of earlier runs and exits 130 (143).\n\n"
+      "buffers, and writes DIR/painted.gltf (+ .bin and one PNG per texture atlas page;\n"
+      "alpha 0 = never painted) and DIR/metrics.json. The outputs are written all or nothing\n"
+      "at the end: a run that fails or is stopped leaves DIR as it was. Ctrl-C (or SIGTERM)\n"
+      "stops between frames, keeps the outputs of earlier runs and exits 130 (143).\n\n"
       "  --set KEY=VALUE   override a project setting by JSON path, e.g.\n"
       "                    --set pipeline.sampling=nearest --set pipeline.update_every=20\n"
       "  --debug-images    write per-stage debug images under DIR/stages/ (costs time)\n"
@@ -303,15 +303,14 @@ int RunVerbRun(const CommandArgs& argv) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   progress.Finish();
 
-  // Outputs: painted.gltf (+ .bin + textures), then metrics.json, each atomically.
-  const Scene painted = session->PaintedScene();
-  if (Status s = SaveGltfScene(painted, out_dir + "/painted.gltf"); !s.ok()) {
+  // Outputs: written into a staging folder inside DIR, then moved into DIR with metrics.json
+  // last; a failure before that leaves DIR as it was (all or nothing).
+  StagedFolder outputs;
+  if (Status s = outputs.Open(out_dir + "/.outputs"); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
-  // A picture of the painted buffers, for people (alpha 0 as a checkerboard).
-  if (Status s = WriteImageAtomic(out_dir + "/buffers.png", BufferContactSheet(session->painted()));
-      !s.ok()) {
+  if (Status s = SaveGltfScene(session->PaintedScene(), outputs.path() + "/painted.gltf"); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
@@ -338,6 +337,10 @@ int RunVerbRun(const CommandArgs& argv) {
   metrics["base_buffers"] = session->buffers().size();
   metrics["texel_size_m"] = session->default_texel_size_m();
   metrics["groups_split_for_folds"] = session->folds_split();
+  const ChartStretch stretch = MeasureChartStretch(capture.scene.mesh, session->grouping());
+  metrics["charts"] = {{"count", session->buffers().size()},
+                       {"max_stretch", stretch.max},
+                       {"mean_stretch", stretch.mean}};
   metrics["triangles"] = capture.scene.mesh.NumTriangles();
   nlohmann::json buffers = nlohmann::json::array();
   for (size_t b = 0; b < session->buffers().size(); ++b) {
@@ -351,8 +354,20 @@ int RunVerbRun(const CommandArgs& argv) {
                        {"painted", session->painted()[b].painted_surface_texels}});
   }
   metrics["buffers"] = buffers;
+  const TextureAtlas& atlas = session->atlas();
+  nlohmann::json pages = nlohmann::json::array();
+  for (const cv::Size& page : atlas.pages) pages.push_back({page.width, page.height});
+  metrics["atlas"] = {{"pages", atlas.pages.size()},
+                      {"page_sizes", pages},
+                      {"occupancy", atlas.Occupancy()},
+                      {"padding_texels", atlas.padding}};
   if (live) metrics["live"] = LiveMetrics(live_inputs, recorder.frames());
-  if (Status s = WriteFileAtomic(out_dir + "/metrics.json", metrics.dump(2) + "\n"); !s.ok()) {
+  if (Status s = WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n");
+      !s.ok()) {
+    std::cerr << "error: " << s.message() << "\n";
+    return kExitFailure;
+  }
+  if (Status s = MoveFilesInto(outputs.path(), out_dir, {"metrics.json"}); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }

@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -223,6 +224,30 @@ Status StagedFolder::Commit() {
   // After an exchange the staging name holds the earlier folder.
   fs::remove_all(staging_, ec);
   SyncFolder(ParentFolder(target_));
+  return Status::Ok();
+}
+
+Status MoveFilesInto(const std::string& from_dir, const std::string& to_dir,
+                     const std::vector<std::string>& last) {
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(from_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file(ec) && std::find(last.begin(), last.end(), name) == last.end())
+      names.push_back(name);
+  }
+  if (ec) return Status::Error(from_dir + ": cannot list it: " + ec.message());
+  for (const std::string& name : last)
+    if (fs::exists(fs::path(from_dir) / name, ec)) names.push_back(name);
+  for (const std::string& name : names) {
+    const std::string from = (fs::path(from_dir) / name).string();
+    const std::string to = (fs::path(to_dir) / name).string();
+    if (std::rename(from.c_str(), to.c_str()) != 0) {
+      const int error = errno;
+      return Status::Error(to + ": cannot move the written file into place: " + ErrnoText(error));
+    }
+  }
+  SyncFolder(to_dir);
   return Status::Ok();
 }
 

@@ -4,6 +4,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "pipeline/core/status.h"
 
@@ -41,5 +42,12 @@ class StagedFolder {
   std::string target_, staging_;
   bool committed_ = false;
 };
+
+// Moves every file of `from_dir` into `to_dir` (renames, replacing files of the same name),
+// the names in `last` after all others, in that order: a reader that waits for the last file
+// finds the others complete. Sub-folders are not moved. Both folders must be on one file
+// system (e.g. a StagedFolder inside `to_dir`).
+Status MoveFilesInto(const std::string& from_dir, const std::string& to_dir,
+                     const std::vector<std::string>& last);
 
 }  // namespace fresco

@@ -1131,8 +1131,8 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   }
   root["materials"] = json_materials;
 
-  // Textures: PNG files beside the .gltf (RGBA, so alpha round-trips exactly).
-  std::vector<std::pair<std::string, std::string>> png_files;  // (path, bytes)
+  // Textures: PNG files beside the .gltf (RGBA, so alpha round-trips exactly), each written
+  // as soon as it is encoded (one encoded page in memory at a time), before the .gltf.
   if (!scene.textures.empty()) {
     Json images = Json::array(), samplers = Json::array(), textures = Json::array();
     for (size_t t = 0; t < scene.textures.size(); ++t) {
@@ -1144,7 +1144,8 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
       if (!cv::imencode(".png", bgra, png)) {
         return fail("texture " + std::to_string(t) + ": PNG encoding failed");
       }
-      png_files.emplace_back(beside(png_name), std::string(png.begin(), png.end()));
+      FRESCO_RETURN_IF_ERROR(
+          WriteFileAtomic(beside(png_name), std::string(png.begin(), png.end())));
       Json image = {{"uri", png_name}};
       if (!texture.name.empty()) image["name"] = texture.name;
       images.push_back(image);
@@ -1160,9 +1161,6 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   }
 
   // Dependencies first, the .gltf last: a reader never sees a .gltf whose files are missing.
-  for (const auto& [png_path, bytes] : png_files) {
-    FRESCO_RETURN_IF_ERROR(WriteFileAtomic(png_path, bytes));
-  }
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(beside(bin_name), bin.data()));
   return WriteFileAtomic(path, root.dump(2) + "\n");
 }

@@ -127,6 +127,12 @@ void Fields(BackgroundOptions& o, V& v) {
 }
 
 template <class V>
+void Fields(AtlasOptions& o, V& v) {
+  v.Field("page_size", o.page_size, {.min = 256, .max = 8192});
+  v.Field("padding_texels", o.padding_texels, {.min = 0, .max = 32});
+}
+
+template <class V>
 void Fields(PipelineOptions& o, V& v) {
   v.Enum("sampling", o.sampling, SamplingNames());
   v.Field("texel_size_m", o.texel_size_m, {.min = 0});
@@ -141,6 +147,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Object("occlusion", o.occlusion);
   v.Object("refine", o.refine);
   v.Object("background", o.background);
+  v.Object("atlas", o.atlas);
 }
 
 template <class V>
@@ -161,6 +168,8 @@ void Fields(GroupSpec& g, V& v) {
 template <class V>
 void Fields(GroupingOptions& o, V& v) {
   v.Field("angle_deg", o.angle_deg, {.min = 0, .max = 180});
+  v.Field("min_chart_texels", o.min_chart_texels, {.min = 0});
+  v.Field("max_stretch", o.max_stretch, {.min = 1, .max = 100});
   v.List("groups", o.groups);
   v.List("edits", o.edits);
 }
@@ -211,13 +220,14 @@ void Fields(Project& p, V& v) {
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 232, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(AtlasOptions) == 8, "see Fields(AtlasOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 240, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
-static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 56, "see Fields(GroupingOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 72, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
 static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 616, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 640, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

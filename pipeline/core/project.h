@@ -101,6 +101,16 @@ struct BackgroundOptions {
   bool operator==(const BackgroundOptions&) const = default;
 };
 
+// The painted model's texture atlas (pipeline/paint/texture_atlas.h): base buffers packed
+// into pages of at most page_size x page_size texels, each with padding_texels of its edge
+// repeated around it.
+struct AtlasOptions {
+  int page_size = 4096;
+  int padding_texels = 4;
+
+  bool operator==(const AtlasOptions&) const = default;
+};
+
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
@@ -117,6 +127,7 @@ struct PipelineOptions {
   OcclusionOptions occlusion;
   RefineOptions refine;
   BackgroundOptions background;
+  AtlasOptions atlas;
 
   bool operator==(const PipelineOptions&) const = default;
 };
@@ -143,8 +154,16 @@ struct GroupSpec {
 // The grouping: automatic (region growing with `angle_deg`) unless `groups` is given, in
 // which case exactly those groups are used (triangles in none are never painted); `edits`
 // then apply in order. `fresco group PROJECT.json --save` stores the automatic result.
+//
+// Charts (grouping.h): a triangle joins a chart when its normal is within `angle_deg` of the
+// chart's mean normal (a cone, so normal noise does not stop the growth) and the chart stays
+// under the largest buffer's texels; then charts smaller than `min_chart_texels` are merged
+// into a neighbour whose plane sees all their triangles with a texel stretch (1 / cos of the
+// angle to the plane) of at most `max_stretch`. min_chart_texels = 0: the paper's grouping.
 struct GroupingOptions {
   double angle_deg = 20.0;
+  int min_chart_texels = 256;
+  double max_stretch = 2.0;
   std::vector<GroupSpec> groups;
   std::vector<GroupingEdit> edits;
 

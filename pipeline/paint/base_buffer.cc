@@ -84,8 +84,15 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     hd = std::ceil((pc.b_max - pc.b_min) / size) + 2 * gutter + 1;
   };
   dims(s);
-  for (int iter = 0; iter < 60 && wd * hd > options.max_buffer_texels; ++iter) {
-    s *= std::sqrt(wd * hd / options.max_buffer_texels) * 1.01;
+  const double max_side = options.max_side_texels;
+  for (int iter = 0;
+       iter < 60 && (wd * hd > options.max_buffer_texels || wd > max_side || hd > max_side);
+       ++iter) {
+    // The gutter does not scale with the texel: aim at what the interior may take.
+    const double inner = 2.0 * gutter + 1;
+    s *= std::max({std::sqrt(wd * hd / options.max_buffer_texels),
+                   (wd - inner) / std::max(1.0, max_side - inner),
+                   (hd - inner) / std::max(1.0, max_side - inner), 1.0}) * 1.01;
     dims(s);
   }
   const int w = static_cast<int>(wd), h = static_cast<int>(hd);

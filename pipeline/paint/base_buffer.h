@@ -66,6 +66,7 @@ inline constexpr int kMinTexelsAcross = 4;
 struct BaseBufferOptions {
   double texel_size_m = 0.01;       // default texel size (groups may override)
   int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels
+  int max_side_texels = 1 << 30;    // so does one wider or higher (an atlas page's limit)
   int gutter_texels = 2;
 };
 

@@ -5,6 +5,8 @@
 #include <deque>
 #include <numeric>
 
+#include "pipeline/paint/charts.h"
+
 namespace fresco {
 
 void Grouping::RebuildIndex(int num_triangles) {
@@ -17,16 +19,10 @@ Grouping ComputeGrouping(const TriangleMesh& mesh, const MeshAdjacency& adjacenc
                          double angle_deg) {
   const int n = mesh.NumTriangles();
   const double cos_limit = std::cos(angle_deg * M_PI / 180.0);
-  std::vector<Eigen::Vector3d> normals(n);
-  std::vector<double> areas(n);
-  for (int t = 0; t < n; ++t) {
-    normals[t] = mesh.Normal(t);
-    areas[t] = mesh.Area(t);
-  }
-  // Seeds in order of decreasing area (ties by index: deterministic).
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return areas[a] > areas[b]; });
+  const TriangleFacts facts = ComputeTriangleFacts(mesh);
+  const std::vector<Eigen::Vector3d>& normals = facts.normals;
+  const std::vector<double>& areas = facts.areas;
+  const std::vector<int>& order = facts.by_decreasing_area;
 
   Grouping grouping;
   grouping.group_of_triangle.assign(n, -1);
@@ -130,9 +126,17 @@ Status ApplyGroupingEdits(const std::vector<GroupingEdit>& edits, int num_triang
 }
 
 Status MakeGrouping(const TriangleMesh& mesh, const GroupingOptions& options, Grouping* grouping) {
+  return MakeGrouping(mesh, options, ChartScale(), grouping);
+}
+
+Status MakeGrouping(const TriangleMesh& mesh, const GroupingOptions& options,
+                    const ChartScale& scale, Grouping* grouping) {
   const int num_triangles = mesh.NumTriangles();
   if (options.groups.empty()) {
-    *grouping = ComputeGrouping(mesh, ComputeAdjacency(mesh), options.angle_deg);
+    const MeshAdjacency adjacency = ComputeAdjacency(mesh);
+    *grouping = options.min_chart_texels > 0
+                    ? ComputeCharts(mesh, adjacency, options, scale)
+                    : ComputeGrouping(mesh, adjacency, options.angle_deg);
   } else {
     grouping->groups.clear();
     std::vector<int> owner(num_triangles, -1);
@@ -152,6 +156,22 @@ Status MakeGrouping(const TriangleMesh& mesh, const GroupingOptions& options, Gr
     RemoveEmptyGroups(grouping, num_triangles);
   }
   return ApplyGroupingEdits(options.edits, num_triangles, grouping);
+}
+
+TriangleFacts ComputeTriangleFacts(const TriangleMesh& mesh) {
+  const int n = mesh.NumTriangles();
+  TriangleFacts f;
+  f.normals.resize(n);
+  f.areas.resize(n);
+  for (int t = 0; t < n; ++t) {
+    f.normals[t] = mesh.Normal(t);
+    f.areas[t] = mesh.Area(t);
+  }
+  f.by_decreasing_area.resize(n);
+  std::iota(f.by_decreasing_area.begin(), f.by_decreasing_area.end(), 0);
+  std::stable_sort(f.by_decreasing_area.begin(), f.by_decreasing_area.end(),
+                   [&](int a, int b) { return f.areas[a] > f.areas[b]; });
+  return f;
 }
 
 Eigen::Vector3d GroupNormal(const TriangleMesh& mesh, const BaseBufferGroup& group) {

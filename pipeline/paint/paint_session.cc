@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/paint/charts.h"
 #include "pipeline/render/renderer.h"
 
 namespace fresco {
@@ -95,11 +96,18 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
                  ? AutomaticTexelSize(*inputs.scene, *inputs.typical_camera, inputs.expected_poses)
                  : 0.01);
   Grouping grouping;
-  FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, &grouping));
+  ChartScale chart_scale;
+  chart_scale.texel_size_m = s->texel_size_m_;
+  chart_scale.max_chart_texels = inputs.pipeline.max_buffer_texels;
+  FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, chart_scale, &grouping));
   BaseBufferOptions buffer_options;
   buffer_options.texel_size_m = s->texel_size_m_;
   buffer_options.max_buffer_texels = inputs.pipeline.max_buffer_texels;
+  buffer_options.max_side_texels = MaxBufferSide(inputs.pipeline.atlas);
   s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
+  std::vector<cv::Size> sizes;
+  for (const BaseBuffer& b : s->set_.buffers) sizes.emplace_back(b.width, b.height);
+  FRESCO_RETURN_IF_ERROR(PackAtlas(sizes, inputs.pipeline.atlas, &s->atlas_));
   s->painted_.resize(s->set_.buffers.size());
   s->anchors_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
@@ -549,21 +557,62 @@ double PaintSession::Coverage() const {
   return total > 0 ? static_cast<double>(NumPaintedSurfaceTexels()) / total : 0.0;
 }
 
-Scene PaintSession::PaintedScene() const {
+// The scene's geometry with no UVs, every triangle on material 0: transparent (never
+// painted) until a buffer's material replaces it.
+static Scene UnpaintedCopy(const Scene& scene) {
   Scene out;
-  out.origin_in_world = scene_->origin_in_world;
-  out.source_path = scene_->source_path;
-  out.mesh = scene_->mesh;
-  const TriangleMesh& mesh = scene_->mesh;
-  out.mesh.uvs.assign(mesh.NumTriangles(),
-                      {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()});
-  out.mesh.has_uv.assign(mesh.NumTriangles(), false);
-  out.mesh.material.assign(mesh.NumTriangles(), 0);
-  // Material 0: triangles in no buffer (never painted): transparent.
+  out.origin_in_world = scene.origin_in_world;
+  out.source_path = scene.source_path;
+  out.mesh = scene.mesh;
+  const int n = scene.mesh.NumTriangles();
+  out.mesh.uvs.assign(n, {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()});
+  out.mesh.has_uv.assign(n, false);
+  out.mesh.material.assign(n, 0);
   Material unpainted;
   unpainted.name = "unpainted";
   unpainted.base_color_factor = Eigen::Vector4d(1, 1, 1, 0);
   out.materials.push_back(unpainted);
+  return out;
+}
+
+Scene PaintSession::PaintedScene() const {
+  Scene out = UnpaintedCopy(*scene_);
+  const TriangleMesh& mesh = scene_->mesh;
+  std::vector<cv::Mat> images(painted_.size());
+  for (size_t b = 0; b < painted_.size(); ++b) images[b] = painted_[b].bgra;
+  for (size_t page = 0; page < atlas_.pages.size(); ++page) {
+    Texture texture;
+    texture.name = "page_" + std::to_string(page);
+    cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), images), texture.rgba,
+                 cv::COLOR_BGRA2RGBA);
+    texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
+    out.textures.push_back(texture);
+    Material material;
+    material.name = texture.name;
+    material.base_color_texture = static_cast<int>(page);
+    out.materials.push_back(material);
+  }
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    const BaseBuffer& buffer = set_.buffers[b];
+    const AtlasPlacement& place = atlas_.placements[b];
+    if (place.page < 0) continue;
+    const cv::Size page = atlas_.pages[place.page];
+    for (int t : buffer.triangles) {
+      out.mesh.material[t] = place.page + 1;
+      out.mesh.has_uv[t] = true;
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d q = buffer.TexelCoords(mesh.Corner(t, k));
+        out.mesh.uvs[t][k] = Eigen::Vector2f(static_cast<float>((place.x + q.x()) / page.width),
+                                             static_cast<float>((place.y + q.y()) / page.height));
+      }
+    }
+  }
+  return out;
+}
+
+Scene PaintSession::PaintedSceneByBuffer() const {
+  Scene out = UnpaintedCopy(*scene_);
+  const TriangleMesh& mesh = scene_->mesh;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     const BaseBuffer& buffer = set_.buffers[b];
     Texture texture;

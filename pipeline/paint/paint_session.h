@@ -29,6 +29,7 @@
 #include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/refine_alignment.h"
 #include "pipeline/paint/refine_anchor.h"
+#include "pipeline/paint/texture_atlas.h"
 #include "pipeline/paint/refine_pose.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/render/rasterizer.h"
@@ -64,9 +65,14 @@ class PaintSession {
   // the same frames once per candidate offset).
   void ResetPainting();
 
-  // The scene's geometry with the painted buffers as base-colour textures (alpha 0 where
-  // never painted) and new UVs into them.
+  // The scene's geometry with the painted buffers packed into texture atlas pages
+  // (texture_atlas.h), one base-colour texture and material per page (alpha 0 where never
+  // painted), and new UVs into them: what `fresco run` writes.
   Scene PaintedScene() const;
+  // The same with one texture and material per buffer (material b + 1 = buffer b, material 0
+  // for triangles in no buffer): the per-buffer view the app and debug images use.
+  Scene PaintedSceneByBuffer() const;
+  const TextureAtlas& atlas() const { return atlas_; }
 
   // Debug images on or off from the next frame on (the app asks only for frames it shows).
   void set_debug_images(bool on) { options_.debug_images = on; }
@@ -115,6 +121,7 @@ class PaintSession {
   PipelineOptions options_;
   double texel_size_m_ = 0.0;
   BaseBufferSet set_;
+  TextureAtlas atlas_;  // where each buffer goes in PaintedScene()
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
   std::vector<RefineAnchor> anchors_;              // per buffer (refinement on)

@@ -111,6 +111,10 @@ Project NonDefaultProject() {
   p.pipeline.background.min_blob_texels = 40;
   p.pipeline.background.dilate_texels = 5;
   p.grouping.angle_deg = 12.5;
+  p.grouping.min_chart_texels = 77;
+  p.grouping.max_stretch = 1.5;
+  p.pipeline.atlas.page_size = 2048;
+  p.pipeline.atlas.padding_texels = 6;
   GroupingEdit merge;
   merge.op = "merge";
   merge.groups = {3, 4, 7};
@@ -182,7 +186,9 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"grouping\"",        "\"angle_deg\"",
                           "\"edits\"",           "\"truth\"",
                           "\"background\"",      "\"mode\": \"robust\"",
-                          "\"window_frames\"",   "\"dilate_texels\""}) {
+                          "\"window_frames\"",   "\"dilate_texels\"",
+                          "\"atlas\"",           "\"page_size\"",
+                          "\"min_chart_texels\"", "\"max_stretch\""}) {
     EXPECT_THAT(text, HasSubstr(key));
   }
   // Pretty: one key per line.

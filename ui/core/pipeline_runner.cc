@@ -124,7 +124,7 @@ void PipelineRunner::OpenSession(const Project& project) {
     }
   }
   auto geometry = std::make_shared<SessionGeometry>();
-  geometry->painted_layout = s->paint->PaintedScene();
+  geometry->painted_layout = s->paint->PaintedSceneByBuffer();
   geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
   geometry->groups = s->paint->grouping().groups;
   geometry->buffer_of_triangle = s->paint->grouping().group_of_triangle;
@@ -200,7 +200,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   // Review: the painted model, as it stands before this frame, seen from this frame.
   if (show && s.review && s.paint->NumPaintedSurfaceTexels() > 0) {
     RenderOutput out;
-    s.review->Render(s.paint->PaintedScene(), posed.cam_from_world, &out);
+    s.review->Render(s.paint->PaintedSceneByBuffer(), posed.cam_from_world, &out);
     cv::Mat small, rephoto, grey_frame, grey_rephoto, diff;
     cv::resize(frame.bgr, small, out.rgba.size(), 0, 0, cv::INTER_AREA);
     cv::cvtColor(out.rgba, rephoto, cv::COLOR_RGBA2BGR);

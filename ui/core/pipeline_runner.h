@@ -35,7 +35,7 @@ namespace fresco {
 // What does not change while one session paints: the model with its buffers' UVs, and the
 // grouping (one group per base buffer).
 struct SessionGeometry {
-  Scene painted_layout;                 // PaintSession::PaintedScene() of the fresh session
+  Scene painted_layout;                 // PaintSession::PaintedSceneByBuffer() of the fresh session
   std::vector<int> buffer_of_triangle;  // (T) base buffer of each triangle, -1 for none
   std::vector<GroupSpec> groups;        // one per base buffer, as the session built them
   std::vector<int> buffer_texels;       // on-surface texels per buffer

@@ -1,0 +1,154 @@
+#include "pipeline/paint/charts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <numeric>
+
+namespace fresco {
+namespace {
+
+struct Chart {
+  std::vector<int> triangles;
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();  // area-weighted
+  double area = 0.0;
+  int worst = -1;  // its triangle furthest from its mean normal
+  bool alive = true;
+
+  Eigen::Vector3d Normal() const {
+    const double n = normal_sum.norm();
+    return n > 0 ? Eigen::Vector3d(normal_sum / n) : Eigen::Vector3d::UnitZ();
+  }
+};
+
+}  // namespace
+
+Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
+                       const GroupingOptions& options, const ChartScale& scale) {
+  const int n = mesh.NumTriangles();
+  const double cos_cone = std::cos(options.angle_deg * M_PI / 180.0);
+  const double cos_stretch = 1.0 / options.max_stretch;
+  const double texel_area = scale.texel_size_m * scale.texel_size_m;
+  // Growth stops at half the largest buffer: a chart's bounding rectangle in its plane holds
+  // more texels than the chart covers.
+  const double max_area = texel_area > 0 && scale.max_chart_texels > 0
+                              ? 0.5 * static_cast<double>(scale.max_chart_texels) * texel_area
+                              : std::numeric_limits<double>::infinity();
+  const TriangleFacts facts = ComputeTriangleFacts(mesh);
+  const std::vector<Eigen::Vector3d>& normals = facts.normals;
+  const std::vector<double>& areas = facts.areas;
+  const std::vector<int>& order = facts.by_decreasing_area;
+
+  // 1. Region growing.
+  std::vector<Chart> charts;
+  std::vector<int> chart_of(n, -1);
+  std::deque<int> queue;
+  for (int seed : order) {
+    if (chart_of[seed] >= 0 || areas[seed] <= 0.0) continue;
+    const int c = static_cast<int>(charts.size());
+    charts.emplace_back();
+    Chart& chart = charts.back();
+    const Eigen::Vector3d seed_normal = normals[seed];
+    chart_of[seed] = c;
+    queue.assign(1, seed);
+    while (!queue.empty()) {
+      const int t = queue.front();
+      queue.pop_front();
+      chart.triangles.push_back(t);
+      chart.normal_sum += normals[t] * areas[t];
+      chart.area += areas[t];
+      const Eigen::Vector3d mean = chart.Normal();
+      for (const auto& edge : adjacency.edge_neighbours[t]) {
+        for (int nb : edge) {
+          if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
+          if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
+            continue;
+          if (chart.area + areas[nb] > max_area) continue;
+          chart_of[nb] = c;
+          queue.push_back(nb);
+        }
+      }
+    }
+    const Eigen::Vector3d mean = chart.Normal();
+    chart.worst = *std::min_element(chart.triangles.begin(), chart.triangles.end(),
+                                    [&](int a, int b) { return normals[a].dot(mean) < normals[b].dot(mean); });
+  }
+
+  // 2. Small charts into a neighbour.
+  if (texel_area > 0 && options.min_chart_texels > 0) {
+    const double min_area = options.min_chart_texels * texel_area;
+    std::vector<int> by_area(charts.size());
+    std::iota(by_area.begin(), by_area.end(), 0);
+    std::stable_sort(by_area.begin(), by_area.end(),
+                     [&](int a, int b) { return charts[a].area < charts[b].area; });
+    for (int c : by_area) {
+      Chart& small = charts[c];
+      if (!small.alive || small.area >= min_area) continue;
+      std::map<int, int> shared;  // neighbouring chart -> edges shared
+      for (int t : small.triangles)
+        for (const auto& edge : adjacency.edge_neighbours[t])
+          for (int nb : edge)
+            if (chart_of[nb] >= 0 && chart_of[nb] != c) ++shared[chart_of[nb]];
+      std::vector<std::pair<int, int>> candidates(shared.begin(), shared.end());
+      std::stable_sort(candidates.begin(), candidates.end(),
+                       [](const auto& a, const auto& b) { return a.second > b.second; });
+      for (const auto& [d, edges] : candidates) {
+        Chart& big = charts[d];
+        if (small.area + big.area > max_area) continue;
+        const Eigen::Vector3d merged = (small.normal_sum + big.normal_sum).normalized();
+        if (!std::isfinite(merged.x())) continue;
+        bool ok = normals[big.worst].dot(merged) >= cos_stretch;
+        int worst = big.worst;
+        for (int t : small.triangles) {
+          if (normals[t].dot(merged) < cos_stretch) {
+            ok = false;
+            break;
+          }
+          if (normals[t].dot(merged) < normals[worst].dot(merged)) worst = t;
+        }
+        if (!ok) continue;
+        for (int t : small.triangles) chart_of[t] = d;
+        big.triangles.insert(big.triangles.end(), small.triangles.begin(), small.triangles.end());
+        big.normal_sum += small.normal_sum;
+        big.area += small.area;
+        big.worst = worst;
+        small.alive = false;
+        small.triangles.clear();
+        break;
+      }
+    }
+  }
+
+  Grouping grouping;
+  for (Chart& chart : charts) {
+    if (!chart.alive) continue;
+    std::sort(chart.triangles.begin(), chart.triangles.end());
+    BaseBufferGroup group;
+    group.triangles = std::move(chart.triangles);
+    grouping.groups.push_back(std::move(group));
+  }
+  grouping.RebuildIndex(n);
+  return grouping;
+}
+
+ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& grouping) {
+  ChartStretch s;
+  double weighted = 0.0, area = 0.0;
+  for (const BaseBufferGroup& group : grouping.groups) {
+    const Eigen::Vector3d normal = GroupNormal(mesh, group);
+    for (int t : group.triangles) {
+      const double c = mesh.Normal(t).dot(normal);
+      const double stretch = c > 1e-6 ? 1.0 / c : std::numeric_limits<double>::infinity();
+      const double a = mesh.Area(t);
+      s.max = std::max(s.max, stretch);
+      weighted += std::min(stretch, 1e6) * a;
+      area += a;
+    }
+  }
+  if (area > 0) s.mean = weighted / area;
+  return s;
+}
+
+}  // namespace fresco

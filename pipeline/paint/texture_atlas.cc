@@ -1,0 +1,105 @@
+#include "pipeline/paint/texture_atlas.h"
+
+#include <algorithm>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <stb/stb_rect_pack.h>  // implementation in Debian's libstb
+
+namespace fresco {
+namespace {
+
+int AlignmentFor(int padding) {
+  int a = 1;
+  while (a < padding) a *= 2;
+  return a;
+}
+
+int AlignUp(int v, int a) { return (v + a - 1) / a * a; }
+
+}  // namespace
+
+double TextureAtlas::Occupancy() const {
+  long long total = 0;
+  for (const cv::Size& s : pages) total += static_cast<long long>(s.width) * s.height;
+  return total > 0 ? static_cast<double>(used_texels) / total : 0.0;
+}
+
+int MaxBufferSide(const AtlasOptions& options) {
+  const int align = AlignmentFor(options.padding_texels);
+  // The placement (buffer + padding on both sides, rounded up) must fit on the page.
+  return (options.page_size / align) * align - 2 * options.padding_texels;
+}
+
+Status PackAtlas(const std::vector<cv::Size>& buffer_sizes, const AtlasOptions& options,
+                 TextureAtlas* atlas) {
+  *atlas = TextureAtlas();
+  atlas->padding = options.padding_texels;
+  atlas->alignment = AlignmentFor(options.padding_texels);
+  atlas->placements.assign(buffer_sizes.size(), AtlasPlacement());
+  const int pad = atlas->padding, align = atlas->alignment;
+  const int max_side = MaxBufferSide(options);
+  std::vector<stbrp_rect> pending;
+  pending.reserve(buffer_sizes.size());
+  for (size_t b = 0; b < buffer_sizes.size(); ++b) {
+    const cv::Size s = buffer_sizes[b];
+    if (s.width > max_side || s.height > max_side)
+      return Status::Error("base buffer " + std::to_string(b) + " is " + std::to_string(s.width) +
+                           "x" + std::to_string(s.height) + " texels: larger than an atlas page of " +
+                           std::to_string(options.page_size) + " holds (pipeline.atlas.page_size)");
+    if (s.width <= 0 || s.height <= 0) continue;  // nothing to place
+    stbrp_rect r{};
+    r.id = static_cast<int>(b);
+    r.w = AlignUp(s.width + 2 * pad, align);
+    r.h = AlignUp(s.height + 2 * pad, align);
+    pending.push_back(r);
+    atlas->used_texels += static_cast<long long>(s.width) * s.height;
+  }
+  // Packing in units of the alignment keeps every placement aligned.
+  const int cells = options.page_size / align;
+  std::vector<stbrp_node> nodes(cells);
+  while (!pending.empty()) {
+    for (stbrp_rect& r : pending) r.w /= align, r.h /= align;
+    stbrp_context context;
+    stbrp_init_target(&context, cells, cells, nodes.data(), static_cast<int>(nodes.size()));
+    stbrp_setup_heuristic(&context, STBRP_HEURISTIC_Skyline_BL_sortHeight);
+    stbrp_pack_rects(&context, pending.data(), static_cast<int>(pending.size()));
+    const int page = static_cast<int>(atlas->pages.size());
+    int used_w = 0, used_h = 0;
+    std::vector<stbrp_rect> rest;
+    for (stbrp_rect r : pending) {
+      r.w *= align, r.h *= align;
+      if (!r.was_packed) {
+        rest.push_back(r);
+        continue;
+      }
+      AtlasPlacement& p = atlas->placements[r.id];
+      p.page = page;
+      p.x = r.x * align + pad;
+      p.y = r.y * align + pad;
+      used_w = std::max(used_w, r.x * align + r.w);
+      used_h = std::max(used_h, r.y * align + r.h);
+    }
+    if (used_w == 0)  // cannot happen: every rect fits an empty page
+      return Status::Error("texture atlas: a buffer does not fit an empty page");
+    atlas->pages.emplace_back(used_w, used_h);
+    pending.swap(rest);
+  }
+  return Status::Ok();
+}
+
+cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images) {
+  const int type = images.empty() ? CV_8UC4 : images.front().type();
+  cv::Mat out = cv::Mat::zeros(atlas.pages[page], type);
+  const int pad = atlas.padding;
+  for (size_t b = 0; b < images.size() && b < atlas.placements.size(); ++b) {
+    const AtlasPlacement& p = atlas.placements[b];
+    const cv::Mat& image = images[b];
+    if (p.page != page || image.empty()) continue;
+    const cv::Rect with_padding(p.x - pad, p.y - pad, image.cols + 2 * pad, image.rows + 2 * pad);
+    cv::copyMakeBorder(image, out(with_padding), pad, pad, pad, pad, cv::BORDER_REPLICATE);
+  }
+  return out;
+}
+
+}  // namespace fresco

@@ -1,0 +1,128 @@
+// Charts on meshes with noisy normals at every triangle (as photogrammetry and TSDF fusion
+// make them): the chart count follows the surface's shape, not its triangle count; charts
+// never fold in their plane; their texel stretch stays bounded.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/paint/base_buffer.h"
+#include "pipeline/paint/charts.h"
+#include "pipeline/paint/grouping.h"
+#include "pipeline/synth/procedural_scenes.h"
+
+namespace fresco {
+namespace {
+
+// A 120-degree arc of a cylinder wall (radius 2 m, 1.5 m high) as a grid of `cells` x
+// `cells` quads, each vertex moved along the radius by noise of `noise_m` (1 cm cells and
+// 2 mm noise tilt the normals by ~15 degrees at random).
+TriangleMesh NoisyCylinderWall(int cells, double noise_m, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, noise_m);
+  TriangleMesh mesh;
+  const double radius = 2.0, height = 1.5, arc = 2.0 * M_PI / 3.0;
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) {
+      const double a = arc * (static_cast<double>(i) / cells - 0.5);
+      const double r = radius + noise(rng);
+      // Seen from the cylinder's axis: the wall faces the origin.
+      mesh.vertices.emplace_back(r * std::sin(a), height * j / cells, r * std::cos(a));
+    }
+  auto v = [&](int i, int j) { return j * (cells + 1) + i; };
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i) {
+      // Counter-clockwise seen from the origin (front faces the axis).
+      mesh.triangles.emplace_back(v(i, j), v(i, j + 1), v(i + 1, j));
+      mesh.triangles.emplace_back(v(i + 1, j), v(i, j + 1), v(i + 1, j + 1));
+    }
+  const int n = mesh.NumTriangles();
+  mesh.uvs.assign(n, {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero()});
+  mesh.material.assign(n, 0);
+  mesh.has_uv.assign(n, false);
+  return mesh;
+}
+
+double AngleSpreadDeg(const TriangleMesh& mesh) {  // RMS angle between neighbours' normals
+  double sum = 0;
+  int count = 0;
+  for (int t = 0; t + 1 < mesh.NumTriangles(); t += 2) {
+    const double c = std::clamp(mesh.Normal(t).dot(mesh.Normal(t + 1)), -1.0, 1.0);
+    sum += std::pow(std::acos(c) * 180 / M_PI, 2), ++count;
+  }
+  return std::sqrt(sum / count);
+}
+
+TEST(Charts, NoisyNormalsGiveABoundedChartCount) {
+  const TriangleMesh mesh = NoisyCylinderWall(150, 0.002, 1);  // 45,000 triangles
+  ASSERT_GT(AngleSpreadDeg(mesh), 10.0);  // the normals really are noisy
+  const MeshAdjacency adjacency = ComputeAdjacency(mesh);
+  const Grouping paper = ComputeGrouping(mesh, adjacency, 20.0);
+  GroupingOptions options;  // defaults: cone 20 deg, charts >= 256 texels, stretch <= 2
+  ChartScale scale;
+  scale.texel_size_m = 0.005;
+  scale.max_chart_texels = 1 << 20;
+  const Grouping charts = ComputeCharts(mesh, adjacency, options, scale);
+  // 120 degrees of arc in cones of 20 degrees: a handful of charts, whatever the noise.
+  EXPECT_LE(charts.groups.size(), 30u);
+  EXPECT_GE(charts.groups.size(), 3u);
+  EXPECT_GT(paper.groups.size(), 20 * charts.groups.size());
+  // Every triangle is in a chart.
+  for (int t = 0; t < mesh.NumTriangles(); ++t) ASSERT_GE(charts.group_of_triangle[t], 0) << t;
+  const ChartStretch stretch = MeasureChartStretch(mesh, charts);
+  EXPECT_LE(stretch.max, 1.05 * options.max_stretch);
+  EXPECT_LT(stretch.mean, 1.1);
+  // Other noise, other seed: the count stays in the same range.
+  const TriangleMesh other = NoisyCylinderWall(200, 0.0015, 2);  // 80,000 triangles
+  const Grouping other_charts = ComputeCharts(other, ComputeAdjacency(other), options, scale);
+  EXPECT_LE(other_charts.groups.size(), 30u);
+}
+
+TEST(Charts, ChartsNeverFoldInTheirBuffers) {
+  const TriangleMesh mesh = NoisyCylinderWall(100, 0.003, 3);
+  GroupingOptions options;
+  options.angle_deg = 45;  // wide cones: charts that bend a lot
+  ChartScale scale;
+  scale.texel_size_m = 0.01;
+  scale.max_chart_texels = 1 << 20;
+  const Grouping charts = ComputeCharts(mesh, ComputeAdjacency(mesh), options, scale);
+  BaseBufferOptions buffer_options;
+  buffer_options.texel_size_m = scale.texel_size_m;
+  const BaseBufferSet set = BuildBaseBuffers(mesh, charts, buffer_options);
+  for (const BaseBuffer& b : set.buffers) {
+    // Folding would put two triangles over one texel: the triangles' projected areas would
+    // add up to more than the texels they cover.
+    double projected_texels = 0;
+    for (int t : b.triangles) {
+      const Eigen::Vector2d q0 = b.TexelCoords(mesh.Corner(t, 0));
+      const Eigen::Vector2d q1 = b.TexelCoords(mesh.Corner(t, 1));
+      const Eigen::Vector2d q2 = b.TexelCoords(mesh.Corner(t, 2));
+      const Eigen::Vector2d e1 = q1 - q0, e2 = q2 - q0;
+      projected_texels += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+      EXPECT_GT(mesh.Normal(t).dot(b.normal), 0.0);  // front side up in its plane
+    }
+    if (projected_texels < 200) continue;  // too small to compare areas with texel counts
+    EXPECT_NEAR(b.num_surface_texels / projected_texels, 1.0, 0.05)
+        << "buffer of " << b.triangles.size() << " triangles";
+  }
+}
+
+TEST(Charts, PlanarModelsKeepOneChartPerFace) {
+  CubeRoomOptions room;
+  room.procedural_texture_px = 64;
+  Scene scene;
+  ASSERT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  GroupingOptions options;
+  ChartScale scale;
+  scale.texel_size_m = 0.01;
+  scale.max_chart_texels = 1 << 22;
+  EXPECT_EQ(ComputeCharts(scene.mesh, ComputeAdjacency(scene.mesh), options, scale).groups.size(),
+            6u);
+  // A chart does not outgrow the largest buffer: it is split instead of getting coarser texels.
+  scale.max_chart_texels = 40000;  // 4 m^2 at 1 cm
+  const Grouping limited = ComputeCharts(scene.mesh, ComputeAdjacency(scene.mesh), options, scale);
+  EXPECT_GT(limited.groups.size(), 6u);
+}
+
+}  // namespace
+}  // namespace fresco
