@@ -22,6 +22,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -48,7 +50,80 @@ struct TriangleSetup {
   int col0 = 0, col1 = -1;  // bucket columns covered
 };
 
+// Triangles per cluster: 128 consecutive triangles of a photogrammetry mesh lie close
+// together, so a cluster's box is small and culls well.
+constexpr int kClusterTriangles = 128;
+
 }  // namespace
+
+struct Rasterizer::TriangleClusters {
+  std::vector<Eigen::Vector3d> bounds_min, bounds_max;  // per cluster, local coordinates
+};
+
+// The clusters of the last mesh seen, recognised by its arrays and a sample of its vertices
+// (a mesh edited in place gets new clusters).
+struct Rasterizer::ClusterCache {
+  std::mutex mutex;
+  const void* vertices = nullptr;
+  const void* triangles = nullptr;
+  size_t num_vertices = 0, num_triangles = 0;
+  Eigen::Vector3d fingerprint = Eigen::Vector3d::Zero();
+  std::shared_ptr<const TriangleClusters> clusters;
+};
+
+namespace {
+
+Eigen::Vector3d VertexFingerprint(const TriangleMesh& mesh) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  const size_t n = mesh.vertices.size(), step = std::max<size_t>(1, n / 61);
+  for (size_t i = 0; i < n; i += step) sum += mesh.vertices[i] * static_cast<double>(i + 1);
+  return sum;
+}
+
+}  // namespace
+
+std::shared_ptr<const Rasterizer::TriangleClusters> Rasterizer::ClustersFor(
+    const TriangleMesh& mesh) const {
+  ClusterCache& cache = *cluster_cache_;
+  const Eigen::Vector3d fingerprint = VertexFingerprint(mesh);
+  std::lock_guard<std::mutex> lock(cache.mutex);
+  if (cache.clusters && cache.vertices == mesh.vertices.data() &&
+      cache.triangles == mesh.triangles.data() && cache.num_vertices == mesh.vertices.size() &&
+      cache.num_triangles == mesh.triangles.size() &&
+      (cache.fingerprint.array() == fingerprint.array()).all())
+    return cache.clusters;
+  auto clusters = std::make_shared<TriangleClusters>();
+  const int num_triangles = mesh.NumTriangles();
+  const int num_vertices = static_cast<int>(mesh.vertices.size());
+  const int num_clusters = (num_triangles + kClusterTriangles - 1) / kClusterTriangles;
+  clusters->bounds_min.assign(num_clusters, Eigen::Vector3d::Constant(kInf));
+  clusters->bounds_max.assign(num_clusters, Eigen::Vector3d::Constant(-kInf));
+  cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
+    for (int c = range.start; c < range.end; ++c) {
+      Eigen::Vector3d& lo = clusters->bounds_min[c];
+      Eigen::Vector3d& hi = clusters->bounds_max[c];
+      const int end = std::min(num_triangles, (c + 1) * kClusterTriangles);
+      bool any = false;
+      for (int tri = c * kClusterTriangles; tri < end; ++tri) {
+        const Eigen::Vector3i& idx = mesh.triangles[tri];
+        if ((idx.array() < 0).any() || (idx.array() >= num_vertices).any()) continue;
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d& p = mesh.vertices[idx[k]];
+          if (!p.allFinite()) continue;  // such triangles are skipped in set-up
+          lo = lo.cwiseMin(p), hi = hi.cwiseMax(p), any = true;
+        }
+      }
+      if (!any) lo = hi = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
+  });
+  cache.vertices = mesh.vertices.data();
+  cache.triangles = mesh.triangles.data();
+  cache.num_vertices = mesh.vertices.size();
+  cache.num_triangles = mesh.triangles.size();
+  cache.fingerprint = fingerprint;
+  cache.clusters = clusters;
+  return clusters;
+}
 
 struct Rasterizer::RayTable {
   int width = 0;                           // sample grid width (camera width * N)
@@ -75,7 +150,10 @@ struct Rasterizer::RayTable {
 };
 
 Rasterizer::Rasterizer(const Camera& camera, const RasterOptions& options)
-    : camera_(camera), options_(options), rays_(std::make_unique<RayTable>()) {
+    : camera_(camera),
+      options_(options),
+      rays_(std::make_unique<RayTable>()),
+      cluster_cache_(std::make_unique<ClusterCache>()) {
   if (camera.width <= 0 || camera.height <= 0)
     throw std::invalid_argument("Rasterizer: camera size must be positive");
   if (options.supersample < 1 || options.supersample > 4)
@@ -218,60 +296,95 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   const double near_m = options_.near_m;
   const bool cull = options_.cull_back_faces;
 
-  // Vertices to the camera frame (double).
+  // Clusters of consecutive triangles whose bounds lie outside the rays' frustum are skipped
+  // whole: the per-frame work follows the triangles in view, not the mesh's size.
+  const std::shared_ptr<const TriangleClusters> clusters = ClustersFor(mesh);
   const int num_vertices = static_cast<int>(mesh.vertices.size());
-  std::vector<Eigen::Vector3d> cam_vertices(num_vertices);
+  const int num_triangles = mesh.NumTriangles();
   const Eigen::Matrix3d rotation = cam_from_local.RotationMatrix();
   const Eigen::Vector3d translation = cam_from_local.translation;
-  for (int i = 0; i < num_vertices; ++i)
-    cam_vertices[i] = rotation * mesh.vertices[i] + translation;
-
-  // Triangle set-up (independent per triangle, so parallel and deterministic).
-  const int num_triangles = mesh.NumTriangles();
-  std::vector<TriangleSetup> setups(num_triangles);
   const double grid_x1 = t.x0 + t.cell_w * t.cols, grid_y1 = t.y0 + t.cell_h * t.rows;
-  cv::parallel_for_(cv::Range(0, num_triangles), [&](const cv::Range& range) {
-    for (int tri = range.start; tri < range.end; ++tri) {
-      TriangleSetup& s = setups[tri];
-      s.num_poly = 0;
-      const Eigen::Vector3i& idx = mesh.triangles[tri];
-      if ((idx.array() < 0).any() || (idx.array() >= num_vertices).any()) continue;
-      const Eigen::Vector3d v[3] = {cam_vertices[idx[0]], cam_vertices[idx[1]],
-                                    cam_vertices[idx[2]]};
-      if (!v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) continue;
-      if (v[0].z() < near_m && v[1].z() < near_m && v[2].z() < near_m) continue;
-      const Eigen::Vector3d normal = (v[1] - v[0]).cross(v[2] - v[0]);
-      const double det = normal.dot(v[0]);                 // det(v0, v1, v2): < 0 when front-facing
-      if (!(det != 0.0) || !std::isfinite(det)) continue;  // plane through the eye
-      if (cull && det > 0) continue;
-      const int n = ClipAndProject(v, near_m, s.poly);
-      if (n < 3) continue;
-      double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
-      for (int i = 0; i < n; ++i) {
-        xmin = std::min(xmin, s.poly[i][0]);
-        xmax = std::max(xmax, s.poly[i][0]);
-        ymin = std::min(ymin, s.poly[i][1]);
-        ymax = std::max(ymax, s.poly[i][1]);
+  const int num_clusters = static_cast<int>(clusters->bounds_min.size());
+  std::vector<int> slot_start(num_clusters + 1, 0);  // set-up slots of the clusters in view
+  cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
+    for (int c = range.start; c < range.end; ++c) {
+      const Eigen::Vector3d& lo = clusters->bounds_min[c];
+      const Eigen::Vector3d& hi = clusters->bounds_max[c];
+      // Outside when all 8 corners are beyond one of the frustum's planes (the near plane
+      // and the four planes through the eye bounding the rays' normalized extent).
+      int out[5] = {0, 0, 0, 0, 0};
+      for (int k = 0; k < 8; ++k) {
+        const Eigen::Vector3d p =
+            rotation * Eigen::Vector3d((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(),
+                                       (k & 4) ? hi.z() : lo.z()) +
+            translation;
+        out[0] += p.z() < near_m;
+        out[1] += p.x() < t.x0 * p.z();
+        out[2] += p.x() > grid_x1 * p.z();
+        out[3] += p.y() < t.y0 * p.z();
+        out[4] += p.y() > grid_y1 * p.z();
       }
-      // Margin for rounding (the float inside test may accept rays a hair outside).
-      const double margin =
-          1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax), std::abs(ymin), std::abs(ymax)});
-      xmin -= margin, ymin -= margin, xmax += margin, ymax += margin;
-      if (!(xmax >= t.x0 && xmin <= grid_x1 && ymax >= t.y0 && ymin <= grid_y1)) continue;
-      const double sign = det > 0 ? 1.0 : -1.0;
-      for (int i = 0; i < 3; ++i) {
-        const Eigen::Vector3d e = sign * v[(i + 1) % 3].cross(v[(i + 2) % 3]);
-        for (int k = 0; k < 3; ++k) s.edge[i][k] = static_cast<float>(e[k]);
+      const bool culled = !lo.allFinite() || !hi.allFinite() ||
+                          std::any_of(out, out + 5, [](int n) { return n == 8; });
+      slot_start[c + 1] =
+          culled ? 0 : std::min(num_triangles, (c + 1) * kClusterTriangles) - c * kClusterTriangles;
+    }
+  });
+  for (int c = 0; c < num_clusters; ++c) slot_start[c + 1] += slot_start[c];
+  const int num_slots = slot_start[num_clusters];
+
+  // Triangle set-up (independent per triangle, so parallel and deterministic), in the camera
+  // frame (double).
+  std::vector<TriangleSetup> setups(num_slots);
+  std::vector<int> triangle_of_slot(num_slots);
+  cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
+    for (int c = range.start; c < range.end; ++c) {
+      const int first = c * kClusterTriangles;
+      for (int slot = slot_start[c]; slot < slot_start[c + 1]; ++slot) {
+        const int tri = first + (slot - slot_start[c]);
+        triangle_of_slot[slot] = tri;
+        TriangleSetup& s = setups[slot];
+        s.num_poly = 0;
+        const Eigen::Vector3i& idx = mesh.triangles[tri];
+        if ((idx.array() < 0).any() || (idx.array() >= num_vertices).any()) continue;
+        const Eigen::Vector3d v[3] = {rotation * mesh.vertices[idx[0]] + translation,
+                                      rotation * mesh.vertices[idx[1]] + translation,
+                                      rotation * mesh.vertices[idx[2]] + translation};
+        if (!v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) continue;
+        if (v[0].z() < near_m && v[1].z() < near_m && v[2].z() < near_m) continue;
+        const Eigen::Vector3d normal = (v[1] - v[0]).cross(v[2] - v[0]);
+        const double det = normal.dot(v[0]);  // det(v0, v1, v2): < 0 when front-facing
+        if (!(det != 0.0) || !std::isfinite(det)) continue;  // plane through the eye
+        if (cull && det > 0) continue;
+        const int n = ClipAndProject(v, near_m, s.poly);
+        if (n < 3) continue;
+        double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
+        for (int i = 0; i < n; ++i) {
+          xmin = std::min(xmin, s.poly[i][0]);
+          xmax = std::max(xmax, s.poly[i][0]);
+          ymin = std::min(ymin, s.poly[i][1]);
+          ymax = std::max(ymax, s.poly[i][1]);
+        }
+        // Margin for rounding (the float inside test may accept rays a hair outside).
+        const double margin = 1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax),
+                                                      std::abs(ymin), std::abs(ymax)});
+        xmin -= margin, ymin -= margin, xmax += margin, ymax += margin;
+        if (!(xmax >= t.x0 && xmin <= grid_x1 && ymax >= t.y0 && ymin <= grid_y1)) continue;
+        const double sign = det > 0 ? 1.0 : -1.0;
+        for (int i = 0; i < 3; ++i) {
+          const Eigen::Vector3d e = sign * v[(i + 1) % 3].cross(v[(i + 2) % 3]);
+          for (int k = 0; k < 3; ++k) s.edge[i][k] = static_cast<float>(e[k]);
+        }
+        for (int k = 0; k < 3; ++k) s.inv_depth[k] = normal[k] / det;
+        s.bbox[0] = xmin, s.bbox[1] = ymin, s.bbox[2] = xmax, s.bbox[3] = ymax;
+        s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
+        s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
+        s.num_poly = n;
       }
-      for (int k = 0; k < 3; ++k) s.inv_depth[k] = normal[k] / det;
-      s.bbox[0] = xmin, s.bbox[1] = ymin, s.bbox[2] = xmax, s.bbox[3] = ymax;
-      s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
-      s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
-      s.num_poly = n;
     }
   });
 
-  // Triangles per bucket row, in ascending id order (counting sort).
+  // Set-ups per bucket row, in ascending triangle order (counting sort).
   std::vector<int> row_start(t.rows + 1, 0);
   for (const TriangleSetup& s : setups) {
     if (s.num_poly == 0) continue;
@@ -281,10 +394,10 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   std::vector<int> row_triangles(row_start[t.rows]);
   {
     std::vector<int> fill(row_start.begin(), row_start.end() - 1);
-    for (int tri = 0; tri < num_triangles; ++tri) {
-      const TriangleSetup& s = setups[tri];
+    for (int slot = 0; slot < num_slots; ++slot) {
+      const TriangleSetup& s = setups[slot];
       if (s.num_poly == 0) continue;
-      for (int r = s.row0; r <= s.row1; ++r) row_triangles[fill[r]++] = tri;
+      for (int r = s.row0; r <= s.row1; ++r) row_triangles[fill[r]++] = slot;
     }
   }
 
@@ -292,8 +405,9 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
     for (int row = range.start; row < range.end; ++row) {
       const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
       for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
-        const int tri = row_triangles[j];
-        const TriangleSetup& s = setups[tri];
+        const int slot = row_triangles[j];
+        const TriangleSetup& s = setups[slot];
+        const int tri = triangle_of_slot[slot];
         int col0 = s.col0, col1 = s.col1;
         if (s.row0 != s.row1 && col0 != col1) {
           // Tighten to the polygon's extent within this bucket row.

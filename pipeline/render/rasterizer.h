@@ -66,6 +66,11 @@ class Rasterizer {
 
  private:
   struct RayTable;
+  // Bounds of runs of consecutive triangles, for culling whole runs per frame (computed once
+  // per mesh and cached; see ClustersFor).
+  struct TriangleClusters;
+  struct ClusterCache;
+  std::shared_ptr<const TriangleClusters> ClustersFor(const TriangleMesh& mesh) const;
   // Sets up the triangles and calls record(tri, sample, x, y, inv_z, setup) for every ray
   // inside a triangle at inverse depth inv_z (near plane not yet checked).
   template <class Record>
@@ -74,6 +79,7 @@ class Rasterizer {
   Camera camera_;
   RasterOptions options_;
   std::unique_ptr<RayTable> rays_;
+  std::unique_ptr<ClusterCache> cluster_cache_;
 };
 
 }  // namespace fresco

@@ -10,6 +10,7 @@
 
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/synth/blocks_scene.h"
+#include "pipeline/synth/mesh_refine.h"
 #include "pipeline/synth/procedural_scenes.h"
 
 namespace fresco {
@@ -492,6 +493,18 @@ Status BuildSynthJob(const SynthSpecInput& input, SynthJob* job) {
   if (!scene) return r.Error("scene", "missing (e.g. \"builtin:cube-room\" or a glTF file)");
   SceneInfo info;
   FRESCO_RETURN_IF_ERROR(BuildScene(*scene, file, input.base_dir, job, &info));
+  if (const json* mesh = r.Get("mesh")) {
+    if (!mesh->is_object())
+      return r.Error("mesh", "must be {\"subdivide\": N, \"noise_m\": S, \"seed\": K}");
+    ObjectReader m(*mesh, "mesh", file);
+    MeshRefineOptions refine;
+    FRESCO_RETURN_IF_ERROR(m.Int("subdivide", &refine.subdivide));
+    FRESCO_RETURN_IF_ERROR(m.Number("noise_m", &refine.noise_m));
+    FRESCO_RETURN_IF_ERROR(m.Unsigned("seed", &refine.seed));
+    FRESCO_RETURN_IF_ERROR(m.Finish());
+    if (Status s = RefineMesh(refine, &job->scene); !s.ok())
+      return Status::Error(file + ": " + s.message());
+  }
   job->scene.Bounds(&info.bounds_min, &info.bounds_max);
   info.bounds_min = job->scene.WorldFromLocal(info.bounds_min);
   info.bounds_max = job->scene.WorldFromLocal(info.bounds_max);

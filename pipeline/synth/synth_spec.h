@@ -20,6 +20,7 @@
 //              | {"builtin": "blocks", "ground_m": 6, "blocks": 7, "area_m": 3,
 //                 "min_size_m": 0.4, "max_size_m": 1.1, "max_height_m": 1.6,
 //                 "texels_per_m": 160, "seed": 1},
+//     "mesh": {"subdivide": 1, "noise_m": 0, "seed": 1},  // large noisy meshes (mesh_refine.h)
 //     "out": "capture",                       // output folder
 //     "frames": 120, "size": [640, 480] (or "640x480"), "lens": "pinhole" | "opencv4" |
 //     "opencv5" | "opencv8", "hfov_deg": 70,

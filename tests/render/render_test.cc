@@ -417,6 +417,37 @@ TEST(RasterizerTest, DepthOnlyMatchesFullRaster) {
   ExpectDepthOnlyMatchesFull(DistortedCamera(), grid, 1e-3);
 }
 
+// A large mesh in runs of nearby triangles all around the camera (in view, behind it,
+// beside the frustum): runs outside the view are culled whole, and the result is still
+// exactly the brute force's; moving the vertices in place is noticed (no stale culling).
+TEST(RasterizerTest, CulledRunsOfTrianglesMatchBruteForce) {
+  const Camera camera = PinholeCamera(64, 48, 40.0);
+  TriangleMesh mesh;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> direction(0.0, 1.0);
+  std::uniform_real_distribution<double> offset(-0.25, 0.25);
+  for (int run = 0; run < 24; ++run) {  // 24 runs of 128 triangles
+    Eigen::Vector3d centre(direction(rng), direction(rng), direction(rng));
+    centre = 3.0 * centre.normalized();
+    for (int i = 0; i < 128; ++i) {
+      const Eigen::Vector3d a = centre + Eigen::Vector3d(offset(rng), offset(rng), offset(rng));
+      AddTriangle(&mesh, a, a + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)),
+                  a + Eigen::Vector3d(offset(rng), offset(rng), offset(rng)));
+    }
+  }
+  const Rasterizer rasterizer(camera, RasterOptions());
+  for (int pass = 0; pass < 2; ++pass) {
+    RasterOutput out;
+    rasterizer.Rasterize(mesh, Rigid3d(), &out);
+    const BruteForceComparison c = CompareWithBruteForce(rasterizer, mesh, Rigid3d(), out);
+    EXPECT_GT(c.hits, c.samples / 50) << "pass " << pass;
+    EXPECT_LE(c.id_mismatches, 2) << "pass " << pass;
+    EXPECT_LT(c.max_depth_rel_error, 1e-5) << "pass " << pass;
+    // Turn the mesh half-way round in place: what was behind the camera comes into view.
+    for (Eigen::Vector3d& v : mesh.vertices) v = Eigen::Vector3d(-v.x(), v.y(), -v.z());
+  }
+}
+
 TEST(RasterizerTest, BackFaceCulling) {
   const Camera camera = PinholeCamera(100, 80, 100.0);
   TriangleMesh mesh;
