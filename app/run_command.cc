@@ -277,11 +277,12 @@ int RunVerbRun(const CommandArgs& argv) {
     if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
   const std::string& stages_dir = stages.path();
 
-  int total = live ? -1 : 0;
-  for (const Capture& capture : captures) {
-    if (live) break;
-    const int count = capture.video->FrameCount();
-    total = total < 0 || count < 0 ? -1 : total + count;
+  int total = live ? -1 : 0;  // frames of every stream; -1: unknown
+  if (!live) {
+    for (const Capture& capture : captures) {
+      const int count = capture.video->FrameCount();
+      total = total < 0 || count < 0 ? -1 : total + count;
+    }
   }
   if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
     total = project.pipeline.max_frames;
