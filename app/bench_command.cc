@@ -235,6 +235,7 @@ int RunVerbBench(const CommandArgs& argv) {
     for (const auto& [key, value] : run) overrides.push_back(key + "=" + value);
     Project project;
     if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return InputError(s);
+    if (Status s = CheckOneStream(project, "fresco bench"); !s.ok()) return InputError(s);
   }
   if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
 

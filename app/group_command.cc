@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
@@ -42,11 +44,12 @@ int RunVerbGroup(const CommandArgs& argv) {
   Project project;
   if (Status s = LoadProject(args.positional[0], args.All("--set"), &project); !s.ok())
     return InputError(s);
-  Capture capture;
+  std::vector<Capture> streams;  // every stream's poses choose the automatic texel size
   std::unique_ptr<PaintSession> session;
-  if (Status s = OpenPaintSession(project, &capture, &session); !s.ok()) return InputError(s);
+  if (Status s = OpenPaintSession(project, CaptureLoadOptions(), &streams, &session); !s.ok())
+    return InputError(s);
 
-  const TriangleMesh& mesh = capture.scene.mesh;
+  const TriangleMesh& mesh = streams[0].scene.mesh;
   nlohmann::json table = nlohmann::json::array();
   std::printf("%5s %9s %22s %9s %9s %11s %10s\n", "group", "triangles", "normal (x, y, z)",
               "area m2", "texel m", "buffer", "texels");

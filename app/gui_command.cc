@@ -100,6 +100,7 @@ int RunVerbGui(const CommandArgs& argv) {
   if (!options.project.empty()) {  // bad input is exit 2 before any window opens
     Project project;
     if (Status s = LoadProject(options.project, {}, &project); !s.ok()) return InputError(s);
+    if (Status s = CheckOneStream(project, "fresco gui"); !s.ok()) return InputError(s);
   }
   return RunGuiApp(options);
 #else

@@ -276,6 +276,9 @@ int RunVerbPoses(const CommandArgs& argv) {
   if (int code = ParseVerbArgs(kVerb, argv, spec, &args); code >= 0) return code;
   Project project;
   if (Status s = LoadProject(args.positional[1], {}, &project); !s.ok()) return InputError(s);
+  // One stream, seen as a version-1 project (a bootstrapped project is written as one).
+  if (Status s = CheckOneStream(project, "fresco poses"); !s.ok()) return InputError(s);
+  project = project.ForStream(0);
   const std::string out_dir = args.Get("--out");
   if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
   return sub == "verify" ? RunVerify(args, spec, project, out_dir)

@@ -51,7 +51,11 @@ ArgSpec RunSpec() {
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
       "by time (+ time_offset_s, estimated with live.estimate_offset); the run ends when\n"
       "the video ends (its stream ends, or no frame within live.read_timeout_s; the\n"
-      "\"live\" object in metrics.json says which in end_reason).";
+      "\"live\" object in metrics.json says which in end_reason).\n\n"
+      "Several streams (\"fresco\": 2, `streams`): their frames paint one model, interleaved\n"
+      "by frame index (frame 0 of each stream, then frame 1 of each, ...); a stream that\n"
+      "ends early leaves the others going on. pipeline.max_frames counts frames of all\n"
+      "streams. Live sources need a project with one stream.";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--record"};
   spec.repeatable = {"--set"};
@@ -83,8 +87,67 @@ Status WriteStageImages(const std::string& dir, const FrameReport& report) {
 struct LoopFrame {
   PosedFrame posed;
   const Camera* camera = nullptr;
+  int stream = 0;  // index into Project::Streams()
 };
 using NextLoopFrame = std::function<bool(LoopFrame*, Status*)>;
+
+// The frames of every stream of a file replay, interleaved by frame index: frame 0 of each
+// stream, then frame 1 of each, ... (what cameras recording the same period at the same
+// rate give); a stream that ends leaves the others going on. Each stream is read one frame
+// ahead on its own thread (FrameReader).
+class InterleavedFrames {
+ public:
+  InterleavedFrames(const Project& project, const std::vector<Capture>& streams)
+      : project_(project), specs_(project.Streams()), streams_(streams) {
+    for (const Capture& stream : streams_)
+      readers_.push_back(std::make_unique<FrameReader>(stream.video.get()));
+    ended_.assign(streams_.size(), false);
+  }
+
+  bool Next(LoopFrame* f, Status* status) {
+    for (size_t tried = 0; tried < streams_.size(); ++tried) {
+      const int s = next_;
+      next_ = (next_ + 1) % static_cast<int>(streams_.size());
+      if (ended_[s]) continue;
+      if (!readers_[s]->Next(&f->posed.frame, status)) {
+        if (!status->ok()) return false;
+        ended_[s] = true;
+        continue;
+      }
+      f->stream = s;
+      return Pose(s, f, status);
+    }
+    return false;  // every stream ended
+  }
+
+ private:
+  bool Pose(int s, LoopFrame* f, Status* status) const {
+    const Capture& capture = streams_[s];
+    const PosedImage* pose = capture.PoseForFrame(f->posed.frame);
+    f->posed.has_pose = pose != nullptr;
+    if (!pose) return true;
+    f->posed.cam_from_world = pose->cam_from_world;
+    f->camera = capture.CameraFor(*pose);
+    if (!f->camera) {
+      *status = Status::Error(project_.Resolve(specs_[s].poses) + ": image '" + pose->name +
+                              "': camera " + std::to_string(pose->camera_id) + " not found");
+      return false;
+    }
+    return true;
+  }
+
+  const Project& project_;
+  const std::vector<StreamSpec> specs_;
+  const std::vector<Capture>& streams_;
+  std::vector<std::unique_ptr<FrameReader>> readers_;
+  std::vector<bool> ended_;
+  int next_ = 0;
+};
+
+// Frames read, painted and without a pose, of one stream.
+struct StreamCounts {
+  int frames = 0, painted = 0, without_pose = 0;
+};
 
 nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   const LiveFramesStats s = live.frames->stats();
@@ -170,29 +233,40 @@ int RunVerbRun(const CommandArgs& argv) {
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
   const bool live = IsLiveProject(project);
+  const std::vector<StreamSpec> specs = project.Streams();
+  if (live && specs.size() > 1)
+    return InputError(Status::Error(project_path +
+                                    ": streams: live sources need a project with "
+                                    "one stream (this one has " +
+                                    std::to_string(specs.size()) + ")"));
   const std::string record_dir = args.Get("--record");
   if (!record_dir.empty() && !live)
     return InputError(Status::Error(std::string("--record: only for live sources (") + project_path +
                                     " replays files already)"));
-  Capture capture;
+  std::vector<Capture> captures;  // one per stream; the scene is in captures[0]
   std::unique_ptr<PaintSession> session;
   CaptureLoadOptions load_options;
   load_options.open_video = !live;  // a live video opens after the pose feed connects
-  if (Status s = OpenPaintSession(project, load_options, &capture, &session); !s.ok())
+  if (Status s = OpenPaintSession(project, load_options, &captures, &session); !s.ok())
     return InputError(s);
+  const Scene& scene = captures[0].scene;
   LiveInputs live_inputs;
+  SessionRecorder recorder;
   if (live) {
-    if (Status s = OpenLiveInputs(project, capture, *session, !record_dir.empty(), &live_inputs);
+    const Project one_stream = project.ForStream(0);
+    if (Status s =
+            OpenLiveInputs(one_stream, captures[0], *session, !record_dir.empty(), &live_inputs);
         !s.ok())
       return InputError(s);
+    if (!record_dir.empty())
+      if (Status s = recorder.Start(record_dir, one_stream); !s.ok()) return InputError(s);
   }
-  SessionRecorder recorder;
-  if (!record_dir.empty())
-    if (Status s = recorder.Start(record_dir, project); !s.ok()) return InputError(s);
   if (!quiet) {
-    std::fprintf(stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)\n",
-                 capture.scene.mesh.NumTriangles(), session->buffers().size(),
-                 session->NumSurfaceTexels(), session->default_texel_size_m());
+    std::fprintf(
+        stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)%s\n",
+        scene.mesh.NumTriangles(), session->buffers().size(), session->NumSurfaceTexels(),
+        session->default_texel_size_m(),
+        specs.size() > 1 ? (", " + std::to_string(specs.size()) + " streams").c_str() : "");
   }
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)
@@ -203,15 +277,22 @@ int RunVerbRun(const CommandArgs& argv) {
     if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
   const std::string& stages_dir = stages.path();
 
-  int total = live ? -1 : capture.video->FrameCount();
+  int total = live ? -1 : 0;  // frames of every stream; -1: unknown
+  if (!live) {
+    for (const Capture& capture : captures) {
+      const int count = capture.video->FrameCount();
+      total = total < 0 || count < 0 ? -1 : total + count;
+    }
+  }
   if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
     total = project.pipeline.max_frames;
   Progress progress("painting", total, quiet);
   StageTotals totals;
   int frames = 0, frames_painted = 0, frames_without_pose = 0;
+  std::vector<StreamCounts> stream_counts(specs.size());
   const auto loop_start = std::chrono::steady_clock::now();
   NextLoopFrame next;
-  std::unique_ptr<FrameReader> reader;
+  std::unique_ptr<InterleavedFrames> reader;
   if (live) {
     next = [&](LoopFrame* f, Status* status) {
       if (!live_inputs.frames->Next(&f->posed, status)) return false;
@@ -219,22 +300,9 @@ int RunVerbRun(const CommandArgs& argv) {
       return true;
     };
   } else {
-    // Frames are read and decoded on a second thread, one frame ahead of the painting.
-    reader = std::make_unique<FrameReader>(capture.video.get());
-    next = [&](LoopFrame* f, Status* status) {
-      if (!reader->Next(&f->posed.frame, status)) return false;
-      const PosedImage* pose = capture.PoseForFrame(f->posed.frame);
-      f->posed.has_pose = pose != nullptr;
-      if (!pose) return true;
-      f->posed.cam_from_world = pose->cam_from_world;
-      f->camera = capture.CameraFor(*pose);
-      if (!f->camera) {
-        *status = Status::Error(project.Resolve(project.poses) + ": image '" + pose->name +
-                                "': camera " + std::to_string(pose->camera_id) + " not found");
-        return false;
-      }
-      return true;
-    };
+    // Frames are read and decoded on other threads, one frame ahead of the painting.
+    reader = std::make_unique<InterleavedFrames>(project, captures);
+    next = [&](LoopFrame* f, Status* status) { return reader->Next(f, status); };
   }
   LoopFrame loop_frame;
   const Frame& frame = loop_frame.posed.frame;
@@ -244,27 +312,29 @@ int RunVerbRun(const CommandArgs& argv) {
          !Interrupted() && next(&loop_frame, &read_status)) {
     if (Interrupted()) break;  // arrived while the frame was read
     ++frames;
+    StreamCounts& counts = stream_counts[loop_frame.stream];
+    ++counts.frames;
     if (live_inputs.feed)
       if (Status s = live_inputs.feed->error(); !s.ok()) return InputError(s);
     if (!loop_frame.posed.has_pose) {
-      ++frames_without_pose;
+      ++frames_without_pose, ++counts.without_pose;
       progress.Update(frames);
       continue;
     }
     const Camera* camera = loop_frame.camera;
     if (frame.bgr.cols != camera->width || frame.bgr.rows != camera->height) {
-      return InputError(Status::Error(project.Resolve(project.video) + ": frame '" + frame.name +
-                                      "' is " + std::to_string(frame.bgr.cols) + "x" +
-                                      std::to_string(frame.bgr.rows) + " but the camera is " +
-                                      std::to_string(camera->width) + "x" +
-                                      std::to_string(camera->height)));
+      return InputError(
+          Status::Error(project.Resolve(specs[loop_frame.stream].video) + ": frame '" + frame.name +
+                        "' is " + std::to_string(frame.bgr.cols) + "x" +
+                        std::to_string(frame.bgr.rows) + " but the camera is " +
+                        std::to_string(camera->width) + "x" + std::to_string(camera->height)));
     }
     if (!record_dir.empty())
       if (Status s = recorder.Add(frame, loop_frame.posed.cam_from_world); !s.ok())
         return InputError(s);
     session->PaintFrame(frame, *camera, loop_frame.posed.cam_from_world, &report);
     if (report.painted) {
-      ++frames_painted;
+      ++frames_painted, ++counts.painted;
       for (const StageReport& st : report.stages) {
         totals.ms[st.name] += st.wall_ms;
         for (const auto& [key, value] : st.metrics) {
@@ -337,11 +407,19 @@ int RunVerbRun(const CommandArgs& argv) {
   metrics["base_buffers"] = session->buffers().size();
   metrics["texel_size_m"] = session->default_texel_size_m();
   metrics["groups_split_for_folds"] = session->folds_split();
-  const ChartStretch stretch = MeasureChartStretch(capture.scene.mesh, session->grouping());
+  const ChartStretch stretch = MeasureChartStretch(scene.mesh, session->grouping());
   metrics["charts"] = {{"count", session->buffers().size()},
                        {"max_stretch", stretch.max},
                        {"mean_stretch", stretch.mean}};
-  metrics["triangles"] = capture.scene.mesh.NumTriangles();
+  metrics["triangles"] = scene.mesh.NumTriangles();
+  // Per stream, in the project's order: its video and what came of its frames.
+  nlohmann::json streams = nlohmann::json::array();
+  for (size_t i = 0; i < specs.size(); ++i)
+    streams.push_back({{"video", specs[i].video},
+                       {"frames", stream_counts[i].frames},
+                       {"frames_painted", stream_counts[i].painted},
+                       {"frames_without_pose", stream_counts[i].without_pose}});
+  metrics["streams"] = streams;
   nlohmann::json buffers = nlohmann::json::array();
   for (size_t b = 0; b < session->buffers().size(); ++b) {
     const BaseBuffer& buf = session->buffers()[b];

@@ -3,8 +3,10 @@
 // frame of the video folder.
 #include "pipeline/core/capture.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
+#include <stdexcept>
 
 #include "pipeline/core/cameramodel_io.h"
 
@@ -38,13 +40,13 @@ Status CheckNotEmpty(const Project& project, const std::string& key, const std::
   return Status::Ok();
 }
 
-Status CheckCameras(const Project& project, const Capture& capture) {
+Status CheckCameras(const StreamSpec& stream, const Capture& capture) {
   if (capture.cameras.empty()) {
-    return Status::Error(project.camera + ": holds no camera");
+    return Status::Error(stream.camera + ": holds no camera");
   }
   if (capture.poses_are_tum) {
     if (capture.cameras.size() != 1) {
-      return Status::Error(project.poses + ": TUM poses name no camera, but " + project.camera +
+      return Status::Error(stream.poses + ": TUM poses name no camera, but " + stream.camera +
                            " holds " + std::to_string(capture.cameras.size()) +
                            " cameras (give a file with one)");
     }
@@ -52,9 +54,9 @@ Status CheckCameras(const Project& project, const Capture& capture) {
   }
   for (const PosedImage& pose : capture.poses) {
     if (!capture.cameras.count(pose.camera_id)) {
-      return Status::Error(project.poses + ": image '" + pose.name + "' (IMAGE_ID " +
+      return Status::Error(stream.poses + ": image '" + pose.name + "' (IMAGE_ID " +
                            std::to_string(pose.image_id) + "): CAMERA_ID " +
-                           std::to_string(pose.camera_id) + " is not in " + project.camera);
+                           std::to_string(pose.camera_id) + " is not in " + stream.camera);
     }
   }
   return Status::Ok();
@@ -79,7 +81,7 @@ void IndexPoseNames(Capture* capture) {
 
 // Every image the COLMAP poses list must be a frame of the video folder (by name, or by
 // stem when the extension differs); frames then map to their poses by name.
-Status MatchFolderFrames(const Project& project, Capture* capture) {
+Status MatchFolderFrames(const StreamSpec& stream, Capture* capture) {
   const std::vector<std::string> frame_names = capture->video->FrameNames();
   if (frame_names.empty() || capture->poses_are_tum) return Status::Ok();
   std::set<std::string> names(frame_names.begin(), frame_names.end());
@@ -89,8 +91,8 @@ Status MatchFolderFrames(const Project& project, Capture* capture) {
     const std::string file_name = fs::path(pose.name).filename().string();
     if (names.count(pose.name) || names.count(file_name)) continue;
     if (stem_count[Stem(pose.name)] == 1) continue;
-    return Status::Error(project.poses + ": image '" + pose.name +
-                         "' is listed but missing from video folder " + project.video);
+    return Status::Error(stream.poses + ": image '" + pose.name +
+                         "' is listed but missing from video folder " + stream.video);
   }
   // Poses named with a subfolder ("images/000012.png") match frames by file name.
   for (int i = 0; i < static_cast<int>(capture->poses.size()); ++i) {
@@ -122,18 +124,26 @@ const Camera* Capture::CameraFor(const PosedImage& pose) const {
 }
 
 Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture) {
+  const std::vector<StreamSpec> streams = project.Streams();
+  if (options.stream < 0) FRESCO_RETURN_IF_ERROR(CheckOneStream(project, "this command"));
+  const int index = std::max(options.stream, 0);
+  if (index >= static_cast<int>(streams.size())) {
+    throw std::out_of_range("LoadCapture: no stream " + std::to_string(index));
+  }
+  const StreamSpec& stream = streams[index];
+  const auto key = [&](const char* name) { return project.StreamKey(index, name); };
   Capture result;
   // Every file the project names must exist before anything is parsed.
-  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, "camera", project.camera));
-  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, "poses", project.poses));
-  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, "video", project.video));
+  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, key("camera"), stream.camera));
+  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, key("poses"), stream.poses));
+  FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, key("video"), stream.video));
   if (options.load_scene) {
     FRESCO_RETURN_IF_ERROR(CheckNotEmpty(project, "scene", project.scene));
     FRESCO_RETURN_IF_ERROR(CheckExists(project, "scene", project.scene));
   }
-  FRESCO_RETURN_IF_ERROR(CheckExists(project, "camera", project.camera));
-  FRESCO_RETURN_IF_ERROR(CheckExists(project, "poses", project.poses));
-  FRESCO_RETURN_IF_ERROR(CheckExists(project, "video", project.video));
+  FRESCO_RETURN_IF_ERROR(CheckExists(project, key("camera"), stream.camera));
+  FRESCO_RETURN_IF_ERROR(CheckExists(project, key("poses"), stream.poses));
+  FRESCO_RETURN_IF_ERROR(CheckExists(project, key("video"), stream.video));
   if (!project.truth.poses.empty()) {
     FRESCO_RETURN_IF_ERROR(CheckExists(project, "truth.poses", project.truth.poses));
   }
@@ -142,12 +152,12 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
     FRESCO_RETURN_IF_ERROR(
         LoadGltfScene(project.Resolve(project.scene), SceneLoadOptions(), &result.scene));
   }
-  FRESCO_RETURN_IF_ERROR(ReadCameras(project.Resolve(project.camera), &result.cameras));
-  if (!IsUrlOrDevice(project.poses)) {  // live poses (tcp://) arrive while running
+  FRESCO_RETURN_IF_ERROR(ReadCameras(project.Resolve(stream.camera), &result.cameras));
+  if (!IsUrlOrDevice(stream.poses)) {  // live poses (tcp://) arrive while running
     FRESCO_RETURN_IF_ERROR(
-        ReadPoses(project.Resolve(project.poses), &result.poses, &result.poses_are_tum));
+        ReadPoses(project.Resolve(stream.poses), &result.poses, &result.poses_are_tum));
     if (result.poses.empty() && options.require_poses) {
-      return Status::Error(project.poses + ": holds no poses");
+      return Status::Error(stream.poses + ": holds no poses");
     }
   } else {
     result.poses_are_tum = true;
@@ -157,14 +167,28 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
     FRESCO_RETURN_IF_ERROR(
         ReadPoses(project.Resolve(project.truth.poses), &result.truth_poses, &truth_is_tum));
   }
-  FRESCO_RETURN_IF_ERROR(CheckCameras(project, result));
+  FRESCO_RETURN_IF_ERROR(CheckCameras(stream, result));
   IndexPoseNames(&result);
 
   if (options.open_video) {
-    FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(project.video), &result.video));
-    FRESCO_RETURN_IF_ERROR(MatchFolderFrames(project, &result));
+    FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(stream.video), &result.video));
+    FRESCO_RETURN_IF_ERROR(MatchFolderFrames(stream, &result));
   }
   *capture = std::move(result);
+  return Status::Ok();
+}
+
+Status LoadStreamCaptures(const Project& project, const CaptureLoadOptions& options,
+                          std::vector<Capture>* streams) {
+  const int count = static_cast<int>(project.Streams().size());
+  std::vector<Capture> result(count);
+  for (int i = 0; i < count; ++i) {
+    CaptureLoadOptions one = options;
+    one.stream = i;
+    one.load_scene = options.load_scene && i == 0;
+    FRESCO_RETURN_IF_ERROR(LoadCapture(project, one, &result[i]));
+  }
+  *streams = std::move(result);
   return Status::Ok();
 }
 

@@ -42,8 +42,18 @@ struct CaptureLoadOptions {
   // When false, a poses file that holds no poses is accepted (`fresco poses bootstrap` makes
   // the poses for such a project).
   bool require_poses = true;
+  // Which of the project's video streams (Project::Streams()) to load. -1: the project's
+  // only stream; a project with several is then an error naming `streams` (callers that
+  // read one stream refuse them). Messages name a version-2 stream's keys by JSON path
+  // ("streams[1].video").
+  int stream = -1;
 };
 
+// Loads the scene (when asked) and one video stream's cameras, poses and video.
 Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture);
+// Every video stream of the project, in order: the scene is loaded once, into (*streams)[0]
+// (the others' scenes stay empty); each stream's files as LoadCapture loads them.
+Status LoadStreamCaptures(const Project& project, const CaptureLoadOptions& options,
+                          std::vector<Capture>* streams);
 
 }  // namespace fresco

@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,7 +25,10 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr int kProjectVersion = 1;
+constexpr int kOldestVersion = 1;
+constexpr int kProjectVersion = 2;  // the newest this Fresco reads
+// Version-1 keys that version 2 replaces by `streams`.
+constexpr const char* kStreamKeys[] = {"camera", "video", "poses", "time_offset_s"};
 
 // What a field accepts beyond its type. Numbers: [min, max] (min exclusive when asked);
 // strings: non-empty, or one of `choices`.
@@ -202,13 +206,24 @@ void Fields(LiveOptions& o, V& v) {
 }
 
 template <class V>
+void Fields(StreamSpec& s, V& v) {
+  v.Field("camera", s.camera, {.required = true, .non_empty = true});
+  v.Field("video", s.video, {.required = true, .non_empty = true});
+  v.Field("poses", s.poses, {.required = true, .non_empty = true});
+  v.Field("time_offset_s", s.time_offset_s);
+}
+
+// camera, video, poses and time_offset_s (version 1) and streams (version 2) are each
+// allowed in one version only: ParseProject checks which, ProjectToJsonText writes its own.
+template <class V>
 void Fields(Project& p, V& v) {
   v.Field("fresco", p.fresco_version, {.required = true});
   v.Field("scene", p.scene, {.required = true, .non_empty = true});
-  v.Field("camera", p.camera, {.required = true, .non_empty = true});
-  v.Field("video", p.video, {.required = true, .non_empty = true});
-  v.Field("poses", p.poses, {.required = true, .non_empty = true});
+  v.Field("camera", p.camera, {.non_empty = true});
+  v.Field("video", p.video, {.non_empty = true});
+  v.Field("poses", p.poses, {.non_empty = true});
   v.Field("time_offset_s", p.time_offset_s);
+  v.List("streams", p.streams);
   v.Object("pipeline", p.pipeline);
   v.Object("grouping", p.grouping);
   v.Object("truth", p.truth);
@@ -227,7 +242,8 @@ static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSp
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 72, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
 static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 640, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(StreamSpec) == 104, "see Fields(StreamSpec)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 664, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 
@@ -449,7 +465,8 @@ class JsonReader {
     values = std::move(result);
   }
 
-  // Reports keys that no field asked for (typos must not pass silently).
+  // Reports keys that no field asked for (typos must not pass silently), then a missing
+  // required key (a typo in a required key's name is reported as the typo).
   void Finish() {
     for (const auto& [key, value] : object_.items()) {
       if (std::find(known_.begin(), known_.end(), key) != known_.end()) continue;
@@ -464,6 +481,7 @@ class JsonReader {
       context_->Fail(ChildPath(path_, key), what);
       return;
     }
+    if (!missing_.empty()) Fail(missing_.c_str(), "missing required key");
   }
 
  private:
@@ -472,7 +490,7 @@ class JsonReader {
     if (!context_->status.ok()) return nullptr;
     const auto it = object_.find(key);
     if (it == object_.end()) {
-      if (rule.required) Fail(key, "missing required key");
+      if (rule.required && missing_.empty()) missing_ = key;
       return nullptr;
     }
     return &*it;
@@ -531,6 +549,7 @@ class JsonReader {
   std::string path_;
   ReadContext* context_;
   std::vector<std::string> known_;
+  std::string missing_;  // the first required key not found
 };
 
 // ---- Parsing the text: malformed JSON and duplicate keys. -----------------------------------
@@ -699,6 +718,30 @@ std::string Rebase(const std::string& path, const fs::path& old_folder,
   return result;
 }
 
+// Version 1 names its one stream at the top level, version 2 lists `streams` instead.
+void CheckVersionKeys(const Json& root, const Project& project, ReadContext* context) {
+  if (project.fresco_version == 1) {
+    if (root.contains("streams")) {
+      return context->Fail("streams",
+                           "needs \"fresco\": 2 (version 1 names one stream with "
+                           "top-level camera, video and poses)");
+    }
+    for (const char* key : {"camera", "video", "poses"}) {
+      if (!root.contains(key)) return context->Fail(key, "missing required key");
+    }
+    return;
+  }
+  for (const char* key : kStreamKeys) {
+    if (root.contains(key)) {
+      return context->Fail(key, std::string("not allowed in version 2 (each entry of streams "
+                                            "has its own ") +
+                                    key + ")");
+    }
+  }
+  if (!root.contains("streams")) return context->Fail("streams", "missing required key");
+  if (project.streams.empty()) return context->Fail("streams", "must list at least one stream");
+}
+
 }  // namespace
 
 std::string SamplingModeName(SamplingMode mode) {
@@ -737,6 +780,39 @@ std::string Project::Resolve(const std::string& relative) const {
   return (fs::path(file_path).parent_path() / relative).lexically_normal().string();
 }
 
+Status CheckOneStream(const Project& project, const std::string& who) {
+  const size_t count = project.Streams().size();
+  if (count == 1) return Status::Ok();
+  const std::string name = project.file_path.empty() ? "project" : project.file_path;
+  return Status::Error(name + ": streams: " + std::to_string(count) + " video streams, but " + who +
+                       " reads one (fresco run paints several)");
+}
+
+std::vector<StreamSpec> Project::Streams() const {
+  if (fresco_version >= 2) return streams;
+  return {StreamSpec{camera, video, poses, time_offset_s}};
+}
+
+std::string Project::StreamKey(int index, const std::string& key) const {
+  if (fresco_version < 2) return key;
+  return "streams[" + std::to_string(index) + "]." + key;
+}
+
+Project Project::ForStream(int index) const {
+  const std::vector<StreamSpec> all = Streams();
+  if (index < 0 || index >= static_cast<int>(all.size())) {
+    throw std::out_of_range("Project::ForStream: no stream " + std::to_string(index));
+  }
+  Project view = *this;
+  view.fresco_version = 1;
+  view.camera = all[index].camera;
+  view.video = all[index].video;
+  view.poses = all[index].poses;
+  view.time_offset_s = all[index].time_offset_s;
+  view.streams.clear();
+  return view;
+}
+
 Status ParseProject(const std::string& text, const std::string& name,
                     const std::vector<std::string>& overrides, Project* project) {
   Json root;
@@ -754,11 +830,13 @@ Status ParseProject(const std::string& text, const std::string& name,
   JsonReader reader(root, "", &context);
   Fields(result, reader);
   reader.Finish();
-  if (context.status.ok() && result.fresco_version != kProjectVersion) {
+  if (context.status.ok() &&
+      (result.fresco_version < kOldestVersion || result.fresco_version > kProjectVersion)) {
     context.Fail("fresco", "unsupported version " + std::to_string(result.fresco_version) +
-                               " (this Fresco reads version " + std::to_string(kProjectVersion) +
-                               ")");
+                               " (this Fresco reads versions " + std::to_string(kOldestVersion) +
+                               " and " + std::to_string(kProjectVersion) + ")");
   }
+  if (context.status.ok()) CheckVersionKeys(root, result, &context);
   FRESCO_RETURN_IF_ERROR(context.status);
   result.file_path = AbsoluteNormal(name);
   *project = std::move(result);
@@ -777,6 +855,11 @@ std::string ProjectToJsonText(const Project& project) {
   Json root;
   JsonWriter writer(&root);
   Fields(copy, writer);
+  if (project.fresco_version >= 2) {
+    for (const char* key : kStreamKeys) root.erase(key);
+  } else {
+    root.erase("streams");
+  }
   return root.dump(2) + "\n";
 }
 
@@ -786,10 +869,12 @@ Status SaveProject(const Project& project, const std::string& path) {
   if (!project.file_path.empty()) {
     const fs::path old_folder = fs::path(project.file_path).parent_path();
     const fs::path new_folder = fs::path(new_file).parent_path();
-    for (std::string* p :
-         {&moved.scene, &moved.camera, &moved.video, &moved.poses, &moved.truth.poses}) {
-      *p = Rebase(*p, old_folder, new_folder);
+    std::vector<std::string*> paths = {&moved.scene, &moved.camera, &moved.video, &moved.poses,
+                                       &moved.truth.poses};
+    for (StreamSpec& stream : moved.streams) {
+      for (std::string* p : {&stream.camera, &stream.video, &stream.poses}) paths.push_back(p);
     }
+    for (std::string* p : paths) *p = Rebase(*p, old_folder, new_folder);
   }
   return WriteFileAtomic(path, ProjectToJsonText(moved));
 }

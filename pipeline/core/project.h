@@ -215,6 +215,20 @@ struct LiveOptions {
   bool operator==(const LiveOptions&) const = default;
 };
 
+// One video stream of a version-2 project (`streams`): its own camera, video and poses, and
+// its own time offset (tracker clock minus video clock), paths as written in the file.
+struct StreamSpec {
+  std::string camera;
+  std::string video;
+  std::string poses;
+  double time_offset_s = 0.0;
+
+  bool operator==(const StreamSpec&) const = default;
+};
+
+// Version 1 (`"fresco": 1`): one stream, as top-level `camera`, `video`, `poses` and
+// `time_offset_s`; `streams` is not allowed. Version 2: a non-empty `streams` list and none
+// of those four top-level keys (they stay empty here).
 struct Project {
   int fresco_version = 1;
   std::string scene;  // as written in the file
@@ -222,6 +236,7 @@ struct Project {
   std::string video;
   std::string poses;
   double time_offset_s = 0.0;  // tracker clock minus video clock (live/TUM matching)
+  std::vector<StreamSpec> streams;  // version 2 only
   PipelineOptions pipeline;
   GroupingOptions grouping;
   TruthFiles truth;
@@ -231,6 +246,15 @@ struct Project {
   // Resolves a path as written in the project against the project file's folder.
   // Empty stays empty; absolute paths, URLs and "device:N" are returned as written.
   std::string Resolve(const std::string& relative) const;
+
+  // The video streams, whatever the version: a version-1 file's one stream, or `streams`.
+  std::vector<StreamSpec> Streams() const;
+  // JSON path naming stream `index`'s key in messages: "camera" (version 1) or
+  // "streams[1].camera" (version 2).
+  std::string StreamKey(int index, const std::string& key) const;
+  // A version-1 view of stream `index` (every other setting as here), for code that reads
+  // one stream (LoadCapture, live inputs). `index` must be < Streams().size().
+  Project ForStream(int index) const;
 
   // Every field, file_path included.
   bool operator==(const Project&) const = default;
@@ -252,6 +276,10 @@ std::string SamplingModeName(SamplingMode mode);
 std::string BackgroundModeName(BackgroundMode mode);  // "off" | "average" | "robust"
 // Parses "nearest" | "bilinear" | "area". Returns false for other names.
 bool SamplingModeFromName(const std::string& name, SamplingMode* mode);
+
+// Ok when the project has one video stream; else an error "FILE: streams: N video streams,
+// but WHO reads one (fresco run paints several)" for code that reads a single stream.
+Status CheckOneStream(const Project& project, const std::string& who);
 
 // True for names that are not files: URLs ("udp://...", "tcp://...") and "device:N".
 bool IsUrlOrDevice(const std::string& path);

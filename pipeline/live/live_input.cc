@@ -14,7 +14,9 @@ VideoSourceOptions VideoOptions(const LiveOptions& live) {
 }  // namespace
 
 bool IsLiveProject(const Project& project) {
-  return IsUrlOrDevice(project.video) || IsUrlOrDevice(project.poses);
+  for (const StreamSpec& stream : project.Streams())
+    if (IsUrlOrDevice(stream.video) || IsUrlOrDevice(stream.poses)) return true;
+  return false;
 }
 
 Status OpenLiveInputs(const Project& project, const Capture& capture, const PaintSession& session,

@@ -16,7 +16,8 @@
 
 namespace fresco {
 
-// True when the project's video or poses are live (a camera, a stream or a pose feed).
+// True when a stream's video or poses are live (a camera, a stream or a pose feed).
+// OpenLiveInputs reads a project with one stream (Project::ForStream(0) of a version-2 file).
 bool IsLiveProject(const Project& project);
 
 struct LiveInputs {

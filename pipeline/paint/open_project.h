@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
@@ -11,11 +12,18 @@
 
 namespace fresco {
 
+// A project with one video stream (a version-1 file, or version 2 with one entry in
+// `streams`); a project with several is an error naming `streams`.
 Status OpenPaintSession(const Project& project, Capture* capture,
                         std::unique_ptr<PaintSession>* session);
 // The same with the capture's load options (e.g. open_video false: a live video is opened
 // later, once the pose feed is connected).
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
                         Capture* capture, std::unique_ptr<PaintSession>* session);
+// Every video stream of the project (LoadStreamCaptures: the scene is in (*streams)[0]),
+// painting one model. The automatic texel size is the finest any stream asks for (each
+// stream's first camera at its own poses).
+Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
+                        std::vector<Capture>* streams, std::unique_ptr<PaintSession>* session);
 
 }  // namespace fresco

@@ -1,9 +1,13 @@
 // The `fresco` command line as users and outside checks drive it (CONTRACT.md): the
 // dispatcher, --help on every verb, `fresco run` end to end on a small synthetic capture,
 // and bad input: exit 2, one line naming the file, and earlier outputs left as they were.
-#include <cctype>
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -263,6 +267,137 @@ TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
     EXPECT_NE(errors[0].find(c.expect), std::string::npos) << c.what << ": " << r.err;
     EXPECT_EQ(ReadText(out + "/metrics.json"), metrics_before) << c.what;
     EXPECT_EQ(ReadText(out + "/painted.gltf"), gltf_before) << c.what;
+  }
+}
+
+// A version-2 project: the capture split into two streams (even frames in a/, odd frames in
+// b/, each with its own copy of the camera and its own poses). Interleaved by frame index
+// the two streams bring the frames in the capture's own order, so the one model is painted
+// as the version-1 project paints it.
+class StreamsTest : public RunCommandTest {
+ protected:
+  // Writes DIR/{a,b}/{frames/,camera.cameramodel,images.txt} and DIR/streams.json.
+  static std::string SplitIntoTwoStreams(const std::string& dir) {
+    std::vector<fs::path> frames;
+    for (const auto& entry : fs::directory_iterator(dir + "/frames")) frames.push_back(entry);
+    std::sort(frames.begin(), frames.end());
+    for (const char* s : {"a", "b"}) {
+      fs::create_directories(dir + "/" + s + "/frames");
+      fs::copy_file(dir + "/camera.cameramodel", dir + "/" + s + "/camera.cameramodel");
+    }
+    std::map<std::string, std::string> stream_of;  // frame name -> "a" | "b"
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const std::string stream = i % 2 == 0 ? "a" : "b";
+      stream_of[frames[i].filename().string()] = stream;
+      fs::rename(frames[i], dir + "/" + stream + "/frames/" + frames[i].filename().string());
+    }
+    // images.txt: comment lines, then per image a pose line (NAME last) and a points line.
+    std::map<std::string, std::string> images = {{"a", ""}, {"b", ""}};
+    std::istringstream in(ReadText(dir + "/sparse/images.txt"));
+    std::string line, stream;
+    for (bool pose_line = true; std::getline(in, line);) {
+      if (!line.empty() && line[0] == '#') continue;
+      if (pose_line) stream = stream_of.at(line.substr(line.rfind(' ') + 1));
+      images[stream] += line + "\n";
+      pose_line = !pose_line;
+    }
+    for (const auto& [s, text] : images) WriteText(dir + "/" + s + "/images.txt", text);
+    const std::string project = dir + "/streams.json";
+    WriteText(project, R"({"fresco": 2, "scene": "scene.gltf", "streams": [
+      {"camera": "a/camera.cameramodel", "video": "a/frames/", "poses": "a/images.txt"},
+      {"camera": "b/camera.cameramodel", "video": "b/frames/", "poses": "b/images.txt",
+       "time_offset_s": 0}]})");
+    return project;
+  }
+};
+
+TEST_F(StreamsTest, TwoStreamsPaintTheModelAsOneDoes) {
+  const std::string dir = CopyCapture("run-streams");
+  const std::string project = SplitIntoTwoStreams(dir);
+  const auto one = RunFresco({"run", Project(), "--out", dir + "/one", "--quiet"});
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const auto two = RunFresco({"run", project, "--out", dir + "/two", "--quiet"});
+  ASSERT_EQ(two.exit_code, 0) << two.err;
+  const nlohmann::json m1 = nlohmann::json::parse(ReadText(dir + "/one/metrics.json"));
+  const nlohmann::json m2 = nlohmann::json::parse(ReadText(dir + "/two/metrics.json"));
+  EXPECT_EQ(m2["frames"], 12);
+  EXPECT_EQ(m2["frames_painted"], 12);
+  EXPECT_EQ(m2["base_buffers"], m1["base_buffers"]);
+  for (const char* stage : {"depth", "warp", "paint"})
+    EXPECT_TRUE(m2["stage_ms"].contains(stage)) << stage;
+  // The automatic texel size looks at both streams' poses: about the same as for all frames.
+  EXPECT_NEAR(m2["texel_size_m"].get<double>(), m1["texel_size_m"].get<double>(),
+              0.05 * m1["texel_size_m"].get<double>());
+  EXPECT_GT(m1["coverage"].get<double>(), 0.2);
+  EXPECT_NEAR(m2["coverage"].get<double>(), m1["coverage"].get<double>(), 0.01);
+  ASSERT_EQ(m1["streams"].size(), 1u);
+  EXPECT_EQ(m1["streams"][0]["frames"], 12);
+  ASSERT_EQ(m2["streams"].size(), 2u);
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_EQ(m2["streams"][s]["video"], s == 0 ? "a/frames/" : "b/frames/");
+    EXPECT_EQ(m2["streams"][s]["frames"], 6) << s;
+    EXPECT_EQ(m2["streams"][s]["frames_painted"], 6) << s;
+  }
+  // Interleaved by frame index: the first 5 frames are 3 of a's and 2 of b's.
+  const auto first = RunFresco(
+      {"run", project, "--out", dir + "/first", "--quiet", "--set", "pipeline.max_frames=5"});
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const nlohmann::json m3 = nlohmann::json::parse(ReadText(dir + "/first/metrics.json"));
+  EXPECT_EQ(m3["frames"], 5);
+  EXPECT_EQ(m3["streams"][0]["frames"], 3);
+  EXPECT_EQ(m3["streams"][1]["frames"], 2);
+  // `fresco group` reads every stream too.
+  const auto group = RunFresco({"group", project});
+  EXPECT_EQ(group.exit_code, 0) << group.err;
+  EXPECT_NE(group.out.find("6 base buffers"), std::string::npos) << group.out;
+}
+
+TEST_F(StreamsTest, BadStreamsExit2NamingTheStream) {
+  const std::string dir = CopyCapture("run-streams-bad");
+  const std::string project = SplitIntoTwoStreams(dir);
+  const std::string out = dir + "/out";
+  struct Case {
+    std::string what;
+    std::vector<std::string> args;
+    std::vector<std::string> expect;  // in the message
+  };
+  std::vector<Case> cases;
+  cases.push_back({"unknown stream key",
+                   {"run", project, "--out", out, "--set", "streams.1.vidoe=b/frames/"},
+                   {"streams.json", "streams[1].vidoe", "unknown key"}});
+  cases.push_back({"top-level camera in version 2",
+                   {"run", project, "--out", out, "--set", "camera=a/camera.cameramodel"},
+                   {"streams.json", "camera: not allowed in version 2"}});
+  cases.push_back({"live source among several streams",
+                   {"run", project, "--out", out, "--set", "streams.1.video=udp://127.0.0.1:5999"},
+                   {"streams.json", "streams", "one stream"}});
+  cases.push_back({"bench reads one stream",
+                   {"bench", project, "--out", out},
+                   {"streams.json", "streams: 2 video streams", "fresco bench"}});
+  {
+    const std::string broken = CopyCapture("run-streams-missing");
+    const std::string broken_project = SplitIntoTwoStreams(broken);
+    fs::remove_all(broken + "/b/frames");
+    cases.push_back({"missing video folder",
+                     {"run", broken_project, "--out", out},
+                     {"streams.json", "streams[1].video", "b/frames/"}});
+  }
+  {
+    const std::string broken = CopyCapture("run-streams-size");
+    const std::string broken_project = SplitIntoTwoStreams(broken);
+    cv::imwrite(broken + "/b/frames/000007.png", cv::Mat(60, 80, CV_8UC3, cv::Scalar(1, 2, 3)));
+    cases.push_back({"frame of the wrong size in stream b",
+                     {"run", broken_project, "--out", out},
+                     {"b/frames", "000007.png"}});
+  }
+  for (const Case& c : cases) {
+    const auto r = RunFresco(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.what << ": " << r.err;
+    const std::vector<std::string> errors = ErrorLines(r.err);
+    ASSERT_EQ(errors.size(), 1u) << c.what << ": " << r.err;
+    for (const std::string& expect : c.expect)
+      EXPECT_NE(errors[0].find(expect), std::string::npos) << c.what << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out + "/metrics.json")) << c.what;
   }
 }
 

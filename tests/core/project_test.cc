@@ -3,6 +3,7 @@
 #include "pipeline/core/project.h"
 
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 const char kMinimal[] = R"({
@@ -131,6 +133,35 @@ Project NonDefaultProject() {
   p.grouping.groups = {GroupSpec{{0, 1, 2}, 0.0}, GroupSpec{{3, 5}, 0.01}};
   p.truth.poses = "truth/poses.tum";
   return p;
+}
+
+// The same as a version-2 file with two streams (every stream key away from its default).
+Project NonDefaultProjectV2() {
+  Project p = NonDefaultProject();
+  p.fresco_version = 2;
+  p.camera = p.video = p.poses = "";
+  p.time_offset_s = 0;
+  p.streams = {
+      StreamSpec{"a/cameras.txt", "a/frames/", "a/images.txt", 0.25},
+      StreamSpec{"b/camera.cameramodel", "udp://127.0.0.1:5001", "tcp://127.0.0.1:6001", -0.5}};
+  return p;
+}
+
+const char kTwoStreams[] = R"({
+  "fresco": 2,
+  "scene": "scene.gltf",
+  "streams": [
+    {"camera": "a/cameras.txt", "video": "a/frames/", "poses": "a/images.txt"},
+    {"camera": "b/cameras.txt", "video": "udp://127.0.0.1:5001", "poses": "tcp://127.0.0.1:6001",
+     "time_offset_s": 0.5}
+  ]
+})";
+
+// kTwoStreams with `extra` spliced in as more top-level keys.
+std::string TwoStreamsWith(const std::string& extra) {
+  std::string text = kTwoStreams;
+  text.insert(text.rfind('}'), ", " + extra + "\n");
+  return text;
 }
 
 TEST(ProjectTest, MinimalProjectGetsDefaults) {
@@ -316,9 +347,12 @@ TEST(ProjectTest, RequiredKeysAndVersion) {
     if (std::string(key) == "poses") text.replace(text.rfind(','), 1, "");
     EXPECT_EQ(ParseError(text), std::string("p.json: ") + key + ": missing required key");
   }
-  std::string v2 = kMinimal;
-  v2.replace(v2.find("\"fresco\": 1"), 11, "\"fresco\": 2");
-  EXPECT_THAT(ParseError(v2), StartsWith("p.json: fresco: unsupported version 2"));
+  for (const char* version : {"0", "3"}) {
+    std::string text = kMinimal;
+    text.replace(text.find("\"fresco\": 1"), 11, std::string("\"fresco\": ") + version);
+    EXPECT_THAT(ParseError(text),
+                StartsWith(std::string("p.json: fresco: unsupported version ") + version));
+  }
   std::string empty = kMinimal;
   empty.replace(empty.find("\"frames/\""), 9, "\"\"");
   EXPECT_EQ(ParseError(empty), "p.json: video: must not be empty");
@@ -411,6 +445,114 @@ TEST(ProjectTest, SamplingModeNames) {
   }
   SamplingMode parsed;
   EXPECT_FALSE(SamplingModeFromName("cubic", &parsed));
+}
+
+// Version 2: several video streams, each with its own camera, video, poses and time offset.
+TEST(ProjectTest, Version2ListsStreams) {
+  Project project;
+  const Status status = Parse(kTwoStreams, &project);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(project.fresco_version, 2);
+  EXPECT_EQ(project.camera, "");
+  ASSERT_EQ(project.streams.size(), 2u);
+  EXPECT_EQ(project.streams[0], (StreamSpec{"a/cameras.txt", "a/frames/", "a/images.txt", 0.0}));
+  EXPECT_EQ(project.streams[1].video, "udp://127.0.0.1:5001");
+  EXPECT_EQ(project.streams[1].time_offset_s, 0.5);
+  EXPECT_EQ(project.Streams(), project.streams);
+  EXPECT_EQ(project.StreamKey(1, "video"), "streams[1].video");
+  EXPECT_FALSE(CheckOneStream(project, "fresco bench").ok());
+  EXPECT_EQ(CheckOneStream(project, "fresco bench").message(),
+            project.file_path +
+                ": streams: 2 video streams, but fresco bench reads one (fresco "
+                "run paints several)");
+  // A version-1 view of one stream, for code that reads one.
+  const Project second = project.ForStream(1);
+  EXPECT_EQ(second.fresco_version, 1);
+  EXPECT_EQ(second.camera, "b/cameras.txt");
+  EXPECT_EQ(second.poses, "tcp://127.0.0.1:6001");
+  EXPECT_EQ(second.time_offset_s, 0.5);
+  EXPECT_TRUE(second.streams.empty());
+  EXPECT_EQ(second.scene, project.scene);
+  EXPECT_THROW(project.ForStream(2), std::out_of_range);
+  // --set reaches into the list.
+  ASSERT_TRUE(Parse(kTwoStreams, &project, {"streams.0.video=c/frames/"}).ok());
+  EXPECT_EQ(project.streams[0].video, "c/frames/");
+}
+
+TEST(ProjectTest, Version1IsOneStream) {
+  Project project;
+  ASSERT_TRUE(Parse(WithExtra(R"("time_offset_s": 0.125)"), &project).ok());
+  EXPECT_TRUE(project.streams.empty());
+  EXPECT_EQ(
+      project.Streams(),
+      (std::vector<StreamSpec>{{"sparse/cameras.txt", "frames/", "sparse/images.txt", 0.125}}));
+  EXPECT_EQ(project.StreamKey(0, "video"), "video");
+  EXPECT_EQ(project.ForStream(0), project);
+  EXPECT_TRUE(CheckOneStream(project, "fresco bench").ok());
+}
+
+TEST(ProjectTest, StreamsBelongToVersion2Only) {
+  EXPECT_THAT(
+      ParseError(WithExtra(R"("streams": [{"camera": "c.txt", "video": "f/", "poses": "i.txt"}])")),
+      StartsWith("p.json: streams: needs \"fresco\": 2"));
+  for (const char* key : {"camera", "video", "poses", "time_offset_s"}) {
+    const std::string value = std::string(key) == "time_offset_s" ? "0" : "\"x\"";
+    EXPECT_THAT(ParseError(TwoStreamsWith("\"" + std::string(key) + "\": " + value)),
+                StartsWith(std::string("p.json: ") + key + ": not allowed in version 2"));
+  }
+  std::string missing = kTwoStreams;
+  missing.erase(missing.find("\"streams\""), missing.rfind(']') - missing.find("\"streams\"") + 1);
+  missing.replace(missing.rfind(','), 1, "");
+  EXPECT_EQ(ParseError(missing), "p.json: streams: missing required key");
+  EXPECT_EQ(ParseError(R"({"fresco": 2, "scene": "s.gltf", "streams": []})"),
+            "p.json: streams: must list at least one stream");
+  EXPECT_EQ(ParseError(R"({"fresco": 2, "scene": "s.gltf", "streams": {}})"),
+            "p.json: streams: expected an array, got object");
+}
+
+TEST(ProjectTest, StreamKeysAreStrict) {
+  std::string typo = kTwoStreams;
+  typo.replace(typo.find("\"video\": \"udp"), 7, "\"vidoe\"");
+  EXPECT_EQ(ParseError(typo), "p.json: streams[1].vidoe: unknown key (did you mean 'video'?)");
+  std::string no_poses = kTwoStreams;
+  const std::string poses = R"(, "poses": "a/images.txt")";
+  no_poses.erase(no_poses.find(poses), poses.size());
+  EXPECT_EQ(ParseError(no_poses), "p.json: streams[0].poses: missing required key");
+  EXPECT_THAT(ParseError(kTwoStreams, {"streams.1.time_offset_s=\"late\""}),
+              StartsWith("p.json: streams[1].time_offset_s: expected a number, got string"));
+  EXPECT_THAT(ParseError(kTwoStreams, {"streams.0.camera=\"\""}),
+              StartsWith("p.json: streams[0].camera: must not be empty"));
+  EXPECT_EQ(ParseError(R"({"fresco": 2, "scene": "s.gltf", "streams": ["a"]})"),
+            "p.json: streams[0]: expected an object, got string \"a\"");
+}
+
+TEST(ProjectTest, Version2SaveThenLoadGivesTheSameProject) {
+  const std::string dir = testing::MakeTempDir("project");
+  Project project = NonDefaultProjectV2();
+  project.file_path = dir + "/project.json";
+  ASSERT_TRUE(SaveProject(project, project.file_path).ok());
+  const std::string text = testing::ReadText(project.file_path);
+  EXPECT_THAT(text, HasSubstr("\"fresco\": 2"));
+  EXPECT_THAT(text, HasSubstr("\"streams\": ["));
+  EXPECT_THAT(text, Not(HasSubstr("\n  \"camera\"")));  // no top-level stream keys
+  Project loaded;
+  const Status status = LoadProject(project.file_path, {}, &loaded);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(loaded.streams, project.streams);
+  EXPECT_EQ(loaded, project);
+  // And a version-1 file writes no `streams`.
+  EXPECT_THAT(ProjectToJsonText(NonDefaultProject()), Not(HasSubstr("streams")));
+  // Saved elsewhere, the streams' paths still name the same files.
+  fs::create_directories(dir + "/b");
+  ASSERT_TRUE(SaveProject(project, dir + "/b/copy.json").ok());
+  Project copy;
+  ASSERT_TRUE(LoadProject(dir + "/b/copy.json", {}, &copy).ok());
+  EXPECT_EQ(copy.streams[0].camera, "../a/cameras.txt");
+  EXPECT_EQ(copy.streams[0].video, "../a/frames/");
+  EXPECT_EQ(copy.streams[1].video, "udp://127.0.0.1:5001");
+  for (size_t i = 0; i < copy.streams.size(); ++i)
+    for (auto field : {&StreamSpec::camera, &StreamSpec::video, &StreamSpec::poses})
+      EXPECT_EQ(copy.Resolve(copy.streams[i].*field), project.Resolve(project.streams[i].*field));
 }
 
 }  // namespace

@@ -489,6 +489,18 @@ TEST(LiveStreamTest, UnreachableSourcesExitTwoNamingTheAddress) {
        dir + "/out"});
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_THAT(r.err, HasSubstr(poses + ": cannot connect"));
+  // The same as a version-2 file with one stream: the same live path.
+  const Json v2 = {{"fresco", 2},
+                   {"scene", scene},
+                   {"streams",
+                    {{{"camera", "camera.txt"},
+                      {"video", "udp://127.0.0.1:" + std::to_string(silent_udp)},
+                      {"poses", poses}}}},
+                   {"live", {{"connect_timeout_s", 0.3}, {"open_timeout_s", 1}}}};
+  testing::WriteText(dir + "/v2.json", v2.dump());
+  r = testing::RunFresco({"run", dir + "/v2.json", "--out", dir + "/out"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_THAT(r.err, HasSubstr(poses + ": cannot connect"));
   // Nothing is ever sent to the video port: opening times out.
   testing::WriteText(dir + "/poses.txt", "0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n");
   const std::string video = "udp://127.0.0.1:" + std::to_string(silent_udp);

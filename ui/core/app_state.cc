@@ -31,6 +31,10 @@ Status Apply(const std::vector<GroupSpec>& current, const GroupingEdit& edit, in
 Status AppState::Open(const std::string& path) {
   Project loaded;
   FRESCO_RETURN_IF_ERROR(LoadProject(path, {}, &loaded));
+  FRESCO_RETURN_IF_ERROR(CheckOneStream(loaded, "the app"));
+  // The app edits one stream as version-1 keys: a version-2 file's one stream is saved back
+  // as version 1 (the same project).
+  loaded = loaded.ForStream(0);
   project = loaded;
   has_project = true;
   dirty = false;
