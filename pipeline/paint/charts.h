@@ -4,8 +4,8 @@
 // 1. Region growing from the largest unassigned triangle; a neighbour joins when its normal
 //    is within `angle_deg` of the chart's area-weighted mean normal (a cone that follows the
 //    chart, not the seed, so noise averages out), within the stretch bound of the seed's
-//    normal (so a slowly curving surface cannot drift around), and while the chart stays
-//    under `max_chart_texels` (a bigger buffer would get coarser texels).
+//    normal (so a slowly curving surface cannot drift around), and while the chart's area
+//    stays under `max_chart_texels` texels (a bigger buffer would get coarser texels).
 // 2. Charts under `min_chart_texels` are merged, smallest first, into the neighbour they
 //    share the most edges with, when the merged chart's plane sees every triangle of the
 //    small chart (and the larger chart's worst one) with a texel stretch 1 / cos(angle) of at
