@@ -8,7 +8,7 @@ namespace fresco {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> kCommands = {
       {"run", "paint a project's video onto its model (headless)", RunVerbRun},
-      {"render", "render a (painted or original) glTF model through a camera", RunVerbRender},
+      {"render", "render a (painted or original) glTF, PLY or OBJ model through a camera", RunVerbRender},
       {"synth", "make a synthetic capture from a glTF scene", RunVerbSynth},
       {"group", "show, or store in the project, the base-buffer grouping", RunVerbGroup},
       {"calib", "calibrate camera intrinsics from board images (mrcal)", RunVerbCalib},

@@ -1,5 +1,6 @@
-// `fresco render MODEL.gltf --camera CAMERA --poses POSES --out DIR [options]`: renders a glTF
-// model through a camera (full lens model) at every pose, one RGBA PNG per pose (CONTRACT.md).
+// `fresco render MODEL --camera CAMERA --poses POSES --out DIR [options]`: renders a model
+// (glTF, PLY or OBJ) through a camera (full lens model) at every pose, one RGBA PNG per pose
+// (CONTRACT.md).
 // Everything is read and checked before the first image is written, so bad input never
 // leaves a partial output; every image is written atomically (temp file + rename).
 #include <algorithm>
@@ -35,9 +36,10 @@ namespace fs = std::filesystem;
 constexpr double kMaxSamplesPerImage = 1 << 26;
 
 const char kHelp[] =
-    R"(Renders MODEL (glTF 2.0: .gltf or .glb) through CAMERA at every pose of POSES and writes
-DIR/NAME.png per pose: 8-bit RGBA at the camera's image size, alpha 255 where a surface
-with texture alpha >= 0.5 is seen and 0 elsewhere. Deterministic, CPU only, no display.
+    R"(Renders MODEL (glTF 2.0 .gltf/.glb, PLY .ply or OBJ .obj) through CAMERA at every pose of
+POSES and writes DIR/NAME.png per pose: 8-bit RGBA at the camera's image size, alpha 255
+where a surface with texture alpha >= 0.5 is seen and 0 elsewhere. Deterministic, CPU only,
+no display.
 
   CAMERA   an mrcal .cameramodel or a COLMAP cameras.txt (each image uses its CAMERA_ID;
            a single camera serves every pose)
@@ -135,7 +137,7 @@ struct Job {
 
 int RunVerbRender(const CommandArgs& args) {
   ArgSpec spec;
-  spec.usage = "fresco render MODEL.gltf --camera CAMERA --poses POSES --out DIR [options]";
+  spec.usage = "fresco render MODEL --camera CAMERA --poses POSES --out DIR [options]";
   spec.help = kHelp;
   spec.min_positional = 1;
   spec.max_positional = 1;
@@ -256,7 +258,7 @@ int RunVerbRender(const CommandArgs& args) {
   // Scene.
   Scene scene;
   {
-    const Status loaded = LoadGltfScene(model_path, SceneLoadOptions(), &scene);
+    const Status loaded = LoadScene(model_path, SceneLoadOptions(), &scene);
     if (!loaded.ok()) return InputError(loaded);
   }
 

@@ -42,7 +42,7 @@ ArgSpec SynthArgSpec() {
       "  --scene SCENE       builtin:cube-room (4x3x4 m room, the paper's fig. 8),\n"
       "                      builtin:street (facades and a street), builtin:plane,\n"
       "                      builtin:cube, builtin:blocks (boxes on a ground, for\n"
-      "                      COLMAP), or a glTF file (.gltf/.glb)\n"
+      "                      COLMAP), or a scene file (.gltf/.glb, .ply, .obj)\n"
       "  --out DIR           output folder (default: the spec's \"out\")\n"
       "  --frames N          number of frames (default 60)\n"
       "  --size WxH          image size in pixels (default 640x480)\n"

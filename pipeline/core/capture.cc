@@ -150,7 +150,7 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
 
   if (options.load_scene) {
     FRESCO_RETURN_IF_ERROR(
-        LoadGltfScene(project.Resolve(project.scene), SceneLoadOptions(), &result.scene));
+        LoadScene(project.Resolve(project.scene), SceneLoadOptions(), &result.scene));
   }
   FRESCO_RETURN_IF_ERROR(ReadCameras(project.Resolve(stream.camera), &result.cameras));
   if (!IsUrlOrDevice(stream.poses)) {  // live poses (tcp://) arrive while running

@@ -1,5 +1,6 @@
 // A triangle scene loaded from glTF 2.0 (via tinygltf): all primitives of all nodes of the
-// default scene, flattened into one triangle mesh with node transforms applied. Vertices are
+// default scene, flattened into one triangle mesh with node transforms applied; or from PLY
+// or OBJ (mesh_scene.h; LoadScene picks the reader by extension). Vertices are
 // stored relative to a local origin (`origin_in_world`) so that map-scale coordinates
 // (~1e6 m) keep their precision: world = local + origin_in_world.
 #pragma once
@@ -62,10 +63,10 @@ struct Scene {
   std::vector<Texture> textures;
   Eigen::Vector3d origin_in_world = Eigen::Vector3d::Zero();
   std::string source_path;
-  // Filled by LoadGltfScene (informational; not written by SaveGltfScene).
+  // Filled by the loaders (informational; not written by SaveGltfScene).
   int dropped_degenerate = 0;         // triangles dropped: area < min_triangle_area_m2
   int skipped_primitives = 0;         // points / lines primitives (not triangles), skipped
-  std::vector<std::string> warnings;  // one line each (tinygltf warnings, skipped parts)
+  std::vector<std::string> warnings;  // one line each (reader warnings, skipped parts)
 
   Eigen::Vector3d LocalFromWorld(const Eigen::Vector3d& p) const { return p - origin_in_world; }
   Eigen::Vector3d WorldFromLocal(const Eigen::Vector3d& p) const { return p + origin_in_world; }
@@ -79,6 +80,11 @@ struct SceneLoadOptions {
   // Local origin: the centre of the bounding box when true, (0,0,0) when false.
   bool recentre = true;
 };
+
+// Loads a scene file by its extension (case-insensitive): `.gltf`/`.glb` with LoadGltfScene,
+// `.ply`/`.obj` with LoadMeshScene (mesh_scene.h); any other extension is an error naming the
+// file and the formats read. Defined in mesh_scene.cc.
+Status LoadScene(const std::string& path, const SceneLoadOptions& options, Scene* scene);
 
 // Loads `.gltf` (with its .bin and images) or `.glb`. Errors name the file and what is wrong
 // (missing file, parse error, out-of-range indices, no triangles).

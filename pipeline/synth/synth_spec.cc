@@ -160,7 +160,7 @@ Status BuildScene(const json& value, const std::string& file, const std::string&
     } else {
       const std::string path = Resolve(base_dir, s);
       if (!fs::is_regular_file(path)) return top.Error("scene", "no such file: " + path);
-      FRESCO_RETURN_IF_ERROR(LoadGltfScene(path, SceneLoadOptions(), &job->scene));
+      FRESCO_RETURN_IF_ERROR(LoadScene(path, SceneLoadOptions(), &job->scene));
       job->scene_source = path;
       job->texture_files.assign(job->scene.textures.size(), "");
       info->kind = SceneKind::kObject;
@@ -173,7 +173,7 @@ Status BuildScene(const json& value, const std::string& file, const std::string&
     }
     builtin = value["builtin"].get<std::string>();
   } else {
-    return top.Error("scene", "must be \"builtin:NAME\", a glTF path or an object");
+    return top.Error("scene", "must be \"builtin:NAME\", a scene file path or an object");
   }
   ObjectReader r(object ? *object : kEmpty, "scene", file);
   std::string ignored;
@@ -490,7 +490,7 @@ Status BuildSynthJob(const SynthSpecInput& input, SynthJob* job) {
 
   // Scene first: the defaults depend on it.
   const json* scene = r.Get("scene");
-  if (!scene) return r.Error("scene", "missing (e.g. \"builtin:cube-room\" or a glTF file)");
+  if (!scene) return r.Error("scene", "missing (e.g. \"builtin:cube-room\" or a glTF, PLY or OBJ file)");
   SceneInfo info;
   FRESCO_RETURN_IF_ERROR(BuildScene(*scene, file, input.base_dir, job, &info));
   if (const json* mesh = r.Get("mesh")) {

@@ -1,5 +1,5 @@
 // What to synthesize, from a JSON spec file and/or the command line: the scene (a built-in
-// procedural scene or a glTF file) and every SynthOptions setting, with defaults that fit the
+// procedural scene or a glTF, PLY or OBJ file) and every SynthOptions setting, with defaults that fit the
 // scene (a hand-held walk inside the room, a walk down the street, an orbit around an
 // object). Parsing is strict: an unknown key, a wrong type or a bad value is an error that
 // names the spec file and the field.
@@ -63,7 +63,7 @@ struct SynthSpecInput {
 
 struct SynthJob {
   Scene scene;
-  std::string scene_source;  // "builtin:cube-room", ... or the glTF file
+  std::string scene_source;  // "builtin:cube-room", ... or the scene file
   // Per scene texture: the image file it was made from (absolute), "" when procedural or
   // loaded from glTF. ExportSynthScene points the written glTF at these files.
   std::vector<std::string> texture_files;

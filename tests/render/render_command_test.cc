@@ -195,7 +195,7 @@ TEST(RenderCommandTest, TumPosesAreNumberedInOrder) {
 TEST(RenderCommandTest, HelpAndUsage) {
   const CommandResult help = RunFresco({"render", "--help"});
   EXPECT_EQ(help.exit_code, 0);
-  EXPECT_NE(help.out.find("fresco render MODEL.gltf --camera CAMERA --poses POSES --out DIR"),
+  EXPECT_NE(help.out.find("fresco render MODEL --camera CAMERA --poses POSES --out DIR"),
             std::string::npos);
   const CommandResult missing = RunFresco({"render", "x.gltf", "--camera", "c.txt"});
   EXPECT_EQ(missing.exit_code, 2);
