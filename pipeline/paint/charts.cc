@@ -41,39 +41,64 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
   const std::vector<double>& areas = facts.areas;
   const std::vector<int>& order = facts.by_decreasing_area;
 
-  // 1. Region growing.
+  // 1. Region growing, in rounds: a chart's mean normal moves as it grows, so triangles that
+  // end up beyond the stretch bound of the final mean leave it and seed charts of their own
+  // in the next round (the last round keeps what it grows).
   std::vector<Chart> charts;
   std::vector<int> chart_of(n, -1);
   std::deque<int> queue;
-  for (int seed : order) {
-    if (chart_of[seed] >= 0 || areas[seed] <= 0.0) continue;
-    const int c = static_cast<int>(charts.size());
-    charts.emplace_back();
-    Chart& chart = charts.back();
-    const Eigen::Vector3d seed_normal = normals[seed];
-    chart_of[seed] = c;
-    queue.assign(1, seed);
-    while (!queue.empty()) {
-      const int t = queue.front();
-      queue.pop_front();
-      chart.triangles.push_back(t);
-      chart.normal_sum += normals[t] * areas[t];
-      chart.area += areas[t];
-      const Eigen::Vector3d mean = chart.Normal();
-      for (const auto& edge : adjacency.edge_neighbours[t]) {
-        for (int nb : edge) {
-          if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
-          if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
-            continue;
-          if (chart.area + areas[nb] > max_area) continue;
-          chart_of[nb] = c;
-          queue.push_back(nb);
+  constexpr int kRounds = 4;
+  for (int round = 0; round < kRounds; ++round) {
+    bool evicted = false;
+    for (int seed : order) {
+      if (chart_of[seed] >= 0 || areas[seed] <= 0.0) continue;
+      const int c = static_cast<int>(charts.size());
+      charts.emplace_back();
+      Chart& chart = charts.back();
+      const Eigen::Vector3d seed_normal = normals[seed];
+      chart_of[seed] = c;
+      queue.assign(1, seed);
+      while (!queue.empty()) {
+        const int t = queue.front();
+        queue.pop_front();
+        chart.triangles.push_back(t);
+        chart.normal_sum += normals[t] * areas[t];
+        chart.area += areas[t];
+        const Eigen::Vector3d mean = chart.Normal();
+        for (const auto& edge : adjacency.edge_neighbours[t]) {
+          for (int nb : edge) {
+            if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
+            if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
+              continue;
+            if (chart.area + areas[nb] > max_area) continue;
+            chart_of[nb] = c;
+            queue.push_back(nb);
+          }
         }
       }
+      if (round + 1 < kRounds) {
+        const Eigen::Vector3d mean = chart.Normal();
+        auto beyond = [&](int t) { return normals[t].dot(mean) < cos_stretch; };
+        for (int t : chart.triangles) {
+          if (!beyond(t)) continue;
+          chart_of[t] = -1;
+          chart.normal_sum -= normals[t] * areas[t];
+          chart.area -= areas[t];
+          evicted = true;
+        }
+        chart.triangles.erase(std::remove_if(chart.triangles.begin(), chart.triangles.end(), beyond),
+                              chart.triangles.end());
+      }
+      if (chart.triangles.empty()) {  // cannot happen (the seed is within the bound), but
+        chart.alive = false;           // an empty chart must not be used
+        continue;
+      }
+      const Eigen::Vector3d mean = chart.Normal();
+      chart.worst = *std::min_element(
+          chart.triangles.begin(), chart.triangles.end(),
+          [&](int a, int b) { return normals[a].dot(mean) < normals[b].dot(mean); });
     }
-    const Eigen::Vector3d mean = chart.Normal();
-    chart.worst = *std::min_element(chart.triangles.begin(), chart.triangles.end(),
-                                    [&](int a, int b) { return normals[a].dot(mean) < normals[b].dot(mean); });
+    if (!evicted) break;
   }
 
   // 2. Small charts into a neighbour.

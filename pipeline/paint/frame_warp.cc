@@ -357,6 +357,25 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
   return b;
 }
 
+bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d& bounds_max,
+                       const FrameView& view, double near_m) {
+  int behind = 0, left = 0, right = 0, top = 0, bottom = 0;
+  const NormalizedBounds& b = view.bounds;
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner((c & 1) ? bounds_max.x() : bounds_min.x(),
+                                 (c & 2) ? bounds_max.y() : bounds_min.y(),
+                                 (c & 4) ? bounds_max.z() : bounds_min.z());
+    const Eigen::Vector3d p = view.cam_from_local * corner;
+    behind += p.z() <= near_m;
+    left += p.x() < b.x_min * p.z();
+    right += p.x() > b.x_max * p.z();
+    top += p.y() < b.y_min * p.z();
+    bottom += p.y() > b.y_max * p.z();
+  }
+  if (behind == 8) return true;
+  return b.valid && (left == 8 || right == 8 || top == 8 || bottom == 8);
+}
+
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
                        WarpedBuffer* warped) {
   const int w = buffer.width, h = buffer.height;

@@ -67,6 +67,11 @@ struct WarpedBuffer {
   }
 };
 
+// True when the box (local coordinates) lies wholly behind the near plane or beyond one side
+// of the view frustum: nothing in it can be seen.
+bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d& bounds_max,
+                       const FrameView& view, double near_m);
+
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view,
                        const WarpOptions& options, WarpedBuffer* warped);
 

@@ -144,6 +144,34 @@ const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
   return cameras_.back();
 }
 
+// The indices where `flags` is true.
+static std::vector<size_t> Indices(const std::vector<bool>& flags) {
+  std::vector<size_t> out;
+  for (size_t i = 0; i < flags.size(); ++i)
+    if (flags[i]) out.push_back(i);
+  return out;
+}
+
+void PaintSession::ForEachBuffer(const std::vector<size_t>& todo, bool serial,
+                                 const std::function<void(size_t)>& fn) const {
+  // A buffer of this many chunks (16 x 16 texels each) keeps both cores busy on its own.
+  constexpr size_t kLargeBufferChunks = 64;
+  std::vector<size_t> small;
+  for (size_t b : todo) {
+    if (serial || set_.buffers[b].chunks.size() >= kLargeBufferChunks)
+      fn(b);  // parallel inside
+    else
+      small.push_back(b);
+  }
+  // Small buffers one per task: their own parallel loops run inline (OpenCV does not nest).
+  cv::parallel_for_(
+      cv::Range(0, static_cast<int>(small.size())),
+      [&](const cv::Range& range) {
+        for (int i = range.start; i < range.end; ++i) fn(small[i]);
+      },
+      static_cast<double>(small.size()));
+}
+
 void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
                               const Rigid3d& cam_from_world, FrameReport* report) {
   const auto frame_start = std::chrono::steady_clock::now();
@@ -199,18 +227,16 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   long long in_view = 0, visible = 0, occluded = 0, grazing = 0, buffers_seen = 0;
   long long tested = 0, chunks_culled = 0;
   std::vector<bool> seen(set_.buffers.size(), false);
-  for (size_t b = 0; b < set_.buffers.size(); ++b) {
-    const BaseBuffer& buffer = set_.buffers[b];
-    // Cull buffers entirely behind the camera.
-    bool any_in_front = false;
-    for (int c = 0; c < 8 && !any_in_front; ++c) {
-      const Eigen::Vector3d corner((c & 1) ? buffer.bounds_max.x() : buffer.bounds_min.x(),
-                                   (c & 2) ? buffer.bounds_max.y() : buffer.bounds_min.y(),
-                                   (c & 4) ? buffer.bounds_max.z() : buffer.bounds_min.z());
-      any_in_front = (cam_from_local * corner).z() > warp_options.near_m;
-    }
-    if (!any_in_front) continue;
-    WarpFrameToBuffer(buffer, view, warp_options, &warped_[b]);
+  // Buffers whose bounds lie outside the view frustum are skipped whole (no work, not even
+  // clearing their warped images: later stages look only at buffers seen).
+  std::vector<size_t> in_frustum;
+  for (size_t b = 0; b < set_.buffers.size(); ++b)
+    if (!BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view,
+                           warp_options.near_m))
+      in_frustum.push_back(b);
+  ForEachBuffer(in_frustum, false,
+                [&](size_t b) { WarpFrameToBuffer(set_.buffers[b], view, warp_options, &warped_[b]); });
+  for (size_t b : in_frustum) {
     in_view += warped_[b].in_view;
     visible += warped_[b].visible;
     occluded += warped_[b].occluded;
@@ -228,6 +254,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
       }
     }
   }
+  warp_report.metrics["buffers_culled"] = static_cast<double>(set_.buffers.size() - in_frustum.size());
   warp_report.metrics["texels_in_view"] = static_cast<double>(in_view);
   warp_report.metrics["texels_visible"] = static_cast<double>(visible);
   warp_report.metrics["texels_occluded"] = static_cast<double>(occluded);
@@ -259,15 +286,18 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   paint_report.name = "paint";
   long long written = 0, rejected = 0, compared = 0;
   double difference_sum = 0;
-  for (size_t b = 0; b < set_.buffers.size(); ++b) {
-    if (!seen[b]) continue;
+  const std::vector<size_t> seen_list = Indices(seen);
+  std::vector<PaintUpdateStats> paint_stats(set_.buffers.size());
+  ForEachBuffer(seen_list, false, [&](size_t b) {
     const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
                              ? cv::Mat()
                              : background_frame_[b].foreground;
-    const PaintUpdateStats stats =
-        PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
+    paint_stats[b] = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
     if (!background_.empty())
       MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
+  });
+  for (size_t b : seen_list) {
+    const PaintUpdateStats& stats = paint_stats[b];
     written += stats.written;
     rejected += stats.rejected;
     compared += stats.compared;
@@ -511,10 +541,12 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool 
     gain = histogram.MedianGain();
   }
   long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
-  for (size_t b = 0; b < set_.buffers.size(); ++b) {
-    if (!seen[b]) continue;
-    BackgroundFrame& frame = background_frame_[b];
-    background_[b].Update(set_.buffers[b], warped_[b], gain, debug, &frame);
+  const std::vector<size_t> seen_list = Indices(seen);
+  ForEachBuffer(seen_list, false, [&](size_t b) {
+    background_[b].Update(set_.buffers[b], warped_[b], gain, debug, &background_frame_[b]);
+  });
+  for (size_t b : seen_list) {
+    const BackgroundFrame& frame = background_frame_[b];
     observed += frame.observed, raw += frame.foreground_raw, masked += frame.masked;
     warming += frame.warming_up, blobs += frame.blobs_removed;
     if (debug) {

@@ -13,6 +13,7 @@
 // FrameReport that the CLI and the GUI both consume.
 #pragma once
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -99,6 +100,11 @@ class PaintSession {
     NormalizedBounds bounds;
   };
   const CameraCache& CacheFor(const Camera& camera);
+  // Runs fn(b) for every buffer in `todo` (each b at most once, buffers independent): large
+  // buffers one after the other (each runs in parallel inside), the many small ones of a
+  // charted photogrammetry mesh spread over the threads. `serial`: all in order.
+  void ForEachBuffer(const std::vector<size_t>& todo, bool serial,
+                     const std::function<void(size_t)>& fn) const;
   // The refinement stage over the buffers seen this frame (re-warps warped_).
   StageReport RefineAlignment(const std::vector<bool>& seen, bool debug);
   struct BufferRefinement;
