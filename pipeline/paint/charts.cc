@@ -23,6 +23,13 @@ struct Chart {
   }
 };
 
+// A triangle merged into a chart must face its plane at least this much (cos 84 degrees):
+// well away from edge-on, where its texels would fold or stretch without bound.
+constexpr double kMinMergeCos = 0.1;
+// A chart grown to the size limit still takes in its small neighbours up to this factor over
+// the limit (its buffer's texels then get at most 5 % coarser).
+constexpr double kMergeHeadroom = 1.1;
+
 }  // namespace
 
 Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
@@ -101,11 +108,16 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
     if (!evicted) break;
   }
 
-  // 2. Small charts into a neighbour.
-  if (texel_area > 0 && options.min_chart_texels > 0) {
+  // 2. Small charts into a neighbour, in passes (smallest first in each): a small chart that
+  // took in a smaller one may be merged itself in the next pass.
+  const bool merging = texel_area > 0 && options.min_chart_texels > 0;
+  bool merged_any = merging;
+  for (int pass = 0; pass < 8 && merged_any; ++pass) {
+    merged_any = false;
     const double min_area = options.min_chart_texels * texel_area;
-    std::vector<int> by_area(charts.size());
-    std::iota(by_area.begin(), by_area.end(), 0);
+    std::vector<int> by_area;
+    for (int c = 0; c < static_cast<int>(charts.size()); ++c)
+      if (charts[c].alive && charts[c].area < min_area) by_area.push_back(c);
     std::stable_sort(by_area.begin(), by_area.end(),
                      [&](int a, int b) { return charts[a].area < charts[b].area; });
     for (int c : by_area) {
@@ -121,19 +133,26 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
                        [](const auto& a, const auto& b) { return a.second > b.second; });
       for (const auto& [d, edges] : candidates) {
         Chart& big = charts[d];
-        if (small.area + big.area > max_area) continue;
+        if (small.area + big.area > kMergeHeadroom * max_area) continue;
         const Eigen::Vector3d merged = (small.normal_sum + big.normal_sum).normalized();
         if (!std::isfinite(merged.x())) continue;
-        bool ok = normals[big.worst].dot(merged) >= cos_stretch;
+        // The larger chart keeps its worst triangle within the bound; the small chart's
+        // triangles must face the plane (no fold: at most kMaxMergeAngle away) and stretch
+        // within the bound on average (by area): a noise spike of one triangle steeper than
+        // the bound goes with its neighbours instead of staying a chart of its own.
+        bool ok = normals[big.worst].dot(merged) >= std::min(cos_stretch, kMinMergeCos);
         int worst = big.worst;
+        double stretch_area = 0.0;
         for (int t : small.triangles) {
-          if (normals[t].dot(merged) < cos_stretch) {
+          const double c = normals[t].dot(merged);
+          if (c < kMinMergeCos) {
             ok = false;
             break;
           }
-          if (normals[t].dot(merged) < normals[worst].dot(merged)) worst = t;
+          stretch_area += areas[t] / c;
+          if (c < normals[worst].dot(merged)) worst = t;
         }
-        if (!ok) continue;
+        if (!ok || stretch_area > options.max_stretch * small.area) continue;
         for (int t : small.triangles) chart_of[t] = d;
         big.triangles.insert(big.triangles.end(), small.triangles.begin(), small.triangles.end());
         big.normal_sum += small.normal_sum;
@@ -141,6 +160,7 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
         big.worst = worst;
         small.alive = false;
         small.triangles.clear();
+        merged_any = true;
         break;
       }
     }

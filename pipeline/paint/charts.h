@@ -7,9 +7,11 @@
 //    normal (so a slowly curving surface cannot drift around), and while the chart's area
 //    stays under `max_chart_texels` texels (a bigger buffer would get coarser texels).
 // 2. Charts under `min_chart_texels` are merged, smallest first, into the neighbour they
-//    share the most edges with, when the merged chart's plane sees every triangle of the
-//    small chart (and the larger chart's worst one) with a texel stretch 1 / cos(angle) of at
-//    most `max_stretch`.
+//    share the most edges with, when the merged chart's plane sees the small chart's
+//    triangles with an area-weighted mean texel stretch 1 / cos(angle) of at most
+//    `max_stretch`, each of them within 84 degrees (no fold), and the larger chart's worst
+//    triangle still within the bound. (Single noise spikes steeper than the bound so join
+//    their neighbours: MeasureChartStretch reports the largest stretch as it is.)
 // The chart count then follows the surface's shape, not its triangle count. Charts that
 // would still fold in their plane are split when their buffers are built (base_buffer.h).
 #pragma once
