@@ -38,10 +38,11 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
   const double cos_cone = std::cos(options.angle_deg * M_PI / 180.0);
   const double cos_stretch = 1.0 / options.max_stretch;
   const double texel_area = scale.texel_size_m * scale.texel_size_m;
-  // Growth stops at the largest buffer's texels (a chart whose bounding rectangle in its
-  // plane holds more gets slightly coarser texels, base_buffer.h).
+  // Growth stops at 4x the largest buffer's texels: a bigger chart gets texels at most ~2x
+  // coarser (base_buffer.h) before it is split, so a planar model's faces stay one chart
+  // each (as in the paper) while a photogrammetry mesh's ground does not lose its detail.
   const double max_area = texel_area > 0 && scale.max_chart_texels > 0
-                              ? static_cast<double>(scale.max_chart_texels) * texel_area
+                              ? 4.0 * static_cast<double>(scale.max_chart_texels) * texel_area
                               : std::numeric_limits<double>::infinity();
   const TriangleFacts facts = ComputeTriangleFacts(mesh);
   const std::vector<Eigen::Vector3d>& normals = facts.normals;

@@ -5,7 +5,7 @@
 //    is within `angle_deg` of the chart's area-weighted mean normal (a cone that follows the
 //    chart, not the seed, so noise averages out), within the stretch bound of the seed's
 //    normal (so a slowly curving surface cannot drift around), and while the chart's area
-//    stays under `max_chart_texels` texels (a bigger buffer would get coarser texels).
+//    stays under 4 x `max_chart_texels` texels (a bigger buffer gets coarser texels).
 // 2. Charts under `min_chart_texels` are merged, smallest first, into the neighbour they
 //    share the most edges with, when the merged chart's plane sees the small chart's
 //    triangles with an area-weighted mean texel stretch 1 / cos(angle) of at most
