@@ -146,6 +146,7 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
     const int index = frames++;
     const PosedImage* pose = capture.PoseForFrame(frame);
     if (!pose || !capture.CameraFor(*pose)) continue;
+    FRESCO_RETURN_IF_ERROR(CheckFrameSize(frame, *capture.CameraFor(*pose), project.Resolve(project.video)));
     if (holdout > 0 && index % holdout == holdout / 2) {
       const size_t k = pose - capture.poses.data();
       const PosedImage* truth = k < capture.truth_poses.size() ? &capture.truth_poses[k] : nullptr;

@@ -322,13 +322,9 @@ int RunVerbRun(const CommandArgs& argv) {
       continue;
     }
     const Camera* camera = loop_frame.camera;
-    if (frame.bgr.cols != camera->width || frame.bgr.rows != camera->height) {
-      return InputError(
-          Status::Error(project.Resolve(specs[loop_frame.stream].video) + ": frame '" + frame.name +
-                        "' is " + std::to_string(frame.bgr.cols) + "x" +
-                        std::to_string(frame.bgr.rows) + " but the camera is " +
-                        std::to_string(camera->width) + "x" + std::to_string(camera->height)));
-    }
+    if (Status s = CheckFrameSize(frame, *camera, project.Resolve(specs[loop_frame.stream].video));
+        !s.ok())
+      return InputError(s);
     if (!record_dir.empty())
       if (Status s = recorder.Add(frame, loop_frame.posed.cam_from_world); !s.ok())
         return InputError(s);

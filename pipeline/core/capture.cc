@@ -192,4 +192,11 @@ Status LoadStreamCaptures(const Project& project, const CaptureLoadOptions& opti
   return Status::Ok();
 }
 
+Status CheckFrameSize(const Frame& frame, const Camera& camera, const std::string& video) {
+  if (frame.bgr.cols == camera.width && frame.bgr.rows == camera.height) return Status::Ok();
+  return Status::Error(video + ": frame '" + frame.name + "' is " + std::to_string(frame.bgr.cols) +
+                       "x" + std::to_string(frame.bgr.rows) + " but the camera is " +
+                       std::to_string(camera.width) + "x" + std::to_string(camera.height));
+}
+
 }  // namespace fresco

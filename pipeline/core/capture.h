@@ -51,6 +51,11 @@ struct CaptureLoadOptions {
 
 // Loads the scene (when asked) and one video stream's cameras, poses and video.
 Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Capture* capture);
+
+// A frame must have its camera's size (painting samples it through the camera's rays): an
+// error "VIDEO: frame 'NAME' is WxH but the camera is WxH" otherwise. `fresco run`, `fresco
+// bench` and the app all stop on it.
+Status CheckFrameSize(const Frame& frame, const Camera& camera, const std::string& video);
 // Every video stream of the project, in order: the scene is loaded once, into (*streams)[0]
 // (the others' scenes stay empty); each stream's files as LoadCapture loads them.
 Status LoadStreamCaptures(const Project& project, const CaptureLoadOptions& options,

@@ -74,5 +74,21 @@ TEST_F(BenchCommandTest, BadSweepsAreRefusedBeforeAnyRun) {
   EXPECT_FALSE(fs::exists(out + "/bench.json"));
 }
 
+// A frame of another size than its camera: exit 2 naming the frame, as `fresco run` does (it
+// used to crash bench).
+TEST_F(BenchCommandTest, FrameOfTheWrongSizeExits2NamingIt) {
+  const std::string dir = MakeTempDir("bench-frame-size") + "/capture";
+  fs::copy(*capture_, dir, fs::copy_options::recursive);
+  for (const auto& entry : fs::directory_iterator(dir + "/frames"))  // all: the video is
+    cv::imwrite(entry.path().string(), cv::Mat(60, 80, CV_8UC3, cv::Scalar(1, 2, 3)));  // consistent
+  const std::string out = MakeTempDir("bench-frame-size-out") + "/out";
+  const auto r = RunFresco({"bench", dir + "/project.json", "--out", out, "--sweep",
+                            "pipeline.sampling=nearest", "--no-baseline", "--quiet"});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("' is 80x60 but the camera is 160x120"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out + "/bench.json"));
+}
+
 }  // namespace
 }  // namespace fresco::testing

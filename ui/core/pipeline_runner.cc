@@ -181,14 +181,23 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   ++s.next_frame;
   working_.frame = frame.index;
   working_.frame_name = frame.name;
-  working_.has_pose =
-      posed.has_pose && frame.bgr.cols == camera->width && frame.bgr.rows == camera->height;
+  // A frame of another size than its camera ends the session with that error, as in `fresco
+  // run` and `fresco bench`.
+  if (posed.has_pose) {
+    const Status size = CheckFrameSize(
+        frame, *camera, s.live ? std::string("the live video") : s.project.Resolve(s.project.video));
+    if (!size.ok()) {
+      s.ended = true;
+      s.end_message = "error: " + size.message();
+      return Painted::kEnded;
+    }
+  }
+  working_.has_pose = posed.has_pose;
   if (show) working_.frame_bgr = frame.bgr.clone();
   if (!working_.has_pose) {
     working_.report = FrameReport();
     working_.report.frame = frame.index;
-    working_.report.skipped_reason =
-        posed.has_pose ? "frame size differs from the camera" : "no pose";
+    working_.report.skipped_reason = "no pose";
     return Painted::kFrame;
   }
   if (s.live) {
