@@ -1,0 +1,122 @@
+// End-to-end painting throughput against the memory-bound floor: texels x frames per second
+// of the painting loop (depth test, project, sample, update; background and refinement off)
+// against OpenCV's cv::remap doing only the bilinear gather of the same buffers' texels from
+// the same frames (maps precomputed, not timed), both on 2 threads, on a 640x480 street walk
+// with OpenCV5 distortion (`fresco synth` builtin:street, 30 frames):
+//   BM_PaintStreet   items/s = surface texels x frames / painting seconds
+//   BM_RemapStreet   items/s = the same texels x frames / remap seconds (the remap gathers
+//                    only the texels each frame sees: the painting culls the rest too)
+//   build/tests/throughput_bench --benchmark_min_time=2
+#include <benchmark/benchmark.h>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/render/renderer.h"
+#include "pipeline/synth/synth_spec.h"
+#include "pipeline/synth/synthesize.h"
+
+namespace fresco {
+namespace {
+
+struct Street {
+  SynthJob job;
+  SynthCapture capture;
+  PipelineOptions pipeline;
+  bool ok = false;
+
+  Street() {
+    SynthSpecInput input;
+    input.text = R"({"scene": "builtin:street", "frames": 30, "size": [640, 480],
+                     "lens": "opencv5", "seed": 3})";
+    if (!BuildSynthJob(input, &job).ok()) return;
+    if (!SynthesizeCapture(job.scene, job.options, &capture).ok()) return;
+    pipeline.background.mode = BackgroundMode::kOff;
+    pipeline.refine.mode = RefineMode::kOff;
+    ok = true;
+  }
+  std::unique_ptr<PaintSession> Session() const {
+    PaintSessionInputs inputs;
+    inputs.scene = &job.scene;
+    inputs.pipeline = pipeline;
+    inputs.typical_camera = &capture.camera;
+    for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
+    std::unique_ptr<PaintSession> session;
+    if (!PaintSession::Create(inputs, &session).ok()) return nullptr;
+    return session;
+  }
+};
+
+const Street& TheStreet() {
+  static const Street* street = new Street();
+  return *street;
+}
+
+void BM_PaintStreet(benchmark::State& state) {
+  const Street& street = TheStreet();
+  if (!street.ok) return state.SkipWithError("synth failed");
+  cv::setNumThreads(2);
+  long long texels = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    std::unique_ptr<PaintSession> session = street.Session();
+    texels = session->NumSurfaceTexels();
+    state.ResumeTiming();
+    FrameReport report;
+    for (size_t i = 0; i < street.capture.frames_bgr.size(); ++i) {
+      Frame frame;
+      frame.index = static_cast<int>(i);
+      frame.bgr = street.capture.frames_bgr[i];
+      session->PaintFrame(frame, street.capture.camera, street.capture.true_poses[i].cam_from_world,
+                          &report);
+    }
+  }
+  state.SetItemsProcessed(state.iterations() * texels *
+                          static_cast<long long>(street.capture.frames_bgr.size()));
+  state.counters["texels"] = static_cast<double>(texels);
+}
+
+void BM_RemapStreet(benchmark::State& state) {
+  const Street& street = TheStreet();
+  if (!street.ok) return state.SkipWithError("synth failed");
+  cv::setNumThreads(2);
+  const std::unique_ptr<PaintSession> session = street.Session();
+  const Camera& camera = street.capture.camera;
+  // Per frame: where each texel of every buffer that the frame sees falls in it (texels
+  // outside the frame or behind the camera are left out, as the painting's culling leaves
+  // them out), as one compact map of rows of 1024.
+  std::vector<cv::Mat> maps(street.capture.frames_bgr.size());
+  long long gathered = 0;
+  for (size_t i = 0; i < maps.size(); ++i) {
+    const Rigid3d cam_from_local =
+        CamFromLocal(street.job.scene, street.capture.true_poses[i].cam_from_world);
+    std::vector<cv::Vec2f> pixels;
+    for (const BaseBuffer& b : session->buffers())
+      for (int k = 0; k < b.NumTexels(); ++k) {
+        if (!b.on_surface[k]) continue;
+        const Eigen::Vector3d p = cam_from_local * b.Point(k).cast<double>();
+        Eigen::Vector2d pixel;
+        if (p.z() <= 0 || !camera.Project(p, &pixel) || pixel.x() < 0 || pixel.y() < 0 ||
+            pixel.x() > camera.width - 1 || pixel.y() > camera.height - 1)
+          continue;
+        pixels.emplace_back(static_cast<float>(pixel.x()), static_cast<float>(pixel.y()));
+      }
+    gathered += static_cast<long long>(pixels.size());
+    pixels.resize((pixels.size() + 1023) / 1024 * 1024, cv::Vec2f(-1, -1));
+    maps[i] = cv::Mat(pixels, true).reshape(2, static_cast<int>(pixels.size() / 1024));
+  }
+  cv::Mat out;
+  for (auto _ : state)
+    for (size_t i = 0; i < maps.size(); ++i)
+      cv::remap(street.capture.frames_bgr[i], out, maps[i], cv::noArray(), cv::INTER_LINEAR,
+                cv::BORDER_CONSTANT);
+  state.counters["texels_in_view_per_frame"] = static_cast<double>(gathered) / maps.size();
+  state.SetItemsProcessed(state.iterations() * session->NumSurfaceTexels() *
+                          static_cast<long long>(maps.size()));
+}
+
+BENCHMARK(BM_PaintStreet)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RemapStreet)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace fresco
