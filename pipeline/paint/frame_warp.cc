@@ -92,23 +92,30 @@ struct KernelContext {
   float* out_quality;
 };
 
-// True when the chunk's bounding box lies wholly behind the near plane or outside one side
-// of the view frustum (all eight corners outside the same plane).
-bool ChunkCulled(const KernelContext& k, const BaseBuffer::Chunk& chunk) {
+// True when the box lies wholly behind the near plane or outside one side of the view
+// frustum (all eight corners outside the same plane); R, t map the box's frame to the camera.
+// Float for the chunks (per frame, many), double for whole buffers.
+template <class T>
+bool BoxOutsideView(const Eigen::Matrix<T, 3, 1>& lo, const Eigen::Matrix<T, 3, 1>& hi,
+                    const Eigen::Matrix<T, 3, 3>& R, const Eigen::Matrix<T, 3, 1>& t,
+                    const NormalizedBounds& bounds, T near_m) {
   int behind = 0, left = 0, right = 0, top = 0, bottom = 0;
   for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3f corner((c & 1) ? chunk.bounds_max.x() : chunk.bounds_min.x(),
-                                 (c & 2) ? chunk.bounds_max.y() : chunk.bounds_min.y(),
-                                 (c & 4) ? chunk.bounds_max.z() : chunk.bounds_min.z());
-    const Eigen::Vector3f p = k.R * corner + k.t;
-    behind += p.z() <= k.near_m;
-    left += p.x() < k.bounds.x_min * p.z();
-    right += p.x() > k.bounds.x_max * p.z();
-    top += p.y() < k.bounds.y_min * p.z();
-    bottom += p.y() > k.bounds.y_max * p.z();
+    const Eigen::Matrix<T, 3, 1> corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                                        (c & 4) ? hi.z() : lo.z());
+    const Eigen::Matrix<T, 3, 1> p = R * corner + t;
+    behind += p.z() <= near_m;
+    left += p.x() < bounds.x_min * p.z();
+    right += p.x() > bounds.x_max * p.z();
+    top += p.y() < bounds.y_min * p.z();
+    bottom += p.y() > bounds.y_max * p.z();
   }
   if (behind == 8) return true;
-  return k.bounds.valid && (left == 8 || right == 8 || top == 8 || bottom == 8);
+  return bounds.valid && (left == 8 || right == 8 || top == 8 || bottom == 8);
+}
+
+bool ChunkCulled(const KernelContext& k, const BaseBuffer::Chunk& chunk) {
+  return BoxOutsideView<float>(chunk.bounds_min, chunk.bounds_max, k.R, k.t, k.bounds, k.near_m);
 }
 
 // Pass 1, for a chunk of texels at once (SIMD: plain arithmetic over arrays, compiled for
@@ -359,21 +366,8 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
 
 bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d& bounds_max,
                        const FrameView& view, double near_m) {
-  int behind = 0, left = 0, right = 0, top = 0, bottom = 0;
-  const NormalizedBounds& b = view.bounds;
-  for (int c = 0; c < 8; ++c) {
-    const Eigen::Vector3d corner((c & 1) ? bounds_max.x() : bounds_min.x(),
-                                 (c & 2) ? bounds_max.y() : bounds_min.y(),
-                                 (c & 4) ? bounds_max.z() : bounds_min.z());
-    const Eigen::Vector3d p = view.cam_from_local * corner;
-    behind += p.z() <= near_m;
-    left += p.x() < b.x_min * p.z();
-    right += p.x() > b.x_max * p.z();
-    top += p.y() < b.y_min * p.z();
-    bottom += p.y() > b.y_max * p.z();
-  }
-  if (behind == 8) return true;
-  return b.valid && (left == 8 || right == 8 || top == 8 || bottom == 8);
+  return BoxOutsideView<double>(bounds_min, bounds_max, view.cam_from_local.RotationMatrix(),
+                                view.cam_from_local.translation, view.bounds, near_m);
 }
 
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
