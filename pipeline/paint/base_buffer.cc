@@ -211,23 +211,40 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       chunk.y1 = std::min(tj + tile, h);
       chunk.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
       chunk.bounds_max = -chunk.bounds_min;
-      for (int j = tj; j < std::min(tj + tile, h); ++j) {
-        for (int i = ti; i < std::min(ti + tile, w); ++i) {
+      const int j1 = std::min(tj + tile, h), i1 = std::min(ti + tile, w);
+      for (int j = tj; j < j1; ++j) {
+        for (int i = ti; i < i1; ++i) {
+          const size_t idx = static_cast<size_t>(j) * w + i;
+          if (owner[idx] < 0) continue;
+          chunk.bounds_min = chunk.bounds_min.cwiseMin(point[idx]);
+          chunk.bounds_max = chunk.bounds_max.cwiseMax(point[idx]);
+        }
+      }
+      chunk.point_step = (chunk.bounds_max - chunk.bounds_min) / 65535.0f;
+      for (int j = tj; j < j1; ++j) {
+        for (int i = ti; i < i1; ++i) {
           const size_t idx = static_cast<size_t>(j) * w + i;
           if (owner[idx] < 0) continue;
           buffer.texel_index.push_back(static_cast<int32_t>(idx));
+          const auto quantize_point = [&](int axis) {
+            const float step = chunk.point_step[axis];
+            if (!(step > 0.0f)) return uint16_t{0};
+            const float q = (point[idx][axis] - chunk.bounds_min[axis]) / step;
+            return static_cast<uint16_t>(std::clamp(std::lround(q), 0L, 65535L));
+          };
+          buffer.point_qx.push_back(quantize_point(0));
+          buffer.point_qy.push_back(quantize_point(1));
+          buffer.point_qz.push_back(quantize_point(2));
           const Eigen::Vector3d n = mesh.Normal(owner[idx]);
-          buffer.point_x.push_back(point[idx].x());
-          buffer.point_y.push_back(point[idx].y());
-          buffer.point_z.push_back(point[idx].z());
-          buffer.normal_x.push_back(static_cast<float>(n.x()));
-          buffer.normal_y.push_back(static_cast<float>(n.y()));
-          buffer.normal_z.push_back(static_cast<float>(n.z()));
-          buffer.triangle.push_back(owner[idx]);
+          const auto quantize_normal = [](double value) {
+            return static_cast<int16_t>(
+                std::lround(std::clamp(value, -1.0, 1.0) * BaseBuffer::kNormalScale));
+          };
+          buffer.normal_qx.push_back(quantize_normal(n.x()));
+          buffer.normal_qy.push_back(quantize_normal(n.y()));
+          buffer.normal_qz.push_back(quantize_normal(n.z()));
           buffer.on_surface.push_back(surface[idx]);
           buffer.num_surface_texels += surface[idx];
-          chunk.bounds_min = chunk.bounds_min.cwiseMin(point[idx]);
-          chunk.bounds_max = chunk.bounds_max.cwiseMax(point[idx]);
         }
       }
       chunk.end = buffer.NumTexels();
@@ -238,6 +255,18 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
 }
 
 }  // namespace
+
+const BaseBuffer::Chunk& BaseBuffer::ChunkOf(int k) const {
+  const auto it = std::upper_bound(chunks.begin(), chunks.end(), k,
+                                   [](int texel, const Chunk& c) { return texel < c.begin; });
+  return *std::prev(it);
+}
+
+Eigen::Vector3f BaseBuffer::Point(int k) const {
+  const Chunk& c = ChunkOf(k);
+  return c.bounds_min +
+         Eigen::Vector3f(point_qx[k], point_qy[k], point_qz[k]).cwiseProduct(c.point_step);
+}
 
 Eigen::Vector2d BaseBuffer::TexelCoords(const Eigen::Vector3d& local_point) const {
   const Eigen::Vector3d d = local_point - origin;

@@ -134,14 +134,19 @@ struct ChunkProjection {
 
 template <bool kDistorted>
 __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext& k,
-                                                            const BaseBuffer& buffer, int begin,
-                                                            int n, ChunkProjection* out) {
-  const float* __restrict X = buffer.point_x.data() + begin;
-  const float* __restrict Y = buffer.point_y.data() + begin;
-  const float* __restrict Z = buffer.point_z.data() + begin;
-  const float* __restrict NX = buffer.normal_x.data() + begin;
-  const float* __restrict NY = buffer.normal_y.data() + begin;
-  const float* __restrict NZ = buffer.normal_z.data() + begin;
+                                                            const BaseBuffer& buffer,
+                                                            const BaseBuffer::Chunk& chunk,
+                                                            ChunkProjection* out) {
+  const int begin = chunk.begin, n = chunk.end - chunk.begin;
+  const uint16_t* __restrict QX = buffer.point_qx.data() + begin;
+  const uint16_t* __restrict QY = buffer.point_qy.data() + begin;
+  const uint16_t* __restrict QZ = buffer.point_qz.data() + begin;
+  const int16_t* __restrict QNX = buffer.normal_qx.data() + begin;
+  const int16_t* __restrict QNY = buffer.normal_qy.data() + begin;
+  const int16_t* __restrict QNZ = buffer.normal_qz.data() + begin;
+  const float bx = chunk.bounds_min.x(), by = chunk.bounds_min.y(), bz = chunk.bounds_min.z();
+  const float sx = chunk.point_step.x(), sy = chunk.point_step.y(), sz = chunk.point_step.z();
+  constexpr float kInvNormal = 1.0f / BaseBuffer::kNormalScale;
   float* __restrict u = out->u;
   float* __restrict v = out->v;
   float* __restrict zo = out->z;
@@ -169,13 +174,20 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   const float max_u_in = std::max(0.0f, max_u - 1.0f / 1024);
   const float max_v_in = std::max(0.0f, max_v - 1.0f / 1024);
   const float tol_rel = k.tol_rel, tol_abs = k.tol_abs, slope_px = k.slope_px;
+  constexpr float kEdgeSlackPx = 1.0f / 256;
   const float focal_texel = k.focal_texel;
   for (int i = 0; i < n; ++i) {
-    const float px = r00 * X[i] + r01 * Y[i] + r02 * Z[i] + tx;
-    const float py = r10 * X[i] + r11 * Y[i] + r12 * Z[i] + ty;
-    const float pz = r20 * X[i] + r21 * Y[i] + r22 * Z[i] + tz;
-    const float dx = ox - X[i], dy = oy - Y[i], dz = oz - Z[i];
-    const float nd = NX[i] * dx + NY[i] * dy + NZ[i] * dz;
+    const float X = bx + static_cast<float>(QX[i]) * sx;
+    const float Y = by + static_cast<float>(QY[i]) * sy;
+    const float Z = bz + static_cast<float>(QZ[i]) * sz;
+    const float NX = static_cast<float>(QNX[i]) * kInvNormal;
+    const float NY = static_cast<float>(QNY[i]) * kInvNormal;
+    const float NZ = static_cast<float>(QNZ[i]) * kInvNormal;
+    const float px = r00 * X + r01 * Y + r02 * Z + tx;
+    const float py = r10 * X + r11 * Y + r12 * Z + ty;
+    const float pz = r20 * X + r21 * Y + r22 * Z + tz;
+    const float dx = ox - X, dy = oy - Y, dz = oz - Z;
+    const float nd = NX * dx + NY * dy + NZ * dz;
     const float dd = dx * dx + dy * dy + dz * dz;
     // Branch-free (bitwise & on 0/1 ints, selects on floats) so that the loop vectorizes.
     const int front = pz > near_m;
@@ -198,11 +210,14 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
       vv = fy * (y * f + p1 * (r2 + 2.0f * y * y) + p2 * two_xy) + cy;
       inside_fold = r2 <= fold_r2;
     }
-    const int in_image = (uu >= 0.0f) & (vv >= 0.0f) & (uu <= max_u) & (vv <= max_v) & inside_fold;
+    // A texel centre projecting onto the border pixels' centres (a texel per pixel facing
+    // the camera) must not drop out for a rounding error: 1/256 px of slack, clamped back.
+    const int in_image = (uu >= -kEdgeSlackPx) & (vv >= -kEdgeSlackPx) &
+                         (uu <= max_u + kEdgeSlackPx) & (vv <= max_v + kEdgeSlackPx) & inside_fold;
     const int c = front * (1 - facing + 2 * facing * in_image);
     code[i] = c;
-    u[i] = c == 2 ? uu : 0.0f;  // inside the image wherever pass 2 looks
-    v[i] = c == 2 ? vv : 0.0f;
+    u[i] = c == 2 ? std::min(std::max(uu, 0.0f), max_u) : 0.0f;  // inside the image wherever
+    v[i] = c == 2 ? std::min(std::max(vv, 0.0f), max_v) : 0.0f;  // pass 2 looks
     const float uc = std::min(std::max(u[i], 0.0f), max_u_in);
     const float vc = std::min(std::max(v[i], 0.0f), max_v_in);
     const int xi = static_cast<int>(uc), yi = static_cast<int>(vc);
@@ -221,16 +236,16 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   }
 }
 
-__attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(const KernelContext& k,
-                                                                           const BaseBuffer& buffer,
-                                                                           int begin, int n,
-                                                                           ChunkProjection* out) {
-  ProjectChunkBody<false>(k, buffer, begin, n, out);
+__attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(
+    const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
+    ChunkProjection* out) {
+  ProjectChunkBody<false>(k, buffer, chunk, out);
 }
 
 __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
-    const KernelContext& k, const BaseBuffer& buffer, int begin, int n, ChunkProjection* out) {
-  ProjectChunkBody<true>(k, buffer, begin, n, out);
+    const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
+    ChunkProjection* out) {
+  ProjectChunkBody<true>(k, buffer, chunk, out);
 }
 
 // Pass 2, texel by texel for those in view: the depth test and the sample. Works on local
@@ -242,9 +257,9 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
   ChunkProjection proj;
   const int n = chunk.end - chunk.begin;
   if constexpr (kDistorted)
-    ProjectChunkDistorted(k, *k.buffer, chunk.begin, n, &proj);
+    ProjectChunkDistorted(k, *k.buffer, chunk, &proj);
   else
-    ProjectChunkPinhole(k, *k.buffer, chunk.begin, n, &proj);
+    ProjectChunkPinhole(k, *k.buffer, chunk, &proj);
 
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const float texel_size_m = static_cast<float>(k.buffer->texel_size_m);

@@ -24,6 +24,7 @@
 #include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 #include "tests/ui/headless_ui.h"
+#include "ui/core/orbit_frame.h"
 #include "ui/core/app_frame.h"
 #include "ui/core/calibration_runner.h"
 #include "ui/core/panel.h"
@@ -632,4 +633,52 @@ TEST(UiCli, PosesNeedsAProjectAndAKnownMode) {
 }
 
 }  // namespace
+// The 3D view's up: +Y for a capture of an upright glTF model (cameras level or tilted down
+// 30 degrees), the cameras' up for a reconstruction whose frame is the first camera's (up is
+// -Y there) or lies on its side; the orbit basis stays right-handed and orthonormal.
+TEST(OrbitFrame, UpComesFromTheCapturesCameras) {
+  const auto pose = [](const Eigen::Matrix3d& world_from_cam) {
+    Rigid3d p;
+    p.rotation = Eigen::Quaterniond(world_from_cam.transpose());
+    return p;
+  };
+  // A level camera in a Y-up world looking along -Z: camera x = X, y = -Y, z = -Z.
+  Eigen::Matrix3d level;
+  level.col(0) = Eigen::Vector3d::UnitX();
+  level.col(1) = -Eigen::Vector3d::UnitY();
+  level.col(2) = -Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix3d tilted =
+      Eigen::AngleAxisd(-30 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix() * level;
+  for (const Eigen::Matrix3d& r : {level, tilted}) {
+    const OrbitFrame f = OrbitFrameFromPoses({pose(r), pose(r)});
+    EXPECT_EQ(f.up, Eigen::Vector3f::UnitY());
+    EXPECT_EQ(f.front, Eigen::Vector3f::UnitZ());
+  }
+  // COLMAP-like: the world is the first camera's frame (identity), a second camera turned
+  // 20 degrees about the vertical: up is -Y, the front towards the cameras (-Z).
+  const Eigen::Matrix3d turned =
+      Eigen::AngleAxisd(20 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  const OrbitFrame colmap = OrbitFrameFromPoses({pose(Eigen::Matrix3d::Identity()), pose(turned)});
+  EXPECT_NEAR((colmap.up - Eigen::Vector3f(0, -1, 0)).norm(), 0.0f, 1e-5f);
+  EXPECT_LT(colmap.front.z(), -0.9f);
+  // On its side: cameras whose up is +X.
+  Eigen::Matrix3d side;
+  side.col(0) = Eigen::Vector3d::UnitY();
+  side.col(1) = -Eigen::Vector3d::UnitX();
+  side.col(2) = Eigen::Vector3d::UnitZ();
+  const OrbitFrame lying = OrbitFrameFromPoses({pose(side)});
+  EXPECT_NEAR((lying.up - Eigen::Vector3f::UnitX()).norm(), 0.0f, 1e-5f);
+  for (const OrbitFrame& f : {colmap, lying}) {
+    EXPECT_NEAR(f.up.norm(), 1.0f, 1e-5f);
+    EXPECT_NEAR(f.front.norm(), 1.0f, 1e-5f);
+    EXPECT_NEAR(f.up.dot(f.front), 0.0f, 1e-5f);
+    EXPECT_NEAR((f.up.cross(f.front) - f.side).norm(), 0.0f, 1e-5f);
+    // Looking from yaw 0, pitch 0 the eye is in front and the screen's up is the frame's up.
+    EXPECT_NEAR((OrbitEyeDirection(f, 0, 0) - f.front).norm(), 0.0f, 1e-5f);
+    EXPECT_NEAR((OrbitScreenUp(f, 0.3f, 0) - f.up).norm(), 0.0f, 1e-5f);
+  }
+  // No poses: +Y.
+  EXPECT_EQ(OrbitFrameFromPoses({}).up, Eigen::Vector3f::UnitY());
+}
+
 }  // namespace fresco

@@ -16,6 +16,7 @@
 
 #include "ui/core/app_state.h"
 #include "ui/core/calibration_runner.h"
+#include "ui/core/orbit_frame.h"
 #include "ui/core/pipeline_runner.h"
 #include "ui/core/poses_runner.h"
 
@@ -37,6 +38,8 @@ struct ViewportView {
   float distance_m = 0;                // 0 = fit the model
   float target[3] = {0, 0, 0};         // orbit centre, world
   bool target_set = false;
+  OrbitFrame orbit;                    // which way is up (from the capture's poses)
+  uint64_t orbit_geometry_version = 0; // the geometry `orbit` was taken from (0: none yet)
   bool show_path = true, show_frustum = true;
 };
 

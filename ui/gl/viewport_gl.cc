@@ -340,13 +340,16 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   const float yaw = view->yaw_deg * static_cast<float>(M_PI) / 180;
   const float pitch = view->pitch_deg * static_cast<float>(M_PI) / 180;
   const Eigen::Vector3f target(view->target[0], view->target[1], view->target[2]);
-  const Eigen::Vector3f eye =
-      target + view->distance_m * Eigen::Vector3f(std::cos(pitch) * std::sin(yaw), std::sin(pitch),
-                                                  std::cos(pitch) * std::cos(yaw));
+  if (view->orbit_geometry_version != snapshot.geometry_version &&
+      (!geo.path.empty() || !snapshot.live_path.empty())) {
+    view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.live_path : geo.path);
+    view->orbit_geometry_version = snapshot.geometry_version;
+  }
+  const Eigen::Vector3f eye = target + view->distance_m * OrbitEyeDirection(view->orbit, yaw, pitch);
   const float near = std::max(1e-3f, 0.01f * view->distance_m);
   const Mat4 view_projection = Perspective(fov, static_cast<float>(width) / height, near,
                                            10.0f * (view->distance_m + radius)) *
-                               LookAt(eye, target, Eigen::Vector3f::UnitY());
+                               LookAt(eye, target, view->orbit.up);
 
   GLint previous_fbo = 0, previous_viewport[4];
   glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);

@@ -64,9 +64,8 @@ class ViewportPanel : public Panel {
       const float yaw = view_.yaw_deg * static_cast<float>(M_PI) / 180,
                   pitch = view_.pitch_deg * static_cast<float>(M_PI) / 180;
       const float scale = std::max(view_.distance_m, 0.1f) / h;
-      const float right[3] = {std::cos(yaw), 0, -std::sin(yaw)};
-      const float up[3] = {-std::sin(pitch) * std::sin(yaw), std::cos(pitch),
-                           -std::sin(pitch) * std::cos(yaw)};
+      const Eigen::Vector3f right = OrbitScreenRight(view_.orbit, yaw);
+      const Eigen::Vector3f up = OrbitScreenUp(view_.orbit, yaw, pitch);
       for (int k = 0; k < 3; ++k)
         view_.target[k] += (-io.MouseDelta.x * right[k] + io.MouseDelta.y * up[k]) * scale;
     }
