@@ -1,6 +1,7 @@
 // The painting job (pipeline/run) on its own: the frame policy on each kind of bad frame,
 // the run's counts (frames read, painted, without a pose, held out; per stream) on small
 // synthetic captures, max_frames, and several streams interleaved.
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -189,6 +190,36 @@ TEST(PaintRun, UnknownCameraIdIsRefusedWhenTheJobOpens) {
   EXPECT_NE(r.status.message().find("image '000003.png'"), std::string::npos) << r.status.message();
   EXPECT_NE(r.status.message().find("CAMERA_ID 7"), std::string::npos) << r.status.message();
   EXPECT_EQ(r.stats.frames, 0);
+}
+
+// The figures other code reads back are typed (FrameReport::paint): the string-keyed view of
+// panels and metrics.json is made from them, so both say the same.
+TEST(PaintRun, TypedPaintFiguresAreWhatTheMetricsShow) {
+  Project project;
+  ASSERT_TRUE(LoadProject(testing::GoodCaptureDir() + "/project.json", {}, &project).ok());
+  std::unique_ptr<PaintJob> job;
+  ASSERT_TRUE(OpenPaintJob(project, PaintJobOptions(), &job).ok());
+  PaintRun run(job->session.get(), job->source.get(), PaintRunOptions());
+  int compared = 0, painted = 0;
+  PaintRunHooks hooks;
+  hooks.after_frame = [&](const RunFrame&, const FrameReport* report) {
+    if (!report) return Status::Ok();
+    ++painted;
+    const double typed = report->paint.difference_to_buffer;
+    const double shown = report->Stage("paint")->metrics.at("difference_to_buffer");
+    if (std::isnan(typed)) {
+      EXPECT_TRUE(std::isnan(shown));
+    } else {
+      EXPECT_EQ(typed, shown);
+      EXPECT_GE(typed, 0.0);
+      EXPECT_LT(typed, 64.0);  // the synthetic frames agree with what is painted
+      ++compared;
+    }
+    return Status::Ok();
+  };
+  ASSERT_TRUE(RunToEnd(&run, hooks).ok());
+  EXPECT_EQ(painted, 12);
+  EXPECT_GE(compared, 10);  // every frame after the first sees painted texels
 }
 
 // Two streams (the good poses, and the same frames with frame 3's pose missing): frames

@@ -226,18 +226,12 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     working_.frames_painted.push_back(frame.index);
     for (const StageReport& st : working_.report.stages)
       working_.stage_ms[st.name].push_back(static_cast<float>(st.wall_ms));
-    const StageReport* paint = working_.report.Stage("paint");
-    double diff = std::numeric_limits<double>::quiet_NaN();
-    if (paint && paint->metrics.count("difference_to_buffer"))
-      diff = paint->metrics.at("difference_to_buffer");
-    working_.misalignment.push_back(static_cast<float>(diff));
-    if (const StageReport* refine = working_.report.Stage("refine")) {
-      const auto value = [&](const char* key) {
-        const auto it = refine->metrics.find(key);
-        return static_cast<float>(it == refine->metrics.end() ? std::nan("") : it->second);
-      };
-      working_.refine_before_px.push_back(value("residual_before_px"));
-      working_.refine_after_px.push_back(value("residual_after_px"));
+    working_.misalignment.push_back(static_cast<float>(working_.report.paint.difference_to_buffer));
+    if (working_.report.Stage("refine")) {
+      working_.refine_before_px.push_back(
+          static_cast<float>(working_.report.refine.residual_before_px));
+      working_.refine_after_px.push_back(
+          static_cast<float>(working_.report.refine.residual_after_px));
     }
     const size_t keep = static_cast<size_t>(std::max(1, options_.history_frames));
     TrimHistory(keep, &working_.frames_painted);
