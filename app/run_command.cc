@@ -195,6 +195,19 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   return metrics;
 }
 
+// Writes DIR/painted.gltf (+ .bin, PNGs) and DIR/metrics.json: into a staging folder inside
+// DIR first, then moved into DIR with metrics.json last; a failure before that leaves DIR
+// as it was (all or nothing). Errors are not bad input (exit 1).
+Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job,
+                       const nlohmann::json& metrics) {
+  StagedFolder outputs;
+  FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
+  FRESCO_RETURN_IF_ERROR(
+      SaveGltfScene(job.session->PaintedScene(), outputs.path() + "/painted.gltf"));
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
+  return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
+}
+
 }  // namespace
 
 int RunVerbRun(const CommandArgs& argv) {
@@ -289,25 +302,9 @@ int RunVerbRun(const CommandArgs& argv) {
   const double seconds = stats.seconds;
   progress.Finish();
 
-  // Outputs: written into a staging folder inside DIR, then moved into DIR with metrics.json
-  // last; a failure before that leaves DIR as it was (all or nothing).
-  StagedFolder outputs;
-  if (Status s = outputs.Open(out_dir + "/.outputs"); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  if (Status s = SaveGltfScene(session->PaintedScene(), outputs.path() + "/painted.gltf");
+  if (Status s =
+          WriteRunOutputs(out_dir, *job, RunMetrics(project, *job, stats, recorder.frames()));
       !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  const nlohmann::json metrics = RunMetrics(project, *job, stats, recorder.frames());
-  if (Status s = WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n");
-      !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  if (Status s = MoveFilesInto(outputs.path(), out_dir, {"metrics.json"}); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
@@ -326,9 +323,8 @@ int RunVerbRun(const CommandArgs& argv) {
     std::fprintf(stderr,
                  "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; coverage %.1f%% of %lld "
                  "texels in %zu buffers -> %s\n",
-                 frames, stats.frames_painted, seconds, metrics["fps"].get<double>(),
-                 100.0 * session->Coverage(), session->NumSurfaceTexels(),
-                 session->buffers().size(), out_dir.c_str());
+                 frames, stats.frames_painted, seconds, stats.Fps(), 100.0 * session->Coverage(),
+                 session->NumSurfaceTexels(), session->buffers().size(), out_dir.c_str());
   }
   return kExitOk;
 }

@@ -39,8 +39,10 @@ FrameRead PaintRun::Next(RunFrame* frame) {
     started_ = true;
     start_ = std::chrono::steady_clock::now();
   }
-  if (options_.max_frames > 0 && stats_.frames >= options_.max_frames)
+  if (options_.max_frames > 0 && stats_.frames >= options_.max_frames) {
+    max_frames_reached_ = true;
     return End(FrameRead::kEnded);
+  }
   const FrameRead read = source_->Next(frame, &status_);
   if (read != FrameRead::kFrame) return End(read);
   frame->counter = stats_.frames++;
@@ -57,6 +59,12 @@ FrameRead PaintRun::Next(RunFrame* frame) {
     ++stats_.frames_held_out;
   }
   return End(FrameRead::kFrame);
+}
+
+std::string PaintRun::EndReason() const {
+  if (max_frames_reached_)
+    return "pipeline.max_frames (" + std::to_string(options_.max_frames) + ") reached";
+  return source_->EndReason();
 }
 
 void PaintRun::Paint(const RunFrame& frame, FrameReport* report) {

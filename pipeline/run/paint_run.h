@@ -86,6 +86,9 @@ class PaintRun {
 
   const Status& status() const { return status_; }
   bool ended() const { return ended_; }
+  // Why the run ended without an error: "pipeline.max_frames (N) reached", or the source's
+  // reason ("end of video", "live video ended: ...").
+  std::string EndReason() const;
   const PaintRunStats& stats() const { return stats_; }
   PosedFrameSource& source() { return *source_; }
   PaintSession& session() { return *session_; }
@@ -99,6 +102,7 @@ class PaintRun {
   PaintRunStats stats_;
   Status status_;
   bool ended_ = false;
+  bool max_frames_reached_ = false;
   bool started_ = false;
   std::chrono::steady_clock::time_point start_;
 };

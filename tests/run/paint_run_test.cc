@@ -106,6 +106,7 @@ struct Ran {
   PaintRunStats stats;
   std::vector<std::string> held_out;  // names of the held-out frames
   std::vector<int> stream_order;      // stream of each frame read
+  std::string end_reason;             // PaintRun::EndReason()
 };
 Ran RunJob(const std::string& project_json, const PaintRunOptions& options) {
   Project project;
@@ -124,6 +125,7 @@ Ran RunJob(const std::string& project_json, const PaintRunOptions& options) {
   };
   ran.status = RunToEnd(&run, hooks);
   ran.stats = run.stats();
+  ran.end_reason = run.EndReason();
   return ran;
 }
 
@@ -134,6 +136,7 @@ TEST(PaintRun, FrameWithoutAPoseIsCountedAndTheRestPainted) {
   EXPECT_EQ(r.stats.frames_without_pose, 1);
   EXPECT_EQ(r.stats.frames_painted, 11);
   EXPECT_EQ(r.stats.frames_held_out, 0);
+  EXPECT_EQ(r.end_reason, "end of video");
   ASSERT_EQ(r.stats.streams.size(), 1u);
   EXPECT_EQ(r.stats.streams[0].frames, 12);
   EXPECT_EQ(r.stats.streams[0].painted, 11);
@@ -162,6 +165,7 @@ TEST(PaintRun, MaxFramesEndsTheRunWithoutAnError) {
   ASSERT_TRUE(r.status.ok()) << r.status.message();
   EXPECT_EQ(r.stats.frames, 4);
   EXPECT_EQ(r.stats.frames_painted, 4);
+  EXPECT_EQ(r.end_reason, "pipeline.max_frames (4) reached");
 }
 
 TEST(PaintRun, CorruptImageEndsTheRunNamingTheFile) {

@@ -173,7 +173,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   if (read == FrameRead::kEnded) {
     s.ended = true;
     const Status& status = s.run->status();
-    s.end_message = status.ok() ? s.source->EndReason() : "error: " + status.message();
+    s.end_message = status.ok() ? s.run->EndReason() : "error: " + status.message();
     std::string recorded;
     if (s.live && s.live->recording()) s.live->StopRecording(&recorded);  // errors: in its status
     return Painted::kEnded;
@@ -257,8 +257,8 @@ void PipelineRunner::SetRecording(const std::string& dir) {
 
 void PipelineRunner::Publish(bool with_painted) {
   working_.playing = playing_;
-  if (session_) working_.run = session_->run->stats();
   if (session_) {  // without one, the status says why (no project, error, connecting)
+    working_.run = session_->run->stats();
     working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
