@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "tests/test_support.h"
@@ -85,6 +86,20 @@ std::string MakeBadCapture(BadCapture how) {
       break;
   }
   return dir + "/project.json";
+}
+
+std::string MakeTwoStreamCapture() {
+  const std::string dir = fs::path(MakeBadCapture(BadCapture::kMissingPose)).parent_path();
+  fs::create_directories(dir + "/good");
+  fs::copy_file(GoodCaptureDir() + "/sparse/images.txt", dir + "/good/images.txt");
+  nlohmann::json project = nlohmann::json::parse(ReadText(dir + "/project.json"));
+  for (const char* key : {"camera", "video", "poses", "time_offset_s"}) project.erase(key);
+  project["fresco"] = 2;
+  project["streams"] = {
+      {{"camera", "camera.cameramodel"}, {"video", "frames/"}, {"poses", "good/images.txt"}},
+      {{"camera", "camera.cameramodel"}, {"video", "frames/"}, {"poses", "sparse/images.txt"}}};
+  WriteText(dir + "/two.json", project.dump(2));
+  return dir + "/two.json";
 }
 
 std::string Describe(BadCapture how) {

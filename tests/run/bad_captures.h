@@ -22,6 +22,11 @@ constexpr int kGoodCaptureFrames = 12;
 
 // A fresh copy of the good capture broken as `how`; returns its project.json.
 std::string MakeBadCapture(BadCapture how);
+// A version-2 project with two streams over the good capture's frames: stream 0 with all
+// its poses, stream 1 with frame 3's pose missing (24 frames, 23 with a pose). Returns its
+// project file.
+std::string MakeTwoStreamCapture();
+
 // "frames smaller than the camera", ... (test output).
 std::string Describe(BadCapture how);
 std::vector<BadCapture> AllBadCaptures();

@@ -5,7 +5,6 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 
 #include "pipeline/core/project.h"
 #include "pipeline/run/frame_policy.h"
@@ -229,17 +228,7 @@ TEST(PaintRun, TypedPaintFiguresAreWhatTheMetricsShow) {
 // Two streams (the good poses, and the same frames with frame 3's pose missing): frames
 // interleave stream by stream and each stream keeps its own counts.
 TEST(PaintRun, TwoStreamsInterleaveAndCountPerStream) {
-  const std::string dir = fs::path(MakeBadCapture(BadCapture::kMissingPose)).parent_path().string();
-  fs::create_directories(dir + "/good");
-  fs::copy_file(testing::GoodCaptureDir() + "/sparse/images.txt", dir + "/good/images.txt");
-  nlohmann::json project = nlohmann::json::parse(testing::ReadText(dir + "/project.json"));
-  for (const char* key : {"camera", "video", "poses", "time_offset_s"}) project.erase(key);
-  project["fresco"] = 2;
-  project["streams"] = {
-      {{"camera", "camera.cameramodel"}, {"video", "frames/"}, {"poses", "good/images.txt"}},
-      {{"camera", "camera.cameramodel"}, {"video", "frames/"}, {"poses", "sparse/images.txt"}}};
-  testing::WriteText(dir + "/two.json", project.dump(2));
-  const Ran r = RunJob(dir + "/two.json", PaintRunOptions());
+  const Ran r = RunJob(testing::MakeTwoStreamCapture(), PaintRunOptions());
   ASSERT_TRUE(r.status.ok()) << r.status.message();
   EXPECT_EQ(r.stats.frames, 24);
   ASSERT_EQ(r.stats.streams.size(), 2u);
