@@ -1,4 +1,4 @@
-// `fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...]` (CONTRACT.md): runs the
+// `fresco bench PROJECT.json --out DIR [--sweep KEY=V1,V2,... ...]` (docs/contract.md): runs the
 // project once per combination of the swept settings and measures speed (fps, per-stage
 // ms) against accuracy. Accuracy needs no ground truth: every `--holdout`-th frame is left
 // out of painting and the painted model, rendered at its pose, is compared with it (virtual

@@ -1,4 +1,4 @@
-// `fresco calib`: camera intrinsics from images of a board (CONTRACT.md "Calibration").
+// `fresco calib`: camera intrinsics from images of a board (docs/contract.md "Calibration").
 //   fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]
 //   fresco calib board BOARD --out BOARD.png [--dpi N]
 // Bad input (a bad board spec, a folder without usable images) is one line on stderr and

@@ -1,5 +1,5 @@
 // The `fresco` verbs. Each verb is a function in its own file taking the arguments after the
-// verb; the dispatcher maps verb -> function. Exit codes (CONTRACT.md): 0 success, 2 bad
+// verb; the dispatcher maps verb -> function. Exit codes (docs/contract.md): 0 success, 2 bad
 // usage or bad input (one line on stderr naming file and field), 1 anything else.
 #pragma once
 

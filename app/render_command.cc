@@ -1,6 +1,6 @@
 // `fresco render MODEL --camera CAMERA --poses POSES --out DIR [options]`: renders a model
 // (glTF, PLY or OBJ) through a camera (full lens model) at every pose, one RGBA PNG per pose
-// (CONTRACT.md).
+// (docs/contract.md).
 // Everything is read and checked before the first image is written, so bad input never
 // leaves a partial output; every image is written atomically (temp file + rename).
 #include <algorithm>

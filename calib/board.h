@@ -1,7 +1,7 @@
 // Calibration boards: the spec string, the physical corner positions (metres), and how the
 // corners map onto mrcal's regular board grid.
 //
-// Specs (CONTRACT.md):
+// Specs (docs/contract.md):
 //   chessboard:COLSxROWS:SQUARE_M        inner corners, e.g. chessboard:9x6:0.025
 //   aprilgrid:COLSxROWS:TAG_M:SPACING    Kalibr AprilGrid of tag36h11, e.g. aprilgrid:6x6:0.088:0.3
 //

@@ -1,6 +1,6 @@
 // What `fresco calib solve` writes: the mrcal .cameramodel (any mrcal lens model, numbers at
 // full precision, checked with mrcal's own reader before the file is replaced) and the
-// report JSON beside it (CONTRACT.md fields plus the evidence for the model choice).
+// report JSON beside it (docs/contract.md fields plus the evidence for the model choice).
 #pragma once
 
 #include <string>

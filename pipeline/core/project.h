@@ -1,4 +1,4 @@
-// The project file (CONTRACT.md): which scene, camera, video and poses, plus every setting
+// The project file (docs/contract.md): which scene, camera, video and poses, plus every setting
 // of the pipeline, with defaults that work. Parsing is strict: an unknown key, a wrong type
 // or a bad value is an error naming the file and the JSON path of the field. Paths in the
 // file are relative to the folder holding it; Project keeps them as written and resolves

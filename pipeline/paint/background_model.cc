@@ -235,10 +235,23 @@ void BufferBackground::Clean(const cv::Rect& roi, BackgroundFrame* frame) {
 
 void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
                               bool debug, BackgroundFrame* frame) {
+  // The images are reused from frame to frame (no allocation, no page faults per frame),
+  // except when debugging: then the stage's report holds them and each frame gets its own.
+  const auto clear = [&](cv::Mat* image) {
+    if (debug) {
+      *image = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    } else {
+      image->create(buffer.height, buffer.width, CV_8U);
+      image->setTo(0);
+    }
+  };
+  cv::Mat foreground = std::move(frame->foreground), warming = std::move(frame->warming);
   *frame = BackgroundFrame{};
-  frame->foreground = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
-  frame->warming = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
-  if (debug) frame->difference = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  frame->foreground = std::move(foreground);
+  frame->warming = std::move(warming);
+  clear(&frame->foreground);
+  clear(&frame->warming);
+  if (debug) clear(&frame->difference);
   if (options_.mode == BackgroundMode::kOff) return;
   // Only chunks that may hold valid texels; a skipped chunk's raw foreground from an earlier
   // frame is cleared (Clean reads raw_ around this frame's foreground).

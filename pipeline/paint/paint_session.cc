@@ -539,9 +539,22 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool 
   report.name = "background";
   float gain = 1.0f;
   if (options_.background.mode == BackgroundMode::kRobust && options_.background.normalize_gain) {
+    // One histogram per buffer seen, in parallel, summed in buffer order (integer counts:
+    // the same whatever the threads).
+    const std::vector<size_t> seen_buffers = Indices(seen);
+    std::vector<GainHistogram> per_buffer(seen_buffers.size());
+    cv::parallel_for_(cv::Range(0, static_cast<int>(seen_buffers.size())),
+                      [&](const cv::Range& range) {
+                        for (int i = range.start; i < range.end; ++i) {
+                          const size_t b = seen_buffers[i];
+                          background_[b].AccumulateGain(set_.buffers[b], warped_[b], &per_buffer[i]);
+                        }
+                      });
     GainHistogram histogram;
-    for (size_t b = 0; b < set_.buffers.size(); ++b)
-      if (seen[b]) background_[b].AccumulateGain(set_.buffers[b], warped_[b], &histogram);
+    for (const GainHistogram& h : per_buffer) {
+      for (int i = 0; i < GainHistogram::kBins; ++i) histogram.bins[i] += h.bins[i];
+      histogram.count += h.count;
+    }
     gain = histogram.MedianGain();
   }
   long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;

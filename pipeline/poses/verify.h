@@ -1,4 +1,4 @@
-// Verification of given poses against an independent COLMAP reconstruction (CONTRACT.md,
+// Verification of given poses against an independent COLMAP reconstruction (docs/contract.md,
 // `fresco poses verify`): COLMAP's poses are aligned to the given ones (pose_alignment.h),
 // globally, or locally (a window of neighbouring frames) on long sequences whose
 // reconstruction drifts in scale, and each frame's rotation and position disagreement is

@@ -1,4 +1,4 @@
-// The files `fresco poses verify` writes: DIR/verify.json (CONTRACT.md: frames with name,
+// The files `fresco poses verify` writes: DIR/verify.json (docs/contract.md: frames with name,
 // rotation_error_deg, position_error_m, flagged; registered; plus thresholds, alignment and
 // COLMAP timings) and DIR/verify.png (both errors along the sequence, thresholds dashed,
 // flagged frames marked red, frames COLMAP did not register marked grey). Written atomically.

@@ -20,6 +20,7 @@
 #include "pipeline/render/rasterizer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -36,6 +37,10 @@ namespace {
 // Target bucket side in rays (a pinhole lens puts about 6x6 rays in a bucket); 4..8 measured
 // within 10% of each other on the benchmark scenes, 16 is 1.5x slower.
 constexpr int kBucketSideRays = 6;
+// Grid traversal: sample rows per task, and boxes narrower than this many columns are
+// scanned whole rather than per row between the edges.
+constexpr int kBandRows = 8;
+constexpr int kNarrowColumns = 12;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 
@@ -44,10 +49,15 @@ struct TriangleSetup {
   float edge[3][3];         // sign-normalised edge functions: w_i = e0 x + e1 y + e2 >= 0 inside
   double inv_depth[3];      // 1/z = a x + b y + c
   double bbox[4];           // xmin, ymin, xmax, ymax of the near-clipped projection (+ margin)
-  double poly[4][2];        // the near-clipped triangle projected to z=1 (convex, 3 or 4 corners)
   int num_poly = 0;         // 0: triangle rejected (culled, behind the near plane, degenerate)
   int row0 = 0, row1 = -1;  // bucket rows covered
   int col0 = 0, col1 = -1;  // bucket columns covered
+};
+
+// The near-clipped triangle projected to z=1 (convex, TriangleSetup::num_poly = 3 or 4
+// corners): kept only for the bucket traversal, which tightens each bucket row to it.
+struct TrianglePolygon {
+  double corner[4][2];
 };
 
 // Triangles per cluster: 128 consecutive triangles of a photogrammetry mesh lie close
@@ -139,6 +149,44 @@ struct Rasterizer::RayTable {
   std::vector<float> xs, ys;              // rays in bucket order
   std::vector<int> sample;                // bucket order -> sample index (row*width + col)
 
+  // A lens without distortion (pinhole) puts the rays on a grid: x depends on the column
+  // only, y on the row only, both increasing. Then triangles are scanned row by row over
+  // exactly the samples they can cover, instead of testing whole buckets of rays: a triangle
+  // a few pixels across tests a few samples, not several buckets of 36.
+  bool grid = false;
+  std::vector<float> col_x;  // (width) x of every column's rays
+  std::vector<float> row_y;  // (height) y of every row's rays
+
+  // Linear fits of col_x and row_y (exact for a pinhole up to rounding): the searches below
+  // start at the fitted index and walk to the exact one, so they are right for any
+  // increasing table and take a step or two on a pinhole's.
+  double col_origin = 0, col_inv_step = 0, row_origin = 0, row_inv_step = 0;
+
+  // First index in [lo, hi] of an increasing table whose entry is >= value (strict: > value),
+  // hi when none.
+  template <bool kStrict>
+  static int FirstFrom(const std::vector<float>& table, double origin, double inv_step, int lo,
+                       int hi, double value) {
+    const auto beyond = [&](int i) { return kStrict ? table[i] > value : table[i] >= value; };
+    const double guess = std::floor((value - origin) * inv_step);
+    int i = static_cast<int>(std::clamp(guess, static_cast<double>(lo), static_cast<double>(hi)));
+    while (i > lo && beyond(i - 1)) --i;
+    while (i < hi && !beyond(i)) ++i;
+    return i;
+  }
+  int FirstColAtLeast(int lo, int hi, double value) const {
+    return FirstFrom<false>(col_x, col_origin, col_inv_step, lo, hi, value);
+  }
+  int FirstColAbove(int lo, int hi, double value) const {
+    return FirstFrom<true>(col_x, col_origin, col_inv_step, lo, hi, value);
+  }
+  int FirstRowAtLeast(double value) const {
+    return FirstFrom<false>(row_y, row_origin, row_inv_step, 0, height, value);
+  }
+  int FirstRowAbove(double value) const {
+    return FirstFrom<true>(row_y, row_origin, row_inv_step, 0, height, value);
+  }
+
   int Col(double x) const {
     const double c = std::floor((x - x0) * inv_cell_w);
     return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(cols - 1)));
@@ -227,6 +275,29 @@ Rasterizer::Rasterizer(const Camera& camera, const RasterOptions& options)
     t.ys[k] = t.by_sample[i].y();
     t.sample[k] = static_cast<int>(i);
   }
+
+  // Grid of rays? Every ray valid, x a function of the column alone and y of the row alone
+  // (bit for bit), both strictly increasing.
+  t.col_x.resize(t.width);
+  t.row_y.resize(t.height);
+  bool grid = num_valid == t.width * t.height;
+  for (int c = 0; c < t.width && grid; ++c) t.col_x[c] = t.by_sample[c].x();
+  for (int r = 0; r < t.height && grid; ++r) t.row_y[r] = t.by_sample[static_cast<size_t>(r) * t.width].y();
+  for (int c = 1; c < t.width && grid; ++c) grid = t.col_x[c] > t.col_x[c - 1];
+  for (int r = 1; r < t.height && grid; ++r) grid = t.row_y[r] > t.row_y[r - 1];
+  for (int r = 0; r < t.height && grid; ++r) {
+    const Eigen::Vector2f* row = &t.by_sample[static_cast<size_t>(r) * t.width];
+    for (int c = 0; c < t.width && grid; ++c)
+      grid = row[c].x() == t.col_x[c] && row[c].y() == t.row_y[r];
+  }
+  t.grid = grid;
+  if (!grid) {
+    t.col_x.clear(), t.row_y.clear();
+  } else {
+    t.col_origin = t.col_x.front(), t.row_origin = t.row_y.front();
+    if (t.width > 1) t.col_inv_step = (t.width - 1) / (static_cast<double>(t.col_x.back()) - t.col_origin);
+    if (t.height > 1) t.row_inv_step = (t.height - 1) / (static_cast<double>(t.row_y.back()) - t.row_origin);
+  }
 }
 
 Rasterizer::~Rasterizer() = default;
@@ -264,11 +335,12 @@ int ClipAndProject(const Eigen::Vector3d v[3], double near_m, double poly[4][2])
 }
 
 // x-range of the convex polygon within the slab y in [ylo, yhi]; false when they miss.
-bool PolygonSlabRange(const TriangleSetup& s, double ylo, double yhi, double* xlo, double* xhi) {
+bool PolygonSlabRange(const TriangleSetup& s, const TrianglePolygon& poly, double ylo, double yhi,
+                      double* xlo, double* xhi) {
   double lo = kInf, hi = -kInf;
   for (int i = 0; i < s.num_poly; ++i) {
-    const double* a = s.poly[i];
-    const double* b = s.poly[(i + 1) % s.num_poly];
+    const double* a = poly.corner[i];
+    const double* b = poly.corner[(i + 1) % s.num_poly];
     if (a[1] >= ylo && a[1] <= yhi) {
       lo = std::min(lo, a[0]);
       hi = std::max(hi, a[0]);
@@ -289,7 +361,52 @@ bool PolygonSlabRange(const TriangleSetup& s, double ylo, double yhi, double* xl
 
 }  // namespace
 
-template <class Record>
+// Scans one triangle over the grid's sample rows [row_lo, row_hi): per row, the columns
+// between the triangle's edges (widened for rounding), each tested exactly as a bucket's rays
+// are, so the two traversals accept the same samples.
+template <class Table, class Record>
+void ScanGridTriangle(const Table& t, const TriangleSetup& s, int tri, int row_lo, int row_hi,
+                      const Record& record) {
+  const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
+  const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
+  const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
+  const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
+  const int r0 = std::max(s.row0, row_lo), r1 = std::min(s.row1, row_hi - 1);
+  // Narrow boxes are scanned whole; wider ones per row between the edges.
+  const bool spans = s.col1 - s.col0 >= kNarrowColumns;
+  const double x_abs = std::max({std::abs(s.bbox[0]), std::abs(s.bbox[2]), 1.0});
+  for (int r = r0; r <= r1; ++r) {
+    const float y = t.row_y[r];
+    int c0 = s.col0, c1 = s.col1;
+    if (spans) {
+      double lo = s.bbox[0], hi = s.bbox[2];
+      for (int i = 0; i < 3; ++i) {
+        const double a = s.edge[i][0], b = s.edge[i][1] * static_cast<double>(y) + s.edge[i][2];
+        if (a == 0.0) continue;  // an edge along the row: the exact tests below decide
+        const double x = -b / a;
+        const double slack =
+            1e-6 * (std::abs(a) * x_abs + std::abs(s.edge[i][1] * static_cast<double>(y)) +
+                    std::abs(s.edge[i][2])) / std::abs(a);
+        if (a > 0) lo = std::max(lo, x - slack);
+        else hi = std::min(hi, x + slack);
+      }
+      if (!(lo <= hi)) continue;
+      c0 = t.FirstColAtLeast(s.col0, s.col1 + 1, lo);
+      c1 = t.FirstColAbove(c0, s.col1 + 1, hi) - 1;
+    }
+    const size_t row_sample = static_cast<size_t>(r) * t.width;
+    for (int c = c0; c <= c1; ++c) {
+      const float x = t.col_x[c];
+      const float w0 = e00 * x + e01 * y + e02;
+      const float w1 = e10 * x + e11 * y + e12;
+      const float w2 = e20 * x + e21 * y + e22;
+      if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
+      record(tri, static_cast<int>(row_sample + c), x, y, ia * x + ib * y + ic, s);
+    }
+  }
+}
+
+template <bool kDirect, class Record>
 void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                           const Record& record) const {
   const RayTable& t = *rays_;
@@ -337,12 +454,19 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   // frame (double).
   // In per-thread scratch buffers that only grow (every slot used is written below): no
   // allocation and no page faults per frame (a 175k-triangle mesh needs 30 MB of set-ups).
+  // Direct (a grid of rays): each triangle is scanned as soon as it is set up, by the thread
+  // that set it up; nothing is stored.
+  if (kDirect && !t.grid) throw std::logic_error("Rasterizer: direct traversal needs a grid");
   thread_local std::vector<TriangleSetup> setup_scratch;
   thread_local std::vector<int> triangle_scratch;
-  if (setup_scratch.size() < static_cast<size_t>(num_slots)) {
+  thread_local std::vector<TrianglePolygon> polygon_scratch;
+  if (!kDirect && setup_scratch.size() < static_cast<size_t>(num_slots)) {
     setup_scratch.resize(num_slots);
     triangle_scratch.resize(num_slots);
   }
+  if (!kDirect && !t.grid && polygon_scratch.size() < static_cast<size_t>(num_slots))
+    polygon_scratch.resize(num_slots);
+  TrianglePolygon* const polygons = polygon_scratch.data();
   TriangleSetup* const setups = setup_scratch.data();
   int* const triangle_of_slot = triangle_scratch.data();
   cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
@@ -350,8 +474,9 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
       const int first = c * kClusterTriangles;
       for (int slot = slot_start[c]; slot < slot_start[c + 1]; ++slot) {
         const int tri = first + (slot - slot_start[c]);
-        triangle_of_slot[slot] = tri;
-        TriangleSetup& s = setups[slot];
+        TriangleSetup direct_setup;
+        TriangleSetup& s = kDirect ? direct_setup : setups[slot];
+        if constexpr (!kDirect) triangle_of_slot[slot] = tri;
         s.num_poly = 0;
         const Eigen::Vector3i& idx = mesh.triangles[tri];
         if ((idx.array() < 0).any() || (idx.array() >= num_vertices).any()) continue;
@@ -364,14 +489,15 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
         const double det = normal.dot(v[0]);  // det(v0, v1, v2): < 0 when front-facing
         if (!(det != 0.0) || !std::isfinite(det)) continue;  // plane through the eye
         if (cull && det > 0) continue;
-        const int n = ClipAndProject(v, near_m, s.poly);
+        double poly[4][2];
+        const int n = ClipAndProject(v, near_m, poly);
         if (n < 3) continue;
         double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
         for (int i = 0; i < n; ++i) {
-          xmin = std::min(xmin, s.poly[i][0]);
-          xmax = std::max(xmax, s.poly[i][0]);
-          ymin = std::min(ymin, s.poly[i][1]);
-          ymax = std::max(ymax, s.poly[i][1]);
+          xmin = std::min(xmin, poly[i][0]);
+          xmax = std::max(xmax, poly[i][0]);
+          ymin = std::min(ymin, poly[i][1]);
+          ymax = std::max(ymax, poly[i][1]);
         }
         // Margin for rounding (the float inside test may accept rays a hair outside).
         const double margin = 1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax),
@@ -385,29 +511,55 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
         }
         for (int k = 0; k < 3; ++k) s.inv_depth[k] = normal[k] / det;
         s.bbox[0] = xmin, s.bbox[1] = ymin, s.bbox[2] = xmax, s.bbox[3] = ymax;
-        s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
-        s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
+        if (t.grid) {  // the columns and rows of samples inside the box
+          s.col0 = t.FirstColAtLeast(0, t.width, xmin);
+          s.col1 = t.FirstColAbove(s.col0, t.width, xmax) - 1;
+          s.row0 = t.FirstRowAtLeast(ymin);
+          s.row1 = t.FirstRowAbove(ymax) - 1;
+          if (s.col0 > s.col1 || s.row0 > s.row1) continue;  // between samples: covers none
+        } else {
+          s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
+          s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
+          if constexpr (!kDirect) std::copy(&poly[0][0], &poly[0][0] + 8, &polygons[slot].corner[0][0]);
+        }
         s.num_poly = n;
+        if constexpr (kDirect) ScanGridTriangle(t, s, tri, 0, t.height, record);
       }
     }
   });
+  if constexpr (kDirect) return;
 
-  // Set-ups per bucket row, in ascending triangle order (counting sort).
-  std::vector<int> row_start(t.rows + 1, 0);
+  // Set-ups per bucket row (grid: per band of kBandRows sample rows), in ascending triangle
+  // order (counting sort).
+  const int num_bins = t.grid ? (t.height + kBandRows - 1) / kBandRows : t.rows;
+  const int bin_div = t.grid ? kBandRows : 1;
+  std::vector<int> row_start(num_bins + 1, 0);
   for (int slot = 0; slot < num_slots; ++slot) {
     const TriangleSetup& s = setups[slot];
     if (s.num_poly == 0) continue;
-    for (int r = s.row0; r <= s.row1; ++r) ++row_start[r + 1];
+    for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) ++row_start[r + 1];
   }
-  for (int r = 0; r < t.rows; ++r) row_start[r + 1] += row_start[r];
-  std::vector<int> row_triangles(row_start[t.rows]);
+  for (int r = 0; r < num_bins; ++r) row_start[r + 1] += row_start[r];
+  std::vector<int> row_triangles(row_start[num_bins]);
   {
     std::vector<int> fill(row_start.begin(), row_start.end() - 1);
     for (int slot = 0; slot < num_slots; ++slot) {
       const TriangleSetup& s = setups[slot];
       if (s.num_poly == 0) continue;
-      for (int r = s.row0; r <= s.row1; ++r) row_triangles[fill[r]++] = slot;
+      for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) row_triangles[fill[r]++] = slot;
     }
+  }
+
+  if (t.grid) {
+    cv::parallel_for_(cv::Range(0, num_bins), [&](const cv::Range& range) {
+      for (int band = range.start; band < range.end; ++band) {
+        const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
+        for (int j = row_start[band]; j < row_start[band + 1]; ++j)
+          ScanGridTriangle(t, setups[row_triangles[j]], triangle_of_slot[row_triangles[j]],
+                           band_lo, band_hi, record);
+      }
+    });
+    return;
   }
 
   cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
@@ -422,7 +574,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           // Tighten to the polygon's extent within this bucket row.
           const double m = 1e-6 + 1e-7 * std::max(std::abs(slab_lo), std::abs(slab_hi));
           double xlo, xhi;
-          if (!PolygonSlabRange(s, slab_lo - m, slab_hi + m, &xlo, &xhi)) continue;
+          if (!PolygonSlabRange(s, polygons[slot], slab_lo - m, slab_hi + m, &xlo, &xhi)) continue;
           const double mx = 1e-6 + 1e-7 * std::max(std::abs(xlo), std::abs(xhi));
           col0 = std::max(col0, t.Col(xlo - mx));
           col1 = std::min(col1, t.Col(xhi + mx));
@@ -497,7 +649,7 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
 
   // Records a hit of triangle `tri` on sample `sample` at inverse depth inv_z when it is the
   // nearest so far (ties: smallest id), with z >= near_m.
-  Traverse(mesh, cam_from_local,
+  Traverse<false>(mesh, cam_from_local,
            [&](int tri, int sample, float x, float y, double inv_z, const TriangleSetup& s) {
              RayHit& h = hits[sample];
              if (!(inv_z > h.inv_depth || (inv_z == h.inv_depth && tri < h.id))) return;
@@ -545,11 +697,27 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   });
   float* inv = depth->ptr<float>();
   const double inv_near = 1.0 / options_.near_m;
-  Traverse(mesh, cam_from_local,
-           [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
-             const float inv_zf = static_cast<float>(inv_z);
-             if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near) inv[sample] = inv_zf;
-           });
+  if (rays_->grid) {
+    // Triangles scanned by whichever thread set them up: a sample may be hit from two
+    // threads at once, so the maximum is taken atomically (and is still order-independent).
+    Traverse<true>(mesh, cam_from_local,
+                   [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
+                     if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
+                     const float inv_zf = static_cast<float>(inv_z);
+                     std::atomic_ref<float> cell(inv[sample]);
+                     float current = cell.load(std::memory_order_relaxed);
+                     while (inv_zf > current &&
+                            !cell.compare_exchange_weak(current, inv_zf, std::memory_order_relaxed)) {
+                     }
+                   });
+  } else {
+    Traverse<false>(mesh, cam_from_local,
+                    [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
+                      const float inv_zf = static_cast<float>(inv_z);
+                      if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near)
+                        inv[sample] = inv_zf;
+                    });
+  }
   cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       float* d = depth->ptr<float>(r);

@@ -72,8 +72,10 @@ class Rasterizer {
   struct ClusterCache;
   std::shared_ptr<const TriangleClusters> ClustersFor(const TriangleMesh& mesh) const;
   // Sets up the triangles and calls record(tri, sample, x, y, inv_z, setup) for every ray
-  // inside a triangle at inverse depth inv_z (near plane not yet checked).
-  template <class Record>
+  // inside a triangle at inverse depth inv_z (near plane not yet checked). Binned (kDirect
+  // false): each sample is recorded by one thread only. Direct (rays on a grid only): each
+  // triangle is scanned by the thread that set it up, so record must be thread-safe.
+  template <bool kDirect, class Record>
   void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                 const Record& record) const;
   Camera camera_;

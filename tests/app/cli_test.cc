@@ -1,4 +1,4 @@
-// The `fresco` command line as users and outside checks drive it (CONTRACT.md): the
+// The `fresco` command line as users and outside checks drive it (docs/contract.md): the
 // dispatcher, --help on every verb, `fresco run` end to end on a small synthetic capture,
 // and bad input: exit 2, one line naming the file, and earlier outputs left as they were.
 #include <algorithm>

@@ -1,6 +1,6 @@
 // libFuzzer target: the project file (ParseProject). Bytes after a NUL are `--set KEY=VALUE`
 // overrides (one per NUL-separated part). Whatever parses must save and parse back to the
-// same project (CONTRACT.md: loading what was saved gives back the same project).
+// same project (docs/contract.md: loading what was saved gives back the same project).
 #include <string>
 #include <vector>
 

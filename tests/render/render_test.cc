@@ -565,8 +565,10 @@ TEST(RasterizerTest, RaysTheLensCannotUnprojectNeverHit) {
 
 // Many overlapping random triangles: two renders are bit-identical, and identical with one
 // thread and with the default thread count.
-TEST(RasterizerTest, DeterministicAcrossRunsAndThreads) {
-  const Camera camera = DistortedCamera();
+// Through a distorted lens (rays in buckets) and a pinhole (rays on a grid, depth scanned
+// directly with an atomic maximum), full and depth-only: bit-identical every run, on any
+// number of threads, with exact depth ties (coplanar duplicates) resolved the same way.
+void ExpectDeterministicAcrossRunsAndThreads(const Camera& camera) {
   TriangleMesh mesh;
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> xy(-3.0, 3.0), z(0.5, 6.0), jitter(-0.4, 0.4);
@@ -586,17 +588,31 @@ TEST(RasterizerTest, DeterministicAcrossRunsAndThreads) {
   Rasterizer rasterizer(camera, options);
   const int default_threads = cv::getNumThreads();
   RasterOutput a, b, single;
+  cv::Mat depth_a, depth_b, depth_single;
   rasterizer.Rasterize(mesh, Rigid3d(), &a);
   rasterizer.Rasterize(mesh, Rigid3d(), &b);
+  rasterizer.RasterizeDepth(mesh, Rigid3d(), &depth_a);
+  rasterizer.RasterizeDepth(mesh, Rigid3d(), &depth_b);
   cv::setNumThreads(1);
   rasterizer.Rasterize(mesh, Rigid3d(), &single);
+  rasterizer.RasterizeDepth(mesh, Rigid3d(), &depth_single);
   cv::setNumThreads(default_threads);
   for (const RasterOutput* other : {&b, &single}) {
     EXPECT_EQ(cv::countNonZero(a.triangle_id != other->triangle_id), 0);
     EXPECT_EQ(std::memcmp(a.depth.data, other->depth.data, a.depth.total() * 4), 0);
     EXPECT_EQ(std::memcmp(a.bary.data, other->bary.data, a.bary.total() * 8), 0);
   }
+  for (const cv::Mat* other : {&depth_b, &depth_single})
+    EXPECT_EQ(std::memcmp(depth_a.data, other->data, depth_a.total() * 4), 0);
   EXPECT_GT(cv::countNonZero(a.triangle_id >= 0), static_cast<int>(a.triangle_id.total() / 2));
+}
+
+TEST(RasterizerTest, DeterministicAcrossRunsAndThreadsDistorted) {
+  ExpectDeterministicAcrossRunsAndThreads(DistortedCamera());
+}
+
+TEST(RasterizerTest, DeterministicAcrossRunsAndThreadsPinhole) {
+  ExpectDeterministicAcrossRunsAndThreads(PinholeCamera(320, 240, 250.0));
 }
 
 // ---------------------------------------------------------------------------------------
