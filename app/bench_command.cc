@@ -4,7 +4,6 @@
 // out of painting and the painted model, rendered at its pose, is compared with it (virtual
 // rephotography); a synthetic project's true poses add the same comparison at the truth.
 // Writes DIR/bench.json and DIR/pareto.png.
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -15,15 +14,15 @@
 #include <opencv2/core/utility.hpp>
 
 #include "app/commands.h"
-#include "app/frame_reader.h"
 #include "app/interrupt.h"
 #include "app/pareto_plot.h"
 #include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
-#include "pipeline/paint/open_project.h"
 #include "pipeline/paint/rephotography.h"
+#include "pipeline/run/paint_job.h"
+#include "pipeline/run/paint_run.h"
 
 namespace fresco {
 namespace {
@@ -122,9 +121,12 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   FRESCO_RETURN_IF_ERROR(LoadProject(project_path, overrides, &project));
   const int threads = project.pipeline.threads > 0 ? project.pipeline.threads : -1;
   cv::setNumThreads(threads);
-  Capture capture;
-  std::unique_ptr<PaintSession> session;
-  FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, &capture, &session));
+  PaintJobOptions job_options;
+  job_options.one_stream_for = "fresco bench";
+  std::unique_ptr<PaintJob> job;
+  FRESCO_RETURN_IF_ERROR(OpenPaintJob(project, job_options, &job));
+  const Capture& capture = job->captures[0];
+  PaintSession* session = job->session.get();
 
   struct HeldOut {
     Frame frame;
@@ -132,38 +134,24 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
     const PosedImage* truth;
   };
   std::vector<HeldOut> held_out;
-  std::map<std::string, double> stage_ms;
-  int frames = 0, painted = 0;
-  FrameReader reader(capture.video.get());
-  Frame frame;
-  Status read_status;
-  FrameReport report;
-  const auto start = std::chrono::steady_clock::now();
+  PaintRunOptions run_options;
+  run_options.max_frames = project.pipeline.max_frames;
+  run_options.holdout_every = holdout;
+  run_options.naive = naive;
+  PaintRun run(session, job->source.get(), run_options);
+  PaintRunHooks hooks;
+  hooks.stop = [] { return Interrupted(); };
+  hooks.after_frame = [&](const RunFrame& f, const FrameReport*) {
+    if (f.fate != FrameFate::kHeldOut) return Status::Ok();
+    const size_t k = f.pose_index;
+    const PosedImage* truth = k < capture.truth_poses.size() ? &capture.truth_poses[k] : nullptr;
+    held_out.push_back({f.posed.frame, &capture.poses[k], truth});
+    return Status::Ok();
+  };
+  FRESCO_RETURN_IF_ERROR(RunToEnd(&run, hooks));
   const Status interrupted = Status::Error(project_path + ": interrupted");
-  while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
-         reader.Next(&frame, &read_status)) {
-    if (Interrupted()) return interrupted;
-    const int index = frames++;
-    const PosedImage* pose = capture.PoseForFrame(frame);
-    if (!pose || !capture.CameraFor(*pose)) continue;
-    FRESCO_RETURN_IF_ERROR(CheckFrameSize(frame, *capture.CameraFor(*pose), project.Resolve(project.video)));
-    if (holdout > 0 && index % holdout == holdout / 2) {
-      const size_t k = pose - capture.poses.data();
-      const PosedImage* truth = k < capture.truth_poses.size() ? &capture.truth_poses[k] : nullptr;
-      held_out.push_back({frame, pose, truth});
-      continue;
-    }
-    if (naive)
-      session->PaintFrameNaive(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
-    else
-      session->PaintFrame(frame, *capture.CameraFor(*pose), pose->cam_from_world, &report);
-    if (!report.painted) continue;
-    ++painted;
-    for (const StageReport& st : report.stages) stage_ms[st.name] += st.wall_ms;
-  }
-  FRESCO_RETURN_IF_ERROR(read_status);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (Interrupted()) return interrupted;
+  const PaintRunStats& stats = run.stats();
 
   // Accuracy on the held-out frames (at the given poses; at the true poses when known).
   const Scene scene = session->PaintedScene();
@@ -195,13 +183,14 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
     row["baseline"] = "naive";
     label = "naive baseline";
   }
-  row["frames"] = frames;
-  row["frames_painted"] = painted;
-  row["seconds"] = seconds;
-  row["fps"] = seconds > 0 ? (frames - held_out.size()) / seconds : 0.0;
+  row["frames"] = stats.frames;
+  row["frames_painted"] = stats.frames_painted;
+  row["frames_without_pose"] = stats.frames_without_pose;
+  row["seconds"] = stats.seconds;
+  row["fps"] = stats.seconds > 0 ? (stats.frames - stats.frames_held_out) / stats.seconds : 0.0;
   row["stage_ms"] = nlohmann::json::object();
-  for (const auto& [name, ms] : stage_ms) row["stage_ms"][name] = painted > 0 ? ms / painted : 0;
-  row["holdout_frames"] = held_out.size();
+  for (const auto& [name, ms] : stats.MeanStageMs()) row["stage_ms"][name] = ms;
+  row["holdout_frames"] = stats.frames_held_out;
   row["psnr_db"] = scored > 0 ? psnr / scored : 0.0;
   row["one_minus_ncc"] = scored > 0 ? ncc / scored : 1.0;
   row["completeness"] = held_out.empty() ? 0.0 : completeness / held_out.size();

@@ -3,22 +3,22 @@
 //            [--poses verify|bootstrap [--poses-out DIR] [--poses-model DIR]]: the authoring
 // app (ui/). With --screenshot it paints N frames (default 30), draws every panel, writes the
 // window to FILE.png (and FILE.png.json: the panels and where they are) and exits 0; it
-// needs a display (xvfb-run works).
+// needs a display (xvfb-run works). Built into the `fresco-gui` executable only, which
+// `fresco gui` starts (gui_launcher.cc): the `fresco` CLI links no GL, GLFW or ImGui.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include "app/commands.h"
+#include "app/gui_command.h"
 #include "calib/model_select.h"
 #include "pipeline/core/project.h"
-#ifdef FRESCO_HAVE_GUI
 #include "ui/gl/app_window.h"
-#endif
 
 namespace fresco {
 
-int RunVerbGui(const CommandArgs& argv) {
+int RunGuiCommand(const CommandArgs& argv) {
   ArgSpec spec;
   spec.usage =
       "fresco gui [PROJECT.json] [--screenshot FILE.png] [--frames N] [--size WxH]\n"
@@ -49,7 +49,6 @@ int RunVerbGui(const CommandArgs& argv) {
                   "--poses-model"};
   Args args;
   if (int code = ParseVerbArgs("gui", argv, spec, &args); code >= 0) return code;
-#ifdef FRESCO_HAVE_GUI
   GuiOptions options;
   if (!args.positional.empty()) options.project = args.positional[0];
   options.screenshot = args.Get("--screenshot");
@@ -103,10 +102,6 @@ int RunVerbGui(const CommandArgs& argv) {
     if (Status s = CheckOneStream(project, "fresco gui"); !s.ok()) return InputError(s);
   }
   return RunGuiApp(options);
-#else
-  std::cerr << "fresco gui: this build has no GUI (configured with -DFRESCO_GUI=OFF)\n";
-  return kExitFailure;
-#endif
 }
 
 }  // namespace fresco

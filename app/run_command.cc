@@ -1,30 +1,25 @@
 // fresco run PROJECT.json --out DIR [--set KEY=VALUE ...]: replays a project headless,
 // paints every frame, writes DIR/painted.gltf, DIR/metrics.json and (opt-in) DIR/stages/.
-#include <chrono>
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <functional>
-#include <future>
 #include <iostream>
-#include <map>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core/utility.hpp>
 
 #include "app/commands.h"
-#include "app/frame_reader.h"
 #include "app/interrupt.h"
 #include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
-#include "pipeline/paint/charts.h"
-#include "pipeline/paint/open_project.h"
-#include "pipeline/paint/paint_session.h"
 #include "pipeline/live/live_input.h"
 #include "pipeline/live/session_recorder.h"
+#include "pipeline/paint/charts.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/run/paint_job.h"
+#include "pipeline/run/paint_run.h"
 
 namespace fresco {
 namespace {
@@ -64,13 +59,6 @@ ArgSpec RunSpec() {
   return spec;
 }
 
-struct StageTotals {
-  std::map<std::string, double> ms;
-  // Per stage and metric: sum and count over the frames where it was finite.
-  std::map<std::string, std::map<std::string, std::pair<double, int>>> metrics;
-  int frames = 0;
-};
-
 Status WriteStageImages(const std::string& dir, const FrameReport& report) {
   for (const StageReport& stage : report.stages) {
     for (const auto& [name, image] : stage.images) {
@@ -82,72 +70,6 @@ Status WriteStageImages(const std::string& dir, const FrameReport& report) {
   }
   return Status::Ok();
 }
-
-// What the painting loop gets per frame, from files or live sources.
-struct LoopFrame {
-  PosedFrame posed;
-  const Camera* camera = nullptr;
-  int stream = 0;  // index into Project::Streams()
-};
-using NextLoopFrame = std::function<bool(LoopFrame*, Status*)>;
-
-// The frames of every stream of a file replay, interleaved by frame index: frame 0 of each
-// stream, then frame 1 of each, ... (what cameras recording the same period at the same
-// rate give); a stream that ends leaves the others going on. Each stream is read one frame
-// ahead on its own thread (FrameReader).
-class InterleavedFrames {
- public:
-  InterleavedFrames(const Project& project, const std::vector<Capture>& streams)
-      : project_(project), specs_(project.Streams()), streams_(streams) {
-    for (const Capture& stream : streams_)
-      readers_.push_back(std::make_unique<FrameReader>(stream.video.get()));
-    ended_.assign(streams_.size(), false);
-  }
-
-  bool Next(LoopFrame* f, Status* status) {
-    for (size_t tried = 0; tried < streams_.size(); ++tried) {
-      const int s = next_;
-      next_ = (next_ + 1) % static_cast<int>(streams_.size());
-      if (ended_[s]) continue;
-      if (!readers_[s]->Next(&f->posed.frame, status)) {
-        if (!status->ok()) return false;
-        ended_[s] = true;
-        continue;
-      }
-      f->stream = s;
-      return Pose(s, f, status);
-    }
-    return false;  // every stream ended
-  }
-
- private:
-  bool Pose(int s, LoopFrame* f, Status* status) const {
-    const Capture& capture = streams_[s];
-    const PosedImage* pose = capture.PoseForFrame(f->posed.frame);
-    f->posed.has_pose = pose != nullptr;
-    if (!pose) return true;
-    f->posed.cam_from_world = pose->cam_from_world;
-    f->camera = capture.CameraFor(*pose);
-    if (!f->camera) {
-      *status = Status::Error(project_.Resolve(specs_[s].poses) + ": image '" + pose->name +
-                              "': camera " + std::to_string(pose->camera_id) + " not found");
-      return false;
-    }
-    return true;
-  }
-
-  const Project& project_;
-  const std::vector<StreamSpec> specs_;
-  const std::vector<Capture>& streams_;
-  std::vector<std::unique_ptr<FrameReader>> readers_;
-  std::vector<bool> ended_;
-  int next_ = 0;
-};
-
-// Frames read, painted and without a pose, of one stream.
-struct StreamCounts {
-  int frames = 0, painted = 0, without_pose = 0;
-};
 
 nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   const LiveFramesStats s = live.frames->stats();
@@ -186,17 +108,12 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   if (!s.estimate.candidates.empty() || !s.estimate.note.empty()) {
     nlohmann::json candidates = nlohmann::json::array();
     for (const TimeOffsetCandidate& c : s.estimate.candidates)
-      candidates.push_back({{"offset_s", c.offset_s},
-                            {"score", c.score},
-                            {"frames", c.frames_scored}});
-    j["offset_estimate"] = {{"ok", s.estimate.ok},
-                            {"offset_s", s.estimate.offset_s},
-                            {"score", s.estimate.score},
-                            {"contrast", s.estimate.contrast},
-                            {"frames", s.estimate.frames},
-                            {"seconds", s.estimate.seconds},
-                            {"note", s.estimate.note},
-                            {"candidates", candidates}};
+      candidates.push_back(
+          {{"offset_s", c.offset_s}, {"score", c.score}, {"frames", c.frames_scored}});
+    j["offset_estimate"] = {{"ok", s.estimate.ok},         {"offset_s", s.estimate.offset_s},
+                            {"score", s.estimate.score},   {"contrast", s.estimate.contrast},
+                            {"frames", s.estimate.frames}, {"seconds", s.estimate.seconds},
+                            {"note", s.estimate.note},     {"candidates", candidates}};
   }
   if (!s.offset_track.empty()) {
     nlohmann::json track = nlohmann::json::array();
@@ -214,6 +131,81 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   }
   j["recorded_frames"] = recorded;
   return j;
+}
+
+// What metrics.json holds (CONTRACT.md): the run's statistics, the session's buffers and
+// atlas, and for live projects the sources' state.
+nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const PaintRunStats& stats,
+                          int recorded_frames) {
+  const PaintSession* session = job.session.get();
+  const Scene& scene = job.scene();
+  const std::vector<StreamSpec> specs = project.Streams();
+  nlohmann::json metrics;
+  metrics["frames"] = stats.frames;
+  metrics["frames_painted"] = stats.frames_painted;
+  metrics["frames_without_pose"] = stats.frames_without_pose;
+  metrics["seconds"] = stats.seconds;
+  metrics["fps"] = stats.Fps();
+  metrics["paint_fps"] = stats.PaintFps();
+  metrics["stage_ms"] = nlohmann::json::object();
+  for (const auto& [name, ms] : stats.MeanStageMs()) metrics["stage_ms"][name] = ms;
+  // Each stage's metrics, averaged over the frames where they were defined.
+  metrics["stage_metrics"] = nlohmann::json::object();
+  for (const auto& [stage, by_key] : stats.MeanStageMetrics())
+    for (const auto& [key, mean] : by_key) metrics["stage_metrics"][stage][key] = mean;
+  metrics["texels"] = session->NumSurfaceTexels();
+  metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
+  metrics["coverage"] = session->Coverage();
+  metrics["base_buffers"] = session->buffers().size();
+  metrics["texel_size_m"] = session->default_texel_size_m();
+  metrics["groups_split_for_folds"] = session->folds_split();
+  const ChartStretch stretch = MeasureChartStretch(scene.mesh, session->grouping());
+  metrics["charts"] = {{"count", session->buffers().size()},
+                       {"max_stretch", stretch.max},
+                       {"mean_stretch", stretch.mean}};
+  metrics["triangles"] = scene.mesh.NumTriangles();
+  // Per stream, in the project's order: its video and what came of its frames.
+  nlohmann::json streams = nlohmann::json::array();
+  for (size_t i = 0; i < specs.size(); ++i)
+    streams.push_back({{"video", specs[i].video},
+                       {"frames", stats.streams[i].frames},
+                       {"frames_painted", stats.streams[i].painted},
+                       {"frames_without_pose", stats.streams[i].without_pose}});
+  metrics["streams"] = streams;
+  nlohmann::json buffers = nlohmann::json::array();
+  for (size_t b = 0; b < session->buffers().size(); ++b) {
+    const BaseBuffer& buf = session->buffers()[b];
+    buffers.push_back({{"id", b},
+                       {"triangles", buf.triangles.size()},
+                       {"width", buf.width},
+                       {"height", buf.height},
+                       {"texel_size_m", buf.texel_size_m},
+                       {"texels", buf.num_surface_texels},
+                       {"painted", session->painted()[b].painted_surface_texels}});
+  }
+  metrics["buffers"] = buffers;
+  const TextureAtlas& atlas = session->atlas();
+  nlohmann::json pages = nlohmann::json::array();
+  for (const cv::Size& page : atlas.pages) pages.push_back({page.width, page.height});
+  metrics["atlas"] = {{"pages", atlas.pages.size()},
+                      {"page_sizes", pages},
+                      {"occupancy", atlas.Occupancy()},
+                      {"padding_texels", atlas.padding}};
+  if (job.live) metrics["live"] = LiveMetrics(job.live_inputs, recorded_frames);
+  return metrics;
+}
+
+// Writes DIR/painted.gltf (+ .bin, PNGs) and DIR/metrics.json: into a staging folder inside
+// DIR first, then moved into DIR with metrics.json last; a failure before that leaves DIR
+// as it was (all or nothing). Errors are not bad input (exit 1).
+Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job,
+                       const nlohmann::json& metrics) {
+  StagedFolder outputs;
+  FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
+  FRESCO_RETURN_IF_ERROR(
+      SaveGltfScene(job.session->PaintedScene(), outputs.path() + "/painted.gltf"));
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
+  return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
 }
 
 }  // namespace
@@ -241,26 +233,17 @@ int RunVerbRun(const CommandArgs& argv) {
                                     std::to_string(specs.size()) + ")"));
   const std::string record_dir = args.Get("--record");
   if (!record_dir.empty() && !live)
-    return InputError(Status::Error(std::string("--record: only for live sources (") + project_path +
-                                    " replays files already)"));
-  std::vector<Capture> captures;  // one per stream; the scene is in captures[0]
-  std::unique_ptr<PaintSession> session;
-  CaptureLoadOptions load_options;
-  load_options.open_video = !live;  // a live video opens after the pose feed connects
-  if (Status s = OpenPaintSession(project, load_options, &captures, &session); !s.ok())
-    return InputError(s);
-  const Scene& scene = captures[0].scene;
-  LiveInputs live_inputs;
+    return InputError(Status::Error(std::string("--record: only for live sources (") +
+                                    project_path + " replays files already)"));
+  PaintJobOptions job_options;
+  job_options.keep_tracker_poses = !record_dir.empty();
+  std::unique_ptr<PaintJob> job;
+  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
+  PaintSession* session = job->session.get();
+  const Scene& scene = job->scene();
   SessionRecorder recorder;
-  if (live) {
-    const Project one_stream = project.ForStream(0);
-    if (Status s =
-            OpenLiveInputs(one_stream, captures[0], *session, !record_dir.empty(), &live_inputs);
-        !s.ok())
-      return InputError(s);
-    if (!record_dir.empty())
-      if (Status s = recorder.Start(record_dir, one_stream); !s.ok()) return InputError(s);
-  }
+  if (!record_dir.empty())
+    if (Status s = recorder.Start(record_dir, project.ForStream(0)); !s.ok()) return InputError(s);
   if (!quiet) {
     std::fprintf(
         stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)%s\n",
@@ -277,77 +260,29 @@ int RunVerbRun(const CommandArgs& argv) {
     if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
   const std::string& stages_dir = stages.path();
 
-  int total = live ? -1 : 0;  // frames of every stream; -1: unknown
-  if (!live) {
-    for (const Capture& capture : captures) {
-      const int count = capture.video->FrameCount();
-      total = total < 0 || count < 0 ? -1 : total + count;
-    }
-  }
+  int total = job->source->FrameCount();  // frames of every stream; -1: unknown
   if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
     total = project.pipeline.max_frames;
   Progress progress("painting", total, quiet);
-  StageTotals totals;
-  int frames = 0, frames_painted = 0, frames_without_pose = 0;
-  std::vector<StreamCounts> stream_counts(specs.size());
-  const auto loop_start = std::chrono::steady_clock::now();
-  NextLoopFrame next;
-  std::unique_ptr<InterleavedFrames> reader;
-  if (live) {
-    next = [&](LoopFrame* f, Status* status) {
-      if (!live_inputs.frames->Next(&f->posed, status)) return false;
-      f->camera = live_inputs.camera;
-      return true;
-    };
-  } else {
-    // Frames are read and decoded on other threads, one frame ahead of the painting.
-    reader = std::make_unique<InterleavedFrames>(project, captures);
-    next = [&](LoopFrame* f, Status* status) { return reader->Next(f, status); };
-  }
-  LoopFrame loop_frame;
-  const Frame& frame = loop_frame.posed.frame;
-  Status read_status;
-  FrameReport report;
-  while ((project.pipeline.max_frames <= 0 || frames < project.pipeline.max_frames) &&
-         !Interrupted() && next(&loop_frame, &read_status)) {
-    if (Interrupted()) break;  // arrived while the frame was read
-    ++frames;
-    StreamCounts& counts = stream_counts[loop_frame.stream];
-    ++counts.frames;
-    if (live_inputs.feed)
-      if (Status s = live_inputs.feed->error(); !s.ok()) return InputError(s);
-    if (!loop_frame.posed.has_pose) {
-      ++frames_without_pose, ++counts.without_pose;
-      progress.Update(frames);
-      continue;
-    }
-    const Camera* camera = loop_frame.camera;
-    if (Status s = CheckFrameSize(frame, *camera, project.Resolve(specs[loop_frame.stream].video));
-        !s.ok())
-      return InputError(s);
-    if (!record_dir.empty())
-      if (Status s = recorder.Add(frame, loop_frame.posed.cam_from_world); !s.ok())
-        return InputError(s);
-    session->PaintFrame(frame, *camera, loop_frame.posed.cam_from_world, &report);
-    if (report.painted) {
-      ++frames_painted, ++counts.painted;
-      for (const StageReport& st : report.stages) {
-        totals.ms[st.name] += st.wall_ms;
-        for (const auto& [key, value] : st.metrics) {
-          if (!std::isfinite(value)) continue;
-          auto& [sum, count] = totals.metrics[st.name][key];
-          sum += value, ++count;
-        }
-      }
-      if (project.pipeline.debug_images)
-        if (Status s = WriteStageImages(stages_dir, report); !s.ok()) return InputError(s);
-    }
+  PaintRunOptions run_options;
+  run_options.max_frames = project.pipeline.max_frames;
+  PaintRun run(session, job->source.get(), run_options);
+  PaintRunHooks hooks;
+  hooks.stop = [] { return Interrupted(); };
+  hooks.before_paint = [&](const RunFrame& f) {
+    return record_dir.empty() ? Status::Ok() : recorder.Add(f.posed.frame, f.posed.cam_from_world);
+  };
+  hooks.after_frame = [&](const RunFrame&, const FrameReport* report) {
+    if (report && project.pipeline.debug_images)
+      FRESCO_RETURN_IF_ERROR(WriteStageImages(stages_dir, *report));
     char detail[64];
     std::snprintf(detail, sizeof detail, "coverage %.1f%%", 100.0 * session->Coverage());
-    progress.Update(frames, detail);
-  }
-  if (live_inputs.frames) live_inputs.frames->Stop();
-  if (!read_status.ok()) return InputError(read_status);
+    progress.Update(run.stats().frames, detail);
+    return Status::Ok();
+  };
+  if (Status s = RunToEnd(&run, hooks); !s.ok()) return InputError(s);
+  const PaintRunStats& stats = run.stats();
+  const int frames = stats.frames;
   if (Interrupted()) {
     progress.Clear();
     std::fprintf(stderr,
@@ -356,8 +291,7 @@ int RunVerbRun(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
     return InterruptExitCode();
   }
-  if (live_inputs.feed)
-    if (Status s = live_inputs.feed->error(); !s.ok()) return InputError(s);
+  const LiveInputs& live_inputs = job->live_inputs;
   if (!record_dir.empty()) {
     const std::vector<TimedPose> tracker =
         live_inputs.feed ? live_inputs.feed->AllPoses()
@@ -365,83 +299,12 @@ int RunVerbRun(const CommandArgs& argv) {
                                                   live_inputs.track->samples().end());
     if (Status s = recorder.Finish(tracker); !s.ok()) return InputError(s);
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
+  const double seconds = stats.seconds;
   progress.Finish();
 
-  // Outputs: written into a staging folder inside DIR, then moved into DIR with metrics.json
-  // last; a failure before that leaves DIR as it was (all or nothing).
-  StagedFolder outputs;
-  if (Status s = outputs.Open(out_dir + "/.outputs"); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  if (Status s = SaveGltfScene(session->PaintedScene(), outputs.path() + "/painted.gltf"); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  nlohmann::json metrics;
-  metrics["frames"] = frames;
-  metrics["frames_painted"] = frames_painted;
-  metrics["frames_without_pose"] = frames_without_pose;
-  metrics["seconds"] = seconds;
-  metrics["fps"] = seconds > 0 ? frames / seconds : 0.0;
-  metrics["paint_fps"] = seconds > 0 ? frames_painted / seconds : 0.0;
-  nlohmann::json stage_ms = nlohmann::json::object();
-  for (const auto& [name, ms] : totals.ms)
-    stage_ms[name] = frames_painted > 0 ? ms / frames_painted : 0.0;
-  metrics["stage_ms"] = stage_ms;
-  // Each stage's metrics, averaged over the frames where they were defined.
-  nlohmann::json stage_metrics = nlohmann::json::object();
-  for (const auto& [stage, by_key] : totals.metrics)
-    for (const auto& [key, sum_count] : by_key)
-      stage_metrics[stage][key] = sum_count.first / sum_count.second;
-  metrics["stage_metrics"] = stage_metrics;
-  metrics["texels"] = session->NumSurfaceTexels();
-  metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
-  metrics["coverage"] = session->Coverage();
-  metrics["base_buffers"] = session->buffers().size();
-  metrics["texel_size_m"] = session->default_texel_size_m();
-  metrics["groups_split_for_folds"] = session->folds_split();
-  const ChartStretch stretch = MeasureChartStretch(scene.mesh, session->grouping());
-  metrics["charts"] = {{"count", session->buffers().size()},
-                       {"max_stretch", stretch.max},
-                       {"mean_stretch", stretch.mean}};
-  metrics["triangles"] = scene.mesh.NumTriangles();
-  // Per stream, in the project's order: its video and what came of its frames.
-  nlohmann::json streams = nlohmann::json::array();
-  for (size_t i = 0; i < specs.size(); ++i)
-    streams.push_back({{"video", specs[i].video},
-                       {"frames", stream_counts[i].frames},
-                       {"frames_painted", stream_counts[i].painted},
-                       {"frames_without_pose", stream_counts[i].without_pose}});
-  metrics["streams"] = streams;
-  nlohmann::json buffers = nlohmann::json::array();
-  for (size_t b = 0; b < session->buffers().size(); ++b) {
-    const BaseBuffer& buf = session->buffers()[b];
-    buffers.push_back({{"id", b},
-                       {"triangles", buf.triangles.size()},
-                       {"width", buf.width},
-                       {"height", buf.height},
-                       {"texel_size_m", buf.texel_size_m},
-                       {"texels", buf.num_surface_texels},
-                       {"painted", session->painted()[b].painted_surface_texels}});
-  }
-  metrics["buffers"] = buffers;
-  const TextureAtlas& atlas = session->atlas();
-  nlohmann::json pages = nlohmann::json::array();
-  for (const cv::Size& page : atlas.pages) pages.push_back({page.width, page.height});
-  metrics["atlas"] = {{"pages", atlas.pages.size()},
-                      {"page_sizes", pages},
-                      {"occupancy", atlas.Occupancy()},
-                      {"padding_texels", atlas.padding}};
-  if (live) metrics["live"] = LiveMetrics(live_inputs, recorder.frames());
-  if (Status s = WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n");
+  if (Status s =
+          WriteRunOutputs(out_dir, *job, RunMetrics(project, *job, stats, recorder.frames()));
       !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
-  if (Status s = MoveFilesInto(outputs.path(), out_dir, {"metrics.json"}); !s.ok()) {
     std::cerr << "error: " << s.message() << "\n";
     return kExitFailure;
   }
@@ -460,9 +323,8 @@ int RunVerbRun(const CommandArgs& argv) {
     std::fprintf(stderr,
                  "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; coverage %.1f%% of %lld "
                  "texels in %zu buffers -> %s\n",
-                 frames, frames_painted, seconds, metrics["fps"].get<double>(),
-                 100.0 * session->Coverage(), session->NumSurfaceTexels(),
-                 session->buffers().size(), out_dir.c_str());
+                 frames, stats.frames_painted, seconds, stats.Fps(), 100.0 * session->Coverage(),
+                 session->NumSurfaceTexels(), session->buffers().size(), out_dir.c_str());
   }
   return kExitOk;
 }

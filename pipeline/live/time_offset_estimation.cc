@@ -50,11 +50,8 @@ TimeOffsetCandidate ScoreTimeOffset(const std::vector<Frame>& frames, const Came
     Rigid3d cam_from_world;
     if (!pose_at(frame.timestamp_s + offset_s, &cam_from_world)) continue;
     session->PaintFrame(frame, camera, cam_from_world, &report);
-    const StageReport* paint = report.Stage("paint");
-    if (!paint) continue;
-    const auto it = paint->metrics.find("difference_to_buffer");
-    if (it == paint->metrics.end() || !std::isfinite(it->second)) continue;
-    sum += it->second;
+    if (!report.painted || !std::isfinite(report.paint.difference_to_buffer)) continue;
+    sum += report.paint.difference_to_buffer;
     ++c.frames_scored;
   }
   c.score = c.frames_scored > 0 ? sum / c.frames_scored : kNaN;

@@ -178,6 +178,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   report->frame = frame.index;
   report->name = frame.name;
   report->stages.clear();
+  report->paint = PaintFigures();
+  report->refine = RefineFigures();
   const int frame_number = frames_seen_++;
   if (options_.update_every > 1 && frame_number % options_.update_every != 0) {
     report->painted = false;
@@ -270,7 +272,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   frame_cam_from_local_ = cam_from_local;
   if (options_.refine.mode != RefineMode::kOff) {
     if (frame_number % options_.refine.every_n_frames == 0) {
-      report->stages.push_back(RefineAlignment(seen, debug));
+      report->stages.push_back(RefineAlignment(seen, debug, &report->refine));
     } else {  // not registered this frame: it only fills what the buffers lack
       for (size_t b = 0; b < set_.buffers.size(); ++b)
         if (seen[b]) KeepOutOfPainted(b, warped_[b].valid_box);
@@ -308,8 +310,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   paint_report.metrics["texels_kept_sharper"] = static_cast<double>(rejected);
   // Mean |grey difference| between this frame and what the buffers held, where both exist:
   // a cheap misalignment signal (pose error, exposure change, movers), NaN when none.
-  paint_report.metrics["difference_to_buffer"] =
-      compared > 0 ? difference_sum / compared : std::numeric_limits<double>::quiet_NaN();
+  if (compared > 0) report->paint.difference_to_buffer = difference_sum / compared;
+  report->paint.PutInto(&paint_report);
   paint_report.metrics["coverage"] = Coverage();
   paint_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(paint_report));
@@ -435,7 +437,8 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
   report->metrics["pose_ms"] = MsSince(start);
 }
 
-StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug) {
+StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug,
+                                          RefineFigures* figures) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
@@ -508,10 +511,11 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   report.metrics["inliers"] = inliers;
   report.metrics["ambiguous_matches"] = ambiguous;  // dropped: repetitive texture
   // RMS over all inliers, texels: identity before, the chosen corrections after.
-  report.metrics["residual_before_px"] =
-      inliers > 0 ? std::sqrt(before_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
-  report.metrics["residual_after_px"] =
-      inliers > 0 ? std::sqrt(after_sq / inliers) : std::numeric_limits<double>::quiet_NaN();
+  if (inliers > 0) {
+    figures->residual_before_px = std::sqrt(before_sq / inliers);
+    figures->residual_after_px = std::sqrt(after_sq / inliers);
+  }
+  figures->PutInto(&report);
   report.metrics["correction_px"] = correction;
   report.metrics["buffers_moved"] = moved;
   report.metrics["buffers_unregistered"] = unregistered_kept_out;
@@ -692,6 +696,8 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
   report->frame = frame.index;
   report->name = frame.name;
   report->stages.clear();
+  report->paint = PaintFigures();
+  report->refine = RefineFigures();
   const Rigid3d cam_from_local = CamFromLocal(*scene_, cam_from_world);
   CacheFor(camera).rasterizer->RasterizeDepth(scene_->mesh, cam_from_local, &depth_);
   const float tolerance = static_cast<float>(options_.occlusion.tolerance_rel);

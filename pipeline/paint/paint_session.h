@@ -105,8 +105,9 @@ class PaintSession {
   // charted photogrammetry mesh spread over the threads. `serial`: all in order.
   void ForEachBuffer(const std::vector<size_t>& todo, bool serial,
                      const std::function<void(size_t)>& fn) const;
-  // The refinement stage over the buffers seen this frame (re-warps warped_).
-  StageReport RefineAlignment(const std::vector<bool>& seen, bool debug);
+  // The refinement stage over the buffers seen this frame (re-warps warped_); its typed
+  // figures go to `figures` too.
+  StageReport RefineAlignment(const std::vector<bool>& seen, bool debug, RefineFigures* figures);
   struct BufferRefinement;
   // Clears the frame's valid texels of buffer `b` (within `roi`) where the buffer is painted.
   void KeepOutOfPainted(size_t b, const cv::Rect& roi);

@@ -12,6 +12,8 @@
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/render/renderer.h"
+#include "pipeline/run/file_frame_source.h"
+#include "ui/core/live_session_source.h"
 
 namespace fresco {
 
@@ -20,12 +22,15 @@ struct PipelineRunner::Session {
   Capture capture;
   std::unique_ptr<PaintSession> paint;
   std::unique_ptr<LiveSession> live;  // live sources (reads capture and paint: after them)
-  std::unique_ptr<Renderer> review;   // half-size renderer for the misalignment review
+  // The painting job (pipeline/run): the capture's frames read ahead, or the live session's
+  // (reads the above: after them), judged and counted as `fresco run` does.
+  std::unique_ptr<PosedFrameSource> source;
+  std::unique_ptr<PaintRun> run;
+  std::unique_ptr<Renderer> review;  // half-size renderer for the misalignment review
   Camera review_camera;
   int next_frame = 0;  // index of the next frame to read (live: frames taken so far)
   bool ended = false;
   std::string end_message;  // the status once ended ("end of video", "error: ...")
-  long long frames_painted = 0;
 };
 
 namespace {
@@ -123,6 +128,16 @@ void PipelineRunner::OpenSession(const Project& project) {
       return;
     }
   }
+  const StreamSpec stream = project.Streams()[0];  // the capture's (one stream)
+  const FrameOrigin origin{project.Resolve(stream.video), project.Resolve(stream.poses)};
+  if (live)
+    s->source = std::make_unique<LiveSessionSource>(s->live.get(), options_.live_poll_ms, origin);
+  else
+    s->source =
+        std::make_unique<FileFrameSource>(project, std::vector<const Capture*>{&s->capture});
+  PaintRunOptions run_options;
+  run_options.max_frames = project.pipeline.max_frames;
+  s->run = std::make_unique<PaintRun>(s->paint.get(), s->source.get(), run_options);
   auto geometry = std::make_shared<SessionGeometry>();
   geometry->painted_layout = s->paint->PaintedSceneByBuffer();
   geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
@@ -151,50 +166,25 @@ void PipelineRunner::OpenSession(const Project& project) {
 PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   if (!session_ || session_->ended) return Painted::kEnded;
   Session& s = *session_;
-  PosedFrame posed;
-  const Camera* camera = nullptr;
-  if (s.live) {
-    std::string end;
-    const LiveSession::Poll poll = s.live->Next(options_.live_poll_ms, &posed, &end);
-    if (poll == LiveSession::Poll::kWaiting) return Painted::kWaiting;
-    if (poll == LiveSession::Poll::kEnded) {
-      s.ended = true;
-      s.end_message = end;
-      std::string recorded;
-      if (s.live->recording()) s.live->StopRecording(&recorded);  // errors: in its status
-      return Painted::kEnded;
-    }
-    camera = &s.live->camera();
-  } else {
-    Status read;
-    if (!s.capture.video->Next(&posed.frame, &read)) {
-      s.ended = true;
-      s.end_message = read.ok() ? "end of video" : "error: " + read.message();
-      return Painted::kEnded;
-    }
-    const PosedImage* pose = s.capture.PoseForFrame(posed.frame);
-    camera = pose ? s.capture.CameraFor(*pose) : nullptr;
-    posed.has_pose = pose && camera;
-    if (pose) posed.cam_from_world = pose->cam_from_world;
+  RunFrame f;
+  const FrameRead read = s.run->Next(&f);  // the frame policy of `fresco run` and bench
+  s.next_frame = s.run->stats().frames;
+  if (read == FrameRead::kWaiting) return Painted::kWaiting;
+  if (read == FrameRead::kEnded) {
+    s.ended = true;
+    const Status& status = s.run->status();
+    s.end_message = status.ok() ? s.run->EndReason() : "error: " + status.message();
+    std::string recorded;
+    if (s.live && s.live->recording()) s.live->StopRecording(&recorded);  // errors: in its status
+    return Painted::kEnded;
   }
+  const PosedFrame& posed = f.posed;
   const Frame& frame = posed.frame;
-  ++s.next_frame;
   working_.frame = frame.index;
   working_.frame_name = frame.name;
-  // A frame of another size than its camera ends the session with that error, as in `fresco
-  // run` and `fresco bench`.
-  if (posed.has_pose) {
-    const Status size = CheckFrameSize(
-        frame, *camera, s.live ? std::string("the live video") : s.project.Resolve(s.project.video));
-    if (!size.ok()) {
-      s.ended = true;
-      s.end_message = "error: " + size.message();
-      return Painted::kEnded;
-    }
-  }
   working_.has_pose = posed.has_pose;
   if (show) working_.frame_bgr = frame.bgr.clone();
-  if (!working_.has_pose) {
+  if (f.fate != FrameFate::kPaint) {  // no pose (the app holds no frame out)
     working_.report = FrameReport();
     working_.report.frame = frame.index;
     working_.report.skipped_reason = "no pose";
@@ -231,24 +221,17 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     working_.difference_heat.release();
   }
   s.paint->set_debug_images(show && options_.debug_images);
-  s.paint->PaintFrame(frame, *camera, posed.cam_from_world, &working_.report);
+  s.run->Paint(f, &working_.report);
   if (working_.report.painted) {
-    ++s.frames_painted;
     working_.frames_painted.push_back(frame.index);
     for (const StageReport& st : working_.report.stages)
       working_.stage_ms[st.name].push_back(static_cast<float>(st.wall_ms));
-    const StageReport* paint = working_.report.Stage("paint");
-    double diff = std::numeric_limits<double>::quiet_NaN();
-    if (paint && paint->metrics.count("difference_to_buffer"))
-      diff = paint->metrics.at("difference_to_buffer");
-    working_.misalignment.push_back(static_cast<float>(diff));
-    if (const StageReport* refine = working_.report.Stage("refine")) {
-      const auto value = [&](const char* key) {
-        const auto it = refine->metrics.find(key);
-        return static_cast<float>(it == refine->metrics.end() ? std::nan("") : it->second);
-      };
-      working_.refine_before_px.push_back(value("residual_before_px"));
-      working_.refine_after_px.push_back(value("residual_after_px"));
+    working_.misalignment.push_back(static_cast<float>(working_.report.paint.difference_to_buffer));
+    if (working_.report.Stage("refine")) {
+      working_.refine_before_px.push_back(
+          static_cast<float>(working_.report.refine.residual_before_px));
+      working_.refine_after_px.push_back(
+          static_cast<float>(working_.report.refine.residual_after_px));
     }
     const size_t keep = static_cast<size_t>(std::max(1, options_.history_frames));
     TrimHistory(keep, &working_.frames_painted);
@@ -275,10 +258,11 @@ void PipelineRunner::SetRecording(const std::string& dir) {
 void PipelineRunner::Publish(bool with_painted) {
   working_.playing = playing_;
   if (session_) {  // without one, the status says why (no project, error, connecting)
+    working_.run = session_->run->stats();
     working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
-      working_.live.frames_painted = session_->frames_painted;
+      working_.live.frames_painted = session_->run->stats().frames_painted;
       if (!session_->ended) working_.status += " (live: " + working_.live.state + ")";
     }
   }

@@ -28,6 +28,7 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
+#include "pipeline/run/paint_run.h"
 #include "ui/core/live_session.h"
 
 namespace fresco {
@@ -61,6 +62,9 @@ struct RunnerSnapshot {
   std::shared_ptr<const std::vector<cv::Mat>> painted;  // per buffer BGRA (alpha 0 = never)
   uint64_t painted_version = 0;
   double coverage = 0;
+  // The painting job's counts so far (frames read, painted, without a pose), as `fresco run`
+  // counts them (pipeline/run/paint_run.h).
+  PaintRunStats run;
   // Per painted frame, in order: stage wall times, and the misalignment figure (mean
   // absolute grey difference between the frame and the painted model rendered into its
   // view before the frame was painted; NaN where nothing was painted yet).

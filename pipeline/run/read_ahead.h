@@ -1,4 +1,6 @@
-// Frames for the painting loops of `fresco run` and `fresco bench`.
+// Reads a video source one frame ahead on another thread (decoding a 1280x720 PNG takes
+// about as long as painting it). Next() hands over the frame read in the background and
+// starts reading the one after it.
 #pragma once
 
 #include <future>
@@ -9,16 +11,18 @@
 
 namespace fresco {
 
-// Reads a video source one frame ahead on another thread (decoding a 1280x720 PNG takes
-// about as long as painting it). Next() hands over the frame read in the background and
-// starts reading the one after it.
-class FrameReader {
+class ReadAhead {
  public:
-  explicit FrameReader(VideoSource* video) : video_(video) { Start(); }
-  ~FrameReader() {
+  explicit ReadAhead(VideoSource* video) : video_(video) { Start(); }
+  ~ReadAhead() {
     if (pending_.valid()) pending_.wait();
   }
+  ReadAhead(const ReadAhead&) = delete;
+  ReadAhead& operator=(const ReadAhead&) = delete;
+
+  // False at the end of the video, or on an error (then in `status`); stays so after it.
   bool Next(Frame* frame, Status* status) {
+    if (!pending_.valid()) return false;
     Result r = pending_.get();
     *status = r.status;
     if (!r.ok) return false;

@@ -1,0 +1,40 @@
+// Posed frames from files: each stream's video (a folder of images or a video file) with
+// its poses file (COLMAP images.txt matched by name, TUM matched in order). Several streams
+// are interleaved by frame index: frame 0 of each stream, then frame 1 of each, ... (what
+// cameras recording the same period at the same rate give); a stream that ends leaves the
+// others going on. Each stream is read one frame ahead on its own thread (read_ahead.h).
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/core/project.h"
+#include "pipeline/run/posed_frame_source.h"
+#include "pipeline/run/read_ahead.h"
+
+namespace fresco {
+
+class FileFrameSource : public PosedFrameSource {
+ public:
+  // `streams[i]`: stream i of `project` (Project::Streams() order) loaded with its video
+  // open (LoadCapture); each must outlive the source.
+  FileFrameSource(const Project& project, const std::vector<const Capture*>& streams);
+
+  FrameRead Next(SourcedFrame* frame, Status* status) override;
+  int NumStreams() const override { return static_cast<int>(streams_.size()); }
+  const FrameOrigin& Origin(int stream) const override { return origins_[stream]; }
+  int FrameCount() const override;
+
+ private:
+  // Fills the pose, camera and its identity of a frame of stream `s`.
+  void MatchPose(int s, SourcedFrame* frame) const;
+
+  std::vector<const Capture*> streams_;
+  std::vector<FrameOrigin> origins_;
+  std::vector<std::unique_ptr<ReadAhead>> readers_;
+  std::vector<bool> ended_;
+  int next_ = 0;  // the stream to read from next
+};
+
+}  // namespace fresco

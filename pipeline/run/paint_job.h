@@ -1,0 +1,44 @@
+// A project opened for painting, ready for a PaintRun (paint_run.h): every stream's capture
+// (scene, cameras, poses, video), the PaintSession over the scene, and the source of its
+// posed frames: files read ahead (file_frame_source.h), or the live inputs
+// (live_frame_source.h) for a live project. `fresco run` and `fresco bench` open their
+// projects this way; the app opens the same captures and source for file projects.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/core/project.h"
+#include "pipeline/live/live_input.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/run/posed_frame_source.h"
+
+namespace fresco {
+
+struct PaintJobOptions {
+  // Non-empty: the project must have one stream, else an error naming `streams` and this
+  // ("fresco bench").
+  std::string one_stream_for;
+  // Live projects: keep every tracker pose (a recording writes them; LiveInputs).
+  bool keep_tracker_poses = false;
+};
+
+struct PaintJob {
+  bool live = false;
+  std::vector<Capture> captures;  // one per stream (Project::Streams()); the scene in [0]
+  std::unique_ptr<PaintSession> session;
+  LiveInputs live_inputs;  // live projects only
+  std::unique_ptr<PosedFrameSource> source;
+
+  const Scene& scene() const { return captures[0].scene; }
+};
+
+// Loads and checks every input, builds the session and opens the source (live sources
+// connect here). Errors are bad input (exit 2), naming the file and field. A live project
+// needs one stream.
+Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
+                    std::unique_ptr<PaintJob>* job);
+
+}  // namespace fresco

@@ -1,0 +1,58 @@
+// Where a paint run's frames come from: a source hands out frames one at a time, each with
+// its pose and camera when it has them. Sources read; they do not judge: what a frame
+// without a pose, with an unknown camera or of the wrong size means is decided once, by
+// the frame policy (frame_policy.h), for every source and every client (`fresco run`,
+// `fresco bench`, the app).
+//
+// Sources: FileFrameSource (file_frame_source.h: folders or video files with poses files,
+// several streams interleaved, read ahead on threads) and LiveFrameSource
+// (live_frame_source.h: a live video with a pose feed or a TUM file, matched by time).
+#pragma once
+
+#include <string>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/status.h"
+#include "pipeline/live/live_frames.h"
+
+namespace fresco {
+
+// One frame as a source gives it.
+struct SourcedFrame {
+  PosedFrame posed;                // the frame, and its pose (cam_from_world) when it has one
+  const Camera* camera = nullptr;  // the pose's camera; null without a pose or when unknown
+  int camera_id = -1;              // the pose's CAMERA_ID (-1: the stream's only camera)
+  std::string pose_name;           // the pose's image name as the poses file lists it
+  int pose_index = -1;             // index into the stream's Capture::poses (file sources)
+  int stream = 0;                  // index into Project::Streams()
+};
+
+// The files (or addresses) one stream's frames and poses come from, as messages name them.
+struct FrameOrigin {
+  std::string video;
+  std::string poses;
+};
+
+enum class FrameRead {
+  kFrame,    // a frame was handed out
+  kWaiting,  // none yet (a live source polled with a short wait); ask again
+  kEnded,    // the end of every stream, or an error (then in `status`)
+};
+
+class PosedFrameSource {
+ public:
+  virtual ~PosedFrameSource() = default;
+  // The next frame. kEnded with `status` set: a frame that does not decode, a truncated
+  // video, a pose feed that failed (errors name the file or address).
+  virtual FrameRead Next(SourcedFrame* frame, Status* status) = 0;
+  virtual int NumStreams() const = 0;
+  virtual const FrameOrigin& Origin(int stream) const = 0;
+  // Frames of all streams when known up front, else -1.
+  virtual int FrameCount() const { return -1; }
+  // Why the source ended without an error, for status lines ("end of video").
+  virtual std::string EndReason() const { return "end of video"; }
+  // Stops reading (threads, live captures); Next then ends.
+  virtual void Stop() {}
+};
+
+}  // namespace fresco

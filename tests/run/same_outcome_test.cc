@@ -1,0 +1,148 @@
+// Issue 22: `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner,
+// headless) are thin clients of one painting job, so on the same bad capture they come to
+// the same outcome: the same one-line error (exit 2 for the CLI, "error: ..." as the app's
+// status), or the same counts of frames read, painted and without a pose.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "pipeline/core/project.h"
+#include "tests/run/bad_captures.h"
+#include "tests/test_support.h"
+#include "ui/core/pipeline_runner.h"
+
+namespace fresco {
+namespace {
+
+using testing::BadCapture;
+using testing::CommandResult;
+using testing::MakeTempDir;
+using testing::ReadText;
+using testing::RunFresco;
+
+struct Outcome {
+  std::string error;  // the one-line message without "error: "; "" when the run finished
+  int frames = -1, painted = -1, without_pose = -1;
+};
+
+std::ostream& operator<<(std::ostream& os, const Outcome& o) {
+  return os << "{error '" << o.error << "', frames " << o.frames << ", painted " << o.painted
+            << ", without pose " << o.without_pose << "}";
+}
+
+// A failed command's stderr must be one line "error: MESSAGE" and its exit code 2.
+std::string OneLineError(const CommandResult& r) {
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  std::string line = r.err;
+  if (!line.empty() && line.back() == '\n') line.pop_back();
+  EXPECT_EQ(line.find('\n'), std::string::npos) << "more than one line: " << r.err;
+  EXPECT_EQ(line.rfind("error: ", 0), 0u) << line;
+  return line.rfind("error: ", 0) == 0 ? line.substr(7) : line;
+}
+
+Outcome RunCommand(const std::string& project) {
+  const std::string out = MakeTempDir("same-run") + "/out";
+  const CommandResult r = RunFresco({"run", project, "--out", out, "--quiet"});
+  Outcome o;
+  if (r.exit_code != 0) {
+    o.error = OneLineError(r);
+    return o;
+  }
+  const nlohmann::json m = nlohmann::json::parse(ReadText(out + "/metrics.json"));
+  o.frames = m["frames"], o.painted = m["frames_painted"],
+  o.without_pose = m["frames_without_pose"];
+  return o;
+}
+
+// One run with the project's own settings, no baseline. Held-out frames are posed frames
+// bench scores instead of painting: they count as painted here.
+Outcome BenchCommand(const std::string& project) {
+  const std::string out = MakeTempDir("same-bench") + "/out";
+  const CommandResult r = RunFresco({"bench", project, "--out", out, "--sweep",
+                                     "pipeline.sampling=bilinear", "--no-baseline", "--quiet"});
+  Outcome o;
+  if (r.exit_code != 0) {
+    o.error = OneLineError(r);
+    return o;
+  }
+  const nlohmann::json rows = nlohmann::json::parse(ReadText(out + "/bench.json"));
+  EXPECT_EQ(rows.size(), 1u);
+  const nlohmann::json& row = rows.at(0);
+  EXPECT_EQ(row["holdout_frames"], 1);  // counter 5 of 12 (--holdout 10)
+  o.frames = row["frames"];
+  o.painted = row["frames_painted"].get<int>() + row["holdout_frames"].get<int>();
+  o.without_pose = row["frames_without_pose"];
+  return o;
+}
+
+// The app's worker, played to the end.
+Outcome AppWorker(const std::string& project_json) {
+  Project project;
+  const Status loaded = LoadProject(project_json, {}, &project);
+  EXPECT_TRUE(loaded.ok()) << loaded.message();
+  RunnerOptions options;
+  options.misalignment = false;
+  options.debug_images = false;
+  PipelineRunner runner(options);
+  runner.Restart(project);
+  runner.Play();
+  runner.WaitIdle();
+  const auto snap = runner.Snapshot();
+  Outcome o;
+  if (snap->status.rfind("error: ", 0) == 0) {
+    o.error = snap->status.substr(7);
+    return o;
+  }
+  EXPECT_EQ(snap->status, "end of video");
+  o.frames = snap->run.frames, o.painted = snap->run.frames_painted;
+  o.without_pose = snap->run.frames_without_pose;
+  return o;
+}
+
+class SameOutcomeTest : public ::testing::TestWithParam<BadCapture> {};
+
+TEST_P(SameOutcomeTest, RunBenchAndAppAgree) {
+  const std::string project = testing::MakeBadCapture(GetParam());
+  const Outcome run = RunCommand(project);
+  const Outcome bench = BenchCommand(project);
+  const Outcome app = AppWorker(project);
+  SCOPED_TRACE("run " + ::testing::PrintToString(run));
+  EXPECT_EQ(bench.error, run.error);
+  EXPECT_EQ(app.error, run.error);
+  EXPECT_EQ(bench.frames, run.frames);
+  EXPECT_EQ(app.frames, run.frames);
+  EXPECT_EQ(bench.painted, run.painted);
+  EXPECT_EQ(app.painted, run.painted);
+  EXPECT_EQ(bench.without_pose, run.without_pose);
+  EXPECT_EQ(app.without_pose, run.without_pose);
+  // And the outcome is the policy's (frame_policy.h).
+  const std::string dir = project.substr(0, project.rfind('/'));
+  switch (GetParam()) {
+    case BadCapture::kFramesSmallerThanCamera:
+      EXPECT_EQ(run.error, dir + "/frames/: frame '000000.png' is 80x60 but the camera is 160x120");
+      break;
+    case BadCapture::kUnknownCameraId:
+      EXPECT_NE(run.error.find("image '000003.png'"), std::string::npos);
+      EXPECT_NE(run.error.find("CAMERA_ID 7"), std::string::npos);
+      break;
+    case BadCapture::kMissingPose:
+      EXPECT_EQ(run.error, "");
+      EXPECT_EQ(run.frames, 12);
+      EXPECT_EQ(run.painted, 11);
+      EXPECT_EQ(run.without_pose, 1);
+      break;
+    case BadCapture::kCorruptImage:
+      EXPECT_EQ(run.error.rfind(dir + "/frames/000005.png: ", 0), 0u);
+      break;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(BadCaptures, SameOutcomeTest,
+                         ::testing::ValuesIn(testing::AllBadCaptures()), [](const auto& info) {
+                           std::string name = testing::Describe(info.param);
+                           for (char& c : name)
+                             c = isalnum(static_cast<unsigned char>(c)) ? c : '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace fresco
