@@ -14,6 +14,7 @@ const std::vector<Command>& AllCommands() {
       {"calib", "calibrate camera intrinsics from board images (mrcal)", RunVerbCalib},
       {"poses", "bootstrap or verify poses with COLMAP", RunVerbPoses},
       {"bench", "measure the speed/accuracy trade of pipeline settings", RunVerbBench},
+      {"eval", "score a setting over a suite of synthetic captures", RunVerbEval},
       {"gui", "the authoring app", RunVerbGui},
   };
   return kCommands;

@@ -44,6 +44,7 @@ int RunVerbSynth(const CommandArgs& args);
 int RunVerbCalib(const CommandArgs& args);
 int RunVerbPoses(const CommandArgs& args);
 int RunVerbBench(const CommandArgs& args);
+int RunVerbEval(const CommandArgs& args);
 int RunVerbGui(const CommandArgs& args);
 
 }  // namespace fresco

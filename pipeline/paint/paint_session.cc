@@ -21,6 +21,14 @@ double MsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+// A frame that refinement could not register keeps out of painted texels only when its
+// matches show it misaligned by more than this (texels): otherwise it paints as it would
+// without refinement. Keeping every unregistered frame out froze each texel at its first
+// sample wherever matches were too few (short sequences, small frames: -4.8 dB on a 30-frame
+// street with perfect poses, docs/results.md "Evaluation suite"). Perfect poses measure
+// 0.15-0.45 texels there, 0.5 degree of noise about 2.
+constexpr double kKeepOutMisalignmentPx = 1.0;
+
 bool SameCamera(const Camera& a, const Camera& b) {
   return a.width == b.width && a.height == b.height && a.Params() == b.Params() &&
          a.model == b.model;
@@ -381,9 +389,12 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
     r->moved = true;
   }
   r->anchor_ms = MsSince(t0);
-  if (!e.registered && !e.region.empty()) {
-    // Not registered: it may fill what the buffer lacks but not overwrite registered texels
-    // (which all lie in the region: it bounds where the frame and the buffer overlap).
+  const bool misaligned = (e.inliers > 0 && e.residual_before_px > kKeepOutMisalignmentPx) ||
+                          frame_misalignment_px_ > kKeepOutMisalignmentPx;
+  if (!e.registered && !e.region.empty() && misaligned) {
+    // Not registered and seen misaligned: it may fill what the buffer lacks but not overwrite
+    // registered texels (which all lie in the region: it bounds where the frame and the
+    // buffer overlap).
     KeepOutOfPainted(b, e.region);
     r->kept_out = true;
   }
@@ -414,6 +425,7 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
   report->metrics["pose_translation_m"] = pose.delta.translation.norm();
   report->metrics["pose_model_" + pose.model] = 1;
   report->notes["pose"] = pose.applied ? pose.model : "no pose correction: " + pose.fallback;
+  if (pose.inliers > 0) frame_misalignment_px_ = pose.residual_before_px;
   if (!pose.applied) return;  // the buffers keep their own 2D estimates
   const Rigid3d corrected = pose.delta * frame_cam_from_local_;
   results->resize(todo.size() + fresh.size());
@@ -442,6 +454,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
+  frame_misalignment_px_ = -1;
   std::vector<size_t> todo, fresh;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (seen[b] && painted_[b].painted_surface_texels > 0)

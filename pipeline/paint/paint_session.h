@@ -139,6 +139,9 @@ class PaintSession {
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;
   int frames_seen_ = 0;
+  // This frame's misalignment before correction as the pose fit measured it over every
+  // buffer's matches (RMS over its inliers, pixels); -1 when it could not tell.
+  double frame_misalignment_px_ = -1;
 };
 
 // The automatic texel size: the median depth the cameras see (rasterized at a few of the

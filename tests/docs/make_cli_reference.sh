@@ -48,4 +48,5 @@ block "fresco calib board" calib board
 block "fresco poses verify" poses verify
 block "fresco poses bootstrap" poses bootstrap
 block "fresco bench" bench
+block "fresco eval" eval
 block "fresco gui" gui

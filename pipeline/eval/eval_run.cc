@@ -1,0 +1,164 @@
+#include "pipeline/eval/eval_run.h"
+
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include <opencv2/core/utility.hpp>
+
+#include "pipeline/core/capture.h"
+#include "pipeline/core/project.h"
+#include "pipeline/eval/eval_score.h"
+#include "pipeline/paint/open_project.h"
+#include "pipeline/paint/rephotography.h"
+#include "pipeline/synth/synth_writer.h"
+
+namespace fresco {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The held-out frames of a painting run, with their truth.
+struct HeldOut {
+  Frame frame;
+  Rigid3d given_cam_from_world;
+  int plan_index = 0;  // into the synth plan (true pose, gain)
+};
+
+}  // namespace
+
+Status EvalOptions::Check() const {
+  if (cache_dir.empty()) return Status::Error("cache: no folder for the captures");
+  if (holdout < 2) return Status::Error("holdout: must be >= 2");
+  if (!(leak_threshold > 0 && leak_threshold < 255))
+    return Status::Error("leak_threshold: must be in (0, 255)");
+  return Status::Ok();
+}
+
+Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
+                       const EvalOptions& options, CaptureEval* result) {
+  FRESCO_RETURN_IF_ERROR(options.Check());
+  *result = CaptureEval();
+  result->name = capture.name;
+  result->family = capture.family;
+  SynthJob job;
+  FRESCO_RETURN_IF_ERROR(BuildSuiteCaptureJob(suite, capture, &job));
+  const std::string dir = options.cache_dir + "/" + capture.name;
+  SynthWriteOptions write_options;
+  write_options.skip_if_current = true;
+  write_options.scene_source = job.scene_source;
+  write_options.stop = options.stop;
+  SynthWriteResult written;
+  const auto generate_start = Clock::now();
+  FRESCO_RETURN_IF_ERROR(WriteSynthCapture(job.scene, job.options, dir, write_options, &written));
+  result->generated = !written.skipped;
+  result->generate_seconds = SecondsSince(generate_start);
+  SynthCapture plan;  // true poses, gains, movers (no pixels)
+  FRESCO_RETURN_IF_ERROR(PlanSynthCapture(job.scene, job.options, &plan));
+  std::map<std::string, int> plan_index;
+  for (size_t k = 0; k < plan.true_poses.size(); ++k) plan_index[plan.true_poses[k].name] = k;
+
+  Project project;
+  FRESCO_RETURN_IF_ERROR(LoadProject(dir + "/project.json", options.overrides, &project));
+  cv::setNumThreads(project.pipeline.threads > 0 ? project.pipeline.threads : -1);
+  Capture loaded;
+  std::unique_ptr<PaintSession> session;
+  FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, &loaded, &session));
+
+  std::vector<HeldOut> held_out;
+  std::vector<PaintedFrameCentre> painted_frames;
+  double paint_seconds = 0;
+  Frame frame;
+  Status read_status;
+  FrameReport report;
+  while (loaded.video->Next(&frame, &read_status)) {
+    if (options.stop && options.stop()) return Status::Error(dir + ": interrupted");
+    const int index = result->frames++;
+    const PosedImage* pose = loaded.PoseForFrame(frame);
+    if (!pose || !loaded.CameraFor(*pose)) continue;
+    const auto k = plan_index.find(pose->name);
+    if (k == plan_index.end())
+      return Status::Error(dir + ": frame " + pose->name + " is not in the synth plan");
+    if (index % options.holdout == options.holdout / 2) {
+      held_out.push_back({frame, pose->cam_from_world, k->second});
+      continue;
+    }
+    const auto start = Clock::now();
+    session->PaintFrame(frame, *loaded.CameraFor(*pose), pose->cam_from_world, &report);
+    paint_seconds += SecondsSince(start);
+    if (!report.painted) continue;
+    ++result->painted_frames;
+    painted_frames.push_back({k->second, plan.true_poses[k->second].cam_from_world.Centre()});
+  }
+  FRESCO_RETURN_IF_ERROR(read_status);
+  result->paint_fps = paint_seconds > 0 ? result->painted_frames / paint_seconds : 0.0;
+  result->coverage = session->Coverage();
+  result->has_movers = !plan.movers.empty();
+  result->holdout_frames = static_cast<int>(held_out.size());
+
+  const Scene painted = session->PaintedScene();
+  const Renderer painted_renderer(plan.camera, RenderOptions());
+  RenderOptions clean_options;
+  clean_options.raster.supersample = job.options.supersample;
+  const Renderer clean_renderer(plan.camera, clean_options);
+  long long painted_pixels = 0, leak_pixels = 0;
+  int scored = 0, truth_scored = 0;
+  for (const HeldOut& h : held_out) {
+    if (options.stop && options.stop()) return Status::Error(dir + ": interrupted");
+    const RephotoScore s =
+        ScoreRephoto(painted_renderer, painted, h.given_cam_from_world, h.frame.bgr);
+    result->completeness += s.completeness / held_out.size();
+    if (s.pixels > 0) {
+      result->psnr_db += s.psnr_db, result->one_minus_ncc += s.one_minus_ncc;
+      ++scored;
+    }
+    TruthViewInputs in;
+    in.painted_renderer = &painted_renderer;
+    in.clean_renderer = &clean_renderer;
+    in.painted = &painted;
+    in.truth = &job.scene;
+    in.true_cam_from_world = plan.true_poses[h.plan_index].cam_from_world;
+    in.exposure_gain = plan.exposure_gains[h.plan_index];
+    in.movers = &plan.movers;
+    in.painted_frames = &painted_frames;
+    in.leak_threshold = options.leak_threshold;
+    const TruthViewScore t = ScoreTruthView(in);
+    if (t.painted_pixels > 0) {
+      result->truth_psnr_db += t.psnr_db, result->truth_one_minus_ncc += t.one_minus_ncc;
+      ++truth_scored;
+    }
+    painted_pixels += t.painted_pixels;
+    leak_pixels += t.leak_pixels;
+  }
+  if (scored > 0) result->psnr_db /= scored, result->one_minus_ncc /= scored;
+  if (truth_scored > 0)
+    result->truth_psnr_db /= truth_scored, result->truth_one_minus_ncc /= truth_scored;
+  result->mover_leak = painted_pixels > 0 ? double(leak_pixels) / painted_pixels : 0.0;
+  return Status::Ok();
+}
+
+Status EvaluateSuite(const EvalSuite& suite, const EvalOptions& options,
+                     std::vector<CaptureEval>* results) {
+  results->clear();
+  const int total = static_cast<int>(suite.captures.size());
+  for (int i = 0; i < total; ++i) {
+    const SuiteCapture& c = suite.captures[i];
+    if (options.progress) options.progress(i, total, c.name + " started");
+    CaptureEval r;
+    FRESCO_RETURN_IF_ERROR(EvaluateCapture(suite, c, options, &r));
+    results->push_back(r);
+    if (options.progress) {
+      char line[200];
+      std::snprintf(line, sizeof line, "%s: truth %.2f dB, rephoto %.2f dB, leak %.3f %%, %.0f fps",
+                    c.name.c_str(), r.truth_psnr_db, r.psnr_db, 100 * r.mover_leak, r.paint_fps);
+      options.progress(i + 1, total, line);
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace fresco

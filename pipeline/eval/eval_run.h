@@ -1,0 +1,52 @@
+// Runs one setting over an evaluation suite (eval_suite.h): each capture is generated into
+// the cache (or found current there), painted with the project's settings plus the given
+// overrides while every `holdout`-th frame is held out, and scored on the held-out frames
+// (eval_score.h): rephotography at the given poses, truth at the true poses, mover leak.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/status.h"
+#include "pipeline/eval/eval_suite.h"
+
+namespace fresco {
+
+struct EvalOptions {
+  std::vector<std::string> overrides;  // project settings "KEY=VALUE" (as `fresco run --set`)
+  std::string cache_dir;               // captures are written to CACHE/NAME/
+  int holdout = 10;                    // every N-th frame is held out of painting (>= 2)
+  double leak_threshold = 40.0;        // levels; see TruthViewInputs::leak_threshold
+  // Progress: (captures done, total, a line about the capture just started or finished).
+  std::function<void(int done, int total, const std::string& line)> progress;
+  std::function<bool()> stop;  // checked between frames; true: stop with an error
+  Status Check() const;
+};
+
+// One capture's figures (means over its held-out frames).
+struct CaptureEval {
+  std::string name, family;
+  int frames = 0, painted_frames = 0, holdout_frames = 0;
+  bool generated = false;  // false: the cached capture was current
+  double generate_seconds = 0;
+  double paint_fps = 0;  // painted frames per second spent in PaintFrame
+  double psnr_db = 0;    // rephotography at the given poses
+  double one_minus_ncc = 0;
+  double completeness = 0;   // surface pixels of the held-out views that are painted
+  double truth_psnr_db = 0;  // at the true poses against the clean scene
+  double truth_one_minus_ncc = 0;
+  bool has_movers = false;
+  double mover_leak = 0;  // painted pixels showing a mover / painted pixels (truth views)
+  double coverage = 0;    // on-surface texels painted
+};
+
+// Generates (or finds current) and evaluates one capture.
+Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
+                       const EvalOptions& options, CaptureEval* result);
+
+// Every capture in order.
+Status EvaluateSuite(const EvalSuite& suite, const EvalOptions& options,
+                     std::vector<CaptureEval>* results);
+
+}  // namespace fresco

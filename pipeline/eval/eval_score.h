@@ -1,0 +1,61 @@
+// Scores of a painted model on one held-out frame of a synthetic capture, where the truth
+// is known: the frame's true pose, its exposure gain, and where the moving objects were.
+//
+//   rephotography  the painted model rendered at the frame's GIVEN pose against the frame
+//                  itself (movers, exposure and all): what a user without truth can measure
+//                  (rephotography.h);
+//   truth          the painted model rendered at the TRUE pose against the static scene
+//                  rendered there with the frame's exposure gain (no movers): how close the
+//                  painted texture is to the true one where it is seen;
+//   mover leak     of the painted pixels in that truth view, those that are off the clean
+//                  render by more than `leak_threshold` levels (any channel) at a surface
+//                  point that a mover hid from the camera in at least one painted frame:
+//                  painted pixels showing a mover.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/rigid3.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/paint/rephotography.h"
+#include "pipeline/render/renderer.h"
+#include "pipeline/synth/movers.h"
+
+namespace fresco {
+
+// Where the camera was (true centre, world) at each painted frame, to tell which surface
+// points a mover hid at some time.
+struct PaintedFrameCentre {
+  int frame = 0;
+  Eigen::Vector3d centre_world = Eigen::Vector3d::Zero();
+};
+
+struct TruthViewInputs {
+  const Renderer* painted_renderer = nullptr;  // the capture's camera, 1 sample per pixel
+  const Renderer* clean_renderer = nullptr;    // the same camera, the capture's supersampling
+  const Scene* painted = nullptr;              // PaintSession::PaintedScene()
+  const Scene* truth = nullptr;                // the static scene the frames were made of
+  Rigid3d true_cam_from_world;
+  double exposure_gain = 1.0;
+  const std::vector<MoverOptions>* movers = nullptr;
+  const std::vector<PaintedFrameCentre>* painted_frames = nullptr;
+  double leak_threshold = 40.0;  // levels (0..255), largest channel difference
+};
+
+struct TruthViewScore {
+  double psnr_db = 0;        // painted vs clean, where both show the surface and it is painted
+  double one_minus_ncc = 0;  // the same pixels, gain- and offset-invariant
+  long long painted_pixels = 0;
+  long long leak_pixels = 0;  // painted pixels showing a mover
+};
+
+TruthViewScore ScoreTruthView(const TruthViewInputs& inputs);
+
+// Does the segment from `from` to `to` pass within `radius` of `centre`?
+bool SegmentNearPoint(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                      const Eigen::Vector3d& centre, double radius);
+
+}  // namespace fresco

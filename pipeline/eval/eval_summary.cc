@@ -1,0 +1,150 @@
+#include "pipeline/eval/eval_summary.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+
+#include <nlohmann/json.hpp>
+
+namespace fresco {
+namespace {
+
+using json = nlohmann::json;
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// `higher_is_worse`: the worst is the largest value.
+FigureSpread Spread(const std::vector<const CaptureEval*>& group,
+                    const std::function<double(const CaptureEval&)>& figure, bool higher_is_worse,
+                    bool movers_only = false) {
+  std::vector<double> values;
+  for (const CaptureEval* c : group)
+    if (!movers_only || c->has_movers) values.push_back(figure(*c));
+  FigureSpread s;
+  s.count = static_cast<int>(values.size());
+  if (values.empty()) return s;
+  s.median = Median(values);
+  s.worst = higher_is_worse ? *std::max_element(values.begin(), values.end())
+                            : *std::min_element(values.begin(), values.end());
+  return s;
+}
+
+FamilySummary Summarize(const std::string& family, const std::vector<const CaptureEval*>& group) {
+  FamilySummary f;
+  f.family = family;
+  f.captures = static_cast<int>(group.size());
+  f.truth_psnr_db = Spread(
+      group, [](const CaptureEval& c) { return c.truth_psnr_db; }, false);
+  f.truth_one_minus_ncc = Spread(
+      group, [](const CaptureEval& c) { return c.truth_one_minus_ncc; }, true);
+  f.psnr_db = Spread(
+      group, [](const CaptureEval& c) { return c.psnr_db; }, false);
+  f.one_minus_ncc = Spread(
+      group, [](const CaptureEval& c) { return c.one_minus_ncc; }, true);
+  f.mover_leak = Spread(
+      group, [](const CaptureEval& c) { return c.mover_leak; }, true, true);
+  f.paint_fps = Spread(
+      group, [](const CaptureEval& c) { return c.paint_fps; }, false);
+  f.coverage = Spread(
+      group, [](const CaptureEval& c) { return c.coverage; }, false);
+  return f;
+}
+
+json SpreadJson(const FigureSpread& s) {
+  if (s.count == 0) return nullptr;
+  return {{"median", s.median}, {"worst", s.worst}, {"captures", s.count}};
+}
+
+}  // namespace
+
+std::vector<FamilySummary> SummarizeByFamily(const std::vector<CaptureEval>& results) {
+  std::vector<std::string> order;
+  for (const CaptureEval& c : results)
+    if (std::find(order.begin(), order.end(), c.family) == order.end()) order.push_back(c.family);
+  std::vector<FamilySummary> out;
+  std::vector<const CaptureEval*> all;
+  for (const CaptureEval& c : results) all.push_back(&c);
+  for (const std::string& family : order) {
+    std::vector<const CaptureEval*> group;
+    for (const CaptureEval& c : results)
+      if (c.family == family) group.push_back(&c);
+    out.push_back(Summarize(family, group));
+  }
+  out.push_back(Summarize("all", all));
+  return out;
+}
+
+std::string EvalToJson(const std::vector<std::string>& settings,
+                       const std::vector<CaptureEval>& results,
+                       const std::vector<FamilySummary>& families) {
+  json root;
+  root["settings"] = settings;
+  root["captures"] = json::array();
+  for (const CaptureEval& c : results) {
+    json row = {
+        {"name", c.name},
+        {"family", c.family},
+        {"frames", c.frames},
+        {"painted_frames", c.painted_frames},
+        {"holdout_frames", c.holdout_frames},
+        {"generated", c.generated},
+        {"generate_seconds", c.generate_seconds},
+        {"paint_fps", c.paint_fps},
+        {"psnr_db", c.psnr_db},
+        {"one_minus_ncc", c.one_minus_ncc},
+        {"completeness", c.completeness},
+        {"coverage", c.coverage},
+        {"truth", {{"psnr_db", c.truth_psnr_db}, {"one_minus_ncc", c.truth_one_minus_ncc}}}};
+    row["mover_leak"] = c.has_movers ? json(c.mover_leak) : json(nullptr);
+    root["captures"].push_back(row);
+  }
+  root["families"] = json::array();
+  for (const FamilySummary& f : families) {
+    root["families"].push_back({{"family", f.family},
+                                {"captures", f.captures},
+                                {"truth_psnr_db", SpreadJson(f.truth_psnr_db)},
+                                {"truth_one_minus_ncc", SpreadJson(f.truth_one_minus_ncc)},
+                                {"psnr_db", SpreadJson(f.psnr_db)},
+                                {"one_minus_ncc", SpreadJson(f.one_minus_ncc)},
+                                {"mover_leak", SpreadJson(f.mover_leak)},
+                                {"paint_fps", SpreadJson(f.paint_fps)},
+                                {"coverage", SpreadJson(f.coverage)}});
+  }
+  return root.dump(2) + "\n";
+}
+
+std::string EvalToText(const std::vector<CaptureEval>& results,
+                       const std::vector<FamilySummary>& families) {
+  std::string out =
+      "| capture | family | truth PSNR dB | truth 1-NCC | rephoto PSNR dB | rephoto 1-NCC | "
+      "mover leak % | coverage % | paint fps |\n|---|---|---|---|---|---|---|---|---|\n";
+  char line[400];
+  for (const CaptureEval& c : results) {
+    char leak[32] = "-";
+    if (c.has_movers) std::snprintf(leak, sizeof leak, "%.3f", 100 * c.mover_leak);
+    std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.4f | %.2f | %.4f | %s | %.1f | %.0f |\n",
+                  c.name.c_str(), c.family.c_str(), c.truth_psnr_db, c.truth_one_minus_ncc,
+                  c.psnr_db, c.one_minus_ncc, leak, 100 * c.coverage, c.paint_fps);
+    out += line;
+  }
+  out +=
+      "\n| family | captures | truth PSNR dB median / worst | rephoto PSNR dB median / worst | "
+      "mover leak % median / worst | paint fps median / worst |\n|---|---|---|---|---|---|\n";
+  for (const FamilySummary& f : families) {
+    char leak[48] = "-";
+    if (f.mover_leak.count > 0)
+      std::snprintf(leak, sizeof leak, "%.3f / %.3f", 100 * f.mover_leak.median,
+                    100 * f.mover_leak.worst);
+    std::snprintf(line, sizeof line, "| %s | %d | %.2f / %.2f | %.2f / %.2f | %s | %.0f / %.0f |\n",
+                  f.family.c_str(), f.captures, f.truth_psnr_db.median, f.truth_psnr_db.worst,
+                  f.psnr_db.median, f.psnr_db.worst, leak, f.paint_fps.median, f.paint_fps.worst);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace fresco

@@ -1,0 +1,37 @@
+// The distribution of a suite's figures: per family and over all captures, the median and
+// the worst of each figure (lowest PSNR, coverage and fps; highest 1-NCC and mover leak;
+// mover leak over the captures that have movers only). Written as JSON and as a text table.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/eval/eval_run.h"
+
+namespace fresco {
+
+struct FigureSpread {
+  double median = 0, worst = 0;
+  int count = 0;  // captures it is taken over (0: none, e.g. no movers in the family)
+};
+
+struct FamilySummary {
+  std::string family;  // "all" for the whole suite
+  int captures = 0;
+  FigureSpread truth_psnr_db, truth_one_minus_ncc, psnr_db, one_minus_ncc, mover_leak, paint_fps,
+      coverage;
+};
+
+// Families in order of first appearance, then "all".
+std::vector<FamilySummary> SummarizeByFamily(const std::vector<CaptureEval>& results);
+
+// {"settings": [...], "captures": [...], "families": [...]} (pretty-printed).
+std::string EvalToJson(const std::vector<std::string>& settings,
+                       const std::vector<CaptureEval>& results,
+                       const std::vector<FamilySummary>& families);
+
+// Per capture one line, then per family median and worst (Markdown table).
+std::string EvalToText(const std::vector<CaptureEval>& results,
+                       const std::vector<FamilySummary>& families);
+
+}  // namespace fresco
