@@ -159,7 +159,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   metrics["base_buffers"] = session->buffers().size();
   metrics["texel_size_m"] = session->default_texel_size_m();
   metrics["groups_split_for_folds"] = session->folds_split();
-  const ChartStretch stretch = MeasureChartStretch(scene.mesh, session->grouping());
+  const ChartStretch stretch = MeasureBufferStretch(scene.mesh, session->buffers());
   metrics["charts"] = {{"count", session->buffers().size()},
                        {"max_stretch", stretch.max},
                        {"mean_stretch", stretch.mean}};

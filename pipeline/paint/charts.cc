@@ -179,12 +179,17 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
   return grouping;
 }
 
-ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& grouping) {
+namespace {
+
+// Area-weighted stretch 1/cos of triangles against the plane normals given per group.
+template <class Groups, class NormalOf, class TrianglesOf>
+ChartStretch StretchOf(const TriangleMesh& mesh, const Groups& groups, const NormalOf& normal_of,
+                       const TrianglesOf& triangles_of) {
   ChartStretch s;
   double weighted = 0.0, area = 0.0;
-  for (const BaseBufferGroup& group : grouping.groups) {
-    const Eigen::Vector3d normal = GroupNormal(mesh, group);
-    for (int t : group.triangles) {
+  for (const auto& group : groups) {
+    const Eigen::Vector3d normal = normal_of(group);
+    for (int t : triangles_of(group)) {
       const double c = mesh.Normal(t).dot(normal);
       const double stretch = c > 1e-6 ? 1.0 / c : std::numeric_limits<double>::infinity();
       const double a = mesh.Area(t);
@@ -195,6 +200,20 @@ ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& group
   }
   if (area > 0) s.mean = weighted / area;
   return s;
+}
+
+}  // namespace
+
+ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& grouping) {
+  return StretchOf(
+      mesh, grouping.groups, [&](const BaseBufferGroup& g) { return GroupNormal(mesh, g); },
+      [](const BaseBufferGroup& g) -> const std::vector<int>& { return g.triangles; });
+}
+
+ChartStretch MeasureBufferStretch(const TriangleMesh& mesh, const std::vector<BaseBuffer>& buffers) {
+  return StretchOf(
+      mesh, buffers, [](const BaseBuffer& b) { return b.normal; },
+      [](const BaseBuffer& b) -> const std::vector<int>& { return b.triangles; });
 }
 
 }  // namespace fresco

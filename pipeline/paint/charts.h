@@ -16,8 +16,11 @@
 // would still fold in their plane are split when their buffers are built (base_buffer.h).
 #pragma once
 
+#include <vector>
+
 #include "pipeline/core/project.h"
 #include "pipeline/core/scene.h"
+#include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/grouping.h"
 
 namespace fresco {
@@ -40,5 +43,10 @@ struct ChartStretch {
   double mean = 1.0;
 };
 ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& grouping);
+// The same, each triangle against the plane its base buffer actually projects it onto (what
+// `metrics.json` reports): after fold splits a triangle facing away from its chart's plane
+// has moved to a buffer of its own, so this is finite (at most 1000: BuildBaseBuffers moves
+// out anything steeper).
+ChartStretch MeasureBufferStretch(const TriangleMesh& mesh, const std::vector<BaseBuffer>& buffers);
 
 }  // namespace fresco

@@ -89,6 +89,12 @@ TEST(Charts, ChartsNeverFoldInTheirBuffers) {
   BaseBufferOptions buffer_options;
   buffer_options.texel_size_m = scale.texel_size_m;
   const BaseBufferSet set = BuildBaseBuffers(mesh, charts, buffer_options);
+  // Against the planes the buffers project onto, every triangle faces its buffer: finite
+  // stretch, at most the 1000 that BuildBaseBuffers allows.
+  const ChartStretch stretch = MeasureBufferStretch(mesh, set.buffers);
+  EXPECT_GE(stretch.max, 1.0);
+  EXPECT_LE(stretch.max, 1000.0);
+  EXPECT_LT(stretch.mean, 1.5);
   for (const BaseBuffer& b : set.buffers) {
     // Folding would put two triangles over one texel: the triangles' projected areas would
     // add up to more than the texels they cover.
