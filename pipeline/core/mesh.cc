@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <tuple>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -94,24 +95,45 @@ std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, doub
   auto cell_of = [&](double v) {
     return static_cast<int64_t>(std::clamp(std::floor(v / cell), -kMaxCell, kMaxCell));
   };
-  std::unordered_map<CellKey, std::vector<int>, CellKeyHash> grid;
-  grid.reserve(static_cast<size_t>(n));
+  // Vertices sorted by cell, and each occupied cell's run in that order (no list per cell:
+  // a 10^6-vertex mesh would allocate 10^6 of them).
+  std::vector<CellKey> key_of(n);
+  std::vector<int> order;
+  order.reserve(n);
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d& p = vertices[i];
     if (!p.allFinite()) continue;  // never welded
-    const CellKey key{cell_of(p.x()), cell_of(p.y()), cell_of(p.z())};
+    key_of[i] = {cell_of(p.x()), cell_of(p.y()), cell_of(p.z())};
+    order.push_back(i);
+  }
+  const auto key_less = [&](int a, int b) {
+    const CellKey &ka = key_of[a], &kb = key_of[b];
+    return std::tie(ka.x, ka.y, ka.z, a) < std::tie(kb.x, kb.y, kb.z, b);
+  };
+  std::sort(order.begin(), order.end(), key_less);
+  std::unordered_map<CellKey, std::pair<int, int>, CellKeyHash> runs;  // [begin, end) in order
+  runs.reserve(order.size());
+  for (int r = 0; r < static_cast<int>(order.size());) {
+    int end = r + 1;
+    while (end < static_cast<int>(order.size()) && key_of[order[end]] == key_of[order[r]]) ++end;
+    runs.emplace(key_of[order[r]], std::make_pair(r, end));
+    r = end;
+  }
+  for (int i : order) {
+    const Eigen::Vector3d& p = vertices[i];
+    const CellKey& key = key_of[i];
     for (int64_t dx = -1; dx <= 1; ++dx) {
       for (int64_t dy = -1; dy <= 1; ++dy) {
         for (int64_t dz = -1; dz <= 1; ++dz) {
-          auto it = grid.find({key.x + dx, key.y + dy, key.z + dz});
-          if (it == grid.end()) continue;
-          for (int j : it->second) {
-            if ((vertices[j] - p).squaredNorm() <= tolerance2) sets.Union(i, j);
+          auto it = runs.find({key.x + dx, key.y + dy, key.z + dz});
+          if (it == runs.end()) continue;
+          for (int r = it->second.first; r < it->second.second; ++r) {
+            const int j = order[r];
+            if (j != i && (vertices[j] - p).squaredNorm() <= tolerance2) sets.Union(i, j);
           }
         }
       }
     }
-    grid[key].push_back(i);
   }
   std::vector<int> canonical(n);
   for (int i = 0; i < n; ++i) canonical[i] = sets.Find(i);
@@ -126,13 +148,15 @@ MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m
   const int num_triangles = mesh.NumTriangles();
   adjacency.edge_neighbours.resize(num_triangles);
 
-  // Undirected welded edge -> (triangle, edge k) entries.
+  // Undirected welded edges with their (triangle, edge k), sorted by edge: the uses of one
+  // edge are a run (one array, no list per edge).
   struct EdgeUse {
+    uint64_t key;
     int tri;
     int k;
   };
-  std::unordered_map<uint64_t, std::vector<EdgeUse>> edges;
-  edges.reserve(static_cast<size_t>(num_triangles) * 2);
+  std::vector<EdgeUse> uses;
+  uses.reserve(static_cast<size_t>(num_triangles) * 3);
   const int num_vertices = static_cast<int>(mesh.vertices.size());
   auto welded = [&](int v) { return v >= 0 && v < num_vertices ? adjacency.welded_vertex[v] : -1; };
   for (int t = 0; t < num_triangles; ++t) {
@@ -142,20 +166,24 @@ MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m
       if (a < 0 || b < 0 || a == b) continue;  // invalid or collapsed edge
       const uint64_t key =
           (static_cast<uint64_t>(std::min(a, b)) << 32) | static_cast<uint32_t>(std::max(a, b));
-      edges[key].push_back({t, k});
+      uses.push_back({key, t, k});
     }
   }
-  for (const auto& [key, uses] : edges) {
-    if (uses.size() < 2) continue;
-    for (const EdgeUse& use : uses) {
-      std::vector<int>& list = adjacency.edge_neighbours[use.tri][use.k];
-      for (const EdgeUse& other : uses) {
-        if (other.tri == use.tri) continue;
-        if (std::find(list.begin(), list.end(), other.tri) == list.end()) {
-          list.push_back(other.tri);
-        }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+    return std::tie(a.key, a.tri, a.k) < std::tie(b.key, b.tri, b.k);
+  });
+  for (size_t r = 0; r < uses.size();) {
+    size_t end = r + 1;
+    while (end < uses.size() && uses[end].key == uses[r].key) ++end;
+    for (size_t u = r; end - r >= 2 && u < end; ++u) {
+      std::vector<int>& list = adjacency.edge_neighbours[uses[u].tri][uses[u].k];
+      for (size_t o = r; o < end; ++o) {
+        const int other = uses[o].tri;
+        if (other == uses[u].tri) continue;
+        if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
       }
     }
+    r = end;
   }
   // Deterministic order regardless of hash-map iteration.
   for (auto& tri_lists : adjacency.edge_neighbours) {
