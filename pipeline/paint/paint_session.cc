@@ -354,11 +354,6 @@ void PaintSession::EstimateBuffer(size_t b, bool debug, BufferRefinement* r) {
         ResidualHeatMap(w.bgr, w.valid, painted.bgra, e.region);
 }
 
-void PaintSession::RefineBuffer(size_t b, bool debug, BufferRefinement* r) {
-  EstimateBuffer(b, debug, r);
-  FinishBuffer(b, debug, r);
-}
-
 void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   WarpedBuffer& w = warped_[b];
   PaintedBuffer& painted = painted_[b];
@@ -484,8 +479,16 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     CorrectThroughPose(todo, fresh, &results, &report);
     if (results.size() > todo.size()) todo.insert(todo.end(), fresh.begin(), fresh.end());
     for_each_buffer(&PaintSession::FinishBuffer);
-  } else {  // each buffer on its own: one pass
-    for_each_buffer(&PaintSession::RefineBuffer);
+  } else {  // each buffer on its own; the frame's misalignment pooled over their inliers
+    for_each_buffer(&PaintSession::EstimateBuffer);
+    double sum_sq = 0;
+    int pooled = 0;
+    for (const BufferRefinement& r : results) {
+      sum_sq += r.estimate.inliers * r.estimate.residual_before_px * r.estimate.residual_before_px;
+      pooled += r.estimate.inliers;
+    }
+    if (pooled > 0) frame_misalignment_px_ = std::sqrt(sum_sq / pooled);
+    for_each_buffer(&PaintSession::FinishBuffer);
   }
 
   int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, ambiguous = 0, moved = 0,

@@ -113,10 +113,8 @@ class PaintSession {
   void KeepOutOfPainted(size_t b, const cv::Rect& roi);
   // Registers the frame's warped buffer `b` to what it holds (fills result->estimate).
   void EstimateBuffer(size_t b, bool debug, BufferRefinement* result);
-  // Applies the estimate: warps again, anchors, keeps unregistered frames out.
+  // Applies the estimate: warps again, anchors, keeps unregistered misaligned frames out.
   void FinishBuffer(size_t b, bool debug, BufferRefinement* result);
-  // Both, for one buffer on its own (refine.pose off).
-  void RefineBuffer(size_t b, bool debug, BufferRefinement* result);
   // Replaces the buffers' estimates by what one correction of the frame's pose implies
   // (refine_pose.h); `fresh`: buffers seen but never painted, which get it too.
   void CorrectThroughPose(const std::vector<size_t>& todo, const std::vector<size_t>& fresh,
@@ -139,8 +137,9 @@ class PaintSession {
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;
   int frames_seen_ = 0;
-  // This frame's misalignment before correction as the pose fit measured it over every
-  // buffer's matches (RMS over its inliers, pixels); -1 when it could not tell.
+  // This frame's misalignment before correction, measured over every buffer's matches (the
+  // pose fit's RMS over its inliers, pixels; without pose correction the RMS over every
+  // buffer's inliers, texels); -1 when it could not tell.
   double frame_misalignment_px_ = -1;
 };
 
