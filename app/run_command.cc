@@ -41,7 +41,7 @@ ArgSpec RunSpec() {
       "  --quiet           no progress on stderr\n"
       "  --record DIR      (live sources) also write the session as a project to replay:\n"
       "                    DIR/frames/, DIR/poses.txt, DIR/project.json\n\n"
-      "Live sources (README \"Live capture\"): `video` may be device:N or a stream URL\n"
+      "Live sources (docs/guide/live.md): `video` may be device:N or a stream URL\n"
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
       "by time (+ time_offset_s, estimated with live.estimate_offset); the run ends when\n"
