@@ -262,12 +262,6 @@ const BaseBuffer::Chunk& BaseBuffer::ChunkOf(int k) const {
   return *std::prev(it);
 }
 
-Eigen::Vector3f BaseBuffer::Point(int k) const {
-  const Chunk& c = ChunkOf(k);
-  return c.bounds_min +
-         Eigen::Vector3f(point_qx[k], point_qy[k], point_qz[k]).cwiseProduct(c.point_step);
-}
-
 Eigen::Vector2d BaseBuffer::TexelCoords(const Eigen::Vector3d& local_point) const {
   const Eigen::Vector3d d = local_point - origin;
   return Eigen::Vector2d(d.dot(axis_u) / texel_size_m, d.dot(axis_v) / texel_size_m);

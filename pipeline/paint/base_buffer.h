@@ -57,8 +57,13 @@ struct BaseBuffer {
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();
 
   int NumTexels() const { return static_cast<int>(texel_index.size()); }
-  // Texel k's model point (local coordinates) and normal, dequantized.
-  Eigen::Vector3f Point(int k) const;
+  // Texel k's model point (local coordinates) and normal, dequantized. PointIn takes the
+  // chunk holding k (loops over chunks need no search); Point finds it.
+  Eigen::Vector3f PointIn(const Chunk& chunk, int k) const {
+    return chunk.bounds_min +
+           Eigen::Vector3f(point_qx[k], point_qy[k], point_qz[k]).cwiseProduct(chunk.point_step);
+  }
+  Eigen::Vector3f Point(int k) const { return PointIn(ChunkOf(k), k); }
   Eigen::Vector3f Normal(int k) const {
     return Eigen::Vector3f(normal_qx[k], normal_qy[k], normal_qz[k]) / kNormalScale;
   }

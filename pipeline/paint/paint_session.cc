@@ -726,8 +726,9 @@ void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
     w.valid = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
     w.valid_box = cv::Rect(0, 0, buffer.width, buffer.height);
     w.quality = cv::Mat::ones(buffer.height, buffer.width, CV_32F);
-    for (int k = 0; k < buffer.NumTexels(); ++k) {
-      const Eigen::Vector3d p = cam_from_local * buffer.Point(k).cast<double>();
+    for (const BaseBuffer::Chunk& chunk : buffer.chunks)
+    for (int k = chunk.begin; k < chunk.end; ++k) {
+      const Eigen::Vector3d p = cam_from_local * buffer.PointIn(chunk, k).cast<double>();
       Eigen::Vector2d pixel;
       if (p.z() <= 0 || !camera.Project(p, &pixel)) continue;
       const int u = static_cast<int>(std::lround(pixel.x())),
