@@ -2,6 +2,10 @@
 
 #include <exception>
 #include <iostream>
+#include <new>
+#include <string>
+
+#include <opencv2/core.hpp>
 
 namespace fresco {
 
@@ -29,6 +33,19 @@ static void PrintMainUsage(std::ostream& out) {
   }
 }
 
+namespace {
+
+// What a user can do when the machine runs out of memory (outputs are all or nothing, so
+// nothing was half-written).
+std::string OutOfMemoryMessage(const std::string& verb) {
+  return "fresco " + verb +
+         ": out of memory (files already there are left as they were); fewer texels (a larger pipeline.texel_size_m "
+         "or a smaller pipeline.max_buffer_texels) or fewer charts (a larger "
+         "grouping.min_chart_texels) need less";
+}
+
+}  // namespace
+
 int Dispatch(const std::vector<std::string>& argv) {
   if (argv.empty()) {
     PrintMainUsage(std::cerr);
@@ -47,6 +64,16 @@ int Dispatch(const std::vector<std::string>& argv) {
     if (verb != c.verb) continue;
     try {
       return c.run(CommandArgs(argv.begin() + 1, argv.end()));
+    } catch (const std::bad_alloc&) {
+      std::cerr << OutOfMemoryMessage(verb) << "\n";
+      return kExitFailure;
+    } catch (const cv::Exception& e) {
+      if (e.code == cv::Error::StsNoMem) {
+        std::cerr << OutOfMemoryMessage(verb) << "\n";
+        return kExitFailure;
+      }
+      std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";
+      return kExitFailure;
     } catch (const std::exception& e) {
       std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";
       return kExitFailure;

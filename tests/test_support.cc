@@ -1,6 +1,7 @@
 #include "tests/test_support.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -68,7 +69,7 @@ std::string ReadText(const std::string& path) {
   return ss.str();
 }
 
-StartedCommand StartFresco(const std::vector<std::string>& args) {
+StartedCommand StartFresco(const std::vector<std::string>& args, long long address_space_bytes) {
   const char* env = std::getenv("FRESCO_BINARY");
 #ifdef FRESCO_TEST_BINARY
   const std::string binary = env ? env : FRESCO_TEST_BINARY;  // as CMake knows it
@@ -87,6 +88,11 @@ StartedCommand StartFresco(const std::vector<std::string>& args) {
     dup2(out_fd, 1);
     dup2(err_fd, 2);
     dup2(null_fd, 0);
+    if (address_space_bytes > 0) {
+      const rlimit limit{static_cast<rlim_t>(address_space_bytes),
+                         static_cast<rlim_t>(address_space_bytes)};
+      setrlimit(RLIMIT_AS, &limit);
+    }
     // "--xvfb" first: run under xvfb-run with a 1600x1000 screen (GUI tests).
     const bool xvfb = !args.empty() && args[0] == "--xvfb";
     static const std::string kXvfb = "/usr/bin/xvfb-run", kA = "-a", kS = "-s",

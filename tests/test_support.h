@@ -35,7 +35,10 @@ struct StartedCommand {
   int pid = -1;
   std::string out_path, err_path;
 };
-StartedCommand StartFresco(const std::vector<std::string>& args);
+// `address_space_bytes` > 0: the child's address space is limited to it (RLIMIT_AS), so
+// that allocations beyond it fail as they do on a machine out of memory.
+StartedCommand StartFresco(const std::vector<std::string>& args,
+                           long long address_space_bytes = 0);
 // Waits for it to end; exit_code is 128 + the signal when a signal ended it.
 CommandResult WaitFresco(const StartedCommand& command);
 

@@ -11,9 +11,10 @@ namespace fresco {
 namespace {
 
 // A float copy of the camera for the hot loop (local coordinates keep values small, so
-// float is ample: 1e-4 px at 1280 px). The same formulas as Camera::Project.
+// float is ample: 1e-4 px at 1280 px). ProjectChunkBody applies Camera::Project's formulas.
 struct Projector {
   float fx, fy, cx, cy, k1, k2, k3, k4, k5, k6, p1, p2, fold_r2;
+  bool rational;  // k4..k6 not all 0
   explicit Projector(const Camera& c)
       : fx(c.fx),
         fy(c.fy),
@@ -28,28 +29,8 @@ struct Projector {
         p1(c.p1),
         p2(c.p2),
         fold_r2(std::isfinite(c.fold_r2) ? static_cast<float>(c.fold_r2)
-                                         : std::numeric_limits<float>::infinity()) {}
-
-  // `p` in the camera frame with p.z > 0. False beyond the lens's fold.
-  template <bool kDistorted>
-  inline bool Project(const Eigen::Vector3f& p, float* u, float* v) const {
-    const float inv_z = 1.0f / p.z();
-    const float x = p.x() * inv_z, y = p.y() * inv_z;
-    if constexpr (!kDistorted) {
-      *u = fx * x + cx;
-      *v = fy * y + cy;
-      return true;
-    } else {
-      const float r2 = x * x + y * y;
-      const float num = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-      const float den = 1.0f + r2 * (k4 + r2 * (k5 + r2 * k6));
-      const float f = num / den;
-      const float two_xy = 2.0f * x * y;
-      *u = fx * (x * f + p1 * two_xy + p2 * (r2 + 2.0f * x * x)) + cx;
-      *v = fy * (y * f + p1 * (r2 + 2.0f * y * y) + p2 * two_xy) + cy;
-      return r2 <= fold_r2;
-    }
-  }
+                                         : std::numeric_limits<float>::infinity()),
+        rational(c.k4 != 0.0 || c.k5 != 0.0 || c.k6 != 0.0) {}
 };
 
 inline void SampleBilinear(const cv::Mat& img, float u, float v, uint8_t out[3]) {
@@ -72,6 +53,7 @@ inline void SampleBilinear(const cv::Mat& img, float u, float v, uint8_t out[3])
 struct Counts {
   int in_view = 0, visible = 0, occluded = 0, grazing = 0, culled = 0;
   long long tested = 0;
+  PaintUpdateStats paint;  // when painting directly
 };
 
 // Everything the kernel needs, resolved once per buffer and frame.
@@ -90,6 +72,10 @@ struct KernelContext {
   uint8_t* out_bgr;
   uint8_t* out_valid;
   float* out_quality;
+  // Painting directly (WarpAndPaintBuffer): the buffer's texels and the rule.
+  uint8_t* paint_bgra = nullptr;
+  float* paint_quality = nullptr;
+  TexelUpdateRule rule;
 };
 
 // True when the box lies wholly behind the near plane or outside one side of the view
@@ -132,7 +118,11 @@ struct ChunkProjection {
   int32_t code[kMax];
 };
 
-template <bool kDistorted>
+// The lens terms the loop evaluates: none, the polynomial radial and tangential terms, or
+// those and the rational denominator (k4..k6; most lenses have none: one division less).
+enum class LensTerms { kNone, kPolynomial, kRational };
+
+template <LensTerms kLens>
 __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext& k,
                                                             const BaseBuffer& buffer,
                                                             const BaseBuffer::Chunk& chunk,
@@ -197,14 +187,14 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
     const float x = px * inv_z, y = py * inv_z;
     float uu, vv;
     int inside_fold = 1;
-    if constexpr (!kDistorted) {
+    if constexpr (kLens == LensTerms::kNone) {
       uu = fx * x + cx;
       vv = fy * y + cy;
     } else {
       const float r2 = x * x + y * y;
       const float num = 1.0f + r2 * (k1 + r2 * (k2 + r2 * k3));
-      const float den = 1.0f + r2 * (k4 + r2 * (k5 + r2 * k6));
-      const float f = num / den;
+      float f = num;
+      if constexpr (kLens == LensTerms::kRational) f /= 1.0f + r2 * (k4 + r2 * (k5 + r2 * k6));
       const float two_xy = 2.0f * x * y;
       uu = fx * (x * f + p1 * two_xy + p2 * (r2 + 2.0f * x * x)) + cx;
       vv = fy * (y * f + p1 * (r2 + 2.0f * y * y) + p2 * two_xy) + cy;
@@ -239,19 +229,22 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
 __attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
-  ProjectChunkBody<false>(k, buffer, chunk, out);
+  ProjectChunkBody<LensTerms::kNone>(k, buffer, chunk, out);
 }
 
 __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
-  ProjectChunkBody<true>(k, buffer, chunk, out);
+  if (k.projector.rational)
+    ProjectChunkBody<LensTerms::kRational>(k, buffer, chunk, out);
+  else
+    ProjectChunkBody<LensTerms::kPolynomial>(k, buffer, chunk, out);
 }
 
 // Pass 2, texel by texel for those in view: the depth test and the sample. Works on local
 // copies of what it reads: its outputs are written through byte pointers, which may alias
 // anything, so fields read through references would be reloaded for every texel.
-template <bool kDistorted, SamplingMode kMode, bool kDepth>
+template <bool kDistorted, SamplingMode kMode, bool kDepth, bool kPaint>
 void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Counts* counts) {
   const KernelContext k = context;
   ChunkProjection proj;
@@ -262,6 +255,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     ProjectChunkPinhole(k, *k.buffer, chunk, &proj);
 
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
+  const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
   const float texel_size_m = static_cast<float>(k.buffer->texel_size_m);
   const uint8_t* const frame = k.frame->data;
   const size_t frame_step = k.frame->step[0];
@@ -301,11 +295,11 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     }
     ++visible;
     const int idx = texel_index[i];
-    uint8_t* out = k.out_bgr + 3 * static_cast<size_t>(idx);
+    uint8_t sample[3];
     if constexpr (kMode == SamplingMode::kNearest) {
       const uint8_t* src =
           frame + static_cast<int>(v + 0.5f) * frame_step + 3 * static_cast<int>(u + 0.5f);
-      out[0] = src[0], out[1] = src[1], out[2] = src[2];
+      sample[0] = src[0], sample[1] = src[1], sample[2] = src[2];
     } else if constexpr (kMode == SamplingMode::kBilinear) {
       const uint8_t* r0 = frame + proj.y0[i] * frame_step + 3 * proj.x0[i];
       const uint8_t* r1 = r0 + frame_step;
@@ -313,8 +307,8 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
       const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
                   w11 = fx * fy;
       for (int c = 0; c < 3; ++c)
-        out[c] = static_cast<uint8_t>(w00 * r0[c] + w10 * r0[3 + c] + w01 * r1[c] +
-                                      w11 * r1[3 + c] + 0.5f);
+        sample[c] = static_cast<uint8_t>(w00 * r0[c] + w10 * r0[3 + c] + w01 * r1[c] +
+                                         w11 * r1[3 + c] + 0.5f);
     } else {
       // Area: bilinear on the pyramid level whose pixels match the texel's footprint.
       const float footprint = k.focal * texel_size_m / z;
@@ -322,10 +316,18 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
           static_cast<int>(std::floor(std::log2(std::max(footprint, 1.0f)))), 0, levels - 1);
       const float scale = 1.0f / static_cast<float>(1 << level);
       SampleBilinear(levels > 0 ? (*k.pyramid)[level] : *k.frame, (u + 0.5f) * scale - 0.5f,
-                     (v + 0.5f) * scale - 0.5f, out);
+                     (v + 0.5f) * scale - 0.5f, sample);
     }
-    k.out_valid[idx] = 255;
-    k.out_quality[idx] = proj.quality[i];
+    if constexpr (kPaint) {
+      UpdateTexel(k.rule, sample, proj.quality[i], on_surface[i] != 0,
+                  k.paint_bgra + 4 * static_cast<size_t>(idx), k.paint_quality + idx,
+                  &counts->paint);
+    } else {
+      uint8_t* out = k.out_bgr + 3 * static_cast<size_t>(idx);
+      out[0] = sample[0], out[1] = sample[1], out[2] = sample[2];
+      k.out_valid[idx] = 255;
+      k.out_quality[idx] = proj.quality[i];
+    }
   }
   counts->in_view += in_view, counts->visible += visible;
   counts->occluded += occluded, counts->grazing += grazing;
@@ -333,21 +335,23 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
 
 using ChunkKernel = void (*)(const KernelContext&, const BaseBuffer::Chunk&, Counts*);
 
-template <bool kDistorted, bool kDepth>
+template <bool kDistorted, bool kDepth, bool kPaint>
 ChunkKernel SelectForMode(SamplingMode mode) {
   switch (mode) {
     case SamplingMode::kNearest:
-      return &WarpChunk<kDistorted, SamplingMode::kNearest, kDepth>;
+      return &WarpChunk<kDistorted, SamplingMode::kNearest, kDepth, kPaint>;
     case SamplingMode::kArea:
-      return &WarpChunk<kDistorted, SamplingMode::kArea, kDepth>;
+      return &WarpChunk<kDistorted, SamplingMode::kArea, kDepth, kPaint>;
     default:
-      return &WarpChunk<kDistorted, SamplingMode::kBilinear, kDepth>;
+      return &WarpChunk<kDistorted, SamplingMode::kBilinear, kDepth, kPaint>;
   }
 }
 
+template <bool kPaint>
 ChunkKernel SelectKernel(bool distorted, bool depth, SamplingMode mode) {
-  if (distorted) return depth ? SelectForMode<true, true>(mode) : SelectForMode<true, false>(mode);
-  return depth ? SelectForMode<false, true>(mode) : SelectForMode<false, false>(mode);
+  if (distorted)
+    return depth ? SelectForMode<true, true, kPaint>(mode) : SelectForMode<true, false, kPaint>(mode);
+  return depth ? SelectForMode<false, true, kPaint>(mode) : SelectForMode<false, false, kPaint>(mode);
 }
 
 }  // namespace
@@ -385,18 +389,14 @@ bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d&
                                 view.cam_from_local.translation, view.bounds, near_m);
 }
 
-void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
-                       WarpedBuffer* warped) {
-  const int w = buffer.width, h = buffer.height;
-  if (warped->bgr.rows != h || warped->bgr.cols != w) {
-    warped->bgr.create(h, w, CV_8UC3);
-    warped->valid.create(h, w, CV_8U);
-    warped->quality.create(h, w, CV_32F);
-  }
-  warped->valid.setTo(0);
+namespace {
+
+// The kernel's context for one buffer and frame; outputs left null.
+KernelContext MakeContext(const BaseBuffer& buffer, const FrameView& view,
+                          const WarpOptions& options, bool use_depth) {
   const Camera& camera = *view.camera;
-  const bool use_depth = options.occlusion.enabled && view.depth && !view.depth->empty();
-  KernelContext k{
+  const double focal = 0.5 * (camera.fx + camera.fy);
+  return KernelContext{
       .buffer = &buffer,
       .R = view.cam_from_local.RotationMatrix().cast<float>(),
       .t = view.cam_from_local.translation.cast<float>(),
@@ -407,21 +407,32 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
       .cos_max = static_cast<float>(std::cos(options.occlusion.max_view_angle_deg * M_PI / 180.0)),
       .max_u = static_cast<float>(camera.width - 1),
       .max_v = static_cast<float>(camera.height - 1),
-      .focal = static_cast<float>(0.5 * (camera.fx + camera.fy)),
+      .focal = static_cast<float>(focal),
       .tol_rel = static_cast<float>(options.occlusion.tolerance_rel),
       .tol_abs = static_cast<float>(options.occlusion.tolerance_m),
-      .slope_px = static_cast<float>(1.5 / (0.5 * (camera.fx + camera.fy))),
-      .focal_texel = static_cast<float>(0.5 * (camera.fx + camera.fy) * buffer.texel_size_m),
+      .slope_px = static_cast<float>(1.5 / focal),
+      .focal_texel = static_cast<float>(focal * buffer.texel_size_m),
       .frame = view.frame_bgr,
       .depth = use_depth ? view.depth : view.frame_bgr,
       .pyramid = &view.pyramid,
-      .out_bgr = warped->bgr.data,
-      .out_valid = warped->valid.data,
-      .out_quality = warped->quality.ptr<float>()};
-  const ChunkKernel kernel = SelectKernel(camera.HasDistortion(), use_depth, options.sampling);
-  std::atomic<int> in_view{0}, visible{0}, occluded{0}, grazing{0}, culled{0};
-  std::atomic<long long> tested{0};
-  std::mutex box_mutex;
+      .out_bgr = nullptr,
+      .out_valid = nullptr,
+      .out_quality = nullptr,
+      .paint_bgra = nullptr,
+      .paint_quality = nullptr,
+      .rule = TexelUpdateRule()};
+}
+
+bool UsesDepth(const FrameView& view, const WarpOptions& options) {
+  return options.occlusion.enabled && view.depth && !view.depth->empty();
+}
+
+// Every chunk of the buffer that is not culled, through `kernel`, in parallel; the counts
+// summed (integers: the same whatever the order) and the tiles with visible texels.
+Counts RunChunks(const KernelContext& k, ChunkKernel kernel, cv::Rect* visible_box) {
+  const BaseBuffer& buffer = *k.buffer;
+  std::mutex mutex;
+  Counts total;
   cv::Rect box;
   const int num_chunks = static_cast<int>(buffer.chunks.size());
   const double stripes = std::max(1, std::min(num_chunks, 16 * cv::getNumThreads()));
@@ -429,7 +440,7 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
       cv::Range(0, num_chunks),
       [&](const cv::Range& range) {
         Counts n;
-        cv::Rect range_box;  // the tiles of the chunks with visible texels
+        cv::Rect range_box;
         for (int c = range.start; c < range.end; ++c) {
           const BaseBuffer::Chunk& chunk = buffer.chunks[c];
           if (ChunkCulled(k, chunk)) {
@@ -442,21 +453,68 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
           if (n.visible > visible_before)
             range_box |= cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0, chunk.y1 - chunk.y0);
         }
-        if (!range_box.empty()) {
-          const std::lock_guard<std::mutex> lock(box_mutex);
-          box |= range_box;
-        }
-        in_view += n.in_view, visible += n.visible, occluded += n.occluded;
-        grazing += n.grazing, culled += n.culled, tested += n.tested;
+        const std::lock_guard<std::mutex> lock(mutex);
+        box |= range_box;
+        total.in_view += n.in_view, total.visible += n.visible, total.occluded += n.occluded;
+        total.grazing += n.grazing, total.culled += n.culled, total.tested += n.tested;
+        total.paint.Add(n.paint);
       },
       stripes);
-  warped->in_view = in_view;
-  warped->visible = visible;
-  warped->occluded = occluded;
-  warped->grazing = grazing;
-  warped->chunks_culled = culled;
-  warped->texels_tested = tested;
-  warped->valid_box = box;
+  *visible_box = box;
+  return total;
+}
+
+void SetCounts(const Counts& n, WarpedBuffer* warped) {
+  warped->in_view = n.in_view;
+  warped->visible = n.visible;
+  warped->occluded = n.occluded;
+  warped->grazing = n.grazing;
+  warped->chunks_culled = n.culled;
+  warped->texels_tested = n.tested;
+}
+
+}  // namespace
+
+void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
+                       WarpedBuffer* warped) {
+  const int w = buffer.width, h = buffer.height;
+  const bool fresh = warped->bgr.rows != h || warped->bgr.cols != w ||
+                     warped->valid.size() != warped->bgr.size();
+  if (fresh) {
+    warped->bgr.create(h, w, CV_8UC3);
+    warped->valid.create(h, w, CV_8U);
+    warped->quality.create(h, w, CV_32F);
+    warped->valid.setTo(0);
+  } else if (!warped->valid_box.empty()) {
+    // Valid texels lie inside valid_box (every writer keeps it so): clearing it clears all.
+    warped->valid(warped->valid_box & cv::Rect(0, 0, w, h)).setTo(0);
+  }
+  const bool use_depth = UsesDepth(view, options);
+  KernelContext k = MakeContext(buffer, view, options, use_depth);
+  k.out_bgr = warped->bgr.data;
+  k.out_valid = warped->valid.data;
+  k.out_quality = warped->quality.ptr<float>();
+  const Counts n = RunChunks(
+      k, SelectKernel<false>(view.camera->HasDistortion(), use_depth, options.sampling),
+      &warped->valid_box);
+  SetCounts(n, warped);
+}
+
+PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& view,
+                                    const WarpOptions& options, const TexelUpdateRule& rule,
+                                    WarpedBuffer* counts, PaintedBuffer* painted) {
+  const bool use_depth = UsesDepth(view, options);
+  KernelContext k = MakeContext(buffer, view, options, use_depth);
+  k.paint_bgra = painted->bgra.data;
+  k.paint_quality = painted->quality.ptr<float>();
+  k.rule = rule;
+  cv::Rect visible_box;
+  const Counts n = RunChunks(
+      k, SelectKernel<true>(view.camera->HasDistortion(), use_depth, options.sampling),
+      &visible_box);
+  SetCounts(n, counts);
+  painted->painted_surface_texels += n.paint.newly_painted;
+  return n.paint;
 }
 
 }  // namespace fresco

@@ -16,6 +16,7 @@
 #include "pipeline/core/project.h"
 #include "pipeline/core/rigid3.h"
 #include "pipeline/paint/base_buffer.h"
+#include "pipeline/paint/texel_update.h"
 
 namespace fresco {
 
@@ -57,7 +58,8 @@ struct WarpedBuffer {
   int grazing = 0;              // back-facing or beyond max_view_angle
   int chunks_culled = 0;        // chunks of texels skipped whole (outside the view frustum)
   long long texels_tested = 0;  // texels in chunks that were not culled
-  cv::Rect valid_box;           // bounds every valid texel (empty when none)
+  cv::Rect valid_box;  // bounds every valid texel (empty when none); whoever writes `valid`
+                       // keeps it so: the next warp clears only this box
 
   // Whether `chunk` may hold valid texels (its tile meets valid_box): later stages skip
   // the others whole.
@@ -74,5 +76,14 @@ bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d&
 
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view,
                        const WarpOptions& options, WarpedBuffer* warped);
+
+// The warp and the paint update in one pass, for frames where no stage looks at the warped
+// samples between the two (no background model, no refinement, no debug images): each
+// visible sample goes straight into `painted` by `rule`, with no warped images written or
+// read back. Paints exactly what WarpFrameToBuffer then PaintBuffer (no mask) paint; sets
+// only the counts of `counts` (its images and valid_box are left as they were).
+PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& view,
+                                    const WarpOptions& options, const TexelUpdateRule& rule,
+                                    WarpedBuffer* counts, PaintedBuffer* painted);
 
 }  // namespace fresco

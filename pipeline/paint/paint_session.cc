@@ -244,8 +244,20 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     if (!BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view,
                            warp_options.near_m))
       in_frustum.push_back(b);
-  ForEachBuffer(in_frustum, false,
-                [&](size_t b) { WarpFrameToBuffer(set_.buffers[b], view, warp_options, &warped_[b]); });
+  // When no stage looks at the warped samples before the paint stage (no background
+  // model, no refinement, no debug images), the warp paints them directly: the same texels,
+  // without writing and reading back the warped images.
+  const bool paint_in_warp =
+      background_.empty() && options_.refine.mode == RefineMode::kOff && !debug;
+  const TexelUpdateRule rule = TexelUpdateRule::From(options_);
+  std::vector<PaintUpdateStats> paint_stats(set_.buffers.size());
+  ForEachBuffer(in_frustum, false, [&](size_t b) {
+    if (paint_in_warp)
+      paint_stats[b] =
+          WarpAndPaintBuffer(set_.buffers[b], view, warp_options, rule, &warped_[b], &painted_[b]);
+    else
+      WarpFrameToBuffer(set_.buffers[b], view, warp_options, &warped_[b]);
+  });
   for (size_t b : in_frustum) {
     in_view += warped_[b].in_view;
     visible += warped_[b].visible;
@@ -297,15 +309,18 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   long long written = 0, rejected = 0, compared = 0;
   double difference_sum = 0;
   const std::vector<size_t> seen_list = Indices(seen);
-  std::vector<PaintUpdateStats> paint_stats(set_.buffers.size());
-  ForEachBuffer(seen_list, false, [&](size_t b) {
-    const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
-                             ? cv::Mat()
-                             : background_frame_[b].foreground;
-    paint_stats[b] = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
-    if (!background_.empty())
-      MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
-  });
+  if (paint_in_warp) {
+    paint_report.notes["painted"] = "during the warp (no stage between them)";
+  } else {
+    ForEachBuffer(seen_list, false, [&](size_t b) {
+      const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
+                               ? cv::Mat()
+                               : background_frame_[b].foreground;
+      paint_stats[b] = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
+      if (!background_.empty())
+        MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
+    });
+  }
   for (size_t b : seen_list) {
     const PaintUpdateStats& stats = paint_stats[b];
     written += stats.written;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <exception>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -222,45 +223,65 @@ Status RenderSynthFrames(const Scene& scene, const SynthOptions& options, const 
   std::map<int, cv::Mat> ready;
   int next_to_render = 0, next_to_emit = 0;
   bool stop = false;
+  // The first exception of any thread (out of memory): it stops every thread and is
+  // rethrown here once they are joined, never ending the process from a worker.
+  std::exception_ptr failure;
+  const auto fail = [&](std::exception_ptr e) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!failure) failure = e;
+      stop = true;
+    }
+    changed.notify_all();
+  };
   std::vector<std::thread> workers;
   for (int t = 0; t < threads; ++t) {
     workers.emplace_back([&] {
-      FrameRenderer frame_renderer(scene, renderer, plan);
-      while (true) {
-        int index;
-        {
-          std::unique_lock<std::mutex> lock(mutex);
-          changed.wait(lock, [&] { return stop || next_to_render < next_to_emit + window; });
-          if (stop || next_to_render >= frames) return;
-          index = next_to_render++;
+      try {
+        FrameRenderer frame_renderer(scene, renderer, plan);
+        while (true) {
+          int index;
+          {
+            std::unique_lock<std::mutex> lock(mutex);
+            changed.wait(lock, [&] { return stop || next_to_render < next_to_emit + window; });
+            if (stop || next_to_render >= frames) return;
+            index = next_to_render++;
+          }
+          cv::Mat bgr;
+          frame_renderer.Render(index, &bgr);
+          {
+            std::lock_guard<std::mutex> lock(mutex);
+            ready[index] = std::move(bgr);
+          }
+          changed.notify_all();
         }
-        cv::Mat bgr;
-        frame_renderer.Render(index, &bgr);
-        {
-          std::lock_guard<std::mutex> lock(mutex);
-          ready[index] = std::move(bgr);
-        }
-        changed.notify_all();
+      } catch (...) {
+        fail(std::current_exception());
       }
     });
   }
   Status status;
-  while (next_to_emit < frames) {
-    cv::Mat bgr;
-    {
-      std::unique_lock<std::mutex> lock(mutex);
-      changed.wait(lock, [&] { return ready.count(next_to_emit) > 0; });
-      bgr = std::move(ready[next_to_emit]);
-      ready.erase(next_to_emit);
+  try {
+    while (next_to_emit < frames) {
+      cv::Mat bgr;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        changed.wait(lock, [&] { return failure || ready.count(next_to_emit) > 0; });
+        if (failure) break;
+        bgr = std::move(ready[next_to_emit]);
+        ready.erase(next_to_emit);
+      }
+      status = sink(next_to_emit, bgr);
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        ++next_to_emit;
+        if (!status.ok()) stop = true;
+      }
+      changed.notify_all();
+      if (!status.ok()) break;
     }
-    status = sink(next_to_emit, bgr);
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      ++next_to_emit;
-      if (!status.ok()) stop = true;
-    }
-    changed.notify_all();
-    if (!status.ok()) break;
+  } catch (...) {
+    fail(std::current_exception());
   }
   {
     std::lock_guard<std::mutex> lock(mutex);
@@ -268,6 +289,7 @@ Status RenderSynthFrames(const Scene& scene, const SynthOptions& options, const 
   }
   changed.notify_all();
   for (std::thread& w : workers) w.join();
+  if (failure) std::rethrow_exception(failure);
   return status;
 }
 

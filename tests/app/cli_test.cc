@@ -22,6 +22,8 @@ namespace fs = std::filesystem;
 using testing::MakeTempDir;
 using testing::ReadText;
 using testing::RunFresco;
+using testing::StartFresco;
+using testing::WaitFresco;
 using testing::WriteText;
 
 // The lines of stderr that report an error (progress lines may come before them).
@@ -200,6 +202,26 @@ TEST_F(RunCommandTest, GroupingIsStoredEditedAndHonoured) {
 
 // Bad input: exit 2, a one-line message naming the file (and field), and an output folder
 // from an earlier good run left exactly as it was.
+// Out of memory (here: 0.5 mm texels on a room, several GB, in a 700 MB address space) is a
+// one-line message saying what needs less, exit 1, and the earlier outputs kept; never an
+// abort.
+TEST_F(RunCommandTest, OutOfMemoryExits1WithOneLineAndKeepsEarlierOutputs) {
+  const std::string out = MakeTempDir("run-oom") + "/out";
+  ASSERT_EQ(RunFresco({"run", Project(), "--out", out, "--quiet"}).exit_code, 0);
+  const std::string metrics_before = ReadText(out + "/metrics.json");
+  const std::string gltf_before = ReadText(out + "/painted.gltf");
+  const auto r = WaitFresco(StartFresco({"run", Project(), "--out", out, "--quiet", "--set",
+                                         "pipeline.texel_size_m=0.0005", "--set",
+                                         "pipeline.max_buffer_texels=2000000000"},
+                                        700LL << 20));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("fresco run: out of memory"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("pipeline.texel_size_m"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(ReadText(out + "/metrics.json"), metrics_before);
+  EXPECT_EQ(ReadText(out + "/painted.gltf"), gltf_before);
+}
+
 TEST_F(RunCommandTest, BadInputExits2NamingTheFileAndKeepsEarlierOutputs) {
   const std::string out = MakeTempDir("run-bad") + "/out";
   ASSERT_EQ(RunFresco({"run", Project(), "--out", out, "--quiet"}).exit_code, 0);

@@ -8,6 +8,9 @@
 //                    only the texels each frame sees: the painting culls the rest too)
 //   build/tests/throughput_bench --benchmark_min_time=2
 #include <benchmark/benchmark.h>
+
+#include <map>
+#include <string>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -57,6 +60,8 @@ void BM_PaintStreet(benchmark::State& state) {
   if (!street.ok) return state.SkipWithError("synth failed");
   cv::setNumThreads(2);
   long long texels = 0;
+  std::map<std::string, double> stage_ms;  // summed over every painted frame
+  long long frames = 0;
   for (auto _ : state) {
     state.PauseTiming();
     std::unique_ptr<PaintSession> session = street.Session();
@@ -69,8 +74,11 @@ void BM_PaintStreet(benchmark::State& state) {
       frame.bgr = street.capture.frames_bgr[i];
       session->PaintFrame(frame, street.capture.camera, street.capture.true_poses[i].cam_from_world,
                           &report);
+      for (const StageReport& stage : report.stages) stage_ms[stage.name] += stage.wall_ms;
+      ++frames;
     }
   }
+  for (const auto& [name, ms] : stage_ms) state.counters[name + "_ms"] = ms / frames;
   state.SetItemsProcessed(state.iterations() * texels *
                           static_cast<long long>(street.capture.frames_bgr.size()));
   state.counters["texels"] = static_cast<double>(texels);

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <new>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -325,6 +326,32 @@ TEST(Synthesize, PoseNoiseHasTheRequestedRms) {
     EXPECT_EQ(plan.true_poses[i].cam_from_world.translation,
               plan.given_poses[i].cam_from_world.translation);
   }
+}
+
+// Out of memory while frames are rendered on several threads comes back to the caller as
+// the exception (the CLI turns it into a one-line error), never ends the process.
+TEST(Synthesize, AnExceptionWhileRenderingOnThreadsReachesTheCaller) {
+  const Scene scene = Room();
+  SynthOptions o = RoomOptions(12);
+  o.threads = 2;
+  SynthCapture plan;
+  ASSERT_TRUE(PlanSynthCapture(scene, o, &plan).ok());
+  int emitted = 0;
+  EXPECT_THROW(RenderSynthFrames(scene, o, plan,
+                                 [&](int i, const cv::Mat&) {
+                                   if (i == 3) throw std::bad_alloc();
+                                   ++emitted;
+                                   return Status::Ok();
+                                 }),
+               std::bad_alloc);
+  EXPECT_EQ(emitted, 3);
+  // The same capture renders whole afterwards: nothing was left locked or running.
+  emitted = 0;
+  EXPECT_TRUE(RenderSynthFrames(scene, o, plan, [&](int, const cv::Mat&) {
+                ++emitted;
+                return Status::Ok();
+              }).ok());
+  EXPECT_EQ(emitted, 12);
 }
 
 TEST(Synthesize, ExposureGainsScaleTheFrames) {

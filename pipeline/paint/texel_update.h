@@ -1,0 +1,82 @@
+// How one new sample updates one stored texel (the paper's §4 policy, or quality-aware, with
+// an optional running average), shared by the paint stage and by the warp when it paints
+// directly (frame_warp.h): one rule, one place.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/project.h"
+
+namespace fresco {
+
+struct PaintedBuffer {
+  cv::Mat bgra;     // CV_8UC4, alpha 255 where painted, 0 where never painted
+  cv::Mat quality;  // CV_32F, quality of the stored sample (pixels per texel)
+  int painted_surface_texels = 0;  // on-surface texels painted at least once
+};
+
+struct PaintUpdateStats {
+  int written = 0;   // texels written this frame
+  int rejected = 0;  // visible but kept the stored, sharper sample
+  // Misalignment signal: over texels that were already painted and are seen again, the sum
+  // of |grey(new sample) - grey(stored)| (0..255 each) and how many there were.
+  double abs_grey_difference_sum = 0;
+  int compared = 0;
+  int newly_painted = 0;  // on-surface texels painted for the first time
+
+  void Add(const PaintUpdateStats& o) {
+    written += o.written, rejected += o.rejected, compared += o.compared;
+    abs_grey_difference_sum += o.abs_grey_difference_sum, newly_painted += o.newly_painted;
+  }
+};
+
+// The pipeline's update options resolved for the per-texel loop.
+struct TexelUpdateRule {
+  UpdatePolicy policy = UpdatePolicy::kQuality;
+  float keep = 0.8f;  // kQuality: a sample at least this fraction as sharp overwrites
+  int weight = 256;   // the new sample's weight out of 256 (256 = replace)
+
+  static TexelUpdateRule From(const PipelineOptions& options) {
+    TexelUpdateRule rule;
+    rule.policy = options.update;
+    rule.keep = static_cast<float>(1.0 - options.quality_slack);
+    rule.weight =
+        std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
+    return rule;
+  }
+};
+
+// `sample`: BGR; `quality`: its pixels per texel; `texel`: the stored BGRA; `stored_quality`:
+// the stored sample's quality. Counts into `stats`.
+inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, float quality,
+                        bool on_surface, uint8_t* texel, float* stored_quality,
+                        PaintUpdateStats* stats) {
+  if (texel[3] != 0) {  // compare with what the buffer holds (BT.601 luma, integer weights)
+    const int new_grey = (29 * sample[0] + 150 * sample[1] + 77 * sample[2]) >> 8;
+    const int old_grey = (29 * texel[0] + 150 * texel[1] + 77 * texel[2]) >> 8;
+    stats->abs_grey_difference_sum += std::abs(new_grey - old_grey);
+    ++stats->compared;
+  }
+  if (rule.policy == UpdatePolicy::kQuality && quality < *stored_quality * rule.keep) {
+    ++stats->rejected;
+    return;
+  }
+  if (texel[3] == 0 && on_surface) ++stats->newly_painted;
+  if (texel[3] == 0 || rule.weight == 256) {
+    texel[0] = sample[0], texel[1] = sample[1], texel[2] = sample[2], texel[3] = 255;
+  } else {
+    for (int c = 0; c < 3; ++c)
+      texel[c] = static_cast<uint8_t>(
+          (texel[c] * (256 - rule.weight) + sample[c] * rule.weight + 128) >> 8);
+  }
+  *stored_quality =
+      rule.policy == UpdatePolicy::kQuality ? std::max(*stored_quality, quality) : quality;
+  ++stats->written;
+}
+
+}  // namespace fresco

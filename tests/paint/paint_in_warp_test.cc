@@ -1,0 +1,110 @@
+// Painting during the warp (frame_warp.h WarpAndPaintBuffer, taken when no stage looks at the
+// warped samples before the paint stage) paints exactly what the two stages paint one after
+// the other: the same texels, colours, stored qualities and figures, bit for bit, for every
+// sampling mode, both update policies, a running average and a distorted lens.
+#include <gtest/gtest.h>
+#include <opencv2/core.hpp>
+
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/synth/procedural_scenes.h"
+#include "pipeline/synth/synthesize.h"
+#include "tests/paint/room_capture.h"
+
+namespace fresco {
+namespace {
+
+struct Painted {
+  std::vector<PaintedBuffer> buffers;
+  std::vector<FrameReport> reports;
+};
+
+// Debug images make the session keep the two stages apart (the warped samples are shown);
+// without them, with no background model and no refinement, it paints during the warp.
+Painted Paint(const Scene& scene, const SynthCapture& capture, const PipelineOptions& options,
+              bool separate_stages) {
+  PaintSessionInputs inputs;
+  inputs.scene = &scene;
+  inputs.pipeline = options;
+  inputs.typical_camera = &capture.camera;
+  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
+  std::unique_ptr<PaintSession> session;
+  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  session->set_debug_images(separate_stages);
+  Painted out;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
+    Frame frame;
+    frame.index = static_cast<int>(i);
+    frame.bgr = capture.frames_bgr[i];
+    FrameReport report;
+    session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, &report);
+    out.reports.push_back(report);
+  }
+  out.buffers = session->painted();
+  return out;
+}
+
+void ExpectSame(const Painted& a, const Painted& b, const std::string& what) {
+  ASSERT_EQ(a.buffers.size(), b.buffers.size());
+  long long painted_texels = 0;
+  for (size_t k = 0; k < a.buffers.size(); ++k) {
+    EXPECT_EQ(cv::norm(a.buffers[k].bgra, b.buffers[k].bgra, cv::NORM_INF), 0) << what << " b" << k;
+    EXPECT_EQ(cv::norm(a.buffers[k].quality, b.buffers[k].quality, cv::NORM_INF), 0)
+        << what << " b" << k;
+    EXPECT_EQ(a.buffers[k].painted_surface_texels, b.buffers[k].painted_surface_texels) << what;
+    painted_texels += a.buffers[k].painted_surface_texels;
+  }
+  EXPECT_GT(painted_texels, 10000) << what;  // the capture paints the room
+  ASSERT_EQ(a.reports.size(), b.reports.size());
+  for (size_t i = 0; i < a.reports.size(); ++i) {
+    const StageReport* pa = a.reports[i].Stage("paint");
+    const StageReport* pb = b.reports[i].Stage("paint");
+    ASSERT_TRUE(pa && pb);
+    for (const char* m : {"texels_written", "texels_kept_sharper", "coverage"})
+      EXPECT_EQ(pa->metrics.at(m), pb->metrics.at(m)) << what << " frame " << i << " " << m;
+    const double da = a.reports[i].paint.difference_to_buffer;
+    const double db = b.reports[i].paint.difference_to_buffer;
+    EXPECT_TRUE(da == db || (std::isnan(da) && std::isnan(db))) << what << " frame " << i;
+    EXPECT_EQ(a.reports[i].Stage("warp")->metrics.at("texels_visible"),
+              b.reports[i].Stage("warp")->metrics.at("texels_visible"));
+  }
+}
+
+TEST(PaintInWarp, PaintsWhatTheTwoStagesPaint) {
+  CubeRoomOptions room;
+  room.procedural_texture_px = 256;
+  Scene scene;
+  ASSERT_TRUE(MakeCubeRoomScene(room, &scene).ok());
+  for (const LensModel lens : {LensModel::kPinhole, LensModel::kOpenCV8}) {
+    SynthOptions synth = testing::HandheldRoomCapture(8, 0.8);
+    synth.width = 160, synth.height = 120;
+    synth.lens = lens;
+    synth.seed = 5;
+    SynthCapture capture;
+    ASSERT_TRUE(SynthesizeCapture(scene, synth, &capture).ok());
+    PipelineOptions options;
+    options.background.mode = BackgroundMode::kOff;
+    options.refine.mode = RefineMode::kOff;
+    for (const SamplingMode sampling :
+         {SamplingMode::kNearest, SamplingMode::kBilinear, SamplingMode::kArea}) {
+      options.sampling = sampling;
+      for (const UpdatePolicy policy : {UpdatePolicy::kQuality, UpdatePolicy::kLatest}) {
+        options.update = policy;
+        for (const double weight : {1.0, 0.3}) {
+          options.update_weight = weight;
+          const std::string what = "lens " + std::to_string(static_cast<int>(lens)) +
+                                   " sampling " + std::to_string(static_cast<int>(sampling)) +
+                                   " policy " + std::to_string(static_cast<int>(policy)) +
+                                   " weight " + std::to_string(weight);
+          const Painted fused = Paint(scene, capture, options, false);
+          const Painted separate = Paint(scene, capture, options, true);
+          EXPECT_EQ(fused.reports[0].Stage("paint")->notes.count("painted"), 1u) << what;
+          EXPECT_EQ(separate.reports[0].Stage("paint")->notes.count("painted"), 0u) << what;
+          ExpectSame(fused, separate, what);
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fresco
