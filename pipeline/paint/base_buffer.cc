@@ -9,6 +9,23 @@
 namespace fresco {
 namespace {
 
+// The cone holding the chunk's stored normals (as the warp dequantizes them), with a margin
+// for float rounding; none when they spread over 80 degrees or more from their mean.
+void SetNormalCone(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
+  Eigen::Vector3f mean = Eigen::Vector3f::Zero();
+  for (int k = chunk->begin; k < chunk->end; ++k) mean += buffer.Normal(k).normalized();
+  if (!(mean.norm() > 0.0f)) return;
+  const Eigen::Vector3f axis = mean.normalized();
+  float min_cos = 1.0f;
+  for (int k = chunk->begin; k < chunk->end; ++k)
+    min_cos = std::min(min_cos, axis.dot(buffer.Normal(k).normalized()));
+  const double half_angle = std::acos(std::clamp(static_cast<double>(min_cos), -1.0, 1.0)) + 1e-3;
+  if (half_angle >= 80.0 * M_PI / 180.0) return;
+  chunk->normal_axis = axis;
+  chunk->normal_cos = static_cast<float>(std::cos(half_angle));
+  chunk->normal_sin = static_cast<float>(std::sin(half_angle));
+}
+
 // Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                        const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -248,6 +265,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
         }
       }
       chunk.end = buffer.NumTexels();
+      SetNormalCone(buffer, &chunk);
       if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
     }
   }
@@ -255,6 +273,24 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
 }
 
 }  // namespace
+
+// For a normal n within the chunk's cone (axis a, half-angle h) and d = c - p from a point p
+// in the box, n.d <= cos(h) a.d + sin(h) |d|, whose maximum over the box is at most the sum
+// of the two terms' maxima over its corners (a.d is linear in p, |d| convex).
+bool BaseBuffer::Chunk::FacesAwayFrom(const Eigen::Vector3f& c) const {
+  if (normal_sin >= 1.0f) return false;
+  float max_ad = -std::numeric_limits<float>::infinity(), max_d = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3f corner((i & 1) ? bounds_max.x() : bounds_min.x(),
+                                 (i & 2) ? bounds_max.y() : bounds_min.y(),
+                                 (i & 4) ? bounds_max.z() : bounds_min.z());
+    const Eigen::Vector3f d = c - corner;
+    max_ad = std::max(max_ad, normal_axis.dot(d));
+    max_d = std::max(max_d, d.norm());
+  }
+  // The margin covers float rounding in the texels' own test (relative 1e-5 of |d|).
+  return normal_cos * max_ad + normal_sin * max_d < -1e-5f * max_d;
+}
 
 const BaseBuffer::Chunk& BaseBuffer::ChunkOf(int k) const {
   const auto it = std::upper_bound(chunks.begin(), chunks.end(), k,

@@ -50,6 +50,16 @@ struct BaseBuffer {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // the tile's texels: columns [x0, x1), rows [y0, y1)
     Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();
     Eigen::Vector3f point_step = Eigen::Vector3f::Zero();  // (bounds_max - bounds_min) / 65535
+    // Every texel normal (as stored) lies within the cone around `normal_axis` (unit) of
+    // half-angle acos(normal_cos) (sin: normal_sin); normal_cos 0, normal_sin 1 when the
+    // normals spread over a half-space or more. A chunk all of whose texels face away from
+    // the camera is culled whole.
+    Eigen::Vector3f normal_axis = Eigen::Vector3f::Zero();
+    float normal_cos = 0.0f, normal_sin = 1.0f;
+
+    // True only when every texel of the chunk faces away from `centre` (its stored normal n
+    // and point p have n . (centre - p) < 0): conservative, from the box and the cone.
+    bool FacesAwayFrom(const Eigen::Vector3f& centre) const;
   };
   std::vector<Chunk> chunks;
   static constexpr int kTileTexels = 16;

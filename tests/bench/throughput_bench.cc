@@ -62,6 +62,7 @@ void BM_PaintStreet(benchmark::State& state) {
   long long texels = 0;
   std::map<std::string, double> stage_ms;  // summed over every painted frame
   long long frames = 0;
+  double tested = 0, in_view = 0;  // texels per frame: projected (chunks not culled), in view
   for (auto _ : state) {
     state.PauseTiming();
     std::unique_ptr<PaintSession> session = street.Session();
@@ -75,10 +76,15 @@ void BM_PaintStreet(benchmark::State& state) {
       session->PaintFrame(frame, street.capture.camera, street.capture.true_poses[i].cam_from_world,
                           &report);
       for (const StageReport& stage : report.stages) stage_ms[stage.name] += stage.wall_ms;
+      const StageReport* warp = report.Stage("warp");
+      tested += warp->metrics.at("texels_tested");
+      in_view += warp->metrics.at("texels_in_view");
       ++frames;
     }
   }
   for (const auto& [name, ms] : stage_ms) state.counters[name + "_ms"] = ms / frames;
+  state.counters["texels_tested_per_frame"] = tested / frames;
+  state.counters["texels_in_view_per_frame"] = in_view / frames;
   state.SetItemsProcessed(state.iterations() * texels *
                           static_cast<long long>(street.capture.frames_bgr.size()));
   state.counters["texels"] = static_cast<double>(texels);
