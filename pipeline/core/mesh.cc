@@ -146,7 +146,6 @@ MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m
   MeshAdjacency adjacency;
   adjacency.welded_vertex = WeldVertices(mesh.vertices, weld_tolerance_m);
   const int num_triangles = mesh.NumTriangles();
-  adjacency.edge_neighbours.resize(num_triangles);
 
   // Undirected welded edges with their (triangle, edge k), sorted by edge: the uses of one
   // edge are a run (one array, no list per edge).
@@ -172,23 +171,39 @@ MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m
   std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
     return std::tie(a.key, a.tri, a.k) < std::tie(b.key, b.tri, b.k);
   });
-  for (size_t r = 0; r < uses.size();) {
-    size_t end = r + 1;
-    while (end < uses.size() && uses[end].key == uses[r].key) ++end;
-    for (size_t u = r; end - r >= 2 && u < end; ++u) {
-      std::vector<int>& list = adjacency.edge_neighbours[uses[u].tri][uses[u].k];
-      for (size_t o = r; o < end; ++o) {
-        const int other = uses[o].tri;
-        if (other == uses[u].tri) continue;
-        if (std::find(list.begin(), list.end(), other) == list.end()) list.push_back(other);
-      }
+  // Each use's slot (3 t + k) gets the other triangles of its run: counted, then filled,
+  // then each slot sorted and deduplicated in place and compacted.
+  const size_t slots = static_cast<size_t>(num_triangles) * 3;
+  std::vector<int64_t> start(slots + 1, 0);
+  auto for_each_pair = [&](auto&& fn) {
+    for (size_t r = 0; r < uses.size();) {
+      size_t end = r + 1;
+      while (end < uses.size() && uses[end].key == uses[r].key) ++end;
+      for (size_t u = r; end - r >= 2 && u < end; ++u)
+        for (size_t o = r; o < end; ++o)
+          if (uses[o].tri != uses[u].tri)
+            fn(3 * static_cast<size_t>(uses[u].tri) + uses[u].k, uses[o].tri);
+      r = end;
     }
-    r = end;
+  };
+  for_each_pair([&](size_t slot, int) { ++start[slot + 1]; });
+  for (size_t i = 0; i < slots; ++i) start[i + 1] += start[i];
+  std::vector<int> all(static_cast<size_t>(start[slots]));
+  std::vector<int64_t> fill(start.begin(), start.end() - 1);
+  for_each_pair([&](size_t slot, int other) { all[fill[slot]++] = other; });
+  adjacency.offsets.assign(slots + 1, 0);
+  int64_t out = 0;
+  for (size_t i = 0; i < slots; ++i) {
+    int* first = all.data() + start[i];
+    int* last = all.data() + start[i + 1];
+    std::sort(first, last);
+    last = std::unique(first, last);
+    for (int* p = first; p < last; ++p) all[out++] = *p;
+    adjacency.offsets[i + 1] = out;
   }
-  // Deterministic order regardless of hash-map iteration.
-  for (auto& tri_lists : adjacency.edge_neighbours) {
-    for (auto& list : tri_lists) std::sort(list.begin(), list.end());
-  }
+  all.resize(static_cast<size_t>(out));
+  all.shrink_to_fit();
+  adjacency.neighbours = std::move(all);
   return adjacency;
 }
 

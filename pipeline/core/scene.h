@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -52,8 +53,21 @@ struct TriangleMesh {
 // duplicate vertices for UV seams are still connected. Non-manifold edges (3+ triangles)
 // list every other triangle on the edge.
 struct MeshAdjacency {
-  std::vector<std::array<std::vector<int>, 3>> edge_neighbours;  // (T, 3) lists
+  // The other triangles on edge k of triangle t (from corner k to corner k + 1), sorted:
+  // neighbours[offsets[3 t + k] .. offsets[3 t + k + 1]). One array for the whole mesh (a
+  // list per edge cost a heap block each: 5 M of them at 1.8 M triangles).
+  std::vector<int64_t> offsets;  // (3 T + 1)
+  std::vector<int> neighbours;
   std::vector<int> welded_vertex;  // (V) canonical vertex index after welding
+
+  int NumTriangles() const { return offsets.empty() ? 0 : static_cast<int>(offsets.size() / 3); }
+  std::span<const int> EdgeNeighbours(int t, int k) const {
+    return {neighbours.data() + offsets[3 * t + k], neighbours.data() + offsets[3 * t + k + 1]};
+  }
+  // The three edges' neighbours one after the other (a triangle may appear more than once).
+  std::span<const int> Neighbours(int t) const {
+    return {neighbours.data() + offsets[3 * t], neighbours.data() + offsets[3 * t + 3]};
+  }
 };
 MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m = 1e-6);
 

@@ -120,16 +120,23 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       anchor + (pc.a_min - gutter * s) * buffer.axis_u + (pc.b_min - gutter * s) * buffer.axis_v;
 
   const Eigen::Vector3d& n = buffer.normal;
+  // owner: the texel's triangle as its position in `triangles` (-1: none); per-buffer arrays
+  // are indexed by that position, never by the mesh's triangle id (10^4 charts of a 10^6
+  // triangle mesh would otherwise clear 10^10 flags).
+  const int num_local = static_cast<int>(triangles.size());
   std::vector<int32_t> owner(static_cast<size_t>(w) * h, -1);
   std::vector<Eigen::Vector3f> point(static_cast<size_t>(w) * h);
-  std::vector<bool> is_folded(mesh.NumTriangles(), false);
+  std::vector<uint8_t> is_folded(num_local, 0);
+  std::vector<Eigen::Vector3d> normal_of(num_local);
+  for (int li = 0; li < num_local; ++li) normal_of[li] = mesh.Normal(triangles[li]);
   auto plane_point = [&](int i, int j) {
     return buffer.origin + ((i + 0.5) * s) * buffer.axis_u + ((j + 0.5) * s) * buffer.axis_v;
   };
-  for (int t : triangles) {
-    const Eigen::Vector3d nt = mesh.Normal(t);
+  for (int li = 0; li < num_local; ++li) {
+    const int t = triangles[li];
+    const Eigen::Vector3d& nt = normal_of[li];
     if (nt.dot(n) < 1e-3) {  // edge-on or back-facing in this projection: cannot serve it
-      is_folded[t] = true;
+      is_folded[li] = 1;
       continue;
     }
     Eigen::Vector2d q[3];
@@ -164,10 +171,10 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
         const size_t idx = static_cast<size_t>(j) * w + i;
         if (owner[idx] >= 0) {
           // Shared edge: same point. Different point: the projection folds here.
-          if ((point[idx].cast<double>() - m).norm() > 0.5 * s) is_folded[t] = true;
+          if ((point[idx].cast<double>() - m).norm() > 0.5 * s) is_folded[li] = 1;
           continue;
         }
-        owner[idx] = t;
+        owner[idx] = li;
         point[idx] = m.cast<float>();
       }
     }
@@ -179,14 +186,14 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       const int j = std::clamp(static_cast<int>(std::floor(c.y())), 0, h - 1);
       const size_t idx = static_cast<size_t>(j) * w + i;
       if (owner[idx] < 0) {
-        owner[idx] = t;
+        owner[idx] = li;
         point[idx] = ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0)
                          .cast<float>();
       }
     }
   }
-  for (int t : triangles)
-    if (is_folded[t]) folded->push_back(t);
+  for (int li = 0; li < num_local; ++li)
+    if (is_folded[li]) folded->push_back(triangles[li]);
   if (!folded->empty()) {
     // Drop folded triangles' texels; they go to another buffer.
     for (size_t idx = 0; idx < owner.size(); ++idx)
@@ -212,8 +219,9 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
           }
         if (best < 0) continue;
         next[idx] = best;
-        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(best, 0),
-                                            mesh.Corner(best, 1), mesh.Corner(best, 2))
+        const int t = triangles[best];
+        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(t, 0),
+                                            mesh.Corner(t, 1), mesh.Corner(t, 2))
                          .cast<float>();
       }
     }
@@ -247,15 +255,15 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
             const float step = chunk.point_step[axis];
             if (!(step > 0.0f)) return uint16_t{0};
             const float q = (point[idx][axis] - chunk.bounds_min[axis]) / step;
-            return static_cast<uint16_t>(std::clamp(std::lround(q), 0L, 65535L));
+            return static_cast<uint16_t>(std::clamp(q, 0.0f, 65535.0f) + 0.5f);  // rounded
           };
           buffer.point_qx.push_back(quantize_point(0));
           buffer.point_qy.push_back(quantize_point(1));
           buffer.point_qz.push_back(quantize_point(2));
-          const Eigen::Vector3d n = mesh.Normal(owner[idx]);
-          const auto quantize_normal = [](double value) {
-            return static_cast<int16_t>(
-                std::lround(std::clamp(value, -1.0, 1.0) * BaseBuffer::kNormalScale));
+          const Eigen::Vector3d& n = normal_of[owner[idx]];
+          const auto quantize_normal = [](double value) {  // rounded half away from zero
+            const double q = std::clamp(value, -1.0, 1.0) * BaseBuffer::kNormalScale;
+            return static_cast<int16_t>(q >= 0 ? q + 0.5 : q - 0.5);
           };
           buffer.normal_qx.push_back(quantize_normal(n.x()));
           buffer.normal_qy.push_back(quantize_normal(n.y()));

@@ -73,15 +73,13 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
         chart.normal_sum += normals[t] * areas[t];
         chart.area += areas[t];
         const Eigen::Vector3d mean = chart.Normal();
-        for (const auto& edge : adjacency.edge_neighbours[t]) {
-          for (int nb : edge) {
-            if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
-            if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
-              continue;
-            if (chart.area + areas[nb] > max_area) continue;
-            chart_of[nb] = c;
-            queue.push_back(nb);
-          }
+        for (int nb : adjacency.Neighbours(t)) {
+          if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
+          if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
+            continue;
+          if (chart.area + areas[nb] > max_area) continue;
+          chart_of[nb] = c;
+          queue.push_back(nb);
         }
       }
       if (round + 1 < kRounds) {
@@ -126,9 +124,8 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
       if (!small.alive || small.area >= min_area) continue;
       std::map<int, int> shared;  // neighbouring chart -> edges shared
       for (int t : small.triangles)
-        for (const auto& edge : adjacency.edge_neighbours[t])
-          for (int nb : edge)
-            if (chart_of[nb] >= 0 && chart_of[nb] != c) ++shared[chart_of[nb]];
+        for (int nb : adjacency.Neighbours(t))
+          if (chart_of[nb] >= 0 && chart_of[nb] != c) ++shared[chart_of[nb]];
       std::vector<std::pair<int, int>> candidates(shared.begin(), shared.end());
       std::stable_sort(candidates.begin(), candidates.end(),
                        [](const auto& a, const auto& b) { return a.second > b.second; });

@@ -39,13 +39,11 @@ Grouping ComputeGrouping(const TriangleMesh& mesh, const MeshAdjacency& adjacenc
       const int t = queue.front();
       queue.pop_front();
       group.triangles.push_back(t);
-      for (const auto& edge : adjacency.edge_neighbours[t]) {
-        for (int nb : edge) {
-          if (grouping.group_of_triangle[nb] >= 0 || areas[nb] <= 0.0) continue;
-          if (normals[nb].dot(seed_normal) < cos_limit) continue;
-          grouping.group_of_triangle[nb] = g;
-          queue.push_back(nb);
-        }
+      for (int nb : adjacency.Neighbours(t)) {
+        if (grouping.group_of_triangle[nb] >= 0 || areas[nb] <= 0.0) continue;
+        if (normals[nb].dot(seed_normal) < cos_limit) continue;
+        grouping.group_of_triangle[nb] = g;
+        queue.push_back(nb);
       }
     }
     std::sort(group.triangles.begin(), group.triangles.end());

@@ -1,12 +1,17 @@
 // TriangleMesh geometry (normal, area), Scene::Bounds and ComputeAdjacency (welding + edges).
-#include <gtest/gtest.h>
-
 #include <set>
+#include <span>
+#include <vector>
+
+#include <gtest/gtest.h>
 
 #include "pipeline/core/scene.h"
 
 namespace fresco {
 namespace {
+
+// One edge's neighbours as a vector (to compare with expected lists).
+std::vector<int> Vec(std::span<const int> s) { return std::vector<int>(s.begin(), s.end()); }
 
 // A unit cube centred at `centre` with 4 vertices per face (split at every UV seam, as glTF
 // exporters do): 24 vertices, 12 counter-clockwise (outward) triangles.
@@ -79,12 +84,12 @@ TEST(AdjacencyTest, SplitCubeWeldsToClosedManifold) {
     EXPECT_LE(w, v);
     EXPECT_EQ(mesh.vertices[w], mesh.vertices[v]);
   }
-  ASSERT_EQ(adjacency.edge_neighbours.size(), 12u);
+  ASSERT_EQ(adjacency.NumTriangles(), 12);
   for (int t = 0; t < 12; ++t) {
     std::set<int> neighbours;
     for (int k = 0; k < 3; ++k) {
-      ASSERT_EQ(adjacency.edge_neighbours[t][k].size(), 1u) << "triangle " << t << " edge " << k;
-      const int other = adjacency.edge_neighbours[t][k][0];
+      ASSERT_EQ(adjacency.EdgeNeighbours(t, k).size(), 1u) << "triangle " << t << " edge " << k;
+      const int other = adjacency.EdgeNeighbours(t, k)[0];
       neighbours.insert(other);
       // The neighbour really shares this edge's (welded) end points.
       const Eigen::Vector3d a = mesh.Corner(t, k), b = mesh.Corner(t, (k + 1) % 3);
@@ -103,7 +108,7 @@ TEST(AdjacencyTest, WithoutWeldingSplitSeamsAreOpen) {
   // Tolerance 0 still welds exactly coincident vertices.
   const MeshAdjacency exact = ComputeAdjacency(SplitCube(), 0.0);
   for (int t = 0; t < 12; ++t) {
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(exact.edge_neighbours[t][k].size(), 1u);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(exact.EdgeNeighbours(t, k).size(), 1u);
   }
   // Move one face's vertices slightly apart: that face separates from the rest.
   TriangleMesh mesh = SplitCube();
@@ -113,8 +118,8 @@ TEST(AdjacencyTest, WithoutWeldingSplitSeamsAreOpen) {
   int loose_links = 0, tight_links = 0;
   for (int t = 0; t < 12; ++t) {
     for (int k = 0; k < 3; ++k) {
-      loose_links += static_cast<int>(loose.edge_neighbours[t][k].size());
-      tight_links += static_cast<int>(tight.edge_neighbours[t][k].size());
+      loose_links += static_cast<int>(loose.EdgeNeighbours(t, k).size());
+      tight_links += static_cast<int>(tight.EdgeNeighbours(t, k).size());
     }
   }
   EXPECT_EQ(loose_links, 36);
@@ -132,9 +137,9 @@ TEST(AdjacencyTest, WeldsAcrossGridCellBoundaries) {
   const MeshAdjacency adjacency = ComputeAdjacency(mesh, 1e-6);
   EXPECT_EQ(adjacency.welded_vertex[3], 0);
   EXPECT_EQ(adjacency.welded_vertex[4], 1);
-  EXPECT_EQ(adjacency.edge_neighbours[0][0], std::vector<int>{1});
-  EXPECT_EQ(adjacency.edge_neighbours[1][2], std::vector<int>{0});
-  EXPECT_TRUE(adjacency.edge_neighbours[0][1].empty());
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(0, 0)), std::vector<int>{1});
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(1, 2)), std::vector<int>{0});
+  EXPECT_TRUE(adjacency.EdgeNeighbours(0, 1).empty());
 }
 
 TEST(AdjacencyTest, NonManifoldFanEdgeListsAllOthers) {
@@ -143,13 +148,13 @@ TEST(AdjacencyTest, NonManifoldFanEdgeListsAllOthers) {
   mesh.vertices = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}};
   mesh.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {1, 0, 5}};
   const MeshAdjacency adjacency = ComputeAdjacency(mesh);
-  EXPECT_EQ(adjacency.edge_neighbours[0][0], (std::vector<int>{1, 2, 3}));
-  EXPECT_EQ(adjacency.edge_neighbours[1][0], (std::vector<int>{0, 2, 3}));
-  EXPECT_EQ(adjacency.edge_neighbours[2][0], (std::vector<int>{0, 1, 3}));
-  EXPECT_EQ(adjacency.edge_neighbours[3][0], (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(0, 0)), (std::vector<int>{1, 2, 3}));
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(1, 0)), (std::vector<int>{0, 2, 3}));
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(2, 0)), (std::vector<int>{0, 1, 3}));
+  EXPECT_EQ(Vec(adjacency.EdgeNeighbours(3, 0)), (std::vector<int>{0, 1, 2}));
   for (int t = 0; t < 4; ++t) {
-    EXPECT_TRUE(adjacency.edge_neighbours[t][1].empty());
-    EXPECT_TRUE(adjacency.edge_neighbours[t][2].empty());
+    EXPECT_TRUE(adjacency.EdgeNeighbours(t, 1).empty());
+    EXPECT_TRUE(adjacency.EdgeNeighbours(t, 2).empty());
   }
 }
 
@@ -175,7 +180,7 @@ TEST(AdjacencyTest, LargeGridInteriorHasThreeNeighbours) {
   int boundary_edges = 0;
   for (int t = 0; t < mesh.NumTriangles(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      const size_t count = adjacency.edge_neighbours[t][k].size();
+      const size_t count = adjacency.EdgeNeighbours(t, k).size();
       ASSERT_LE(count, 1u);
       boundary_edges += count == 0;
     }

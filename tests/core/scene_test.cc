@@ -790,7 +790,7 @@ TEST(GltfSampleModelsTest, Cube) {
   // Closed: welded adjacency gives 3 neighbours per triangle.
   const MeshAdjacency adjacency = ComputeAdjacency(scene.mesh, 1e-5);
   for (int t = 0; t < 12; ++t) {
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(adjacency.edge_neighbours[t][k].size(), 1u);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(adjacency.EdgeNeighbours(t, k).size(), 1u);
   }
 }
 

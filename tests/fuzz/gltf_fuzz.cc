@@ -29,6 +29,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FUZZ_CHECK(material.base_color_texture < static_cast<int>(scene.textures.size()));
   }
   const fresco::MeshAdjacency adjacency = fresco::ComputeAdjacency(mesh);
-  FUZZ_CHECK(adjacency.edge_neighbours.size() == mesh.triangles.size());
+  FUZZ_CHECK(adjacency.NumTriangles() == static_cast<int>(mesh.triangles.size()));
   return 0;
 }

@@ -50,7 +50,7 @@ TEST(MeshRefine, NoiseMovesSharedVerticesTogether) {
   // ...and the cube is still closed: every edge has exactly one neighbour across it.
   const MeshAdjacency adjacency = ComputeAdjacency(scene.mesh);
   for (int t = 0; t < scene.mesh.NumTriangles(); ++t)
-    for (int k = 0; k < 3; ++k) ASSERT_EQ(adjacency.edge_neighbours[t][k].size(), 1u) << t;
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(adjacency.EdgeNeighbours(t, k).size(), 1u) << t;
 }
 
 TEST(MeshRefine, RefusesBadSettings) {
