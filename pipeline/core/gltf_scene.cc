@@ -1005,22 +1005,30 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   }
   root["nodes"] = Json::array({node});
 
-  // Geometry: one primitive per run of triangles with the same material and UV presence,
+  // Geometry: one primitive per material and UV presence (in the order they first appear),
   // each with its own vertices (split where a vertex has different UVs on different
-  // corners). Triangle order, and vertex order within a run, are preserved.
+  // corners). Within a primitive, triangles and vertices keep their order. (Charts on an
+  // atlas of several pages interleave materials in the mesh's order: a primitive per run
+  // would make 10^5 primitives, which viewers load badly.)
+  std::map<std::pair<int, bool>, int> primitive_of_key;
+  std::vector<std::vector<int>> primitive_triangles;
+  for (int t = 0; t < num_triangles; ++t) {
+    const auto key = std::make_pair(triangle_material(t), triangle_has_uv(t));
+    auto it = primitive_of_key.find(key);
+    if (it == primitive_of_key.end()) {
+      it = primitive_of_key.emplace(key, static_cast<int>(primitive_triangles.size())).first;
+      primitive_triangles.emplace_back();
+    }
+    primitive_triangles[it->second].push_back(t);
+  }
   Json views = Json::array(), accessors = Json::array(), primitives = Json::array();
   BinaryWriter bin;
   std::vector<int> slot(num_vertices, -1);
-  for (int begin = 0; begin < num_triangles;) {
-    const int material = triangle_material(begin);
-    const bool has_uv = triangle_has_uv(begin);
-    int end = begin + 1;
-    while (end < num_triangles && triangle_material(end) == material &&
-           triangle_has_uv(end) == has_uv) {
-      ++end;
-    }
+  for (const std::vector<int>& run : primitive_triangles) {
+    const int material = triangle_material(run[0]);
+    const bool has_uv = triangle_has_uv(run[0]);
     std::vector<int> used;
-    for (int t = begin; t < end; ++t) {
+    for (int t : run) {
       for (int k = 0; k < 3; ++k) {
         const int v = mesh.triangles[t][k];
         if (slot[v] == -1) {
@@ -1037,8 +1045,8 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
     std::vector<char> uv_set(used.size(), 0);
     std::map<std::tuple<int, float, float>, int> splits;
     std::vector<uint32_t> indices;
-    indices.reserve(3 * static_cast<size_t>(end - begin));
-    for (int t = begin; t < end; ++t) {
+    indices.reserve(3 * run.size());
+    for (int t : run) {
       for (int k = 0; k < 3; ++k) {
         const int v = mesh.triangles[t][k];
         int out = slot[v];
@@ -1099,7 +1107,6 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
                           {"indices", accessors.size() - 1},
                           {"material", material},
                           {"mode", TINYGLTF_MODE_TRIANGLES}});
-    begin = end;
   }
   Json json_mesh = Json::object();
   json_mesh["name"] = "fresco_mesh";

@@ -21,6 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::fresco::testing::MakeTempDir;
+using ::fresco::testing::ReadText;
 using ::fresco::testing::SharedDataDir;
 using ::fresco::testing::WriteText;
 using nlohmann::json;
@@ -305,6 +306,40 @@ TEST(GltfSceneTest, SaveSplitsVerticesWithSeveralUvs) {
       EXPECT_EQ(loaded.mesh.Corner(t, k), scene.mesh.Corner(t, k));
       EXPECT_EQ(loaded.mesh.uvs[t][k], scene.mesh.uvs[t][k]);
     }
+  }
+}
+
+// Triangles of two materials interleaved in the mesh's order (charts on two atlas pages):
+// one primitive per material, not one per run, and every triangle kept with its material.
+TEST(GltfSceneTest, SaveMakesOnePrimitivePerMaterialHoweverTrianglesInterleave) {
+  Scene scene;
+  const int n = 40;
+  for (int i = 0; i <= n; ++i) {
+    scene.mesh.vertices.emplace_back(i, 0, 0);
+    scene.mesh.vertices.emplace_back(i, 1, 0);
+  }
+  for (int i = 0; i < n; ++i) {
+    scene.mesh.triangles.push_back({2 * i, 2 * i + 2, 2 * i + 1});
+    scene.mesh.material.push_back(i % 2);
+  }
+  scene.mesh.uvs.assign(n, {Eigen::Vector2f::Zero(), Eigen::Vector2f::Zero(),
+                            Eigen::Vector2f::Zero()});
+  scene.mesh.has_uv.assign(n, false);
+  scene.materials.resize(2);
+  scene.materials[1].base_color_factor = Eigen::Vector4d(1, 0, 0, 1);
+  const std::string dir = MakeTempDir("scene");
+  ASSERT_TRUE(SaveGltfScene(scene, dir + "/strip.gltf").ok());
+  const json doc = json::parse(ReadText(dir + "/strip.gltf"));
+  EXPECT_EQ(doc["meshes"][0]["primitives"].size(), 2u);
+  const Scene loaded = LoadOk(dir + "/strip.gltf", /*recentre=*/false);
+  ASSERT_EQ(loaded.mesh.NumTriangles(), n);
+  // Each material's triangles in their order: the even ones, then the odd ones.
+  for (int j = 0; j < n; ++j) {
+    const int t = j < n / 2 ? 2 * j : 2 * (j - n / 2) + 1;
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(loaded.mesh.Corner(j, k), scene.mesh.Corner(t, k)) << j;
+    EXPECT_EQ(loaded.materials[loaded.mesh.material[j]].base_color_factor,
+              scene.materials[t % 2].base_color_factor)
+        << j;
   }
 }
 
