@@ -11,10 +11,24 @@
 #include <gtest/gtest.h>
 #include <imgui.h>
 
+#include "tests/test_support.h"
 #include "ui/core/app_frame.h"
+#include "ui/core/input_queue.h"
 #include "ui/core/panel.h"
 
 namespace fresco::testing {
+
+// A 12-frame 160x120 capture of the cube room (`fresco synth`), made once per test program.
+inline std::string Capture() {
+  static const std::string dir = [] {
+    const std::string d = MakeTempDir("ui") + "/capture";
+    const auto r = RunFresco({"synth", "--scene", "builtin:cube-room", "--out", d, "--frames", "12",
+                              "--size", "160x120", "--seed", "3"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return d;
+  }();
+  return dir;
+}
 
 class NullTextures : public ImageTextures {
  public:
@@ -50,6 +64,10 @@ struct ImGuiHeadless {
     io.DisplaySize = ImVec2(1600, 1000);
     io.DeltaTime = 1.0f / 60;
     io.IniFilename = nullptr;
+    // The keys as ImGui's GLFW backend maps them (GLFW key codes).
+    io.KeyMap[ImGuiKey_Space] = 32;
+    io.KeyMap[ImGuiKey_LeftArrow] = 263;
+    io.KeyMap[ImGuiKey_RightArrow] = 262;
     unsigned char* pixels = nullptr;
     int w = 0, h = 0;
     io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);  // a font atlas, no texture upload
@@ -62,7 +80,11 @@ struct ImGuiHeadless {
     panel.Draw(ui);
     ImGui::Render();
   }
-  void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  // One frame of the whole app; with `input`, the mouse and keys as the GL app gives them
+  // (CopyToImGui) for that frame.
+  void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels,
+             const InputState* input = nullptr) {
+    if (input) CopyToImGui(*input, &ImGui::GetIO());
     ImGui::NewFrame();
     DrawAppFrame(ui, panels);
     ImGui::Render();

@@ -5,6 +5,14 @@
 namespace fresco {
 namespace {
 
+const ImVec4 kErrorColour(1.0f, 0.4f, 0.4f, 1.0f);
+
+// ImGui 1.86 indexes io.KeysDown by the backend's key codes: GLFW_KEY_F5 (letters are
+// their ASCII capitals there, as 'S' below).
+constexpr int kKeyF5 = 294;
+
+bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
+
 void OpenNow(UiContext& ui, const std::string& path) {
   if (Status s = ui.state->Open(path); !s.ok()) {
     ui.state->message = "error: " + s.message();
@@ -75,7 +83,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   if (ImGui::BeginMenu("Edit")) {
     if (ImGui::MenuItem("Undo", "Ctrl+Z", false, !state.undo.empty())) UndoRedo(ui, true);
     if (ImGui::MenuItem("Redo", "Ctrl+Y", false, !state.redo.empty())) UndoRedo(ui, false);
-    if (ImGui::MenuItem("Apply to the pipeline (restart)", "F5", false, state.has_project))
+    if (ImGui::MenuItem("Apply (repaint up to this frame)", "F5", false, state.has_project))
       ApplyProject(ui);
     ImGui::EndMenu();
   }
@@ -85,8 +93,12 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   }
   const auto& snap = *ui.snapshot;
   ImGui::Separator();
-  ImGui::Text("frame %d  %s  coverage %.1f%%  %s", snap.frame, snap.status.c_str(),
-              100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
+  if (IsError(snap.status)) {  // said once, in the status bar
+    ImGui::TextColored(kErrorColour, "error (see the status bar)");
+  } else {
+    ImGui::Text("%s  %s  coverage %.1f%%  %s", FrameLabel(snap).c_str(), snap.status.c_str(),
+                100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
+  }
   ImGui::EndMainMenuBar();
 }
 
@@ -105,19 +117,40 @@ void HandleShortcuts(UiContext& ui) {
       ui.runner->Play();
   }
   if (io.KeyCtrl && ImGui::IsKeyPressed('Q')) state.pending_quit = true;
+  if (ImGui::IsKeyPressed(kKeyF5, false) && state.has_project) ApplyProject(ui);
+  // Left: back one frame (a file source repaints from the start); Right: the next frame.
+  const RunnerSnapshot& snap = *ui.snapshot;
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_LeftArrow), false) && !snap.live.active &&
+      ShownFrame(snap) > 0)
+    ui.runner->Seek(ShownFrame(snap) - 1);
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_RightArrow), false) && state.has_project)
+    ui.runner->Step();
 }
 
 void DrawStatusBar(UiContext& ui) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowPos(ImVec2(0, display.y - 24));
-  ImGui::SetNextWindowSize(ImVec2(display.x, 24));
+  ImGui::SetNextWindowPos(ImVec2(0, display.y - kStatusBarHeight));
+  ImGui::SetNextWindowSize(ImVec2(display.x, kStatusBarHeight));
   ImGui::Begin("##status", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
-  ImGui::TextUnformatted(ui.state->message.c_str());
+  // One message: the worker's error replaces "opened ..." (the project named a file it
+  // could not read); other messages (saved, grouping edited) stay beside it.
+  const std::string& message = ui.state->message;
+  if (IsError(ui.snapshot->status)) {
+    ImGui::TextColored(kErrorColour, "%s", ui.snapshot->status.c_str());
+    if (!message.empty() && message.rfind("opened ", 0) != 0 && message != ui.snapshot->status) {
+      ImGui::SameLine();
+      ImGui::TextUnformatted(("  " + message).c_str());
+    }
+  } else if (IsError(message)) {
+    ImGui::TextColored(kErrorColour, "%s", message.c_str());
+  } else {
+    ImGui::TextUnformatted(message.c_str());
+  }
   if (const std::string& problem = ui.snapshot->live.problem; !problem.empty()) {
     ImGui::SameLine();  // a live source that stalled, dropped or ended
-    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "  live: %s", problem.c_str());
+    ImGui::TextColored(kErrorColour, "  live: %s", problem.c_str());
   }
   ImGui::End();
 }
@@ -139,7 +172,14 @@ void UndoRedo(UiContext& ui, bool undo) {
 }
 
 void ApplyProject(UiContext& ui) {
-  if (ui.state->has_project) ui.runner->Restart(ui.state->project);
+  if (!ui.state->has_project) return;
+  // Back to the frame being looked at (or sought), where the source can go back to it.
+  const RunnerSnapshot* snap = ui.snapshot.get();
+  const int frame = !snap || snap->live.active ? -1
+                    : snap->seek_target >= 0   ? snap->seek_target
+                                               : snap->frame;
+  ui.runner->Restart(ui.state->project);
+  if (frame > 0) ui.runner->Seek(frame);
 }
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {

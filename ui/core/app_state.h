@@ -59,4 +59,11 @@ Status SetGroupTexelSize(const std::vector<GroupSpec>& current, int num_triangle
                          const std::set<int>& groups, double texel_size_m,
                          std::vector<GroupSpec>* result);
 
+// Why the painting shows more groups than the project stores, or "" when it does not: a
+// stored group (a merge, typically) whose triangles fold over on its own projection plane
+// is split back apart when the buffers are built (BuildBaseBuffers). `stored`: the
+// project's explicit groups; `built`: the session's groups (one per base buffer).
+std::string DescribeGroupsSplitBack(const std::vector<GroupSpec>& stored,
+                                    const std::vector<GroupSpec>& built, int num_triangles);
+
 }  // namespace fresco

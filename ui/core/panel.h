@@ -38,8 +38,8 @@ struct ViewportView {
   float distance_m = 0;                // 0 = fit the model
   float target[3] = {0, 0, 0};         // orbit centre, world
   bool target_set = false;
-  OrbitFrame orbit;                    // which way is up (from the capture's poses)
-  uint64_t orbit_geometry_version = 0; // the geometry `orbit` was taken from (0: none yet)
+  OrbitFrame orbit;                     // which way is up (from the capture's poses)
+  uint64_t orbit_geometry_version = 0;  // the geometry `orbit` was taken from (0: none yet)
   bool show_path = true, show_frustum = true;
 };
 
@@ -80,8 +80,12 @@ class Panel {
 // Every panel, in menu order (panel_registry.cc).
 std::vector<std::unique_ptr<Panel>> MakePanels();
 
+// The status bar at the bottom of the window (app_frame.cc), pixels.
+inline constexpr float kStatusBarHeight = 24;
+
 // Helpers for panels.
-// Starts the panel's window at its default place the first time (scaled to the display).
+// Starts the panel's window at its default place the first time (scaled to the display),
+// and keeps its title bar below the menu bar and on screen.
 bool BeginPanel(Panel& panel);
 // The same for a large window over other panels (opaque) that shows a worker: false, with
 // the window already ended, when it is collapsed or there is no worker (it says so).
@@ -89,6 +93,10 @@ bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker);
 // An image scaled to fit `max_width` (0 = the available width), keeping its aspect.
 void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,
                float max_width = 0);
+// The frame the user is looking at: a seek's target while it runs, else the last painted.
+int ShownFrame(const RunnerSnapshot& snap);
+// "frame 12", "seeking to frame 40: at 17", "no frame painted yet".
+std::string FrameLabel(const RunnerSnapshot& snap);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
 

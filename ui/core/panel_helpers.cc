@@ -1,5 +1,6 @@
 #include <cmath>
 
+#include "ui/core/layout.h"
 #include "ui/core/panel.h"
 
 namespace fresco {
@@ -11,7 +12,14 @@ bool BeginPanel(Panel& panel) {
                           ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(panel.default_size.x * sx, panel.default_size.y * sy),
                            ImGuiCond_FirstUseEver);
-  return ImGui::Begin(panel.Title(), &panel.open);
+  const bool visible = ImGui::Begin(panel.Title(), &panel.open);
+  // However it was dragged, the title bar stays below the menu bar and on screen.
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), kStatusBarHeight};
+  const LayoutRect kept =
+      KeepTitleBarReachable({pos.x, pos.y, size.x, size.y}, band, ImGui::GetFrameHeight());
+  if (kept.x != pos.x || kept.y != pos.y) ImGui::SetWindowPos(ImVec2(kept.x, kept.y));
+  return visible;
 }
 
 bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker) {
@@ -39,6 +47,19 @@ void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint
   const float height = width * image.rows / std::max(1, image.cols);
   ImGui::Image(ui.textures->Get(key, image, version), ImVec2(width, height));
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %d x %d", key.c_str(), image.cols, image.rows);
+}
+
+int ShownFrame(const RunnerSnapshot& snap) {
+  return snap.seek_target >= 0 ? snap.seek_target : snap.frame;
+}
+
+std::string FrameLabel(const RunnerSnapshot& snap) {
+  const std::string target = std::to_string(snap.seek_target);
+  if (snap.seek_target >= 0 && snap.frame < 0) return "seeking to frame " + target + ": reopening";
+  if (snap.seek_target >= 0)
+    return "seeking to frame " + target + ": at " + std::to_string(snap.frame);
+  if (snap.frame < 0) return "no frame painted yet";
+  return "frame " + std::to_string(snap.frame);
 }
 
 void ShowMetrics(const std::map<std::string, double>& metrics) {

@@ -257,9 +257,11 @@ void PipelineRunner::SetRecording(const std::string& dir) {
 
 void PipelineRunner::Publish(bool with_painted) {
   working_.playing = playing_;
+  working_.seek_target = seek_target_;
   if (session_) {  // without one, the status says why (no project, error, connecting)
     working_.run = session_->run->stats();
     working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
+    if (seek_target_ >= 0 && !session_->ended) working_.status = "seeking";
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
       working_.live.frames_painted = session_->run->stats().frames_painted;
@@ -341,7 +343,9 @@ void PipelineRunner::Loop() {
           }
           seek_target_ = session_ ? command.frame : -1;
           if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
-          if (seek_target_ < 0) Publish(true);
+          // Either the result, or that a seek is under way (the UI shows its progress).
+          Publish(seek_target_ < 0);
+          last_publish = Clock::now();
           break;
       }
       continue;
@@ -354,7 +358,7 @@ void PipelineRunner::Loop() {
       if (painted == Painted::kEnded || (painted == Painted::kFrame && last)) {
         seek_target_ = -1;
         Publish(true);
-      } else if (painted == Painted::kWaiting && due) {
+      } else if (due) {  // progress (or a live source's state while waiting)
         Publish(false);
         last_publish = Clock::now();
       }

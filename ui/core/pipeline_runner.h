@@ -54,6 +54,9 @@ struct RunnerSnapshot {
   std::string status;                               // "paused", "playing", "error: ..."
   bool playing = false;
   int frame = -1;  // index of the frame last painted
+  // A seek under way: the frame it paints up to (`frame` says how far it got; -1 while a
+  // seek back reopens the video); -1 when none.
+  int seek_target = -1;
   std::string frame_name;
   bool has_pose = false;
   Rigid3d cam_from_world;

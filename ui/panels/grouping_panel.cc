@@ -4,7 +4,9 @@
 // 3D view); all undoable, stored in the project as explicit groups and honoured by
 // `fresco run`.
 #include <algorithm>
+#include <cstdio>
 
+#include "ui/core/group_colour.h"
 #include "ui/core/panel.h"
 #include "ui/panels/panels.h"
 
@@ -30,6 +32,24 @@ class GroupingPanel : public Panel {
     const SessionGeometry& geo = *snap.geometry;
     const int num_triangles = static_cast<int>(geo.buffer_of_triangle.size());
     const bool explicit_groups = !state.project.grouping.groups.empty();
+    if (snap.geometry_version != checked_geometry_) {  // a new session: did a merge hold?
+      checked_geometry_ = snap.geometry_version;
+      split_message_ = explicit_groups ? DescribeGroupsSplitBack(state.project.grouping.groups,
+                                                                 geo.groups, num_triangles)
+                                       : "";
+      if (!split_message_.empty()) state.message = "grouping: " + split_message_;
+      colours_.clear();
+      for (const GroupSpec& g : geo.groups) {
+        const auto rgb = GroupColour(StableGroupKey(g));
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "#%02x%02x%02x", static_cast<int>(rgb[0] * 255 + 0.5f),
+                      static_cast<int>(rgb[1] * 255 + 0.5f), static_cast<int>(rgb[2] * 255 + 0.5f));
+        colours_ += (colours_.empty() ? "" : " ") + std::to_string(StableGroupKey(g)) + hex;
+      }
+    }
+    if (!split_message_.empty())
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "%s", "Grouping changed when painting:");
+    if (!split_message_.empty()) ImGui::TextWrapped("%s", split_message_.c_str());
     ImGui::TextWrapped("%s: %zu groups for %d triangles (%d split for fold-over)",
                        explicit_groups ? "stored groups" : "automatic", geo.groups.size(),
                        num_triangles, geo.folds_split);
@@ -79,6 +99,14 @@ class GroupingPanel : public Panel {
         ImGui::TableNextRow();
         ImGui::TableSetColumnIndex(0);
         const bool selected = state.selected_groups.count(static_cast<int>(g)) > 0;
+        // The group's colour in the 3D view's "groups" mode (stable across edits).
+        const auto rgb = GroupColour(StableGroupKey(geo.groups[g]));
+        ImGui::PushID(static_cast<int>(g));
+        ImGui::ColorButton("##colour", ImVec4(rgb[0], rgb[1], rgb[2], 1.0f),
+                           ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoBorder,
+                           ImVec2(ImGui::GetTextLineHeight(), ImGui::GetTextLineHeight()));
+        ImGui::PopID();
+        ImGui::SameLine();
         if (ImGui::Selectable(std::to_string(g).c_str(), selected,
                               ImGuiSelectableFlags_SpanAllColumns)) {
           if (!ImGui::GetIO().KeyCtrl) state.selected_groups.clear();
@@ -139,6 +167,10 @@ class GroupingPanel : public Panel {
     ImGui::End();
   }
 
+  std::map<std::string, std::string> Report() const override {
+    return {{"colours", colours_}, {"split", split_message_}};
+  }
+
  private:
   static void Commit(UiContext& ui, const Status& status, const std::vector<GroupSpec>& groups) {
     AppState& state = *ui.state;
@@ -156,6 +188,9 @@ class GroupingPanel : public Panel {
   }
 
   float angle_ = 20, texel_ = 0, group_texel_ = 0.01f;
+  uint64_t checked_geometry_ = 0;
+  std::string split_message_;  // why stored groups were split back apart ("" = they held)
+  std::string colours_;        // "KEY#rrggbb ..." per group, for Report()
   int target_group_ = 0;
 };
 
