@@ -10,11 +10,14 @@
 
 #include <gtest/gtest.h>
 #include <imgui.h>
+#include <imgui_internal.h>
 
 #include "tests/test_support.h"
 #include "ui/core/app_frame.h"
+#include "ui/core/calibration_runner.h"
 #include "ui/core/input_queue.h"
 #include "ui/core/panel.h"
+#include "ui/panels/panels.h"
 
 namespace fresco::testing {
 
@@ -89,6 +92,78 @@ struct ImGuiHeadless {
     DrawAppFrame(ui, panels);
     ImGui::Render();
   }
+};
+
+// The whole app headless over a real painting worker on `project`, paused at `frame`, in a
+// display of `display` pixels; each frame's mouse and keys come from `input`.
+struct HeadlessApp {
+  HeadlessApp(const std::string& project, int frame, ImVec2 display = ImVec2(1600, 1000)) {
+    EXPECT_TRUE(state.Open(project).ok()) << project;
+    runner.Restart(state.project);
+    runner.Seek(frame);
+    runner.WaitIdle();
+    ui.state = &state;
+    ui.runner = &runner;
+    ui.calibration = &calibration;
+    ui.textures = &textures;
+    ui.viewport = &viewport;
+    panels = MakePanels();
+    ImGui::GetIO().DisplaySize = display;
+    Frames(4);  // scroll bars and content sizes settle over a few frames
+  }
+  void Frame() {
+    ui.snapshot = runner.Snapshot();
+    imgui.Frame(ui, panels, &input);
+  }
+  void Frames(int n) {
+    for (int i = 0; i < n; ++i) Frame();
+  }
+  // Frames until the queued events are all in, and one more.
+  void Drain(InputQueue* queue) {
+    while (queue->pending() > 0) {
+      queue->NextFrame(&input);
+      Frame();
+    }
+    queue->NextFrame(&input);
+    Frame();
+  }
+  void MouseTo(float x, float y) { input.mouse_x = x, input.mouse_y = y; }
+  // Presses the left button at `from`, moves to `to` in `steps` frames, releases.
+  void Drag(ImVec2 from, ImVec2 to, int steps) {
+    MouseTo(from.x, from.y);
+    Frames(2);
+    input.mouse_down[0] = true;
+    Frame();
+    for (int s = 1; s <= steps; ++s) {
+      MouseTo(from.x + (to.x - from.x) * s / steps, from.y + (to.y - from.y) * s / steps);
+      Frame();
+    }
+    input.mouse_down[0] = false;
+    Frame();
+  }
+  void Click(ImVec2 at) {
+    MouseTo(at.x, at.y);
+    Frame();
+    input.mouse_down[0] = true;
+    Frame();
+    input.mouse_down[0] = false;
+    Frame();
+  }
+  static ImGuiWindow* Window(const std::string& title) {
+    ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
+    EXPECT_NE(w, nullptr) << title;
+    return w;
+  }
+
+  AppState state;
+  PipelineRunner runner;
+  NullTextures textures;
+  NullViewport viewport;
+  CalibrationRunner calibration;
+  UiContext ui;
+  ImGuiHeadless imgui;
+  std::vector<std::unique_ptr<Panel>> panels;
+  InputState input;
 };
 
 }  // namespace fresco::testing

@@ -3,6 +3,7 @@
 // debug images zoom and read pixels, group colours stay put across grouping edits, a
 // missing video is one error, the seek slider, step back and F5 keep the frame, and a key
 // tap or a drag shorter than a frame still arrives (input_queue.h).
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -32,53 +33,17 @@ using testing::NullViewport;
 
 constexpr int kKeyF5 = 294, kKeyLeft = 263, kKeyRight = 262;  // GLFW's codes
 
-// The whole app headless on a copy of the capture, paused at `frame`, with the mouse and
-// keys of each frame in `input`.
-struct App {
-  explicit App(int frame, RunnerOptions options = RunnerOptions()) : runner(options) {
-    dir = MakeTempDir("ui-input");
-    fs::copy(Capture(), dir + "/capture", fs::copy_options::recursive);
-    EXPECT_TRUE(state.Open(dir + "/capture/project.json").ok());
-    runner.Restart(state.project);
-    runner.Seek(frame);
-    runner.WaitIdle();
-    ui.state = &state;
-    ui.runner = &runner;
-    ui.calibration = &calibration;
-    ui.textures = &textures;
-    ui.viewport = &viewport;
-    panels = MakePanels();
-    Frames(2);
-  }
-  void Frame() {
-    ui.snapshot = runner.Snapshot();
-    imgui.Frame(ui, panels, &input);
-  }
-  void Frames(int n) {
-    for (int i = 0; i < n; ++i) Frame();
-  }
-  // Frames until the queued events are all in, and one more.
-  void Drain(InputQueue* queue) {
-    while (queue->pending() > 0) {
-      queue->NextFrame(&input);
-      Frame();
-    }
-    queue->NextFrame(&input);
-    Frame();
-  }
-  void MouseTo(float x, float y) { input.mouse_x = x, input.mouse_y = y; }
-  // Presses the left button at `from`, moves to `to` in `steps` frames, releases.
-  void Drag(ImVec2 from, ImVec2 to, int steps) {
-    MouseTo(from.x, from.y);
-    Frames(2);
-    input.mouse_down[0] = true;
-    Frame();
-    for (int s = 1; s <= steps; ++s) {
-      MouseTo(from.x + (to.x - from.x) * s / steps, from.y + (to.y - from.y) * s / steps);
-      Frame();
-    }
-    input.mouse_down[0] = false;
-    Frame();
+// The whole app headless on a copy of the capture, paused at `frame`.
+std::string CopyOfCapture() {
+  const std::string dir = MakeTempDir("ui-input");
+  fs::copy(Capture(), dir + "/capture", fs::copy_options::recursive);
+  return dir;
+}
+
+struct App : testing::HeadlessApp {
+  explicit App(int frame) : App(CopyOfCapture(), frame) {}
+  App(const std::string& copy, int frame) : HeadlessApp(copy + "/capture/project.json", frame) {
+    dir = copy;
   }
   void Tap(int key) {
     input.keys_down[key] = true;
@@ -97,22 +62,7 @@ struct App {
     const auto it = report.find(key);
     return it == report.end() ? "" : it->second;
   }
-  static ImGuiWindow* Window(const std::string& title) {
-    ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
-    EXPECT_NE(w, nullptr) << title;
-    return w;
-  }
-
   std::string dir;
-  AppState state;
-  PipelineRunner runner;
-  NullTextures textures;
-  NullViewport viewport;
-  CalibrationRunner calibration;
-  UiContext ui;
-  ImGuiHeadless imgui;
-  std::vector<std::unique_ptr<Panel>> panels;
-  InputState input;
 };
 
 std::vector<float> Numbers(const std::string& text) {
@@ -153,7 +103,9 @@ TEST(UiInput, DraggingThe3DViewOrbitsAndNeverMovesTheWindow) {
 
 TEST(UiInput, TitleBarsStayBelowTheMenuBar) {
   App app(0);
-  ImGuiWindow* window = App::Window("3D view");
+  app.Find(kCalibrationPanelTitle).open = true;  // a floating panel
+  app.Frames(2);
+  ImGuiWindow* window = App::Window(kCalibrationPanelTitle);
   const ImVec2 grab(window->Pos.x + 60, window->Pos.y + 5);  // on the title bar
   app.Drag(grab, ImVec2(grab.x + 40, 0), 10);                // up past the menu bar
   EXPECT_EQ(window->Pos.y, ImGui::GetFrameHeight()) << "the title bar went under the menu bar";
@@ -161,6 +113,12 @@ TEST(UiInput, TitleBarsStayBelowTheMenuBar) {
   app.Drag(ImVec2(window->Pos.x + 60, window->Pos.y + 5), ImVec2(5000, 5000), 10);
   EXPECT_LE(window->Pos.y, 1000 - kStatusBarHeight - ImGui::GetFrameHeight());
   EXPECT_LE(window->Pos.x, 1600 - 48);
+  // Tiled panels do not move at all: dragging a title bar leaves the tile where it was.
+  ImGuiWindow* view = App::Window("3D view");
+  const ImVec2 pos = view->Pos;
+  app.Drag(ImVec2(pos.x + 60, pos.y + 5), ImVec2(pos.x + 200, 0), 5);
+  EXPECT_EQ(view->Pos.x, pos.x);
+  EXPECT_EQ(view->Pos.y, pos.y);
 }
 
 TEST(UiInput, StageImageStartsOnTheLargestZoomsAndReadsPixels) {
@@ -182,9 +140,11 @@ TEST(UiInput, StageImageStartsOnTheLargestZoomsAndReadsPixels) {
   ASSERT_EQ(view.size(), 4u);
   EXPECT_NEAR(view[3] / view[2], static_cast<float>(image.rows) / image.cols, 0.02);
   // The readout names the pixel under the cursor and its value.
-  const float mx = view[0] + 0.3f * view[2], my = view[1] + 0.6f * view[3];
+  // Whole pixels: ImGui floors the mouse position.
+  const float mx = std::floor(view[0] + 0.3f * view[2]), my = std::floor(view[1] + 0.6f * view[3]);
   app.MouseTo(mx, my);
   app.Frames(2);
+  ASSERT_EQ(Numbers(app.ReportOf(title, "view")), view) << "the view moved";
   const int col = static_cast<int>((mx - view[0]) / view[2] * image.cols);
   const int row = static_cast<int>((my - view[1]) / view[3] * image.rows);
   EXPECT_EQ(app.ReportOf(title, "pixel"), DescribePixel(image, col, row));

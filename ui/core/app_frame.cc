@@ -1,5 +1,9 @@
 #include "ui/core/app_frame.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -10,6 +14,9 @@ const ImVec4 kErrorColour(1.0f, 0.4f, 0.4f, 1.0f);
 // ImGui 1.86 indexes io.KeysDown by the backend's key codes: GLFW_KEY_F5 (letters are
 // their ASCII capitals there, as 'S' below).
 constexpr int kKeyF5 = 294;
+constexpr float kSplitterPx = 5;   // the bars between tiled panels
+constexpr float kMinTilePx = 120;  // a splitter stops before a side gets narrower
+constexpr float kMinFontScale = 0.75f, kMaxFontScale = 2.0f;
 
 bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
 
@@ -89,6 +96,22 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   }
   if (ImGui::BeginMenu("View")) {
     for (auto& panel : panels) ImGui::MenuItem(panel->Title(), nullptr, &panel->open);
+    ImGui::Separator();
+    TileLayout& layout = ui.layout;
+    if (ImGui::BeginMenu("Maximise")) {  // also: double-click a panel's title bar
+      for (auto& panel : panels)
+        if (layout.Contains(panel->Title()) &&
+            ImGui::MenuItem(panel->Title(), nullptr, layout.maximised() == panel->Title(),
+                            panel->open))
+          layout.ToggleMaximised(panel->Title());
+      ImGui::EndMenu();
+    }
+    if (ImGui::MenuItem("Restore", nullptr, false, !layout.maximised().empty()))
+      layout.ToggleMaximised(layout.maximised());
+    if (ImGui::MenuItem("Default layout")) layout = DefaultTileLayout();
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8);
+    ImGui::SliderFloat("font scale", &ImGui::GetIO().FontGlobalScale, kMinFontScale, kMaxFontScale,
+                       "%.2f");
     ImGui::EndMenu();
   }
   const auto& snap = *ui.snapshot;
@@ -155,6 +178,61 @@ void DrawStatusBar(UiContext& ui) {
   ImGui::End();
 }
 
+// The tiled panels' places this frame (between the menu bar and the status bar); returns the
+// splitters.
+std::vector<TileLayout::Splitter> PlaceTiles(const TileLayout& layout,
+                                             std::vector<std::unique_ptr<Panel>>& panels) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float top = std::ceil(ImGui::GetFrameHeight());  // the menu bar's height
+  const LayoutRect band{0, top, display.x, std::max(0.0f, display.y - top - kStatusBarHeight)};
+  auto is_open = [&](const std::string& title) {
+    for (const auto& p : panels)
+      if (title == p->Title()) return p->open;
+    return false;
+  };
+  std::vector<TileLayout::Tile> tiles;
+  std::vector<TileLayout::Splitter> splitters;
+  layout.Compute(band, kSplitterPx, is_open, &tiles, &splitters);
+  for (auto& panel : panels) {
+    panel->tiled = false;
+    for (const TileLayout::Tile& t : tiles) {
+      if (t.panel != panel->Title()) continue;
+      panel->tiled = true;
+      panel->tile_pos = ImVec2(t.rect.x, t.rect.y);
+      panel->tile_size = ImVec2(t.rect.w, t.rect.h);
+    }
+  }
+  return splitters;
+}
+
+// The bars between tiles: drag to resize the panels on both sides.
+void DrawSplitters(TileLayout* layout, const std::vector<TileLayout::Splitter>& splitters) {
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1, 1));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
+  for (const TileLayout::Splitter& s : splitters) {
+    const std::string name = "##splitter" + std::to_string(s.node);
+    ImGui::SetNextWindowPos(ImVec2(s.rect.x, s.rect.y));
+    ImGui::SetNextWindowSize(ImVec2(s.rect.w, s.rect.h));
+    ImGui::Begin(name.c_str(), nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoBringToFrontOnFocus |
+                     ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoScrollWithMouse);
+    ImGui::InvisibleButton("##bar", ImVec2(std::max(1.0f, s.rect.w), std::max(1.0f, s.rect.h)));
+    const ImGuiIO& io = ImGui::GetIO();
+    if (ImGui::IsItemActive())
+      layout->Drag(s, s.stacked ? io.MouseDelta.y : io.MouseDelta.x, kMinTilePx);
+    if (ImGui::IsItemHovered() || ImGui::IsItemActive()) {
+      ImGui::SetMouseCursor(s.stacked ? ImGuiMouseCursor_ResizeNS : ImGuiMouseCursor_ResizeEW);
+      ImGui::GetWindowDrawList()->AddRectFilled(ImVec2(s.rect.x, s.rect.y),
+                                                ImVec2(s.rect.x + s.rect.w, s.rect.y + s.rect.h),
+                                                ImGui::GetColorU32(ImGuiCol_SeparatorActive));
+    }
+    ImGui::End();
+  }
+  ImGui::PopStyleVar(3);
+}
+
 }  // namespace
 
 void RequestOpen(UiContext& ui, const std::string& path) { ui.state->pending_open = path; }
@@ -185,8 +263,14 @@ void ApplyProject(UiContext& ui) {
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   HandleShortcuts(ui);
   DrawMenuBar(ui, panels);
-  for (auto& panel : panels)
-    if (panel->open) panel->Draw(ui);
+  const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);
+  for (auto& panel : panels) {
+    // A tiled panel without a tile is hidden behind a maximised one.
+    if (panel->open && (panel->tiled || !ui.layout.Contains(panel->Title()))) panel->Draw(ui);
+    if (panel->maximise_requested) ui.layout.ToggleMaximised(panel->Title());
+    panel->maximise_requested = false;
+  }
+  DrawSplitters(&ui.layout, splitters);
   DrawUnsavedPrompt(ui);
   DrawStatusBar(ui);
 }

@@ -110,11 +110,12 @@ void ImageView::Draw(UiContext& ui, const std::string& key, const cv::Mat& image
   int col = -1, row = -1;
   if (ImGui::IsItemHovered() && PixelUnder(zp_, v, mx, my, &col, &row))
     readout_ = DescribePixel(image, col, row);
+  if (ImGui::IsItemHovered() && readout_.empty())
+    ImGui::SetTooltip("wheel zooms, drag pans, double-click fits");
   if (!readout_.empty())
-    ImGui::Text("%s  (%dx%d, zoom %.1fx)", readout_.c_str(), image.cols, image.rows, zp_.zoom);
+    ImGui::TextWrapped("%s", readout_.c_str());
   else
-    ImGui::TextDisabled("%d x %d, zoom %.1fx: wheel zooms, drag pans, double-click fits",
-                        image.cols, image.rows, zp_.zoom);
+    ImGui::TextDisabled("%d x %d, zoom %.1fx", image.cols, image.rows, zp_.zoom);
   if (scale) DrawLegend(*scale);
 }
 
@@ -123,7 +124,7 @@ void ImageView::ReportInto(std::map<std::string, std::string>* report) const {
   std::snprintf(text, sizeof(text), "%.3f", zp_.zoom);
   (*report)["zoom"] = text;
   (*report)["pixel"] = readout_;
-  std::snprintf(text, sizeof(text), "%.0f %.0f %.0f %.0f", view_[0], view_[1], view_[2], view_[3]);
+  std::snprintf(text, sizeof(text), "%.3f %.3f %.3f %.3f", view_[0], view_[1], view_[2], view_[3]);
   (*report)["view"] = text;
   if (!legend_.empty()) (*report)["legend"] = legend_;
 }

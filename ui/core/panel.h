@@ -19,6 +19,7 @@
 #include "ui/core/orbit_frame.h"
 #include "ui/core/pipeline_runner.h"
 #include "ui/core/poses_runner.h"
+#include "ui/core/tile_layout.h"
 
 namespace fresco {
 
@@ -63,6 +64,8 @@ struct UiContext {
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
   bool request_quit = false;
   PosesRunner* poses = nullptr;  // the COLMAP worker (Poses panel)
+  // Where the tiled panels go (splitters, maximise); panels not in it float.
+  TileLayout layout = DefaultTileLayout();
 };
 
 class Panel {
@@ -73,8 +76,14 @@ class Panel {
   // What the panel shows, for `fresco gui --screenshot`'s FILE.json (name -> value).
   virtual std::map<std::string, std::string> Report() const { return {}; }
   bool open = true;
-  // Where the panel starts, in a 1600 x 1000 window (scaled to the real size).
+  // Where a floating panel starts, in a 1600 x 1000 window (scaled to the real size).
   ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);
+  // Set by the app frame before each frame: the panel's tile in the layout (a tiled panel
+  // neither moves nor resizes itself), or floating.
+  bool tiled = false;
+  ImVec2 tile_pos, tile_size;
+  // A double-click on a tiled panel's title bar: the app frame maximises or restores it.
+  bool maximise_requested = false;
 };
 
 // Every panel, in menu order (panel_registry.cc).
@@ -84,8 +93,9 @@ std::vector<std::unique_ptr<Panel>> MakePanels();
 inline constexpr float kStatusBarHeight = 24;
 
 // Helpers for panels.
-// Starts the panel's window at its default place the first time (scaled to the display),
-// and keeps its title bar below the menu bar and on screen.
+// Starts the panel's window: in its tile when tiled (a double-click on the title bar asks to
+// maximise or restore it); else at its default place the first time (scaled to the
+// display), its title bar kept below the menu bar and on screen.
 bool BeginPanel(Panel& panel);
 // The same for a large window over other panels (opaque) that shows a worker: false, with
 // the window already ended, when it is collapsed or there is no worker (it says so).
@@ -97,6 +107,12 @@ void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint
 int ShownFrame(const RunnerSnapshot& snap);
 // "frame 12", "seeking to frame 40: at 17", "no frame painted yet".
 std::string FrameLabel(const RunnerSnapshot& snap);
+// Layout in narrow panels: the next item's width so that `following` (a button's label on
+// the same line after it, or a widget's own label) still fits, at least `min_px`; and
+// SameLine only when an item `next_width` wide fits after the last one (else a new line).
+void FitNextItem(const char* following = nullptr, float min_px = 40);
+void SameLineIfFits(float next_width);
+float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
 

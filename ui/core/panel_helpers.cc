@@ -7,12 +7,29 @@ namespace fresco {
 
 bool BeginPanel(Panel& panel) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (panel.tiled) {
+    ImGui::SetNextWindowPos(panel.tile_pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(panel.tile_size, ImGuiCond_Always);
+    const bool visible =
+        ImGui::Begin(panel.Title(), &panel.open,
+                     ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
+                         ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
+    // Text wraps at the panel's edge instead of running out of a narrow tile (ImGui resets
+    // the wrap position at every Begin, so nothing needs popping).
+    ImGui::PushTextWrapPos(0.0f);
+    const float title_bottom = ImGui::GetWindowPos().y + ImGui::GetFrameHeight();
+    if (ImGui::IsWindowHovered() && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left) &&
+        ImGui::GetIO().MousePos.y < title_bottom)
+      panel.maximise_requested = true;
+    return visible;
+  }
   const float sx = display.x / 1600.0f, sy = display.y / 1000.0f;
   ImGui::SetNextWindowPos(ImVec2(panel.default_pos.x * sx, panel.default_pos.y * sy),
                           ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(panel.default_size.x * sx, panel.default_size.y * sy),
                            ImGuiCond_FirstUseEver);
   const bool visible = ImGui::Begin(panel.Title(), &panel.open);
+  ImGui::PushTextWrapPos(0.0f);
   // However it was dragged, the title bar stays below the menu bar and on screen.
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), kStatusBarHeight};
@@ -47,6 +64,22 @@ void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint
   const float height = width * image.rows / std::max(1, image.cols);
   ImGui::Image(ui.textures->Get(key, image, version), ImVec2(width, height));
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %d x %d", key.c_str(), image.cols, image.rows);
+}
+
+float ButtonWidth(const char* label) {
+  return ImGui::CalcTextSize(label, nullptr, true).x + 2 * ImGui::GetStyle().FramePadding.x;
+}
+
+void FitNextItem(const char* following, float min_px) {
+  float width = ImGui::GetContentRegionAvail().x;
+  if (following) width -= ButtonWidth(following) + ImGui::GetStyle().ItemSpacing.x;
+  ImGui::SetNextItemWidth(std::max(min_px, width));
+}
+
+void SameLineIfFits(float next_width) {
+  const float x = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x;
+  if (x + next_width <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x)
+    ImGui::SameLine();
 }
 
 int ShownFrame(const RunnerSnapshot& snap) {

@@ -59,10 +59,13 @@ class GroupingPanel : public Panel {
       angle_ = static_cast<float>(state.project.grouping.angle_deg);
       texel_ = static_cast<float>(state.project.pipeline.texel_size_m);
     }
+    ImGui::PushItemWidth(-ImGui::CalcTextSize("texel m (0 = auto)").x -
+                         ImGui::GetStyle().ItemInnerSpacing.x);
     ImGui::SliderFloat("angle deg", &angle_, 0.0f, 90.0f, "%.1f");
     const bool angle_done = ImGui::IsItemDeactivatedAfterEdit();
     ImGui::DragFloat("texel m (0 = auto)", &texel_, 0.0005f, 0.0f, 1.0f, "%.4f");
     const bool texel_done = ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::PopItemWidth();
     if (angle_done || texel_done) {
       state.BeginEdit();
       state.project.grouping.angle_deg = angle_;
@@ -79,7 +82,7 @@ class GroupingPanel : public Panel {
       state.project.grouping.edits.clear();
       ApplyProject(ui);
     }
-    if (!explicit_groups && ImGui::Button("Store these groups in the project")) {
+    if (!explicit_groups && ImGui::Button("Store these groups")) {
       state.BeginEdit();
       state.project.grouping.groups = geo.groups;
       state.project.grouping.edits.clear();
@@ -140,14 +143,14 @@ class GroupingPanel : public Panel {
     if (ImGui::Button("Merge groups"))
       Commit(ui, MergeGroups(geo.groups, num_triangles, state.selected_groups, &result), result);
     ImGui::EndDisabled();
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Split triangles"));
     ImGui::BeginDisabled(state.selected_triangles.empty());
     if (ImGui::Button("Split triangles"))
       Commit(ui, SplitTriangles(geo.groups, num_triangles, state.selected_triangles, &result),
              result);
-    ImGui::SetNextItemWidth(80);
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 6);
     ImGui::InputInt("##target", &target_group_);
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Move triangles to group"));
     if (ImGui::Button("Move triangles to group"))
       Commit(ui,
              MoveTriangles(geo.groups, num_triangles, state.selected_triangles, target_group_,
@@ -155,9 +158,9 @@ class GroupingPanel : public Panel {
              result);
     ImGui::EndDisabled();
     ImGui::BeginDisabled(state.selected_groups.empty());
-    ImGui::SetNextItemWidth(80);
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 6);
     ImGui::InputFloat("##texel", &group_texel_, 0, 0, "%.4f");
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Set texel size (m)"));
     if (ImGui::Button("Set texel size (m)"))
       Commit(ui,
              SetGroupTexelSize(geo.groups, num_triangles, state.selected_groups, group_texel_,

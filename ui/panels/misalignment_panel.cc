@@ -25,10 +25,11 @@ class MisalignmentPanel : public Panel {
       return;
     }
     const RunnerSnapshot& snap = *ui.snapshot;
+    const float radio = ImGui::GetFrameHeight() + ImGui::GetStyle().ItemInnerSpacing.x;
     ImGui::RadioButton("heat map", &mode_, 0);
-    ImGui::SameLine();
+    SameLineIfFits(radio + ImGui::CalcTextSize("overlay").x);
     ImGui::RadioButton("overlay", &mode_, 1);
-    ImGui::SameLine();
+    SameLineIfFits(radio + ImGui::CalcTextSize("blink").x);
     ImGui::RadioButton("blink", &mode_, 2);
     if (snap.rephoto_bgr.empty() || snap.frame_bgr.empty()) {
       ImGui::TextDisabled("(shown for paused or stepped frames once something is painted)");

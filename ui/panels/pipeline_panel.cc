@@ -41,13 +41,18 @@ class PipelinePanel : public Panel {
     if (ImGui::Button("Restart")) ui.runner->Restart(state.project);
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("start again from the first frame");
     if (snap.live.active) {  // a live source has no end to seek to
-      ImGui::SameLine();
+      SameLineIfFits(ImGui::CalcTextSize("live frame 000000").x);
       ImGui::Text("live frame %d", snap.frame);
     } else {
       const int last = snap.geometry ? std::max(0, snap.geometry->num_frames - 1) : 0;
       // The slider shows the frame asked for until the worker has taken the seek up.
       if (snap.version > posted_version_) posted_seek_ = -1;
-      ImGui::SetNextItemWidth(-60);
+      // The slider on a line of its own, as wide as the panel allows.
+      char of_last[32];
+      std::snprintf(of_last, sizeof(of_last), "/ %d", last);
+      ImGui::SetNextItemWidth(std::max(60.0f, ImGui::GetContentRegionAvail().x -
+                                                  ImGui::CalcTextSize(of_last).x -
+                                                  ImGui::GetStyle().ItemSpacing.x));
       const float x = ImGui::GetCursorScreenPos().x, y = ImGui::GetCursorScreenPos().y;
       if (!slider_active_) seek_ = posted_seek_ >= 0 ? posted_seek_ : std::max(0, ShownFrame(snap));
       ImGui::SliderInt("##seek", &seek_, 0, last, "frame %d");
@@ -56,7 +61,7 @@ class PipelinePanel : public Panel {
       slider_rect_[2] = ImGui::GetItemRectSize().x, slider_rect_[3] = ImGui::GetItemRectSize().y;
       if (ImGui::IsItemDeactivatedAfterEdit()) PostSeek(ui, snap, seek_);
       ImGui::SameLine();
-      ImGui::Text("/ %d", last);
+      ImGui::TextUnformatted(of_last);
     }
     ImGui::EndDisabled();
     if (snap.seek_target >= 0) {  // a seek (back: from the start) under way
@@ -74,6 +79,9 @@ class PipelinePanel : public Panel {
     ImGui::Separator();
     ImGui::TextDisabled("Settings (Apply restarts painting)");
     if (!ImGui::IsAnyItemActive()) edit_ = state.project.pipeline;
+    // Widgets take what the longest label leaves, so no label runs out of a narrow panel.
+    ImGui::PushItemWidth(-ImGui::CalcTextSize("texel size m (0 = auto)").x -
+                         ImGui::GetStyle().ItemInnerSpacing.x);
     PipelineOptions& p = edit_;
     bool commit = false;
     auto done = [&] { commit |= ImGui::IsItemDeactivatedAfterEdit(); };
@@ -141,7 +149,8 @@ class PipelinePanel : public Panel {
     if (ImGui::SliderFloat("min correction texels", &dead_band, 0.0f, 2.0f, "%.2f"))
       p.refine.min_correction_px = dead_band;
     done();
-    if (ImGui::Checkbox("correct the pose (all buffers)", &p.refine.pose)) commit = true;
+    if (ImGui::Checkbox("correct the pose", &p.refine.pose)) commit = true;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("one pose correction for all buffers");
     if (ImGui::Checkbox("consensus anchoring", &p.refine.anchor)) commit = true;
     float step = static_cast<float>(p.refine.anchor_step_px);
     if (ImGui::SliderFloat("anchor step texels", &step, 0.0f, 2.0f, "%.2f"))
@@ -164,6 +173,7 @@ class PipelinePanel : public Panel {
       state.BeginEdit();
       state.project.pipeline = edit_;
     }
+    ImGui::PopItemWidth();
     ImGui::BeginDisabled(!state.has_project);
     if (ImGui::Button("Apply")) ApplyProject(ui);
     ImGui::EndDisabled();

@@ -59,7 +59,8 @@ class StagePanel : public Panel {
     if (!names.empty()) {
       if (std::find(names.begin(), names.end(), selected_) == names.end())
         selected_ = DefaultImage(stage->images, names);
-      ImGui::SetNextItemWidth(std::min(200.0f, ImGui::GetContentRegionAvail().x));
+      FitNextItem("image");
+      ImGui::SetNextItemWidth(std::min(200.0f, ImGui::CalcItemWidth()));
       if (ImGui::BeginCombo("image", selected_.c_str())) {
         for (const std::string& n : names)
           if (ImGui::Selectable(n.c_str(), n == selected_)) selected_ = n;
