@@ -15,7 +15,7 @@ ColourScale DifferenceHeatScale() {
 
 bool FalseColourScaleOf(const std::string& stage, const std::string& image, ColourScale* scale) {
   if (stage == "depth" && image == "depth") {  // nearest surface bright, scaled per frame
-    *scale = {cv::COLORMAP_VIRIDIS, "far", "near (this frame's range)"};
+    *scale = {cv::COLORMAP_VIRIDIS, "far", "near"};
     return true;
   }
   if (stage == "refine" &&

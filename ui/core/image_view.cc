@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include <imgui_internal.h>
 #include <opencv2/imgproc.hpp>
 
 namespace fresco {
@@ -13,11 +14,9 @@ void DrawLegend(const ColourScale& scale) {
   cv::Mat ramp(1, 256, CV_8UC1), colours;
   for (int i = 0; i < 256; ++i) ramp.at<uint8_t>(0, i) = static_cast<uint8_t>(i);
   cv::applyColorMap(ramp, colours, scale.colormap);
-  ImGui::TextUnformatted(scale.low.c_str());
-  ImGui::SameLine();
+  // The bar across the panel, what its two ends mean under them.
   const ImVec2 origin = ImGui::GetCursorScreenPos();
-  const float width = std::max(
-      32.0f, ImGui::GetContentRegionAvail().x - ImGui::CalcTextSize(scale.high.c_str()).x - 16);
+  const float width = std::max(32.0f, ImGui::GetContentRegionAvail().x);
   const float height = ImGui::GetTextLineHeight();
   ImDrawList* draw = ImGui::GetWindowDrawList();
   constexpr int kSteps = 32;
@@ -28,7 +27,11 @@ void DrawLegend(const ColourScale& scale) {
                         IM_COL32(bgr[2], bgr[1], bgr[0], 255));
   }
   ImGui::Dummy(ImVec2(width, height));
-  ImGui::SameLine();
+  ImGui::TextUnformatted(scale.low.c_str());
+  const float high = ImGui::CalcTextSize(scale.high.c_str()).x;
+  SameLineIfFits(high);
+  ImGui::SetCursorPosX(
+      std::max(ImGui::GetCursorPosX(), ImGui::GetWindowContentRegionMax().x - high));
   ImGui::TextUnformatted(scale.high.c_str());
 }
 
@@ -82,7 +85,11 @@ void ImageView::Draw(UiContext& ui, const std::string& key, const cv::Mat& image
     zp_ = ZoomPan{};
     shown_ = image.size();
   }
-  const float width = std::max(16.0f, ImGui::GetContentRegionAvail().x);
+  // Room for a vertical scroll bar whether or not there is one: an image whose height
+  // follows its width would otherwise make the scroll bar come and go every frame.
+  const bool scrollbar = ImGui::GetCurrentWindow()->ScrollbarY;
+  const float width = std::max(16.0f, ImGui::GetContentRegionAvail().x -
+                                          (scrollbar ? 0.0f : ImGui::GetStyle().ScrollbarSize));
   const float height = width * image.rows / std::max(1, image.cols);
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   // The view captures the mouse: a drag pans the image and never moves the window.

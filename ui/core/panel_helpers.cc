@@ -18,9 +18,11 @@ bool BeginPanel(Panel& panel) {
     // the wrap position at every Begin, so nothing needs popping).
     ImGui::PushTextWrapPos(0.0f);
     const float title_bottom = ImGui::GetWindowPos().y + ImGui::GetFrameHeight();
-    if (ImGui::IsWindowHovered() && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left) &&
-        ImGui::GetIO().MousePos.y < title_bottom)
+    const bool on_title = ImGui::IsWindowHovered() && ImGui::GetIO().MousePos.y < title_bottom;
+    if (on_title && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left))
       panel.maximise_requested = true;
+    if (on_title)  // the whole title where a narrow tile cuts it short
+      ImGui::SetTooltip("%s (double-click: maximise / restore)", panel.Title());
     return visible;
   }
   const float sx = display.x / 1600.0f, sy = display.y / 1000.0f;
@@ -98,10 +100,12 @@ std::string FrameLabel(const RunnerSnapshot& snap) {
 void ShowMetrics(const std::map<std::string, double>& metrics) {
   if (!ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV))
     return;
+  ImGui::PushTextWrapPos(-1.0f);  // names do not break mid-word
   for (const auto& [name, value] : metrics) {
     ImGui::TableNextRow();
     ImGui::TableSetColumnIndex(0);
-    ImGui::TextUnformatted(name.c_str());
+    ImGui::TextUnformatted(name.c_str());  // clipped by its column, whole in a tooltip
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", name.c_str());
     ImGui::TableSetColumnIndex(1);
     if (std::isnan(value))
       ImGui::TextDisabled("-");
@@ -110,6 +114,7 @@ void ShowMetrics(const std::map<std::string, double>& metrics) {
     else
       ImGui::Text("%.4g", value);
   }
+  ImGui::PopTextWrapPos();
   ImGui::EndTable();
 }
 

@@ -61,7 +61,9 @@ class StagePanel : public Panel {
         selected_ = DefaultImage(stage->images, names);
       FitNextItem("image");
       ImGui::SetNextItemWidth(std::min(200.0f, ImGui::CalcItemWidth()));
-      if (ImGui::BeginCombo("image", selected_.c_str())) {
+      const bool open_combo = ImGui::BeginCombo("image", selected_.c_str());
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", selected_.c_str());
+      if (open_combo) {
         for (const std::string& n : names)
           if (ImGui::Selectable(n.c_str(), n == selected_)) selected_ = n;
         ImGui::EndCombo();
