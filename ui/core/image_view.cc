@@ -88,9 +88,17 @@ void ImageView::Draw(UiContext& ui, const std::string& key, const cv::Mat& image
   // Room for a vertical scroll bar whether or not there is one: an image whose height
   // follows its width would otherwise make the scroll bar come and go every frame.
   const bool scrollbar = ImGui::GetCurrentWindow()->ScrollbarY;
-  const float width = std::max(16.0f, ImGui::GetContentRegionAvail().x -
-                                          (scrollbar ? 0.0f : ImGui::GetStyle().ScrollbarSize));
-  const float height = width * image.rows / std::max(1, image.cols);
+  // The whole image in view where the panel is tall enough (a maximised panel), leaving
+  // room for the readout and legend lines under it.
+  const float aspect = static_cast<float>(image.rows) / std::max(1, image.cols);
+  // (Window height less where the image starts in the content: the same however scrolled.)
+  const float room_y = ImGui::GetWindowHeight() - ImGui::GetCursorPosY() -
+                       ImGui::GetStyle().WindowPadding.y - 3 * ImGui::GetFrameHeightWithSpacing();
+  const float width =
+      std::max(16.0f, std::min(ImGui::GetContentRegionAvail().x -
+                                   (scrollbar ? 0.0f : ImGui::GetStyle().ScrollbarSize),
+                               std::max(8 * ImGui::GetFontSize(), room_y) / aspect));
+  const float height = width * aspect;
   const ImVec2 origin = ImGui::GetCursorScreenPos();
   // The view captures the mouse: a drag pans the image and never moves the window.
   ImGui::InvisibleButton("##image_view", ImVec2(width, height),
