@@ -75,8 +75,11 @@ class StagePanel : public Panel {
     } else {
       ImGui::TextDisabled("(debug images appear when paused or stepping)");
     }
-    for (const auto& [key, text] : stage->notes)
-      ImGui::TextWrapped("%s: %s", key.c_str(), text.c_str());
+    std::vector<std::string> note_keys;  // buffer2 before buffer19
+    for (const auto& [key, text] : stage->notes) note_keys.push_back(key);
+    SortNaturally(&note_keys);
+    for (const std::string& key : note_keys)
+      ImGui::TextWrapped("%s: %s", key.c_str(), stage->notes.at(key).c_str());
     ShowMetrics(stage->metrics);
     ImGui::End();
   }
