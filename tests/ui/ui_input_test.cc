@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -255,6 +256,31 @@ TEST(UiInput, AMissingVideoIsOneErrorAndNotARecentProject) {
   EXPECT_EQ(app.state.message.find("opened"), std::string::npos) << app.state.message;
   EXPECT_EQ(app.state.project.file_path, before);
   EXPECT_EQ(std::count(app.state.recent.begin(), app.state.recent.end(), bad), 0);
+}
+
+TEST(UiInput, AProjectTheWorkerCannotReadIsOneErrorAndLeavesTheRecentList) {
+  App app(0);
+  const std::string bad = app.dir + "/broken/project.json";
+  fs::copy(app.dir + "/capture", app.dir + "/broken", fs::copy_options::recursive);
+  {
+    std::ofstream poses(app.dir + "/broken/sparse/images.txt");
+    poses << "1 not a pose line\n";
+  }
+  RequestOpen(app.ui, bad);
+  app.Frame();  // opened: the files are there
+  EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message.rfind("error: ", 0), 0u) << app.state.message;
+  EXPECT_NE(app.state.message.find("images.txt"), std::string::npos) << app.state.message;
+  EXPECT_EQ(std::count(app.state.recent.begin(), app.state.recent.end(), bad), 0);
+  // A good project after it opens, stays in the list and says so.
+  RequestOpen(app.ui, app.dir + "/capture/project.json");
+  app.Frame();
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+  EXPECT_EQ(app.state.recent.front(), app.dir + "/capture/project.json");
 }
 
 TEST(UiInput, SeekSliderKeepsTheReleasedFrame) {

@@ -26,6 +26,19 @@ void OpenNow(UiContext& ui, const std::string& path) {
     return;
   }
   ui.runner->Restart(ui.state->project);
+  ui.open_pending = true;
+  ui.opened_version = ui.snapshot ? ui.snapshot->version : 0;
+}
+
+// The worker could not read what the project names (a corrupt video or poses file): the
+// worker's error replaces "opened ...", and the project leaves the recent list.
+void CheckOpened(UiContext& ui) {
+  const RunnerSnapshot& snap = *ui.snapshot;
+  if (!ui.open_pending || snap.version <= ui.opened_version) return;
+  ui.open_pending = false;
+  if (!IsError(snap.status)) return;
+  ui.state->RemoveRecent(ui.state->project.file_path);
+  ui.state->message = snap.status;
 }
 
 void DrawUnsavedPrompt(UiContext& ui) {
@@ -261,6 +274,7 @@ void ApplyProject(UiContext& ui) {
 }
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  CheckOpened(ui);
   HandleShortcuts(ui);
   DrawMenuBar(ui, panels);
   const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);

@@ -122,6 +122,16 @@ void AppState::AddRecent(const std::string& path) {
   recent.erase(std::remove(recent.begin(), recent.end(), path), recent.end());
   recent.insert(recent.begin(), path);
   if (recent.size() > kMaxRecent) recent.resize(kMaxRecent);
+  SaveRecent();
+}
+
+void AppState::RemoveRecent(const std::string& path) {
+  const size_t before = recent.size();
+  recent.erase(std::remove(recent.begin(), recent.end(), path), recent.end());
+  if (recent.size() != before) SaveRecent();
+}
+
+void AppState::SaveRecent() const {
   if (recent_file.empty()) return;
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(recent_file).parent_path(), ec);

@@ -41,7 +41,9 @@ struct AppState {
   bool Redo();
 
   void LoadRecent();
+  void SaveRecent() const;  // to recent_file (when set)
   void AddRecent(const std::string& path);
+  void RemoveRecent(const std::string& path);  // a project that failed to open
 };
 
 // Grouping edits as the app makes them: on the groups the current session built (one per

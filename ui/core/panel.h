@@ -64,6 +64,10 @@ struct UiContext {
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
   bool request_quit = false;
   PosesRunner* poses = nullptr;  // the COLMAP worker (Poses panel)
+  // A project just opened: the worker's first snapshot after `opened_version` says whether
+  // its files could be read (app_frame.cc turns a failure into one error).
+  bool open_pending = false;
+  uint64_t opened_version = 0;
   // Where the tiled panels go (splitters, maximise); panels not in it float.
   TileLayout layout = DefaultTileLayout();
 };

@@ -221,7 +221,10 @@ int RunGuiApp(const GuiOptions& options) {
     ui.textures = &textures;
     ui.viewport = &viewport;
     ui.poses = &poses;
-    if (state.has_project) runner.Restart(state.project);
+    if (state.has_project) {
+      runner.Restart(state.project);
+      ui.open_pending = true;  // a worker error then replaces "opened ..."
+    }
     if (screenshot && state.has_project) {
       runner.Seek(std::max(0, options.frames - 1));
       runner.WaitIdle();
