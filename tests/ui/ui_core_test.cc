@@ -1,17 +1,21 @@
 // The app's pure logic, no ImGui frame and no display: natural name order, stable group
 // colours, zoom and pan, window clamping, the input queue, pixel readouts, colour scales,
 // and the message when stored groups are split back apart.
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <imgui.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/test_support.h"
 #include "ui/core/app_state.h"
 #include "ui/core/colour_scale.h"
 #include "ui/core/group_colour.h"
 #include "ui/core/image_view.h"
 #include "ui/core/input_queue.h"
 #include "ui/core/layout.h"
+#include "ui/core/layout_file.h"
 #include "ui/core/natural_sort.h"
 #include "ui/core/zoom_pan.h"
 
@@ -209,6 +213,37 @@ TEST(GroupingSplitBack, SaysWhichStoredGroupWasSplitAndWhy) {
   EXPECT_NE(message.find("group 0"), std::string::npos) << message;
   EXPECT_NE(message.find("became 2 buffers"), std::string::npos) << message;
   EXPECT_NE(message.find("fold over"), std::string::npos) << message;
+}
+
+TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {
+  const std::string dir = testing::MakeTempDir("ui-layout");
+  SavedLayout saved;
+  std::vector<float> fractions = saved.layout.Fractions();
+  ASSERT_GE(fractions.size(), 10u);
+  fractions[0] = 0.31f;
+  fractions.back() = 0.66f;
+  saved.layout.SetFractions(fractions);
+  saved.font_scale = 1.5f;
+  ASSERT_TRUE(SaveLayoutFile(dir + "/cfg/layout.json", saved).ok());
+  SavedLayout loaded;
+  ASSERT_TRUE(LoadLayoutFile(dir + "/cfg/layout.json", &loaded).ok());
+  EXPECT_EQ(loaded.layout.Fractions(), fractions);
+  EXPECT_EQ(loaded.font_scale, 1.5f);
+  // No file: the defaults, no error.
+  SavedLayout fresh;
+  EXPECT_TRUE(LoadLayoutFile(dir + "/none.json", &fresh).ok());
+  EXPECT_EQ(fresh.layout.Fractions(), DefaultTileLayout().Fractions());
+  // Another arrangement's fractions are ignored; a damaged file is an error naming it.
+  std::ofstream(dir + "/other.json") << R"({"fractions": [0.5, 0.5], "font_scale": 1.25})";
+  ASSERT_TRUE(LoadLayoutFile(dir + "/other.json", &fresh).ok());
+  EXPECT_EQ(fresh.layout.Fractions(), DefaultTileLayout().Fractions());
+  EXPECT_EQ(fresh.font_scale, 1.25f);
+  std::ofstream(dir + "/bad.json") << "{\"fractions\": ";
+  const Status bad = LoadLayoutFile(dir + "/bad.json", &fresh);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("bad.json"), std::string::npos) << bad.message();
+  std::ofstream(dir + "/scale.json") << R"({"fractions": [], "font_scale": 40})";
+  EXPECT_FALSE(LoadLayoutFile(dir + "/scale.json", &fresh).ok());
 }
 
 }  // namespace

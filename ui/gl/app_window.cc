@@ -18,6 +18,7 @@
 #include "pipeline/core/image_io.h"
 #include "ui/core/app_frame.h"
 #include "ui/core/input_queue.h"
+#include "ui/core/layout_file.h"
 #include "ui/gl/gl.h"
 #include "ui/gl/gl_textures.h"
 #include "ui/gl/viewport_gl.h"
@@ -221,6 +222,17 @@ int RunGuiApp(const GuiOptions& options) {
     ui.textures = &textures;
     ui.viewport = &viewport;
     ui.poses = &poses;
+    // The splitters and font scale as the last session left them (not for screenshots,
+    // which show the default layout).
+    const std::string layout_file =
+        screenshot || ConfigDir().empty() ? "" : ConfigDir() + "/layout.json";
+    SavedLayout saved;
+    if (!layout_file.empty()) {
+      if (Status s = LoadLayoutFile(layout_file, &saved); !s.ok())
+        std::fprintf(stderr, "fresco gui: %s (the default layout instead)\n", s.message().c_str());
+      ui.layout = saved.layout;
+      io.FontGlobalScale = saved.font_scale;
+    }
     if (state.has_project) {
       runner.Restart(state.project);
       ui.open_pending = true;  // a worker error then replaces "opened ..."
@@ -271,6 +283,12 @@ int RunGuiApp(const GuiOptions& options) {
       }
       glfwSwapBuffers(window);
       if (ui.request_quit) break;
+    }
+    if (!layout_file.empty()) {
+      saved.layout = ui.layout;
+      saved.font_scale = io.FontGlobalScale;
+      if (Status s = SaveLayoutFile(layout_file, saved); !s.ok())
+        std::fprintf(stderr, "fresco gui: %s\n", s.message().c_str());
     }
   }
   ImGui_ImplOpenGL3_Shutdown();
