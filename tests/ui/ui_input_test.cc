@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -327,6 +328,51 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
   app.runner.WaitIdle();
   EXPECT_GT(app.runner.Snapshot()->geometry_version, geometry) << "F5 did not apply";
   EXPECT_EQ(app.runner.Snapshot()->frame, 5);
+}
+
+// Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
+// where the seek goes and how far it got, never a bare "frame -1".
+TEST(UiInput, SeekingBackPublishesItsProgress) {
+  struct Seen {
+    int seek_target, frame;
+    std::string status;
+  };
+  std::mutex mutex;
+  std::vector<Seen> seen;
+  RunnerOptions options;
+  options.publish_interval_ms = 0;  // publish after every frame painted
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.push_back({s.seek_target, s.frame, s.status});
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  PipelineRunner runner(options);
+  runner.Restart(state.project);
+  runner.Seek(9);
+  runner.WaitIdle();
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.clear();
+  }
+  runner.Seek(6);
+  runner.WaitIdle();
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GE(seen.size(), 3u);
+  EXPECT_EQ(seen.front().seek_target, 6) << "the seek is announced first";
+  EXPECT_EQ(seen.front().frame, -1);
+  EXPECT_EQ(seen.front().status, "seeking");
+  int last_frame = -1;
+  for (size_t i = 0; i + 1 < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].seek_target, 6) << i;
+    EXPECT_EQ(seen[i].status.rfind("seeking", 0), 0u) << i << ": " << seen[i].status;
+    EXPECT_GE(seen[i].frame, last_frame) << i;
+    last_frame = seen[i].frame;
+  }
+  EXPECT_GE(seen.size(), 6u) << "progress while frames 0..5 are repainted";
+  EXPECT_EQ(seen.back().seek_target, -1);
+  EXPECT_EQ(seen.back().frame, 6);
+  EXPECT_EQ(seen.back().status, "paused");
 }
 
 TEST(UiInput, SeekProgressIsNamedNotFrameMinusOne) {

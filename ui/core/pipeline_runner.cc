@@ -276,6 +276,7 @@ void PipelineRunner::Publish(bool with_painted) {
   }
   ++working_.version;
   auto snapshot = std::make_shared<RunnerSnapshot>(working_);
+  if (options_.on_publish) options_.on_publish(*snapshot);
   std::lock_guard<std::mutex> lock(mutex_);
   snapshot_ = snapshot;
 }
@@ -338,6 +339,11 @@ void PipelineRunner::Loop() {
           playing_ = false;
           // A live source cannot go back: only forward seeks (paint N more frames) apply.
           if (session_ && !session_->live && command.frame < session_->next_frame) {
+            // Back: reopen and repaint from frame 0. Say so at once (reopening can take
+            // seconds on large buffers); progress follows as frames are painted.
+            seek_target_ = command.frame;
+            working_.frame = -1;
+            Publish(false);
             const Project project = session_->project;
             OpenSession(project);
           }

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -99,6 +100,8 @@ struct RunnerOptions {
   // Live sources: the worker waits at most this long for a frame before it looks at its
   // commands again (and publishes the sources' state at least every publish_interval_ms).
   int live_poll_ms = 50;
+  // Tests: called on the worker thread with every snapshot it publishes, in order.
+  std::function<void(const RunnerSnapshot&)> on_publish;
 };
 
 class PipelineRunner {
