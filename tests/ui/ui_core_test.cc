@@ -183,6 +183,28 @@ TEST(InputQueue, AFastDragIsPressMovesAndReleaseInFramesOfTheirOwn) {
   ImGui::DestroyContext();
 }
 
+// Ctrl held for a click, all between two frames: the release (where ImGui's selectables
+// act) still sees ctrl, and ctrl's release comes a frame later.
+TEST(InputQueue, ACtrlClickWithinOneFrameKeepsCtrlForTheRelease) {
+  InputQueue queue;
+  InputState state;
+  queue.Push(Key(kKeyLeftControl, true));
+  queue.Push(Move(5, 5));
+  queue.Push(Button(true));
+  queue.Push(Button(false));
+  queue.Push(Key(kKeyLeftControl, false));
+  bool released_with_ctrl = false;
+  for (int frame = 0; frame < 8 && queue.pending() > 0; ++frame) {
+    const bool was_down = state.mouse_down[0];
+    queue.NextFrame(&state);
+    if (was_down && !state.mouse_down[0]) released_with_ctrl = state.keys_down[kKeyLeftControl];
+  }
+  EXPECT_EQ(queue.pending(), 0u);
+  EXPECT_TRUE(released_with_ctrl);
+  EXPECT_FALSE(state.keys_down[kKeyLeftControl]);
+  EXPECT_EQ(state.mouse_x, 5);
+}
+
 TEST(ImageView, PixelReadoutNamesPositionAndChannels) {
   cv::Mat bgr(4, 5, CV_8UC3, cv::Scalar(10, 20, 30));
   EXPECT_EQ(DescribePixel(bgr, 2, 3), "x 2 y 3: B 10 G 20 R 30");

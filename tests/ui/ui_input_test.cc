@@ -328,6 +328,13 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
   app.runner.WaitIdle();
   EXPECT_GT(app.runner.Snapshot()->geometry_version, geometry) << "F5 did not apply";
   EXPECT_EQ(app.runner.Snapshot()->frame, 5);
+  // At the first frame too (frame 0 is a frame to come back to, not "nothing painted").
+  app.runner.Seek(0);
+  app.runner.WaitIdle();
+  app.Frame();
+  app.Tap(kKeyF5);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 0);
 }
 
 // Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says

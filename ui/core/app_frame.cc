@@ -270,7 +270,7 @@ void ApplyProject(UiContext& ui) {
                     : snap->seek_target >= 0   ? snap->seek_target
                                                : snap->frame;
   ui.runner->Restart(ui.state->project);
-  if (frame > 0) ui.runner->Seek(frame);
+  if (frame >= 0) ui.runner->Seek(frame);
 }
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {

@@ -8,14 +8,14 @@ int InputQueue::NextFrame(InputState* state) {
   state->wheel_x = state->wheel_y = 0;
   std::array<bool, 5> button_changed{};
   std::array<bool, 512> key_changed{};
-  bool any_button_changed = false, moved = false;
+  bool any_button_changed = false, any_key_changed = false, moved = false;
   int taken = 0;
   while (!events_.empty()) {
     const InputEvent& e = events_.front();
     bool take = true;
     switch (e.kind) {
       case InputEvent::Kind::kMouseMove:
-        take = !any_button_changed;
+        take = !any_button_changed && !any_key_changed;
         if (take) state->mouse_x = e.x, state->mouse_y = e.y, moved = true;
         break;
       case InputEvent::Kind::kMouseButton:
@@ -32,10 +32,10 @@ int InputQueue::NextFrame(InputState* state) {
         break;
       case InputEvent::Kind::kKey:
         if (e.code < 0 || e.code >= static_cast<int>(state->keys_down.size())) break;
-        take = !key_changed[e.code];
+        take = !key_changed[e.code] && !any_button_changed;
         if (take && state->keys_down[e.code] != e.down) {
           state->keys_down[e.code] = e.down;
-          key_changed[e.code] = true;
+          key_changed[e.code] = any_key_changed = true;
         }
         break;
     }

@@ -41,9 +41,10 @@ class InputQueue {
  public:
   void Push(const InputEvent& event) { events_.push_back(event); }
   // Advances `state` by one frame's events: in order, until a key or button would change a
-  // second time, a button would change after the mouse moved or the mouse would move after
-  // a button changed (so a press, each drag step and the release land in frames of their
-  // own, at the positions they happened). The wheel is this frame's sum (reset first).
+  // second time, a button would change after the mouse moved, the mouse would move after a
+  // button or key changed, or a key would change after a button changed (so a press, each
+  // drag step and the release land in frames of their own, at the positions they happened,
+  // and a ctrl-click's release still sees ctrl held). The wheel is this frame's sum.
   // Returns how many events this frame took; the rest stay queued.
   int NextFrame(InputState* state);
   size_t pending() const { return events_.size(); }
