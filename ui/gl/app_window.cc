@@ -212,7 +212,7 @@ int RunGuiApp(const GuiOptions& options) {
     PipelineRunner runner;
     CalibrationRunner calibration;
     PosesRunner poses;
-    GlTextures textures;
+    GlTextures textures(/*crisp_pixels=*/true);
     GlViewport viewport;
     auto panels = MakePanels();
     UiContext ui;
