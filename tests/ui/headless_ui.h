@@ -67,6 +67,7 @@ struct ImGuiHeadless {
     io.DisplaySize = ImVec2(1600, 1000);
     io.DeltaTime = 1.0f / 60;
     io.IniFilename = nullptr;
+    ConfigureImGui(&io);
     // The keys as ImGui's GLFW backend maps them (GLFW key codes).
     io.KeyMap[ImGuiKey_Space] = 32;
     io.KeyMap[ImGuiKey_LeftArrow] = 263;

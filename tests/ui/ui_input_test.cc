@@ -112,6 +112,12 @@ TEST(UiInput, TitleBarsStayBelowTheMenuBar) {
   app.Drag(grab, ImVec2(grab.x + 40, 0), 10);                // up past the menu bar
   EXPECT_EQ(window->Pos.y, ImGui::GetFrameHeight()) << "the title bar went under the menu bar";
   EXPECT_NEAR(window->Pos.x, grab.x + 40 - 60, 1e-3) << "sideways it follows the mouse";
+  // A floating panel moves by its title bar only: a drag on its content leaves it in place.
+  const ImVec2 floating = window->Pos;
+  const ImVec2 inside(floating.x + 20, floating.y + window->Size.y - 20);  // empty content
+  app.Drag(inside, ImVec2(inside.x + 80, inside.y - 60), 5);
+  EXPECT_EQ(window->Pos.x, floating.x);
+  EXPECT_EQ(window->Pos.y, floating.y);
   app.Drag(ImVec2(window->Pos.x + 60, window->Pos.y + 5), ImVec2(5000, 5000), 10);
   EXPECT_LE(window->Pos.y, 1000 - kStatusBarHeight - ImGui::GetFrameHeight());
   EXPECT_LE(window->Pos.x, 1600 - 48);

@@ -273,6 +273,8 @@ void ApplyProject(UiContext& ui) {
   if (frame >= 0) ui.runner->Seek(frame);
 }
 
+void ConfigureImGui(ImGuiIO* io) { io->ConfigWindowsMoveFromTitleBarOnly = true; }
+
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   CheckOpened(ui);
   HandleShortcuts(ui);

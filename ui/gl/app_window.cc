@@ -201,6 +201,7 @@ int RunGuiApp(const GuiOptions& options) {
     io.IniFilename = ini.c_str();
   }
   ImGui::StyleColorsDark();
+  ConfigureImGui(&io);
   ImGui_ImplGlfw_InitForOpenGL(window, false);
   InputQueue input_queue;
   InputState input;
