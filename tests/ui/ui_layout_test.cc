@@ -63,8 +63,11 @@ void ExpectUsable(ImVec2 display) {
   EXPECT_GT(view_area, 1.5f * largest_other) << "the 3D view is the large one";
   EXPECT_GT(view_area, 0.15f * display.x * display.y);
   // Nothing is clipped at the right edge (ImGui would need to scroll sideways).
-  for (const auto& p : app.panels)
-    if (p->open) EXPECT_EQ(LayoutApp::Window(p->Title())->ScrollMax.x, 0) << p->Title();
+  for (const auto& p : app.panels) {
+    if (p->open) {
+      EXPECT_EQ(LayoutApp::Window(p->Title())->ScrollMax.x, 0) << p->Title();
+    }
+  }
 }
 
 TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1600x1000) { ExpectUsable({1600, 1000}); }

@@ -44,7 +44,8 @@ class GroupingPanel : public Panel {
         char hex[8];
         std::snprintf(hex, sizeof(hex), "#%02x%02x%02x", static_cast<int>(rgb[0] * 255 + 0.5f),
                       static_cast<int>(rgb[1] * 255 + 0.5f), static_cast<int>(rgb[2] * 255 + 0.5f));
-        colours_ += (colours_.empty() ? "" : " ") + std::to_string(StableGroupKey(g)) + hex;
+        if (!colours_.empty()) colours_ += ' ';
+        colours_.append(std::to_string(StableGroupKey(g))).append(hex);
       }
     }
     if (!split_message_.empty())
