@@ -10,11 +10,28 @@
 
 #include <gtest/gtest.h>
 #include <imgui.h>
+#include <imgui_internal.h>
 
+#include "tests/test_support.h"
 #include "ui/core/app_frame.h"
+#include "ui/core/calibration_runner.h"
+#include "ui/core/input_queue.h"
 #include "ui/core/panel.h"
+#include "ui/panels/panels.h"
 
 namespace fresco::testing {
+
+// A 12-frame 160x120 capture of the cube room (`fresco synth`), made once per test program.
+inline std::string Capture() {
+  static const std::string dir = [] {
+    const std::string d = MakeTempDir("ui") + "/capture";
+    const auto r = RunFresco({"synth", "--scene", "builtin:cube-room", "--out", d, "--frames", "12",
+                              "--size", "160x120", "--seed", "3"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return d;
+  }();
+  return dir;
+}
 
 class NullTextures : public ImageTextures {
  public:
@@ -50,6 +67,11 @@ struct ImGuiHeadless {
     io.DisplaySize = ImVec2(1600, 1000);
     io.DeltaTime = 1.0f / 60;
     io.IniFilename = nullptr;
+    ConfigureImGui(&io);
+    // The keys as ImGui's GLFW backend maps them (GLFW key codes).
+    io.KeyMap[ImGuiKey_Space] = 32;
+    io.KeyMap[ImGuiKey_LeftArrow] = 263;
+    io.KeyMap[ImGuiKey_RightArrow] = 262;
     unsigned char* pixels = nullptr;
     int w = 0, h = 0;
     io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);  // a font atlas, no texture upload
@@ -62,11 +84,87 @@ struct ImGuiHeadless {
     panel.Draw(ui);
     ImGui::Render();
   }
-  void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  // One frame of the whole app; with `input`, the mouse and keys as the GL app gives them
+  // (CopyToImGui) for that frame.
+  void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels,
+             const InputState* input = nullptr) {
+    if (input) CopyToImGui(*input, &ImGui::GetIO());
     ImGui::NewFrame();
     DrawAppFrame(ui, panels);
     ImGui::Render();
   }
+};
+
+// The whole app headless over a real painting worker on `project`, paused at `frame`, in a
+// display of `display` pixels; each frame's mouse and keys come from `input`.
+struct HeadlessApp {
+  HeadlessApp(const std::string& project, int frame, ImVec2 display = ImVec2(1600, 1000)) {
+    EXPECT_TRUE(state.Open(project).ok()) << project;
+    runner.Restart(state.project);
+    runner.Seek(frame);
+    runner.WaitIdle();
+    ui.state = &state;
+    ui.runner = &runner;
+    ui.calibration = &calibration;
+    ui.textures = &textures;
+    ui.viewport = &viewport;
+    panels = MakePanels();
+    ImGui::GetIO().DisplaySize = display;
+    Frames(4);  // scroll bars and content sizes settle over a few frames
+  }
+  void Frame() {
+    ui.snapshot = runner.Snapshot();
+    imgui.Frame(ui, panels, &input);
+  }
+  void Frames(int n) {
+    for (int i = 0; i < n; ++i) Frame();
+  }
+  // Frames until the queued events are all in, and one more.
+  void Drain(InputQueue* queue) {
+    while (queue->pending() > 0) {
+      queue->NextFrame(&input);
+      Frame();
+    }
+    queue->NextFrame(&input);
+    Frame();
+  }
+  void MouseTo(float x, float y) { input.mouse_x = x, input.mouse_y = y; }
+  // Presses the left button at `from`, moves to `to` in `steps` frames, releases.
+  void Drag(ImVec2 from, ImVec2 to, int steps) {
+    MouseTo(from.x, from.y);
+    Frames(2);
+    input.mouse_down[0] = true;
+    Frame();
+    for (int s = 1; s <= steps; ++s) {
+      MouseTo(from.x + (to.x - from.x) * s / steps, from.y + (to.y - from.y) * s / steps);
+      Frame();
+    }
+    input.mouse_down[0] = false;
+    Frame();
+  }
+  void Click(ImVec2 at) {
+    MouseTo(at.x, at.y);
+    Frame();
+    input.mouse_down[0] = true;
+    Frame();
+    input.mouse_down[0] = false;
+    Frame();
+  }
+  static ImGuiWindow* Window(const std::string& title) {
+    ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
+    EXPECT_NE(w, nullptr) << title;
+    return w;
+  }
+
+  AppState state;
+  PipelineRunner runner;
+  NullTextures textures;
+  NullViewport viewport;
+  CalibrationRunner calibration;
+  UiContext ui;
+  ImGuiHeadless imgui;
+  std::vector<std::unique_ptr<Panel>> panels;
+  InputState input;
 };
 
 }  // namespace fresco::testing

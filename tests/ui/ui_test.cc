@@ -19,14 +19,14 @@
 
 #include "calib/report.h"
 #include "pipeline/core/poses.h"
-#include "pipeline/core/scene.h"
 #include "pipeline/core/run_process.h"
+#include "pipeline/core/scene.h"
 #include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 #include "tests/ui/headless_ui.h"
-#include "ui/core/orbit_frame.h"
 #include "ui/core/app_frame.h"
 #include "ui/core/calibration_runner.h"
+#include "ui/core/orbit_frame.h"
 #include "ui/core/panel.h"
 #include "ui/core/poses_runner.h"
 #include "ui/panels/panels.h"
@@ -42,17 +42,7 @@ using testing::NullViewport;
 using testing::ReadText;
 using testing::RunFresco;
 
-// A 12-frame capture of the cube room, made once.
-std::string Capture() {
-  static const std::string dir = [] {
-    const std::string d = MakeTempDir("ui") + "/capture";
-    const auto r = RunFresco({"synth", "--scene", "builtin:cube-room", "--out", d, "--frames", "12",
-                              "--size", "160x120", "--seed", "3"});
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    return d;
-  }();
-  return dir;
-}
+using testing::Capture;
 
 TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   AppState state;
@@ -448,9 +438,8 @@ TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
   const std::string dir = MakeTempDir("ui-poses");
   const std::string capture = dir + "/capture";
   auto r = RunFresco({"synth", "--scene", "builtin:blocks", "--out", capture, "--frames",
-                      std::to_string(kFrames),
-                      "--size", "480x360", "--supersample", "2", "--seed", "3", "--path", "orbit",
-                      "--set", "path.turns=0.5"});
+                      std::to_string(kFrames), "--size", "480x360", "--supersample", "2", "--seed",
+                      "3", "--path", "orbit", "--set", "path.turns=0.5"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   Scene scene;
   ASSERT_TRUE(LoadGltfScene(capture + "/scene.gltf", SceneLoadOptions(), &scene).ok());
@@ -513,8 +502,7 @@ TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
   EXPECT_EQ(flagged, (std::set<int>{3, 5, 7}));
   for (int i : rotated) EXPECT_NEAR(snap->verify.frames[i].rotation_error_deg, 1.0, 0.2) << i;
   for (int i : moved)
-    EXPECT_NEAR(snap->verify.frames[i].position_error_m, 0.02 * scene_size_m,
-                0.002 * scene_size_m)
+    EXPECT_NEAR(snap->verify.frames[i].position_error_m, 0.02 * scene_size_m, 0.002 * scene_size_m)
         << i;
   EXPECT_TRUE(fs::is_regular_file(dir + "/poses/verify.json"));  // as `fresco poses verify`
   EXPECT_TRUE(fs::is_regular_file(dir + "/poses/colmap/commands.txt"));
@@ -602,9 +590,9 @@ TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
   // The GL app under Xvfb on the same reconstruction: the panel open with the table.
   if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) return;
   const std::string shot = dir + "/poses.png";
-  r = RunFresco({"--xvfb", "gui", capture + "/project.json", "--poses", "bootstrap",
-                 "--poses-out", dir + "/gui", "--poses-model", dir + "/poses/colmap/sparse_txt/0",
-                 "--frames", "5", "--screenshot", shot});
+  r = RunFresco({"--xvfb", "gui", capture + "/project.json", "--poses", "bootstrap", "--poses-out",
+                 dir + "/gui", "--poses-model", dir + "/poses/colmap/sparse_txt/0", "--frames", "5",
+                 "--screenshot", shot});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_FALSE(cv::imread(shot).empty());
   const nlohmann::json list = nlohmann::json::parse(ReadText(shot + ".json"));
@@ -626,8 +614,8 @@ TEST(UiCli, PosesNeedsAProjectAndAKnownMode) {
   r = RunFresco({"gui", Capture() + "/project.json", "--poses", "check"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("verify or bootstrap"), std::string::npos) << r.err;
-  r = RunFresco({"gui", Capture() + "/project.json", "--poses", "verify", "--poses-model",
-                 "/no/such/model"});
+  r = RunFresco(
+      {"gui", Capture() + "/project.json", "--poses", "verify", "--poses-model", "/no/such/model"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("/no/such/model"), std::string::npos) << r.err;
 }

@@ -1,9 +1,24 @@
 #include "ui/core/app_frame.h"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
+
+const ImVec4 kErrorColour(1.0f, 0.4f, 0.4f, 1.0f);
+
+// ImGui 1.86 indexes io.KeysDown by the backend's key codes: GLFW_KEY_F5 (letters are
+// their ASCII capitals there, as 'S' below).
+constexpr int kKeyF5 = 294;
+constexpr float kSplitterPx = 5;   // the bars between tiled panels
+constexpr float kMinTilePx = 120;  // a splitter stops before a side gets narrower
+constexpr float kMinFontScale = 0.75f, kMaxFontScale = 2.0f;
+
+bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
 
 void OpenNow(UiContext& ui, const std::string& path) {
   if (Status s = ui.state->Open(path); !s.ok()) {
@@ -11,6 +26,19 @@ void OpenNow(UiContext& ui, const std::string& path) {
     return;
   }
   ui.runner->Restart(ui.state->project);
+  ui.open_pending = true;
+  ui.opened_version = ui.snapshot ? ui.snapshot->version : 0;
+}
+
+// The worker could not read what the project names (a corrupt video or poses file): the
+// worker's error replaces "opened ...", and the project leaves the recent list.
+void CheckOpened(UiContext& ui) {
+  const RunnerSnapshot& snap = *ui.snapshot;
+  if (!ui.open_pending || snap.version <= ui.opened_version) return;
+  ui.open_pending = false;
+  if (!IsError(snap.status)) return;
+  ui.state->RemoveRecent(ui.state->project.file_path);
+  ui.state->message = snap.status;
 }
 
 void DrawUnsavedPrompt(UiContext& ui) {
@@ -75,18 +103,38 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   if (ImGui::BeginMenu("Edit")) {
     if (ImGui::MenuItem("Undo", "Ctrl+Z", false, !state.undo.empty())) UndoRedo(ui, true);
     if (ImGui::MenuItem("Redo", "Ctrl+Y", false, !state.redo.empty())) UndoRedo(ui, false);
-    if (ImGui::MenuItem("Apply to the pipeline (restart)", "F5", false, state.has_project))
+    if (ImGui::MenuItem("Apply (repaint up to this frame)", "F5", false, state.has_project))
       ApplyProject(ui);
     ImGui::EndMenu();
   }
   if (ImGui::BeginMenu("View")) {
     for (auto& panel : panels) ImGui::MenuItem(panel->Title(), nullptr, &panel->open);
+    ImGui::Separator();
+    TileLayout& layout = ui.layout;
+    if (ImGui::BeginMenu("Maximise")) {  // also: double-click a panel's title bar
+      for (auto& panel : panels)
+        if (layout.Contains(panel->Title()) &&
+            ImGui::MenuItem(panel->Title(), nullptr, layout.maximised() == panel->Title(),
+                            panel->open))
+          layout.ToggleMaximised(panel->Title());
+      ImGui::EndMenu();
+    }
+    if (ImGui::MenuItem("Restore", nullptr, false, !layout.maximised().empty()))
+      layout.ToggleMaximised(layout.maximised());
+    if (ImGui::MenuItem("Default layout")) layout = DefaultTileLayout();
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8);
+    ImGui::SliderFloat("font scale", &ImGui::GetIO().FontGlobalScale, kMinFontScale, kMaxFontScale,
+                       "%.2f");
     ImGui::EndMenu();
   }
   const auto& snap = *ui.snapshot;
   ImGui::Separator();
-  ImGui::Text("frame %d  %s  coverage %.1f%%  %s", snap.frame, snap.status.c_str(),
-              100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
+  if (IsError(snap.status)) {  // said once, in the status bar
+    ImGui::TextColored(kErrorColour, "error (see the status bar)");
+  } else {
+    ImGui::Text("%s  %s  coverage %.1f%%  %s", FrameLabel(snap).c_str(), snap.status.c_str(),
+                100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
+  }
   ImGui::EndMainMenuBar();
 }
 
@@ -105,21 +153,97 @@ void HandleShortcuts(UiContext& ui) {
       ui.runner->Play();
   }
   if (io.KeyCtrl && ImGui::IsKeyPressed('Q')) state.pending_quit = true;
+  if (ImGui::IsKeyPressed(kKeyF5, false) && state.has_project) ApplyProject(ui);
+  // Left: back one frame (a file source repaints from the start); Right: the next frame.
+  const RunnerSnapshot& snap = *ui.snapshot;
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_LeftArrow), false) && !snap.live.active &&
+      ShownFrame(snap) > 0)
+    ui.runner->Seek(ShownFrame(snap) - 1);
+  if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_RightArrow), false) && state.has_project)
+    ui.runner->Step();
 }
 
 void DrawStatusBar(UiContext& ui) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowPos(ImVec2(0, display.y - 24));
-  ImGui::SetNextWindowSize(ImVec2(display.x, 24));
+  ImGui::SetNextWindowPos(ImVec2(0, display.y - kStatusBarHeight));
+  ImGui::SetNextWindowSize(ImVec2(display.x, kStatusBarHeight));
   ImGui::Begin("##status", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
-  ImGui::TextUnformatted(ui.state->message.c_str());
+  // One message: the worker's error replaces "opened ..." (the project named a file it
+  // could not read); other messages (saved, grouping edited) stay beside it.
+  const std::string& message = ui.state->message;
+  if (IsError(ui.snapshot->status)) {
+    ImGui::TextColored(kErrorColour, "%s", ui.snapshot->status.c_str());
+    if (!message.empty() && message.rfind("opened ", 0) != 0 && message != ui.snapshot->status) {
+      ImGui::SameLine();
+      ImGui::TextUnformatted(("  " + message).c_str());
+    }
+  } else if (IsError(message)) {
+    ImGui::TextColored(kErrorColour, "%s", message.c_str());
+  } else {
+    ImGui::TextUnformatted(message.c_str());
+  }
   if (const std::string& problem = ui.snapshot->live.problem; !problem.empty()) {
     ImGui::SameLine();  // a live source that stalled, dropped or ended
-    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "  live: %s", problem.c_str());
+    ImGui::TextColored(kErrorColour, "  live: %s", problem.c_str());
   }
   ImGui::End();
+}
+
+// The tiled panels' places this frame (between the menu bar and the status bar); returns the
+// splitters.
+std::vector<TileLayout::Splitter> PlaceTiles(const TileLayout& layout,
+                                             std::vector<std::unique_ptr<Panel>>& panels) {
+  const ImVec2 display = ImGui::GetIO().DisplaySize;
+  const float top = std::ceil(ImGui::GetFrameHeight());  // the menu bar's height
+  const LayoutRect band{0, top, display.x, std::max(0.0f, display.y - top - kStatusBarHeight)};
+  auto is_open = [&](const std::string& title) {
+    for (const auto& p : panels)
+      if (title == p->Title()) return p->open;
+    return false;
+  };
+  std::vector<TileLayout::Tile> tiles;
+  std::vector<TileLayout::Splitter> splitters;
+  layout.Compute(band, kSplitterPx, is_open, &tiles, &splitters);
+  for (auto& panel : panels) {
+    panel->tiled = false;
+    for (const TileLayout::Tile& t : tiles) {
+      if (t.panel != panel->Title()) continue;
+      panel->tiled = true;
+      panel->tile_pos = ImVec2(t.rect.x, t.rect.y);
+      panel->tile_size = ImVec2(t.rect.w, t.rect.h);
+    }
+  }
+  return splitters;
+}
+
+// The bars between tiles: drag to resize the panels on both sides.
+void DrawSplitters(TileLayout* layout, const std::vector<TileLayout::Splitter>& splitters) {
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1, 1));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowBorderSize, 0.0f);
+  for (const TileLayout::Splitter& s : splitters) {
+    const std::string name = "##splitter" + std::to_string(s.node);
+    ImGui::SetNextWindowPos(ImVec2(s.rect.x, s.rect.y));
+    ImGui::SetNextWindowSize(ImVec2(s.rect.w, s.rect.h));
+    ImGui::Begin(name.c_str(), nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoBringToFrontOnFocus |
+                     ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoScrollWithMouse);
+    ImGui::InvisibleButton("##bar", ImVec2(std::max(1.0f, s.rect.w), std::max(1.0f, s.rect.h)));
+    const ImGuiIO& io = ImGui::GetIO();
+    if (ImGui::IsItemActive())
+      layout->Drag(s, s.stacked ? io.MouseDelta.y : io.MouseDelta.x, kMinTilePx);
+    if (ImGui::IsItemHovered() || ImGui::IsItemActive()) {
+      ImGui::SetMouseCursor(s.stacked ? ImGuiMouseCursor_ResizeNS : ImGuiMouseCursor_ResizeEW);
+      ImGui::GetWindowDrawList()->AddRectFilled(ImVec2(s.rect.x, s.rect.y),
+                                                ImVec2(s.rect.x + s.rect.w, s.rect.y + s.rect.h),
+                                                ImGui::GetColorU32(ImGuiCol_SeparatorActive));
+    }
+    ImGui::End();
+  }
+  ImGui::PopStyleVar(3);
 }
 
 }  // namespace
@@ -139,14 +263,30 @@ void UndoRedo(UiContext& ui, bool undo) {
 }
 
 void ApplyProject(UiContext& ui) {
-  if (ui.state->has_project) ui.runner->Restart(ui.state->project);
+  if (!ui.state->has_project) return;
+  // Back to the frame being looked at (or sought), where the source can go back to it.
+  const RunnerSnapshot* snap = ui.snapshot.get();
+  const int frame = !snap || snap->live.active ? -1
+                    : snap->seek_target >= 0   ? snap->seek_target
+                                               : snap->frame;
+  ui.runner->Restart(ui.state->project);
+  if (frame >= 0) ui.runner->Seek(frame);
 }
 
+void ConfigureImGui(ImGuiIO* io) { io->ConfigWindowsMoveFromTitleBarOnly = true; }
+
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
+  CheckOpened(ui);
   HandleShortcuts(ui);
   DrawMenuBar(ui, panels);
-  for (auto& panel : panels)
-    if (panel->open) panel->Draw(ui);
+  const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);
+  for (auto& panel : panels) {
+    // A tiled panel without a tile is hidden behind a maximised one.
+    if (panel->open && (panel->tiled || !ui.layout.Contains(panel->Title()))) panel->Draw(ui);
+    if (panel->maximise_requested) ui.layout.ToggleMaximised(panel->Title());
+    panel->maximise_requested = false;
+  }
+  DrawSplitters(&ui.layout, splitters);
   DrawUnsavedPrompt(ui);
   DrawStatusBar(ui);
 }

@@ -11,4 +11,8 @@ namespace fresco {
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels);
 
+// The app's Dear ImGui settings (the GL app and the headless tests): windows move by their
+// title bar only, so a drag on an image or a plot never moves its window.
+void ConfigureImGui(ImGuiIO* io);
+
 }  // namespace fresco

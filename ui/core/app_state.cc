@@ -26,6 +26,24 @@ Status Apply(const std::vector<GroupSpec>& current, const GroupingEdit& edit, in
   return Status::Ok();
 }
 
+// The files the project names must exist before the app calls it opened: a missing video
+// is one clear error naming the project, the key and the path (live sources and built-in
+// scenes are not files).
+Status CheckInputsExist(const Project& project) {
+  const std::pair<const char*, const std::string*> inputs[] = {{"scene", &project.scene},
+                                                               {"camera", &project.camera},
+                                                               {"video", &project.video},
+                                                               {"poses", &project.poses}};
+  for (const auto& [key, value] : inputs) {
+    if (value->empty() || IsUrlOrDevice(*value) || value->rfind("builtin:", 0) == 0) continue;
+    const std::string path = project.Resolve(*value);
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec))
+      return Status::Error(project.file_path + ": " + key + ": " + path + " does not exist");
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status AppState::Open(const std::string& path) {
@@ -35,6 +53,7 @@ Status AppState::Open(const std::string& path) {
   // The app edits one stream as version-1 keys: a version-2 file's one stream is saved back
   // as version 1 (the same project).
   loaded = loaded.ForStream(0);
+  FRESCO_RETURN_IF_ERROR(CheckInputsExist(loaded));
   project = loaded;
   has_project = true;
   dirty = false;
@@ -103,6 +122,16 @@ void AppState::AddRecent(const std::string& path) {
   recent.erase(std::remove(recent.begin(), recent.end(), path), recent.end());
   recent.insert(recent.begin(), path);
   if (recent.size() > kMaxRecent) recent.resize(kMaxRecent);
+  SaveRecent();
+}
+
+void AppState::RemoveRecent(const std::string& path) {
+  const size_t before = recent.size();
+  recent.erase(std::remove(recent.begin(), recent.end(), path), recent.end());
+  if (recent.size() != before) SaveRecent();
+}
+
+void AppState::SaveRecent() const {
   if (recent_file.empty()) return;
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(recent_file).parent_path(), ec);
@@ -143,6 +172,32 @@ Status SetGroupTexelSize(const std::vector<GroupSpec>& current, int num_triangle
   edit.groups.assign(groups.begin(), groups.end());
   edit.texel_size_m = texel_size_m;
   return Apply(current, edit, num_triangles, result);
+}
+
+std::string DescribeGroupsSplitBack(const std::vector<GroupSpec>& stored,
+                                    const std::vector<GroupSpec>& built, int num_triangles) {
+  std::vector<int> built_of(num_triangles, -1);
+  for (size_t g = 0; g < built.size(); ++g)
+    for (int t : built[g].triangles)
+      if (t >= 0 && t < num_triangles) built_of[t] = static_cast<int>(g);
+  int split = 0, pieces = 0;
+  std::string first;
+  for (size_t g = 0; g < stored.size(); ++g) {
+    std::set<int> parts;
+    for (int t : stored[g].triangles)
+      if (t >= 0 && t < num_triangles && built_of[t] >= 0) parts.insert(built_of[t]);
+    if (parts.size() < 2) continue;
+    if (split == 0) first = std::to_string(g);
+    ++split;
+    pieces += static_cast<int>(parts.size());
+  }
+  if (split == 0) return "";
+  return "split back apart: " + std::to_string(split) + " stored group" +
+         (split > 1 ? "s (first: group " : " (group ") + first + ") became " +
+         std::to_string(pieces) +
+         " buffers while painting, because some of their triangles face away from the "
+         "group's mean plane (they would fold over in one buffer); merge only surfaces that "
+         "face the same way";
 }
 
 }  // namespace fresco

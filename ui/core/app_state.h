@@ -41,7 +41,9 @@ struct AppState {
   bool Redo();
 
   void LoadRecent();
+  void SaveRecent() const;  // to recent_file (when set)
   void AddRecent(const std::string& path);
+  void RemoveRecent(const std::string& path);  // a project that failed to open
 };
 
 // Grouping edits as the app makes them: on the groups the current session built (one per
@@ -58,5 +60,12 @@ Status MoveTriangles(const std::vector<GroupSpec>& current, int num_triangles,
 Status SetGroupTexelSize(const std::vector<GroupSpec>& current, int num_triangles,
                          const std::set<int>& groups, double texel_size_m,
                          std::vector<GroupSpec>* result);
+
+// Why the painting shows more groups than the project stores, or "" when it does not: a
+// stored group (a merge, typically) whose triangles fold over on its own projection plane
+// is split back apart when the buffers are built (BuildBaseBuffers). `stored`: the
+// project's explicit groups; `built`: the session's groups (one per base buffer).
+std::string DescribeGroupsSplitBack(const std::vector<GroupSpec>& stored,
+                                    const std::vector<GroupSpec>& built, int num_triangles);
 
 }  // namespace fresco

@@ -19,6 +19,7 @@
 #include "ui/core/orbit_frame.h"
 #include "ui/core/pipeline_runner.h"
 #include "ui/core/poses_runner.h"
+#include "ui/core/tile_layout.h"
 
 namespace fresco {
 
@@ -38,8 +39,8 @@ struct ViewportView {
   float distance_m = 0;                // 0 = fit the model
   float target[3] = {0, 0, 0};         // orbit centre, world
   bool target_set = false;
-  OrbitFrame orbit;                    // which way is up (from the capture's poses)
-  uint64_t orbit_geometry_version = 0; // the geometry `orbit` was taken from (0: none yet)
+  OrbitFrame orbit;                     // which way is up (from the capture's poses)
+  uint64_t orbit_geometry_version = 0;  // the geometry `orbit` was taken from (0: none yet)
   bool show_path = true, show_frustum = true;
 };
 
@@ -63,6 +64,12 @@ struct UiContext {
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
   bool request_quit = false;
   PosesRunner* poses = nullptr;  // the COLMAP worker (Poses panel)
+  // A project just opened: the worker's first snapshot after `opened_version` says whether
+  // its files could be read (app_frame.cc turns a failure into one error).
+  bool open_pending = false;
+  uint64_t opened_version = 0;
+  // Where the tiled panels go (splitters, maximise); panels not in it float.
+  TileLayout layout = DefaultTileLayout();
 };
 
 class Panel {
@@ -73,15 +80,26 @@ class Panel {
   // What the panel shows, for `fresco gui --screenshot`'s FILE.json (name -> value).
   virtual std::map<std::string, std::string> Report() const { return {}; }
   bool open = true;
-  // Where the panel starts, in a 1600 x 1000 window (scaled to the real size).
+  // Where a floating panel starts, in a 1600 x 1000 window (scaled to the real size).
   ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);
+  // Set by the app frame before each frame: the panel's tile in the layout (a tiled panel
+  // neither moves nor resizes itself), or floating.
+  bool tiled = false;
+  ImVec2 tile_pos, tile_size;
+  // A double-click on a tiled panel's title bar: the app frame maximises or restores it.
+  bool maximise_requested = false;
 };
 
 // Every panel, in menu order (panel_registry.cc).
 std::vector<std::unique_ptr<Panel>> MakePanels();
 
+// The status bar at the bottom of the window (app_frame.cc), pixels.
+inline constexpr float kStatusBarHeight = 24;
+
 // Helpers for panels.
-// Starts the panel's window at its default place the first time (scaled to the display).
+// Starts the panel's window: in its tile when tiled (a double-click on the title bar asks to
+// maximise or restore it); else at its default place the first time (scaled to the
+// display), its title bar kept below the menu bar and on screen.
 bool BeginPanel(Panel& panel);
 // The same for a large window over other panels (opaque) that shows a worker: false, with
 // the window already ended, when it is collapsed or there is no worker (it says so).
@@ -89,6 +107,16 @@ bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker);
 // An image scaled to fit `max_width` (0 = the available width), keeping its aspect.
 void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,
                float max_width = 0);
+// The frame the user is looking at: a seek's target while it runs, else the last painted.
+int ShownFrame(const RunnerSnapshot& snap);
+// "frame 12", "seeking to frame 40: at 17", "no frame painted yet".
+std::string FrameLabel(const RunnerSnapshot& snap);
+// Layout in narrow panels: the next item's width so that `following` (a button's label on
+// the same line after it, or a widget's own label) still fits, at least `min_px`; and
+// SameLine only when an item `next_width` wide fits after the last one (else a new line).
+void FitNextItem(const char* following = nullptr, float min_px = 40);
+void SameLineIfFits(float next_width);
+float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
 

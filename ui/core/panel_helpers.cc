@@ -1,17 +1,44 @@
 #include <cmath>
 
+#include "ui/core/layout.h"
 #include "ui/core/panel.h"
 
 namespace fresco {
 
 bool BeginPanel(Panel& panel) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
+  if (panel.tiled) {
+    ImGui::SetNextWindowPos(panel.tile_pos, ImGuiCond_Always);
+    ImGui::SetNextWindowSize(panel.tile_size, ImGuiCond_Always);
+    const bool visible =
+        ImGui::Begin(panel.Title(), &panel.open,
+                     ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
+                         ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
+    // Text wraps at the panel's edge instead of running out of a narrow tile (ImGui resets
+    // the wrap position at every Begin, so nothing needs popping).
+    ImGui::PushTextWrapPos(0.0f);
+    const float title_bottom = ImGui::GetWindowPos().y + ImGui::GetFrameHeight();
+    const bool on_title = ImGui::IsWindowHovered() && ImGui::GetIO().MousePos.y < title_bottom;
+    if (on_title && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left))
+      panel.maximise_requested = true;
+    if (on_title)  // the whole title where a narrow tile cuts it short
+      ImGui::SetTooltip("%s (double-click: maximise / restore)", panel.Title());
+    return visible;
+  }
   const float sx = display.x / 1600.0f, sy = display.y / 1000.0f;
   ImGui::SetNextWindowPos(ImVec2(panel.default_pos.x * sx, panel.default_pos.y * sy),
                           ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(panel.default_size.x * sx, panel.default_size.y * sy),
                            ImGuiCond_FirstUseEver);
-  return ImGui::Begin(panel.Title(), &panel.open);
+  const bool visible = ImGui::Begin(panel.Title(), &panel.open);
+  ImGui::PushTextWrapPos(0.0f);
+  // However it was dragged, the title bar stays below the menu bar and on screen.
+  const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+  const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), kStatusBarHeight};
+  const LayoutRect kept =
+      KeepTitleBarReachable({pos.x, pos.y, size.x, size.y}, band, ImGui::GetFrameHeight());
+  if (kept.x != pos.x || kept.y != pos.y) ImGui::SetWindowPos(ImVec2(kept.x, kept.y));
+  return visible;
 }
 
 bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker) {
@@ -41,13 +68,44 @@ void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint
   if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %d x %d", key.c_str(), image.cols, image.rows);
 }
 
+float ButtonWidth(const char* label) {
+  return ImGui::CalcTextSize(label, nullptr, true).x + 2 * ImGui::GetStyle().FramePadding.x;
+}
+
+void FitNextItem(const char* following, float min_px) {
+  float width = ImGui::GetContentRegionAvail().x;
+  if (following) width -= ButtonWidth(following) + ImGui::GetStyle().ItemSpacing.x;
+  ImGui::SetNextItemWidth(std::max(min_px, width));
+}
+
+void SameLineIfFits(float next_width) {
+  const float x = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x;
+  if (x + next_width <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x)
+    ImGui::SameLine();
+}
+
+int ShownFrame(const RunnerSnapshot& snap) {
+  return snap.seek_target >= 0 ? snap.seek_target : snap.frame;
+}
+
+std::string FrameLabel(const RunnerSnapshot& snap) {
+  const std::string target = std::to_string(snap.seek_target);
+  if (snap.seek_target >= 0 && snap.frame < 0) return "seeking to frame " + target + ": reopening";
+  if (snap.seek_target >= 0)
+    return "seeking to frame " + target + ": at " + std::to_string(snap.frame);
+  if (snap.frame < 0) return "no frame painted yet";
+  return "frame " + std::to_string(snap.frame);
+}
+
 void ShowMetrics(const std::map<std::string, double>& metrics) {
   if (!ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV))
     return;
+  ImGui::PushTextWrapPos(-1.0f);  // names do not break mid-word
   for (const auto& [name, value] : metrics) {
     ImGui::TableNextRow();
     ImGui::TableSetColumnIndex(0);
-    ImGui::TextUnformatted(name.c_str());
+    ImGui::TextUnformatted(name.c_str());  // clipped by its column, whole in a tooltip
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", name.c_str());
     ImGui::TableSetColumnIndex(1);
     if (std::isnan(value))
       ImGui::TextDisabled("-");
@@ -56,6 +114,7 @@ void ShowMetrics(const std::map<std::string, double>& metrics) {
     else
       ImGui::Text("%.4g", value);
   }
+  ImGui::PopTextWrapPos();
   ImGui::EndTable();
 }
 

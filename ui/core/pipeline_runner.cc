@@ -257,9 +257,11 @@ void PipelineRunner::SetRecording(const std::string& dir) {
 
 void PipelineRunner::Publish(bool with_painted) {
   working_.playing = playing_;
+  working_.seek_target = seek_target_;
   if (session_) {  // without one, the status says why (no project, error, connecting)
     working_.run = session_->run->stats();
     working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
+    if (seek_target_ >= 0 && !session_->ended) working_.status = "seeking";
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
       working_.live.frames_painted = session_->run->stats().frames_painted;
@@ -274,6 +276,7 @@ void PipelineRunner::Publish(bool with_painted) {
   }
   ++working_.version;
   auto snapshot = std::make_shared<RunnerSnapshot>(working_);
+  if (options_.on_publish) options_.on_publish(*snapshot);
   std::lock_guard<std::mutex> lock(mutex_);
   snapshot_ = snapshot;
 }
@@ -336,12 +339,19 @@ void PipelineRunner::Loop() {
           playing_ = false;
           // A live source cannot go back: only forward seeks (paint N more frames) apply.
           if (session_ && !session_->live && command.frame < session_->next_frame) {
+            // Back: reopen and repaint from frame 0. Say so at once (reopening can take
+            // seconds on large buffers); progress follows as frames are painted.
+            seek_target_ = command.frame;
+            working_.frame = -1;
+            Publish(false);
             const Project project = session_->project;
             OpenSession(project);
           }
           seek_target_ = session_ ? command.frame : -1;
           if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
-          if (seek_target_ < 0) Publish(true);
+          // Either the result, or that a seek is under way (the UI shows its progress).
+          Publish(seek_target_ < 0);
+          last_publish = Clock::now();
           break;
       }
       continue;
@@ -354,7 +364,7 @@ void PipelineRunner::Loop() {
       if (painted == Painted::kEnded || (painted == Painted::kFrame && last)) {
         seek_target_ = -1;
         Publish(true);
-      } else if (painted == Painted::kWaiting && due) {
+      } else if (due) {  // progress (or a live source's state while waiting)
         Publish(false);
         last_publish = Clock::now();
       }

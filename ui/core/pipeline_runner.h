@@ -14,6 +14,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -54,6 +55,9 @@ struct RunnerSnapshot {
   std::string status;                               // "paused", "playing", "error: ..."
   bool playing = false;
   int frame = -1;  // index of the frame last painted
+  // A seek under way: the frame it paints up to (`frame` says how far it got; -1 while a
+  // seek back reopens the video); -1 when none.
+  int seek_target = -1;
   std::string frame_name;
   bool has_pose = false;
   Rigid3d cam_from_world;
@@ -96,6 +100,8 @@ struct RunnerOptions {
   // Live sources: the worker waits at most this long for a frame before it looks at its
   // commands again (and publishes the sources' state at least every publish_interval_ms).
   int live_poll_ms = 50;
+  // Tests: called on the worker thread with every snapshot it publishes, in order.
+  std::function<void(const RunnerSnapshot&)> on_publish;
 };
 
 class PipelineRunner {

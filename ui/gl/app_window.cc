@@ -17,10 +17,12 @@
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/image_io.h"
 #include "ui/core/app_frame.h"
-#include "ui/panels/panels.h"
+#include "ui/core/input_queue.h"
+#include "ui/core/layout_file.h"
 #include "ui/gl/gl.h"
 #include "ui/gl/gl_textures.h"
 #include "ui/gl/viewport_gl.h"
+#include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
@@ -109,6 +111,50 @@ void StartPoses(const GuiOptions& options, UiContext& ui,
   ui.runner->WaitIdle();
 }
 
+// GLFW's callbacks queue the keyboard and the mouse (input_queue.h) so that a tap or a
+// drag shorter than a frame is still seen; focus, cursor enter and text go to ImGui's
+// backend as before.
+void InstallQueuedInput(GLFWwindow* window, InputQueue* queue) {
+  glfwSetWindowUserPointer(window, queue);
+  glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kMouseMove;
+    e.x = static_cast<float>(x), e.y = static_cast<float>(y);
+    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+  });
+  glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kMouseButton;
+    e.code = button;
+    e.down = action == GLFW_PRESS;
+    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+  });
+  glfwSetScrollCallback(window, [](GLFWwindow* w, double dx, double dy) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kWheel;
+    e.x = static_cast<float>(dx), e.y = static_cast<float>(dy);
+    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+  });
+  glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
+    if (action == GLFW_REPEAT) return;  // ImGui makes its own repeats from the held key
+    InputEvent e;
+    e.kind = InputEvent::Kind::kKey;
+    e.code = key;
+    e.down = action == GLFW_PRESS;
+    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+  });
+  glfwSetCursorEnterCallback(window, [](GLFWwindow* w, int entered) {
+    ImGui_ImplGlfw_CursorEnterCallback(w, entered);
+    if (entered) return;
+    InputEvent e;  // the mouse left the window: nothing hovered
+    e.kind = InputEvent::Kind::kMouseMove;
+    e.x = e.y = -FLT_MAX;
+    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+  });
+  glfwSetWindowFocusCallback(window, ImGui_ImplGlfw_WindowFocusCallback);
+  glfwSetCharCallback(window, ImGui_ImplGlfw_CharCallback);
+}
+
 }  // namespace
 
 int RunGuiApp(const GuiOptions& options) {
@@ -155,7 +201,11 @@ int RunGuiApp(const GuiOptions& options) {
     io.IniFilename = ini.c_str();
   }
   ImGui::StyleColorsDark();
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ConfigureImGui(&io);
+  ImGui_ImplGlfw_InitForOpenGL(window, false);
+  InputQueue input_queue;
+  InputState input;
+  InstallQueuedInput(window, &input_queue);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
   int code = 0;
@@ -163,7 +213,7 @@ int RunGuiApp(const GuiOptions& options) {
     PipelineRunner runner;
     CalibrationRunner calibration;
     PosesRunner poses;
-    GlTextures textures;
+    GlTextures textures(/*crisp_pixels=*/true);
     GlViewport viewport;
     auto panels = MakePanels();
     UiContext ui;
@@ -173,7 +223,21 @@ int RunGuiApp(const GuiOptions& options) {
     ui.textures = &textures;
     ui.viewport = &viewport;
     ui.poses = &poses;
-    if (state.has_project) runner.Restart(state.project);
+    // The splitters and font scale as the last session left them (not for screenshots,
+    // which show the default layout).
+    const std::string layout_file =
+        screenshot || ConfigDir().empty() ? "" : ConfigDir() + "/layout.json";
+    SavedLayout saved;
+    if (!layout_file.empty()) {
+      if (Status s = LoadLayoutFile(layout_file, &saved); !s.ok())
+        std::fprintf(stderr, "fresco gui: %s (the default layout instead)\n", s.message().c_str());
+      ui.layout = saved.layout;
+      io.FontGlobalScale = saved.font_scale;
+    }
+    if (state.has_project) {
+      runner.Restart(state.project);
+      ui.open_pending = true;  // a worker error then replaces "opened ..."
+    }
     if (screenshot && state.has_project) {
       runner.Seek(std::max(0, options.frames - 1));
       runner.WaitIdle();
@@ -190,6 +254,8 @@ int RunGuiApp(const GuiOptions& options) {
       ui.snapshot = runner.Snapshot();
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
+      input_queue.NextFrame(&input);  // this frame's share of the queued input
+      CopyToImGui(input, &io);
       if (screenshot) io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);  // no hover effects in pictures
       ImGui::NewFrame();
       DrawAppFrame(ui, panels);
@@ -218,6 +284,12 @@ int RunGuiApp(const GuiOptions& options) {
       }
       glfwSwapBuffers(window);
       if (ui.request_quit) break;
+    }
+    if (!layout_file.empty()) {
+      saved.layout = ui.layout;
+      saved.font_scale = io.FontGlobalScale;
+      if (Status s = SaveLayoutFile(layout_file, saved); !s.ok())
+        std::fprintf(stderr, "fresco gui: %s\n", s.message().c_str());
     }
   }
   ImGui_ImplOpenGL3_Shutdown();

@@ -4,7 +4,7 @@
 
 namespace fresco {
 
-void UploadTexture(GLuint texture, const cv::Mat& image) {
+void UploadTexture(GLuint texture, const cv::Mat& image, GLint magnify) {
   cv::Mat rgba;
   if (image.type() == CV_8UC1)
     cv::cvtColor(image, rgba, cv::COLOR_GRAY2RGBA);
@@ -19,7 +19,7 @@ void UploadTexture(GLuint texture, const cv::Mat& image) {
   }
   glBindTexture(GL_TEXTURE_2D, texture);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, magnify);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -37,7 +37,7 @@ ImTextureID GlTextures::Get(const std::string& key, const cv::Mat& image, uint64
   Entry& e = entries_[key];
   if (e.texture == 0) glGenTextures(1, &e.texture);
   if (e.version != version || e.width != image.cols || e.height != image.rows) {
-    if (!image.empty()) UploadTexture(e.texture, image);
+    if (!image.empty()) UploadTexture(e.texture, image, crisp_pixels_ ? GL_NEAREST : GL_LINEAR);
     e.version = version;
     e.width = image.cols;
     e.height = image.rows;

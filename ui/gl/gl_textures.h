@@ -12,6 +12,9 @@ namespace fresco {
 
 class GlTextures : public ImageTextures {
  public:
+  // `crisp_pixels`: magnified images show their pixels as squares (the panels' image views,
+  // zoomed in to read pixels) instead of blending them (the 3D view's textures).
+  explicit GlTextures(bool crisp_pixels = false) : crisp_pixels_(crisp_pixels) {}
   ~GlTextures() override;
   ImTextureID Get(const std::string& key, const cv::Mat& image, uint64_t version) override;
   // Called once per UI frame: deletes textures unused for `max_age` frames.
@@ -26,9 +29,11 @@ class GlTextures : public ImageTextures {
   };
   std::map<std::string, Entry> entries_;
   int frame_ = 0;
+  bool crisp_pixels_ = false;
 };
 
-// Uploads a CV_8UC1/3/4 image (BGR order) into `texture` as RGBA.
-void UploadTexture(GLuint texture, const cv::Mat& image);
+// Uploads a CV_8UC1/3/4 image (BGR order) into `texture` as RGBA; `magnify`: the
+// magnification filter (GL_LINEAR or GL_NEAREST).
+void UploadTexture(GLuint texture, const cv::Mat& image, GLint magnify = GL_LINEAR);
 
 }  // namespace fresco

@@ -1,6 +1,7 @@
 #include "ui/gl/viewport_gl.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -11,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include "pipeline/render/renderer.h"
+#include "ui/core/group_colour.h"
 #include "ui/gl/gl.h"
 #include "ui/gl/gl_textures.h"
 
@@ -24,6 +26,7 @@ layout(location = 2) in float group_id;
 layout(location = 3) in float triangle_id;
 layout(location = 4) in vec3 normal;
 layout(location = 5) in float selected;
+layout(location = 6) in vec3 group_rgb;
 uniform mat4 view_projection;
 out vec2 v_uv;
 out vec3 v_position;
@@ -31,6 +34,7 @@ out vec3 v_normal;
 flat out float v_group;
 flat out int v_triangle;
 flat out float v_selected;
+flat out vec3 v_group_rgb;
 void main() {
   v_uv = uv;
   v_position = position;
@@ -38,6 +42,7 @@ void main() {
   v_group = group_id;
   v_triangle = int(triangle_id + 0.5);
   v_selected = selected;
+  v_group_rgb = group_rgb;
   gl_Position = view_projection * vec4(position, 1.0);
 })";
 
@@ -48,6 +53,7 @@ in vec3 v_normal;
 flat in float v_group;
 flat in int v_triangle;
 flat in float v_selected;
+flat in vec3 v_group_rgb;    // the group's stable colour (ui/core/group_colour.h)
 uniform int mode;            // 0 painted, 1 groups, 2 frame projected
 uniform sampler2D painted;   // this draw's base buffer
 uniform sampler2D frame;     // the current frame
@@ -56,18 +62,13 @@ uniform vec2 frame_size;
 uniform vec3 eye;
 layout(location = 0) out vec4 colour;
 layout(location = 1) out int triangle;
-vec3 GroupColour(float g) {
-  float h = fract(g * 0.618034);
-  vec3 k = vec3(0.0, 2.0 / 3.0, 1.0 / 3.0);
-  return clamp(abs(fract(h + k) * 6.0 - 3.0) - 1.0, 0.0, 1.0) * 0.65 + 0.25;
-}
 void main() {
   float shade = 0.55 + 0.45 * abs(dot(normalize(v_normal), normalize(eye - v_position)));
   vec3 base = vec3(0.35);
   if (v_group < 0.0) {
     base = vec3(0.25);
   } else if (mode == 1) {
-    base = GroupColour(v_group) * shade;
+    base = v_group_rgb * shade;
   } else if (mode == 0) {
     vec4 t = texture(painted, v_uv);
     bool checker = (int(floor(gl_FragCoord.x / 8.0) + floor(gl_FragCoord.y / 8.0)) & 1) == 1;
@@ -81,7 +82,10 @@ void main() {
     else
       base = vec3(0.3) * shade;
   }
-  if (v_selected > 0.5) base = mix(base, vec3(1.0, 0.85, 0.1), 0.55);
+  // Selected triangles in yellow, triangles of selected groups in cyan (both striped).
+  bool stripe = (int(floor((gl_FragCoord.x + gl_FragCoord.y) / 6.0)) & 1) == 1;
+  if (v_selected > 1.5) base = mix(base, vec3(0.2, 0.9, 1.0), stripe ? 0.65 : 0.4);
+  else if (v_selected > 0.5) base = mix(base, vec3(1.0, 0.85, 0.1), 0.55);
   colour = vec4(base, 1.0);
   triangle = v_triangle;
 })";
@@ -164,7 +168,8 @@ struct Vertex {
   float group;
   float triangle;
   float normal[3];
-  float selected;
+  float selected;  // 0, 1 (triangle selected), 2 (its group selected)
+  float group_rgb[3];
 };
 
 struct LineVertex {
@@ -180,7 +185,7 @@ struct GlViewport::Impl {
   GLuint fbo = 0, colour = 0, ids = 0, depth = 0;
   int width = 0, height = 0;
   uint64_t geometry_version = ~0ull;
-  std::set<int> selection;
+  std::set<int> selection, selected_groups;
   // Draw ranges: buffer b's triangles are vertices [first[b], first[b] + count[b]).
   std::vector<int> first, count;
   int ungrouped_first = 0, ungrouped_count = 0;
@@ -201,7 +206,8 @@ struct GlViewport::Impl {
     glVertexAttribPointer(3, 1, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, triangle));
     glVertexAttribPointer(4, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, normal));
     glVertexAttribPointer(5, 1, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, selected));
-    for (int a = 0; a < 6; ++a) glEnableVertexAttribArray(a);
+    glVertexAttribPointer(6, 3, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, group_rgb));
+    for (int a = 0; a < 7; ++a) glEnableVertexAttribArray(a);
     glGenVertexArrays(1, &line_vao);
     glGenBuffers(1, &line_vbo);
     glBindVertexArray(line_vao);
@@ -246,7 +252,8 @@ struct GlViewport::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 
-  void Upload(const SessionGeometry& geo, const std::set<int>& selected) {
+  void Upload(const SessionGeometry& geo, const std::set<int>& selected,
+              const std::set<int>& groups_selected) {
     const TriangleMesh& mesh = geo.painted_layout.mesh;
     const int num_buffers = static_cast<int>(geo.groups.size());
     std::vector<std::vector<int>> by_buffer(num_buffers + 1);
@@ -261,6 +268,9 @@ struct GlViewport::Impl {
     count.assign(num_buffers, 0);
     for (int b = 0; b <= num_buffers; ++b) {
       const int start = static_cast<int>(vertices.size());
+      const std::array<float, 3> rgb =
+          GroupColour(b < num_buffers ? StableGroupKey(geo.groups[b]) : -1);
+      const bool group_selected = groups_selected.count(b) > 0;
       for (int t : by_buffer[b]) {
         const Eigen::Vector3d n = mesh.Normal(t);
         for (int k = 0; k < 3; ++k) {
@@ -278,7 +288,8 @@ struct GlViewport::Impl {
           v.normal[0] = static_cast<float>(n.x());
           v.normal[1] = static_cast<float>(n.y());
           v.normal[2] = static_cast<float>(n.z());
-          v.selected = selected.count(t) ? 1.0f : 0.0f;
+          v.selected = selected.count(t) ? 1.0f : group_selected ? 2.0f : 0.0f;
+          for (int c = 0; c < 3; ++c) v.group_rgb[c] = rgb[c];
           vertices.push_back(v);
         }
       }
@@ -320,10 +331,12 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   if (!m.built) m.Build();
   m.Resize(width, height);
   const SessionGeometry& geo = *snapshot.geometry;
-  if (m.geometry_version != snapshot.geometry_version || m.selection != state.selected_triangles) {
-    m.Upload(geo, state.selected_triangles);
+  if (m.geometry_version != snapshot.geometry_version || m.selection != state.selected_triangles ||
+      m.selected_groups != state.selected_groups) {
+    m.Upload(geo, state.selected_triangles, state.selected_groups);
     m.geometry_version = snapshot.geometry_version;
     m.selection = state.selected_triangles;
+    m.selected_groups = state.selected_groups;
   }
   // The orbit camera, in the scene's local frame; fitted to the model on first use.
   const Scene& scene = geo.painted_layout;
@@ -345,7 +358,8 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
     view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.live_path : geo.path);
     view->orbit_geometry_version = snapshot.geometry_version;
   }
-  const Eigen::Vector3f eye = target + view->distance_m * OrbitEyeDirection(view->orbit, yaw, pitch);
+  const Eigen::Vector3f eye =
+      target + view->distance_m * OrbitEyeDirection(view->orbit, yaw, pitch);
   const float near = std::max(1e-3f, 0.01f * view->distance_m);
   const Mat4 view_projection = Perspective(fov, static_cast<float>(width) / height, near,
                                            10.0f * (view->distance_m + radius)) *

@@ -272,6 +272,7 @@ class CalibrationPanel : public Panel {
     const ImGuiTableFlags flags =
         ImGuiTableFlags_RowBg | ImGuiTableFlags_Borders | ImGuiTableFlags_SizingFixedFit;
     if (!ImGui::BeginTable("models", 5, flags)) return;
+    ImGui::PushTextWrapPos(-1.0f);  // columns fit their text: wrapping would shrink them
     for (const char* h : {"model", "rms px", "sigma px", "halves / limit px", "verdict"})
       ImGui::TableSetupColumn(h);
     ImGui::TableHeadersRow();
@@ -300,6 +301,7 @@ class CalibrationPanel : public Panel {
       ImGui::TableSetColumnIndex(4);
       ImGui::TextUnformatted(calib::VerdictText(t).c_str());
     }
+    ImGui::PopTextWrapPos();
     ImGui::EndTable();
   }
 

@@ -4,7 +4,9 @@
 // 3D view); all undoable, stored in the project as explicit groups and honoured by
 // `fresco run`.
 #include <algorithm>
+#include <cstdio>
 
+#include "ui/core/group_colour.h"
 #include "ui/core/panel.h"
 #include "ui/panels/panels.h"
 
@@ -30,6 +32,25 @@ class GroupingPanel : public Panel {
     const SessionGeometry& geo = *snap.geometry;
     const int num_triangles = static_cast<int>(geo.buffer_of_triangle.size());
     const bool explicit_groups = !state.project.grouping.groups.empty();
+    if (snap.geometry_version != checked_geometry_) {  // a new session: did a merge hold?
+      checked_geometry_ = snap.geometry_version;
+      split_message_ = explicit_groups ? DescribeGroupsSplitBack(state.project.grouping.groups,
+                                                                 geo.groups, num_triangles)
+                                       : "";
+      if (!split_message_.empty()) state.message = "grouping: " + split_message_;
+      colours_.clear();
+      for (const GroupSpec& g : geo.groups) {
+        const auto rgb = GroupColour(StableGroupKey(g));
+        char hex[8];
+        std::snprintf(hex, sizeof(hex), "#%02x%02x%02x", static_cast<int>(rgb[0] * 255 + 0.5f),
+                      static_cast<int>(rgb[1] * 255 + 0.5f), static_cast<int>(rgb[2] * 255 + 0.5f));
+        if (!colours_.empty()) colours_ += ' ';
+        colours_.append(std::to_string(StableGroupKey(g))).append(hex);
+      }
+    }
+    if (!split_message_.empty())
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "%s", "Grouping changed when painting:");
+    if (!split_message_.empty()) ImGui::TextWrapped("%s", split_message_.c_str());
     ImGui::TextWrapped("%s: %zu groups for %d triangles (%d split for fold-over)",
                        explicit_groups ? "stored groups" : "automatic", geo.groups.size(),
                        num_triangles, geo.folds_split);
@@ -39,10 +60,13 @@ class GroupingPanel : public Panel {
       angle_ = static_cast<float>(state.project.grouping.angle_deg);
       texel_ = static_cast<float>(state.project.pipeline.texel_size_m);
     }
+    ImGui::PushItemWidth(-ImGui::CalcTextSize("texel m (0 = auto)").x -
+                         ImGui::GetStyle().ItemInnerSpacing.x);
     ImGui::SliderFloat("angle deg", &angle_, 0.0f, 90.0f, "%.1f");
     const bool angle_done = ImGui::IsItemDeactivatedAfterEdit();
     ImGui::DragFloat("texel m (0 = auto)", &texel_, 0.0005f, 0.0f, 1.0f, "%.4f");
     const bool texel_done = ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::PopItemWidth();
     if (angle_done || texel_done) {
       state.BeginEdit();
       state.project.grouping.angle_deg = angle_;
@@ -59,7 +83,7 @@ class GroupingPanel : public Panel {
       state.project.grouping.edits.clear();
       ApplyProject(ui);
     }
-    if (!explicit_groups && ImGui::Button("Store these groups in the project")) {
+    if (!explicit_groups && ImGui::Button("Store these groups")) {
       state.BeginEdit();
       state.project.grouping.groups = geo.groups;
       state.project.grouping.edits.clear();
@@ -79,6 +103,14 @@ class GroupingPanel : public Panel {
         ImGui::TableNextRow();
         ImGui::TableSetColumnIndex(0);
         const bool selected = state.selected_groups.count(static_cast<int>(g)) > 0;
+        // The group's colour in the 3D view's "groups" mode (stable across edits).
+        const auto rgb = GroupColour(StableGroupKey(geo.groups[g]));
+        ImGui::PushID(static_cast<int>(g));
+        ImGui::ColorButton("##colour", ImVec4(rgb[0], rgb[1], rgb[2], 1.0f),
+                           ImGuiColorEditFlags_NoTooltip | ImGuiColorEditFlags_NoBorder,
+                           ImVec2(ImGui::GetTextLineHeight(), ImGui::GetTextLineHeight()));
+        ImGui::PopID();
+        ImGui::SameLine();
         if (ImGui::Selectable(std::to_string(g).c_str(), selected,
                               ImGuiSelectableFlags_SpanAllColumns)) {
           if (!ImGui::GetIO().KeyCtrl) state.selected_groups.clear();
@@ -112,14 +144,14 @@ class GroupingPanel : public Panel {
     if (ImGui::Button("Merge groups"))
       Commit(ui, MergeGroups(geo.groups, num_triangles, state.selected_groups, &result), result);
     ImGui::EndDisabled();
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Split triangles"));
     ImGui::BeginDisabled(state.selected_triangles.empty());
     if (ImGui::Button("Split triangles"))
       Commit(ui, SplitTriangles(geo.groups, num_triangles, state.selected_triangles, &result),
              result);
-    ImGui::SetNextItemWidth(80);
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 6);
     ImGui::InputInt("##target", &target_group_);
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Move triangles to group"));
     if (ImGui::Button("Move triangles to group"))
       Commit(ui,
              MoveTriangles(geo.groups, num_triangles, state.selected_triangles, target_group_,
@@ -127,9 +159,9 @@ class GroupingPanel : public Panel {
              result);
     ImGui::EndDisabled();
     ImGui::BeginDisabled(state.selected_groups.empty());
-    ImGui::SetNextItemWidth(80);
+    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 6);
     ImGui::InputFloat("##texel", &group_texel_, 0, 0, "%.4f");
-    ImGui::SameLine();
+    SameLineIfFits(ButtonWidth("Set texel size (m)"));
     if (ImGui::Button("Set texel size (m)"))
       Commit(ui,
              SetGroupTexelSize(geo.groups, num_triangles, state.selected_groups, group_texel_,
@@ -137,6 +169,10 @@ class GroupingPanel : public Panel {
              result);
     ImGui::EndDisabled();
     ImGui::End();
+  }
+
+  std::map<std::string, std::string> Report() const override {
+    return {{"colours", colours_}, {"split", split_message_}};
   }
 
  private:
@@ -156,6 +192,9 @@ class GroupingPanel : public Panel {
   }
 
   float angle_ = 20, texel_ = 0, group_texel_ = 0.01f;
+  uint64_t checked_geometry_ = 0;
+  std::string split_message_;  // why stored groups were split back apart ("" = they held)
+  std::string colours_;        // "KEY#rrggbb ..." per group, for Report()
   int target_group_ = 0;
 };
 

@@ -8,6 +8,7 @@
 #include <imgui.h>
 #include <opencv2/imgproc.hpp>
 
+#include "ui/core/image_view.h"
 #include "ui/core/panel.h"
 #include "ui/panels/panels.h"
 
@@ -24,26 +25,28 @@ class MisalignmentPanel : public Panel {
       return;
     }
     const RunnerSnapshot& snap = *ui.snapshot;
+    const float radio = ImGui::GetFrameHeight() + ImGui::GetStyle().ItemInnerSpacing.x;
     ImGui::RadioButton("heat map", &mode_, 0);
-    ImGui::SameLine();
+    SameLineIfFits(radio + ImGui::CalcTextSize("overlay").x);
     ImGui::RadioButton("overlay", &mode_, 1);
-    ImGui::SameLine();
+    SameLineIfFits(radio + ImGui::CalcTextSize("blink").x);
     ImGui::RadioButton("blink", &mode_, 2);
     if (snap.rephoto_bgr.empty() || snap.frame_bgr.empty()) {
       ImGui::TextDisabled("(shown for paused or stepped frames once something is painted)");
     } else if (mode_ == 0) {
-      ShowImage(ui, "misalignment/heat", snap.difference_heat, snap.version);
+      const ColourScale scale = DifferenceHeatScale();
+      view_.Draw(ui, "misalignment/heat", snap.difference_heat, snap.version, &scale);
     } else {
       cv::Mat frame;
       cv::resize(snap.frame_bgr, frame, snap.rephoto_bgr.size(), 0, 0, cv::INTER_AREA);
       if (mode_ == 1) {
         cv::Mat overlay;
         cv::addWeighted(frame, 0.5, snap.rephoto_bgr, 0.5, 0.0, overlay);
-        ShowImage(ui, "misalignment/overlay", overlay, snap.version);
+        view_.Draw(ui, "misalignment/overlay", overlay, snap.version);
       } else {
         const bool show_frame = static_cast<int>(ImGui::GetTime() * 2.0) % 2 == 0;
-        ShowImage(ui, show_frame ? "misalignment/frame" : "misalignment/rephoto",
-                  show_frame ? frame : snap.rephoto_bgr, snap.version);
+        view_.Draw(ui, show_frame ? "misalignment/frame" : "misalignment/rephoto",
+                   show_frame ? frame : snap.rephoto_bgr, snap.version);
         ImGui::TextDisabled(show_frame ? "frame" : "painted model");
       }
     }
@@ -85,8 +88,15 @@ class MisalignmentPanel : public Panel {
     ImGui::End();
   }
 
+  std::map<std::string, std::string> Report() const override {
+    std::map<std::string, std::string> report;
+    view_.ReportInto(&report);
+    return report;
+  }
+
  private:
   int mode_ = 0;
+  ImageView view_;  // one zoom for the three modes: the same pixels compared
 };
 
 }  // namespace

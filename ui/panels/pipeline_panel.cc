@@ -2,6 +2,7 @@
 // (live_status_section.h); and the settings of every stage, edited in the project
 // (undoable) and applied by restarting the worker.
 #include <algorithm>
+#include <cstdio>
 
 #include "ui/core/panel.h"
 #include "ui/panels/live_status_section.h"
@@ -13,7 +14,6 @@ namespace {
 class PipelinePanel : public Panel {
  public:
   const char* Title() const override { return "Pipeline"; }
-  std::map<std::string, std::string> Report() const override { return live_.report(); }
 
   void Draw(UiContext& ui) override {
     if (!BeginPanel(*this)) {
@@ -29,22 +29,47 @@ class PipelinePanel : public Panel {
       ui.runner->Play();
     }
     ImGui::SameLine();
+    // A file source can go back (repainting from the start up to the previous frame).
+    ImGui::BeginDisabled(snap.live.active || snap.frame < 1);
+    if (ImGui::Button("<")) PostSeek(ui, snap, std::max(0, ShownFrame(snap) - 1));
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip("step back one frame (repaints from the start)");
+    ImGui::EndDisabled();
+    ImGui::SameLine();
     if (ImGui::Button("Step")) ui.runner->Step();
     ImGui::SameLine();
-    if (ImGui::Button("Restart")) ApplyProject(ui);
+    if (ImGui::Button("Restart")) ui.runner->Restart(state.project);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("start again from the first frame");
     if (snap.live.active) {  // a live source has no end to seek to
-      ImGui::SameLine();
+      SameLineIfFits(ImGui::CalcTextSize("live frame 000000").x);
       ImGui::Text("live frame %d", snap.frame);
     } else {
       const int last = snap.geometry ? std::max(0, snap.geometry->num_frames - 1) : 0;
-      if (!ImGui::IsItemActive()) seek_ = std::max(0, snap.frame);
-      ImGui::SetNextItemWidth(-60);
+      // The slider shows the frame asked for until the worker has taken the seek up.
+      if (snap.version > posted_version_) posted_seek_ = -1;
+      // The slider on a line of its own, as wide as the panel allows.
+      char of_last[32];
+      std::snprintf(of_last, sizeof(of_last), "/ %d", last);
+      ImGui::SetNextItemWidth(std::max(60.0f, ImGui::GetContentRegionAvail().x -
+                                                  ImGui::CalcTextSize(of_last).x -
+                                                  ImGui::GetStyle().ItemSpacing.x));
+      const float x = ImGui::GetCursorScreenPos().x, y = ImGui::GetCursorScreenPos().y;
+      if (!slider_active_) seek_ = posted_seek_ >= 0 ? posted_seek_ : std::max(0, ShownFrame(snap));
       ImGui::SliderInt("##seek", &seek_, 0, last, "frame %d");
-      if (ImGui::IsItemDeactivatedAfterEdit()) ui.runner->Seek(seek_);
+      slider_active_ = ImGui::IsItemActive();
+      slider_rect_[0] = x, slider_rect_[1] = y;
+      slider_rect_[2] = ImGui::GetItemRectSize().x, slider_rect_[3] = ImGui::GetItemRectSize().y;
+      if (ImGui::IsItemDeactivatedAfterEdit()) PostSeek(ui, snap, seek_);
       ImGui::SameLine();
-      ImGui::Text("/ %d", last);
+      ImGui::TextUnformatted(of_last);
     }
     ImGui::EndDisabled();
+    if (snap.seek_target >= 0) {  // a seek (back: from the start) under way
+      const float done = snap.frame < 0 ? 0.0f
+                                        : static_cast<float>(snap.frame + 1) /
+                                              static_cast<float>(snap.seek_target + 1);
+      ImGui::ProgressBar(done, ImVec2(-1, 0), FrameLabel(snap).c_str());
+    }
     ImGui::TextWrapped("%s", snap.status.c_str());
     if (snap.geometry)
       ImGui::Text("%zu base buffers, texel %.4f m, coverage %.1f %%", snap.geometry->groups.size(),
@@ -54,6 +79,9 @@ class PipelinePanel : public Panel {
     ImGui::Separator();
     ImGui::TextDisabled("Settings (Apply restarts painting)");
     if (!ImGui::IsAnyItemActive()) edit_ = state.project.pipeline;
+    // Widgets take what the longest label leaves, so no label runs out of a narrow panel.
+    ImGui::PushItemWidth(-ImGui::CalcTextSize("texel size m (0 = auto)").x -
+                         ImGui::GetStyle().ItemInnerSpacing.x);
     PipelineOptions& p = edit_;
     bool commit = false;
     auto done = [&] { commit |= ImGui::IsItemDeactivatedAfterEdit(); };
@@ -121,7 +149,8 @@ class PipelinePanel : public Panel {
     if (ImGui::SliderFloat("min correction texels", &dead_band, 0.0f, 2.0f, "%.2f"))
       p.refine.min_correction_px = dead_band;
     done();
-    if (ImGui::Checkbox("correct the pose (all buffers)", &p.refine.pose)) commit = true;
+    if (ImGui::Checkbox("correct the pose", &p.refine.pose)) commit = true;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("one pose correction for all buffers");
     if (ImGui::Checkbox("consensus anchoring", &p.refine.anchor)) commit = true;
     float step = static_cast<float>(p.refine.anchor_step_px);
     if (ImGui::SliderFloat("anchor step texels", &step, 0.0f, 2.0f, "%.2f"))
@@ -144,14 +173,35 @@ class PipelinePanel : public Panel {
       state.BeginEdit();
       state.project.pipeline = edit_;
     }
+    ImGui::PopItemWidth();
     ImGui::BeginDisabled(!state.has_project);
     if (ImGui::Button("Apply")) ApplyProject(ui);
     ImGui::EndDisabled();
     ImGui::End();
   }
 
+  std::map<std::string, std::string> Report() const override {
+    auto report = live_.report();
+    report["seek"] = std::to_string(seek_);
+    char rect[64];
+    std::snprintf(rect, sizeof(rect), "%.0f %.0f %.0f %.0f", slider_rect_[0], slider_rect_[1],
+                  slider_rect_[2], slider_rect_[3]);
+    report["seek slider"] = rect;
+    return report;
+  }
+
  private:
+  void PostSeek(UiContext& ui, const RunnerSnapshot& snap, int frame) {
+    ui.runner->Seek(frame);
+    posted_seek_ = frame;
+    posted_version_ = snap.version;
+  }
+
   int seek_ = 0;
+  int posted_seek_ = -1;         // a seek posted, not yet in a snapshot
+  uint64_t posted_version_ = 0;  // the snapshot version when it was posted
+  bool slider_active_ = false;
+  float slider_rect_[4] = {0, 0, 0, 0};
   PipelineOptions edit_;
   LiveStatusSection live_;
 };

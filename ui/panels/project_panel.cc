@@ -22,14 +22,14 @@ class ProjectPanel : public Panel {
       ImGui::TextWrapped("%s%s", state.project.file_path.c_str(), state.dirty ? "  (unsaved)" : "");
       if (ImGui::Button("Save")) Report(state, state.Save());
       ImGui::SameLine();
-      ImGui::SetNextItemWidth(180);
+      FitNextItem("Save As");
       ImGui::InputTextWithHint("##saveas", "path for Save As", &save_as_);
       ImGui::SameLine();
       if (ImGui::Button("Save As") && !save_as_.empty()) Report(state, state.Save(save_as_));
     } else {
       ImGui::TextDisabled("no project open");
     }
-    ImGui::SetNextItemWidth(260);
+    FitNextItem("Open");
     ImGui::InputTextWithHint("##open", "project.json to open", &open_path_);
     ImGui::SameLine();
     if (ImGui::Button("Open") && !open_path_.empty()) RequestOpen(ui, open_path_);
@@ -45,7 +45,7 @@ class ProjectPanel : public Panel {
     ImGui::BeginDisabled(state.redo.empty());
     if (ImGui::Button("Redo")) UndoRedo(ui, false);
     ImGui::EndDisabled();
-    ImGui::SameLine();
+    SameLineIfFits(ImGui::CalcTextSize("(000 / 000 steps)").x);
     ImGui::TextDisabled("(%zu / %zu steps)", state.undo.size(), state.redo.size());
     ImGui::End();
   }

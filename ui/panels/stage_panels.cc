@@ -3,11 +3,31 @@
 // input frame and the painted buffers.
 #include <algorithm>
 
+#include "ui/core/image_view.h"
+#include "ui/core/natural_sort.h"
 #include "ui/core/panel.h"
 #include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
+
+// The image a stage panel shows first: a warped frame, else a painted buffer, else the
+// first name; among several, the largest (most pixels; ties: the first in natural order),
+// not a sliver of a buffer that happens to have the highest number.
+std::string DefaultImage(const std::map<std::string, cv::Mat>& images,
+                         const std::vector<std::string>& names) {
+  for (const char* prefix : {"warped", "painted"}) {
+    std::string best;
+    double best_area = -1;
+    for (const std::string& n : names) {
+      if (n.rfind(prefix, 0) != 0) continue;
+      const double area = static_cast<double>(images.at(n).total());
+      if (area > best_area) best = n, best_area = area;
+    }
+    if (!best.empty()) return best;
+  }
+  return names.front();
+}
 
 class StagePanel : public Panel {
  public:
@@ -35,32 +55,44 @@ class StagePanel : public Panel {
     ImGui::Text("frame %d: %.2f ms", snap.report.frame, stage->wall_ms);
     std::vector<std::string> names;
     for (const auto& [name, image] : stage->images) names.push_back(name);
+    SortNaturally(&names);
     if (!names.empty()) {
-      if (std::find(names.begin(), names.end(), selected_) == names.end()) {
-        // Prefer the warped frame, then the painted buffer, over masks.
-        selected_ = names.front();
-        for (const char* prefix : {"painted", "warped"})
-          for (const std::string& n : names)
-            if (n.rfind(prefix, 0) == 0) selected_ = n;
-      }
-      ImGui::SetNextItemWidth(200);
-      if (ImGui::BeginCombo("image", selected_.c_str())) {
+      if (std::find(names.begin(), names.end(), selected_) == names.end())
+        selected_ = DefaultImage(stage->images, names);
+      FitNextItem("image");
+      ImGui::SetNextItemWidth(std::min(200.0f, ImGui::CalcItemWidth()));
+      const bool open_combo = ImGui::BeginCombo("image", selected_.c_str());
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", selected_.c_str());
+      if (open_combo) {
         for (const std::string& n : names)
           if (ImGui::Selectable(n.c_str(), n == selected_)) selected_ = n;
         ImGui::EndCombo();
       }
-      ShowImage(ui, stage_ + "/" + selected_, stage->images.at(selected_), snap.version);
+      ColourScale scale;
+      const bool false_colour = FalseColourScaleOf(stage_, selected_, &scale);
+      view_.Draw(ui, stage_ + "/" + selected_, stage->images.at(selected_), snap.version,
+                 false_colour ? &scale : nullptr);
     } else {
       ImGui::TextDisabled("(debug images appear when paused or stepping)");
     }
-    for (const auto& [key, text] : stage->notes)
-      ImGui::TextWrapped("%s: %s", key.c_str(), text.c_str());
+    std::vector<std::string> note_keys;  // buffer2 before buffer19
+    for (const auto& [key, text] : stage->notes) note_keys.push_back(key);
+    SortNaturally(&note_keys);
+    for (const std::string& key : note_keys)
+      ImGui::TextWrapped("%s: %s", key.c_str(), stage->notes.at(key).c_str());
     ShowMetrics(stage->metrics);
     ImGui::End();
   }
 
+  std::map<std::string, std::string> Report() const override {
+    std::map<std::string, std::string> report{{"image", selected_}};
+    view_.ReportInto(&report);
+    return report;
+  }
+
  private:
   std::string stage_, title_, selected_;
+  ImageView view_;
 };
 
 class InputFramePanel : public Panel {
@@ -72,11 +104,19 @@ class InputFramePanel : public Panel {
       return;
     }
     const RunnerSnapshot& snap = *ui.snapshot;
-    ImGui::Text("frame %d %s%s", snap.frame, snap.frame_name.c_str(),
+    ImGui::Text("%s %s%s", FrameLabel(snap).c_str(), snap.frame_name.c_str(),
                 snap.has_pose ? "" : " (no pose)");
-    ShowImage(ui, "input", snap.frame_bgr, snap.version);
+    view_.Draw(ui, "input", snap.frame_bgr, snap.version);
     ImGui::End();
   }
+  std::map<std::string, std::string> Report() const override {
+    std::map<std::string, std::string> report;
+    view_.ReportInto(&report);
+    return report;
+  }
+
+ private:
+  ImageView view_;
 };
 
 class PaintedBuffersPanel : public Panel {
@@ -94,6 +134,15 @@ class PaintedBuffersPanel : public Panel {
       return;
     }
     const int n = static_cast<int>(snap.painted->size());
+    if (snap.geometry_version != shown_geometry_ && snap.geometry) {
+      // A new session: start on its largest buffer (most texels).
+      const auto& texels = snap.geometry->buffer_texels;
+      buffer_ =
+          texels.empty()
+              ? 0
+              : static_cast<int>(std::max_element(texels.begin(), texels.end()) - texels.begin());
+      shown_geometry_ = snap.geometry_version;
+    }
     buffer_ = std::clamp(buffer_, 0, n - 1);
     ImGui::SetNextItemWidth(120);
     ImGui::SliderInt("buffer", &buffer_, 0, n - 1);
@@ -102,13 +151,20 @@ class PaintedBuffersPanel : public Panel {
       ImGui::Text("%zu triangles, %d texels", snap.geometry->groups[buffer_].triangles.size(),
                   snap.geometry->buffer_texels[buffer_]);
     }
-    ShowImage(ui, "painted/" + std::to_string(buffer_), (*snap.painted)[buffer_],
-              snap.painted_version);
+    view_.Draw(ui, "painted/" + std::to_string(buffer_), (*snap.painted)[buffer_],
+               snap.painted_version);
     ImGui::End();
+  }
+  std::map<std::string, std::string> Report() const override {
+    std::map<std::string, std::string> report{{"buffer", std::to_string(buffer_)}};
+    view_.ReportInto(&report);
+    return report;
   }
 
  private:
   int buffer_ = 0;
+  uint64_t shown_geometry_ = 0;
+  ImageView view_;
 };
 
 }  // namespace

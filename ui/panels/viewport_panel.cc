@@ -4,6 +4,7 @@
 // (shift-click adds to the selection; ctrl-click selects its group) for the grouping editor.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "ui/core/panel.h"
 #include "ui/panels/panels.h"
@@ -43,23 +44,37 @@ class ViewportPanel : public Panel {
     }
     const ImTextureID image = ui.viewport->Render(*ui.snapshot, *ui.state, &view_, w, h);
     const ImVec2 origin = ImGui::GetCursorScreenPos();
+    const ImVec2 size(static_cast<float>(w), static_cast<float>(h));
+    // The view captures the mouse (an invisible button under the image): a drag orbits and
+    // never moves the window, and keeps orbiting when the cursor leaves the view.
+    ImGui::InvisibleButton("##view", size,
+                           ImGuiButtonFlags_MouseButtonLeft | ImGuiButtonFlags_MouseButtonRight |
+                               ImGuiButtonFlags_MouseButtonMiddle);
     // The offscreen image is bottom-up (OpenGL): flip it.
-    ImGui::Image(image, ImVec2(static_cast<float>(w), static_cast<float>(h)), ImVec2(0, 1),
-                 ImVec2(1, 0));
+    ImGui::GetWindowDrawList()->AddImage(
+        image, origin, ImVec2(origin.x + size.x, origin.y + size.y), ImVec2(0, 1), ImVec2(1, 0));
     HandleMouse(ui, origin, w, h);
     ImGui::End();
   }
 
+  std::map<std::string, std::string> Report() const override {
+    char text[64];
+    std::snprintf(text, sizeof(text), "%.2f %.2f %.4f", view_.yaw_deg, view_.pitch_deg,
+                  view_.distance_m);
+    return {{"yaw pitch distance", text}};
+  }
+
  private:
   void HandleMouse(UiContext& ui, ImVec2 origin, int w, int h) {
-    if (!ImGui::IsItemHovered()) return;
+    const bool active = ImGui::IsItemActive();
+    if (!ImGui::IsItemHovered() && !active) return;
     ImGuiIO& io = ImGui::GetIO();
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
+    if (active && ImGui::IsMouseDragging(ImGuiMouseButton_Left)) {
       view_.yaw_deg -= io.MouseDelta.x * 0.4f;
       view_.pitch_deg = std::clamp(view_.pitch_deg + io.MouseDelta.y * 0.4f, -89.0f, 89.0f);
     }
-    if (ImGui::IsMouseDragging(ImGuiMouseButton_Right) ||
-        ImGui::IsMouseDragging(ImGuiMouseButton_Middle)) {
+    if (active && (ImGui::IsMouseDragging(ImGuiMouseButton_Right) ||
+                   ImGui::IsMouseDragging(ImGuiMouseButton_Middle))) {
       // Pan in the view plane, by the distance so a texel-sized drag stays texel-sized.
       const float yaw = view_.yaw_deg * static_cast<float>(M_PI) / 180,
                   pitch = view_.pitch_deg * static_cast<float>(M_PI) / 180;
@@ -69,8 +84,9 @@ class ViewportPanel : public Panel {
       for (int k = 0; k < 3; ++k)
         view_.target[k] += (-io.MouseDelta.x * right[k] + io.MouseDelta.y * up[k]) * scale;
     }
-    if (io.MouseWheel != 0) view_.distance_m *= std::pow(0.9f, io.MouseWheel);
-    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && !dragged_) {
+    if (ImGui::IsItemHovered() && io.MouseWheel != 0)
+      view_.distance_m *= std::pow(0.9f, io.MouseWheel);
+    if (ImGui::IsItemHovered() && ImGui::IsMouseReleased(ImGuiMouseButton_Left) && !dragged_) {
       const int x = static_cast<int>(io.MousePos.x - origin.x);
       const int y = h - 1 - static_cast<int>(io.MousePos.y - origin.y);  // GL rows go up
       const int triangle = ui.viewport->Pick(x, y);

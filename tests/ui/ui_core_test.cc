@@ -1,0 +1,272 @@
+// The app's pure logic, no ImGui frame and no display: natural name order, stable group
+// colours, zoom and pan, window clamping, the input queue, pixel readouts, colour scales,
+// and the message when stored groups are split back apart.
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <imgui.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "tests/test_support.h"
+#include "ui/core/app_state.h"
+#include "ui/core/colour_scale.h"
+#include "ui/core/group_colour.h"
+#include "ui/core/image_view.h"
+#include "ui/core/input_queue.h"
+#include "ui/core/layout.h"
+#include "ui/core/layout_file.h"
+#include "ui/core/natural_sort.h"
+#include "ui/core/zoom_pan.h"
+
+namespace fresco {
+namespace {
+
+TEST(NaturalSort, NumbersCompareByValue) {
+  std::vector<std::string> names = {"warped_b19", "visible_b2", "warped_b2", "warped_b10",
+                                    "warped_b02", "depth",      "warped_b1"};
+  SortNaturally(&names);
+  EXPECT_EQ(names, (std::vector<std::string>{"depth", "visible_b2", "warped_b1", "warped_b2",
+                                             "warped_b02", "warped_b10", "warped_b19"}));
+  EXPECT_TRUE(NaturalLess("b2", "b19"));
+  EXPECT_FALSE(NaturalLess("b19", "b2"));
+  EXPECT_FALSE(NaturalLess("b2", "b2"));
+  EXPECT_TRUE(NaturalLess("b", "b0"));
+  EXPECT_TRUE(NaturalLess("frame9.png", "frame10.png"));
+  EXPECT_TRUE(NaturalLess("a99999999999999999999", "a100000000000000000000"));  // no overflow
+}
+
+TEST(GroupColour, KeyIsTheLowestTriangleAndColoursDiffer) {
+  EXPECT_EQ(StableGroupKey(GroupSpec{{7, 3, 9}}), 3);
+  EXPECT_EQ(StableGroupKey(GroupSpec{}), -1);
+  const auto a = GroupColour(3), b = GroupColour(4), a2 = GroupColour(3);
+  EXPECT_EQ(a, a2);
+  float diff = 0;
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_GE(a[c], 0.25f);
+    EXPECT_LE(a[c], 0.9f + 1e-6f);
+    diff += std::abs(a[c] - b[c]);
+  }
+  EXPECT_GT(diff, 0.05f) << "neighbouring keys should not look alike";
+  // A merge keeps the untouched groups' keys, and the merged group takes the lower one.
+  const std::vector<GroupSpec> before = {{{0, 1}}, {{2, 3}}, {{4, 5}}, {{6, 7}}};
+  std::vector<GroupSpec> merged;
+  ASSERT_TRUE(MergeGroups(before, 8, {1, 3}, &merged).ok());
+  std::vector<int> keys = StableGroupKeys(merged);
+  std::sort(keys.begin(), keys.end());
+  EXPECT_EQ(keys, (std::vector<int>{0, 2, 4}));
+}
+
+TEST(ZoomPan, ZoomKeepsThePointUnderTheCursorAndPanMoves) {
+  const ZoomPanView v{200, 100, 400, 200};  // fit: 0.5 view px per image px
+  ZoomPan zp;
+  EXPECT_FLOAT_EQ(zp.Scale(v.view_w, v.view_h, v.image_w, v.image_h), 0.5f);
+  int col = 0, row = 0;
+  ASSERT_TRUE(PixelUnder(zp, v, 50, 25, &col, &row));
+  EXPECT_EQ(col, 100);
+  EXPECT_EQ(row, 50);
+  float ix = 0, iy = 0, x = 0, y = 0;
+  ViewToImage(zp, v, 50, 25, &ix, &iy);
+  ZoomPan zoomed;
+  ZoomAbout(zp, v, 50, 25, 4.0f, &zoomed);
+  EXPECT_FLOAT_EQ(zoomed.zoom, 4.0f);
+  ImageToView(zoomed, v, ix, iy, &x, &y);
+  EXPECT_NEAR(x, 50, 1e-3);
+  EXPECT_NEAR(y, 25, 1e-3);
+  ASSERT_TRUE(PixelUnder(zoomed, v, 51, 25, &col, &row));  // one view px = 0.5 image px now
+  EXPECT_EQ(col, 100);
+  // A drag of 20 view pixels right shows what was 10 image pixels to the left.
+  ZoomPan panned;
+  PanBy(zoomed, v, 20, 0, &panned);
+  ViewToImage(panned, v, 70, 25, &x, &y);
+  EXPECT_NEAR(x, ix, 1e-3);
+  // Zooming out fully fits the image again; never beyond the limits.
+  ZoomPan out;
+  ZoomAbout(panned, v, 10, 10, 1e-3f, &out);
+  EXPECT_FLOAT_EQ(out.zoom, 1.0f);
+  EXPECT_LT(out.centre_x, 0);
+  ZoomAbout(zp, v, 10, 10, 1e6f, &out);
+  EXPECT_FLOAT_EQ(out.zoom, ZoomPan::kMaxZoom);
+  EXPECT_FALSE(PixelUnder(zp, v, 250, 25, &col, &row));  // right of the image
+}
+
+TEST(Layout, TitleBarStaysBelowTheMenuBarAndOnScreen) {
+  const LayoutBand band{1280, 800, 19, 24};
+  LayoutRect r = KeepTitleBarReachable({100, -40, 300, 200}, band, 19);
+  EXPECT_EQ(r.y, 19);
+  EXPECT_EQ(r.x, 100);
+  r = KeepTitleBarReachable({1270, 900, 300, 200}, band, 19);
+  EXPECT_EQ(r.y, 800 - 24 - 19);
+  EXPECT_EQ(r.x, 1280 - 48);
+  r = KeepTitleBarReachable({-500, 300, 300, 200}, band, 19);
+  EXPECT_EQ(r.x, 48 - 300);
+  const LayoutRect inside{10, 30, 300, 200};
+  r = KeepTitleBarReachable(inside, band, 19);
+  EXPECT_EQ(r.x, inside.x);
+  EXPECT_EQ(r.y, inside.y);
+}
+
+InputEvent Key(int code, bool down) {
+  InputEvent e;
+  e.kind = InputEvent::Kind::kKey;
+  e.code = code;
+  e.down = down;
+  return e;
+}
+InputEvent Button(bool down) {
+  InputEvent e;
+  e.kind = InputEvent::Kind::kMouseButton;
+  e.down = down;
+  return e;
+}
+InputEvent Move(float x, float y) {
+  InputEvent e;
+  e.kind = InputEvent::Kind::kMouseMove;
+  e.x = x, e.y = y;
+  return e;
+}
+
+TEST(InputQueue, ATapWithinOneFrameIsSeenOverTwoFrames) {
+  InputQueue queue;
+  InputState state;
+  queue.Push(Key(kKeyLeftControl, true));
+  queue.Push(Key('S', true));
+  queue.Push(Key('S', false));
+  queue.Push(Key(kKeyLeftControl, false));
+  EXPECT_EQ(queue.NextFrame(&state), 2);  // ctrl and S down; S's release waits
+  EXPECT_TRUE(state.keys_down['S']);
+  EXPECT_TRUE(state.keys_down[kKeyLeftControl]);
+  EXPECT_EQ(queue.NextFrame(&state), 2);
+  EXPECT_FALSE(state.keys_down['S']);
+  EXPECT_FALSE(state.keys_down[kKeyLeftControl]);
+  EXPECT_EQ(queue.pending(), 0u);
+  EXPECT_EQ(queue.NextFrame(&state), 0);
+}
+
+TEST(InputQueue, AFastDragIsPressMovesAndReleaseInFramesOfTheirOwn) {
+  InputQueue queue;
+  InputState state;
+  queue.Push(Move(10, 10));
+  queue.Push(Button(true));
+  queue.Push(Move(20, 10));
+  queue.Push(Move(30, 10));
+  queue.Push(Button(false));
+  InputEvent wheel;
+  wheel.kind = InputEvent::Kind::kWheel;
+  wheel.y = 1;
+  queue.Push(wheel);
+  queue.Push(wheel);
+  // Frame 1: moved to the press point; the press itself waits (a button after a move).
+  queue.NextFrame(&state);
+  EXPECT_EQ(state.mouse_x, 10);
+  EXPECT_FALSE(state.mouse_down[0]);
+  queue.NextFrame(&state);  // the press, where it happened
+  EXPECT_TRUE(state.mouse_down[0]);
+  EXPECT_EQ(state.mouse_x, 10);
+  queue.NextFrame(&state);  // the drag, still pressed
+  EXPECT_TRUE(state.mouse_down[0]);
+  EXPECT_EQ(state.mouse_x, 30);
+  queue.NextFrame(&state);  // the release, then the wheel in the same frame
+  EXPECT_FALSE(state.mouse_down[0]);
+  EXPECT_EQ(state.wheel_y, 2);
+  queue.NextFrame(&state);
+  EXPECT_EQ(state.wheel_y, 0);  // per frame
+  // Into ImGui: position, buttons, keys and modifiers.
+  ImGui::CreateContext();
+  state.keys_down[kKeyRightControl] = true;
+  state.mouse_down[1] = true;
+  CopyToImGui(state, &ImGui::GetIO());
+  EXPECT_TRUE(ImGui::GetIO().KeyCtrl);
+  EXPECT_FALSE(ImGui::GetIO().KeyShift);
+  EXPECT_TRUE(ImGui::GetIO().MouseDown[1]);
+  EXPECT_EQ(ImGui::GetIO().MousePos.x, 30);
+  ImGui::DestroyContext();
+}
+
+// Ctrl held for a click, all between two frames: the release (where ImGui's selectables
+// act) still sees ctrl, and ctrl's release comes a frame later.
+TEST(InputQueue, ACtrlClickWithinOneFrameKeepsCtrlForTheRelease) {
+  InputQueue queue;
+  InputState state;
+  queue.Push(Key(kKeyLeftControl, true));
+  queue.Push(Move(5, 5));
+  queue.Push(Button(true));
+  queue.Push(Button(false));
+  queue.Push(Key(kKeyLeftControl, false));
+  bool released_with_ctrl = false;
+  for (int frame = 0; frame < 8 && queue.pending() > 0; ++frame) {
+    const bool was_down = state.mouse_down[0];
+    queue.NextFrame(&state);
+    if (was_down && !state.mouse_down[0]) released_with_ctrl = state.keys_down[kKeyLeftControl];
+  }
+  EXPECT_EQ(queue.pending(), 0u);
+  EXPECT_TRUE(released_with_ctrl);
+  EXPECT_FALSE(state.keys_down[kKeyLeftControl]);
+  EXPECT_EQ(state.mouse_x, 5);
+}
+
+TEST(ImageView, PixelReadoutNamesPositionAndChannels) {
+  cv::Mat bgr(4, 5, CV_8UC3, cv::Scalar(10, 20, 30));
+  EXPECT_EQ(DescribePixel(bgr, 2, 3), "x 2 y 3: B 10 G 20 R 30");
+  cv::Mat grey(4, 5, CV_8UC1, cv::Scalar(7));
+  EXPECT_EQ(DescribePixel(grey, 0, 0), "x 0 y 0: 7");
+  cv::Mat depth(4, 5, CV_32FC1, cv::Scalar(2.5));
+  EXPECT_EQ(DescribePixel(depth, 4, 1), "x 4 y 1: 2.5");
+  EXPECT_EQ(DescribePixel(bgr, 5, 0), "");
+  EXPECT_EQ(DescribePixel(bgr, -1, 0), "");
+}
+
+TEST(ColourScale, FalseColouredImagesHaveAScale) {
+  ColourScale scale;
+  ASSERT_TRUE(FalseColourScaleOf("depth", "depth", &scale));
+  EXPECT_EQ(scale.colormap, cv::COLORMAP_VIRIDIS);
+  ASSERT_TRUE(FalseColourScaleOf("refine", "residual_before_b3", &scale));
+  EXPECT_EQ(scale.colormap, cv::COLORMAP_INFERNO);
+  EXPECT_FALSE(FalseColourScaleOf("warp", "warped_b3", &scale));
+  EXPECT_FALSE(FalseColourScaleOf("paint", "painted_b0", &scale));
+}
+
+TEST(GroupingSplitBack, SaysWhichStoredGroupWasSplitAndWhy) {
+  const std::vector<GroupSpec> stored = {{{0, 1, 2, 3}}, {{4, 5}}};
+  EXPECT_EQ(DescribeGroupsSplitBack(stored, stored, 6), "");
+  const std::vector<GroupSpec> built = {{{0, 1}}, {{4, 5}}, {{2, 3}}};
+  const std::string message = DescribeGroupsSplitBack(stored, built, 6);
+  EXPECT_NE(message.find("split back apart"), std::string::npos) << message;
+  EXPECT_NE(message.find("group 0"), std::string::npos) << message;
+  EXPECT_NE(message.find("became 2 buffers"), std::string::npos) << message;
+  EXPECT_NE(message.find("fold over"), std::string::npos) << message;
+}
+
+TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {
+  const std::string dir = testing::MakeTempDir("ui-layout");
+  SavedLayout saved;
+  std::vector<float> fractions = saved.layout.Fractions();
+  ASSERT_GE(fractions.size(), 10u);
+  fractions[0] = 0.31f;
+  fractions.back() = 0.66f;
+  saved.layout.SetFractions(fractions);
+  saved.font_scale = 1.5f;
+  ASSERT_TRUE(SaveLayoutFile(dir + "/cfg/layout.json", saved).ok());
+  SavedLayout loaded;
+  ASSERT_TRUE(LoadLayoutFile(dir + "/cfg/layout.json", &loaded).ok());
+  EXPECT_EQ(loaded.layout.Fractions(), fractions);
+  EXPECT_EQ(loaded.font_scale, 1.5f);
+  // No file: the defaults, no error.
+  SavedLayout fresh;
+  EXPECT_TRUE(LoadLayoutFile(dir + "/none.json", &fresh).ok());
+  EXPECT_EQ(fresh.layout.Fractions(), DefaultTileLayout().Fractions());
+  // Another arrangement's fractions are ignored; a damaged file is an error naming it.
+  std::ofstream(dir + "/other.json") << R"({"fractions": [0.5, 0.5], "font_scale": 1.25})";
+  ASSERT_TRUE(LoadLayoutFile(dir + "/other.json", &fresh).ok());
+  EXPECT_EQ(fresh.layout.Fractions(), DefaultTileLayout().Fractions());
+  EXPECT_EQ(fresh.font_scale, 1.25f);
+  std::ofstream(dir + "/bad.json") << "{\"fractions\": ";
+  const Status bad = LoadLayoutFile(dir + "/bad.json", &fresh);
+  EXPECT_FALSE(bad.ok());
+  EXPECT_NE(bad.message().find("bad.json"), std::string::npos) << bad.message();
+  std::ofstream(dir + "/scale.json") << R"({"fractions": [], "font_scale": 40})";
+  EXPECT_FALSE(LoadLayoutFile(dir + "/scale.json", &fresh).ok());
+}
+
+}  // namespace
+}  // namespace fresco

@@ -1,0 +1,443 @@
+// The app driven headless by mouse and key events, frame by frame, over a real painting
+// worker: orbiting the 3D view never moves its window, title bars stay below the menu bar,
+// debug images zoom and read pixels, group colours stay put across grouping edits, a
+// missing video is one error, the seek slider, step back and F5 keep the frame, and a key
+// tap or a drag shorter than a frame still arrives (input_queue.h).
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <imgui.h>
+#include <imgui_internal.h>
+
+#include "tests/test_support.h"
+#include "tests/ui/headless_ui.h"
+#include "ui/core/app_frame.h"
+#include "ui/core/calibration_runner.h"
+#include "ui/core/group_colour.h"
+#include "ui/core/image_view.h"
+#include "ui/core/input_queue.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::Capture;
+using testing::ImGuiHeadless;
+using testing::MakeTempDir;
+using testing::NullTextures;
+using testing::NullViewport;
+
+constexpr int kKeyF5 = 294, kKeyLeft = 263, kKeyRight = 262;  // GLFW's codes
+
+// The whole app headless on a copy of the capture, paused at `frame`.
+std::string CopyOfCapture() {
+  const std::string dir = MakeTempDir("ui-input");
+  fs::copy(Capture(), dir + "/capture", fs::copy_options::recursive);
+  return dir;
+}
+
+struct App : testing::HeadlessApp {
+  explicit App(int frame) : App(CopyOfCapture(), frame) {}
+  App(const std::string& copy, int frame) : HeadlessApp(copy + "/capture/project.json", frame) {
+    dir = copy;
+  }
+  void Tap(int key) {
+    input.keys_down[key] = true;
+    Frame();
+    input.keys_down[key] = false;
+    Frame();
+  }
+  Panel& Find(const std::string& title) {
+    for (auto& p : panels)
+      if (title == p->Title()) return *p;
+    ADD_FAILURE() << "no panel " << title;
+    return *panels.front();
+  }
+  std::string ReportOf(const std::string& title, const std::string& key) {
+    const auto report = Find(title).Report();
+    const auto it = report.find(key);
+    return it == report.end() ? "" : it->second;
+  }
+  std::string dir;
+};
+
+std::vector<float> Numbers(const std::string& text) {
+  std::istringstream in(text);
+  std::vector<float> v;
+  for (float x; in >> x;) v.push_back(x);
+  return v;
+}
+
+float Yaw(App& app) {
+  const auto v = Numbers(app.ReportOf("3D view", "yaw pitch distance"));
+  return v.empty() ? -1e9f : v[0];
+}
+
+// A point in the 3D view's image (below its two rows of controls).
+ImVec2 InsideThe3DView() {
+  ImGuiWindow* w = App::Window("3D view");
+  return ImVec2(w->Pos.x + 0.5f * w->Size.x, w->Pos.y + 0.7f * w->Size.y);
+}
+
+TEST(UiInput, DraggingThe3DViewOrbitsAndNeverMovesTheWindow) {
+  App app(3);
+  const ImVec2 pos = App::Window("3D view")->Pos;
+  const float yaw = Yaw(app);
+  const ImVec2 from = InsideThe3DView();
+  app.Drag(from, ImVec2(from.x + 60, from.y), 6);  // 10 px per frame
+  EXPECT_EQ(App::Window("3D view")->Pos.x, pos.x);
+  EXPECT_EQ(App::Window("3D view")->Pos.y, pos.y);
+  EXPECT_NEAR(Yaw(app), yaw - 0.4f * 60, 1e-3);  // 0.4 degrees per pixel
+  // Dragging on past the view's edge keeps orbiting (the view holds the mouse).
+  app.Drag(from, ImVec2(from.x, from.y - 400), 8);
+  EXPECT_EQ(App::Window("3D view")->Pos.y, pos.y);
+  EXPECT_NEAR(Yaw(app), yaw - 0.4f * 60, 1e-3);
+  const std::vector<float> view = Numbers(app.ReportOf("3D view", "yaw pitch distance"));
+  ASSERT_EQ(view.size(), 3u);
+  EXPECT_EQ(view[1], -89.0f);  // pitch, clamped
+}
+
+TEST(UiInput, TitleBarsStayBelowTheMenuBar) {
+  App app(0);
+  app.Find(kCalibrationPanelTitle).open = true;  // a floating panel
+  app.Frames(2);
+  ImGuiWindow* window = App::Window(kCalibrationPanelTitle);
+  const ImVec2 grab(window->Pos.x + 60, window->Pos.y + 5);  // on the title bar
+  app.Drag(grab, ImVec2(grab.x + 40, 0), 10);                // up past the menu bar
+  EXPECT_EQ(window->Pos.y, ImGui::GetFrameHeight()) << "the title bar went under the menu bar";
+  EXPECT_NEAR(window->Pos.x, grab.x + 40 - 60, 1e-3) << "sideways it follows the mouse";
+  // A floating panel moves by its title bar only: a drag on its content leaves it in place.
+  const ImVec2 floating = window->Pos;
+  const ImVec2 inside(floating.x + 20, floating.y + window->Size.y - 20);  // empty content
+  app.Drag(inside, ImVec2(inside.x + 80, inside.y - 60), 5);
+  EXPECT_EQ(window->Pos.x, floating.x);
+  EXPECT_EQ(window->Pos.y, floating.y);
+  app.Drag(ImVec2(window->Pos.x + 60, window->Pos.y + 5), ImVec2(5000, 5000), 10);
+  EXPECT_LE(window->Pos.y, 1000 - kStatusBarHeight - ImGui::GetFrameHeight());
+  EXPECT_LE(window->Pos.x, 1600 - 48);
+  // Tiled panels do not move at all: dragging a title bar leaves the tile where it was.
+  ImGuiWindow* view = App::Window("3D view");
+  const ImVec2 pos = view->Pos;
+  app.Drag(ImVec2(pos.x + 60, pos.y + 5), ImVec2(pos.x + 200, 0), 5);
+  EXPECT_EQ(view->Pos.x, pos.x);
+  EXPECT_EQ(view->Pos.y, pos.y);
+}
+
+TEST(UiInput, StageImageStartsOnTheLargestZoomsAndReadsPixels) {
+  App app(5);
+  const std::string title = "Stage: warp to buffer";
+  const auto snap = app.runner.Snapshot();
+  const StageReport* warp = snap->report.Stage("warp");
+  ASSERT_NE(warp, nullptr);
+  std::string largest;
+  size_t largest_area = 0;
+  int warped = 0;
+  for (const auto& [name, image] : warp->images)
+    if (name.rfind("warped", 0) == 0 && (++warped, image.total() > largest_area))
+      largest = name, largest_area = image.total();
+  ASSERT_GE(warped, 2) << "several buffers seen";
+  EXPECT_EQ(app.ReportOf(title, "image"), largest);
+  const cv::Mat& image = warp->images.at(largest);
+  const std::vector<float> view = Numbers(app.ReportOf(title, "view"));
+  ASSERT_EQ(view.size(), 4u);
+  EXPECT_NEAR(view[3] / view[2], static_cast<float>(image.rows) / image.cols, 0.02);
+  // The readout names the pixel under the cursor and its value.
+  // Whole pixels: ImGui floors the mouse position.
+  const float mx = std::floor(view[0] + 0.3f * view[2]), my = std::floor(view[1] + 0.6f * view[3]);
+  app.MouseTo(mx, my);
+  app.Frames(2);
+  ASSERT_EQ(Numbers(app.ReportOf(title, "view")), view) << "the view moved";
+  const int col = static_cast<int>((mx - view[0]) / view[2] * image.cols);
+  const int row = static_cast<int>((my - view[1]) / view[3] * image.rows);
+  EXPECT_EQ(app.ReportOf(title, "pixel"), DescribePixel(image, col, row));
+  EXPECT_EQ(app.ReportOf(title, "zoom"), "1.000");
+  // The wheel zooms about the cursor: the same pixel stays under it.
+  ImGui::GetIO().MouseWheel = 2;
+  app.Frame();
+  EXPECT_EQ(app.ReportOf(title, "zoom"), "1.562");
+  EXPECT_EQ(app.ReportOf(title, "pixel"), DescribePixel(image, col, row));
+  const ImVec2 window_pos = App::Window(title)->Pos;
+  // A drag pans (and does not move the window): another pixel comes under the cursor.
+  app.Drag(ImVec2(mx, my), ImVec2(mx - 40, my), 4);
+  EXPECT_EQ(App::Window(title)->Pos.x, window_pos.x);
+  app.MouseTo(mx, my);
+  app.Frame();
+  EXPECT_NE(app.ReportOf(title, "pixel"), DescribePixel(image, col, row));
+  EXPECT_FALSE(app.ReportOf(title, "pixel").empty());
+}
+
+TEST(UiInput, FalseColouredImagesShowTheirScale) {
+  App app(5);
+  EXPECT_FALSE(app.ReportOf("Stage: depth and visibility", "legend").empty())
+      << "the depth image is false-coloured";
+  EXPECT_TRUE(app.ReportOf("Stage: warp to buffer", "legend").empty());
+  EXPECT_NE(app.ReportOf("Misalignment", "legend").find("grey levels"), std::string::npos);
+}
+
+TEST(UiInput, PaintedBuffersStartOnTheLargestBuffer) {
+  App app(5);
+  const auto& texels = app.runner.Snapshot()->geometry->buffer_texels;
+  const int largest =
+      static_cast<int>(std::max_element(texels.begin(), texels.end()) - texels.begin());
+  EXPECT_EQ(app.ReportOf("Painted buffers", "buffer"), std::to_string(largest));
+}
+
+// Stored groups after a merge of groups `a` and `b`, applied as the Grouping panel does.
+void MergeAndApply(App& app, int a, int b) {
+  const auto geometry = app.runner.Snapshot()->geometry;
+  std::vector<GroupSpec> merged;
+  ASSERT_TRUE(MergeGroups(geometry->groups, static_cast<int>(geometry->buffer_of_triangle.size()),
+                          {a, b}, &merged)
+                  .ok());
+  app.state.BeginEdit();
+  app.state.project.grouping.groups = merged;
+  ApplyProject(app.ui);
+  app.runner.WaitIdle();
+  app.Frames(2);
+}
+
+std::set<std::string> Tokens(const std::string& text) {
+  std::istringstream in(text);
+  std::set<std::string> s;
+  for (std::string t; in >> t;) s.insert(t);
+  return s;
+}
+
+TEST(UiInput, GroupColoursStayAcrossEditsAndASplitBackIsExplained) {
+  App app(2);
+  const std::set<std::string> before = Tokens(app.ReportOf("Grouping", "colours"));
+  ASSERT_EQ(before.size(), 6u);  // the cube room's six walls
+  // Merge group 0 with each other wall until one merge holds (walls at right angles share
+  // a plane's projection) and one is split back (opposite walls fold over).
+  bool held = false, split = false;
+  for (int other = 1; other < 6 && !(held && split); ++other) {
+    app.state.Undo();  // back to the automatic groups
+    app.state.project.grouping.groups.clear();
+    ApplyProject(app.ui);
+    app.runner.WaitIdle();
+    app.Frames(1);
+    MergeAndApply(app, 0, other);
+    const std::set<std::string> after = Tokens(app.ReportOf("Grouping", "colours"));
+    const std::string message = app.ReportOf("Grouping", "split");
+    if (after.size() == 5u) {
+      held = true;
+      EXPECT_EQ(message, "");
+      // Four walls untouched: their colours are as before; the merged one keeps one colour.
+      int kept = 0;
+      for (const std::string& t : after) kept += before.count(t) > 0;
+      EXPECT_EQ(kept, 5) << app.ReportOf("Grouping", "colours");
+    } else {
+      split = true;
+      EXPECT_EQ(after, before) << "split back: every wall in its old colour";
+      EXPECT_NE(message.find("split back apart"), std::string::npos) << message;
+      EXPECT_NE(app.state.message.find("split back apart"), std::string::npos) << app.state.message;
+    }
+    EXPECT_EQ(app.runner.Snapshot()->frame, 2) << "the edit kept the frame";
+  }
+  EXPECT_TRUE(held);
+  EXPECT_TRUE(split);
+}
+
+TEST(UiInput, AMissingVideoIsOneErrorAndNotARecentProject) {
+  App app(0);
+  const std::string bad = app.dir + "/broken/project.json";
+  fs::copy(app.dir + "/capture", app.dir + "/broken", fs::copy_options::recursive);
+  fs::remove_all(app.dir + "/broken/frames");
+  AppState fresh;
+  const Status s = fresh.Open(bad);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("video"), std::string::npos) << s.message();
+  EXPECT_NE(s.message().find("frames"), std::string::npos) << s.message();
+  EXPECT_TRUE(fresh.recent.empty());
+  // Through the File menu's path: an error in the status bar, the open project unchanged.
+  const std::string before = app.state.project.file_path;
+  RequestOpen(app.ui, bad);
+  app.Frame();
+  EXPECT_EQ(app.state.message.rfind("error: ", 0), 0u) << app.state.message;
+  EXPECT_EQ(app.state.message.find("opened"), std::string::npos) << app.state.message;
+  EXPECT_EQ(app.state.project.file_path, before);
+  EXPECT_EQ(std::count(app.state.recent.begin(), app.state.recent.end(), bad), 0);
+}
+
+TEST(UiInput, AProjectTheWorkerCannotReadIsOneErrorAndLeavesTheRecentList) {
+  App app(0);
+  const std::string bad = app.dir + "/broken/project.json";
+  fs::copy(app.dir + "/capture", app.dir + "/broken", fs::copy_options::recursive);
+  {
+    std::ofstream poses(app.dir + "/broken/sparse/images.txt");
+    poses << "1 not a pose line\n";
+  }
+  RequestOpen(app.ui, bad);
+  app.Frame();  // opened: the files are there
+  EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message.rfind("error: ", 0), 0u) << app.state.message;
+  EXPECT_NE(app.state.message.find("images.txt"), std::string::npos) << app.state.message;
+  EXPECT_EQ(std::count(app.state.recent.begin(), app.state.recent.end(), bad), 0);
+  // A good project after it opens, stays in the list and says so.
+  RequestOpen(app.ui, app.dir + "/capture/project.json");
+  app.Frame();
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+  EXPECT_EQ(app.state.recent.front(), app.dir + "/capture/project.json");
+}
+
+TEST(UiInput, SeekSliderKeepsTheReleasedFrame) {
+  App app(9);
+  const std::vector<float> slider = Numbers(app.ReportOf("Pipeline", "seek slider"));
+  ASSERT_EQ(slider.size(), 4u);
+  ASSERT_GT(slider[2], 50);
+  const float y = slider[1] + 0.5f * slider[3];
+  // Press near the left end and drag to about a third of the way.
+  app.MouseTo(slider[0] + 4, y);
+  app.Frames(2);
+  app.input.mouse_down[0] = true;
+  app.Frame();
+  app.MouseTo(slider[0] + 0.3f * slider[2], y);
+  app.Frame();
+  const std::string dragged = app.ReportOf("Pipeline", "seek");
+  ASSERT_NE(dragged, "9");
+  app.input.mouse_down[0] = false;
+  app.Frame();
+  app.Frame();
+  EXPECT_EQ(app.ReportOf("Pipeline", "seek"), dragged) << "snapped back on release";
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(std::to_string(app.runner.Snapshot()->frame), dragged);
+  EXPECT_EQ(app.runner.Snapshot()->seek_target, -1);
+  EXPECT_EQ(app.ReportOf("Pipeline", "seek"), dragged);
+}
+
+TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
+  App app(5);
+  app.Tap(kKeyLeft);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 4);
+  app.Frame();
+  app.Tap(kKeyRight);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 5);
+  // F5 applies an edit and repaints up to the frame being looked at.
+  app.Frame();
+  const uint64_t geometry = app.runner.Snapshot()->geometry_version;
+  app.state.BeginEdit();
+  app.state.project.pipeline.update_every = 2;
+  app.Tap(kKeyF5);
+  app.runner.WaitIdle();
+  EXPECT_GT(app.runner.Snapshot()->geometry_version, geometry) << "F5 did not apply";
+  EXPECT_EQ(app.runner.Snapshot()->frame, 5);
+  // At the first frame too (frame 0 is a frame to come back to, not "nothing painted").
+  app.runner.Seek(0);
+  app.runner.WaitIdle();
+  app.Frame();
+  app.Tap(kKeyF5);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 0);
+}
+
+// Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
+// where the seek goes and how far it got, never a bare "frame -1".
+TEST(UiInput, SeekingBackPublishesItsProgress) {
+  struct Seen {
+    int seek_target, frame;
+    std::string status;
+  };
+  std::mutex mutex;
+  std::vector<Seen> seen;
+  RunnerOptions options;
+  options.publish_interval_ms = 0;  // publish after every frame painted
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.push_back({s.seek_target, s.frame, s.status});
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  PipelineRunner runner(options);
+  runner.Restart(state.project);
+  runner.Seek(9);
+  runner.WaitIdle();
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    seen.clear();
+  }
+  runner.Seek(6);
+  runner.WaitIdle();
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_GE(seen.size(), 3u);
+  EXPECT_EQ(seen.front().seek_target, 6) << "the seek is announced first";
+  EXPECT_EQ(seen.front().frame, -1);
+  EXPECT_EQ(seen.front().status, "seeking");
+  int last_frame = -1;
+  for (size_t i = 0; i + 1 < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].seek_target, 6) << i;
+    EXPECT_EQ(seen[i].status.rfind("seeking", 0), 0u) << i << ": " << seen[i].status;
+    EXPECT_GE(seen[i].frame, last_frame) << i;
+    last_frame = seen[i].frame;
+  }
+  EXPECT_GE(seen.size(), 6u) << "progress while frames 0..5 are repainted";
+  EXPECT_EQ(seen.back().seek_target, -1);
+  EXPECT_EQ(seen.back().frame, 6);
+  EXPECT_EQ(seen.back().status, "paused");
+}
+
+TEST(UiInput, SeekProgressIsNamedNotFrameMinusOne) {
+  RunnerSnapshot snap;
+  snap.seek_target = 40;
+  EXPECT_EQ(FrameLabel(snap), "seeking to frame 40: reopening");
+  snap.frame = 17;
+  EXPECT_EQ(FrameLabel(snap), "seeking to frame 40: at 17");
+  snap.seek_target = -1;
+  EXPECT_EQ(FrameLabel(snap), "frame 17");
+  snap.frame = -1;
+  EXPECT_EQ(FrameLabel(snap), "no frame painted yet");
+}
+
+TEST(UiInput, AKeyTapWithinOneFrameIsStillSeen) {
+  App app(1);
+  app.state.BeginEdit();  // something to save
+  app.state.project.pipeline.update_every = 3;
+  ASSERT_TRUE(app.state.dirty);
+  // Ctrl+S pressed and released between two frames.
+  InputQueue queue;
+  for (auto [key, down] :
+       {std::pair{kKeyLeftControl, true}, {'S', true}, {'S', false}, {kKeyLeftControl, false}}) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kKey;
+    e.code = key;
+    e.down = down;
+    queue.Push(e);
+  }
+  app.Drain(&queue);
+  EXPECT_FALSE(app.state.dirty) << "Ctrl+S was lost";
+  EXPECT_EQ(app.state.message.rfind("saved ", 0), 0u) << app.state.message;
+}
+
+TEST(UiInput, ADragWithinOneFrameStillOrbits) {
+  App app(1);
+  const float yaw = Yaw(app);
+  const ImVec2 p = InsideThe3DView();
+  InputQueue queue;
+  auto push = [&](InputEvent::Kind kind, float x, float y, bool down) {
+    InputEvent e;
+    e.kind = kind;
+    e.x = x, e.y = y, e.down = down;
+    queue.Push(e);
+  };
+  push(InputEvent::Kind::kMouseMove, p.x, p.y, false);
+  push(InputEvent::Kind::kMouseButton, 0, 0, true);
+  for (int s = 1; s <= 5; ++s) push(InputEvent::Kind::kMouseMove, p.x + 10 * s, p.y, false);
+  push(InputEvent::Kind::kMouseButton, 0, 0, false);
+  app.Drain(&queue);
+  EXPECT_NEAR(Yaw(app), yaw - 0.4f * 50, 1e-3) << "the drag was lost";
+}
+
+}  // namespace
+}  // namespace fresco

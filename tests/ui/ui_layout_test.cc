@@ -1,0 +1,154 @@
+// The app's tiled layout driven headless: the 3D view is the largest panel by default, at
+// 1600 x 1000 and at 1280 x 800 every tile is wide enough; a splitter drag resizes both
+// neighbours; a double-click on a title bar maximises a panel and another restores the
+// layout; closing a panel gives its space to its neighbour; the font scale applies.
+#include <gtest/gtest.h>
+#include <imgui.h>
+#include <imgui_internal.h>
+
+#include "tests/ui/headless_ui.h"
+#include "ui/core/calibration_runner.h"
+#include "ui/core/tile_layout.h"
+#include "ui/panels/panels.h"
+
+namespace fresco {
+namespace {
+
+using testing::Capture;
+
+struct LayoutApp : testing::HeadlessApp {
+  explicit LayoutApp(ImVec2 display) : HeadlessApp(Capture() + "/project.json", 2, display) {}
+  static bool Shown(const char* title) {
+    ImGuiWindow* w = ImGui::FindWindowByName(title);
+    return w && w->Active;
+  }
+};
+
+TEST(UiLayout, EveryTiledPanelExistsAndTheLayoutCoversTheBand) {
+  const TileLayout layout = DefaultTileLayout();
+  auto panels = MakePanels();
+  int tiled = 0;
+  for (const auto& p : panels) tiled += layout.Contains(p->Title());
+  EXPECT_EQ(tiled, static_cast<int>(panels.size()) - 2);  // all but Calibration and Poses
+  std::vector<TileLayout::Tile> tiles;
+  std::vector<TileLayout::Splitter> splitters;
+  layout.Compute(
+      {0, 20, 1600, 956}, 5, [](const std::string&) { return true; }, &tiles, &splitters);
+  EXPECT_EQ(tiles.size(), static_cast<size_t>(tiled));
+  EXPECT_EQ(splitters.size(), tiles.size() - 1);
+  double area = 0;
+  for (const auto& t : tiles) area += t.rect.w * t.rect.h;
+  for (const auto& s : splitters) area += s.rect.w * s.rect.h;
+  EXPECT_NEAR(area, 1600.0 * 956, 1600.0 * 956 * 0.005) << "tiles and bars fill the band";
+}
+
+void ExpectUsable(ImVec2 display) {
+  LayoutApp app(display);
+  float view_area = 0, largest_other = 0;
+  for (const auto& p : app.panels) {
+    if (!p->open) continue;
+    ImGuiWindow* w = LayoutApp::Window(p->Title());
+    ASSERT_NE(w, nullptr) << p->Title();
+    EXPECT_GE(w->Size.x, 150) << p->Title() << " at " << display.x << "x" << display.y;
+    EXPECT_GE(w->Size.y, 120) << p->Title() << " at " << display.x << "x" << display.y;
+    EXPECT_GE(w->Pos.y, ImGui::GetFrameHeight()) << p->Title();
+    EXPECT_LE(w->Pos.x + w->Size.x, display.x + 0.5f) << p->Title();
+    EXPECT_LE(w->Pos.y + w->Size.y, display.y - kStatusBarHeight + 0.5f) << p->Title();
+    const float area = w->Size.x * w->Size.y;
+    if (std::string(p->Title()) == "3D view")
+      view_area = area;
+    else
+      largest_other = std::max(largest_other, area);
+  }
+  EXPECT_GT(view_area, 1.5f * largest_other) << "the 3D view is the large one";
+  EXPECT_GT(view_area, 0.15f * display.x * display.y);
+  // Nothing is clipped at the right edge (ImGui would need to scroll sideways).
+  for (const auto& p : app.panels) {
+    if (p->open) {
+      EXPECT_EQ(LayoutApp::Window(p->Title())->ScrollMax.x, 0) << p->Title();
+    }
+  }
+}
+
+TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1600x1000) { ExpectUsable({1600, 1000}); }
+TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1280x800) { ExpectUsable({1280, 800}); }
+
+TEST(UiLayout, DraggingASplitterResizesBothNeighbours) {
+  LayoutApp app({1600, 1000});
+  ImGuiWindow* view = LayoutApp::Window("3D view");
+  ImGuiWindow* input = LayoutApp::Window("Input frame");
+  const float view_w = view->Size.x, input_w = input->Size.x;
+  const float bar_x = 0.5f * (view->Pos.x + view->Size.x + input->Pos.x);
+  const float y = view->Pos.y + 0.5f * view->Size.y;
+  app.input.mouse_x = bar_x, app.input.mouse_y = y;
+  app.Frames(2);
+  app.input.mouse_down[0] = true;
+  app.Frames(1);
+  for (int s = 1; s <= 5; ++s) {
+    app.input.mouse_x = bar_x + 20 * s;
+    app.Frames(1);
+  }
+  app.input.mouse_down[0] = false;
+  app.Frames(2);
+  EXPECT_NEAR(view->Size.x, view_w + 100, 1.5f);
+  EXPECT_NEAR(input->Size.x, input_w - 100, 1.5f);
+  EXPECT_NEAR(input->Pos.x, view->Pos.x + view->Size.x + 5, 1.5f);
+  // A splitter stops before a side gets too narrow.
+  app.input.mouse_x = view->Pos.x + view->Size.x + 2.5f;
+  app.Frames(1);
+  app.input.mouse_down[0] = true;
+  app.Frames(1);
+  app.input.mouse_x += 2000;
+  app.Frames(1);
+  app.input.mouse_down[0] = false;
+  app.Frames(2);
+  EXPECT_GE(input->Size.x, 115);
+}
+
+TEST(UiLayout, DoubleClickOnATitleBarMaximisesAndRestores) {
+  LayoutApp app({1600, 1000});
+  ImGuiWindow* warp = LayoutApp::Window("Stage: warp to buffer");
+  const ImVec2 pos = warp->Pos, size = warp->Size;
+  const ImVec2 title(pos.x + 30, pos.y + 4);
+  app.Click(title);
+  app.Click(title);  // the second click within the double-click time
+  app.Frames(1);
+  EXPECT_EQ(app.ui.layout.maximised(), "Stage: warp to buffer");
+  EXPECT_EQ(warp->Pos.x, 0);
+  EXPECT_EQ(warp->Size.x, 1600);
+  EXPECT_FALSE(LayoutApp::Shown("3D view")) << "hidden behind the maximised panel";
+  EXPECT_FALSE(LayoutApp::Shown("Pipeline"));
+  app.Click(ImVec2(30, warp->Pos.y + 4));
+  app.Click(ImVec2(30, warp->Pos.y + 4));
+  app.Frames(1);
+  EXPECT_EQ(app.ui.layout.maximised(), "");
+  EXPECT_EQ(warp->Pos.x, pos.x);
+  EXPECT_EQ(warp->Size.x, size.x);
+  EXPECT_EQ(warp->Size.y, size.y);
+  EXPECT_TRUE(LayoutApp::Shown("3D view"));
+}
+
+TEST(UiLayout, AClosedPanelGivesItsSpaceToItsNeighbour) {
+  LayoutApp app({1600, 1000});
+  ImGuiWindow* view = LayoutApp::Window("3D view");
+  const float view_w = view->Size.x;
+  for (auto& p : app.panels)
+    if (std::string(p->Title()) == "Input frame" || std::string(p->Title()) == "Painted buffers")
+      p->open = false;
+  app.Frames(2);
+  EXPECT_GT(view->Size.x, view_w * 1.4f);
+}
+
+TEST(UiLayout, FontScaleScalesTheText) {
+  LayoutApp app({1280, 800});
+  const float height = ImGui::GetFrameHeight();
+  ImGui::GetIO().FontGlobalScale = 1.5f;
+  app.Frames(2);
+  EXPECT_NEAR(ImGui::GetFrameHeight() - 2 * ImGui::GetStyle().FramePadding.y,
+              1.5f * (height - 2 * ImGui::GetStyle().FramePadding.y), 0.5f);
+  EXPECT_GE(LayoutApp::Window("Project")->Pos.y, ImGui::GetFrameHeight())
+      << "tiles start below the taller menu bar";
+}
+
+}  // namespace
+}  // namespace fresco
