@@ -7,6 +7,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/run/frame_policy.h"
+
 namespace fresco {
 
 const std::vector<Command>& AllCommands() {
@@ -33,18 +35,6 @@ static void PrintMainUsage(std::ostream& out) {
   }
 }
 
-namespace {
-
-// What a user can do when the machine runs out of memory (outputs are all or nothing, so
-// nothing was half-written).
-std::string OutOfMemoryMessage(const std::string& verb) {
-  return "fresco " + verb +
-         ": out of memory (files already there are left as they were); fewer texels (a larger pipeline.texel_size_m "
-         "or a smaller pipeline.max_buffer_texels) or fewer charts (a larger "
-         "grouping.min_chart_texels) need less";
-}
-
-}  // namespace
 
 int Dispatch(const std::vector<std::string>& argv) {
   if (argv.empty()) {
@@ -65,11 +55,11 @@ int Dispatch(const std::vector<std::string>& argv) {
     try {
       return c.run(CommandArgs(argv.begin() + 1, argv.end()));
     } catch (const std::bad_alloc&) {
-      std::cerr << OutOfMemoryMessage(verb) << "\n";
+      std::cerr << "fresco " << verb << ": " << OutOfMemoryMessage() << "\n";
       return kExitFailure;
     } catch (const cv::Exception& e) {
       if (e.code == cv::Error::StsNoMem) {
-        std::cerr << OutOfMemoryMessage(verb) << "\n";
+        std::cerr << "fresco " << verb << ": " << OutOfMemoryMessage() << "\n";
         return kExitFailure;
       }
       std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";

@@ -18,4 +18,10 @@ Status ApplyFramePolicy(const SourcedFrame& frame, const FrameOrigin& origin, Fr
   return Status::Ok();
 }
 
+std::string OutOfMemoryMessage() {
+  return "out of memory (files already there are left as they were); fewer texels (a larger "
+         "pipeline.texel_size_m or a smaller pipeline.max_buffer_texels) or fewer charts (a "
+         "larger grouping.min_chart_texels) need less";
+}
+
 }  // namespace fresco

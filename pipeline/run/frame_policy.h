@@ -8,8 +8,11 @@
 //                             the file (PosedFrameSource::Next)
 //
 // Bad input ends the run with that one-line message; the CLI exits 2 with it, the app shows
-// it as its status ("error: ...").
+// it as its status ("error: ..."). Running out of memory ends it too (exit 1 in the CLI; the
+// app's worker drops the session): OutOfMemoryMessage() says what needs less.
 #pragma once
+
+#include <string>
 
 #include "pipeline/core/status.h"
 #include "pipeline/run/posed_frame_source.h"
@@ -24,5 +27,9 @@ enum class FrameFate {
 
 // kPaint or kNoPose, or an error naming `origin`'s file and the frame.
 Status ApplyFramePolicy(const SourcedFrame& frame, const FrameOrigin& origin, FrameFate* fate);
+
+// "out of memory (...); fewer texels (...) or fewer charts (...) need less": the same words
+// from the CLI and the app.
+std::string OutOfMemoryMessage();
 
 }  // namespace fresco

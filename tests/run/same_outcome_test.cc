@@ -2,6 +2,10 @@
 // headless) are thin clients of one painting job, so on the same bad capture they come to
 // the same outcome: the same one-line error (exit 2 for the CLI, "error: ..." as the app's
 // status), or the same counts of frames read, painted and without a pose.
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -18,6 +22,8 @@ using testing::CommandResult;
 using testing::MakeTempDir;
 using testing::ReadText;
 using testing::RunFresco;
+using testing::StartFresco;
+using testing::WaitFresco;
 
 struct Outcome {
   std::string error;  // the one-line message without "error: "; "" when the run finished
@@ -143,6 +149,49 @@ INSTANTIATE_TEST_SUITE_P(BadCaptures, SameOutcomeTest,
                              c = isalnum(static_cast<unsigned char>(c)) ? c : '_';
                            return name;
                          });
+
+// Out of memory (0.5 mm texels on the room: several GB, in a 700 MB address space): the CLI
+// exits 1 with "fresco run: MESSAGE", the app's worker shows "error: MESSAGE" as its status
+// and stays up; the same message.
+TEST(SameOutcome, OutOfMemoryIsOneMessageFromTheCliAndTheApp) {
+  const std::string project = testing::GoodCaptureDir() + "/project.json";
+  const std::vector<std::string> overrides = {"pipeline.texel_size_m=0.0005",
+                                              "pipeline.max_buffer_texels=2000000000"};
+  constexpr long long kLimit = 700LL << 20;
+  std::vector<std::string> args = {"run", project, "--out", MakeTempDir("oom-run") + "/out",
+                                   "--quiet"};
+  for (const std::string& o : overrides) args.insert(args.end(), {"--set", o});
+  const CommandResult cli = WaitFresco(StartFresco(args, kLimit));
+  EXPECT_EQ(cli.exit_code, 1) << cli.err;
+  const std::string prefix = "fresco run: ";
+  ASSERT_EQ(cli.err.rfind(prefix, 0), 0u) << cli.err;
+  const std::string message = cli.err.substr(prefix.size(), cli.err.find('\n') - prefix.size());
+  EXPECT_NE(message.find("out of memory"), std::string::npos) << message;
+
+  // The app's worker in a child process under the same limit; the status comes back in a file.
+  const std::string status_file = MakeTempDir("oom-app") + "/status";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const rlimit limit{static_cast<rlim_t>(kLimit), static_cast<rlim_t>(kLimit)};
+    setrlimit(RLIMIT_AS, &limit);
+    Project p;
+    if (!LoadProject(project, overrides, &p).ok()) _exit(3);
+    RunnerOptions options;
+    options.misalignment = false;
+    options.debug_images = false;
+    PipelineRunner runner(options);
+    runner.Restart(p);
+    runner.Play();
+    runner.WaitIdle();
+    testing::WriteText(status_file, runner.Snapshot()->status);
+    _exit(0);
+  }
+  int wstatus = 0;
+  ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
+  ASSERT_TRUE(WIFEXITED(wstatus)) << "the app's worker ended by signal " << WTERMSIG(wstatus);
+  ASSERT_EQ(WEXITSTATUS(wstatus), 0);
+  EXPECT_EQ(ReadText(status_file), "error: " + message);
+}
 
 }  // namespace
 }  // namespace fresco

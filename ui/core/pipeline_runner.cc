@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <new>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -13,6 +16,7 @@
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/render/renderer.h"
 #include "pipeline/run/file_frame_source.h"
+#include "pipeline/run/frame_policy.h"
 #include "ui/core/live_session_source.h"
 
 namespace fresco {
@@ -282,6 +286,30 @@ void PipelineRunner::Publish(bool with_painted) {
 }
 
 void PipelineRunner::Loop() {
+  // An exception (out of memory on a large mesh) ends the session, not the app: the worker
+  // says why in the status, as for bad input, and serves on.
+  for (;;) {
+    std::string failure;
+    try {
+      Serve();
+      return;
+    } catch (const std::bad_alloc&) {
+      failure = OutOfMemoryMessage();
+    } catch (const cv::Exception& e) {
+      failure = e.code == cv::Error::StsNoMem ? OutOfMemoryMessage()
+                                              : std::string("internal error: ") + e.what();
+    } catch (const std::exception& e) {
+      failure = std::string("internal error: ") + e.what();
+    }
+    session_.reset();
+    playing_ = false;
+    seek_target_ = -1;
+    working_.status = "error: " + failure;
+    Publish(true);
+  }
+}
+
+void PipelineRunner::Serve() {
   auto last_publish = Clock::now();
   for (;;) {
     Command command{Command::kPause, {}, -1, {}};

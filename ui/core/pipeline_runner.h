@@ -133,7 +133,8 @@ class PipelineRunner {
   enum class Painted { kFrame, kWaiting, kEnded };
   struct Session;
   void Post(Command command);
-  void Loop();
+  void Loop();   // Serve(), and after an exception the error as the status
+  void Serve();  // commands and painting until kQuit
   // kWaiting: a live source has no frame yet; kEnded: the end of the video, or an error.
   Painted PaintNext(bool show);
   void OpenSession(const Project& project);

@@ -32,7 +32,11 @@ class ViewportPanel : public Panel {
     ImGui::SameLine();
     ImGui::Checkbox("frustum", &view_.show_frustum);
     ImGui::SameLine();
-    if (ImGui::SmallButton("reset view")) view_ = ViewportView{view_.mode};
+    if (ImGui::SmallButton("reset view")) {
+      const ViewportView::Mode mode = view_.mode;
+      view_ = ViewportView();
+      view_.mode = mode;
+    }
 
     const ImVec2 avail = ImGui::GetContentRegionAvail();
     const int w = std::max(16, static_cast<int>(avail.x)),
