@@ -248,6 +248,20 @@ __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
 template <bool kDistorted, SamplingMode kMode, bool kDepth, bool kPaint>
 void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Counts* counts) {
   const KernelContext k = context;
+  // The tile's rows of what pass 2 writes (16 rows, a cache line or two each): fetched while
+  // pass 1 projects, they are in cache when the scattered-by-row writes come.
+  const size_t width = static_cast<size_t>(k.buffer->width);
+  for (int y = chunk.y0; y < chunk.y1; ++y) {
+    const size_t row = static_cast<size_t>(y) * width + static_cast<size_t>(chunk.x0);
+    if constexpr (kPaint) {
+      __builtin_prefetch(k.paint_bgra + 4 * row, 1);
+      __builtin_prefetch(k.paint_quality + row, 1);
+    } else {
+      __builtin_prefetch(k.out_bgr + 3 * row, 1);
+      __builtin_prefetch(k.out_valid + row, 1);
+      __builtin_prefetch(k.out_quality + row, 1);
+    }
+  }
   ChunkProjection proj;
   const int n = chunk.end - chunk.begin;
   if constexpr (kDistorted)
@@ -267,6 +281,9 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     return reinterpret_cast<const float*>(depth + y * depth_step)[x];
   };
   int in_view = 0, visible = 0, occluded = 0, grazing = 0;
+  // A local (the counts behind a pointer could alias the byte writes: every texel would
+  // reload and store the sums).
+  PaintUpdateStats paint_stats;
   for (int i = 0; i < n; ++i) {
     const int code = proj.code[i];
     if (code != 2) {
@@ -322,7 +339,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     if constexpr (kPaint) {
       UpdateTexel(k.rule, sample, proj.quality[i], on_surface[i] != 0,
                   k.paint_bgra + 4 * static_cast<size_t>(idx), k.paint_quality + idx,
-                  &counts->paint);
+                  &paint_stats);
     } else {
       uint8_t* out = k.out_bgr + 3 * static_cast<size_t>(idx);
       out[0] = sample[0], out[1] = sample[1], out[2] = sample[2];
@@ -332,6 +349,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
   }
   counts->in_view += in_view, counts->visible += visible;
   counts->occluded += occluded, counts->grazing += grazing;
+  if constexpr (kPaint) counts->paint.Add(paint_stats);
 }
 
 using ChunkKernel = void (*)(const KernelContext&, const BaseBuffer::Chunk&, Counts*);

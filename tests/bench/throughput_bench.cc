@@ -1,11 +1,14 @@
 // End-to-end painting throughput against the memory-bound floor: texels x frames per second
 // of the painting loop (depth test, project, sample, update; background and refinement off)
 // against OpenCV's cv::remap doing only the bilinear gather of the same buffers' texels from
-// the same frames (maps precomputed, not timed), both on 2 threads, on a 640x480 street walk
-// with OpenCV5 distortion (`fresco synth` builtin:street, 30 frames):
-//   BM_PaintStreet   items/s = surface texels x frames / painting seconds
-//   BM_RemapStreet   items/s = the same texels x frames / remap seconds (the remap gathers
-//                    only the texels each frame sees: the painting culls the rest too)
+// the same frames (maps precomputed, not timed), both on 2 threads, on 30-frame 640x480
+// captures: a street walk with OpenCV5 distortion (`fresco synth` builtin:street, the
+// reference) and, for the spread, a hand-held turn in the room (pinhole) and an orbit of the
+// blocks (OpenCV8):
+//   BM_Paint/<capture>   items/s = surface texels x frames / painting seconds
+//   BM_Remap/<capture>   items/s = the same texels x frames / remap seconds (the remap
+//                        gathers only the texels each frame sees: the painting culls the
+//                        rest too)
 //   build/tests/throughput_bench --benchmark_min_time=2
 #include <benchmark/benchmark.h>
 
@@ -22,16 +25,25 @@
 namespace fresco {
 namespace {
 
-struct Street {
+// The captures, by the benchmarks' argument.
+constexpr const char* kCaptureSpecs[] = {
+    R"({"scene": "builtin:street", "frames": 30, "size": [640, 480], "lens": "opencv5",
+        "seed": 3})",
+    R"({"scene": "builtin:cube-room", "frames": 30, "size": [640, 480], "lens": "pinhole",
+        "seed": 3})",
+    R"({"scene": "builtin:blocks", "frames": 30, "size": [640, 480], "lens": "opencv8",
+        "seed": 3})"};
+constexpr const char* kCaptureNames[] = {"street_opencv5", "room_pinhole", "blocks_opencv8"};
+
+struct Capture {
   SynthJob job;
   SynthCapture capture;
   PipelineOptions pipeline;
   bool ok = false;
 
-  Street() {
+  explicit Capture(int which) {
     SynthSpecInput input;
-    input.text = R"({"scene": "builtin:street", "frames": 30, "size": [640, 480],
-                     "lens": "opencv5", "seed": 3})";
+    input.text = kCaptureSpecs[which];
     if (!BuildSynthJob(input, &job).ok()) return;
     if (!SynthesizeCapture(job.scene, job.options, &capture).ok()) return;
     pipeline.background.mode = BackgroundMode::kOff;
@@ -50,14 +62,16 @@ struct Street {
   }
 };
 
-const Street& TheStreet() {
-  static const Street* street = new Street();
-  return *street;
+const Capture& TheCapture(int which) {
+  static const Capture* captures[3] = {nullptr, nullptr, nullptr};
+  if (!captures[which]) captures[which] = new Capture(which);
+  return *captures[which];
 }
 
-void BM_PaintStreet(benchmark::State& state) {
-  const Street& street = TheStreet();
-  if (!street.ok) return state.SkipWithError("synth failed");
+void BM_Paint(benchmark::State& state) {
+  const Capture& c = TheCapture(static_cast<int>(state.range(0)));
+  state.SetLabel(kCaptureNames[state.range(0)]);
+  if (!c.ok) return state.SkipWithError("synth failed");
   cv::setNumThreads(2);
   long long texels = 0;
   std::map<std::string, double> stage_ms;  // summed over every painted frame
@@ -65,15 +79,15 @@ void BM_PaintStreet(benchmark::State& state) {
   double tested = 0, in_view = 0;  // texels per frame: projected (chunks not culled), in view
   for (auto _ : state) {
     state.PauseTiming();
-    std::unique_ptr<PaintSession> session = street.Session();
+    std::unique_ptr<PaintSession> session = c.Session();
     texels = session->NumSurfaceTexels();
     state.ResumeTiming();
     FrameReport report;
-    for (size_t i = 0; i < street.capture.frames_bgr.size(); ++i) {
+    for (size_t i = 0; i < c.capture.frames_bgr.size(); ++i) {
       Frame frame;
       frame.index = static_cast<int>(i);
-      frame.bgr = street.capture.frames_bgr[i];
-      session->PaintFrame(frame, street.capture.camera, street.capture.true_poses[i].cam_from_world,
+      frame.bgr = c.capture.frames_bgr[i];
+      session->PaintFrame(frame, c.capture.camera, c.capture.true_poses[i].cam_from_world,
                           &report);
       for (const StageReport& stage : report.stages) stage_ms[stage.name] += stage.wall_ms;
       const StageReport* warp = report.Stage("warp");
@@ -86,24 +100,25 @@ void BM_PaintStreet(benchmark::State& state) {
   state.counters["texels_tested_per_frame"] = tested / frames;
   state.counters["texels_in_view_per_frame"] = in_view / frames;
   state.SetItemsProcessed(state.iterations() * texels *
-                          static_cast<long long>(street.capture.frames_bgr.size()));
+                          static_cast<long long>(c.capture.frames_bgr.size()));
   state.counters["texels"] = static_cast<double>(texels);
 }
 
-void BM_RemapStreet(benchmark::State& state) {
-  const Street& street = TheStreet();
-  if (!street.ok) return state.SkipWithError("synth failed");
+void BM_Remap(benchmark::State& state) {
+  const Capture& c = TheCapture(static_cast<int>(state.range(0)));
+  state.SetLabel(kCaptureNames[state.range(0)]);
+  if (!c.ok) return state.SkipWithError("synth failed");
   cv::setNumThreads(2);
-  const std::unique_ptr<PaintSession> session = street.Session();
-  const Camera& camera = street.capture.camera;
+  const std::unique_ptr<PaintSession> session = c.Session();
+  const Camera& camera = c.capture.camera;
   // Per frame: where each texel of every buffer that the frame sees falls in it (texels
   // outside the frame or behind the camera are left out, as the painting's culling leaves
   // them out), as one compact map of rows of 1024.
-  std::vector<cv::Mat> maps(street.capture.frames_bgr.size());
+  std::vector<cv::Mat> maps(c.capture.frames_bgr.size());
   long long gathered = 0;
   for (size_t i = 0; i < maps.size(); ++i) {
     const Rigid3d cam_from_local =
-        CamFromLocal(street.job.scene, street.capture.true_poses[i].cam_from_world);
+        CamFromLocal(c.job.scene, c.capture.true_poses[i].cam_from_world);
     std::vector<cv::Vec2f> pixels;
     for (const BaseBuffer& b : session->buffers())
       for (int k = 0; k < b.NumTexels(); ++k) {
@@ -122,15 +137,20 @@ void BM_RemapStreet(benchmark::State& state) {
   cv::Mat out;
   for (auto _ : state)
     for (size_t i = 0; i < maps.size(); ++i)
-      cv::remap(street.capture.frames_bgr[i], out, maps[i], cv::noArray(), cv::INTER_LINEAR,
+      cv::remap(c.capture.frames_bgr[i], out, maps[i], cv::noArray(), cv::INTER_LINEAR,
                 cv::BORDER_CONSTANT);
   state.counters["texels_in_view_per_frame"] = static_cast<double>(gathered) / maps.size();
   state.SetItemsProcessed(state.iterations() * session->NumSurfaceTexels() *
                           static_cast<long long>(maps.size()));
 }
 
-BENCHMARK(BM_PaintStreet)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_RemapStreet)->Unit(benchmark::kMillisecond)->UseRealTime();
+// Paint and remap of one capture side by side (the ratio is read within one run).
+BENCHMARK(BM_Paint)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Remap)->Arg(0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Paint)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Remap)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Paint)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Remap)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace fresco
