@@ -1,6 +1,7 @@
 #include "pipeline/paint/exposure_gain.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace fresco {
 namespace {
@@ -8,11 +9,40 @@ namespace {
 // Values this far from black and saturation carry the exposure.
 constexpr int kMinValue = 4, kMaxValue = 251;
 
-// The q-quantile (0..1) of v (reorders v).
-double Quantile(std::vector<float>* v, double q) {
-  const size_t k = std::min(v->size() - 1, static_cast<size_t>(q * v->size()));
-  std::nth_element(v->begin(), v->begin() + k, v->end());
-  return (*v)[k];
+double Median(std::vector<float> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// sample = gain * stored + offset fitted robustly: the median ratio and the median residual to
+// start, then a few rounds of least squares weighted by Tukey's biweight (residuals beyond
+// 3 robust sigmas, movers and misregistered texels, weigh nothing).
+void FitAffine(const std::vector<float>& stored, const std::vector<float>& sample, double* gain,
+               double* offset) {
+  const size_t n = stored.size();
+  std::vector<float> work(n);
+  for (size_t i = 0; i < n; ++i) work[i] = sample[i] / stored[i];
+  double a = Median(work);
+  for (size_t i = 0; i < n; ++i) work[i] = static_cast<float>(sample[i] - a * stored[i]);
+  double b = Median(work);
+  for (int round = 0; round < 4; ++round) {
+    for (size_t i = 0; i < n; ++i) work[i] = std::abs(static_cast<float>(sample[i] - a * stored[i] - b));
+    const double cutoff = 3.0 * (1.4826 * Median(work) + 1.0);
+    double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double u = work[i] / cutoff;
+      if (u >= 1) continue;
+      const double w = (1 - u * u) * (1 - u * u);
+      const double x = stored[i], y = sample[i];
+      sw += w, sx += w * x, sy += w * y, sxx += w * x * x, sxy += w * x * y;
+    }
+    const double det = sw * sxx - sx * sx;
+    if (sw <= 0 || det <= 1e-9 * sw * sxx) break;  // no spread in the stored values: keep
+    a = (sw * sxy - sx * sy) / det;
+    b = (sy - a * sx) / sw;
+  }
+  *gain = a;
+  *offset = b;
 }
 
 }  // namespace
@@ -51,15 +81,10 @@ ExposureGain EstimateExposureGain(const std::vector<BaseBuffer>& buffers,
   result.samples = static_cast<int>(std::min({samples[0].size(), samples[1].size(), samples[2].size()}));
   if (result.samples < options.min_samples) return result;
   for (int c = 0; c < 3; ++c) {
-    const double s_lo = Quantile(&samples[c], 0.2), s_mid = Quantile(&samples[c], 0.5),
-                 s_hi = Quantile(&samples[c], 0.8);
-    const double o_lo = Quantile(&stored_values[c], 0.2),
-                 o_mid = Quantile(&stored_values[c], 0.5),
-                 o_hi = Quantile(&stored_values[c], 0.8);
-    const double gain = o_hi - o_lo > 4 ? (s_hi - s_lo) / (o_hi - o_lo) : s_mid / std::max(o_mid, 1.0);
+    double gain = 1, offset = 0;
+    FitAffine(stored_values[c], samples[c], &gain, &offset);
     result.gain[c] = std::clamp(gain, options.min_gain, options.max_gain);
-    result.offset[c] =
-        std::clamp(s_mid - result.gain[c] * o_mid, -options.max_offset, options.max_offset);
+    result.offset[c] = std::clamp(offset, -options.max_offset, options.max_offset);
   }
   result.applied = true;
   return result;

@@ -4,9 +4,9 @@
 // samples before they are compared and painted. Photos of one scene taken with different
 // exposures (or auto-exposure in a video) then paint one consistent texture at the buffers'
 // exposure, which the first frames set; the painted scene is exported at the frames' mean
-// transform (PaintSession::PaintedScene). The transform matches quantiles (20 %, 50 %, 80 %)
-// of the frame's and the buffers' values over the texels both have: movers and misregistered
-// texels are a minority and barely move them. Estimated against the buffers every frame, it
+// transform (PaintSession::PaintedScene). The transform is fitted robustly (median ratio,
+// then least squares weighted by Tukey's biweight) to the frame's and the buffers' values over
+// the texels both have: movers and misregistered texels are a minority and weigh nothing. Estimated against the buffers every frame, it
 // does not drift or flicker from frame to frame.
 #pragma once
 
@@ -23,13 +23,13 @@ namespace fresco {
 struct ExposureGain {
   cv::Vec3d gain = cv::Vec3d(1, 1, 1);    // B, G, R: sample = gain * stored + offset
   cv::Vec3d offset = cv::Vec3d(0, 0, 0);  // levels (0..255)
-  int samples = 0;                        // texels in common the quantiles were taken over
+  int samples = 0;                        // texels in common it was fitted to
   bool applied = false;                   // false: too few texels in common (identity)
 };
 
 struct ExposureOptions {
   int min_samples = 500;     // fewer texels in common: no correction
-  int max_samples = 200000;  // texels sampled at most (evenly spread)
+  int max_samples = 40000;   // texels sampled at most (evenly spread)
   double min_gain = 0.25, max_gain = 4.0;  // clamp
   double max_offset = 96;                  // levels, clamp
 };
