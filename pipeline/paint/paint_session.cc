@@ -291,7 +291,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   }
 
   // 3b. exposure
-  const bool select = options_.select.enabled && options_.update == UpdatePolicy::kQuality;
+  const bool select = SelectActive(options_);
   if (select && options_.select.exposure) report->stages.push_back(CorrectExposure(Indices(seen)));
 
   // 4. background

@@ -158,8 +158,14 @@ class PaintSession {
   double frame_misalignment_px_ = -1;
 };
 
+// Whether the exposure and select stages run: pipeline.select.enabled, with `update: quality`
+// and refinement off (refinement registers each frame to the buffers and moves them; keeping
+// stored samples would keep the offsets it corrects: on refine_paint_test's capture it
+// recovered 60 % of the PSNR lost to pose noise instead of 75 %).
+bool SelectActive(const PipelineOptions& options);
+
 // The background model's warm-up for these inputs: pipeline.background.warmup_frames, but with
-// view selection on (pipeline.select) at most a third of the frames the poses promise (at
+// view selection on (SelectActive) at most a third of the frames the poses promise (at
 // least 2): a capture of a few photos would otherwise never end its warm-up, every texel
 // would stay provisional and the latest photo would win everywhere.
 int EffectiveWarmupFrames(const PaintSessionInputs& inputs);

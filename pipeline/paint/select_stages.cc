@@ -39,10 +39,15 @@ StageReport PaintSession::CorrectExposure(const std::vector<size_t>& seen) {
   return report;
 }
 
+bool SelectActive(const PipelineOptions& options) {
+  return options.select.enabled && options.update == UpdatePolicy::kQuality &&
+         options.refine.mode == RefineMode::kOff;
+}
+
 int EffectiveWarmupFrames(const PaintSessionInputs& inputs) {
   const int warmup = inputs.pipeline.background.warmup_frames;
   const int frames = static_cast<int>(inputs.expected_poses.size());
-  if (!inputs.pipeline.select.enabled || frames == 0) return warmup;
+  if (!SelectActive(inputs.pipeline) || frames == 0) return warmup;
   return std::min(warmup, std::max(2, frames / 3));
 }
 
