@@ -62,29 +62,39 @@ ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& in
                             WarpedBuffer* warped) {
   ViewSelectStats stats;
   const Camera& camera = *inputs.camera;
-  const double focal_texel = 0.5 * (camera.fx + camera.fy) * buffer.texel_size_m;
-  const Eigen::Matrix3d R = inputs.cam_from_local.rotation.toRotationMatrix();
-  const Eigen::Vector3d t = inputs.cam_from_local.translation;
+  const float focal_texel = static_cast<float>(0.5 * (camera.fx + camera.fy) * buffer.texel_size_m);
+  const Eigen::Matrix3f R = inputs.cam_from_local.rotation.toRotationMatrix().cast<float>();
+  const Eigen::Vector3f t = inputs.cam_from_local.translation.cast<float>();
   const cv::Mat& edges = inputs.edge_distance_px;
   const bool use_edges = !edges.empty() && options.edge_px > 0;
+  const bool pinhole = camera.model == LensModel::kPinhole;
+  const float fx = static_cast<float>(camera.fx), fy = static_cast<float>(camera.fy);
+  const float cx = static_cast<float>(camera.cx), cy = static_cast<float>(camera.cy);
   const float edge_px = static_cast<float>(options.edge_px);
   uint8_t* valid = warped->valid.data;
   float* score = warped->quality.ptr<float>();
+  // The pixel a camera point lands on (nearest), or false outside the image.
+  const auto pixel_of = [&](const Eigen::Vector3f& p, int* x, int* y) {
+    Eigen::Vector2d pixel;
+    if (pinhole) {
+      if (p.z() <= 0) return false;
+      pixel = Eigen::Vector2d(fx * p.x() / p.z() + cx, fy * p.y() / p.z() + cy);
+    } else if (!camera.Project(p.cast<double>(), &pixel)) {
+      return false;
+    }
+    *x = static_cast<int>(std::lround(pixel.x()));
+    *y = static_cast<int>(std::lround(pixel.y()));
+    return *x >= 0 && *y >= 0 && *x < edges.cols && *y < edges.rows;
+  };
   // Pass 1: the texels' own scores (no penalty), near-edge flags as the sign.
   stats.near_edge = ForEachValidTexel(buffer, *warped, [&](const BaseBuffer::Chunk& chunk, int k,
                                                            int idx) {
-    const Eigen::Vector3d p = R * buffer.PointIn(chunk, k).cast<double>() + t;
-    const Eigen::Vector3d n = R * buffer.Normal(k).cast<double>();
-    const double cos_view = std::abs(n.dot(p)) / std::max(p.norm(), 1e-12);
-    const float s = static_cast<float>(focal_texel * cos_view / std::max(p.z(), 1e-9));
-    Eigen::Vector2d pixel;
-    bool near = false;
-    if (use_edges && camera.Project(p, &pixel)) {
-      const int x = static_cast<int>(std::lround(pixel.x()));
-      const int y = static_cast<int>(std::lround(pixel.y()));
-      near = x >= 0 && y >= 0 && x < edges.cols && y < edges.rows &&
-             edges.at<float>(y, x) < edge_px;
-    }
+    const Eigen::Vector3f p = R * buffer.PointIn(chunk, k) + t;
+    const Eigen::Vector3f n = R * buffer.Normal(k);
+    const float cos_view = std::abs(n.dot(p)) / std::max(p.norm(), 1e-12f);
+    const float s = focal_texel * cos_view / std::max(p.z(), 1e-9f);
+    int x = 0, y = 0;
+    const bool near = use_edges && pixel_of(p, &x, &y) && edges.at<float>(y, x) < edge_px;
     score[idx] = near ? -s : s;
     return near ? 1 : 0;
   });
@@ -111,7 +121,11 @@ ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& in
   stats.kept = ForEachValidTexel(buffer, *warped, [&](const BaseBuffer::Chunk&, int, int idx) {
     const float own = score[idx];
     const float a = std::max(std::abs(own), 1e-12f);
-    float s = (w == 0.0f ? a : w == 1.0f ? 1.0f : std::pow(a, 1.0f - w)) * region;
+    float s = (w == 0.0f   ? a
+               : w == 1.0f ? 1.0f
+               : w == 0.5f ? std::sqrt(a)
+                           : std::pow(a, 1.0f - w)) *
+              region;
     if (own < 0) s *= penalty;
     score[idx] = s;
     if (stored[idx][3] == 0 || s > stored_quality[idx] * switch_factor) return 0;
