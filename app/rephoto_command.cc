@@ -21,8 +21,7 @@ namespace {
 
 ArgSpec RephotoSpec() {
   ArgSpec spec;
-  spec.usage =
-      "fresco rephoto PROJECT.json --out DIR [--every N] [--set KEY=VALUE ...] [--quiet]";
+  spec.usage = "fresco rephoto PROJECT.json --out DIR [--every N] [--set KEY=VALUE ...] [--quiet]";
   spec.help =
       "Scores how the painted model looks from where the photos were taken, with no ground\n"
       "truth (virtual rephotography): each frame with a pose (or every N-th) is left out in\n"
@@ -106,7 +105,8 @@ int RunVerbRephoto(const CommandArgs& argv) {
   }
   std::cout << text;
   if (!quiet)
-    std::fprintf(stderr, "fresco rephoto: %zu frames -> %s/rephoto.json, %s/rephoto.md, %s/views/\n",
+    std::fprintf(stderr,
+                 "fresco rephoto: %zu frames -> %s/rephoto.json, %s/rephoto.md, %s/views/\n",
                  result.frames.size(), out_dir.c_str(), out_dir.c_str(), out_dir.c_str());
   return kExitOk;
 }

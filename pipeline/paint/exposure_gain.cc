@@ -26,7 +26,8 @@ void FitAffine(const std::vector<float>& stored, const std::vector<float>& sampl
   for (size_t i = 0; i < n; ++i) work[i] = static_cast<float>(sample[i] - a * stored[i]);
   double b = Median(work);
   for (int round = 0; round < 4; ++round) {
-    for (size_t i = 0; i < n; ++i) work[i] = std::abs(static_cast<float>(sample[i] - a * stored[i] - b));
+    for (size_t i = 0; i < n; ++i)
+      work[i] = std::abs(static_cast<float>(sample[i] - a * stored[i] - b));
     const double cutoff = 3.0 * (1.4826 * Median(work) + 1.0);
     double sw = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -50,8 +51,7 @@ void FitAffine(const std::vector<float>& stored, const std::vector<float>& sampl
 ExposureGain EstimateExposureGain(const std::vector<BaseBuffer>& buffers,
                                   const std::vector<WarpedBuffer>& warped,
                                   const std::vector<PaintedBuffer>& painted,
-                                  const std::vector<size_t>& seen,
-                                  const ExposureOptions& options) {
+                                  const std::vector<size_t>& seen, const ExposureOptions& options) {
   long long candidates = 0;  // valid texels (an upper bound on those in common)
   for (size_t b : seen) candidates += warped[b].visible;
   const long long stride = std::max<long long>(1, candidates / options.max_samples);
@@ -78,7 +78,8 @@ ExposureGain EstimateExposureGain(const std::vector<BaseBuffer>& buffers,
     }
   }
   ExposureGain result;
-  result.samples = static_cast<int>(std::min({samples[0].size(), samples[1].size(), samples[2].size()}));
+  result.samples =
+      static_cast<int>(std::min({samples[0].size(), samples[1].size(), samples[2].size()}));
   if (result.samples < options.min_samples) return result;
   for (int c = 0; c < 3; ++c) {
     double gain = 1, offset = 0;

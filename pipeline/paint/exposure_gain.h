@@ -6,8 +6,8 @@
 // exposure, which the first frames set; the painted scene is exported at the frames' mean
 // transform (PaintSession::PaintedScene). The transform is fitted robustly (median ratio,
 // then least squares weighted by Tukey's biweight) to the frame's and the buffers' values over
-// the texels both have: movers and misregistered texels are a minority and weigh nothing. Estimated against the buffers every frame, it
-// does not drift or flicker from frame to frame.
+// the texels both have: movers and misregistered texels are a minority and weigh nothing. Estimated
+// against the buffers every frame, it does not drift or flicker from frame to frame.
 #pragma once
 
 #include <vector>
@@ -28,8 +28,8 @@ struct ExposureGain {
 };
 
 struct ExposureOptions {
-  int min_samples = 500;     // fewer texels in common: no correction
-  int max_samples = 40000;   // texels sampled at most (evenly spread)
+  int min_samples = 500;                   // fewer texels in common: no correction
+  int max_samples = 40000;                 // texels sampled at most (evenly spread)
   double min_gain = 0.25, max_gain = 4.0;  // clamp
   double max_offset = 96;                  // levels, clamp
 };

@@ -53,7 +53,8 @@ int EffectiveWarmupFrames(const PaintSessionInputs& inputs) {
 
 cv::Mat PaintSession::AtMeanExposure(const cv::Mat& bgra) const {
   if (exposure_frames_ == 0) return bgra;
-  cv::Matx<float, 4, 5> mean = cv::Matx<float, 4, 5>::zeros();  // BGRA: the mean transform on B, G, R; alpha kept
+  cv::Matx<float, 4, 5> mean =
+      cv::Matx<float, 4, 5>::zeros();  // BGRA: the mean transform on B, G, R; alpha kept
   for (int c = 0; c < 3; ++c) {
     mean(c, c) = static_cast<float>(exposure_gain_sum_[c] / exposure_frames_);
     mean(c, 4) = static_cast<float>(exposure_offset_sum_[c] / exposure_frames_);

@@ -87,17 +87,17 @@ ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& in
     return *x >= 0 && *y >= 0 && *x < edges.cols && *y < edges.rows;
   };
   // Pass 1: the texels' own scores (no penalty), near-edge flags as the sign.
-  stats.near_edge = ForEachValidTexel(buffer, *warped, [&](const BaseBuffer::Chunk& chunk, int k,
-                                                           int idx) {
-    const Eigen::Vector3f p = R * buffer.PointIn(chunk, k) + t;
-    const Eigen::Vector3f n = R * buffer.Normal(k);
-    const float cos_view = std::abs(n.dot(p)) / std::max(p.norm(), 1e-12f);
-    const float s = focal_texel * cos_view / std::max(p.z(), 1e-9f);
-    int x = 0, y = 0;
-    const bool near = use_edges && pixel_of(p, &x, &y) && edges.at<float>(y, x) < edge_px;
-    score[idx] = near ? -s : s;
-    return near ? 1 : 0;
-  });
+  stats.near_edge =
+      ForEachValidTexel(buffer, *warped, [&](const BaseBuffer::Chunk& chunk, int k, int idx) {
+        const Eigen::Vector3f p = R * buffer.PointIn(chunk, k) + t;
+        const Eigen::Vector3f n = R * buffer.Normal(k);
+        const float cos_view = std::abs(n.dot(p)) / std::max(p.norm(), 1e-12f);
+        const float s = focal_texel * cos_view / std::max(p.z(), 1e-9f);
+        int x = 0, y = 0;
+        const bool near = use_edges && pixel_of(p, &x, &y) && edges.at<float>(y, x) < edge_px;
+        score[idx] = near ? -s : s;
+        return near ? 1 : 0;
+      });
   // The frame's median score over the buffer's valid texels.
   std::vector<float> all;
   all.reserve(warped->visible);

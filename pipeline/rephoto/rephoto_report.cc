@@ -43,10 +43,14 @@ RephotoSummary SummarizeRephoto(const RephotoResult& result) {
   RephotoSummary s;
   const std::vector<RephotoFrame>& f = result.frames;
   s.frames = static_cast<int>(f.size());
-  s.psnr_db = Spread(f, [](const RephotoFrame& r) { return r.psnr_db; }, false);
-  s.one_minus_ncc = Spread(f, [](const RephotoFrame& r) { return r.one_minus_ncc; }, true);
-  s.completeness = Spread(f, [](const RephotoFrame& r) { return r.completeness; }, false);
-  s.paint_seconds = Spread(f, [](const RephotoFrame& r) { return r.paint_seconds; }, true);
+  s.psnr_db = Spread(
+      f, [](const RephotoFrame& r) { return r.psnr_db; }, false);
+  s.one_minus_ncc = Spread(
+      f, [](const RephotoFrame& r) { return r.one_minus_ncc; }, true);
+  s.completeness = Spread(
+      f, [](const RephotoFrame& r) { return r.completeness; }, false);
+  s.paint_seconds = Spread(
+      f, [](const RephotoFrame& r) { return r.paint_seconds; }, true);
   return s;
 }
 
@@ -96,8 +100,8 @@ std::string RephotoToMarkdown(const RephotoResult& result, const RephotoSummary&
   }
   const auto row = [&](const char* label, double RephotoSpread::*field) {
     std::snprintf(line, sizeof line, "| **%s** | %.2f | %.3f | %.3f | | | %.1f |\n", label,
-                  summary.psnr_db.*field, summary.one_minus_ncc.*field,
-                  summary.completeness.*field, summary.paint_seconds.*field);
+                  summary.psnr_db.*field, summary.one_minus_ncc.*field, summary.completeness.*field,
+                  summary.paint_seconds.*field);
     text += line;
   };
   row("mean", &RephotoSpread::mean);

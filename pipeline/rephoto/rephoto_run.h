@@ -34,29 +34,28 @@ struct RephotoOptions {
 
 // One left-out frame.
 struct RephotoFrame {
-  std::string name;         // the frame's name (its pose's name)
-  int counter = 0;          // position among the frames read (all streams), 0-based
-  int stream = 0;           // index into Project::Streams()
-  int frames_painted = 0;   // frames painted from (the others)
-  double paint_seconds = 0; // wall time of that paint run (reading and painting)
-  double psnr_db = 0;       // over the compared pixels (NaN: none)
-  double one_minus_ncc = 1; // local 9 x 9, eroded mask (1 when nothing compared)
-  double completeness = 0;  // surface pixels of the view that are painted
+  std::string name;           // the frame's name (its pose's name)
+  int counter = 0;            // position among the frames read (all streams), 0-based
+  int stream = 0;             // index into Project::Streams()
+  int frames_painted = 0;     // frames painted from (the others)
+  double paint_seconds = 0;   // wall time of that paint run (reading and painting)
+  double psnr_db = 0;         // over the compared pixels (NaN: none)
+  double one_minus_ncc = 1;   // local 9 x 9, eroded mask (1 when nothing compared)
+  double completeness = 0;    // surface pixels of the view that are painted
   double image_coverage = 0;  // compared pixels / image pixels
   long long pixels = 0;       // compared pixels
 };
 
 struct RephotoResult {
-  std::string project;  // the project file as given
-  int frames_read = 0;  // frames of the project read (all streams)
-  int frames_posed = 0; // ... with a pose
+  std::string project;               // the project file as given
+  int frames_read = 0;               // frames of the project read (all streams)
+  int frames_posed = 0;              // ... with a pose
   std::vector<RephotoFrame> frames;  // the left-out frames, in order
 };
 
 // Called once per left-out frame with its figures, the render (black where not painted)
 // and the frame itself (both CV_8UC3, the camera's size); an error stops the run.
-using RephotoViewSink = std::function<Status(const RephotoFrame& frame,
-                                             const cv::Mat& rendered_bgr,
+using RephotoViewSink = std::function<Status(const RephotoFrame& frame, const cv::Mat& rendered_bgr,
                                              const cv::Mat& photo_bgr)>;
 
 // Loads the project (with the overrides), finds its frames with poses and scores each

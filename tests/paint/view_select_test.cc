@@ -90,7 +90,8 @@ TEST(ViewSelect, ExposureChangesPaintOneConsistentTexture) {
   ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
   // The frames' gains vary by tens of percent: the truth for a consistent texture is the
   // frames' mean exposure (geometric), which the painted scene takes.
-  const auto [lo, hi] = std::minmax_element(capture.exposure_gains.begin(), capture.exposure_gains.end());
+  const auto [lo, hi] =
+      std::minmax_element(capture.exposure_gains.begin(), capture.exposure_gains.end());
   ASSERT_GT(*hi / *lo, 1.3);
   double log_sum = 0;
   for (double g : capture.exposure_gains) log_sum += std::log(g);
@@ -105,12 +106,16 @@ TEST(ViewSelect, ExposureChangesPaintOneConsistentTexture) {
   no_exposure.select.exposure = false;
   PipelineOptions with = no_exposure;
   with.select.exposure = true;
-  const double psnr_off = MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, off), capture, g0, views);
+  const double psnr_off =
+      MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, off), capture, g0, views);
   const double psnr_no_exposure =
       MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, no_exposure), capture, g0, views);
-  const double psnr_with = MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, with), capture, g0, views);
-  std::printf("truth PSNR at the frames' mean exposure: select off %.2f, no exposure %.2f, "
-              "with exposure %.2f dB\n", psnr_off, psnr_no_exposure, psnr_with);
+  const double psnr_with =
+      MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, with), capture, g0, views);
+  std::printf(
+      "truth PSNR at the frames' mean exposure: select off %.2f, no exposure %.2f, "
+      "with exposure %.2f dB\n",
+      psnr_off, psnr_no_exposure, psnr_with);
   EXPECT_GT(psnr_with, psnr_off + 8.0);
   EXPECT_GT(psnr_with, psnr_no_exposure + 5.0);
   EXPECT_GT(psnr_with, 28.0);
@@ -174,10 +179,10 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   double ncc_edges = 0, ncc_no_edges = 0;
   const double psnr_edges = score(no_model, &ncc_edges);
   const double psnr_no_edges = score(no_model_no_edges, &ncc_no_edges);
-  std::printf("displaced boxes, exposure changes: select off %.2f dB / 1-NCC %.3f, defaults "
-              "%.2f / %.3f; background off: edge penalty off %.2f / %.3f, on %.2f / %.3f\n",
-              psnr_off, ncc_off, psnr_on, ncc_on, psnr_no_edges, ncc_no_edges, psnr_edges,
-              ncc_edges);
+  std::printf(
+      "displaced boxes, exposure changes: select off %.2f dB / 1-NCC %.3f, defaults "
+      "%.2f / %.3f; background off: edge penalty off %.2f / %.3f, on %.2f / %.3f\n",
+      psnr_off, ncc_off, psnr_on, ncc_on, psnr_no_edges, ncc_no_edges, psnr_edges, ncc_edges);
   EXPECT_GT(psnr_on, psnr_off + 1.0);
   EXPECT_LT(ncc_on, ncc_off - 0.03);
   EXPECT_GT(psnr_edges, psnr_no_edges + 0.3);

@@ -107,10 +107,11 @@ TEST(Rephoto, PerfectPosesScoreHighAndAWrongPoseScoresLow) {
   ASSERT_EQ(bad.frames.size(), static_cast<size_t>(kFrames));
   const RephotoFrame& wrong = bad.frames[4];
   EXPECT_EQ(wrong.name, "000004.png");
-  std::printf("perfect poses: PSNR median %.2f worst %.2f dB, 1-NCC median %.3f; frame 4 at "
-              "a wrong pose: %.2f dB (%.2f at its true pose), 1-NCC %.3f\n",
-              s.psnr_db.median, s.psnr_db.worst, s.one_minus_ncc.median, wrong.psnr_db,
-              good.frames[4].psnr_db, wrong.one_minus_ncc);
+  std::printf(
+      "perfect poses: PSNR median %.2f worst %.2f dB, 1-NCC median %.3f; frame 4 at "
+      "a wrong pose: %.2f dB (%.2f at its true pose), 1-NCC %.3f\n",
+      s.psnr_db.median, s.psnr_db.worst, s.one_minus_ncc.median, wrong.psnr_db,
+      good.frames[4].psnr_db, wrong.one_minus_ncc);
   EXPECT_LT(wrong.psnr_db, good.frames[4].psnr_db - 12.0);
   EXPECT_GT(wrong.one_minus_ncc, 0.7);
   // It is the worst, by far.
