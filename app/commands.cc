@@ -21,6 +21,7 @@ const std::vector<Command>& AllCommands() {
       {"poses", "bootstrap or verify poses with COLMAP", RunVerbPoses},
       {"bench", "measure the speed/accuracy trade of pipeline settings", RunVerbBench},
       {"eval", "score a setting over a suite of synthetic captures", RunVerbEval},
+      {"rephoto", "score a project on its own photos: each left out, painted from the others", RunVerbRephoto},
       {"gui", "the authoring app", RunVerbGui},
   };
   return kCommands;

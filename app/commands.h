@@ -45,6 +45,7 @@ int RunVerbCalib(const CommandArgs& args);
 int RunVerbPoses(const CommandArgs& args);
 int RunVerbBench(const CommandArgs& args);
 int RunVerbEval(const CommandArgs& args);
+int RunVerbRephoto(const CommandArgs& args);
 int RunVerbGui(const CommandArgs& args);
 
 }  // namespace fresco

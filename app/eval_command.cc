@@ -8,6 +8,7 @@
 
 #include "app/commands.h"
 #include "app/interrupt.h"
+#include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/project.h"
 #include "pipeline/eval/eval_run.h"
@@ -77,13 +78,7 @@ int RunVerbEval(const CommandArgs& argv) {
   if (Status s = MakeDirectories(options.cache_dir); !s.ok()) return InputError(s);
 
   const bool quiet = args.Switch("--quiet");
-  const auto start = std::chrono::steady_clock::now();
-  options.progress = [&](int done, int total, const std::string& line) {
-    if (quiet) return;
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::fprintf(stderr, "eval: %d/%d (%.0f s) %s\n", done, total, s, line.c_str());
-  };
+  options.progress = ProgressLines("eval", quiet);
   InterruptCatcher interrupt;
   options.stop = [] { return Interrupted(); };
   std::vector<CaptureEval> results;

@@ -49,4 +49,15 @@ void Progress::Clear() {
   std::fflush(stderr);
 }
 
+std::function<void(int done, int total, const std::string& line)> ProgressLines(
+    const std::string& label, bool quiet) {
+  const auto start = std::chrono::steady_clock::now();
+  return [label, quiet, start](int done, int total, const std::string& line) {
+    if (quiet) return;
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "%s: %d/%d (%.0f s) %s\n", label.c_str(), done, total, s, line.c_str());
+  };
+}
+
 }  // namespace fresco

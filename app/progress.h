@@ -3,9 +3,15 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <string>
 
 namespace fresco {
+
+// Progress as plain lines on stderr for a library's callback (done, total, line): "LABEL:
+// DONE/TOTAL (SECONDS s) LINE", seconds since this call; nothing when quiet.
+std::function<void(int done, int total, const std::string& line)> ProgressLines(
+    const std::string& label, bool quiet);
 
 class Progress {
  public:

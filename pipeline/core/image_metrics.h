@@ -13,5 +13,11 @@ double PsnrDb(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask = cv::Mat(
 // 1 - normalized cross-correlation of the grey values over the mask (0 = identical up to
 // gain and offset; 1 = uncorrelated). NaN when the mask is empty or an image is flat.
 double OneMinusNcc(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask = cv::Mat());
+// Local 1 - NCC (virtual rephotography, Waechter et al. 2017): the grey values' normalized
+// cross-correlation in every `window` x `window` box, 1 - it averaged over the pixels whose
+// whole box lies in `mask` (the mask eroded by the box). Insensitive to exposure (gain and
+// offset per box), sensitive to blur, seams and misalignment. A box flat in either image
+// counts as uncorrelated (1). NaN when no pixel's box lies in the mask.
+double LocalOneMinusNcc(const cv::Mat& a, const cv::Mat& b, const cv::Mat& mask, int window = 9);
 
 }  // namespace fresco

@@ -137,6 +137,17 @@ void Fields(AtlasOptions& o, V& v) {
 }
 
 template <class V>
+void Fields(SelectOptions& o, V& v) {
+  v.Field("enabled", o.enabled);
+  v.Field("exposure", o.exposure);
+  v.Field("switch_margin", o.switch_margin, {.min = 0, .max = 10});
+  v.Field("region_weight", o.region_weight, {.min = 0, .max = 1});
+  v.Field("edge_px", o.edge_px, {.min = 0, .max = 100});
+  v.Field("edge_penalty", o.edge_penalty, {.min = 0, .max = 1});
+  v.Field("edge_depth_rel", o.edge_depth_rel, {.min = 0, .min_exclusive = true, .max = 10});
+}
+
+template <class V>
 void Fields(PipelineOptions& o, V& v) {
   v.Enum("sampling", o.sampling, SamplingNames());
   v.Field("texel_size_m", o.texel_size_m, {.min = 0});
@@ -152,6 +163,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Object("refine", o.refine);
   v.Object("background", o.background);
   v.Object("atlas", o.atlas);
+  v.Object("select", o.select);
 }
 
 template <class V>
@@ -236,14 +248,15 @@ static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(
 static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(AtlasOptions) == 8, "see Fields(AtlasOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 240, "see Fields(PipelineOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(SelectOptions) == 48, "see Fields(SelectOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 288, "see Fields(PipelineOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 72, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
 static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(StreamSpec) == 104, "see Fields(StreamSpec)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 664, "see Fields(Project)");
+static_assert(sizeof(void*) != 8 || sizeof(Project) == 712, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 

@@ -111,6 +111,26 @@ struct AtlasOptions {
   bool operator==(const AtlasOptions&) const = default;
 };
 
+// View selection and colour consistency for real photos (pipeline/paint/view_select.h), the
+// `select` stage between background and paint: per frame a gain per colour channel,
+// estimated against what the buffers already hold (median ratio over the texels both have)
+// and divided out before painting; a score per texel (pixels per texel times the cosine of
+// the view angle, uncapped, blended with the frame's median score over the buffer so that a
+// region keeps one frame), much lower where the texel is seen near a depth discontinuity of
+// the frame's depth map (silhouettes: where a mesh a few pixels off paints background); a
+// painted texel takes a new frame's sample only when it scores clearly better.
+struct SelectOptions {
+  bool enabled = true;          // off: the quality policy alone (`update`, `quality_slack`)
+  bool exposure = true;         // divide out each frame's gain against the buffers
+  double switch_margin = 0.25;  // a painted texel switches frame when the score is this much better
+  double region_weight = 0.5;   // 0: the texel's own score; 1: the frame's median over the buffer
+  double edge_px = 6.0;         // texels seen within this many pixels of a depth discontinuity
+  double edge_penalty = 0.1;    // ... have their score multiplied by this
+  double edge_depth_rel = 0.05;  // neighbouring pixels whose depths differ by this fraction
+
+  bool operator==(const SelectOptions&) const = default;
+};
+
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
@@ -128,6 +148,7 @@ struct PipelineOptions {
   RefineOptions refine;
   BackgroundOptions background;
   AtlasOptions atlas;
+  SelectOptions select;
 
   bool operator==(const PipelineOptions&) const = default;
 };

@@ -251,15 +251,20 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
   // The tile's rows of what pass 2 writes (16 rows, a cache line or two each): fetched while
   // pass 1 projects, they are in cache when the scattered-by-row writes come.
   const size_t width = static_cast<size_t>(k.buffer->width);
+  const size_t last = static_cast<size_t>(chunk.x1 - chunk.x0 - 1);  // a row may span 2 lines
   for (int y = chunk.y0; y < chunk.y1; ++y) {
     const size_t row = static_cast<size_t>(y) * width + static_cast<size_t>(chunk.x0);
     if constexpr (kPaint) {
       __builtin_prefetch(k.paint_bgra + 4 * row, 1);
+      __builtin_prefetch(k.paint_bgra + 4 * (row + last) + 3, 1);
       __builtin_prefetch(k.paint_quality + row, 1);
+      __builtin_prefetch(k.paint_quality + row + last, 1);
     } else {
       __builtin_prefetch(k.out_bgr + 3 * row, 1);
+      __builtin_prefetch(k.out_bgr + 3 * (row + last) + 2, 1);
       __builtin_prefetch(k.out_valid + row, 1);
       __builtin_prefetch(k.out_quality + row, 1);
+      __builtin_prefetch(k.out_quality + row + last, 1);
     }
   }
   ChunkProjection proj;

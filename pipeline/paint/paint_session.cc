@@ -95,6 +95,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   std::unique_ptr<PaintSession> s(new PaintSession());
   s->scene_ = inputs.scene;
   s->options_ = inputs.pipeline;
+  s->options_.background.warmup_frames = EffectiveWarmupFrames(inputs);
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
   s->texel_size_m_ =
@@ -127,7 +128,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
     s->background_.resize(s->set_.buffers.size());
     s->background_frame_.resize(s->set_.buffers.size());
     for (size_t b = 0; b < s->set_.buffers.size(); ++b)
-      s->background_[b].Init(s->set_.buffers[b], inputs.pipeline.background);
+      s->background_[b].Init(s->set_.buffers[b], s->options_.background);
   }
   *session = std::move(s);
   return Status::Ok();
@@ -140,6 +141,8 @@ void PaintSession::ResetPainting() {
     if (!background_.empty()) background_[b].Init(set_.buffers[b], options_.background);
   }
   frames_seen_ = 0;
+  exposure_gain_sum_ = exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
+  exposure_frames_ = 0;
 }
 
 const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
@@ -245,10 +248,10 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
                            warp_options.near_m))
       in_frustum.push_back(b);
   // When no stage looks at the warped samples before the paint stage (no background
-  // model, no refinement, no debug images), the warp paints them directly: the same texels,
-  // without writing and reading back the warped images.
-  const bool paint_in_warp =
-      background_.empty() && options_.refine.mode == RefineMode::kOff && !debug;
+  // model, no refinement, no exposure or view selection, no debug images), the warp paints
+  // them directly: the same texels, without writing and reading back the warped images.
+  const bool paint_in_warp = background_.empty() && options_.refine.mode == RefineMode::kOff &&
+                             !SelectActive(options_) && !debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);
   std::vector<PaintUpdateStats> paint_stats(set_.buffers.size());
   ForEachBuffer(in_frustum, false, [&](size_t b) {
@@ -299,8 +302,15 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     }
   }
 
+  // 3b. exposure
+  const bool select = SelectActive(options_);
+  if (select && options_.select.exposure) report->stages.push_back(CorrectExposure(Indices(seen)));
+
   // 4. background
   if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
+
+  // 4b. select
+  if (select) report->stages.push_back(SelectViewsStage(Indices(seen)));
 
   // 5. paint
   start = std::chrono::steady_clock::now();
@@ -659,7 +669,7 @@ Scene PaintSession::PaintedScene() const {
   Scene out = UnpaintedCopy(*scene_);
   const TriangleMesh& mesh = scene_->mesh;
   std::vector<cv::Mat> images(painted_.size());
-  for (size_t b = 0; b < painted_.size(); ++b) images[b] = painted_[b].bgra;
+  for (size_t b = 0; b < painted_.size(); ++b) images[b] = AtMeanExposure(painted_[b].bgra);
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
     texture.name = "page_" + std::to_string(page);
@@ -697,7 +707,7 @@ Scene PaintSession::PaintedSceneByBuffer() const {
     const BaseBuffer& buffer = set_.buffers[b];
     Texture texture;
     texture.name = "buffer_" + std::to_string(b);
-    cv::cvtColor(painted_[b].bgra, texture.rgba, cv::COLOR_BGRA2RGBA);
+    cv::cvtColor(AtMeanExposure(painted_[b].bgra), texture.rgba, cv::COLOR_BGRA2RGBA);
     texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
     out.textures.push_back(texture);
     Material material;

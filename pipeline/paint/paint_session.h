@@ -4,8 +4,12 @@
 //              (eq. 1-4, §3.2, §3.3)        -> frame_warp.h
 //   3. refine  per buffer: register the warped frame to what the buffer holds in 2D and
 //              warp it again (§3.5; off unless pipeline.refine.mode)   -> refine_alignment.h
+//   3b. exposure  divide out the frame's gain against the buffers (pipeline.select.exposure)
+//                                                                         -> exposure_gain.h
 //   4. background  per texel: compare with the texel's background model, mask foreground
 //              (moving objects), learn (§3.4)                            -> background_model.h
+//   4b. select  view score per texel (resolution, angle, depth edges); painted texels keep
+//              a better stored sample (pipeline.select)                  -> view_select.h
 //   5. paint   update the persistent base buffers where not masked (eq. 4, update policy)
 //                                                                         -> paint_update.h
 // Set-up (once): grouping (§3.6) -> grouping.h, base buffers and texel model points (eq. 2)
@@ -121,6 +125,13 @@ class PaintSession {
                           std::vector<BufferRefinement>* results, StageReport* report);
   // The background stage over the buffers seen this frame (fills background_frame_).
   StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
+  // The exposure and select stages (select_stages.cc) over the buffers seen this frame.
+  StageReport CorrectExposure(const std::vector<size_t>& seen);
+  StageReport SelectViewsStage(const std::vector<size_t>& seen);
+  // A painted buffer (BGRA) at the frames' mean exposure: the buffers hold the first
+  // frames' exposure (exposure stage); the painted scene takes the mean of every painted
+  // frame's transform (select_stages.cc). The buffer itself when the stage is off.
+  cv::Mat AtMeanExposure(const cv::Mat& bgra) const;
 
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
@@ -137,11 +148,27 @@ class PaintSession {
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;
   int frames_seen_ = 0;
+  // Exposure stage: the sums of the gains and offsets (B, G, R) over the frames it ran on
+  // (identity where it could not tell), and how many.
+  cv::Vec3d exposure_gain_sum_ = cv::Vec3d(0, 0, 0), exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
+  int exposure_frames_ = 0;
   // This frame's misalignment before correction, measured over every buffer's matches (the
   // pose fit's RMS over its inliers, pixels; without pose correction the RMS over every
   // buffer's inliers, texels); -1 when it could not tell.
   double frame_misalignment_px_ = -1;
 };
+
+// Whether the exposure and select stages run: pipeline.select.enabled, with `update: quality`
+// and refinement off (refinement registers each frame to the buffers and moves them; keeping
+// stored samples would keep the offsets it corrects: on refine_paint_test's capture it
+// recovered 60 % of the PSNR lost to pose noise instead of 75 %).
+bool SelectActive(const PipelineOptions& options);
+
+// The background model's warm-up for these inputs: pipeline.background.warmup_frames, but with
+// view selection on (SelectActive) at most a third of the frames the poses promise (at
+// least 2): a capture of a few photos would otherwise never end its warm-up, every texel
+// would stay provisional and the latest photo would win everywhere.
+int EffectiveWarmupFrames(const PaintSessionInputs& inputs);
 
 // The automatic texel size: the median depth the cameras see (rasterized at a few of the
 // poses) / focal length, i.e. about one texel per pixel at the typical distance. Buffers

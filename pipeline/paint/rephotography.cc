@@ -8,8 +8,11 @@
 
 namespace fresco {
 
-RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
-                          const Rigid3d& cam_from_world, const cv::Mat& frame_bgr) {
+namespace {
+
+// Renders and scores; `both` and `rendered_bgr`: the compared pixels and the render.
+RephotoScore Score(const Renderer& renderer, const Scene& painted, const Rigid3d& cam_from_world,
+                   const cv::Mat& frame_bgr, cv::Mat* both_out, cv::Mat* rendered_out) {
   RenderOutput out;
   renderer.Render(painted, cam_from_world, &out);
   cv::Mat alpha, rendered_bgr;
@@ -17,6 +20,8 @@ RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
   cv::cvtColor(out.rgba, rendered_bgr, cv::COLOR_RGBA2BGR);
   const cv::Mat surface = out.triangle_id >= 0;
   const cv::Mat both = surface & (alpha == 255);
+  *both_out = both;
+  *rendered_out = rendered_bgr;
   RephotoScore score;
   score.pixels = cv::countNonZero(both);
   score.completeness =
@@ -25,6 +30,26 @@ RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
     score.psnr_db = PsnrDb(frame_bgr, rendered_bgr, both);
     score.one_minus_ncc = OneMinusNcc(frame_bgr, rendered_bgr, both);
   }
+  return score;
+}
+
+}  // namespace
+
+RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
+                          const Rigid3d& cam_from_world, const cv::Mat& frame_bgr) {
+  cv::Mat both, rendered_bgr;
+  return Score(renderer, painted, cam_from_world, frame_bgr, &both, &rendered_bgr);
+}
+
+RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
+                          const Rigid3d& cam_from_world, const cv::Mat& frame_bgr,
+                          RephotoView* view) {
+  const RephotoScore score =
+      Score(renderer, painted, cam_from_world, frame_bgr, &view->compared, &view->rendered_bgr);
+  view->rendered_bgr.setTo(cv::Scalar::all(0), view->compared == 0);
+  view->local_one_minus_ncc =
+      score.pixels > 0 ? LocalOneMinusNcc(frame_bgr, view->rendered_bgr, view->compared) : 0.0;
+  view->image_coverage = static_cast<double>(score.pixels) / std::max<int>(1, frame_bgr.total());
   return score;
 }
 

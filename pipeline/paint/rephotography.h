@@ -22,4 +22,18 @@ struct RephotoScore {
 RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr);
 
+// What `fresco rephoto` keeps of a view besides the score.
+struct RephotoView {
+  cv::Mat rendered_bgr;  // CV_8UC3, the painted model at the pose; black where not painted
+  cv::Mat compared;      // CV_8U, 255 at the pixels scored (painted surface seen)
+  // LocalOneMinusNcc over `compared` (9 x 9 boxes): the protocol's 1 - NCC.
+  double local_one_minus_ncc = 0;
+  double image_coverage = 0;  // compared pixels / image pixels
+};
+
+// The same score, and the view (`view` must not be null).
+RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
+                          const Rigid3d& cam_from_world, const cv::Mat& frame_bgr,
+                          RephotoView* view);
+
 }  // namespace fresco

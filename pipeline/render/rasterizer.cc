@@ -63,6 +63,9 @@ struct TrianglePolygon {
 // Triangles per cluster: 128 consecutive triangles of a photogrammetry mesh lie close
 // together, so a cluster's box is small and culls well.
 constexpr int kClusterTriangles = 128;
+// Depth only, on a grid: a triangle whose box covers more samples than this is scanned by
+// bands of rows over all threads instead of whole by the thread that set it up.
+constexpr long long kLargeTriangleSamples = 4096;
 
 }  // namespace
 
@@ -469,6 +472,10 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   TrianglePolygon* const polygons = polygon_scratch.data();
   TriangleSetup* const setups = setup_scratch.data();
   int* const triangle_of_slot = triangle_scratch.data();
+  // Direct: triangles covering many samples are not scanned by the thread that set them up
+  // but afterwards, by bands of rows over all threads (a few large triangles, as in a room,
+  // would otherwise leave one thread scanning the whole image). Per cluster, in order.
+  std::vector<std::vector<std::pair<int, TriangleSetup>>> large(kDirect ? num_clusters : 0);
   cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
     for (int c = range.start; c < range.end; ++c) {
       const int first = c * kClusterTriangles;
@@ -523,11 +530,32 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           if constexpr (!kDirect) std::copy(&poly[0][0], &poly[0][0] + 8, &polygons[slot].corner[0][0]);
         }
         s.num_poly = n;
-        if constexpr (kDirect) ScanGridTriangle(t, s, tri, 0, t.height, record);
+        if constexpr (kDirect) {
+          const long long samples =
+              static_cast<long long>(s.row1 - s.row0 + 1) * (s.col1 - s.col0 + 1);
+          if (samples > kLargeTriangleSamples)
+            large[c].emplace_back(tri, s);
+          else
+            ScanGridTriangle(t, s, tri, 0, t.height, record);
+        }
       }
     }
   });
-  if constexpr (kDirect) return;
+  if constexpr (kDirect) {
+    std::vector<std::pair<int, TriangleSetup>> all;
+    for (auto& list : large) all.insert(all.end(), list.begin(), list.end());
+    if (all.empty()) return;
+    const int num_bands = (t.height + kBandRows - 1) / kBandRows;
+    cv::parallel_for_(cv::Range(0, num_bands), [&](const cv::Range& range) {
+      for (int band = range.start; band < range.end; ++band) {
+        const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
+        for (const auto& [tri, setup] : all)
+          if (setup.row0 < band_hi && setup.row1 >= band_lo)
+            ScanGridTriangle(t, setup, tri, band_lo, band_hi, record);
+      }
+    });
+    return;
+  }
 
   // Set-ups per bucket row (grid: per band of kBandRows sample rows), in ascending triangle
   // order (counting sort).

@@ -54,7 +54,8 @@ FrameRead PaintRun::Next(RunFrame* frame) {
   if (frame->fate == FrameFate::kNoPose) {
     ++stats_.frames_without_pose;
     ++stream.without_pose;
-  } else if (every > 0 && frame->counter % every == every / 2) {
+  } else if ((every > 0 && frame->counter % every == every / 2) ||
+             frame->counter == options_.holdout_counter) {
     frame->fate = FrameFate::kHeldOut;
     ++stats_.frames_held_out;
   }

@@ -34,6 +34,9 @@ struct PaintRunOptions {
   // holdout_every / 2) that has a pose is held out of painting (`fresco bench` scores
   // them); 0: none.
   int holdout_every = 0;
+  // The frame with this counter (0-based position among the frames read), when it has a
+  // pose, is held out too (`fresco rephoto` leaves one frame out per run); -1: none.
+  int holdout_counter = -1;
   // Paint with PaintSession::PaintFrameNaive (the baseline `fresco bench` measures).
   bool naive = false;
 };

@@ -1,5 +1,6 @@
 // End-to-end painting throughput against the memory-bound floor: texels x frames per second
-// of the painting loop (depth test, project, sample, update; background and refinement off)
+// of the painting loop (depth test, project, sample, update; background, refinement and view
+// selection off)
 // against OpenCV's cv::remap doing only the bilinear gather of the same buffers' texels from
 // the same frames (maps precomputed, not timed), both on 2 threads, on 30-frame 640x480
 // captures: a street walk with OpenCV5 distortion (`fresco synth` builtin:street, the
@@ -48,6 +49,7 @@ struct Capture {
     if (!SynthesizeCapture(job.scene, job.options, &capture).ok()) return;
     pipeline.background.mode = BackgroundMode::kOff;
     pipeline.refine.mode = RefineMode::kOff;
+    pipeline.select.enabled = false;  // the core loop: no exposure or view selection either
     ok = true;
   }
   std::unique_ptr<PaintSession> Session() const {

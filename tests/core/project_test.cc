@@ -117,6 +117,13 @@ Project NonDefaultProject() {
   p.grouping.max_stretch = 1.5;
   p.pipeline.atlas.page_size = 2048;
   p.pipeline.atlas.padding_texels = 6;
+  p.pipeline.select.enabled = false;
+  p.pipeline.select.exposure = false;
+  p.pipeline.select.switch_margin = 0.5;
+  p.pipeline.select.region_weight = 0.25;
+  p.pipeline.select.edge_px = 3.0;
+  p.pipeline.select.edge_penalty = 0.5;
+  p.pipeline.select.edge_depth_rel = 0.1;
   GroupingEdit merge;
   merge.op = "merge";
   merge.groups = {3, 4, 7};
@@ -219,6 +226,7 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"background\"",      "\"mode\": \"robust\"",
                           "\"window_frames\"",   "\"dilate_texels\"",
                           "\"atlas\"",           "\"page_size\"",
+                          "\"select\"",          "\"switch_margin\"",
                           "\"min_chart_texels\"", "\"max_stretch\""}) {
     EXPECT_THAT(text, HasSubstr(key));
   }

@@ -28,7 +28,7 @@ file's settings, [project-file.md](project-file.md).
 | 0 | success |
 | 1 | anything else (a failure that is not the input's fault) |
 | 2 | bad usage or bad input: one line on stderr naming the file, and the field or line, and what is wrong; outputs of earlier runs are left as they were |
-| 130, 143 | stopped by Ctrl-C (SIGINT) or SIGTERM (`run`, `synth`, `bench`): nothing written, earlier outputs kept |
+| 130, 143 | stopped by Ctrl-C (SIGINT) or SIGTERM (`run`, `synth`, `bench`, `eval`, `rephoto`): nothing written, earlier outputs kept |
 
 Long work shows progress on stderr (a bar on a terminal, plain lines otherwise); `--quiet`
 silences it.
@@ -49,4 +49,5 @@ block "fresco poses verify" poses verify
 block "fresco poses bootstrap" poses bootstrap
 block "fresco bench" bench
 block "fresco eval" eval
+block "fresco rephoto" rephoto
 block "fresco gui" gui

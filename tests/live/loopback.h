@@ -3,6 +3,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -66,6 +67,18 @@ class PoseServer {
   std::string Address() const { return "tcp://127.0.0.1:" + std::to_string(port_); }
   // Waits for a connection; its socket (-1 on failure).
   int Accept() { return accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC); }
+  // Waits for a connection until `give_up()` says so (asked every 100 ms): -1 then. A test
+  // that fails before its client connects must not hang in a destructor.
+  template <class GiveUp>
+  int AcceptUnless(const GiveUp& give_up) {
+    for (;;) {
+      pollfd p{fd_, POLLIN, 0};
+      const int ready = poll(&p, 1, 100);
+      if (ready > 0) return Accept();
+      if (ready < 0 && errno != EINTR) return -1;
+      if (give_up()) return -1;
+    }
+  }
   // Accepts one connection, sends `text`, closes it.
   void ServeOnce(const std::string& text) {
     const int c = Accept();
@@ -96,7 +109,10 @@ class DroppingTracker {
       close(c);
       std::this_thread::sleep_for(std::chrono::milliseconds(away_ms));
       PoseServer again(port);
-      c = again.Accept();
+      c = again.AcceptUnless([this] {
+        std::lock_guard<std::mutex> lock(mutex_);
+        return done_;
+      });
       if (c < 0) return;
       send(c, after.data(), after.size(), MSG_NOSIGNAL);
       std::unique_lock<std::mutex> lock(mutex_);

@@ -84,6 +84,7 @@ TEST(PaintInWarp, PaintsWhatTheTwoStagesPaint) {
     PipelineOptions options;
     options.background.mode = BackgroundMode::kOff;
     options.refine.mode = RefineMode::kOff;
+    options.select.enabled = false;
     for (const SamplingMode sampling :
          {SamplingMode::kNearest, SamplingMode::kBilinear, SamplingMode::kArea}) {
       options.sampling = sampling;

@@ -58,13 +58,7 @@ SynthOptions RoomCapture(int frames) {
   return o;
 }
 
-Scene Room() {
-  CubeRoomOptions room;
-  room.procedural_texture_px = 512;
-  Scene scene;
-  EXPECT_TRUE(MakeCubeRoomScene(room, &scene).ok());
-  return scene;
-}
+Scene Room() { return testing::RoomScene(); }
 
 TEST(Grouping, CubeRoomHasOneBufferPerFace) {
   const Scene scene = Room();

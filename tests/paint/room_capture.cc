@@ -1,5 +1,9 @@
 #include "tests/paint/room_capture.h"
 
+#include <cstdlib>
+
+#include "pipeline/synth/procedural_scenes.h"
+
 namespace fresco::testing {
 
 SynthOptions HandheldRoomCapture(int frames, double radius_m) {
@@ -13,6 +17,14 @@ SynthOptions HandheldRoomCapture(int frames, double radius_m) {
   o.radius_m = radius_m;
   o.height_m = 1.5;
   return o;
+}
+
+Scene RoomScene() {
+  CubeRoomOptions room;
+  room.procedural_texture_px = 512;
+  Scene scene;
+  if (!MakeCubeRoomScene(room, &scene).ok()) std::abort();  // also linked by benchmarks
+  return scene;
 }
 
 }  // namespace fresco::testing

@@ -1,0 +1,94 @@
+// PaintSession's exposure and select stages (exposure_gain.h, view_select.h): kept apart from
+// paint_session.cc, which runs them.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "pipeline/paint/exposure_gain.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/view_select.h"
+
+namespace fresco {
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+}  // namespace
+
+StageReport PaintSession::CorrectExposure(const std::vector<size_t>& seen) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "exposure";
+  const ExposureGain gain = EstimateExposureGain(set_.buffers, warped_, painted_, seen);
+  ApplyExposureGain(gain, seen, &warped_);
+  exposure_gain_sum_ += gain.gain;
+  exposure_offset_sum_ += gain.offset;
+  ++exposure_frames_;
+  report.metrics["gain_b"] = gain.gain[0];
+  report.metrics["gain_g"] = gain.gain[1];
+  report.metrics["gain_r"] = gain.gain[2];
+  report.metrics["offset_b"] = gain.offset[0];
+  report.metrics["offset_g"] = gain.offset[1];
+  report.metrics["offset_r"] = gain.offset[2];
+  report.metrics["samples"] = gain.samples;
+  report.metrics["applied"] = gain.applied ? 1.0 : 0.0;
+  report.wall_ms = MsSince(start);
+  return report;
+}
+
+bool SelectActive(const PipelineOptions& options) {
+  return options.select.enabled && options.update == UpdatePolicy::kQuality &&
+         options.refine.mode == RefineMode::kOff;
+}
+
+int EffectiveWarmupFrames(const PaintSessionInputs& inputs) {
+  const int warmup = inputs.pipeline.background.warmup_frames;
+  const int frames = static_cast<int>(inputs.expected_poses.size());
+  if (!SelectActive(inputs.pipeline) || frames == 0) return warmup;
+  return std::min(warmup, std::max(2, frames / 3));
+}
+
+cv::Mat PaintSession::AtMeanExposure(const cv::Mat& bgra) const {
+  if (exposure_frames_ == 0) return bgra;
+  cv::Matx<float, 4, 5> mean =
+      cv::Matx<float, 4, 5>::zeros();  // BGRA: the mean transform on B, G, R; alpha kept
+  for (int c = 0; c < 3; ++c) {
+    mean(c, c) = static_cast<float>(exposure_gain_sum_[c] / exposure_frames_);
+    mean(c, 4) = static_cast<float>(exposure_offset_sum_[c] / exposure_frames_);
+  }
+  mean(3, 3) = 1;
+  cv::Mat out;
+  cv::transform(bgra, out, mean);  // rounded, saturated
+  return out;
+}
+
+StageReport PaintSession::SelectViewsStage(const std::vector<size_t>& seen) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "select";
+  ViewSelectInputs inputs;
+  inputs.camera = frame_camera_;
+  inputs.cam_from_local = frame_cam_from_local_;
+  if (options_.occlusion.enabled && options_.select.edge_px > 0)
+    inputs.edge_distance_px = DistanceToDepthEdges(depth_, options_.select.edge_depth_rel);
+  std::vector<ViewSelectStats> stats(set_.buffers.size());
+  ForEachBuffer(seen, false, [&](size_t b) {
+    stats[b] = SelectViews(set_.buffers[b], inputs, options_.select, painted_[b], &warped_[b]);
+  });
+  long long candidates = 0, kept = 0, near_edge = 0;
+  for (size_t b : seen) {
+    candidates += stats[b].candidates;
+    kept += stats[b].kept;
+    near_edge += stats[b].near_edge;
+  }
+  report.metrics["texels_candidate"] = static_cast<double>(candidates);
+  report.metrics["texels_kept_better"] = static_cast<double>(kept);
+  report.metrics["texels_near_edge"] = static_cast<double>(near_edge);
+  report.wall_ms = MsSince(start);
+  return report;
+}
+
+}  // namespace fresco
