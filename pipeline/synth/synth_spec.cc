@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -479,14 +480,30 @@ Status ApplyOverride(const SynthSpecOverride& o, const std::string& file, json* 
   std::vector<std::string> parts;
   while (std::getline(keys, key, '.')) parts.push_back(key);
   if (parts.empty()) return Status::Error(file + ": empty setting name");
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    path += (path.empty() ? "" : ".") + parts[i];
-    json& child = (*node)[parts[i]];
-    if (child.is_null()) child = json::object();
-    if (!child.is_object()) return Status::Error(file + ": " + path + ": is not an object");
-    node = &child;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    json* child = nullptr;
+    if (node->is_array()) {  // a list's entry by its index: streams.1.lens
+      char* end = nullptr;
+      const unsigned long index = std::strtoul(parts[i].c_str(), &end, 10);
+      if (parts[i].empty() || *end != '\0' || index >= node->size()) {
+        return Status::Error(file + ": " + path + ": has no entry '" + parts[i] + "' (0.." +
+                             std::to_string(static_cast<long>(node->size()) - 1) + ")");
+      }
+      path += "[" + parts[i] + "]";
+      child = &(*node)[index];
+    } else {
+      path += (path.empty() ? "" : ".") + parts[i];
+      child = &(*node)[parts[i]];
+    }
+    if (i + 1 == parts.size()) {
+      *child = value;
+      break;
+    }
+    if (child->is_null()) *child = json::object();
+    if (!child->is_object() && !child->is_array())
+      return Status::Error(file + ": " + path + ": is not an object");
+    node = child;
   }
-  (*node)[parts.back()] = value;
   return Status::Ok();
 }
 

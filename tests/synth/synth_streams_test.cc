@@ -77,6 +77,19 @@ TEST(SynthStreams, SpecGivesEachStreamItsCameraPathAndFrames) {
     EXPECT_GT(target_in_cam.z(), 1.0);
     EXPECT_LT(target_in_cam.head<2>().norm(), 1e-9);
   }
+  // --set reaches a stream by its index.
+  SynthSpecInput input;
+  input.name = "spec.json";
+  input.text = kTwoStreamSpec;
+  input.overrides = {{"streams.1.lens", "opencv8", true}, {"streams.0.path.eye", "[1, 2, 1]"}};
+  SynthJob overridden;
+  Status s = BuildSynthJob(input, &overridden);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(overridden.streams[1].options.lens, LensModel::kOpenCV8);
+  EXPECT_EQ(overridden.streams[0].options.eye, Eigen::Vector3d(1, 2, 1));
+  input.overrides = {{"streams.2.lens", "opencv8", true}};
+  s = BuildSynthJob(input, &overridden);
+  EXPECT_EQ(s.message(), "spec.json: streams: has no entry '2' (0..1)");
   // "eye" places it; the spec without streams is what it was.
   const SynthJob placed =
       BuildJob(R"({"scene": "builtin:cube-room", "path": {"kind": "fixed", "eye": [1, 2, -1.5]}})");
