@@ -604,6 +604,12 @@ Status ReadStreams(const json& value, const std::string& file, const SceneInfo& 
                                                /*stream=*/true, &stream.options));
     FRESCO_RETURN_IF_ERROR(ReadCameraKeys(r, &stream.options));
     FRESCO_RETURN_IF_ERROR(r.Number("time_offset_s", &stream.time_offset_s));
+    FRESCO_RETURN_IF_ERROR(r.Number("fps", &stream.fps));
+    if (r.Has("fps") && !(stream.fps > 0 && stream.fps <= 1000))
+      return r.Error("fps", "must be in (0, 1000]");
+    if (i > 0 && (stream.fps > 0) != (job->streams[0].fps > 0))
+      return r.Error("fps", "give every stream's fps or none (streams[0] " +
+                                std::string(job->streams[0].fps > 0 ? "has one)" : "has none)"));
     FRESCO_RETURN_IF_ERROR(r.Finish());
     if (Status check = stream.options.Check(); !check.ok())
       return Status::Error(file + ": " + what + "." + check.message());

@@ -35,7 +35,7 @@
 //     "supersample": 2, "background_rgb": [128, 128, 128], "seed": 1, "threads": 0,
 //     "streams": [{"name": "fixed", "path": {"kind": "fixed", "eye": [..], "target": [..]},
 //                  "frames", "size", "lens", "hfov_deg", "pose_noise_deg", "pose_noise_m",
-//                  "exposure", "supersample", "seed", "time_offset_s"}, ...]
+//                  "exposure", "supersample", "seed", "time_offset_s", "fps"}, ...]
 //   }
 // "streams" makes a multi-camera capture: each entry starts from the settings above and
 // overrides them (a path with a "kind" starts from the scene's defaults for that kind);

@@ -282,9 +282,16 @@ Status PlanSynthStreams(const Scene& scene, const std::vector<SynthStream>& stre
   plans->assign(streams.size(), SynthCapture());
   for (size_t k = 0; k < streams.size(); ++k) {
     SynthOptions& o = (*resolved)[k].options;
-    if (k > 0) {  // the movers the first stream placed, for every stream
+    if (k > 0) {  // the movers the first stream placed, for every stream, on one clock
       o.movers = (*plans)[0].movers;
       o.random_movers = 0;
+      if (streams[k].fps > 0 && streams[0].fps > 0) {
+        const double frames_per_first_frame = streams[k].fps / streams[0].fps;
+        for (MoverOptions& m : o.movers) {
+          m.period_frames *= frames_per_first_frame;
+          m.spin_deg_per_frame /= frames_per_first_frame;
+        }
+      }
     }
     if (Status s = PlanSynthCapture(scene, o, &(*plans)[k]); !s.ok())
       return Status::Error("streams[" + std::to_string(k) + "]." + s.message());
@@ -307,6 +314,7 @@ Status WriteSynthStreams(const Scene& scene, const std::vector<SynthStream>& str
   for (size_t k = 0; k < resolved.size(); ++k) {
     h.AddString(resolved[k].name);
     h.AddValue(resolved[k].time_offset_s);
+    h.AddValue(resolved[k].fps);
     h.AddString(PlanFingerprint(scene, resolved[k].options, plans[k]));
     result->frames += static_cast<int>(plans[k].true_poses.size());
   }
@@ -338,10 +346,12 @@ Status WriteSynthStreams(const Scene& scene, const std::vector<SynthStream>& str
     FRESCO_RETURN_IF_ERROR(frames_dirs[k]->Commit());
     FRESCO_RETURN_IF_ERROR(WriteStreamFiles(plans[k], root / name));
     project.streams.push_back({name + "/camera.cameramodel", name + "/frames/",
-                               name + "/sparse/images.txt", resolved[k].time_offset_s});
+                               name + "/sparse/images.txt", resolved[k].time_offset_s,
+                               resolved[k].fps});
     json stream = json::parse(SynthOptionsToJson(resolved[k].options));
     stream["name"] = name;
     stream["time_offset_s"] = resolved[k].time_offset_s;
+    if (resolved[k].fps > 0) stream["fps"] = resolved[k].fps;
     settings["streams"].push_back(stream);
   }
   return FinishCaptureFolder(scene, root, settings, write_options, result->fingerprint, project);

@@ -58,7 +58,8 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
 // A multi-camera capture: each stream in DIR/NAME/ (frames/, camera.cameramodel, sparse/,
 // truth/ as above), the scene, synth.json (each stream's settings) and a version-2
 // DIR/project.json listing the streams (NAME/camera.cameramodel, NAME/frames/,
-// NAME/sparse/images.txt, the stream's time offset); true poses are in NAME/truth/images.txt.
+// NAME/sparse/images.txt, the stream's time offset and fps); true poses are in
+// NAME/truth/images.txt.
 // The first stream's movers (explicit and placed) are every stream's movers: frame i of
 // every stream shows them where they are at frame i. All frames are rendered before anything
 // of an earlier capture in DIR is replaced. result->frames counts every stream's frames.

@@ -86,6 +86,10 @@ struct SynthStream {
   std::string name;
   SynthOptions options;
   double time_offset_s = 0.0;
+  // Frames per second, written into the project (frames are painted in time order); 0: not
+  // given (every stream gives it or none does). The movers keep to one clock: a stream at
+  // twice the first stream's rate sees them move half as far per frame.
+  double fps = 0.0;
 };
 
 struct SynthCapture {

@@ -172,6 +172,53 @@ TEST(SynthStreams, WritesAFolderPerStreamAndAVersion2Project) {
   EXPECT_FALSE(fs::exists(dir + "/b/frames/000001.png"));
 }
 
+TEST(SynthStreams, StreamsWithFpsArePaintedInTimeOrderAndMoversKeepOneClock) {
+  const SynthJob job = BuildJob(R"({"scene": "builtin:cube-room", "size": [48, 36],
+    "supersample": 1, "movers": [{"start": [0, 1, 0], "end": [1, 1, 0], "period_frames": 8}],
+    "streams": [{"name": "slow", "frames": 2, "fps": 10, "path": {"kind": "fixed"}},
+                {"name": "fast", "frames": 6, "fps": 30}]})");
+  ASSERT_EQ(job.streams.size(), 2u);
+  const std::string dir = MakeTempDir("synth-streams-fps");
+  Status s = WriteSynthStreams(job.scene, job.streams, dir, SynthWriteOptions());
+  ASSERT_TRUE(s.ok()) << s.message();
+  Project project;
+  s = LoadProject(dir + "/project.json", {}, &project);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(project.streams[0].fps, 10);
+  EXPECT_EQ(project.streams[1].fps, 30);
+  // Time order: slow 0 (t 0), fast 0, 1, 2 (t 0, 1/30, 2/30), slow 1 (t 0.1 = fast 3's time,
+  // the stream listed first), fast 3, 4, 5.
+  std::unique_ptr<PaintJob> paint;
+  s = OpenPaintJob(project, PaintJobOptions(), &paint);
+  ASSERT_TRUE(s.ok()) << s.message();
+  PaintRun run(paint->session.get(), paint->source.get(), PaintRunOptions());
+  std::vector<int> order;
+  PaintRunHooks hooks;
+  hooks.after_frame = [&](const RunFrame& frame, const FrameReport*) {
+    order.push_back(frame.stream);
+    return Status::Ok();
+  };
+  ASSERT_TRUE(RunToEnd(&run, hooks).ok());
+  EXPECT_EQ(order, (std::vector<int>{0, 1, 1, 1, 0, 1, 1, 1}));
+  // The mover is where it is at that time in both streams: slow frame 1 = fast frame 3.
+  const nlohmann::json slow = nlohmann::json::parse(ReadText(dir + "/slow/truth/movers.json"));
+  const nlohmann::json fast = nlohmann::json::parse(ReadText(dir + "/fast/truth/movers.json"));
+  const nlohmann::json& a = slow["movers"][0]["centre_per_frame"][1];
+  const nlohmann::json& b = fast["movers"][0]["centre_per_frame"][3];
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c].get<double>(), b[c].get<double>(), 1e-9) << c;
+  EXPECT_GT(a[0].get<double>(), 0.1);  // it has moved
+  // Without fps on every stream: in turn by frame index, as before.
+  SynthSpecInput input;
+  input.name = "spec.json";
+  input.text = R"({"scene": "builtin:cube-room", "streams": [{"fps": 10}, {}]})";
+  SynthJob bad;
+  EXPECT_EQ(BuildSynthJob(input, &bad).message(),
+            "spec.json: streams[1].fps: give every stream's fps or none (streams[0] has one)");
+  input.text = R"({"scene": "builtin:cube-room", "streams": [{"fps": 0}]})";
+  EXPECT_EQ(BuildSynthJob(input, &bad).message(),
+            "spec.json: streams[0].fps: must be in (0, 1000]");
+}
+
 TEST(SynthStreams, CommandWritesStreamsThatRunPaintsWithPerStreamCounts) {
   const std::string dir = MakeTempDir("synth-streams-cli");
   WriteText(dir + "/spec.json", R"({"scene": "builtin:cube-room", "size": [64, 48],
