@@ -34,6 +34,9 @@ ArgSpec SynthArgSpec() {
       "  (given poses)  DIR/truth/images.txt (true poses)  DIR/truth/exposure.txt\n"
       "  DIR/truth/movers.json  DIR/scene.gltf (without movers)  DIR/synth.json\n"
       "  DIR/project.json\n"
+      "A spec with \"streams\" (several cameras, e.g. a fixed one and a hand-held one) writes\n"
+      "  each stream's files in DIR/NAME/ and a project listing the streams; options below\n"
+      "  set every stream's defaults.\n"
       "The same scene and settings (and seed) give the same files. Ctrl-C (or SIGTERM) while\n"
       "rendering stops, keeps DIR's earlier capture (or none) and exits 130 (143).\n"
       "\n"
@@ -49,9 +52,10 @@ ArgSpec SynthArgSpec() {
       "  --lens L            pinhole (default), or opencv4/opencv5/opencv8 with mild\n"
       "                      barrel distortion\n"
       "  --hfov DEG          horizontal field of view (default 70): fx = W/2 / tan(hfov/2)\n"
-      "  --path P            orbit, walk or handheld (default: handheld in the room, walk\n"
-      "                      down the street, orbit around other scenes); its geometry\n"
-      "                      fits the scene, tune it with --set path.radius_m=... etc.\n"
+      "  --path P            orbit, walk, handheld or fixed (default: handheld in the\n"
+      "                      room, walk down the street, orbit around other scenes); its\n"
+      "                      geometry fits the scene, tune it with --set path.radius_m=...\n"
+      "                      (fixed: a still camera at path.eye looking at path.target)\n"
       "  --movers N          add N moving coloured spheres/boxes (in frames only, never in\n"
       "                      the written scene)\n"
       "  --pose-noise-deg X  RMS rotation error of the given poses, degrees (default 0)\n"
@@ -170,7 +174,9 @@ int RunVerbSynth(const CommandArgs& argv) {
   SynthWriteOptions write_options;
   write_options.skip_if_current = args.Switch("--if-changed");
   write_options.scene_source = job.scene_source;
-  Progress progress("synth", job.options.frames);
+  int total_frames = job.streams.empty() ? job.options.frames : 0;
+  for (const SynthStream& stream : job.streams) total_frames += stream.options.frames;
+  Progress progress("synth", total_frames);
   int frames_written = 0;
   write_options.progress = [&](int done, int total) {
     frames_written = done;
@@ -179,13 +185,15 @@ int RunVerbSynth(const CommandArgs& argv) {
   write_options.stop = [] { return Interrupted(); };
   SynthWriteResult result;
   InterruptCatcher interrupt;
-  status = WriteSynthCapture(job.scene, job.options, out, write_options, &result);
+  status = job.streams.empty()
+               ? WriteSynthCapture(job.scene, job.options, out, write_options, &result)
+               : WriteSynthStreams(job.scene, job.streams, out, write_options, &result);
   if (Interrupted() && !status.ok()) {
     progress.Clear();
     std::fprintf(stderr,
                  "fresco synth: interrupted by %s after %d of %d frames; %s keeps its earlier "
                  "capture, if any (nothing of this one was kept)\n",
-                 InterruptSignalName().c_str(), frames_written, job.options.frames, out.c_str());
+                 InterruptSignalName().c_str(), frames_written, total_frames, out.c_str());
     return InterruptExitCode();
   }
   if (!status.ok()) {
@@ -198,9 +206,19 @@ int RunVerbSynth(const CommandArgs& argv) {
     return kExitOk;
   }
   progress.Finish();
-  std::cout << "wrote " << out << ": " << result.frames << " frames " << job.options.width << "x"
-            << job.options.height << " of " << job.scene_source << "\n"
-            << "run it: fresco run " << (fs::path(out) / "project.json").string() << " --out OUT\n";
+  if (job.streams.empty()) {
+    std::cout << "wrote " << out << ": " << result.frames << " frames " << job.options.width << "x"
+              << job.options.height << " of " << job.scene_source << "\n";
+  } else {
+    std::cout << "wrote " << out << ": " << job.streams.size() << " streams of " << job.scene_source
+              << "\n";
+    for (const SynthStream& stream : job.streams) {
+      const SynthOptions& o = stream.options;
+      std::cout << "  " << stream.name << "/: " << o.frames << " frames " << o.width << "x"
+                << o.height << ", " << CameraPathKindName(o.path) << " path\n";
+    }
+  }
+  std::cout << "run it: fresco run " << (fs::path(out) / "project.json").string() << " --out OUT\n";
   if (Interrupted()) {  // after the frames: the capture was finished first
     std::fprintf(stderr, "fresco synth: interrupted by %s while writing; finished %s first\n",
                  InterruptSignalName().c_str(), out.c_str());

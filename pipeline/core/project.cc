@@ -223,6 +223,7 @@ void Fields(StreamSpec& s, V& v) {
   v.Field("video", s.video, {.required = true, .non_empty = true});
   v.Field("poses", s.poses, {.required = true, .non_empty = true});
   v.Field("time_offset_s", s.time_offset_s);
+  v.Field("fps", s.fps, {.min = 0, .max = 10000});
 }
 
 // camera, video, poses and time_offset_s (version 1) and streams (version 2) are each
@@ -255,7 +256,7 @@ static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSp
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 72, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
 static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(StreamSpec) == 104, "see Fields(StreamSpec)");
+static_assert(sizeof(void*) != 8 || sizeof(StreamSpec) == 112, "see Fields(StreamSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(Project) == 712, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------

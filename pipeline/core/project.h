@@ -243,6 +243,9 @@ struct StreamSpec {
   std::string video;
   std::string poses;
   double time_offset_s = 0.0;
+  // Frames per second of a file video, > 0 on every stream: frames are painted in time order
+  // (frame i of a stream at i / fps). 0 on any stream: in turn by frame index.
+  double fps = 0.0;
 
   bool operator==(const StreamSpec&) const = default;
 };

@@ -103,6 +103,10 @@ Status LoadEvalSuite(const std::string& path, EvalSuite* suite) {
       return Status::Error(c.spec_name + ": name '" + c.name + "' is used twice");
     SynthJob job;
     FRESCO_RETURN_IF_ERROR(BuildSuiteCaptureJob(*suite, c, &job));
+    if (!job.streams.empty()) {
+      return Status::Error(c.spec_name +
+                           ": streams: the evaluation suite scores one-camera captures");
+    }
   }
   return Status::Ok();
 }

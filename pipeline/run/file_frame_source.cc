@@ -1,14 +1,34 @@
 #include "pipeline/run/file_frame_source.h"
 
+#include <algorithm>
+
 namespace fresco {
 
 FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams)
-    : streams_(streams), ended_(streams.size(), false) {
+    : streams_(streams), ended_(streams.size(), false), read_(streams.size(), 0) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < streams_.size(); ++s) {
     origins_.push_back({project.Resolve(specs[s].video), project.Resolve(specs[s].poses)});
     readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get()));
+    fps_.push_back(specs[s].fps);
   }
+  if (std::any_of(fps_.begin(), fps_.end(), [](double fps) { return !(fps > 0); })) fps_.clear();
+}
+
+int FileFrameSource::PickStream() {
+  const int n = static_cast<int>(streams_.size());
+  int best = -1;
+  for (int k = 0; k < n; ++k) {
+    const int s = fps_.empty() ? (next_ + k) % n : k;
+    if (ended_[s]) continue;
+    if (fps_.empty()) {
+      next_ = (s + 1) % n;
+      return s;
+    }
+    // Next frame times read/fps compared without division: equal times stay equal.
+    if (best < 0 || read_[s] * fps_[best] < read_[best] * fps_[s]) best = s;
+  }
+  return best;
 }
 
 int FileFrameSource::FrameCount() const {
@@ -22,15 +42,13 @@ int FileFrameSource::FrameCount() const {
 }
 
 FrameRead FileFrameSource::Next(SourcedFrame* frame, Status* status) {
-  for (size_t tried = 0; tried < streams_.size(); ++tried) {
-    const int s = next_;
-    next_ = (next_ + 1) % static_cast<int>(streams_.size());
-    if (ended_[s]) continue;
+  for (int s = PickStream(); s >= 0; s = PickStream()) {
     if (!readers_[s]->Next(&frame->posed.frame, status)) {
       if (!status->ok()) return FrameRead::kEnded;
       ended_[s] = true;
       continue;
     }
+    ++read_[s];
     frame->stream = s;
     MatchPose(s, frame);
     return FrameRead::kFrame;

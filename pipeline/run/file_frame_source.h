@@ -1,8 +1,10 @@
 // Posed frames from files: each stream's video (a folder of images or a video file) with
 // its poses file (COLMAP images.txt matched by name, TUM matched in order). Several streams
-// are interleaved by frame index: frame 0 of each stream, then frame 1 of each, ... (what
-// cameras recording the same period at the same rate give); a stream that ends leaves the
-// others going on. Each stream is read one frame ahead on its own thread (read_ahead.h).
+// are interleaved in time order when every stream gives its `fps` (frame i at i / fps; at
+// equal times the stream listed first), else by frame index: frame 0 of each stream, then
+// frame 1 of each, ... (what cameras recording the same period at the same rate give); a
+// stream that ends leaves the others going on. Each stream is read one frame ahead on its own
+// thread (read_ahead.h).
 #pragma once
 
 #include <memory>
@@ -29,12 +31,16 @@ class FileFrameSource : public PosedFrameSource {
  private:
   // Fills the pose, camera and its identity of a frame of stream `s`.
   void MatchPose(int s, SourcedFrame* frame) const;
+  // The stream to read from next (time order or in turn), -1 when every stream ended.
+  int PickStream();
 
   std::vector<const Capture*> streams_;
   std::vector<FrameOrigin> origins_;
   std::vector<std::unique_ptr<ReadAhead>> readers_;
   std::vector<bool> ended_;
-  int next_ = 0;  // the stream to read from next
+  std::vector<double> fps_;      // per stream, when every stream has one (else empty)
+  std::vector<long long> read_;  // frames read per stream
+  int next_ = 0;                 // in turn: the stream to read from next
 };
 
 }  // namespace fresco

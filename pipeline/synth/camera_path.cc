@@ -39,13 +39,15 @@ std::string CameraPathKindName(CameraPathKind kind) {
       return "walk";
     case CameraPathKind::kHandheld:
       return "handheld";
+    case CameraPathKind::kFixed:
+      return "fixed";
   }
   return "?";
 }
 
 bool CameraPathKindFromName(const std::string& name, CameraPathKind* kind) {
-  for (CameraPathKind k :
-       {CameraPathKind::kOrbit, CameraPathKind::kWalk, CameraPathKind::kHandheld}) {
+  for (CameraPathKind k : {CameraPathKind::kOrbit, CameraPathKind::kWalk, CameraPathKind::kHandheld,
+                           CameraPathKind::kFixed}) {
     if (name == CameraPathKindName(k)) {
       *kind = k;
       return true;
@@ -58,6 +60,7 @@ Status CameraPathOptions::Check() const {
   if (!FiniteVector(target)) return Status::Error("path.target: not finite");
   if (!FiniteVector(walk_from)) return Status::Error("path.walk_from: not finite");
   if (!FiniteVector(walk_to)) return Status::Error("path.walk_to: not finite");
+  if (!FiniteVector(eye)) return Status::Error("path.eye: not finite");
   const double values[] = {radius_m,   height_m,  turns,    start_deg,       wander_m,
                            wobble_deg, pitch_deg, tilt_deg, look_around_deg, bob_m};
   for (double v : values) {
@@ -74,6 +77,9 @@ Status CameraPathOptions::Check() const {
   }
   if (kind == CameraPathKind::kWalk && (walk_to - walk_from).norm() < 1e-6) {
     return Status::Error("path.walk_to: must differ from path.walk_from");
+  }
+  if (kind == CameraPathKind::kFixed && (target - eye).norm() < 1e-6) {
+    return Status::Error("path.eye: must differ from path.target (the point looked at)");
   }
   return Status::Ok();
 }
@@ -157,6 +163,19 @@ std::vector<Rigid3d> MakeCameraPath(const CameraPathOptions& o, int frames, unsi
         pitch = std::clamp(o.pitch_deg * kDegToRad + wobble * shake_pitch(u), -1.5, 1.5);
         poses.push_back(
             LookAlong(eye, DirectionFromYawPitch(yaw, pitch), 0.4 * wobble * shake_roll(u)));
+        break;
+      }
+      case CameraPathKind::kFixed: {
+        if (wobble == 0.0) {
+          poses.push_back(LookAt(o.eye, o.target));
+          break;
+        }
+        double yaw = 0.0, pitch = 0.0;
+        YawPitchFromDirection(o.target - o.eye, &yaw, &pitch);
+        yaw += wobble * shake_yaw(u);
+        pitch = std::clamp(pitch + wobble * shake_pitch(u), -1.5, 1.5);
+        poses.push_back(
+            LookAlong(o.eye, DirectionFromYawPitch(yaw, pitch), 0.4 * wobble * shake_roll(u)));
         break;
       }
     }

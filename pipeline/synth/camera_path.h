@@ -7,7 +7,9 @@
 //    bob, looking ahead and glancing left and right (`look_around_deg`);
 //  - handheld: a hand-held camera wandering around `target` (circle of `radius_m` plus smooth
 //    random wander of `wander_m`), either looking at the target or looking freely around
-//    (`turns` full turns of heading over the capture), with smooth shake (`wobble_deg`).
+//    (`turns` full turns of heading over the capture), with smooth shake (`wobble_deg`);
+//  - fixed: a camera mounted at `eye` looking at `target` (a surveillance camera), still
+//    unless `wobble_deg` > 0 (a mast in the wind).
 #pragma once
 
 #include <string>
@@ -21,8 +23,9 @@
 
 namespace fresco {
 
-enum class CameraPathKind { kOrbit, kWalk, kHandheld };
-std::string CameraPathKindName(CameraPathKind kind);  // "orbit" | "walk" | "handheld"
+enum class CameraPathKind { kOrbit, kWalk, kHandheld, kFixed };
+// "orbit" | "walk" | "handheld" | "fixed"
+std::string CameraPathKindName(CameraPathKind kind);
 bool CameraPathKindFromName(const std::string& name, CameraPathKind* kind);
 
 struct CameraPathOptions {
@@ -50,6 +53,8 @@ struct CameraPathOptions {
   Eigen::Vector3d walk_to = Eigen::Vector3d(1, 0, 0);
   double look_around_deg = 20.0;  // walk: amplitude of the glances left/right
   double bob_m = 0.02;            // walk: vertical step bob amplitude
+  // fixed: where the camera is mounted, world, metres (it looks at `target`).
+  Eigen::Vector3d eye = Eigen::Vector3d(0, 0, 1);
 
   Status Check() const;  // message names the field
 };

@@ -1,6 +1,8 @@
 #include "pipeline/synth/synth_spec.h"
 
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -361,12 +363,22 @@ void SceneDefaults(const SceneInfo& info, CameraPathKind kind, SynthOptions* o) 
       break;
     }
   }
+  if (kind == CameraPathKind::kFixed) {  // a still camera looking at the target
+    p.wobble_deg = 0.0;
+    if (info.kind == SceneKind::kRoom) {  // up in a corner, as surveillance cameras are
+      p.radius_m = 0.6 * std::min(info.room_size.x(), info.room_size.z());
+      p.height_m = 0.85 * info.room_size.y();
+      p.start_deg = 45.0;
+    }
+  }
   o->SetPathOptions(p);
 }
 
-Status ReadPath(const json& value, const std::string& file, CameraPathOptions* p) {
-  if (!value.is_object()) return Status::Error(file + ": path: must be an object");
-  ObjectReader r(value, "path", file);
+// `field`: "path" or "streams[N].path", for messages.
+Status ReadPath(const json& value, const std::string& file, const std::string& field,
+                CameraPathOptions* p) {
+  if (!value.is_object()) return Status::Error(file + ": " + field + ": must be an object");
+  ObjectReader r(value, field, file);
   std::string kind;
   FRESCO_RETURN_IF_ERROR(r.String("kind", &kind));  // applied before (defaults depend on it)
   FRESCO_RETURN_IF_ERROR(r.Vector<3>("target", &p->target));
@@ -383,6 +395,14 @@ Status ReadPath(const json& value, const std::string& file, CameraPathOptions* p
   FRESCO_RETURN_IF_ERROR(r.Vector<3>("walk_to", &p->walk_to));
   FRESCO_RETURN_IF_ERROR(r.Number("look_around_deg", &p->look_around_deg));
   FRESCO_RETURN_IF_ERROR(r.Number("bob_m", &p->bob_m));
+  // A fixed camera stands where the path's circle starts unless placed with `eye` (or, for
+  // a stream's path without a kind, where the spec's path put it).
+  const double start_rad = p->start_deg * M_PI / 180.0;
+  if (value.contains("kind")) {
+    p->eye = Eigen::Vector3d(p->target.x() + p->radius_m * std::cos(start_rad), p->height_m,
+                             p->target.z() + p->radius_m * std::sin(start_rad));
+  }
+  FRESCO_RETURN_IF_ERROR(r.Vector<3>("eye", &p->eye));
   return r.Finish();
 }
 
@@ -460,14 +480,141 @@ Status ApplyOverride(const SynthSpecOverride& o, const std::string& file, json* 
   std::vector<std::string> parts;
   while (std::getline(keys, key, '.')) parts.push_back(key);
   if (parts.empty()) return Status::Error(file + ": empty setting name");
-  for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    path += (path.empty() ? "" : ".") + parts[i];
-    json& child = (*node)[parts[i]];
-    if (child.is_null()) child = json::object();
-    if (!child.is_object()) return Status::Error(file + ": " + path + ": is not an object");
-    node = &child;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    json* child = nullptr;
+    if (node->is_array()) {  // a list's entry by its index: streams.1.lens
+      char* end = nullptr;
+      const unsigned long index = std::strtoul(parts[i].c_str(), &end, 10);
+      if (parts[i].empty() || *end != '\0' || index >= node->size()) {
+        return Status::Error(file + ": " + path + ": has no entry '" + parts[i] + "' (0.." +
+                             std::to_string(static_cast<long>(node->size()) - 1) + ")");
+      }
+      path += "[" + parts[i] + "]";
+      child = &(*node)[index];
+    } else {
+      path += (path.empty() ? "" : ".") + parts[i];
+      child = &(*node)[parts[i]];
+    }
+    if (i + 1 == parts.size()) {
+      *child = value;
+      break;
+    }
+    if (child->is_null()) *child = json::object();
+    if (!child->is_object() && !child->is_array())
+      return Status::Error(file + ": " + path + ": is not an object");
+    node = child;
   }
-  (*node)[parts.back()] = value;
+  return Status::Ok();
+}
+
+// The path's kind from `object`'s "path" (default `kind`), the scene's defaults for it,
+// then the path's other keys. The spec itself always takes the defaults; a stream (`r`
+// names "streams[N]") only when its path names a kind, and keeps the spec's mover region.
+Status ReadPathAndDefaults(const json& object, ObjectReader& r, const SceneInfo& info,
+                           CameraPathKind kind, bool stream, SynthOptions* o) {
+  const json* path = object.contains("path") ? &object["path"] : nullptr;
+  const bool has_kind = path && path->is_object() && path->contains("kind");
+  if (has_kind) {
+    const json& k = (*path)["kind"];
+    if (!k.is_string() || !CameraPathKindFromName(k.get<std::string>(), &kind)) {
+      return r.Error("path.kind", "must be \"orbit\", \"walk\", \"handheld\" or \"fixed\"");
+    }
+  }
+  if (!stream) {
+    SceneDefaults(info, kind, o);
+  } else if (has_kind) {
+    const Eigen::Vector3d region_min = o->mover_region_min, region_max = o->mover_region_max;
+    SceneDefaults(info, kind, o);
+    o->mover_region_min = region_min;
+    o->mover_region_max = region_max;
+  }
+  if (const json* p = r.Get("path")) {
+    CameraPathOptions path_options = o->PathOptions();
+    FRESCO_RETURN_IF_ERROR(ReadPath(*p, r.file(), r.Field("path"), &path_options));
+    o->SetPathOptions(path_options);
+  }
+  return Status::Ok();
+}
+
+// The keys a spec and each of its streams may set: the camera, its frames and the noise.
+Status ReadCameraKeys(ObjectReader& r, SynthOptions* o) {
+  FRESCO_RETURN_IF_ERROR(r.Int("frames", &o->frames));
+  if (const json* size = r.Get("size")) {
+    bool ok = false;
+    if (size->is_array() && size->size() == 2 && (*size)[0].is_number_integer() &&
+        (*size)[1].is_number_integer()) {
+      o->width = (*size)[0].get<int>();
+      o->height = (*size)[1].get<int>();
+      ok = true;
+    } else if (size->is_string()) {
+      const std::string s = size->get<std::string>();
+      char x = 0, extra = 0;
+      std::istringstream in(s);
+      ok = static_cast<bool>(in >> o->width >> x >> o->height) && (x == 'x' || x == 'X') &&
+           !(in >> extra);
+    }
+    if (!ok) return r.Error("size", "must be [width, height] or \"WIDTHxHEIGHT\"");
+  }
+  std::string lens;
+  FRESCO_RETURN_IF_ERROR(r.String("lens", &lens));
+  if (!lens.empty() && !LensFromName(lens, &o->lens)) {
+    return r.Error("lens", "unknown lens '" + lens + "' (pinhole, opencv4, opencv5, opencv8)");
+  }
+  FRESCO_RETURN_IF_ERROR(r.Number("hfov_deg", &o->hfov_deg));
+  FRESCO_RETURN_IF_ERROR(r.Number("pose_noise_deg", &o->pose_noise_deg));
+  FRESCO_RETURN_IF_ERROR(r.Number("pose_noise_m", &o->pose_noise_m));
+  FRESCO_RETURN_IF_ERROR(r.Number("exposure", &o->exposure_jitter));
+  FRESCO_RETURN_IF_ERROR(r.Int("supersample", &o->supersample));
+  return r.Unsigned("seed", &o->seed);
+}
+
+// A stream's folder name: letters, digits, '-', '_' and '.', not starting with '.'.
+bool StreamNameOk(const std::string& name) {
+  if (name.empty() || name.size() > 64 || name[0] == '.') return false;
+  for (char c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.')
+      return false;
+  }
+  return true;
+}
+
+// "streams": each entry starts from the spec's settings (job->options) and overrides its
+// name, path, camera, frames, noise and time offset.
+Status ReadStreams(const json& value, const std::string& file, const SceneInfo& info,
+                   SynthJob* job) {
+  if (!value.is_array() || value.empty())
+    return Status::Error(file + ": streams: must be a non-empty array of objects");
+  if (value.size() > 64) return Status::Error(file + ": streams: at most 64 streams");
+  std::set<std::string> names;
+  for (size_t i = 0; i < value.size(); ++i) {
+    const std::string what = "streams[" + std::to_string(i) + "]";
+    if (!value[i].is_object()) return Status::Error(file + ": " + what + ": must be an object");
+    ObjectReader r(value[i], what, file);
+    SynthStream stream;
+    stream.name = "stream" + std::to_string(i);
+    stream.options = job->options;
+    FRESCO_RETURN_IF_ERROR(r.String("name", &stream.name));
+    if (!StreamNameOk(stream.name)) {
+      return r.Error("name",
+                     "'" + stream.name + "' is not a folder name (letters, digits, '-', '_', '.')");
+    }
+    if (!names.insert(stream.name).second)
+      return r.Error("name", "'" + stream.name + "' names two streams");
+    FRESCO_RETURN_IF_ERROR(ReadPathAndDefaults(value[i], r, info, stream.options.path,
+                                               /*stream=*/true, &stream.options));
+    FRESCO_RETURN_IF_ERROR(ReadCameraKeys(r, &stream.options));
+    FRESCO_RETURN_IF_ERROR(r.Number("time_offset_s", &stream.time_offset_s));
+    FRESCO_RETURN_IF_ERROR(r.Number("fps", &stream.fps));
+    if (r.Has("fps") && !(stream.fps > 0 && stream.fps <= 1000))
+      return r.Error("fps", "must be in (0, 1000]");
+    if (i > 0 && (stream.fps > 0) != (job->streams[0].fps > 0))
+      return r.Error("fps", "give every stream's fps or none (streams[0] " +
+                                std::string(job->streams[0].fps > 0 ? "has one)" : "has none)"));
+    FRESCO_RETURN_IF_ERROR(r.Finish());
+    if (Status check = stream.options.Check(); !check.ok())
+      return Status::Error(file + ": " + what + "." + check.message());
+    job->streams.push_back(stream);
+  }
   return Status::Ok();
 }
 
@@ -490,7 +637,8 @@ Status BuildSynthJob(const SynthSpecInput& input, SynthJob* job) {
 
   // Scene first: the defaults depend on it.
   const json* scene = r.Get("scene");
-  if (!scene) return r.Error("scene", "missing (e.g. \"builtin:cube-room\" or a glTF, PLY or OBJ file)");
+  if (!scene)
+    return r.Error("scene", "missing (e.g. \"builtin:cube-room\" or a glTF, PLY or OBJ file)");
   SceneInfo info;
   FRESCO_RETURN_IF_ERROR(BuildScene(*scene, file, input.base_dir, job, &info));
   if (const json* mesh = r.Get("mesh")) {
@@ -510,49 +658,15 @@ Status BuildSynthJob(const SynthSpecInput& input, SynthJob* job) {
   info.bounds_max = job->scene.WorldFromLocal(info.bounds_max);
 
   SynthOptions& o = job->options;
-  CameraPathKind kind = info.kind == SceneKind::kStreet   ? CameraPathKind::kWalk
-                        : info.kind == SceneKind::kObject ? CameraPathKind::kOrbit
-                                                          : CameraPathKind::kHandheld;
-  const json* path = spec.contains("path") ? &spec["path"] : nullptr;
-  if (path && path->is_object() && path->contains("kind")) {
-    const json& k = (*path)["kind"];
-    if (!k.is_string() || !CameraPathKindFromName(k.get<std::string>(), &kind)) {
-      return r.Error("path.kind", "must be \"orbit\", \"walk\" or \"handheld\"");
-    }
-  }
-  SceneDefaults(info, kind, &o);
-  if (const json* p = r.Get("path")) {
-    CameraPathOptions path_options = o.PathOptions();
-    FRESCO_RETURN_IF_ERROR(ReadPath(*p, file, &path_options));
-    o.SetPathOptions(path_options);
-  }
+  const CameraPathKind kind = info.kind == SceneKind::kStreet   ? CameraPathKind::kWalk
+                              : info.kind == SceneKind::kObject ? CameraPathKind::kOrbit
+                                                                : CameraPathKind::kHandheld;
+  FRESCO_RETURN_IF_ERROR(ReadPathAndDefaults(spec, r, info, kind, /*stream=*/false, &o));
 
   std::string out;
   FRESCO_RETURN_IF_ERROR(r.String("out", &out));
   job->out_dir = Resolve(input.base_dir, out);
-  FRESCO_RETURN_IF_ERROR(r.Int("frames", &o.frames));
-  if (const json* size = r.Get("size")) {
-    bool ok = false;
-    if (size->is_array() && size->size() == 2 && (*size)[0].is_number_integer() &&
-        (*size)[1].is_number_integer()) {
-      o.width = (*size)[0].get<int>();
-      o.height = (*size)[1].get<int>();
-      ok = true;
-    } else if (size->is_string()) {
-      const std::string s = size->get<std::string>();
-      char x = 0, extra = 0;
-      std::istringstream in(s);
-      ok = static_cast<bool>(in >> o.width >> x >> o.height) && (x == 'x' || x == 'X') &&
-           !(in >> extra);
-    }
-    if (!ok) return r.Error("size", "must be [width, height] or \"WIDTHxHEIGHT\"");
-  }
-  std::string lens;
-  FRESCO_RETURN_IF_ERROR(r.String("lens", &lens));
-  if (!lens.empty() && !LensFromName(lens, &o.lens)) {
-    return r.Error("lens", "unknown lens '" + lens + "' (pinhole, opencv4, opencv5, opencv8)");
-  }
-  FRESCO_RETURN_IF_ERROR(r.Number("hfov_deg", &o.hfov_deg));
+  FRESCO_RETURN_IF_ERROR(ReadCameraKeys(r, &o));
   if (const json* movers = r.Get("movers"))
     FRESCO_RETURN_IF_ERROR(ReadMovers(*movers, file, &o.movers));
   FRESCO_RETURN_IF_ERROR(r.Int("random_movers", &o.random_movers));
@@ -564,18 +678,14 @@ Status BuildSynthJob(const SynthSpecInput& input, SynthJob* job) {
     FRESCO_RETURN_IF_ERROR(m.Vector<3>("max", &o.mover_region_max));
     FRESCO_RETURN_IF_ERROR(m.Finish());
   }
-  FRESCO_RETURN_IF_ERROR(r.Number("pose_noise_deg", &o.pose_noise_deg));
-  FRESCO_RETURN_IF_ERROR(r.Number("pose_noise_m", &o.pose_noise_m));
-  FRESCO_RETURN_IF_ERROR(r.Number("exposure", &o.exposure_jitter));
-  FRESCO_RETURN_IF_ERROR(r.Int("supersample", &o.supersample));
   FRESCO_RETURN_IF_ERROR(r.Rgb("background_rgb", &o.background_rgb));
-  FRESCO_RETURN_IF_ERROR(r.Unsigned("seed", &o.seed));
   FRESCO_RETURN_IF_ERROR(r.Int("threads", &o.threads));
-  FRESCO_RETURN_IF_ERROR(r.Finish());
-
   Status check = o.Check();
   if (!check.ok()) return Status::Error(file + ": " + check.message());
-  return Status::Ok();
+  // Streams last: each starts from every setting above.
+  if (const json* streams = r.Get("streams"))
+    FRESCO_RETURN_IF_ERROR(ReadStreams(*streams, file, info, job));
+  return r.Finish();
 }
 
 Status LoadSynthJob(const std::string& spec_path, const std::vector<SynthSpecOverride>& overrides,
@@ -613,6 +723,7 @@ std::string SynthOptionsToJson(const SynthOptions& o) {
                {"walk_to", vec(p.walk_to)},
                {"look_around_deg", p.look_around_deg},
                {"bob_m", p.bob_m}};
+  if (p.kind == CameraPathKind::kFixed) j["path"]["eye"] = vec(p.eye);  // other kinds: unused
   j["movers"] = json::array();
   for (const MoverOptions& m : o.movers) {
     j["movers"].push_back({{"shape", MoverShapeName(m.shape)},

@@ -1,6 +1,6 @@
 // What to synthesize, from a JSON spec file and/or the command line: the scene (a built-in
-// procedural scene or a glTF, PLY or OBJ file) and every SynthOptions setting, with defaults that fit the
-// scene (a hand-held walk inside the room, a walk down the street, an orbit around an
+// procedural scene or a glTF, PLY or OBJ file) and every SynthOptions setting, with defaults that
+// fit the scene (a hand-held walk inside the room, a walk down the street, an orbit around an
 // object). Parsing is strict: an unknown key, a wrong type or a bad value is an error that
 // names the spec file and the field.
 //
@@ -32,8 +32,15 @@
 //                 "end": [..], "period_frames", "phase", "spin_deg_per_frame"}],
 //     "random_movers": 2, "mover_region": {"min": [..], "max": [..]},
 //     "pose_noise_deg": 0, "pose_noise_m": 0, "exposure": 0,
-//     "supersample": 2, "background_rgb": [128, 128, 128], "seed": 1, "threads": 0
+//     "supersample": 2, "background_rgb": [128, 128, 128], "seed": 1, "threads": 0,
+//     "streams": [{"name": "fixed", "path": {"kind": "fixed", "eye": [..], "target": [..]},
+//                  "frames", "size", "lens", "hfov_deg", "pose_noise_deg", "pose_noise_m",
+//                  "exposure", "supersample", "seed", "time_offset_s", "fps"}, ...]
 //   }
+// "streams" makes a multi-camera capture: each entry starts from the settings above and
+// overrides them (a path with a "kind" starts from the scene's defaults for that kind);
+// scene, movers and background are shared. Path kind "fixed": a still camera at "eye"
+// (default: where the path's circle starts) looking at "target".
 #pragma once
 
 #include <string>
@@ -67,7 +74,10 @@ struct SynthJob {
   // Per scene texture: the image file it was made from (absolute), "" when procedural or
   // loaded from glTF. ExportSynthScene points the written glTF at these files.
   std::vector<std::string> texture_files;
-  SynthOptions options;
+  SynthOptions options;  // the spec's settings (one stream), the streams' defaults
+  // "streams": one entry per camera (synth_writer.h: WriteSynthStreams); empty for a spec
+  // without them (one camera, `options`).
+  std::vector<SynthStream> streams;
   std::string out_dir;  // resolved; "" when neither the spec nor an override gives one
   std::string name;     // the spec's name, for messages
 };

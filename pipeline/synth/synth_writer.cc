@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -149,6 +150,86 @@ std::string PlanFingerprint(const Scene& scene, const SynthOptions& options,
   return h.Hex();
 }
 
+// Renders a planned stream's frames into a staging folder for ROOT/frames (`frames_dir`,
+// committed by the caller). `done` counts the frames written over all streams, of `total`.
+Status RenderFramesStaged(const Scene& scene, const SynthOptions& options, const SynthCapture& plan,
+                          const fs::path& root, const std::string& dir,
+                          const SynthWriteOptions& write_options, int total, int* done,
+                          StagedFolder* frames_dir) {
+  FRESCO_RETURN_IF_ERROR(frames_dir->Open((root / "frames").string()));
+  return RenderSynthFrames(scene, options, plan, [&](int index, const cv::Mat& bgr) -> Status {
+    if (write_options.stop && write_options.stop()) {
+      return Status::Error(dir + ": stopped after " + std::to_string(*done) + " of " +
+                           std::to_string(total) + " frames");
+    }
+    std::vector<uint8_t> png;
+    const std::string name = plan.true_poses[index].name;
+    const std::string path = (fs::path(frames_dir->path()) / name).string();
+    if (Status s = EncodeFastDecodingPng(bgr, &png); !s.ok())
+      return Status::Error((root / "frames" / name).string() + ": " + s.message());
+    FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
+    ++*done;
+    if (write_options.progress) write_options.progress(*done, total);
+    return Status::Ok();
+  });
+}
+
+// A stream's camera, given and true poses, exposure gains and movers, under ROOT.
+Status WriteStreamFiles(const SynthCapture& plan, const fs::path& root) {
+  CameraModelFile model_file;
+  model_file.camera = plan.camera;
+  FRESCO_RETURN_IF_ERROR(WriteCameraModel((root / "camera.cameramodel").string(), model_file));
+  ColmapModel given;
+  given.cameras[1] = ColmapCamera(plan.camera);
+  given.images = plan.given_poses;
+  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "sparse").string(), given));
+  ColmapModel truth = given;
+  truth.images = plan.true_poses;
+  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "truth").string(), truth));
+  std::ostringstream exposure;
+  exposure << "# NAME GAIN: the exposure gain applied to each rendered frame\n";
+  exposure.precision(9);
+  for (size_t i = 0; i < plan.true_poses.size(); ++i) {
+    exposure << plan.true_poses[i].name << " " << plan.exposure_gains[i] << "\n";
+  }
+  FRESCO_RETURN_IF_ERROR(
+      WriteFileAtomic((root / "truth" / "exposure.txt").string(), exposure.str()));
+  return WriteMoversJson((root / "truth" / "movers.json").string(), plan);
+}
+
+// True when DIR holds a complete capture whose stamp is `stamp`.
+bool CaptureIsCurrent(const fs::path& root, const std::string& stamp) {
+  std::string existing;
+  return fs::is_regular_file(root / "project.json") &&
+         fs::is_regular_file(root / "synth_stamp.txt") &&
+         ReadFileToString((root / "synth_stamp.txt").string(), &existing).ok() && existing == stamp;
+}
+
+// The folder's last files: scene, synth.json (`settings` plus scene and fingerprint), the
+// stamp, and the project.
+Status FinishCaptureFolder(const Scene& scene, const fs::path& root, json settings,
+                           const SynthWriteOptions& write_options, const std::string& fingerprint,
+                           Project project) {
+  FRESCO_RETURN_IF_ERROR(SaveGltfScene(scene, (root / "scene.gltf").string()));
+  settings["scene"] =
+      write_options.scene_source.empty() ? "scene.gltf" : write_options.scene_source;
+  settings["fingerprint"] = fingerprint;
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic((root / "synth.json").string(), settings.dump(2) + "\n"));
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic((root / "synth_stamp.txt").string(), fingerprint + "\n"));
+  const std::string project_path = (root / "project.json").string();
+  project.scene = "scene.gltf";
+  project.file_path = fs::absolute(project_path).lexically_normal().string();
+  return SaveProject(project, project_path);
+}
+
+// From here on the folder is rewritten: without project.json (and the stamp) it is
+// incomplete, so a crash is never taken for a finished capture.
+void MarkIncomplete(const fs::path& root) {
+  std::error_code ec;
+  fs::remove(root / "project.json", ec);
+  fs::remove(root / "synth_stamp.txt", ec);
+}
+
 }  // namespace
 
 std::string SynthFingerprint(const Scene& scene, const SynthOptions& options) {
@@ -169,89 +250,111 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
   result->fingerprint = PlanFingerprint(scene, options, plan);
 
   const fs::path root(dir);
-  const std::string stamp_path = (root / "synth_stamp.txt").string();
-  const std::string project_path = (root / "project.json").string();
-  const std::string stamp = result->fingerprint + "\n";
-  if (write_options.skip_if_current && fs::is_regular_file(project_path) &&
-      fs::is_regular_file(stamp_path)) {
-    std::string existing;
-    if (ReadFileToString(stamp_path, &existing).ok() && existing == stamp) {
-      result->skipped = true;
-      return Status::Ok();
-    }
+  if (write_options.skip_if_current && CaptureIsCurrent(root, result->fingerprint + "\n")) {
+    result->skipped = true;
+    return Status::Ok();
   }
-
   for (const char* sub : {"sparse", "truth"}) {
     FRESCO_RETURN_IF_ERROR(MakeDirectories((root / sub).string()));
   }
   // Frames, streamed into a staging folder: the earlier capture stays complete until every
   // frame is written.
   StagedFolder frames_dir;
-  FRESCO_RETURN_IF_ERROR(frames_dir.Open((root / "frames").string()));
   int done = 0;
-  FRESCO_RETURN_IF_ERROR(
-      RenderSynthFrames(scene, options, plan, [&](int index, const cv::Mat& bgr) -> Status {
-        if (write_options.stop && write_options.stop()) {
-          return Status::Error(dir + ": stopped after " + std::to_string(done) + " of " +
-                               std::to_string(frames) + " frames");
-        }
-        std::vector<uint8_t> png;
-        const std::string name = plan.true_poses[index].name;
-        const std::string path = (fs::path(frames_dir.path()) / name).string();
-        if (Status s = EncodeFastDecodingPng(bgr, &png); !s.ok())
-          return Status::Error((root / "frames" / name).string() + ": " + s.message());
-        FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
-        ++done;
-        if (write_options.progress) write_options.progress(done, frames);
-        return Status::Ok();
-      }));
-  // From here on the folder is rewritten: without project.json (and the stamp) it is
-  // incomplete, so a crash is never taken for a finished capture.
-  std::error_code ec;
-  fs::remove(project_path, ec);
-  fs::remove(stamp_path, ec);
+  FRESCO_RETURN_IF_ERROR(RenderFramesStaged(scene, options, plan, root, dir, write_options, frames,
+                                            &done, &frames_dir));
+  MarkIncomplete(root);
   FRESCO_RETURN_IF_ERROR(frames_dir.Commit());
-
-  // Camera and poses.
-  CameraModelFile model_file;
-  model_file.camera = plan.camera;
-  FRESCO_RETURN_IF_ERROR(WriteCameraModel((root / "camera.cameramodel").string(), model_file));
-  ColmapModel given;
-  given.cameras[1] = ColmapCamera(plan.camera);
-  given.images = plan.given_poses;
-  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "sparse").string(), given));
-  ColmapModel truth = given;
-  truth.images = plan.true_poses;
-  FRESCO_RETURN_IF_ERROR(WriteColmapModel((root / "truth").string(), truth));
-  std::ostringstream exposure;
-  exposure << "# NAME GAIN: the exposure gain applied to each rendered frame\n";
-  exposure.precision(9);
-  for (int i = 0; i < frames; ++i) {
-    exposure << plan.true_poses[i].name << " " << plan.exposure_gains[i] << "\n";
-  }
-  FRESCO_RETURN_IF_ERROR(
-      WriteFileAtomic((root / "truth" / "exposure.txt").string(), exposure.str()));
-  FRESCO_RETURN_IF_ERROR(WriteMoversJson((root / "truth" / "movers.json").string(), plan));
-
-  // The static scene (no movers).
-  FRESCO_RETURN_IF_ERROR(SaveGltfScene(scene, (root / "scene.gltf").string()));
-
-  // Settings, stamp, and the project last.
-  json settings = json::parse(SynthOptionsToJson(options));
-  settings["scene"] =
-      write_options.scene_source.empty() ? "scene.gltf" : write_options.scene_source;
-  settings["fingerprint"] = result->fingerprint;
-  FRESCO_RETURN_IF_ERROR(WriteFileAtomic((root / "synth.json").string(), settings.dump(2) + "\n"));
-  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(stamp_path, stamp));
+  FRESCO_RETURN_IF_ERROR(WriteStreamFiles(plan, root));
   Project project;
   project.fresco_version = 1;
-  project.scene = "scene.gltf";
   project.camera = "camera.cameramodel";
   project.video = "frames/";
   project.poses = "sparse/images.txt";
   project.truth.poses = "truth/images.txt";
-  project.file_path = fs::absolute(project_path).lexically_normal().string();
-  return SaveProject(project, project_path);
+  return FinishCaptureFolder(scene, root, json::parse(SynthOptionsToJson(options)), write_options,
+                             result->fingerprint, project);
+}
+
+Status PlanSynthStreams(const Scene& scene, const std::vector<SynthStream>& streams,
+                        std::vector<SynthStream>* resolved, std::vector<SynthCapture>* plans) {
+  *resolved = streams;
+  plans->assign(streams.size(), SynthCapture());
+  for (size_t k = 0; k < streams.size(); ++k) {
+    SynthOptions& o = (*resolved)[k].options;
+    if (k > 0) {  // the movers the first stream placed, for every stream, on one clock
+      o.movers = (*plans)[0].movers;
+      o.random_movers = 0;
+      if (streams[k].fps > 0 && streams[0].fps > 0) {
+        const double frames_per_first_frame = streams[k].fps / streams[0].fps;
+        for (MoverOptions& m : o.movers) {
+          m.period_frames *= frames_per_first_frame;
+          m.spin_deg_per_frame /= frames_per_first_frame;
+        }
+      }
+    }
+    if (Status s = PlanSynthCapture(scene, o, &(*plans)[k]); !s.ok())
+      return Status::Error("streams[" + std::to_string(k) + "]." + s.message());
+  }
+  return Status::Ok();
+}
+
+Status WriteSynthStreams(const Scene& scene, const std::vector<SynthStream>& streams,
+                         const std::string& dir, const SynthWriteOptions& write_options,
+                         SynthWriteResult* result) {
+  SynthWriteResult local;
+  if (!result) result = &local;
+  *result = SynthWriteResult();
+  if (streams.empty()) return Status::Error(dir + ": no streams to write");
+  std::vector<SynthStream> resolved;
+  std::vector<SynthCapture> plans;
+  FRESCO_RETURN_IF_ERROR(PlanSynthStreams(scene, streams, &resolved, &plans));
+  Fnv64 h;
+  h.AddString("streams");
+  for (size_t k = 0; k < resolved.size(); ++k) {
+    h.AddString(resolved[k].name);
+    h.AddValue(resolved[k].time_offset_s);
+    h.AddValue(resolved[k].fps);
+    h.AddString(PlanFingerprint(scene, resolved[k].options, plans[k]));
+    result->frames += static_cast<int>(plans[k].true_poses.size());
+  }
+  result->fingerprint = h.Hex();
+  const fs::path root(dir);
+  if (write_options.skip_if_current && CaptureIsCurrent(root, result->fingerprint + "\n")) {
+    result->skipped = true;
+    return Status::Ok();
+  }
+  // Every stream's frames first, so that a stop keeps the earlier capture whole.
+  std::vector<std::unique_ptr<StagedFolder>> frames_dirs;
+  int done = 0;
+  for (size_t k = 0; k < resolved.size(); ++k) {
+    const fs::path stream_root = root / resolved[k].name;
+    for (const char* sub : {"sparse", "truth"}) {
+      FRESCO_RETURN_IF_ERROR(MakeDirectories((stream_root / sub).string()));
+    }
+    frames_dirs.push_back(std::make_unique<StagedFolder>());
+    FRESCO_RETURN_IF_ERROR(RenderFramesStaged(scene, resolved[k].options, plans[k], stream_root,
+                                              dir, write_options, result->frames, &done,
+                                              frames_dirs.back().get()));
+  }
+  MarkIncomplete(root);
+  Project project;
+  project.fresco_version = 2;
+  json settings = {{"streams", json::array()}};
+  for (size_t k = 0; k < resolved.size(); ++k) {
+    const std::string& name = resolved[k].name;
+    FRESCO_RETURN_IF_ERROR(frames_dirs[k]->Commit());
+    FRESCO_RETURN_IF_ERROR(WriteStreamFiles(plans[k], root / name));
+    project.streams.push_back({name + "/camera.cameramodel", name + "/frames/",
+                               name + "/sparse/images.txt", resolved[k].time_offset_s,
+                               resolved[k].fps});
+    json stream = json::parse(SynthOptionsToJson(resolved[k].options));
+    stream["name"] = name;
+    stream["time_offset_s"] = resolved[k].time_offset_s;
+    if (resolved[k].fps > 0) stream["fps"] = resolved[k].fps;
+    settings["streams"].push_back(stream);
+  }
+  return FinishCaptureFolder(scene, root, settings, write_options, result->fingerprint, project);
 }
 
 Status ExportSynthScene(const Scene& scene, const std::vector<std::string>& texture_files,

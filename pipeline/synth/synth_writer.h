@@ -55,6 +55,24 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
                          const SynthWriteOptions& write_options,
                          SynthWriteResult* result = nullptr);
 
+// A multi-camera capture: each stream in DIR/NAME/ (frames/, camera.cameramodel, sparse/,
+// truth/ as above), the scene, synth.json (each stream's settings) and a version-2
+// DIR/project.json listing the streams (NAME/camera.cameramodel, NAME/frames/,
+// NAME/sparse/images.txt, the stream's time offset and fps); true poses are in
+// NAME/truth/images.txt.
+// The first stream's movers (explicit and placed) are every stream's movers: frame i of
+// every stream shows them where they are at frame i. All frames are rendered before anything
+// of an earlier capture in DIR is replaced. result->frames counts every stream's frames.
+Status WriteSynthStreams(const Scene& scene, const std::vector<SynthStream>& streams,
+                         const std::string& dir, const SynthWriteOptions& write_options,
+                         SynthWriteResult* result = nullptr);
+
+// The streams as written: `resolved` are the streams with the first stream's movers given to
+// every other one, `plans` their planned captures (PlanSynthCapture). Errors name the stream
+// ("streams[1].frames: ...").
+Status PlanSynthStreams(const Scene& scene, const std::vector<SynthStream>& streams,
+                        std::vector<SynthStream>* resolved, std::vector<SynthCapture>* plans);
+
 // A 64-bit fingerprint (16 hex digits) of the scene's content (geometry, UVs, materials,
 // texture pixels), every setting that changes the output (not `threads`), the planned
 // camera, poses, gains and movers, and the rendered pixels of frame 0: a change to the code

@@ -98,6 +98,7 @@ CameraPathOptions SynthOptions::PathOptions() const {
   p.walk_to = walk_to;
   p.look_around_deg = look_around_deg;
   p.bob_m = bob_m;
+  p.eye = eye;
   return p;
 }
 
@@ -117,6 +118,7 @@ void SynthOptions::SetPathOptions(const CameraPathOptions& p) {
   walk_to = p.walk_to;
   look_around_deg = p.look_around_deg;
   bob_m = p.bob_m;
+  eye = p.eye;
 }
 
 std::string SynthFrameName(int index) {

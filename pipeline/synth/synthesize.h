@@ -49,8 +49,9 @@ struct SynthOptions {
   double tilt_deg = 0.0;       // handheld (free look): slow up/down sweep amplitude
   Eigen::Vector3d walk_from = Eigen::Vector3d(-1, 0, 0);  // walk: eye positions, world
   Eigen::Vector3d walk_to = Eigen::Vector3d(1, 0, 0);
-  double look_around_deg = 20.0;  // walk: amplitude of the glances left/right
-  double bob_m = 0.02;            // walk: vertical step bob
+  double look_around_deg = 20.0;                   // walk: amplitude of the glances left/right
+  double bob_m = 0.02;                             // walk: vertical step bob
+  Eigen::Vector3d eye = Eigen::Vector3d(0, 0, 1);  // fixed: the camera's position, world
 
   std::vector<MoverOptions> movers;  // explicit movers
   // Plus this many movers placed automatically (MakeRandomMovers) inside
@@ -76,6 +77,19 @@ struct SynthOptions {
   // The path fields above as CameraPathOptions, and back.
   CameraPathOptions PathOptions() const;
   void SetPathOptions(const CameraPathOptions& path_options);
+};
+
+// One camera of a multi-camera capture: its folder name, its settings (its own camera,
+// path, frames, noise; the scene and the movers are shared) and its time offset as written
+// in the project (tracker clock minus video clock).
+struct SynthStream {
+  std::string name;
+  SynthOptions options;
+  double time_offset_s = 0.0;
+  // Frames per second, written into the project (frames are painted in time order); 0: not
+  // given (every stream gives it or none does). The movers keep to one clock: a stream at
+  // twice the first stream's rate sees them move half as far per frame.
+  double fps = 0.0;
 };
 
 struct SynthCapture {

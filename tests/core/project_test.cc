@@ -149,8 +149,9 @@ Project NonDefaultProjectV2() {
   p.camera = p.video = p.poses = "";
   p.time_offset_s = 0;
   p.streams = {
-      StreamSpec{"a/cameras.txt", "a/frames/", "a/images.txt", 0.25},
-      StreamSpec{"b/camera.cameramodel", "udp://127.0.0.1:5001", "tcp://127.0.0.1:6001", -0.5}};
+      StreamSpec{"a/cameras.txt", "a/frames/", "a/images.txt", 0.25, 12.5},
+      StreamSpec{"b/camera.cameramodel", "udp://127.0.0.1:5001", "tcp://127.0.0.1:6001", -0.5,
+                 30}};
   return p;
 }
 

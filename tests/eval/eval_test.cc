@@ -69,6 +69,8 @@ TEST(EvalSuiteTest, BadInputNamesTheField) {
       {R"({"name": "a", "family": "f", "synth": {"scene": "builtin:cube"}},
           {"name": "a", "family": "f", "synth": {"scene": "builtin:cube"}})",
        "name 'a' is used twice"},
+      {R"({"name": "a", "family": "f", "synth": {"scene": "builtin:cube", "streams": [{}]}})",
+       "captures[0].synth: streams: the evaluation suite scores one-camera captures"},
   };
   for (const Case& c : cases) {
     EvalSuite suite;
