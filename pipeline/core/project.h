@@ -120,7 +120,8 @@ struct AtlasOptions {
 // the frame's depth map (silhouettes: where a mesh a few pixels off paints background); a
 // painted texel takes a new frame's sample only when it scores clearly better.
 struct SelectOptions {
-  bool enabled = true;          // off: the quality policy alone (`update`, `quality_slack`)
+  bool enabled = false;  // off: the quality policy alone (`update`, `quality_slack`); on costs
+                         // 2-4 times the warp stage (real photos: docs/results.md)
   bool exposure = true;         // divide out each frame's gain against the buffers
   double switch_margin = 0.25;  // a painted texel switches frame when the score is this much better
   double region_weight = 0.5;   // 0: the texel's own score; 1: the frame's median over the buffer

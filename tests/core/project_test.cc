@@ -117,7 +117,7 @@ Project NonDefaultProject() {
   p.grouping.max_stretch = 1.5;
   p.pipeline.atlas.page_size = 2048;
   p.pipeline.atlas.padding_texels = 6;
-  p.pipeline.select.enabled = false;
+  p.pipeline.select.enabled = true;
   p.pipeline.select.exposure = false;
   p.pipeline.select.switch_margin = 0.5;
   p.pipeline.select.region_weight = 0.25;

@@ -167,12 +167,14 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   };
   PipelineOptions off;
   off.select.enabled = false;
+  PipelineOptions on;
+  on.select.enabled = true;
   double ncc_off = 0, ncc_on = 0;
   const double psnr_off = score(off, &ncc_off);
-  const double psnr_on = score(PipelineOptions(), &ncc_on);
+  const double psnr_on = score(on, &ncc_on);
   // The edge penalty alone: the robust background model also rejects most background
   // sampled past a silhouette (a minority of a texel's samples), so it shows without it.
-  PipelineOptions no_model;
+  PipelineOptions no_model = on;
   no_model.background.mode = BackgroundMode::kOff;
   PipelineOptions no_model_no_edges = no_model;
   no_model_no_edges.select.edge_px = 0;
@@ -180,7 +182,7 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   const double psnr_edges = score(no_model, &ncc_edges);
   const double psnr_no_edges = score(no_model_no_edges, &ncc_no_edges);
   std::printf(
-      "displaced boxes, exposure changes: select off %.2f dB / 1-NCC %.3f, defaults "
+      "displaced boxes, exposure changes: select off %.2f dB / 1-NCC %.3f, on "
       "%.2f / %.3f; background off: edge penalty off %.2f / %.3f, on %.2f / %.3f\n",
       psnr_off, ncc_off, psnr_on, ncc_on, psnr_no_edges, ncc_no_edges, psnr_edges, ncc_edges);
   EXPECT_GT(psnr_on, psnr_off + 1.0);
