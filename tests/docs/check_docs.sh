@@ -8,7 +8,8 @@
 #   - docs/reference/cli.md is exactly what tests/docs/make_cli_reference.sh writes now;
 #   - every key the project-file reader accepts (pipeline/core/project.cc, Fields()) is in
 #     docs/reference/project-file.md, and every key that page's tables name is accepted;
-#   - docs/contract.md equals ../shared/CONTRACT.md where that file exists.
+#   - docs/contract.md equals ../shared/CONTRACT.md where that file exists;
+#   - no merge conflict markers in any text file of the tree.
 # Usage: bash tests/docs/check_docs.sh [FRESCO]   (default build/app/fresco; run from anywhere)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -97,6 +98,19 @@ def check_command(path, line_no, cmd):
     for opt in re.findall(r"(?:^|\s)(--[a-z][a-z0-9-]*)", rest):
         if opt not in ("--help", "--version") and not re.search(rf"(?<![\w-]){opt}(?![\w-])", text):
             err(f"{path}:{line_no}: 'fresco {' '.join(key)} {opt}': not in its --help")
+
+# Merge conflict markers left in any text file of the tree (a merge that was committed
+# unresolved): "<<<<<<< " and ">>>>>>> " at the start of a line.
+for d, dirs, fs in os.walk("."):
+    dirs[:] = [x for x in dirs if not x.startswith(".") and not x.startswith("build")]
+    for f in fs:
+        if not f.endswith((".md", ".cc", ".h", ".txt", ".json", ".sh", ".py", ".cmake", ".1")):
+            continue
+        path = os.path.relpath(os.path.join(d, f))
+        with open(path, errors="replace") as fh:
+            for line_no, line in enumerate(fh, 1):
+                if line.startswith(("<<<<<<< ", ">>>>>>> ")):
+                    err(f"{path}:{line_no}: merge conflict marker")
 
 for path in files:
     text = open(path).read()
