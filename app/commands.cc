@@ -2,10 +2,7 @@
 
 #include <exception>
 #include <iostream>
-#include <new>
 #include <string>
-
-#include <opencv2/core.hpp>
 
 #include "pipeline/run/frame_policy.h"
 
@@ -55,18 +52,8 @@ int Dispatch(const std::vector<std::string>& argv) {
     if (verb != c.verb) continue;
     try {
       return c.run(CommandArgs(argv.begin() + 1, argv.end()));
-    } catch (const std::bad_alloc&) {
-      std::cerr << "fresco " << verb << ": " << OutOfMemoryMessage() << "\n";
-      return kExitFailure;
-    } catch (const cv::Exception& e) {
-      if (e.code == cv::Error::StsNoMem) {
-        std::cerr << "fresco " << verb << ": " << OutOfMemoryMessage() << "\n";
-        return kExitFailure;
-      }
-      std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";
-      return kExitFailure;
-    } catch (const std::exception& e) {
-      std::cerr << "fresco " << verb << ": internal error: " << e.what() << "\n";
+    } catch (...) {
+      std::cerr << "fresco " << verb << ": " << FailureMessage(std::current_exception()) << "\n";
       return kExitFailure;
     }
   }

@@ -287,15 +287,16 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
 // of the two terms' maxima over its corners (a.d is linear in p, |d| convex).
 bool BaseBuffer::Chunk::FacesAwayFrom(const Eigen::Vector3f& c) const {
   if (normal_sin >= 1.0f) return false;
-  float max_ad = -std::numeric_limits<float>::infinity(), max_d = 0.0f;
+  float max_ad = -std::numeric_limits<float>::infinity(), max_d2 = 0.0f;
   for (int i = 0; i < 8; ++i) {
     const Eigen::Vector3f corner((i & 1) ? bounds_max.x() : bounds_min.x(),
                                  (i & 2) ? bounds_max.y() : bounds_min.y(),
                                  (i & 4) ? bounds_max.z() : bounds_min.z());
     const Eigen::Vector3f d = c - corner;
     max_ad = std::max(max_ad, normal_axis.dot(d));
-    max_d = std::max(max_d, d.norm());
+    max_d2 = std::max(max_d2, d.squaredNorm());
   }
+  const float max_d = std::sqrt(max_d2);  // sqrt is monotonic: the largest |d|, one root
   // The margin covers float rounding in the texels' own test (relative 1e-5 of |d|).
   return normal_cos * max_ad + normal_sin * max_d < -1e-5f * max_d;
 }

@@ -1,5 +1,9 @@
 #include "pipeline/run/frame_policy.h"
 
+#include <new>
+
+#include <opencv2/core.hpp>
+
 #include "pipeline/core/capture.h"
 
 namespace fresco {
@@ -22,6 +26,21 @@ std::string OutOfMemoryMessage() {
   return "out of memory (files already there are left as they were); fewer texels (a larger "
          "pipeline.texel_size_m or a smaller pipeline.max_buffer_texels) or fewer charts (a "
          "larger grouping.min_chart_texels) need less";
+}
+
+std::string FailureMessage(std::exception_ptr failure) {
+  try {
+    std::rethrow_exception(failure);
+  } catch (const std::bad_alloc&) {
+    return OutOfMemoryMessage();
+  } catch (const cv::Exception& e) {
+    if (e.code == cv::Error::StsNoMem) return OutOfMemoryMessage();
+    return std::string("internal error: ") + e.what();
+  } catch (const std::exception& e) {
+    return std::string("internal error: ") + e.what();
+  } catch (...) {
+    return "internal error";
+  }
 }
 
 }  // namespace fresco

@@ -12,6 +12,7 @@
 // app's worker drops the session): OutOfMemoryMessage() says what needs less.
 #pragma once
 
+#include <exception>
 #include <string>
 
 #include "pipeline/core/status.h"
@@ -31,5 +32,10 @@ Status ApplyFramePolicy(const SourcedFrame& frame, const FrameOrigin& origin, Fr
 // "out of memory (...); fewer texels (...) or fewer charts (...) need less": the same words
 // from the CLI and the app.
 std::string OutOfMemoryMessage();
+
+// What a run that ended in an exception says, without the "fresco VERB: " or "error: "
+// prefix: OutOfMemoryMessage() for std::bad_alloc and OpenCV's StsNoMem, "internal error:
+// WHAT" for any other std::exception, "internal error" otherwise.
+std::string FailureMessage(std::exception_ptr failure);
 
 }  // namespace fresco

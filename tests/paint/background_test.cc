@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/paint/room_capture.h"
+#include "tests/paint/synth_session.h"
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/video_source.h"
@@ -77,13 +78,7 @@ struct MoverFigures {
 
 MoverFigures PaintWithMovers(const Scene& scene, const SynthCapture& capture,
                              const PipelineOptions& options) {
-  PaintSessionInputs inputs;
-  inputs.scene = &scene;
-  inputs.pipeline = options;
-  inputs.typical_camera = &capture.camera;
-  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
-  std::unique_ptr<PaintSession> session;
-  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  std::unique_ptr<PaintSession> session = testing::SessionForCapture(scene, capture, options);
   const std::vector<BaseBuffer>& buffers = session->buffers();
   const size_t nb = buffers.size();
   // Per buffer: does the stored sample show a mover; was the texel ever seen mover-free;

@@ -9,6 +9,7 @@
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/paint/room_capture.h"
+#include "tests/paint/synth_session.h"
 
 namespace fresco {
 namespace {
@@ -22,21 +23,12 @@ struct Painted {
 // without them, with no background model and no refinement, it paints during the warp.
 Painted Paint(const Scene& scene, const SynthCapture& capture, const PipelineOptions& options,
               bool separate_stages) {
-  PaintSessionInputs inputs;
-  inputs.scene = &scene;
-  inputs.pipeline = options;
-  inputs.typical_camera = &capture.camera;
-  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
-  std::unique_ptr<PaintSession> session;
-  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  std::unique_ptr<PaintSession> session = testing::SessionForCapture(scene, capture, options);
   session->set_debug_images(separate_stages);
   Painted out;
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
-    Frame frame;
-    frame.index = static_cast<int>(i);
-    frame.bgr = capture.frames_bgr[i];
     FrameReport report;
-    session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, &report);
+    testing::PaintCaptureFrame(session.get(), capture, i, &report);
     out.reports.push_back(report);
   }
   out.buffers = session->painted();

@@ -17,26 +17,17 @@
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/paint/room_capture.h"
+#include "tests/paint/synth_session.h"
 
 namespace fresco {
 namespace {
 
 // Paints every frame at its true pose.
 Scene PaintAll(const Scene& scene, const SynthCapture& capture, const PipelineOptions& options) {
-  PaintSessionInputs inputs;
-  inputs.scene = &scene;
-  inputs.pipeline = options;
-  inputs.typical_camera = &capture.camera;
-  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
-  std::unique_ptr<PaintSession> session;
-  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  std::unique_ptr<PaintSession> session = testing::SessionForCapture(scene, capture, options);
   FrameReport report;
-  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
-    Frame frame;
-    frame.index = static_cast<int>(i);
-    frame.bgr = capture.frames_bgr[i];
-    session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, &report);
-  }
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    testing::PaintCaptureFrame(session.get(), capture, i, &report);
   return session->PaintedScene();
 }
 

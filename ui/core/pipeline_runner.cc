@@ -5,7 +5,6 @@
 #include <cmath>
 #include <exception>
 #include <limits>
-#include <new>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -293,13 +292,8 @@ void PipelineRunner::Loop() {
     try {
       Serve();
       return;
-    } catch (const std::bad_alloc&) {
-      failure = OutOfMemoryMessage();
-    } catch (const cv::Exception& e) {
-      failure = e.code == cv::Error::StsNoMem ? OutOfMemoryMessage()
-                                              : std::string("internal error: ") + e.what();
-    } catch (const std::exception& e) {
-      failure = std::string("internal error: ") + e.what();
+    } catch (...) {
+      failure = FailureMessage(std::current_exception());
     }
     session_.reset();
     playing_ = false;

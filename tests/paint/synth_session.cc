@@ -1,0 +1,28 @@
+#include "tests/paint/synth_session.h"
+
+#include <gtest/gtest.h>
+
+namespace fresco::testing {
+
+std::unique_ptr<PaintSession> SessionForCapture(const Scene& scene, const SynthCapture& capture,
+                                                const PipelineOptions& options) {
+  PaintSessionInputs inputs;
+  inputs.scene = &scene;
+  inputs.pipeline = options;
+  inputs.typical_camera = &capture.camera;
+  for (const auto& p : capture.true_poses) inputs.expected_poses.push_back(p.cam_from_world);
+  std::unique_ptr<PaintSession> session;
+  const Status status = PaintSession::Create(inputs, &session);
+  EXPECT_TRUE(status.ok()) << status.message();
+  return session;
+}
+
+void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_t i,
+                       FrameReport* report) {
+  Frame frame;
+  frame.index = static_cast<int>(i);
+  frame.bgr = capture.frames_bgr[i];
+  session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, report);
+}
+
+}  // namespace fresco::testing

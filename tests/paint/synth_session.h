@@ -1,0 +1,24 @@
+// A painting session over a synthetic capture, as the painting tests set one up: the
+// capture's camera and true poses as the session's expectations, frames painted at their
+// true poses.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "pipeline/core/scene.h"
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/synth/synthesize.h"
+
+namespace fresco::testing {
+
+// The session for `capture` painting `scene` with `options`; a failure to create it fails
+// the calling test (and returns null).
+std::unique_ptr<PaintSession> SessionForCapture(const Scene& scene, const SynthCapture& capture,
+                                                const PipelineOptions& options);
+
+// Paints the capture's frame `i` at its true pose.
+void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_t i,
+                       FrameReport* report);
+
+}  // namespace fresco::testing
