@@ -1,5 +1,6 @@
 #include "app/commands.h"
 
+#include <algorithm>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -19,6 +20,7 @@ const std::vector<Command>& AllCommands() {
       {"bench", "measure the speed/accuracy trade of pipeline settings", RunVerbBench},
       {"eval", "score a setting over a suite of synthetic captures", RunVerbEval},
       {"rephoto", "score a project on its own photos: each left out, painted from the others", RunVerbRephoto},
+      {"settings", "list the project file's settings: default, range, what each does", RunVerbSettings},
       {"gui", "the authoring app", RunVerbGui},
   };
   return kCommands;
@@ -27,9 +29,11 @@ const std::vector<Command>& AllCommands() {
 static void PrintMainUsage(std::ostream& out) {
   out << "usage: fresco VERB [ARGS...]   (fresco VERB --help for a verb's options;\n"
          "       fresco --version prints the version)\n\nverbs:\n";
+  size_t width = 0;  // the summaries line up one space after the longest verb
+  for (const Command& c : AllCommands()) width = std::max(width, std::string(c.verb).size());
   for (const Command& c : AllCommands()) {
-    out << "  " << c.verb << std::string(8 - std::string(c.verb).size(), ' ') << c.summary
-        << "\n";
+    out << "  " << c.verb << std::string(width + 1 - std::string(c.verb).size(), ' ')
+        << c.summary << "\n";
   }
 }
 

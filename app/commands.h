@@ -46,6 +46,7 @@ int RunVerbPoses(const CommandArgs& args);
 int RunVerbBench(const CommandArgs& args);
 int RunVerbEval(const CommandArgs& args);
 int RunVerbRephoto(const CommandArgs& args);
+int RunVerbSettings(const CommandArgs& args);
 int RunVerbGui(const CommandArgs& args);
 
 }  // namespace fresco

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/settings.h"
 
 namespace fresco {
 namespace {
@@ -39,6 +40,7 @@ struct Rule {
   bool min_exclusive = false;
   double max = kInf;
   std::vector<std::string> choices = {};
+  const char* help = "";  // what the setting does (fresco settings, the app, the docs)
 };
 
 const std::vector<std::pair<SamplingMode, std::string>>& SamplingNames() {
@@ -90,75 +92,195 @@ const std::vector<std::pair<BackgroundMode, std::string>>& BackgroundModeNames()
 
 template <class V>
 void Fields(OcclusionOptions& o, V& v) {
-  v.Field("enabled", o.enabled);
-  v.Field("tolerance_rel", o.tolerance_rel, {.min = 0});
-  v.Field("tolerance_m", o.tolerance_m, {.min = 0});
-  v.Field("max_view_angle_deg", o.max_view_angle_deg, {.min = 0, .min_exclusive = true, .max = 90});
+  v.Field("enabled", o.enabled, {.help = "test every texel against the video camera's depth map"});
+  v.Field(
+      "tolerance_rel", o.tolerance_rel,
+      {.min = 0,
+       .help =
+           "a texel is visible when its depth is within this fraction of the rendered depth ..."});
+  v.Field("tolerance_m", o.tolerance_m, {.min = 0, .help = "... plus this many metres"});
+  v.Field("max_view_angle_deg", o.max_view_angle_deg,
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 90,
+           .help = "texels seen at more than this angle from the surface normal (or from behind) "
+                   "are not painted"});
 }
 
 template <class V>
 void Fields(RefineOptions& o, V& v) {
-  v.Enum("mode", o.mode, RefineModeNames());
-  v.Enum("max_model", o.max_model, RefineModelNames());
-  v.Field("max_corners", o.max_corners, {.min = 3});
-  v.Field("search_px", o.search_px, {.min = 1});
-  v.Field("window_px", o.window_px, {.min = 1, .max = 64});
-  v.Field("pyramid_levels", o.pyramid_levels, {.min = 0, .max = 8});
-  v.Field("ransac_px", o.ransac_px, {.min = 0, .min_exclusive = true});
-  v.Field("max_scale_change", o.max_scale_change, {.min = 0, .min_exclusive = true, .max = 1});
-  v.Field("min_inliers", o.min_inliers, {.min = 3});
-  v.Field("min_correction_px", o.min_correction_px, {.min = 0});
-  v.Field("every_n_frames", o.every_n_frames, {.min = 1});
-  v.Field("anchor", o.anchor);
-  v.Field("pose", o.pose);
-  v.Field("anchor_min_frames", o.anchor_min_frames, {.min = 2});
-  v.Field("anchor_window_frames", o.anchor_window_frames, {.min = 0});
-  v.Field("anchor_step_px", o.anchor_step_px, {.min = 0});
+  v.Enum("mode", o.mode, RefineModeNames(),
+         "`paper`: Harris corners, SSD search, affine fit (the paper's §3.5); `robust`: tracked "
+         "corners, RANSAC and model selection");
+  v.Enum("max_model", o.max_model, RefineModelNames(),
+         "the most general 2D motion `robust` may choose (simpler ones win when the evidence does "
+         "not need more)");
+  v.Field("max_corners", o.max_corners, {.min = 3, .help = "corners tracked per buffer and frame"});
+  v.Field("search_px", o.search_px,
+          {.min = 1, .help = "largest correction looked for, texels (larger: no correction)"});
+  v.Field("window_px", o.window_px,
+          {.min = 1, .max = 64, .help = "matching window half-size, texels"});
+  v.Field("pyramid_levels", o.pyramid_levels,
+          {.min = 0, .max = 8, .help = "coarse-to-fine levels (`robust`)"});
+  v.Field("ransac_px", o.ransac_px,
+          {.min = 0, .min_exclusive = true, .help = "inlier threshold, texels"});
+  v.Field("max_scale_change", o.max_scale_change,
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 1,
+           .help = "a fit that scales or shears more is refused"});
+  v.Field("min_inliers", o.min_inliers, {.min = 3, .help = "fewer inliers: no correction"});
+  v.Field("min_correction_px", o.min_correction_px,
+          {.min = 0, .help = "dead band: smaller corrections are measured but not applied"});
+  v.Field("every_n_frames", o.every_n_frames,
+          {.min = 1,
+           .help = "register every N-th frame; the others only fill texels the buffers lack"});
+  v.Field("anchor", o.anchor,
+          {.help = "consensus anchoring: move a buffer back by the mean of the corrections the "
+                   "frames ask for"});
+  v.Field("pose", o.pose,
+          {.help = "correct the frame's camera pose from the matches of all its buffers together, "
+                   "instead of one homography per buffer"});
+  v.Field("anchor_min_frames", o.anchor_min_frames,
+          {.min = 2, .help = "frames that must agree before a buffer is moved"});
+  v.Field("anchor_window_frames", o.anchor_window_frames,
+          {.min = 0, .help = "anchor samples fade with this time constant, frames (0 = never)"});
+  v.Field("anchor_step_px", o.anchor_step_px,
+          {.min = 0, .help = "a buffer is moved when the agreed offset exceeds this, texels"});
 }
 
 template <class V>
 void Fields(BackgroundOptions& o, V& v) {
-  v.Enum("mode", o.mode, BackgroundModeNames());
-  v.Field("training_frames", o.training_frames, {.min = 1, .max = 250});
-  v.Field("average_threshold", o.average_threshold, {.min = 0});
-  v.Field("warmup_frames", o.warmup_frames, {.min = 1});
-  v.Field("window_frames", o.window_frames, {.min = 2, .max = 65535});
-  v.Field("sigma_threshold", o.sigma_threshold, {.min = 0, .min_exclusive = true});
-  v.Field("min_sigma", o.min_sigma, {.min = 0, .min_exclusive = true, .max = 100});
-  v.Field("normalize_gain", o.normalize_gain);
-  v.Field("min_blob_texels", o.min_blob_texels, {.min = 0});
-  v.Field("dilate_texels", o.dilate_texels, {.min = 0, .max = 64});
+  v.Enum("mode", o.mode, BackgroundModeNames(),
+         "`average` is the paper's (§3.4); `robust` follows changes and exposure");
+  v.Field(
+      "training_frames", o.training_frames,
+      {.min = 1, .max = 250, .help = "`average`: samples averaged per texel before it segments"});
+  v.Field("average_threshold", o.average_threshold,
+          {.min = 0,
+           .help = "`average`: foreground beyond this largest-channel difference, grey levels"});
+  v.Field("warmup_frames", o.warmup_frames,
+          {.min = 1,
+           .help = "`robust`: samples before a texel's model is trusted (until then it paints "
+                   "provisionally)"});
+  v.Field("window_frames", o.window_frames,
+          {.min = 2,
+           .max = 65535,
+           .help = "`robust`: learning window in samples: an object that stops for about half of "
+                   "it becomes background"});
+  v.Field(
+      "sigma_threshold", o.sigma_threshold,
+      {.min = 0,
+       .min_exclusive = true,
+       .help = "`robust`: foreground beyond this many standard deviations of the texel's noise"});
+  v.Field("min_sigma", o.min_sigma,
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 100,
+           .help = "`robust`: the noise is never counted below this many grey levels"});
+  v.Field("normalize_gain", o.normalize_gain,
+          {.help = "`robust`: divide each frame by its global gain (exposure changes)"});
+  v.Field("min_blob_texels", o.min_blob_texels,
+          {.min = 0, .help = "mask cleaning: smaller foreground blobs are noise"});
+  v.Field("dilate_texels", o.dilate_texels,
+          {.min = 0,
+           .max = 64,
+           .help = "mask cleaning: the remaining foreground grows by this margin"});
 }
 
 template <class V>
 void Fields(AtlasOptions& o, V& v) {
-  v.Field("page_size", o.page_size, {.min = 256, .max = 8192});
-  v.Field("padding_texels", o.padding_texels, {.min = 0, .max = 32});
+  v.Field("page_size", o.page_size,
+          {.min = 256,
+           .max = 8192,
+           .help = "charts are packed into texture pages of at most this size (8192 is what "
+                   "viewers and GPUs take)"});
+  v.Field("padding_texels", o.padding_texels,
+          {.min = 0,
+           .max = 32,
+           .help = "edge texels repeated around each chart, so bilinear sampling and the first "
+                   "mipmap levels never mix two charts"});
 }
 
 template <class V>
 void Fields(SelectOptions& o, V& v) {
-  v.Field("enabled", o.enabled);
-  v.Field("exposure", o.exposure);
-  v.Field("switch_margin", o.switch_margin, {.min = 0, .max = 10});
-  v.Field("region_weight", o.region_weight, {.min = 0, .max = 1});
-  v.Field("edge_px", o.edge_px, {.min = 0, .max = 100});
-  v.Field("edge_penalty", o.edge_penalty, {.min = 0, .max = 1});
-  v.Field("edge_depth_rel", o.edge_depth_rel, {.min = 0, .min_exclusive = true, .max = 10});
+  v.Field(
+      "enabled", o.enabled,
+      {.help =
+           "score every view of a texel and keep the better one, and match exposures (below): for "
+           "real photos with changing exposure (on the Sceaux castle photos +0.9 to 1.1 dB and 1 - "
+           "NCC 0.07 lower, at 2-4 times the warp stage's cost); it runs with `update: quality` "
+           "and `refine.mode: off` (refinement moves the buffers to the frames and needs them to "
+           "take new samples); it also caps the background model's warm-up at a third of the "
+           "capture's frames. Off (the default): `update` and `quality_slack` alone decide"});
+  v.Field("exposure", o.exposure,
+          {.help = "per frame, a gain per colour channel against what the buffers already hold "
+                   "(the median ratio over the texels both have) is divided out before painting: "
+                   "one consistent exposure, set by the first frames"});
+  v.Field("switch_margin", o.switch_margin,
+          {.min = 0,
+           .max = 10,
+           .help = "a painted texel takes a new frame's sample only when that view scores this "
+                   "much better (0.25: 25 %): fewer switches between frames, fewer seams"});
+  v.Field("region_weight", o.region_weight,
+          {.min = 0,
+           .max = 1,
+           .help = "a view's score blends the texel's own (pixels per texel times the cosine of "
+                   "the view angle) with the frame's median over the chart: 0 per texel, 1 per "
+                   "chart (a chart tends to keep one frame)"});
+  v.Field("edge_px", o.edge_px,
+          {.min = 0,
+           .max = 100,
+           .help = "texels seen within this many pixels of a depth discontinuity of the frame (a "
+                   "silhouette, where a slightly wrong mesh samples the background) ..."});
+  v.Field("edge_penalty", o.edge_penalty,
+          {.min = 0,
+           .max = 1,
+           .help = "... score this times less: they fill texels no better view has painted, and "
+                   "the next good view replaces them"});
+  v.Field("edge_depth_rel", o.edge_depth_rel,
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 10,
+           .help = "neighbouring pixels whose depths differ by this fraction of the nearer one "
+                   "make a discontinuity (surface beside no surface always does)"});
 }
 
 template <class V>
 void Fields(PipelineOptions& o, V& v) {
-  v.Enum("sampling", o.sampling, SamplingNames());
-  v.Field("texel_size_m", o.texel_size_m, {.min = 0});
-  v.Field("max_buffer_texels", o.max_buffer_texels, {.min = 1});
-  v.Field("update_every", o.update_every, {.min = 1});
-  v.Enum("update", o.update, UpdatePolicyNames());
-  v.Field("quality_slack", o.quality_slack, {.min = 0, .max = 1});
-  v.Field("update_weight", o.update_weight, {.min = 0.01, .max = 1});
-  v.Field("max_frames", o.max_frames, {.min = 0});
-  v.Field("threads", o.threads, {.min = 0});
-  v.Field("debug_images", o.debug_images);
+  v.Enum("sampling", o.sampling, SamplingNames(),
+         "how a texel samples the frame: nearest pixel, bilinear (the paper's §3.2), or `area` "
+         "(bilinear on the pyramid level matching the texel's footprint: far or oblique views)");
+  v.Field("texel_size_m", o.texel_size_m,
+          {.min = 0,
+           .help = "texel edge in metres; 0 = automatic: median depth the cameras see over the "
+                   "focal length (one texel per pixel at the typical distance)"});
+  v.Field("max_buffer_texels", o.max_buffer_texels,
+          {.min = 1,
+           .help = "a bigger base buffer gets coarser texels (memory is bounded: buffers are "
+                   "fixed-size, frames are streamed)"});
+  v.Field("update_every", o.update_every,
+          {.min = 1, .help = "paint every N-th frame (the paper's §4)"});
+  v.Enum("update", o.update, UpdatePolicyNames(),
+         "`latest` (the paper: every visible sample overwrites) or `quality` (a sample overwrites "
+         "only if at least `1 - quality_slack` as sharp, in pixels per texel)");
+  v.Field(
+      "quality_slack", o.quality_slack,
+      {.min = 0,
+       .max = 1,
+       .help = "with `update: quality`, accept samples this much blurrier than the stored one"});
+  v.Field(
+      "update_weight", o.update_weight,
+      {.min = 0.01,
+       .max = 1,
+       .help =
+           "weight of an accepted sample against what the texel holds: 1 replaces (the paper's); "
+           "below 1 keeps a running average, which averages out residual misalignment"});
+  v.Field("max_frames", o.max_frames, {.min = 0, .help = "stop after this many frames (0 = all)"});
+  v.Field("threads", o.threads, {.min = 0, .help = "threads for the stages (0 = all cores)"});
+  v.Field("debug_images", o.debug_images,
+          {.help = "make per-stage debug images (`fresco run --debug-images` writes them under "
+                   "`stages/`; costs time)"});
   v.Object("occlusion", o.occlusion);
   v.Object("refine", o.refine);
   v.Object("background", o.background);
@@ -183,9 +305,21 @@ void Fields(GroupSpec& g, V& v) {
 
 template <class V>
 void Fields(GroupingOptions& o, V& v) {
-  v.Field("angle_deg", o.angle_deg, {.min = 0, .max = 180});
-  v.Field("min_chart_texels", o.min_chart_texels, {.min = 0});
-  v.Field("max_stretch", o.max_stretch, {.min = 1, .max = 100});
+  v.Field("angle_deg", o.angle_deg,
+          {.min = 0,
+           .max = 180,
+           .help = "a neighbouring triangle joins a chart when its normal is within this of the "
+                   "chart's mean normal"});
+  v.Field("min_chart_texels", o.min_chart_texels,
+          {.min = 0,
+           .help = "smaller charts are merged into the neighbour they share most edges with, when "
+                   "its plane sees them with a stretch of at most `max_stretch`; 0 = the paper's "
+                   "grouping (§3.6)"});
+  v.Field("max_stretch", o.max_stretch,
+          {.min = 1,
+           .max = 100,
+           .help = "texel stretch (1 / cos of the angle to the chart's plane) allowed when merging "
+                   "small charts"});
   v.List("groups", o.groups);
   v.List("edits", o.edits);
 }
@@ -197,24 +331,60 @@ void Fields(TruthFiles& t, V& v) {
 
 template <class V>
 void Fields(LiveOptions& o, V& v) {
-  v.Field("queue_frames", o.queue_frames, {.min = 1, .max = 1000});
-  v.Field("open_timeout_s", o.open_timeout_s, {.min = 0, .min_exclusive = true});
-  v.Field("read_timeout_s", o.read_timeout_s, {.min = 0, .min_exclusive = true});
-  v.Field("reconnects", o.reconnects, {.min = 0});
-  v.Field("stream_clock", o.stream_clock);
-  v.Field("connect_timeout_s", o.connect_timeout_s, {.min = 0});
-  v.Field("pose_reconnect_give_up_s", o.pose_reconnect_give_up_s, {.min = 0});
-  v.Field("pose_wait_s", o.pose_wait_s, {.min = 0});
-  v.Field("max_pose_gap_s", o.max_pose_gap_s, {.min = 0, .min_exclusive = true});
-  v.Field("max_pose_extrapolate_s", o.max_pose_extrapolate_s, {.min = 0});
-  v.Field("estimate_offset", o.estimate_offset);
-  v.Field("offset_search_s", o.offset_search_s, {.min = 0, .min_exclusive = true, .max = 60});
-  v.Field("offset_window_frames", o.offset_window_frames, {.min = 4, .max = 1000});
-  v.Field("track_offset", o.track_offset);
-  v.Field("offset_track_every_frames", o.offset_track_every_frames, {.min = 1, .max = 100000});
+  v.Field("queue_frames", o.queue_frames,
+          {.min = 1,
+           .max = 1000,
+           .help = "frames waiting between the video and the painter; when full the oldest is "
+                   "dropped (newest wins) and counted"});
+  v.Field("open_timeout_s", o.open_timeout_s,
+          {.min = 0, .min_exclusive = true, .help = "the video stream must start within this"});
+  v.Field("read_timeout_s", o.read_timeout_s,
+          {.min = 0,
+           .min_exclusive = true,
+           .help = "no frame for this long ends the stream (after `reconnects` attempts)"});
+  v.Field("reconnects", o.reconnects, {.min = 0, .help = "times a stalled stream is reopened"});
+  v.Field("stream_clock", o.stream_clock,
+          {.help = "frame times from the stream's timestamps (else arrival times)"});
+  v.Field("connect_timeout_s", o.connect_timeout_s,
+          {.min = 0, .help = "the tracker (`tcp://`) must accept the connection within this"});
+  v.Field("pose_reconnect_give_up_s", o.pose_reconnect_give_up_s,
+          {.min = 0,
+           .help = "a tracker that drops is reconnected with backoff (0.1 s doubling to 2 s); no "
+                   "connection for this long ends the feed with an error (0 = keep trying)"});
+  v.Field("pose_wait_s", o.pose_wait_s,
+          {.min = 0, .help = "a frame waits up to this for the tracker to reach its time"});
+  v.Field("max_pose_gap_s", o.max_pose_gap_s,
+          {.min = 0,
+           .min_exclusive = true,
+           .help = "no pose is interpolated between samples further apart"});
+  v.Field("max_pose_extrapolate_s", o.max_pose_extrapolate_s,
+          {.min = 0,
+           .help = "a frame this far before the first pose or after the last still gets one, "
+                   "extrapolated"});
+  v.Field("estimate_offset", o.estimate_offset,
+          {.help = "estimate `time_offset_s` from the first frames"});
+  v.Field("offset_search_s", o.offset_search_s,
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 60,
+           .help = "candidates within ± this of the set `time_offset_s`"});
+  v.Field("offset_window_frames", o.offset_window_frames,
+          {.min = 4, .max = 1000, .help = "frames used for each estimate"});
+  v.Field("track_offset", o.track_offset, {.help = "estimate the offset again during the session"});
+  v.Field("offset_track_every_frames", o.offset_track_every_frames,
+          {.min = 1,
+           .max = 100000,
+           .help = "re-estimate every N frames, on the last `offset_window_frames` frames"});
   v.Field("offset_track_search_s", o.offset_track_search_s,
-          {.min = 0, .min_exclusive = true, .max = 60});
-  v.Field("offset_track_min_gain", o.offset_track_min_gain, {.min = 0, .max = 1});
+          {.min = 0,
+           .min_exclusive = true,
+           .max = 60,
+           .help = "re-estimation candidates within ± this of the offset in use"});
+  v.Field("offset_track_min_gain", o.offset_track_min_gain,
+          {.min = 0,
+           .max = 1,
+           .help = "a new estimate replaces the offset in use only when its score is at least this "
+                   "fraction lower"});
 }
 
 template <class V>
@@ -247,7 +417,8 @@ void Fields(Project& p, V& v) {
 // NonDefaultProject(); then update the size here. (x86-64 Linux sizes.)
 static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56, "see Fields(BackgroundOptions)");
+static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56,
+              "see Fields(BackgroundOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(AtlasOptions) == 8, "see Fields(AtlasOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(SelectOptions) == 48, "see Fields(SelectOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 288, "see Fields(PipelineOptions)");
@@ -270,7 +441,8 @@ class JsonWriter {
     (*object_)[key] = value;
   }
   template <class E>
-  void Enum(const char* key, const E& value, const std::vector<std::pair<E, std::string>>& names) {
+  void Enum(const char* key, const E& value, const std::vector<std::pair<E, std::string>>& names,
+            const char* /*help*/ = "") {
     for (const auto& [e, name] : names) {
       if (e == value) (*object_)[key] = name;
     }
@@ -429,7 +601,8 @@ class JsonReader {
   }
 
   template <class E>
-  void Enum(const char* key, E& value, const std::vector<std::pair<E, std::string>>& names) {
+  void Enum(const char* key, E& value, const std::vector<std::pair<E, std::string>>& names,
+            const char* /*help*/ = "") {
     const Json* j = Find(key, {});
     if (!j) return;
     std::vector<std::string> choices;
@@ -891,6 +1064,87 @@ Status SaveProject(const Project& project, const std::string& path) {
     for (std::string* p : paths) *p = Rebase(*p, old_folder, new_folder);
   }
   return WriteFileAtomic(path, ProjectToJsonText(moved));
+}
+
+// ---- The settings catalogue. ----------------------------------------------------------------
+
+namespace {
+
+// Walks the same Fields() as the reader and writer, recording every scalar setting with its
+// rule and help, bound to the fields of the object walked.
+class SettingsCollector {
+ public:
+  SettingsCollector(std::string prefix, std::vector<Setting>* out)
+      : prefix_(std::move(prefix)), out_(out) {}
+
+  void Field(const char* key, bool& value, const Rule& rule = {}) {
+    Setting& s = Add(key, Setting::Kind::kBool, rule);
+    s.flag = &value;
+  }
+  void Field(const char* key, int& value, const Rule& rule = {}) {
+    Setting& s = Add(key, Setting::Kind::kInt, rule);
+    s.integer = &value;
+  }
+  void Field(const char* key, double& value, const Rule& rule = {}) {
+    Setting& s = Add(key, Setting::Kind::kNumber, rule);
+    s.number = &value;
+  }
+  void Field(const char* key, std::string& value, const Rule& rule = {}) {
+    Setting& s = Add(key, Setting::Kind::kText, rule);
+    s.text = &value;
+  }
+  void Field(const char*, std::vector<int>&, const Rule& = {}) {}  // lists: not a setting
+  template <class E>
+  void Enum(const char* key, E& value, const std::vector<std::pair<E, std::string>>& names,
+            const char* help = "") {
+    Setting& s = Add(key, Setting::Kind::kChoice, Rule{.help = help});
+    for (const auto& entry : names) s.choices.push_back(entry.second);
+    s.get_choice = [&value, &names] {
+      for (size_t i = 0; i < names.size(); ++i)
+        if (names[i].first == value) return static_cast<int>(i);
+      return 0;
+    };
+    s.set_choice = [&value, &names](int i) {
+      if (i >= 0 && i < static_cast<int>(names.size())) value = names[i].first;
+    };
+  }
+  template <class T>
+  void Object(const char* key, T& value) {
+    SettingsCollector sub(prefix_ + key + ".", out_);
+    Fields(value, sub);
+  }
+  template <class T>
+  void List(const char*, std::vector<T>&) {}  // lists (groups, edits, streams): not settings
+
+ private:
+  Setting& Add(const char* key, Setting::Kind kind, const Rule& rule) {
+    Setting s;
+    s.key = prefix_ + key;
+    s.kind = kind;
+    s.min = rule.min;
+    s.min_exclusive = rule.min_exclusive;
+    s.max = rule.max;
+    s.choices = rule.choices;
+    s.help = rule.help;
+    out_->push_back(std::move(s));
+    return out_->back();
+  }
+
+  std::string prefix_;
+  std::vector<Setting>* out_;
+};
+
+}  // namespace
+
+std::vector<Setting> DescribeSettings(Project* project) {
+  std::vector<Setting> settings;
+  SettingsCollector pipeline("pipeline.", &settings);
+  Fields(project->pipeline, pipeline);
+  SettingsCollector grouping("grouping.", &settings);
+  Fields(project->grouping, grouping);
+  SettingsCollector live("live.", &settings);
+  Fields(project->live, live);
+  return settings;
 }
 
 }  // namespace fresco

@@ -25,7 +25,7 @@ struct PaintUpdateStats {
   int rejected = 0;  // visible but kept the stored, sharper sample
   // Misalignment signal: over texels that were already painted and are seen again, the sum
   // of |grey(new sample) - grey(stored)| (0..255 each) and how many there were.
-  double abs_grey_difference_sum = 0;
+  long long abs_grey_difference_sum = 0;  // an integer: no floating-point chain per texel
   int compared = 0;
   int newly_painted = 0;  // on-surface texels painted for the first time
 

@@ -409,9 +409,9 @@ void ScanGridTriangle(const Table& t, const TriangleSetup& s, int tri, int row_l
   }
 }
 
-template <bool kDirect, class Record>
+template <bool kDirect, class Record, class BandRecord>
 void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                          const Record& record) const {
+                          const Record& record, const BandRecord* band_record) const {
   const RayTable& t = *rays_;
   const double near_m = options_.near_m;
   const bool cull = options_.cull_back_faces;
@@ -549,9 +549,13 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
     cv::parallel_for_(cv::Range(0, num_bands), [&](const cv::Range& range) {
       for (int band = range.start; band < range.end; ++band) {
         const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
-        for (const auto& [tri, setup] : all)
-          if (setup.row0 < band_hi && setup.row1 >= band_lo)
+        for (const auto& [tri, setup] : all) {
+          if (setup.row0 >= band_hi || setup.row1 < band_lo) continue;
+          if (band_record)
+            ScanGridTriangle(t, setup, tri, band_lo, band_hi, *band_record);
+          else
             ScanGridTriangle(t, setup, tri, band_lo, band_hi, record);
+        }
       }
     });
     return;
@@ -725,26 +729,30 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   });
   float* inv = depth->ptr<float>();
   const double inv_near = 1.0 / options_.near_m;
+  // The nearest hit so far, where one thread owns the sample.
+  const auto exclusive_record = [&](int, int sample, float, float, double inv_z,
+                                    const TriangleSetup&) {
+    const float inv_zf = static_cast<float>(inv_z);
+    if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near) inv[sample] = inv_zf;
+  };
   if (rays_->grid) {
     // Triangles scanned by whichever thread set them up: a sample may be hit from two
     // threads at once, so the maximum is taken atomically (and is still order-independent).
-    Traverse<true>(mesh, cam_from_local,
-                   [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
-                     if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
-                     const float inv_zf = static_cast<float>(inv_z);
-                     std::atomic_ref<float> cell(inv[sample]);
-                     float current = cell.load(std::memory_order_relaxed);
-                     while (inv_zf > current &&
-                            !cell.compare_exchange_weak(current, inv_zf, std::memory_order_relaxed)) {
-                     }
-                   });
+    // The large triangles come after, one thread per band of rows: the plain maximum.
+    Traverse<true>(
+        mesh, cam_from_local,
+        [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
+          if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
+          const float inv_zf = static_cast<float>(inv_z);
+          std::atomic_ref<float> cell(inv[sample]);
+          float current = cell.load(std::memory_order_relaxed);
+          while (inv_zf > current &&
+                 !cell.compare_exchange_weak(current, inv_zf, std::memory_order_relaxed)) {
+          }
+        },
+        &exclusive_record);
   } else {
-    Traverse<false>(mesh, cam_from_local,
-                    [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
-                      const float inv_zf = static_cast<float>(inv_z);
-                      if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near)
-                        inv[sample] = inv_zf;
-                    });
+    Traverse<false>(mesh, cam_from_local, exclusive_record);
   }
   cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {

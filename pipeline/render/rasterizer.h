@@ -74,10 +74,12 @@ class Rasterizer {
   // Sets up the triangles and calls record(tri, sample, x, y, inv_z, setup) for every ray
   // inside a triangle at inverse depth inv_z (near plane not yet checked). Binned (kDirect
   // false): each sample is recorded by one thread only. Direct (rays on a grid only): each
-  // triangle is scanned by the thread that set it up, so record must be thread-safe.
-  template <bool kDirect, class Record>
-  void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                const Record& record) const;
+  // triangle is scanned by the thread that set it up, so record must be thread-safe; the
+  // large triangles are scanned afterwards by bands of rows, one thread a band, through
+  // band_record (which need not be: no other thread writes the band's samples then).
+  template <bool kDirect, class Record, class BandRecord = Record>
+  void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local, const Record& record,
+                const BandRecord* band_record = nullptr) const;
   Camera camera_;
   RasterOptions options_;
   std::unique_ptr<RayTable> rays_;

@@ -1,8 +1,12 @@
 // The project file: defaults, strict parsing (unknown keys, wrong types, ranges, malformed
 // JSON, duplicate keys), --set overrides, and load(save(p)) == p, also when saved elsewhere.
 #include "pipeline/core/project.h"
+#include "pipeline/core/settings.h"
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -562,6 +566,111 @@ TEST(ProjectTest, Version2SaveThenLoadGivesTheSameProject) {
   for (size_t i = 0; i < copy.streams.size(); ++i)
     for (auto field : {&StreamSpec::camera, &StreamSpec::video, &StreamSpec::poses})
       EXPECT_EQ(copy.Resolve(copy.streams[i].*field), project.Resolve(project.streams[i].*field));
+}
+
+// ---- The settings catalogue (pipeline/core/settings.h) against the reader: every setting it
+// lists is one the reader takes by --set, within the range it states and no further, and each
+// has its help; what the app's widgets and `fresco settings` show is what the file means.
+
+// The setting `key` of the project parsed with `--set KEY=VALUE`, as text; the error if any.
+std::string ParsedValue(const std::string& key, const std::string& value, bool* ok) {
+  Project project;
+  const Status status = ParseProject(kMinimal, "p.json", {key + "=" + value}, &project);
+  *ok = status.ok();
+  if (!status.ok()) return status.message();
+  for (const Setting& s : DescribeSettings(&project))
+    if (s.key == key) return s.ValueText();
+  return "(not listed)";
+}
+
+// A value inside the setting's range other than `current`.
+double OtherValueInRange(const Setting& s, double current) {
+  const double lo = std::isfinite(s.min) ? s.min : current - 10;
+  const double hi = std::isfinite(s.max) ? s.max : std::max(lo, current) + 10;
+  for (const double candidate : {current + 1, (lo + hi) / 2, hi, current * 2 + 1, lo + 1})
+    if (candidate != current && candidate <= hi &&
+        (candidate > lo || (!s.min_exclusive && candidate == lo)))
+      return s.kind == Setting::Kind::kInt ? std::floor(candidate) : candidate;
+  return current;
+}
+
+TEST(Settings, EverySettingHasHelpAndAUniqueKey) {
+  Project project;
+  const std::vector<Setting> settings = DescribeSettings(&project);
+  EXPECT_GE(settings.size(), 60u);
+  std::set<std::string> keys;
+  for (const Setting& s : settings) {
+    EXPECT_TRUE(keys.insert(s.key).second) << s.key;
+    EXPECT_GE(s.help.size(), 10u) << s.key << ": no help";
+  }
+  for (const char* key : {"pipeline.sampling", "pipeline.background.window_frames",
+                          "pipeline.refine.mode", "grouping.angle_deg", "live.queue_frames"})
+    EXPECT_EQ(keys.count(key), 1u) << key;
+}
+
+TEST(Settings, EverySettingRoundTripsThroughSetWithinItsRangeAndNoFurther) {
+  Project defaults;
+  int checked = 0;
+  for (const Setting& s : DescribeSettings(&defaults)) {
+    bool ok = false;
+    switch (s.kind) {
+      case Setting::Kind::kBool: {
+        const std::string flipped = *s.flag ? "false" : "true";
+        EXPECT_EQ(ParsedValue(s.key, flipped, &ok), flipped) << s.key;
+        break;
+      }
+      case Setting::Kind::kChoice:
+        for (const std::string& name : s.choices)
+          EXPECT_EQ(ParsedValue(s.key, "\"" + name + "\"", &ok), "`" + name + "`") << s.key;
+        ParsedValue(s.key, "\"no-such-choice\"", &ok);
+        EXPECT_FALSE(ok) << s.key;
+        break;
+      case Setting::Kind::kInt:
+      case Setting::Kind::kNumber: {
+        const double current = s.kind == Setting::Kind::kInt ? *s.integer : *s.number;
+        const double other = OtherValueInRange(s, current);
+        ASSERT_NE(other, current) << s.key;
+        Project expected;
+        for (const Setting& e : DescribeSettings(&expected)) {
+          if (e.key != s.key) continue;
+          if (e.integer) *e.integer = static_cast<int>(other);
+          if (e.number) *e.number = other;
+          char text[64];
+          std::snprintf(text, sizeof(text), "%.17g", other);
+          EXPECT_EQ(ParsedValue(s.key, text, &ok), e.ValueText()) << s.key;
+          EXPECT_TRUE(ok) << s.key;
+        }
+        if (std::isfinite(s.max)) {  // just beyond the stated range: refused, naming the key
+          const std::string beyond = std::to_string(s.max + 1);
+          const std::string message = ParsedValue(s.key, beyond, &ok);
+          EXPECT_FALSE(ok) << s.key << " = " << beyond;
+          EXPECT_NE(message.find(s.Name()), std::string::npos) << message;
+        }
+        if (std::isfinite(s.min)) {
+          const std::string below =
+              s.min_exclusive ? std::to_string(s.min) : std::to_string(s.min - 1);
+          ParsedValue(s.key, below, &ok);
+          EXPECT_FALSE(ok) << s.key << " = " << below;
+        }
+        break;
+      }
+      case Setting::Kind::kText:
+        break;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 60);
+}
+
+TEST(Settings, TableRowsShowDefaultRangeAndHelp) {
+  const std::vector<std::string> rows = SettingsTableRows("pipeline.background.window_frames");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].rfind("| `pipeline.background.window_frames` | 40 | int 2 to 65535 | ", 0), 0u)
+      << rows[0];
+  EXPECT_EQ(SettingsTableRows("pipeline.occlusion.max_view_angle_deg")[0].rfind(
+                "| `pipeline.occlusion.max_view_angle_deg` | 80 | > 0 to 90 | ", 0),
+            0u);
+  EXPECT_TRUE(SettingsTableRows("no.such.prefix").empty());
 }
 
 }  // namespace

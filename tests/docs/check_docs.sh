@@ -8,6 +8,8 @@
 #   - docs/reference/cli.md is exactly what tests/docs/make_cli_reference.sh writes now;
 #   - every key the project-file reader accepts (pipeline/core/project.cc, Fields()) is in
 #     docs/reference/project-file.md, and every key that page's tables name is accepted;
+#   - every settings row there is the one `fresco settings --markdown` makes (default, range
+#     and meaning from the declarations);
 #   - docs/contract.md equals ../shared/CONTRACT.md where that file exists;
 #   - no merge conflict markers in any text file of the tree.
 # Usage: bash tests/docs/check_docs.sh [FRESCO]   (default build/app/fresco; run from anywhere)
@@ -158,7 +160,7 @@ for t, name in re.findall(r"^\s+(?:std::vector<)?(\w+)>? (\w+)(?: = [^;]*)?;", h
     member_type[name] = t
 fields = {}
 for t, body in re.findall(r"void Fields\((\w+)& \w+, V& v\) \{(.*?)\n\}", source, re.S):
-    fields[t] = re.findall(r"v\.(Field|Enum|List|Object)\(\"(\w+)\", \w+\.(\w+)", body)
+    fields[t] = re.findall(r"v\.(Field|Enum|List|Object)\(\s*\"(\w+)\",\s*\w+\.(\w+)", body)
 keys = set()
 def walk(t, prefix):
     for kind, name, member in fields.get(t, []):
@@ -181,6 +183,18 @@ for k in sorted(keys - skip):
 for k in sorted(set(re.findall(r"^\| `([a-z_][\w.\[\]]*)`", ref, re.M))):
     if k not in keys:
         err(f"docs/reference/project-file.md: key '{k}' is not one project.cc reads")
+
+# The settings tables: every row `fresco settings --markdown` makes from the declarations
+# (default, range, help) must be in the page as it is.
+rows = subprocess.run([fresco, "settings", "--markdown"], capture_output=True, text=True).stdout
+ref_lines = set(ref.splitlines())
+if len(rows.splitlines()) < 50:
+    err("fresco settings --markdown printed fewer than 50 settings")
+for row in rows.splitlines():
+    if row not in ref_lines:
+        key = row.split("`")[1] if "`" in row else row
+        err(f"docs/reference/project-file.md: the row of '{key}' differs from `fresco settings "
+            f"--markdown`; paste it from there:\n  {row}")
 
 for e in errors:
     print(e)

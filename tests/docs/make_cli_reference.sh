@@ -50,4 +50,5 @@ block "fresco poses bootstrap" poses bootstrap
 block "fresco bench" bench
 block "fresco eval" eval
 block "fresco rephoto" rephoto
+block "fresco settings" settings
 block "fresco gui" gui

@@ -1,12 +1,14 @@
 // Pipeline: play, pause, step, seek, restart; live sources' state and the Record toggle
-// (live_status_section.h); and the settings of every stage, edited in the project
-// (undoable) and applied by restarting the worker.
+// (live_status_section.h); and every pipeline setting of the project file, one widget each
+// made from its declaration (setting_widgets.h), edited in the project (undoable) and
+// applied by restarting the worker.
 #include <algorithm>
 #include <cstdio>
 
 #include "ui/core/panel.h"
 #include "ui/panels/live_status_section.h"
 #include "ui/panels/panels.h"
+#include "ui/panels/setting_widgets.h"
 
 namespace fresco {
 namespace {
@@ -78,100 +80,32 @@ class PipelinePanel : public Panel {
 
     ImGui::Separator();
     ImGui::TextDisabled("Settings (Apply restarts painting)");
-    if (!ImGui::IsAnyItemActive()) edit_ = state.project.pipeline;
+    if (!ImGui::IsAnyItemActive()) edit_.pipeline = state.project.pipeline;
     // Widgets take what the longest label leaves, so no label runs out of a narrow panel.
-    ImGui::PushItemWidth(-ImGui::CalcTextSize("texel size m (0 = auto)").x -
+    ImGui::PushItemWidth(-ImGui::CalcTextSize("anchor window frames").x -
                          ImGui::GetStyle().ItemInnerSpacing.x);
-    PipelineOptions& p = edit_;
+    // Every pipeline setting the project file has, by section, each with the range the file
+    // accepts and its help as the tooltip (pipeline/core/settings.h).
     bool commit = false;
-    auto done = [&] { commit |= ImGui::IsItemDeactivatedAfterEdit(); };
-    const char* sampling[] = {"nearest", "bilinear", "area"};
-    int mode = static_cast<int>(p.sampling);
-    if (ImGui::Combo("sampling", &mode, sampling, 3)) {
-      p.sampling = static_cast<SamplingMode>(mode);
-      commit = true;
+    std::string section;
+    bool open = true;
+    for (const Setting& setting : DescribeSettings(&edit_)) {
+      if (setting.key.compare(0, 9, "pipeline.") != 0) continue;
+      if (setting.Section() != section) {
+        if (!section.empty() && open && section != "pipeline") ImGui::TreePop();
+        section = setting.Section();
+        open = section == "pipeline" ||
+               ImGui::TreeNodeEx(section.c_str() + 9, ImGuiTreeNodeFlags_DefaultOpen);
+      }
+      if (!open) continue;
+      ImGui::PushID(setting.key.c_str());
+      commit |= DrawSettingWidget(setting);
+      ImGui::PopID();
     }
-    float texel = static_cast<float>(p.texel_size_m);
-    if (ImGui::DragFloat("texel size m (0 = auto)", &texel, 0.0005f, 0.0f, 1.0f, "%.4f"))
-      p.texel_size_m = texel;
-    done();
-    ImGui::DragInt("max buffer texels", &p.max_buffer_texels, 4096, 1, 1 << 26);
-    done();
-    const char* policies[] = {"latest", "quality"};
-    int policy = static_cast<int>(p.update);
-    if (ImGui::Combo("update", &policy, policies, 2)) {
-      p.update = static_cast<UpdatePolicy>(policy);
-      commit = true;
-    }
-    float slack = static_cast<float>(p.quality_slack);
-    if (ImGui::SliderFloat("quality slack", &slack, 0.0f, 1.0f)) p.quality_slack = slack;
-    done();
-    float weight = static_cast<float>(p.update_weight);
-    if (ImGui::SliderFloat("update weight", &weight, 0.01f, 1.0f, "%.2f")) p.update_weight = weight;
-    done();
-    ImGui::SliderInt("update every", &p.update_every, 1, 60);
-    done();
-    if (ImGui::Checkbox("occlusion test", &p.occlusion.enabled)) commit = true;
-    float rel = static_cast<float>(p.occlusion.tolerance_rel);
-    if (ImGui::SliderFloat("tolerance (of depth)", &rel, 0.0f, 0.1f, "%.3f"))
-      p.occlusion.tolerance_rel = rel;
-    done();
-    float abs_m = static_cast<float>(p.occlusion.tolerance_m);
-    if (ImGui::SliderFloat("tolerance m", &abs_m, 0.0f, 0.1f, "%.4f"))
-      p.occlusion.tolerance_m = abs_m;
-    done();
-    float angle = static_cast<float>(p.occlusion.max_view_angle_deg);
-    if (ImGui::SliderFloat("max view angle deg", &angle, 1.0f, 90.0f, "%.1f"))
-      p.occlusion.max_view_angle_deg = angle;
-    done();
-    ImGui::TextDisabled("refine alignment (§3.5)");
-    const char* refine_modes[] = {"off", "paper", "robust"};
-    int refine = static_cast<int>(p.refine.mode);
-    if (ImGui::Combo("refine", &refine, refine_modes, 3)) {
-      p.refine.mode = static_cast<RefineMode>(refine);
-      commit = true;
-    }
-    const char* models[] = {"translation", "similarity", "affine", "homography"};
-    int model = static_cast<int>(p.refine.max_model);
-    if (ImGui::Combo("most general model", &model, models, 4)) {
-      p.refine.max_model = static_cast<RefineModelLimit>(model);
-      commit = true;
-    }
-    ImGui::SliderInt("search texels", &p.refine.search_px, 1, 64);
-    done();
-    ImGui::SliderInt("window texels", &p.refine.window_px, 1, 32);
-    done();
-    ImGui::SliderInt("corners", &p.refine.max_corners, 3, 1000);
-    done();
-    ImGui::SliderInt("refine every N frames", &p.refine.every_n_frames, 1, 30);
-    done();
-    float dead_band = static_cast<float>(p.refine.min_correction_px);
-    if (ImGui::SliderFloat("min correction texels", &dead_band, 0.0f, 2.0f, "%.2f"))
-      p.refine.min_correction_px = dead_band;
-    done();
-    if (ImGui::Checkbox("correct the pose", &p.refine.pose)) commit = true;
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("one pose correction for all buffers");
-    if (ImGui::Checkbox("consensus anchoring", &p.refine.anchor)) commit = true;
-    float step = static_cast<float>(p.refine.anchor_step_px);
-    if (ImGui::SliderFloat("anchor step texels", &step, 0.0f, 2.0f, "%.2f"))
-      p.refine.anchor_step_px = step;
-    done();
-    ImGui::SliderInt("anchor window frames", &p.refine.anchor_window_frames, 0, 1000);
-    done();
-    ImGui::TextDisabled("background (§3.4)");
-    const char* background_modes[] = {"off", "average", "robust"};
-    int background = static_cast<int>(p.background.mode);
-    if (ImGui::Combo("background", &background, background_modes, 3)) {
-      p.background.mode = static_cast<BackgroundMode>(background);
-      commit = true;
-    }
-    ImGui::SliderInt("window frames", &p.background.window_frames, 2, 1000);
-    done();
-    ImGui::SliderInt("training frames", &p.background.training_frames, 1, 250);
-    done();
-    if (commit && !(edit_ == state.project.pipeline)) {
+    if (!section.empty() && open && section != "pipeline") ImGui::TreePop();
+    if (commit && !(edit_.pipeline == state.project.pipeline)) {
       state.BeginEdit();
-      state.project.pipeline = edit_;
+      state.project.pipeline = edit_.pipeline;
     }
     ImGui::PopItemWidth();
     ImGui::BeginDisabled(!state.has_project);
@@ -202,7 +136,7 @@ class PipelinePanel : public Panel {
   uint64_t posted_version_ = 0;  // the snapshot version when it was posted
   bool slider_active_ = false;
   float slider_rect_[4] = {0, 0, 0, 0};
-  PipelineOptions edit_;
+  Project edit_;  // its pipeline: the settings being edited
   LiveStatusSection live_;
 };
 
