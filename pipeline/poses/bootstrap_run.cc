@@ -157,8 +157,11 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
     result->refined = true;
     result->icp_max_distance_m = icp.max_distance_m;
   }
+  PoseAlignmentOptions agree = align;
+  agree.inlier_rotation_deg = options.agree_rotation_deg;
+  agree.inlier_position_m = options.agree_position_rel * colmap.scene_size_m;
   result->comparison =
-      Compare(pairs, result->world_from_colmap, align, result->aligned_with == "given_poses");
+      Compare(pairs, result->world_from_colmap, agree, result->aligned_with == "given_poses");
   result->model = TransformModel(colmap.run.model, result->world_from_colmap);
   result->model.cameras = {{1, colmap.camera}};
   for (PosedImage& image : result->model.images) image.camera_id = 1;

@@ -24,17 +24,22 @@ struct BootstrapOptions {
   double inlier_rotation_deg = 2.0;          // ...and within this
   bool refine_mesh = false;                  // then ICP of the sparse points to the mesh
   double refine_max_distance_rel = 0.02;     // ICP pairs within this x scene size
+  // A given pose agrees with its bootstrapped one within these (the verification's
+  // thresholds: stricter than the fit's, so a reconstruction that bends is not vouched for).
+  double agree_rotation_deg = 0.5;
+  double agree_position_rel = 0.01;  // x scene size
 };
 
 // The bootstrapped poses against the given ones on the frames both have: are they better?
-// Aligned with the given poses, they are better when most given poses support the alignment
-// (those agree within the inlier thresholds; the others are replaced by poses the majority
-// vouches for), and likely worse when fewer than half do (then the alignment itself is
-// doubtful: a broken reconstruction). Aligned with control points, a majority agreeing
-// says both are right; otherwise the two disagree and nothing here says which is right.
+// Aligned with the given poses, they are better when most given poses agree with them
+// within the verification's thresholds (the others are replaced by poses the majority
+// vouches for), and likely worse when fewer than half do (a reconstruction that bends or
+// breaks: the alignment's looser thresholds may still take it). Aligned with control points, a
+// majority agreeing says both are right; otherwise the two disagree and nothing here says which is
+// right.
 struct PosesComparison {
   int compared = 0;  // frames with both a given and a bootstrapped pose
-  int agreeing = 0;  // within the inlier thresholds
+  int agreeing = 0;  // within BootstrapOptions::agree_*
   double median_rotation_deg = 0.0, max_rotation_deg = 0.0;  // bootstrapped vs given
   double median_position_m = 0.0, max_position_m = 0.0;
   bool collinear = false;  // the given centres lie on a line (the rotation from orientations)

@@ -126,7 +126,8 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
     std::snprintf(text, sizeof(text),
                   "Only %d of %d frames support the alignment: COLMAP's reconstruction and the "
                   "given poses disagree as a whole, so the flags say little about single frames "
-                  "(check the reconstruction: too few matches, a broken model).",
+                  "(check the reconstruction: one that drifts along the sequence, too few matches, "
+                  "a broken model).",
                   result.global_inliers, result.compared);
     notes.push_back(text);
   }

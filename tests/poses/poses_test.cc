@@ -350,7 +350,7 @@ TEST(Bootstrap, SaysWhetherTheBootstrappedPosesAreBetterThanTheGivenOnes) {
     EXPECT_EQ(result.comparison.better, "bootstrapped") << result.comparison.summary;
     EXPECT_TRUE(result.comparison.collinear);
     EXPECT_EQ(result.comparison.compared, n);
-    EXPECT_EQ(result.comparison.agreeing, n - 3);  // within 2 deg and 2 % of the scene
+    EXPECT_EQ(result.comparison.agreeing, n - 3);  // within 0.5 deg and 1 % of the scene
     EXPECT_NEAR(result.comparison.max_rotation_deg, 3.0, 0.1);
     for (int i = 0; i < n; ++i) {
       EXPECT_LT(
