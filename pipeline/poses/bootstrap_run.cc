@@ -50,6 +50,7 @@ nlohmann::json ReportJson(const ProjectColmap& colmap, const BootstrapResult& re
                                    {"median_position_m", c.median_position_m},
                                    {"max_position_m", c.max_position_m},
                                    {"collinear_centres", c.collinear},
+                                   {"drifts", c.drifts},
                                    {"better", c.better},
                                    {"summary", c.summary}};
   report["project"] = project_path;
@@ -89,7 +90,18 @@ PosesComparison Compare(const std::vector<PosePair>& pairs, const Sim3d& world_f
                 c.median_position_m, c.max_rotation_deg, c.max_position_m);
   const std::string agree =
       std::to_string(c.agreeing) + " of the " + std::to_string(c.compared) + " given poses";
-  if (2 * c.agreeing >= c.compared && c.agreeing >= 3) {
+  const Disagreement d = MeasureDisagreement(
+      pairs, world_from_colmap, thresholds.inlier_rotation_deg, thresholds.inlier_position_m);
+  c.drifts = d.Drifts();
+  if (c.drifts) {
+    c.better = "unknown";
+    c.summary = "The bootstrapped poses agree with " + agree + ", and differ from " +
+                std::to_string(d.smooth) + " smoothly along the sequence (" + pairs[d.first].name +
+                " to " + pairs[d.last].name +
+                "): COLMAP's reconstruction or the given poses drift there, and nothing here "
+                "says which (" +
+                figures + "). Check those frames before applying.";
+  } else if (2 * c.agreeing >= c.compared && c.agreeing >= 3) {
     c.better = "bootstrapped";
     c.summary = "The bootstrapped poses agree with " + agree + " and replace the " +
                 std::to_string(c.compared - c.agreeing) + " that disagree (" + figures + ").";

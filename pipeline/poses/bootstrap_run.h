@@ -43,8 +43,11 @@ struct PosesComparison {
   double median_rotation_deg = 0.0, max_rotation_deg = 0.0;  // bootstrapped vs given
   double median_position_m = 0.0, max_position_m = 0.0;
   bool collinear = false;  // the given centres lie on a line (the rotation from orientations)
-  // "bootstrapped", "given" (the bootstrapped are likely worse), "unknown" (control points
-  // disagree with the given poses), "none" (no frame to compare).
+  // The two differ smoothly along the sequence (a drift of one of them: which is better is
+  // then "unknown").
+  bool drifts = false;
+  // "bootstrapped", "given" (the bootstrapped are likely worse), "unknown" (one of the two
+  // drifts, or control points disagree with the given poses), "none" (no frame to compare).
   std::string better;
   std::string summary;  // one sentence for the CLI and the panel
 };

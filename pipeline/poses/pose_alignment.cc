@@ -229,6 +229,36 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+Disagreement MeasureDisagreement(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
+                                 double rotation_deg, double position_m) {
+  const int n = static_cast<int>(pairs.size());
+  std::vector<Eigen::Matrix<double, 6, 1>> e(n);  // rotation, offset in threshold units
+  std::vector<bool> beyond(n, false);
+  const double rotation_rad = rotation_deg * M_PI / 180.0;
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d aligned = world_from_colmap.TransformPose(pairs[i].colmap_cam_from_colmap);
+    const Eigen::AngleAxisd w(aligned.RotationMatrix().transpose() *
+                              pairs[i].given_cam_from_world.RotationMatrix());
+    e[i].head<3>() = w.angle() * w.axis() / rotation_rad;
+    e[i].tail<3>() = (aligned.Centre() - pairs[i].given_cam_from_world.Centre()) / position_m;
+    beyond[i] = e[i].head<3>().norm() > 1.0 || e[i].tail<3>().norm() > 1.0;
+  }
+  Disagreement d;
+  for (int i = 0; i < n; ++i) {
+    if (!beyond[i]) continue;
+    ++d.disagreeing;
+    bool smooth = false;
+    for (int j : {i - 1, i + 1}) {
+      if (j >= 0 && j < n && beyond[j] && (e[i] - e[j]).norm() < 0.5 * e[i].norm()) smooth = true;
+    }
+    if (!smooth) continue;
+    ++d.smooth;
+    if (d.first < 0) d.first = i;
+    d.last = i;
+  }
+  return d;
+}
+
 PoseError ComparePose(const PosePair& pair, const Sim3d& world_from_colmap) {
   const Rigid3d aligned = world_from_colmap.TransformPose(pair.colmap_cam_from_colmap);
   PoseError error;

@@ -82,6 +82,21 @@ struct PoseError {
 };
 PoseError ComparePose(const PosePair& pair, const Sim3d& world_from_colmap);
 
+// How the frames beyond the thresholds disagree, in sequence order (`pairs` in order): a
+// frame's disagreement is its rotation (world side, in units of `rotation_deg`) and centre
+// offset (in units of `position_m`) from the given pose to the aligned COLMAP pose. It is
+// smooth where a neighbour also disagrees and differs from it by under half its size: one
+// of the two (COLMAP's reconstruction or the given poses) drifts along the sequence, which
+// a wrong given pose here and there does not do.
+struct Disagreement {
+  int disagreeing = 0;        // frames beyond either threshold
+  int smooth = 0;             // of those, the smooth ones
+  int first = -1, last = -1;  // pair indices of the first and last smooth frame
+  bool Drifts() const { return smooth >= 3 && 2 * smooth >= disagreeing; }
+};
+Disagreement MeasureDisagreement(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
+                                 double rotation_deg, double position_m);
+
 // The median of `values` (the upper one of an even count); 0 when empty.
 double Median(std::vector<double> values);
 

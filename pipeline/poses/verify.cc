@@ -56,6 +56,12 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   out.centres = global.centres;
   out.rotation_from = global.rotation_from;
   out.weak_alignment = 2 * global.num_inliers < static_cast<int>(pairs.size());
+  out.disagreement = MeasureDisagreement(pairs, global.world_from_colmap,
+                                         out.rotation_threshold_deg, out.position_threshold_m);
+  if (out.disagreement.Drifts()) {
+    out.drift_first = pairs[out.disagreement.first].name;
+    out.drift_last = pairs[out.disagreement.last].name;
+  }
 
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
@@ -129,6 +135,15 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
                   "(check the reconstruction: one that drifts along the sequence, too few matches, "
                   "a broken model).",
                   result.global_inliers, result.compared);
+    notes.push_back(text);
+  }
+  if (result.disagreement.Drifts()) {
+    std::snprintf(text, sizeof(text),
+                  "%d of the %d frames beyond the thresholds disagree smoothly along the "
+                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there, "
+                  "and flags in that stretch may be the reconstruction's.",
+                  result.disagreement.smooth, result.disagreement.disagreeing,
+                  result.drift_first.c_str(), result.drift_last.c_str());
     notes.push_back(text);
   }
   return notes;

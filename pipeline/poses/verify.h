@@ -58,6 +58,11 @@ struct VerifyResult {
   // Fewer than half the compared frames support the global alignment: COLMAP's
   // reconstruction and the given poses disagree as a whole, so single flags mean little.
   bool weak_alignment = false;
+  // How the frames beyond the thresholds disagree with the global alignment: smoothly along
+  // the sequence (a drift, pose_alignment.h) from frame `drift_first` to `drift_last`, or
+  // frame by frame.
+  Disagreement disagreement;
+  std::string drift_first, drift_last;
   // Statistics of the unflagged frames (how well COLMAP and the poses agree); zero when
   // `unflagged` is 0.
   int unflagged = 0;

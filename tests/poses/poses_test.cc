@@ -380,6 +380,39 @@ TEST(Bootstrap, SaysWhetherTheBootstrappedPosesAreBetterThanTheGivenOnes) {
   }
 }
 
+TEST(Verify, AReconstructionThatDriftsIsToldFromWrongPoses) {
+  // The second half of COLMAP's walk turns away steadily, up to 4 deg at the end (as on the
+  // street walk): the given poses are right, and the disagreement is smooth.
+  const int n = 40;
+  const Sim3d world_from_colmap = SomeSimilarity();
+  const std::vector<Rigid3d> truth = StraightWalkPoses(n, 0.0);
+  std::vector<Rigid3d> drifting;
+  for (int i = 0; i < n; ++i) {
+    const double drift_deg = i < n / 2 ? 0.0 : 4.0 * (i - n / 2 + 1) / (n / 2);
+    const Eigen::Quaterniond dq(
+        Eigen::AngleAxisd(drift_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+    const Eigen::Quaterniond q = (truth[i].rotation * dq).normalized();  // world side
+    drifting.push_back(InColmapFrame(Rigid3d(q, -(q * truth[i].Centre())), world_from_colmap));
+  }
+  std::vector<VerifyFrameInput> inputs;
+  for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &truth[i], &drifting[i]});
+  VerifyOptions options;
+  options.window_frames = 0;
+  VerifyResult result;
+  ASSERT_TRUE(VerifyPoses(inputs, 45.0, options, &result).ok());
+  EXPECT_TRUE(result.disagreement.Drifts());
+  EXPECT_GE(result.disagreement.smooth, 10);
+  const std::vector<std::string> notes = VerifyNotes(result);
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& note) {
+    return note.find("smoothly") != std::string::npos;
+  }));
+  const SyntheticColmap s(truth, drifting);
+  BootstrapResult bootstrap;
+  ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &bootstrap).ok());
+  EXPECT_TRUE(bootstrap.comparison.drifts);
+  EXPECT_EQ(bootstrap.comparison.better, "unknown") << bootstrap.comparison.summary;
+}
+
 TEST(Keyframes, SelectedByMotionAndSequencesAreRecognised) {
   // 30 frames 1 cm apart, turning 0.5 deg per frame: with a 5 cm step, every 5th frame;
   // with a 1 deg turn, every 2nd.
