@@ -55,7 +55,13 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   out.global_inliers = global.num_inliers;
   out.centres = global.centres;
   out.rotation_from = global.rotation_from;
-  out.weak_alignment = 2 * global.num_inliers < static_cast<int>(pairs.size());
+  for (const PosePair& pair : pairs) {
+    const PoseError e = ComparePose(pair, global.world_from_colmap);
+    if (e.rotation_deg <= out.rotation_threshold_deg && e.position_m <= out.position_threshold_m) {
+      ++out.global_agreeing;
+    }
+  }
+  out.weak_alignment = 2 * out.global_agreeing < static_cast<int>(pairs.size());
   out.disagreement = MeasureDisagreement(pairs, global.world_from_colmap,
                                          out.rotation_threshold_deg, out.position_threshold_m);
   if (out.disagreement.Drifts()) {
@@ -130,11 +136,11 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
   }
   if (result.weak_alignment) {
     std::snprintf(text, sizeof(text),
-                  "Only %d of %d frames support the alignment: COLMAP's reconstruction and the "
+                  "Only %d of %d frames agree with the alignment: COLMAP's reconstruction and the "
                   "given poses disagree as a whole, so the flags say little about single frames "
                   "(check the reconstruction: one that drifts along the sequence, too few matches, "
                   "a broken model).",
-                  result.global_inliers, result.compared);
+                  result.global_agreeing, result.compared);
     notes.push_back(text);
   }
   if (result.disagreement.Drifts()) {

@@ -92,6 +92,7 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
           {"translation_m", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
         {"scale", s.scale},
         {"inliers", result.global_inliers},
+        {"agreeing", result.global_agreeing},
         {"weak", result.weak_alignment},
         {"rotation_from", result.rotation_from},
         {"centres",

@@ -302,7 +302,7 @@ TEST(Verify, SummarySaysSoWhenNoFrameAgrees) {
   VerifyResult result;
   result.compared = 19;
   result.flagged = 19;
-  result.global_inliers = 3;
+  result.global_agreeing = 3;
   result.weak_alignment = true;
   const std::string text = VerifyAgreementText(result);
   EXPECT_NE(text.find("No frame agrees"), std::string::npos) << text;
