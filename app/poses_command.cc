@@ -28,8 +28,12 @@ const char* kColmapOptionsHelp =
     "  --max-frames N       at most N frames (default: all)\n"
     "  --max-image-size PX  downscale images to this longest side for SIFT (default: COLMAP's\n"
     "                       3200); keypoints are scaled back, intrinsics stay the project's\n"
-    "  --matcher M          auto (default: exhaustive up to 60 images, else sequential),\n"
+    "  --matcher M          auto (default: sequential for a video or a frame folder whose\n"
+    "                       poses are in sequence, else exhaustive up to 60 images),\n"
     "                       exhaustive or sequential (loop detection off: no vocab tree)\n"
+    "  --keyframe-step F    in a sequence, send a frame to COLMAP when its given pose moved\n"
+    "                       F x scene size since the last one sent (default 0.005)...\n"
+    "  --keyframe-rotation-deg X  ...or turned X degrees (default 2); 0 and 0: every frame\n"
     "  --scene-size-m M     scene size for the position threshold (default: the diagonal of\n"
     "                       the scene's bounding box)\n"
     "  --colmap PROGRAM     the colmap program (default: `colmap` on PATH)\n"
@@ -46,9 +50,9 @@ ArgSpec PosesArgSpec(const std::string& sub) {
   ArgSpec spec;
   spec.min_positional = 2;
   spec.max_positional = 2;
-  spec.options = {"--out",          "--every",        "--max-frames", "--max-image-size",
-                  "--matcher",      "--scene-size-m", "--colmap",     "--threads",
-                  "--colmap-model", "--max-features"};
+  spec.options = {"--out",          "--every",        "--max-frames",    "--max-image-size",
+                  "--matcher",      "--scene-size-m", "--colmap",        "--threads",
+                  "--colmap-model", "--max-features", "--keyframe-step", "--keyframe-rotation-deg"};
   spec.switches = {"--quiet"};
   spec.required = {"--out"};
   if (sub == "verify") {
@@ -131,6 +135,11 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
     return code;
   if ((code = PositiveDoubleOption(args, spec, "--scene-size-m", &options.scene_size_m)) >= 0)
     return code;
+  if ((code = PositiveDoubleOption(args, spec, "--keyframe-step", &options.keyframe_step_rel)) >= 0)
+    return code;
+  if ((code = PositiveDoubleOption(args, spec, "--keyframe-rotation-deg",
+                                   &options.keyframe_rotation_deg)) >= 0)
+    return code;
   options.load_scene = args.Switch("--refine-mesh");
   const std::string matcher = args.Get("--matcher", "auto");
   if (matcher == "auto") {
@@ -167,11 +176,22 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
     std::cerr << "error: " << status.message() << "\n";
     return kExitFailure;
   }
-  char detail[120];
+  char detail[200];
   std::snprintf(detail, sizeof(detail), "%d of %d frames registered, %.1f s",
                 result->run.registered, static_cast<int>(result->frames.size()),
                 result->run.seconds);
   progress.Finish(detail);
+  if (!result->run.matcher.empty()) {
+    std::string steps;
+    for (const auto& [step, seconds] : result->run.step_seconds) {
+      std::snprintf(detail, sizeof(detail), "%s%s %.1f s", steps.empty() ? "" : ", ", step.c_str(),
+                    seconds);
+      steps += detail;
+    }
+    std::cout << "colmap: " << result->frames.size() << " of " << result->run.frames_offered
+              << " frames sent (keyframes), " << result->run.matcher << " matching; " << steps
+              << "\n";
+  }
   return -1;
 }
 
@@ -204,10 +224,10 @@ int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
     return kExitFailure;
   }
   std::cout << "verify: " << result.compared << " frames compared (" << result.registered
-            << " registered by COLMAP), " << result.flagged << " flagged; median error of the "
-            << "others " << result.median_rotation_error_deg << " deg, "
-            << result.median_position_error_m << " m\n"
-            << "wrote " << (fs::path(out_dir) / "verify.json").string() << "\n";
+            << " registered by COLMAP), " << result.flagged << " flagged\n"
+            << VerifyAgreementText(result) << "\n";
+  for (const std::string& note : VerifyNotes(result)) std::cout << "note: " << note << "\n";
+  std::cout << "wrote " << (fs::path(out_dir) / "verify.json").string() << "\n";
   return kExitOk;
 }
 
@@ -253,6 +273,7 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
   }
   std::cout << "bootstrap: " << colmap.run.registered << " of " << colmap.frames.size()
             << " frames posed (" << result.aligned_with << ")\n"
+            << result.comparison.summary << "\n"
             << "wrote " << new_project_path.string() << "\n";
   return kExitOk;
 }

@@ -42,8 +42,7 @@ struct ControlPointFit {
   std::vector<double> residual_m;  // per point: |world - aligned triangulation|
 };
 Status AlignWithControlPoints(const std::vector<ControlPoint>& points, const std::string& what,
-                              const ColmapModel& model, const Camera& camera,
-                              ControlPointFit* fit);
+                              const ColmapModel& model, const Camera& camera, ControlPointFit* fit);
 
 // COLMAP's model moved into the world: cam_from_world poses (names and ids kept), points.
 ColmapModel TransformModel(const ColmapModel& model, const Sim3d& world_from_colmap);

@@ -1,5 +1,7 @@
 #include "pipeline/poses/bootstrap_run.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -40,8 +42,81 @@ nlohmann::json ReportJson(const ProjectColmap& colmap, const BootstrapResult& re
   report["registered"] = colmap.run.registered;
   report["not_registered"] = result.not_registered;
   report["colmap_seconds"] = colmap.run.seconds;
+  const PosesComparison& c = result.comparison;
+  report["compared_with_given"] = {{"frames", c.compared},
+                                   {"agreeing", c.agreeing},
+                                   {"median_rotation_deg", c.median_rotation_deg},
+                                   {"max_rotation_deg", c.max_rotation_deg},
+                                   {"median_position_m", c.median_position_m},
+                                   {"max_position_m", c.max_position_m},
+                                   {"collinear_centres", c.collinear},
+                                   {"drifts", c.drifts},
+                                   {"better", c.better},
+                                   {"summary", c.summary}};
   report["project"] = project_path;
   return report;
+}
+
+PosesComparison Compare(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
+                        const PoseAlignmentOptions& thresholds, bool aligned_with_poses) {
+  PosesComparison c;
+  c.compared = static_cast<int>(pairs.size());
+  std::vector<double> rotation, position;
+  std::vector<Eigen::Vector3d> centres;
+  for (const PosePair& p : pairs) {
+    const PoseError e = ComparePose(p, world_from_colmap);
+    rotation.push_back(e.rotation_deg);
+    position.push_back(e.position_m);
+    c.max_rotation_deg = std::max(c.max_rotation_deg, e.rotation_deg);
+    c.max_position_m = std::max(c.max_position_m, e.position_m);
+    if (e.rotation_deg < thresholds.inlier_rotation_deg &&
+        e.position_m < thresholds.inlier_position_m) {
+      ++c.agreeing;
+    }
+    centres.push_back(p.given_cam_from_world.Centre());
+  }
+  c.median_rotation_deg = Median(rotation);
+  c.median_position_m = Median(position);
+  c.collinear = MeasureCentreSpread(centres, thresholds).collinear;
+  if (c.compared == 0) {
+    c.better = "none";
+    c.summary =
+        "No registered frame has a given pose: nothing to compare the bootstrapped poses with.";
+    return c;
+  }
+  char figures[160];
+  std::snprintf(figures, sizeof(figures),
+                "median difference %.3g deg, %.3g m; up to %.3g deg, %.3g m", c.median_rotation_deg,
+                c.median_position_m, c.max_rotation_deg, c.max_position_m);
+  const std::string agree =
+      std::to_string(c.agreeing) + " of the " + std::to_string(c.compared) + " given poses";
+  const Disagreement d = MeasureDisagreement(
+      pairs, world_from_colmap, thresholds.inlier_rotation_deg, thresholds.inlier_position_m);
+  c.drifts = d.Drifts();
+  if (c.drifts) {
+    c.better = "unknown";
+    c.summary = "The bootstrapped poses agree with " + agree + ", and differ from " +
+                std::to_string(d.smooth) + " smoothly along the sequence (" + pairs[d.first].name +
+                " to " + pairs[d.last].name +
+                "): COLMAP's reconstruction or the given poses drift there, and nothing here "
+                "says which (" +
+                figures + "). Check those frames before applying.";
+  } else if (2 * c.agreeing >= c.compared && c.agreeing >= 3) {
+    c.better = "bootstrapped";
+    c.summary = "The bootstrapped poses agree with " + agree + " and replace the " +
+                std::to_string(c.compared - c.agreeing) + " that disagree (" + figures + ").";
+  } else if (aligned_with_poses) {
+    c.better = "given";
+    c.summary = "Only " + agree +
+                " agree with COLMAP's reconstruction: the bootstrapped poses "
+                "are likely WORSE than the given ones (" +
+                figures + "). Keep the given poses.";
+  } else {
+    c.better = "unknown";
+    c.summary = "Placed by the control points, the bootstrapped poses agree with only " + agree +
+                " (" + figures + "): one of the two is wrong; check the control points.";
+  }
+  return c;
 }
 
 }  // namespace
@@ -49,6 +124,15 @@ nlohmann::json ReportJson(const ProjectColmap& colmap, const BootstrapResult& re
 Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
                            const BootstrapOptions& options, BootstrapResult* result) {
   *result = BootstrapResult();
+  std::vector<PosePair> pairs;
+  for (const ProjectColmapFrame& f : colmap.frames) {
+    if (f.given && f.colmap) {
+      pairs.push_back({f.name, f.given->cam_from_world, f.colmap->cam_from_world});
+    }
+  }
+  PoseAlignmentOptions align;
+  align.inlier_position_m = options.inlier_position_rel * colmap.scene_size_m;
+  align.inlier_rotation_deg = options.inlier_rotation_deg;
   if (!options.control_points.empty()) {
     ControlPointFit fit;
     FRESCO_RETURN_IF_ERROR(AlignWithControlPoints(options.control_points, options.control_file,
@@ -57,20 +141,11 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
     result->aligned_with = "control_points";
     result->control_point_residual_m = fit.residual_m;
   } else {
-    std::vector<PosePair> pairs;
-    for (const ProjectColmapFrame& f : colmap.frames) {
-      if (f.given && f.colmap) {
-        pairs.push_back({f.name, f.given->cam_from_world, f.colmap->cam_from_world});
-      }
-    }
     if (pairs.size() < 3) {
       return Status::Error(project.poses + ": only " + std::to_string(pairs.size()) +
                            " registered frames have a given pose: give --control-points to "
                            "place COLMAP's reconstruction in the scene");
     }
-    PoseAlignmentOptions align;
-    align.inlier_position_m = options.inlier_position_rel * colmap.scene_size_m;
-    align.inlier_rotation_deg = options.inlier_rotation_deg;
     PoseAlignment alignment;
     if (Status s = AlignColmapToPoses(pairs, align, &alignment); !s.ok()) {
       return Status::Error(project.poses + ": " + s.message());
@@ -94,6 +169,11 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
     result->refined = true;
     result->icp_max_distance_m = icp.max_distance_m;
   }
+  PoseAlignmentOptions agree = align;
+  agree.inlier_rotation_deg = options.agree_rotation_deg;
+  agree.inlier_position_m = options.agree_position_rel * colmap.scene_size_m;
+  result->comparison =
+      Compare(pairs, result->world_from_colmap, agree, result->aligned_with == "given_poses");
   result->model = TransformModel(colmap.run.model, result->world_from_colmap);
   result->model.cameras = {{1, colmap.camera}};
   for (PosedImage& image : result->model.images) image.camera_id = 1;

@@ -20,10 +20,36 @@ namespace fresco {
 struct BootstrapOptions {
   std::vector<ControlPoint> control_points;  // >= 3: align with them, not the given poses
   std::string control_file;                  // where they came from (messages)
-  double inlier_position_rel = 0.02;  // given poses within this x scene size support the fit
-  double inlier_rotation_deg = 2.0;   // ...and within this
-  bool refine_mesh = false;           // then ICP of the sparse points to the mesh
-  double refine_max_distance_rel = 0.02;  // ICP pairs within this x scene size
+  double inlier_position_rel = 0.02;         // given poses within this x scene size support the fit
+  double inlier_rotation_deg = 2.0;          // ...and within this
+  bool refine_mesh = false;                  // then ICP of the sparse points to the mesh
+  double refine_max_distance_rel = 0.02;     // ICP pairs within this x scene size
+  // A given pose agrees with its bootstrapped one within these (the verification's
+  // thresholds: stricter than the fit's, so a reconstruction that bends is not vouched for).
+  double agree_rotation_deg = 0.5;
+  double agree_position_rel = 0.01;  // x scene size
+};
+
+// The bootstrapped poses against the given ones on the frames both have: are they better?
+// Aligned with the given poses, they are better when most given poses agree with them
+// within the verification's thresholds (the others are replaced by poses the majority
+// vouches for), and likely worse when fewer than half do (a reconstruction that bends or
+// breaks: the alignment's looser thresholds may still take it). Aligned with control points, a
+// majority agreeing says both are right; otherwise the two disagree and nothing here says which is
+// right.
+struct PosesComparison {
+  int compared = 0;  // frames with both a given and a bootstrapped pose
+  int agreeing = 0;  // within BootstrapOptions::agree_*
+  double median_rotation_deg = 0.0, max_rotation_deg = 0.0;  // bootstrapped vs given
+  double median_position_m = 0.0, max_position_m = 0.0;
+  bool collinear = false;  // the given centres lie on a line (the rotation from orientations)
+  // The two differ smoothly along the sequence (a drift of one of them: which is better is
+  // then "unknown").
+  bool drifts = false;
+  // "bootstrapped", "given" (the bootstrapped are likely worse), "unknown" (one of the two
+  // drifts, or control points disagree with the given poses), "none" (no frame to compare).
+  std::string better;
+  std::string summary;  // one sentence for the CLI and the panel
 };
 
 struct BootstrapResult {
@@ -36,6 +62,7 @@ struct BootstrapResult {
   MeshIcpResult icp;
   double icp_max_distance_m = 0.0;
   std::vector<std::string> not_registered;  // frames COLMAP did not register
+  PosesComparison comparison;
 };
 
 // Aligns `colmap` (RunColmapOnProject's result) to the scene. Errors name the project's

@@ -77,10 +77,9 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
   {
     Step s{"feature_extractor",
            {"feature_extractor", "--database_path", database.string(), "--image_path",
-            options.image_path, "--ImageReader.single_camera", "1",
-            "--ImageReader.camera_model", model_name, "--ImageReader.camera_params",
-            JoinParams(params), "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads",
-            threads}};
+            options.image_path, "--ImageReader.single_camera", "1", "--ImageReader.camera_model",
+            model_name, "--ImageReader.camera_params", JoinParams(params),
+            "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads}};
     if (!options.image_names.empty()) {
       std::string list;
       for (const std::string& name : options.image_names) list += name + "\n";
@@ -104,26 +103,26 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
       if (entry.is_regular_file()) ++image_count;
     }
   }
-  const bool exhaustive =
-      options.matcher == ColmapMatcher::kExhaustive ||
-      (options.matcher == ColmapMatcher::kAuto && image_count <= options.exhaustive_max_images);
+  const bool exhaustive = options.matcher == ColmapMatcher::kExhaustive ||
+                          (options.matcher == ColmapMatcher::kAuto && !options.ordered &&
+                           image_count <= options.exhaustive_max_images);
+  result->matcher = exhaustive ? "exhaustive" : "sequential";
   if (exhaustive) {
     steps.push_back({"exhaustive_matcher",
                      {"exhaustive_matcher", "--database_path", database.string(),
                       "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", threads}});
   } else {
-    steps.push_back({"sequential_matcher",
-                     {"sequential_matcher", "--database_path", database.string(),
-                      "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads", threads,
-                      "--SequentialMatching.overlap", std::to_string(options.sequential_overlap),
-                      "--SequentialMatching.loop_detection", "0"}});
+    steps.push_back(
+        {"sequential_matcher",
+         {"sequential_matcher", "--database_path", database.string(), "--SiftMatching.use_gpu", "0",
+          "--SiftMatching.num_threads", threads, "--SequentialMatching.overlap",
+          std::to_string(options.sequential_overlap), "--SequentialMatching.loop_detection", "0"}});
   }
   steps.push_back({"mapper",
                    {"mapper", "--database_path", database.string(), "--image_path",
                     options.image_path, "--output_path", sparse.string(),
                     "--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point",
-                    "0", "--Mapper.ba_refine_extra_params", "0", "--Mapper.num_threads",
-                    threads}});
+                    "0", "--Mapper.ba_refine_extra_params", "0", "--Mapper.num_threads", threads}});
 
   const int total_steps = static_cast<int>(steps.size()) + 1;
   auto run_step = [&](const Step& step, int index) -> Status {
@@ -168,19 +167,18 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
   result->models = static_cast<int>(model_folders.size());
   if (model_folders.empty()) {
     return Status::Error("colmap mapper made no reconstruction from " +
-                         std::to_string(image_count) +
-                         " images (too few matches?); see its log " +
+                         std::to_string(image_count) + " images (too few matches?); see its log " +
                          (logs / "03_mapper.log").string());
   }
   int best = -1;
   for (size_t i = 0; i < model_folders.size(); ++i) {
     const fs::path txt = sparse_txt / model_folders[i];
     FRESCO_RETURN_IF_ERROR(MakeDirectories(txt.string()));
-    FRESCO_RETURN_IF_ERROR(run_step(
-        {"model_converter",
-         {"model_converter", "--input_path", (sparse / model_folders[i]).string(),
-          "--output_path", txt.string(), "--output_type", "TXT"}},
-        static_cast<int>(steps.size())));
+    FRESCO_RETURN_IF_ERROR(
+        run_step({"model_converter",
+                  {"model_converter", "--input_path", (sparse / model_folders[i]).string(),
+                   "--output_path", txt.string(), "--output_type", "TXT"}},
+                 static_cast<int>(steps.size())));
     ColmapModel model;
     FRESCO_RETURN_IF_ERROR(ReadColmapModel(txt.string(), &model));
     if (best < 0 || model.images.size() > result->model.images.size()) {
@@ -189,8 +187,7 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
     }
   }
   result->registered = static_cast<int>(result->model.images.size());
-  result->seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (result->registered < options.min_registered) {
     return Status::Error("colmap registered only " + std::to_string(result->registered) + " of " +
                          std::to_string(image_count) + " images (at least " +

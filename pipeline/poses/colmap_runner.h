@@ -30,8 +30,11 @@ struct ColmapRunOptions {
   std::string image_path;                // folder holding the images
   std::vector<std::string> image_names;  // relative to image_path; all images when empty
   Camera camera;                         // intrinsics, held fixed ((0,0) convention)
-  // kAuto: exhaustive up to `exhaustive_max_images` images, sequential beyond.
+  // kAuto: sequential when the images are `ordered` (video frames: each is matched with its
+  // next `sequential_overlap` ones, minutes instead of hours on long sequences); else
+  // exhaustive up to `exhaustive_max_images` images, sequential beyond.
   ColmapMatcher matcher = ColmapMatcher::kAuto;
+  bool ordered = false;  // the images are a sequence (neighbours in time see the same things)
   int exhaustive_max_images = 60;
   int sequential_overlap = 10;  // sequential: each image is matched with this many next ones
   // SiftExtraction.max_image_size: images are downscaled to this longest side for feature
@@ -52,6 +55,10 @@ struct ColmapRunResult {
   int registered = 0;
   int models = 0;  // reconstructions the mapper made
   std::string program;
+  std::string matcher;  // "exhaustive" or "sequential"; "" for an earlier run's model
+  // Frames of the project offered (after every_n_frames/max_frames) and the keyframes among
+  // them that COLMAP was given (RunColmapOnProject fills these; 0 = not selected).
+  int frames_offered = 0, keyframes = 0;
   double seconds = 0.0;
   std::vector<std::pair<std::string, double>> step_seconds;  // wall time of each step
 };

@@ -1,5 +1,6 @@
 #include "pipeline/poses/project_colmap.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 
@@ -15,12 +16,53 @@ std::string Stem(const std::string& name) { return fs::path(name).stem().string(
 
 }  // namespace
 
+bool CentresLookOrdered(const std::vector<Eigen::Vector3d>& centres) {
+  const size_t n = centres.size();
+  if (n < 3) return false;
+  std::vector<double> steps, any;
+  for (size_t i = 1; i < n; ++i) steps.push_back((centres[i] - centres[i - 1]).norm());
+  // Pairs a fixed stride apart stand for all pairs (at most ~n of them).
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 1; j < n; j += std::max<size_t>(1, n / 16)) {
+      any.push_back((centres[i] - centres[j]).norm());
+    }
+  }
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  return median(steps) < median(any) / 3.0;
+}
+
+std::vector<int> SelectKeyframes(const std::vector<const Rigid3d*>& poses, double step_m,
+                                 double rotation_deg) {
+  std::vector<int> keyframes;
+  const Rigid3d* last = nullptr;
+  const int n = static_cast<int>(poses.size());
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d* pose = poses[i];
+    bool keep = pose == nullptr || last == nullptr || i == n - 1;
+    if (!keep) {
+      keep = (pose->Centre() - last->Centre()).norm() >= step_m ||
+             RotationDifferenceDeg(pose->rotation, last->rotation) >= rotation_deg;
+    }
+    if (!keep) continue;
+    keyframes.push_back(i);
+    if (pose) last = pose;
+  }
+  return keyframes;
+}
+
 Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
                           ProjectColmap* result, bool* bad_input) {
   *bad_input = true;
   if (options.every_n_frames < 1) return Status::Error("every_n_frames: must be >= 1");
   if (options.max_frames < 0) return Status::Error("max_frames: must be >= 0");
   if (options.scene_size_m < 0) return Status::Error("scene_size_m: must be >= 0");
+  if (!(options.keyframe_step_rel >= 0)) return Status::Error("keyframe_step_rel: must be >= 0");
+  if (!(options.keyframe_rotation_deg >= 0)) {
+    return Status::Error("keyframe_rotation_deg: must be >= 0");
+  }
   CaptureLoadOptions load;
   load.load_scene = options.scene_size_m == 0.0 || options.load_scene;
   load.require_poses = false;
@@ -74,21 +116,37 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     }
     if (!status.ok()) return status;
   }
-  std::vector<std::string> names;
-  int kept = 0;
+  std::vector<ProjectColmapFrame> offered;
   for (size_t i = 0; i < frames.size(); ++i) {
     // Exported frames were already subsampled.
     if (!folder_names.empty() && static_cast<int>(i) % options.every_n_frames != 0) continue;
-    if (options.max_frames > 0 && kept >= options.max_frames) break;
-    ++kept;
+    if (options.max_frames > 0 && static_cast<int>(offered.size()) >= options.max_frames) break;
     Frame lookup = frames[i];
     lookup.name = folder_names.empty() ? Stem(frames[i].name) : frames[i].name;
     ProjectColmapFrame pf;
     pf.name = frames[i].name;
     pf.index = frames[i].index;
     pf.given = capture.PoseForFrame(lookup);
-    result->frames.push_back(pf);
-    names.push_back(frames[i].name);
+    offered.push_back(pf);
+  }
+  // A video file is a sequence; a folder is when its given poses say so.
+  std::vector<const Rigid3d*> given_poses;
+  std::vector<Eigen::Vector3d> given_centres;
+  for (const ProjectColmapFrame& f : offered) {
+    given_poses.push_back(f.given ? &f.given->cam_from_world : nullptr);
+    if (f.given) given_centres.push_back(f.given->cam_from_world.Centre());
+  }
+  const bool ordered = folder_names.empty() || CentresLookOrdered(given_centres);
+  std::vector<int> selected(offered.size());
+  for (size_t i = 0; i < offered.size(); ++i) selected[i] = static_cast<int>(i);
+  if (ordered && options.existing_model.empty()) {  // an earlier model has its own frames
+    selected = SelectKeyframes(given_poses, options.keyframe_step_rel * result->scene_size_m,
+                               options.keyframe_rotation_deg);
+  }
+  std::vector<std::string> names;
+  for (int i : selected) {
+    result->frames.push_back(offered[i]);
+    names.push_back(offered[i].name);
   }
   if (names.size() < 3) {
     return Status::Error(project.video + ": COLMAP needs at least 3 frames, the project has " +
@@ -107,8 +165,11 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     run.image_path = image_path;
     run.image_names = names;
     run.camera = result->camera;
+    run.ordered = ordered;
     FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
   }
+  result->run.frames_offered = static_cast<int>(offered.size());
+  result->run.keyframes = static_cast<int>(names.size());
   *bad_input = false;
   std::map<std::string, const PosedImage*> by_name;
   for (const PosedImage& image : result->run.model.images) by_name[image.name] = &image;

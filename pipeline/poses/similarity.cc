@@ -32,8 +32,9 @@ Status FitMatrices(const Eigen::Matrix3Xd& src, const Eigen::Matrix3Xd& dst,
                          std::to_string(src.cols()));
   }
   if (!NonCollinear(src) || !NonCollinear(dst)) {
-    return Status::Error(what + ": the points are (nearly) collinear: the rotation about "
-                                "their line is undetermined");
+    return Status::Error(what +
+                         ": the points are (nearly) collinear: the rotation about "
+                         "their line is undetermined");
   }
   const Eigen::Matrix4d m = Eigen::umeyama(src, dst, true);
   const Eigen::Matrix3d sr = m.topLeftCorner<3, 3>();
@@ -135,9 +136,8 @@ Status EstimateSimilarityRobust(const std::vector<Eigen::Vector3d>& src,
     if (count > best_count) best_count = count, best = t, best_inliers = inliers;
   }
   if (best_count < 3) {
-    return Status::Error(what + ": no similarity agrees with at least 3 of " +
-                         std::to_string(n) + " point pairs within " +
-                         std::to_string(options.inlier_threshold));
+    return Status::Error(what + ": no similarity agrees with at least 3 of " + std::to_string(n) +
+                         " point pairs within " + std::to_string(options.inlier_threshold));
   }
   // Refit on the inliers until the set stops changing.
   for (int round = 0; round < 10; ++round) {

@@ -2,19 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 namespace fresco {
-namespace {
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
-}
-
-}  // namespace
 
 Status VerifyOptions::Check() const {
   if (!(rotation_threshold_deg > 0)) return Status::Error("rotation_threshold_deg: must be > 0");
@@ -62,6 +53,21 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   FRESCO_RETURN_IF_ERROR(AlignColmapToPoses(pairs, align, &global));
   out.world_from_colmap = global.world_from_colmap;
   out.global_inliers = global.num_inliers;
+  out.centres = global.centres;
+  out.rotation_from = global.rotation_from;
+  for (const PosePair& pair : pairs) {
+    const PoseError e = ComparePose(pair, global.world_from_colmap);
+    if (e.rotation_deg <= out.rotation_threshold_deg && e.position_m <= out.position_threshold_m) {
+      ++out.global_agreeing;
+    }
+  }
+  out.weak_alignment = 2 * out.global_agreeing < static_cast<int>(pairs.size());
+  out.disagreement = MeasureDisagreement(pairs, global.world_from_colmap,
+                                         out.rotation_threshold_deg, out.position_threshold_m);
+  if (out.disagreement.Drifts()) {
+    out.drift_first = pairs[out.disagreement.first].name;
+    out.drift_last = pairs[out.disagreement.last].name;
+  }
 
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
@@ -92,7 +98,8 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     v.rotation_error_deg = e.rotation_deg;
     v.position_error_m = e.position_m;
     v.inlier = fit.inliers[k - begin];
-    v.flagged = e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
+    v.flagged =
+        e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
   }
   out.windows = static_cast<int>(fits.size());
   std::vector<double> rotations, positions;
@@ -102,6 +109,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       ++out.flagged;
       continue;
     }
+    ++out.unflagged;
     rotations.push_back(v.rotation_error_deg);
     positions.push_back(v.position_error_m);
     out.max_unflagged_rotation_error_deg =
@@ -113,6 +121,54 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   out.median_position_error_m = Median(positions);
   *result = std::move(out);
   return Status::Ok();
+}
+
+std::vector<std::string> VerifyNotes(const VerifyResult& result) {
+  std::vector<std::string> notes;
+  char text[400];
+  if (result.centres.collinear) {
+    std::snprintf(text, sizeof(text),
+                  "The camera centres lie nearly on one line (spread ratio %.3g): they leave the "
+                  "rotation about that line free, so the alignment takes its rotation from the "
+                  "camera orientations.",
+                  result.centres.spread_ratio);
+    notes.push_back(text);
+  }
+  if (result.weak_alignment) {
+    std::snprintf(text, sizeof(text),
+                  "Only %d of %d frames agree with the alignment: COLMAP's reconstruction and the "
+                  "given poses disagree as a whole, so the flags say little about single frames "
+                  "(check the reconstruction: one that drifts along the sequence, too few matches, "
+                  "a broken model).",
+                  result.global_agreeing, result.compared);
+    notes.push_back(text);
+  }
+  if (result.disagreement.Drifts()) {
+    std::snprintf(text, sizeof(text),
+                  "%d of the %d frames beyond the thresholds disagree smoothly along the "
+                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there, "
+                  "and flags in that stretch may be the reconstruction's.",
+                  result.disagreement.smooth, result.disagreement.disagreeing,
+                  result.drift_first.c_str(), result.drift_last.c_str());
+    notes.push_back(text);
+  }
+  return notes;
+}
+
+std::string VerifyAgreementText(const VerifyResult& result) {
+  if (result.compared == 0) return "No frame has both a given and a COLMAP pose.";
+  if (result.unflagged == 0) {
+    return "No frame agrees within the thresholds (all " + std::to_string(result.compared) +
+           " compared frames are flagged).";
+  }
+  char text[300];
+  std::snprintf(text, sizeof(text),
+                "The %d unflagged frames agree within %.3f deg and %.4f m (median %.3f deg, "
+                "%.4f m).",
+                result.unflagged, result.max_unflagged_rotation_error_deg,
+                result.max_unflagged_position_error_m, result.median_rotation_error_deg,
+                result.median_position_error_m);
+  return text;
 }
 
 }  // namespace fresco

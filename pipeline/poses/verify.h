@@ -31,8 +31,8 @@ struct VerifyOptions {
 
 struct FrameVerdict {
   std::string name;
-  bool has_given = false;   // the project gives a pose for it
-  bool registered = false;  // COLMAP registered it
+  bool has_given = false;           // the project gives a pose for it
+  bool registered = false;          // COLMAP registered it
   double rotation_error_deg = 0.0;  // when both
   double position_error_m = 0.0;
   bool flagged = false;
@@ -51,15 +51,38 @@ struct VerifyResult {
   Sim3d world_from_colmap;
   int global_inliers = 0;
   int windows = 1;  // distinct local fits (1 = global only)
-  // Statistics of the unflagged frames (how well COLMAP and the poses agree).
+  // The given camera centres: collinear (a straight path: the rotation comes from the
+  // orientations alone) or not; and which start of the fit won (pose_alignment.h).
+  CentreSpread centres;
+  std::string rotation_from;
+  // Frames within the flag thresholds of the global alignment; fewer than half the compared
+  // ones (`weak_alignment`): COLMAP's reconstruction and the given poses disagree as a
+  // whole, so single flags mean little. (Not the inliers: those shrink to 3x their own
+  // median error when COLMAP is precise.)
+  int global_agreeing = 0;
+  bool weak_alignment = false;
+  // How the frames beyond the thresholds disagree with the global alignment: smoothly along
+  // the sequence (a drift, pose_alignment.h) from frame `drift_first` to `drift_last`, or
+  // frame by frame.
+  Disagreement disagreement;
+  std::string drift_first, drift_last;
+  // Statistics of the unflagged frames (how well COLMAP and the poses agree); zero when
+  // `unflagged` is 0.
+  int unflagged = 0;
   double median_rotation_error_deg = 0.0, max_unflagged_rotation_error_deg = 0.0;
   double median_position_error_m = 0.0, max_unflagged_position_error_m = 0.0;
 };
 
+// One line each for the CLI, the report and the panel: what the numbers mean and what to
+// be wary of (degenerate centres, weak alignment, no frame agreeing).
+std::vector<std::string> VerifyNotes(const VerifyResult& result);
+// "Unflagged frames agree within ..." or, with none unflagged, says so.
+std::string VerifyAgreementText(const VerifyResult& result);
+
 // One entry per frame of the sequence, in order.
 struct VerifyFrameInput {
   std::string name;
-  const Rigid3d* given_cam_from_world = nullptr;   // nullptr: no given pose
+  const Rigid3d* given_cam_from_world = nullptr;    // nullptr: no given pose
   const Rigid3d* colmap_cam_from_colmap = nullptr;  // nullptr: not registered
 };
 

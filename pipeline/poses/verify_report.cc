@@ -17,8 +17,7 @@ using nlohmann::json;
 // One panel: values along the sequence, the threshold dashed, flags red.
 void DrawPanel(cv::Mat& image, const cv::Rect& area, const VerifyResult& result, bool rotation) {
   const cv::Scalar kAxis(60, 60, 60), kLine(180, 90, 0), kFlag(0, 0, 220), kMissing(170, 170, 170);
-  const double threshold =
-      rotation ? result.rotation_threshold_deg : result.position_threshold_m;
+  const double threshold = rotation ? result.rotation_threshold_deg : result.position_threshold_m;
   double top = 2.0 * threshold;
   for (const FrameVerdict& v : result.frames) {
     if (v.has_given && v.registered) {
@@ -26,9 +25,7 @@ void DrawPanel(cv::Mat& image, const cv::Rect& area, const VerifyResult& result,
     }
   }
   const int n = std::max<int>(1, static_cast<int>(result.frames.size()));
-  auto x_of = [&](int i) {
-    return area.x + static_cast<int>((i + 0.5) * area.width / n);
-  };
+  auto x_of = [&](int i) { return area.x + static_cast<int>((i + 0.5) * area.width / n); };
   auto y_of = [&](double value) {
     return area.y + area.height - static_cast<int>(std::min(value, top) / top * area.height);
   };
@@ -53,8 +50,8 @@ void DrawPanel(cv::Mat& image, const cv::Rect& area, const VerifyResult& result,
   }
   char label[160];
   std::snprintf(label, sizeof(label), "%s (max shown %.3g %s, threshold %.3g)",
-                rotation ? "rotation error, deg" : "position error, m", top,
-                rotation ? "deg" : "m", threshold);
+                rotation ? "rotation error, deg" : "position error, m", top, rotation ? "deg" : "m",
+                threshold);
   cv::putText(image, label, {area.x + 4, area.y + 16}, cv::FONT_HERSHEY_SIMPLEX, 0.45, kAxis, 1,
               cv::LINE_AA);
 }
@@ -95,15 +92,31 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
           {"translation_m", {s.translation.x(), s.translation.y(), s.translation.z()}}}},
         {"scale", s.scale},
         {"inliers", result.global_inliers},
+        {"agreeing", result.global_agreeing},
+        {"weak", result.weak_alignment},
+        {"rotation_from", result.rotation_from},
+        {"centres",
+         {{"collinear", result.centres.collinear},
+          {"spread_ratio", result.centres.spread_ratio},
+          {"rms_m", result.centres.rms_m}}},
         {"local_windows", result.windows}}},
+      {"drift",
+       {{"detected", result.disagreement.Drifts()},
+        {"smooth_frames", result.disagreement.smooth},
+        {"disagreeing_frames", result.disagreement.disagreeing},
+        {"first", result.drift_first},
+        {"last", result.drift_last}}},
+      {"notes", VerifyNotes(result)},
       {"agreement_unflagged",
-       {{"median_rotation_error_deg", result.median_rotation_error_deg},
+       {{"frames", result.unflagged},
+        {"median_rotation_error_deg", result.median_rotation_error_deg},
         {"max_rotation_error_deg", result.max_unflagged_rotation_error_deg},
         {"median_position_error_m", result.median_position_error_m},
         {"max_position_error_m", result.max_unflagged_position_error_m}}},
       {"colmap",
        {{"program", run.program},
         {"models", run.models},
+        {"matcher", run.matcher},
         {"seconds", run.seconds},
         {"step_seconds", steps}}},
   };

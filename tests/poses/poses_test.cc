@@ -2,15 +2,19 @@
 // outliers, degenerate input), the alignment of a reconstruction to given poses and the
 // verification flags (injected errors on chosen frames), control-point alignment, the
 // control-point file reader.
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 
 #include "pipeline/poses/bootstrap.h"
+#include "pipeline/poses/bootstrap_run.h"
 #include "pipeline/poses/mesh_icp.h"
 #include "pipeline/poses/pose_alignment.h"
+#include "pipeline/poses/project_colmap.h"
 #include "pipeline/poses/similarity.h"
 #include "pipeline/poses/verify.h"
 #include "pipeline/synth/blocks_scene.h"
@@ -160,6 +164,281 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
     EXPECT_LT(result.max_unflagged_rotation_error_deg, 0.2);
     EXPECT_LT(result.max_unflagged_position_error_m, 0.01);
   }
+}
+
+// A straight walk (as the bundled street project): centres on one line from (-14, 1.6, -1.2)
+// to (14, 1.6, 1.2) (plus `wobble_m` sideways, 0 = exactly collinear), looking along it and
+// glancing +-35 deg left and right, 6 deg down.
+std::vector<Rigid3d> StraightWalkPoses(int n, double wobble_m) {
+  std::vector<Rigid3d> poses;
+  const Eigen::Vector3d from(-14, 1.6, -1.2), to(14, 1.6, 1.2);
+  const Eigen::Vector3d along = (to - from).normalized();
+  const Eigen::Vector3d side = along.cross(Eigen::Vector3d::UnitY()).normalized();
+  for (int i = 0; i < n; ++i) {
+    const double u = i / double(n - 1);
+    const Eigen::Vector3d centre = from + u * (to - from) + wobble_m * std::sin(7.0 * u) * side;
+    const double yaw = 35.0 * M_PI / 180.0 * std::sin(5.0 * u * M_PI);
+    const Eigen::Vector3d look = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()) *
+                                 (Eigen::AngleAxisd(-6.0 * M_PI / 180.0, side) * along);
+    const Eigen::Vector3d z = look.normalized();
+    const Eigen::Vector3d x = -Eigen::Vector3d::UnitY().cross(z).normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    Eigen::Matrix3d world_from_cam;
+    world_from_cam << x, y, z;
+    poses.push_back(Rigid3d::FromMatrix(world_from_cam, centre).Inverse());
+  }
+  return poses;
+}
+
+// Given poses = `truth` but for 3 frames turned 3 deg; COLMAP = the truth in another frame
+// with its own small error (0.03 deg, 1 mm before the similarity).
+struct StraightCase {
+  std::vector<Rigid3d> given, colmap;
+  std::set<int> wrong = {7, 19, 33};
+};
+StraightCase MakeStraightCase(const std::vector<Rigid3d>& truth, const Sim3d& world_from_colmap) {
+  StraightCase c;
+  std::mt19937 rng(11);
+  std::normal_distribution<double> small(0.0, 1.0);
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const Rigid3d noisy = Perturbed(truth[i], 0.03 * small(rng), 0.001 * small(rng),
+                                    Eigen::Vector3d(small(rng), small(rng), small(rng)));
+    c.colmap.push_back(InColmapFrame(noisy, world_from_colmap));
+    c.given.push_back(c.wrong.count(static_cast<int>(i))
+                          ? Perturbed(truth[i], 3.0, 0.0, Eigen::Vector3d(0.3, 1, 0.2 * i))
+                          : truth[i]);
+  }
+  return c;
+}
+
+TEST(Verify, StraightPathIsDegenerateButTheOrientationsFixTheAlignment) {
+  const int n = 40;
+  const Sim3d world_from_colmap = SomeSimilarity();
+  for (double wobble_m : {0.0, 0.01}) {  // exactly and nearly collinear
+    const StraightCase c = MakeStraightCase(StraightWalkPoses(n, wobble_m), world_from_colmap);
+    std::vector<VerifyFrameInput> inputs;
+    for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &c.given[i], &c.colmap[i]});
+    for (int window : {0, 16}) {
+      VerifyOptions options;
+      options.window_frames = window;
+      VerifyResult result;
+      const Status s = VerifyPoses(inputs, 45.0, options, &result);
+      ASSERT_TRUE(s.ok()) << s.message();
+      const std::string where =
+          "wobble " + std::to_string(wobble_m) + " window " + std::to_string(window);
+      EXPECT_TRUE(result.centres.collinear) << where;
+      EXPECT_LT(result.centres.spread_ratio, 0.01) << where;
+      EXPECT_EQ(result.rotation_from, "orientations") << where;
+      EXPECT_FALSE(result.weak_alignment) << where;
+      EXPECT_LT(RotationErrorDeg(result.world_from_colmap, world_from_colmap), 0.1) << where;
+      EXPECT_NEAR(result.world_from_colmap.scale, world_from_colmap.scale,
+                  1e-3 * world_from_colmap.scale)
+          << where;
+      EXPECT_LT((result.world_from_colmap.translation - world_from_colmap.translation).norm(), 0.02)
+          << where;
+      EXPECT_EQ(result.flagged, 3) << where;
+      for (int i = 0; i < n; ++i) {
+        EXPECT_EQ(result.frames[i].flagged, c.wrong.count(i) == 1) << "frame " << i << " " << where;
+        if (c.wrong.count(i)) {
+          EXPECT_NEAR(result.frames[i].rotation_error_deg, 3.0, 0.1) << i << " " << where;
+        }
+      }
+      EXPECT_EQ(result.unflagged, n - 3);
+      EXPECT_LT(result.max_unflagged_rotation_error_deg, 0.15) << where;
+      // The notes say the centres are collinear; the summary counts the unflagged frames.
+      const std::vector<std::string> notes = VerifyNotes(result);
+      ASSERT_EQ(notes.size(), 1u) << where;
+      EXPECT_NE(notes[0].find("one line"), std::string::npos) << notes[0];
+      EXPECT_NE(VerifyAgreementText(result).find("The 37 unflagged"), std::string::npos)
+          << VerifyAgreementText(result);
+    }
+  }
+}
+
+TEST(Alignment, PlanarAndGeneralPathsAreNotDegenerate) {
+  const Sim3d world_from_colmap = SomeSimilarity();
+  // A planar circle (y = 0) and the wobbly arc: neither is collinear, and the alignment
+  // recovers the similarity from either start.
+  std::vector<Rigid3d> planar;
+  for (int i = 0; i < 30; ++i) {
+    const double a = 0.1 * i;
+    const Eigen::Vector3d centre(3.0 * std::cos(a), 0.0, 3.0 * std::sin(a));
+    const Eigen::Vector3d z = (-centre).normalized();
+    const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z).normalized();
+    Eigen::Matrix3d world_from_cam;
+    world_from_cam << x, z.cross(x), z;
+    planar.push_back(Rigid3d::FromMatrix(world_from_cam, centre).Inverse());
+  }
+  for (const auto& truth : {planar, ArcPoses(30)}) {
+    std::vector<PosePair> pairs;
+    for (size_t i = 0; i < truth.size(); ++i) {
+      pairs.push_back({std::to_string(i), truth[i], InColmapFrame(truth[i], world_from_colmap)});
+    }
+    PoseAlignment alignment;
+    ASSERT_TRUE(AlignColmapToPoses(pairs, PoseAlignmentOptions(), &alignment).ok());
+    EXPECT_FALSE(alignment.centres.collinear);
+    EXPECT_FALSE(alignment.centres.coincident);
+    EXPECT_GT(alignment.centres.spread_ratio, 0.05);
+    EXPECT_EQ(alignment.num_inliers, 30);
+    EXPECT_LT(RotationErrorDeg(alignment.world_from_colmap, world_from_colmap), 1e-6);
+  }
+}
+
+TEST(Alignment, CoincidentCentresAreAClearError) {
+  // A camera turning on the spot: the scale is undetermined.
+  std::vector<PosePair> pairs;
+  for (int i = 0; i < 10; ++i) {
+    const Rigid3d pose(Eigen::Quaterniond(Eigen::AngleAxisd(0.2 * i, Eigen::Vector3d::UnitY())),
+                       Eigen::Vector3d(0.001 * i, 0, 0));
+    pairs.push_back({std::to_string(i), pose, pose});
+  }
+  PoseAlignment alignment;
+  const Status s = AlignColmapToPoses(pairs, PoseAlignmentOptions(), &alignment);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("coincide"), std::string::npos) << s.message();
+}
+
+TEST(Verify, SummarySaysSoWhenNoFrameAgrees) {
+  VerifyResult result;
+  result.compared = 19;
+  result.flagged = 19;
+  result.global_agreeing = 3;
+  result.weak_alignment = true;
+  const std::string text = VerifyAgreementText(result);
+  EXPECT_NE(text.find("No frame agrees"), std::string::npos) << text;
+  EXPECT_EQ(text.find("0.000"), std::string::npos) << text;
+  const std::vector<std::string> notes = VerifyNotes(result);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("Only 3 of 19 frames"), std::string::npos) << notes[0];
+}
+
+// COLMAP's frames for BootstrapFromColmap: `colmap[i]` (cam_from_colmap) for frame i, whose
+// given pose is `given[i]`.
+struct SyntheticColmap {
+  std::vector<PosedImage> given;
+  ProjectColmap colmap;
+  SyntheticColmap(const std::vector<Rigid3d>& given_poses,
+                  const std::vector<Rigid3d>& colmap_poses) {
+    for (size_t i = 0; i < given_poses.size(); ++i) {
+      PosedImage g;
+      g.name = std::to_string(i) + ".png";
+      g.cam_from_world = given_poses[i];
+      given.push_back(g);
+      g.image_id = static_cast<int>(i) + 1;
+      g.camera_id = 1;
+      g.cam_from_world = colmap_poses[i];
+      colmap.run.model.images.push_back(g);
+    }
+    colmap.scene_size_m = 45.0;
+    colmap.run.registered = static_cast<int>(given_poses.size());
+    for (size_t i = 0; i < given_poses.size(); ++i) {
+      colmap.frames.push_back(
+          {given[i].name, static_cast<int>(i), &given[i], &colmap.run.model.images[i]});
+    }
+  }
+};
+
+TEST(Bootstrap, SaysWhetherTheBootstrappedPosesAreBetterThanTheGivenOnes) {
+  const int n = 40;
+  const Sim3d world_from_colmap = SomeSimilarity();
+  const std::vector<Rigid3d> truth = StraightWalkPoses(n, 0.0);
+  const StraightCase c = MakeStraightCase(truth, world_from_colmap);
+  {  // A straight walk, 3 given poses 3 deg off: the bootstrap is better, and right.
+    const SyntheticColmap s(c.given, c.colmap);
+    BootstrapResult result;
+    ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &result).ok());
+    EXPECT_EQ(result.comparison.better, "bootstrapped") << result.comparison.summary;
+    EXPECT_TRUE(result.comparison.collinear);
+    EXPECT_EQ(result.comparison.compared, n);
+    EXPECT_EQ(result.comparison.agreeing, n - 3);  // within 0.5 deg and 1 % of the scene
+    EXPECT_NEAR(result.comparison.max_rotation_deg, 3.0, 0.1);
+    for (int i = 0; i < n; ++i) {
+      EXPECT_LT(
+          RotationDifferenceDeg(result.model.images[i].cam_from_world.rotation, truth[i].rotation),
+          0.1)
+          << i;
+      EXPECT_LT((result.model.images[i].cam_from_world.Centre() - truth[i].Centre()).norm(), 0.01)
+          << i;
+    }
+  }
+  {  // A broken reconstruction: only 8 of 40 frames where they belong, the rest scrambled.
+    std::vector<Rigid3d> broken = c.colmap;
+    std::mt19937 rng(2);
+    std::normal_distribution<double> g(0.0, 1.0);
+    for (int i = 0; i < n; ++i) {
+      if (i % 5 == 0) continue;
+      broken[i] = Perturbed(broken[i], 20.0 + 5 * g(rng), 1.0 + 0.2 * g(rng),
+                            Eigen::Vector3d(g(rng), g(rng), g(rng)));
+    }
+    const SyntheticColmap s(c.given, broken);
+    BootstrapResult result;
+    ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &result).ok());
+    EXPECT_EQ(result.comparison.better, "given") << result.comparison.summary;
+    EXPECT_LE(result.comparison.agreeing, 8);
+    EXPECT_NE(result.comparison.summary.find("likely WORSE"), std::string::npos)
+        << result.comparison.summary;
+  }
+}
+
+TEST(Verify, AReconstructionThatDriftsIsToldFromWrongPoses) {
+  // The second half of COLMAP's walk turns away steadily, up to 4 deg at the end (as on the
+  // street walk): the given poses are right, and the disagreement is smooth.
+  const int n = 40;
+  const Sim3d world_from_colmap = SomeSimilarity();
+  const std::vector<Rigid3d> truth = StraightWalkPoses(n, 0.0);
+  std::vector<Rigid3d> drifting;
+  for (int i = 0; i < n; ++i) {
+    const double drift_deg = i < n / 2 ? 0.0 : 4.0 * (i - n / 2 + 1) / (n / 2);
+    const Eigen::Quaterniond dq(
+        Eigen::AngleAxisd(drift_deg * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+    const Eigen::Quaterniond q = (truth[i].rotation * dq).normalized();  // world side
+    drifting.push_back(InColmapFrame(Rigid3d(q, -(q * truth[i].Centre())), world_from_colmap));
+  }
+  std::vector<VerifyFrameInput> inputs;
+  for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &truth[i], &drifting[i]});
+  VerifyOptions options;
+  options.window_frames = 0;
+  VerifyResult result;
+  ASSERT_TRUE(VerifyPoses(inputs, 45.0, options, &result).ok());
+  EXPECT_TRUE(result.disagreement.Drifts());
+  EXPECT_GE(result.disagreement.smooth, 10);
+  const std::vector<std::string> notes = VerifyNotes(result);
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& note) {
+    return note.find("smoothly") != std::string::npos;
+  }));
+  const SyntheticColmap s(truth, drifting);
+  BootstrapResult bootstrap;
+  ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &bootstrap).ok());
+  EXPECT_TRUE(bootstrap.comparison.drifts);
+  EXPECT_EQ(bootstrap.comparison.better, "unknown") << bootstrap.comparison.summary;
+}
+
+TEST(Keyframes, SelectedByMotionAndSequencesAreRecognised) {
+  // 30 frames 1 cm apart, turning 0.5 deg per frame: with a 5 cm step, every 5th frame;
+  // with a 1 deg turn, every 2nd.
+  std::vector<Rigid3d> poses;
+  std::vector<Eigen::Vector3d> centres;
+  for (int i = 0; i < 30; ++i) {
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(0.5 * i * M_PI / 180.0, Eigen::Vector3d::UnitY()));
+    const Eigen::Vector3d centre(0.01 * i, 0, 0);
+    poses.emplace_back(q, -(q * centre));
+    centres.push_back(centre);
+  }
+  std::vector<const Rigid3d*> pointers;
+  for (const Rigid3d& p : poses) pointers.push_back(&p);
+  const std::vector<int> by_step = SelectKeyframes(pointers, 0.0499, 90.0);
+  EXPECT_EQ(by_step, (std::vector<int>{0, 5, 10, 15, 20, 25, 29}));
+  const std::vector<int> by_turn = SelectKeyframes(pointers, 10.0, 0.999);
+  EXPECT_EQ(by_turn.size(), 16u);
+  EXPECT_EQ(SelectKeyframes(pointers, 0.0, 0.0).size(), 30u);  // off: every frame
+  pointers[12] = nullptr;                                      // no given pose: always sent
+  const std::vector<int> with_gap = SelectKeyframes(pointers, 0.0499, 90.0);
+  EXPECT_NE(std::find(with_gap.begin(), with_gap.end(), 12), with_gap.end());
+  // A walk is a sequence; the same centres shuffled are not.
+  EXPECT_TRUE(CentresLookOrdered(centres));
+  std::vector<Eigen::Vector3d> shuffled = centres;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(4));
+  EXPECT_FALSE(CentresLookOrdered(shuffled));
 }
 
 TEST(Alignment, PosesSlightlyOffWithinTheThresholdsStopBendingTheFit) {

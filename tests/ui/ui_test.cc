@@ -567,6 +567,9 @@ TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
   ui.snapshot = runner.Snapshot();
   ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(1280, 955));
   EXPECT_EQ(panel->Report().at("applied"), "true");
+  // Most given poses agree with the reconstruction: the bootstrapped ones are the better.
+  EXPECT_EQ(panel->Report().at("bootstrap_better"), "bootstrapped");
+  EXPECT_EQ(panel->Report().at("centres_collinear"), "false");
   ASSERT_TRUE(state.Undo());
   EXPECT_EQ(state.project, before);
   // Another project open: the bootstrap does not apply to it.

@@ -87,8 +87,8 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   working_.busy = true;
   working_.started = working_.step_started = std::chrono::steady_clock::now();
   working_.status = request.colmap.existing_model.empty()
-                         ? std::string("preparing the frames")
-                         : std::string("reading ") + request.colmap.existing_model;
+                        ? std::string("preparing the frames")
+                        : std::string("reading ") + request.colmap.existing_model;
   Publish();
 
   BootstrapOptions bootstrap = request.bootstrap;
@@ -119,8 +119,7 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   // Held by pointer: its frames point into its own capture and model.
   auto colmap = std::make_unique<ProjectColmap>();
   bool bad_input = false;
-  if (Status s = RunColmapOnProject(request.project, options, colmap.get(), &bad_input);
-      !s.ok()) {
+  if (Status s = RunColmapOnProject(request.project, options, colmap.get(), &bad_input); !s.ok()) {
     working_.status = cancel_ ? "cancelled" : std::string("error: ") + s.message();
     return;
   }
@@ -129,11 +128,13 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   working_.registered = colmap->run.registered;
   working_.colmap_seconds = colmap->run.seconds;
   working_.step_seconds = colmap->run.step_seconds;
+  working_.matcher = colmap->run.matcher;
+  working_.frames_offered = colmap->run.frames_offered;
   for (const ProjectColmapFrame& f : colmap->frames) working_.frame_index.push_back(f.index);
 
   // `fresco poses verify`: the table, verify.json and verify.png.
-  Status s = VerifyPoses(VerifyInputs(*colmap), colmap->scene_size_m, request.verify,
-                         &working_.verify);
+  Status s =
+      VerifyPoses(VerifyInputs(*colmap), colmap->scene_size_m, request.verify, &working_.verify);
   if (s.ok()) {
     s = WriteVerifyReport(working_.verify, colmap->run,
                           (fs::path(request.out_dir) / "verify.json").string(),
@@ -152,6 +153,7 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
     working_.aligned_with = result.aligned_with;
     working_.bootstrap_inliers = result.inliers;
     working_.bootstrap_compared = result.compared;
+    working_.bootstrap_comparison = result.comparison;
   } else {
     working_.bootstrap_error = s.message();
   }
@@ -173,8 +175,8 @@ Status ApplyBootstrappedPoses(const PosesSnapshot& snap, AppState* state) {
   if (fs::path(snap.request.project.file_path).lexically_normal() !=
       fs::path(state->project.file_path).lexically_normal()) {
     return Status::Error(std::string("the poses were bootstrapped for ") +
-                         snap.request.project.file_path +
-                         ", not the open project " + state->project.file_path);
+                         snap.request.project.file_path + ", not the open project " +
+                         state->project.file_path);
   }
   state->BeginEdit();
   state->project.poses = snap.bootstrap_poses;

@@ -53,6 +53,8 @@ struct PosesSnapshot {
   int frames = 0, registered = 0;
   double colmap_seconds = 0.0;
   std::vector<std::pair<std::string, double>> step_seconds;
+  std::string matcher;     // "exhaustive" or "sequential" ("" for an earlier model)
+  int frames_offered = 0;  // frames before keyframe selection (`frames` were sent)
   // The verification (`fresco poses verify`): per frame in verify.frames, and the frame's
   // index in the project's video (where the pipeline goes to show it).
   bool verified = false;
@@ -65,6 +67,8 @@ struct PosesSnapshot {
   std::string bootstrap_poses;  // OUT/sparse/images.txt (absolute)
   std::string aligned_with;     // "given_poses" or "control_points"
   int bootstrap_inliers = 0, bootstrap_compared = 0;
+  // The bootstrapped poses against the given ones: which are better (bootstrap_run.h).
+  PosesComparison bootstrap_comparison;
 };
 
 class PosesRunner {

@@ -102,6 +102,11 @@ void StartPoses(const GuiOptions& options, UiContext& ui,
   if (options.screenshot.empty()) return;
   ui.poses->WaitIdle();
   if (options.poses != "bootstrap") return;
+  // Asked for on the command line: applied, but not silently when likely worse.
+  const PosesComparison& comparison = ui.poses->Snapshot()->bootstrap_comparison;
+  if (comparison.better == "given" || comparison.better == "unknown")
+    std::fprintf(stderr, "warning: applying the bootstrapped poses anyway: %s\n",
+                 comparison.summary.c_str());
   if (Status s = ApplyBootstrappedPoses(*ui.poses->Snapshot(), ui.state); !s.ok()) {
     std::fprintf(stderr, "error: %s\n", s.message().c_str());
     return;

@@ -39,8 +39,7 @@ int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool
               double scale, const char* unit, int selected, int current_row) {
   const VerifyResult& v = snap.verify;
   const int n = static_cast<int>(v.frames.size());
-  const double threshold =
-      (rotation ? v.rotation_threshold_deg : v.position_threshold_m) * scale;
+  const double threshold = (rotation ? v.rotation_threshold_deg : v.position_threshold_m) * scale;
   double top = 2.0 * threshold;
   for (const FrameVerdict& f : v.frames)
     if (f.registered && f.has_given)
@@ -150,6 +149,8 @@ class PosesPanel : public Panel {
     max_image_size_ = r.colmap.colmap.max_image_size;
     max_features_ = r.colmap.colmap.max_num_features;
     matcher_ = static_cast<int>(r.colmap.colmap.matcher);
+    keyframe_step_pct_ = static_cast<float>(100 * r.colmap.keyframe_step_rel);
+    keyframe_turn_deg_ = static_cast<float>(r.colmap.keyframe_rotation_deg);
     rotation_threshold_ = static_cast<float>(r.verify.rotation_threshold_deg);
     position_threshold_pct_ = static_cast<float>(100 * r.verify.position_threshold_rel);
   }
@@ -170,16 +171,16 @@ class PosesPanel : public Panel {
       size_t size;
       const char* tip;
     };
-    for (const Text& t : {
-             Text{"output folder", out_dir_, sizeof(out_dir_),
-                  "COLMAP's workspace (colmap/: commands, logs), verify.json and .png,\n"
-                  "the bootstrapped poses (sparse/) and project.json"},
-             Text{"earlier model", model_, sizeof(model_),
-                  "optional: a COLMAP text model of an earlier run (OUT/colmap/sparse_txt/0)\n"
-                  "to use instead of running COLMAP"},
-             Text{"control points", control_, sizeof(control_),
-                  "optional: align the bootstrap with >= 3 known points instead of the\n"
-                  "given poses; one per line: NAME X Y Z IMAGE U V [IMAGE U V ...]"}}) {
+    for (const Text& t :
+         {Text{"output folder", out_dir_, sizeof(out_dir_),
+               "COLMAP's workspace (colmap/: commands, logs), verify.json and .png,\n"
+               "the bootstrapped poses (sparse/) and project.json"},
+          Text{"earlier model", model_, sizeof(model_),
+               "optional: a COLMAP text model of an earlier run (OUT/colmap/sparse_txt/0)\n"
+               "to use instead of running COLMAP"},
+          Text{"control points", control_, sizeof(control_),
+               "optional: align the bootstrap with >= 3 known points instead of the\n"
+               "given poses; one per line: NAME X Y Z IMAGE U V [IMAGE U V ...]"}}) {
       ImGui::SetNextItemWidth(-kLabelWidth);
       ImGui::InputText(t.label, t.buffer, t.size);
       if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", t.tip);
@@ -189,10 +190,10 @@ class PosesPanel : public Panel {
       int* value;
       int step, min;
     };
-    for (const Number& n : {Number{"every Nth frame", &every_, 1, 1},
-                            Number{"max frames", &max_frames_, 1, 0},
-                            Number{"max image size", &max_image_size_, 100, 0},
-                            Number{"max features", &max_features_, 500, 0}}) {
+    for (const Number& n :
+         {Number{"every Nth frame", &every_, 1, 1}, Number{"max frames", &max_frames_, 1, 0},
+          Number{"max image size", &max_image_size_, 100, 0},
+          Number{"max features", &max_features_, 500, 0}}) {
       ImGui::SetNextItemWidth(-kLabelWidth);
       ImGui::InputInt(n.label, n.value, n.step);
       if (n.min == 0 && ImGui::IsItemHovered()) ImGui::SetTooltip("0 = all (COLMAP's default)");
@@ -200,6 +201,17 @@ class PosesPanel : public Panel {
     }
     ImGui::SetNextItemWidth(-kLabelWidth);
     ImGui::Combo("matcher", &matcher_, "auto\0exhaustive\0sequential\0");
+    ImGui::SetNextItemWidth(-kLabelWidth);
+    ImGui::InputFloat("keyframe step %", &keyframe_step_pct_, 0.1f, 0, "%.2f");
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip(
+          "in a sequence, a frame goes to COLMAP when its given pose moved this\n"
+          "%% of the scene size or turned the angle below since the last one\n"
+          "(0 and 0: every frame)");
+    keyframe_step_pct_ = std::max(0.0f, keyframe_step_pct_);
+    ImGui::SetNextItemWidth(-kLabelWidth);
+    ImGui::InputFloat("keyframe turn, deg", &keyframe_turn_deg_, 0.5f, 0, "%.1f");
+    keyframe_turn_deg_ = std::max(0.0f, keyframe_turn_deg_);
     ImGui::SetNextItemWidth(-kLabelWidth);
     ImGui::InputFloat("flag above, deg", &rotation_threshold_, 0.1f, 0, "%.2f");
     rotation_threshold_ = std::max(0.0f, rotation_threshold_);
@@ -214,19 +226,23 @@ class PosesPanel : public Panel {
     }
     if (snap.busy) {
       const float fraction = snap.steps > 0 ? (snap.step - 1) / float(snap.steps) : 0.0f;
-      const std::string text = snap.steps > 0 ? snap.step_name + ", " +
-                                                    Format("%.0f s", Seconds(snap.step_started))
-                                              : Format("%.0f s", Seconds(snap.started));
+      const std::string text =
+          snap.steps > 0 ? snap.step_name + ", " + Format("%.0f s", Seconds(snap.step_started))
+                         : Format("%.0f s", Seconds(snap.started));
       ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
     }
     if (snap.status.rfind("error", 0) == 0)
       ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", snap.status.c_str());
     else
-      ImGui::TextWrapped("%s", snap.status.empty()
-                                   ? "Run COLMAP to verify the project's poses and bootstrap new ones."
-                                   : snap.status.c_str());
+      ImGui::TextWrapped("%s",
+                         snap.status.empty()
+                             ? "Run COLMAP to verify the project's poses and bootstrap new ones."
+                             : snap.status.c_str());
     if (snap.reconstructed) {
       ImGui::Separator();
+      if (!snap.matcher.empty())
+        ImGui::TextWrapped("%d of %d frames sent (keyframes), %s matching", snap.frames,
+                           snap.frames_offered, snap.matcher.c_str());
       for (const auto& [step, seconds] : snap.step_seconds)
         ImGui::Text("  %-20s %6.1f s", step.c_str(), seconds);
     }
@@ -246,6 +262,8 @@ class PosesPanel : public Panel {
     r.colmap.colmap.max_image_size = max_image_size_;
     r.colmap.colmap.max_num_features = max_features_;
     r.colmap.colmap.matcher = static_cast<ColmapMatcher>(matcher_);
+    r.colmap.keyframe_step_rel = keyframe_step_pct_ / 100.0;
+    r.colmap.keyframe_rotation_deg = keyframe_turn_deg_;
     r.verify.rotation_threshold_deg = rotation_threshold_;
     r.verify.position_threshold_rel = position_threshold_pct_ / 100.0;
     if (Status s = r.verify.Check(); !s.ok()) {
@@ -254,6 +272,7 @@ class PosesPanel : public Panel {
     }
     selected_ = -1;
     taken_ = true;
+    apply_anyway_ = false;
     ui.poses->Run(r);
   }
 
@@ -271,9 +290,18 @@ class PosesPanel : public Panel {
     else
       ImGui::TextWrapped("%d frames posed; aligned to the control points", snap.registered);
     ImGui::TextWrapped("%s", snap.bootstrap_poses.c_str());
+    // Which are better, on the frames both have; worse poses need a deliberate click.
+    const PosesComparison& c = snap.bootstrap_comparison;
+    const bool doubtful = c.better == "given" || c.better == "unknown";
+    if (doubtful) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.6f, 0.3f, 1));
+    ImGui::TextWrapped("%s", c.summary.c_str());
+    if (doubtful) ImGui::PopStyleColor();
     const bool applied = ui.state->has_project && ui.state->project.poses == snap.bootstrap_poses;
-    ImGui::BeginDisabled(applied || snap.busy);
-    if (ImGui::Button(applied ? "Applied (Ctrl+Z undoes)" : "Apply to the project")) {
+    if (doubtful && !applied) ImGui::Checkbox("apply anyway", &apply_anyway_);
+    ImGui::BeginDisabled(applied || snap.busy || (doubtful && !apply_anyway_));
+    if (ImGui::Button(applied    ? "Applied (Ctrl+Z undoes)"
+                      : doubtful ? "Apply to the project (likely worse)"
+                                 : "Apply to the project")) {
       if (Status s = ApplyBootstrappedPoses(snap, ui.state); !s.ok()) {
         ui.state->message = std::string("error: ") + s.message();
       } else {
@@ -291,9 +319,10 @@ class PosesPanel : public Panel {
     const VerifyResult& v = snap.verify;
     ImGui::Text("%d frames: %d registered by COLMAP, %d compared, %d flagged", snap.frames,
                 v.registered, v.compared, v.flagged);
-    ImGui::Text("Unflagged frames agree within %.3f deg and %.4f m (median %.3f deg, %.4f m)",
-                v.max_unflagged_rotation_error_deg, v.max_unflagged_position_error_m,
-                v.median_rotation_error_deg, v.median_position_error_m);
+    ImGui::TextWrapped("%s", VerifyAgreementText(v).c_str());
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.75f, 0.3f, 1));
+    for (const std::string& note : VerifyNotes(v)) ImGui::TextWrapped("%s", note.c_str());
+    ImGui::PopStyleColor();
     // The pipeline's frame, as a row.
     int current_row = -1;
     if (ui.snapshot)
@@ -301,9 +330,9 @@ class PosesPanel : public Panel {
         if (snap.frame_index[i] == ui.snapshot->frame) current_row = static_cast<int>(i);
     int go = ErrorPlot("##rotation", "Rotation disagreement", snap, true, 1.0, "deg", selected_,
                        current_row);
-    const int go_position = ErrorPlot("##position", "Position disagreement", snap, false,
-                                      100.0 / std::max(1e-12, v.scene_size_m), "% of scene",
-                                      selected_, current_row);
+    const int go_position =
+        ErrorPlot("##position", "Position disagreement", snap, false,
+                  100.0 / std::max(1e-12, v.scene_size_m), "% of scene", selected_, current_row);
     if (go < 0) go = go_position;
     // Flagged frames, one click away.
     std::vector<int> flagged;
@@ -401,6 +430,11 @@ class PosesPanel : public Panel {
       report_["flagged_frames"] = flagged;
     }
     report_["bootstrapped"] = snap.bootstrapped ? "true" : "false";
+    if (snap.bootstrapped) report_["bootstrap_better"] = snap.bootstrap_comparison.better;
+    if (snap.verified) {
+      report_["agreement"] = VerifyAgreementText(snap.verify);
+      report_["centres_collinear"] = snap.verify.centres.collinear ? "true" : "false";
+    }
     report_["applied"] = snap.bootstrapped && ui.state && ui.state->has_project &&
                                  ui.state->project.poses == snap.bootstrap_poses
                              ? "true"
@@ -420,7 +454,8 @@ class PosesPanel : public Panel {
   char control_[1024] = "";
   int every_ = 1, max_frames_ = 0, max_image_size_ = 0, max_features_ = 0, matcher_ = 0;
   float rotation_threshold_ = 0.5f, position_threshold_pct_ = 1.0f;
-  bool flagged_only_ = false, scroll_to_selected_ = false;
+  float keyframe_step_pct_ = 0.5f, keyframe_turn_deg_ = 2.0f;
+  bool flagged_only_ = false, scroll_to_selected_ = false, apply_anyway_ = false;
   int selected_ = -1;
   float next_button_[4] = {0, 0, 0, 0};
   bool taken_ = false;
