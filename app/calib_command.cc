@@ -45,7 +45,9 @@ CAMERA.report.json, CAMERA.residuals.png, CAMERA.coverage.png and CAMERA.uncerta
   --no-cross-validation  skip the half-data solves (faster; auto then compares fits only)
   --all-halves         solve every model's halves, even where the choice does not depend
                        on them (same choice, slower; the report then compares all)
-  --no-refine          AprilGrid: keep the apriltag library's corners (no cornerSubPix)
+  --no-refine          AprilGrid: keep the detectors' corners (no cornerSubPix)
+  --no-second-look     AprilGrid: the apriltag library alone (no second look for the tags
+                       it misses: thinned black, then OpenCV's aruco)
   --quiet              no summary on stdout)";
 
 const char kBoardHelp[] =
@@ -63,7 +65,7 @@ int RunSolve(const CommandArgs& argv) {
   spec.options = {"--board", "--out", "--model", "--corners-vnl"};
   spec.repeatable = {"--exclude"};
   spec.switches = {"--no-pictures", "--no-cross-validation", "--all-halves", "--no-refine",
-                   "--quiet"};
+                   "--no-second-look", "--quiet"};
   spec.required = {"--board", "--out"};
   Args args;
   if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
@@ -87,6 +89,7 @@ int RunSolve(const CommandArgs& argv) {
   request.cross_validate = !args.Switch("--no-cross-validation");
   request.all_halves = args.Switch("--all-halves");
   request.detect.refine_tag_corners = !args.Switch("--no-refine");
+  request.detect.second_look = !args.Switch("--no-second-look");
   const std::string out = args.Get("--out");
   const bool quiet = args.Switch("--quiet");
 

@@ -53,9 +53,13 @@ SplitTest RunSplit(const std::string& how, const std::vector<int>& a, const std:
   std::vector<int> both = a;
   both.insert(both.end(), b.begin(), b.end());
   double sigma_a = 0, sigma_b = 0, dof_a = 0, dof_b = 0, dof = 0;
+  // The chosen fit is the joint one when the split covers every view with that model.
+  const SolveResult& chosen = run.Chosen().fit;
+  const bool reuse = both.size() == run.views.size() && chosen.lensmodel == options.lensmodel;
+  if (reuse) test.joint_sigma_px = chosen.noise_sigma_px;
   if (!SolveGroup(a, request, run, options, &sigma_a, &dof_a) ||
       !SolveGroup(b, request, run, options, &sigma_b, &dof_b) ||
-      !SolveGroup(both, request, run, options, &test.joint_sigma_px, &dof))
+      (!reuse && !SolveGroup(both, request, run, options, &test.joint_sigma_px, &dof)))
     return test;
   test.split_sigma_px =
       std::sqrt((sigma_a * sigma_a * dof_a + sigma_b * sigma_b * dof_b) / (dof_a + dof_b));
