@@ -45,7 +45,10 @@ void TrafficLight(const DataReadiness& r) {
               100 * calib::kMinCoverage,
               r.max_tilt_deg < 0 ? "?" : Format("%.0f deg", r.max_tilt_deg).c_str(),
               calib::kMinTiltDeg);
-  for (const std::string& reason : r.reasons) ImGui::BulletText("%s", reason.c_str());
+  for (const std::string& reason : r.reasons) {  // wrapped: a mixed-camera reason is long
+    ImGui::Bullet();
+    ImGui::TextWrapped("%s", reason.c_str());
+  }
 }
 
 class CalibrationPanel : public Panel {
