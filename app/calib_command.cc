@@ -3,6 +3,7 @@
 //   fresco calib board BOARD --out BOARD.png [--dpi N]
 // Bad input (a bad board spec, a folder without usable images) is one line on stderr and
 // exit 2; every output is written atomically.
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -35,13 +36,18 @@ CAMERA.report.json, CAMERA.residuals.png, CAMERA.coverage.png and CAMERA.uncerta
                        e.g. aprilgrid:6x6:0.088:0.3)
   --model MODEL        auto (default: the simplest model the data supports, every model
                        tried in the report), pinhole, opencv4, opencv5, opencv8, splined
+  --exclude NAMES      images not to use: file names or shell globs, comma-separated
+                       (e.g. 'right*.jpg,left07.jpg'); may repeat. The report lists them
+                       under images_excluded
   --corners-vnl FILE   also write the detected corners as mrcal's corners.vnl (for
                        mrcal-calibrate-cameras)
   --no-pictures        do not write the PNG pictures
   --no-cross-validation  skip the half-data solves (faster; auto then compares fits only)
   --all-halves         solve every model's halves, even where the choice does not depend
                        on them (same choice, slower; the report then compares all)
-  --no-refine          AprilGrid: keep the apriltag library's corners (no cornerSubPix)
+  --no-refine          AprilGrid: keep the detectors' corners (no cornerSubPix)
+  --no-second-look     AprilGrid: the apriltag library alone (no second look for the tags
+                       it misses: thinned black, then OpenCV's aruco)
   --quiet              no summary on stdout)";
 
 const char kBoardHelp[] =
@@ -57,13 +63,20 @@ int RunSolve(const CommandArgs& argv) {
   spec.min_positional = 1;
   spec.max_positional = 1;
   spec.options = {"--board", "--out", "--model", "--corners-vnl"};
+  spec.repeatable = {"--exclude"};
   spec.switches = {"--no-pictures", "--no-cross-validation", "--all-halves", "--no-refine",
-                   "--quiet"};
+                   "--no-second-look", "--quiet"};
   spec.required = {"--board", "--out"};
   Args args;
   if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
   calib::CalibrateRequest request;
   request.images_dir = args.positional[0];
+  for (const std::string& list : args.All("--exclude"))
+    for (size_t start = 0; start <= list.size();) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      if (comma > start) request.exclude.push_back(list.substr(start, comma - start));
+      start = comma + 1;
+    }
   if (Status s = calib::ParseBoardSpec(args.Get("--board"), "--board", &request.board); !s.ok())
     return InputError(s);
   request.model = args.Get("--model", "auto");
@@ -76,6 +89,7 @@ int RunSolve(const CommandArgs& argv) {
   request.cross_validate = !args.Switch("--no-cross-validation");
   request.all_halves = args.Switch("--all-halves");
   request.detect.refine_tag_corners = !args.Switch("--no-refine");
+  request.detect.second_look = !args.Switch("--no-second-look");
   const std::string out = args.Get("--out");
   const bool quiet = args.Switch("--quiet");
 
@@ -115,6 +129,7 @@ int RunSolve(const CommandArgs& argv) {
 
   for (const std::string& w : run.warnings) std::cerr << "warning: " << w << "\n";
   if (!quiet) {
+    for (const std::string& name : run.excluded) std::cout << "excluded " << name << "\n";
     for (const calib::RejectedImage& r : run.rejected)
       std::cout << "rejected " << r.name << ": " << r.reason << "\n";
     for (const calib::ModelTrial& t : run.choice.trials) {
@@ -131,7 +146,10 @@ int RunSolve(const CommandArgs& argv) {
     std::cout << "chosen " << run.Chosen().short_name << " (" << run.Chosen().lensmodel << "): fx "
               << fit.intrinsics[0] << " fy " << fit.intrinsics[1] << " cx " << fit.intrinsics[2]
               << " cy " << fit.intrinsics[3] << ", rms " << fit.rms_px << " px, "
-              << run.views.size() << " images used, " << run.rejected.size() << " rejected\n";
+              << run.views.size() << " images used, " << run.rejected.size() << " rejected, "
+              << run.excluded.size() << " excluded\n";
+    for (const std::string& doubt : run.camera_doubts)
+      std::cout << "NOT ONE CAMERA: " << doubt << "\n";
     const calib::UncertaintyMap& u = run.uncertainty;
     char line[256];
     std::snprintf(line, sizeof(line),

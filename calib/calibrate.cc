@@ -5,9 +5,12 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <fnmatch.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/camera_consistency.h"
 #include "pipeline/core/image_io.h"
 
 namespace fresco::calib {
@@ -148,7 +151,8 @@ double MaxTiltDeg(const CalibrationSeed& seed) {
 }
 
 DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, int height,
-                              const CalibrationSeed* seed) {
+                              const CalibrationSeed* seed,
+                              const std::vector<std::string>& camera_doubts) {
   DataReadiness r;
   r.views = static_cast<int>(views.size());
   r.coverage_fraction = CoverageFraction(views, width, height);
@@ -167,6 +171,7 @@ DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, in
   else if (r.max_tilt_deg < kMinTiltDeg)
     r.reasons.push_back("most tilted board " + std::to_string(int(std::round(r.max_tilt_deg))) +
                         " deg (want " + std::to_string(int(kMinTiltDeg)) + "): tilt the board");
+  for (const std::string& doubt : camera_doubts) r.reasons.push_back(doubt);
   r.level = r.views < kMinViews ? DataReadiness::Level::kRed
             : r.reasons.empty() ? DataReadiness::Level::kGreen
                                 : DataReadiness::Level::kYellow;
@@ -186,6 +191,12 @@ Status ListImages(const std::string& dir, std::vector<std::string>* paths) {
   return Status::Ok();
 }
 
+bool IsExcluded(const std::string& name, const std::vector<std::string>& patterns) {
+  for (const std::string& pattern : patterns)
+    if (pattern == name || fnmatch(pattern.c_str(), name.c_str(), 0) == 0) return true;
+  return false;
+}
+
 bool DetectImage(const std::string& path, const CalibrateRequest& request, CalibrationRun* run,
                  BoardDetection* detection_out) {
   const std::string name = fs::path(path).filename().string();
@@ -194,6 +205,8 @@ bool DetectImage(const std::string& path, const CalibrateRequest& request, Calib
     run->rejected.push_back({name, "cannot read the image"});
     return false;
   }
+  ++run->image_sizes[std::to_string(gray.cols) + "x" + std::to_string(gray.rows)];
+  run->camera_doubts = ImageSizeDoubts(*run);
   if (run->width == 0) {
     run->width = gray.cols;
     run->height = gray.rows;
@@ -218,9 +231,13 @@ Status DetectViews(const CalibrateRequest& request, CalibrationRun* run) {
   std::vector<std::string> paths;
   FRESCO_RETURN_IF_ERROR(ListImages(request.images_dir, &paths));
   for (size_t i = 0; i < paths.size(); ++i) {
+    const std::string name = fs::path(paths[i]).filename().string();
+    if (IsExcluded(name, request.exclude)) {
+      run->excluded.push_back(name);
+      continue;
+    }
     if (request.progress)
-      request.progress("detect", static_cast<int>(i), static_cast<int>(paths.size()),
-                       fs::path(paths[i]).filename().string());
+      request.progress("detect", static_cast<int>(i), static_cast<int>(paths.size()), name);
     DetectImage(paths[i], request, run);
   }
   if (static_cast<int>(run->views.size()) < kMinViews)
@@ -252,6 +269,7 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   FRESCO_RETURN_IF_ERROR(FitLensModels(run->views, request.board, run->width, run->height,
                                        run->seed, select, &run->choice));
   for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);
+  CheckOneCamera(request, run);
   CheckRequestedModel(request, run);
   if (request.board.kind == BoardKind::kAprilGrid) {
     run->corner_correlation = run->Chosen().corner_correlation;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,6 +17,9 @@ namespace fresco::calib {
 
 struct CalibrateRequest {
   std::string images_dir;
+  // Images not to use: file names or shell globs on the name (`right*.png`); they are listed
+  // in the report as excluded, not detected.
+  std::vector<std::string> exclude;
   BoardSpec board;
   std::string model = "auto";  // auto or a short name (LensModelShortNames)
   DetectOptions detect;
@@ -32,10 +36,26 @@ struct RejectedImage {
   std::string reason;
 };
 
+// One split test of calib/camera_consistency.h: two groups of images solved apart.
+struct SplitTest {
+  std::string how;  // "file names left* / right*" or "first / second half by name"
+  std::vector<std::string> group_a, group_b;  // image names
+  double joint_sigma_px = 0;  // corner noise sigma of one camera fitted to both groups
+  double split_sigma_px = 0;  // pooled over the two groups' separate fits
+  double ratio = 0;           // joint / split; 0 when a solve failed
+};
+
 struct CalibrationRun {
   int width = 0, height = 0;
   std::vector<BoardView> views;  // images used, sorted by name
   std::vector<RejectedImage> rejected;
+  std::vector<std::string> excluded;       // names matched by CalibrateRequest::exclude
+  std::map<std::string, int> image_sizes;  // "WxH" -> images of that size (every image read)
+  // Signs that the folder mixes cameras (image sizes; one camera's fit worse than two
+  // separate ones: calib/camera_consistency.h), one line each; also in `warnings`. They keep
+  // the "enough data" light off green.
+  std::vector<std::string> camera_doubts;
+  std::vector<SplitTest> split_tests;
   CalibrationSeed seed;
   ModelChoice choice;
   std::vector<std::string> warnings;  // data traps and model-choice doubts, one line each
@@ -55,8 +75,11 @@ struct CalibrationRun {
 // Images: *.png *.jpg *.jpeg *.bmp *.tif *.tiff in `dir` (not recursive), by name.
 Status ListImages(const std::string& dir, std::vector<std::string>* paths);
 
-// Detects the board in every image. Fails (bad input) when the folder has no image or fewer
-// than kMinViews images with a board.
+// True when `name` (a file name) matches one of `patterns` (exact names or shell globs).
+bool IsExcluded(const std::string& name, const std::vector<std::string>& patterns);
+
+// Detects the board in every image not excluded. Fails (bad input) when the folder has no
+// image or fewer than kMinViews images with a board.
 Status DetectViews(const CalibrateRequest& request, CalibrationRun* run);
 
 // One image of DetectViews: adds it to run->views or run->rejected (with the reason).
@@ -96,7 +119,9 @@ struct DataReadiness {
   std::vector<std::string> reasons;
 };
 // `seed`: board poses for the tilt (null = tilt unknown, which keeps the light yellow).
+// `camera_doubts` (CalibrationRun::camera_doubts): each is a reason, and the light is not green.
 DataReadiness AssessReadiness(const std::vector<BoardView>& views, int width, int height,
-                              const CalibrationSeed* seed);
+                              const CalibrationSeed* seed,
+                              const std::vector<std::string>& camera_doubts = {});
 
 }  // namespace fresco::calib

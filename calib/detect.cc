@@ -8,6 +8,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "calib/detect_aruco.h"
 #include "calib/kalibr_tag_family.h"
 
 namespace fresco::calib {
@@ -55,18 +56,16 @@ BoardDetection DetectChessboard(const cv::Mat& gray, const BoardSpec& spec,
 
 // Half-size of cornerSubPix's window for a tag: a quarter of its shortest edge in the image
 // (so the window never reaches the next corner of the same tag), at least 2, at most 6.
-int RefineHalfWindow(const apriltag_detection_t& det) {
+int RefineHalfWindow(const TagQuad& quad) {
   double shortest = 1e9;
-  for (int k = 0; k < 4; ++k) {
-    const double dx = det.p[(k + 1) % 4][0] - det.p[k][0], dy = det.p[(k + 1) % 4][1] - det.p[k][1];
-    shortest = std::min(shortest, std::hypot(dx, dy));
-  }
+  for (int k = 0; k < 4; ++k)
+    shortest = std::min(shortest, (quad.p[(k + 1) % 4] - quad.p[k]).norm());
   return std::clamp(static_cast<int>(shortest / 8), 2, 6);
 }
 
-BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
-                               const DetectOptions& options) {
-  BoardDetection out;
+// One run of the apriltag library: tags with ids < num_ids and at most max_hamming bit
+// errors; an id found twice is dropped (trust neither).
+std::vector<TagQuad> RunApriltag(const cv::Mat& gray, int num_ids, const DetectOptions& options) {
   KalibrTagFamily family;
   apriltag_detector_t* detector = apriltag_detector_create();
   apriltag_detector_add_family_bits(detector, family.get(), options.max_hamming);
@@ -77,37 +76,76 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   image_u8_t image = {contiguous.cols, contiguous.rows, static_cast<int32_t>(contiguous.step),
                       contiguous.data};
   zarray_t* detections = apriltag_detector_detect(detector, &image);
-  std::map<int, int> count_by_id;
-  std::vector<apriltag_detection_t> kept;
+  std::vector<TagQuad> quads;
   for (int i = 0; i < zarray_size(detections); ++i) {
     apriltag_detection_t* det = nullptr;
     zarray_get(detections, i, &det);
-    if (det->id >= spec.cols * spec.rows || det->hamming > options.max_hamming) continue;
-    ++count_by_id[det->id];
-    kept.push_back(*det);
+    if (det->id >= num_ids || det->hamming > options.max_hamming) continue;
+    TagQuad quad;
+    quad.id = det->id;
+    for (int k = 0; k < 4; ++k) quad.p[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]);
+    quads.push_back(quad);
   }
-  for (const apriltag_detection_t& det : kept) {
-    if (count_by_id[det.id] > 1) continue;  // the same id twice: trust neither
+  apriltag_detections_destroy(detections);
+  apriltag_detector_destroy(detector);
+  std::map<int, int> count_by_id;
+  for (const TagQuad& q : quads) ++count_by_id[q.id];
+  quads.erase(std::remove_if(quads.begin(), quads.end(),
+                             [&](const TagQuad& q) { return count_by_id[q.id] > 1; }),
+              quads.end());
+  return quads;
+}
+
+// Adds the quads of ids not in `found` yet; returns how many.
+int AddMissing(const std::vector<TagQuad>& quads, std::map<int, TagQuad>* found) {
+  std::map<int, int> count_by_id;
+  for (const TagQuad& q : quads) ++count_by_id[q.id];
+  int added = 0;
+  for (const TagQuad& q : quads)
+    if (count_by_id[q.id] == 1 && found->emplace(q.id, q).second) ++added;
+  return added;
+}
+
+BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
+                               const DetectOptions& options) {
+  BoardDetection out;
+  const int num_ids = spec.cols * spec.rows;
+  std::map<int, TagQuad> found;
+  AddMissing(RunApriltag(gray, num_ids, options), &found);
+  if (options.second_look && static_cast<int>(found.size()) < num_ids) {
+    // Second look for the missing tags. Kalibr prints a black square where the gaps between
+    // tags cross; it touches the corners of 4 tags, so the library's segmentation merges the
+    // board's black into one blob and finds few tag outlines (a whole board under a strong
+    // barrel distortion: 1 tag of 36). Thinning the black (a grey dilation) cuts those
+    // contacts; the quads found on the thinned image are refined on the original below.
+    // Then OpenCV's aruco, which thresholds and traces contours differently.
+    for (int grow : {3, 5}) {
+      if (static_cast<int>(found.size()) >= num_ids) break;
+      cv::Mat thinned;
+      cv::dilate(gray, thinned, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(grow, grow)));
+      out.tags_second_look += AddMissing(RunApriltag(thinned, num_ids, options), &found);
+    }
+    if (static_cast<int>(found.size()) < num_ids)
+      out.tags_second_look += AddMissing(DetectTagsAruco(gray, num_ids), &found);
+  }
+  for (const auto& [id, quad] : found) {
     std::vector<cv::Point2f> corners;
     for (int k = 0; k < 4; ++k)
-      corners.emplace_back(static_cast<float>(det.p[k][0]), static_cast<float>(det.p[k][1]));
+      corners.emplace_back(static_cast<float>(quad.p[k].x()), static_cast<float>(quad.p[k].y()));
     if (options.refine_tag_corners) {
-      const int half = RefineHalfWindow(det);
+      const int half = RefineHalfWindow(quad);
       cv::cornerSubPix(gray, corners, cv::Size(half, half), cv::Size(-1, -1),
                        cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 40, 1e-3));
     }
     for (int k = 0; k < 4; ++k)
-      out.corners.push_back({det.id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
+      out.corners.push_back({id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
     ++out.tags;
   }
-  apriltag_detections_destroy(detections);
-  apriltag_detector_destroy(detector);
   std::sort(out.corners.begin(), out.corners.end(),
             [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
   if (out.tags == 0) {
     out.corners.clear();
-    out.reason = "no tag36h11 tag of the board (ids 0.." + std::to_string(spec.cols * spec.rows - 1) +
-                 ") found";
+    out.reason = "no tag36h11 tag of the board (ids 0.." + std::to_string(num_ids - 1) + ") found";
   } else if (static_cast<int>(out.corners.size()) < options.min_corners) {
     out.reason = "only " + std::to_string(out.tags) + " tag(s) found (need " +
                  std::to_string((options.min_corners + 3) / 4) + ")";

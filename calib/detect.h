@@ -1,6 +1,8 @@
 // Board detection in one image: per-corner pixel observations with their corner ids
-// (calib/board.h), partial boards included. AprilGrid: the apriltag library (tag36h11), then
-// optionally cv::cornerSubPix on each tag corner. Chessboard: OpenCV's
+// (calib/board.h), partial boards included. AprilGrid: the apriltag library (Kalibr's
+// tag36h11); when it misses some of the board's tags, a second look for the missing ones
+// (the apriltag library with blurred quads, then OpenCV's aruco); then optionally
+// cv::cornerSubPix on each tag corner, whichever detector found it. Chessboard: OpenCV's
 // findChessboardCornersSB, falling back to findChessboardCorners + cornerSubPix.
 // Pixel convention: (0,0) is the centre of the top-left pixel (apriltag, OpenCV and mrcal).
 #pragma once
@@ -24,7 +26,8 @@ struct BoardDetection {
   bool found = false;
   std::string reason;  // why not found (one line), empty when found
   std::vector<CornerObservation> corners;
-  int tags = 0;        // AprilGrid: tags kept
+  int tags = 0;              // AprilGrid: tags kept
+  int tags_second_look = 0;  // AprilGrid: of those, found by the second look
 };
 
 struct DetectOptions {
@@ -33,6 +36,11 @@ struct DetectOptions {
   double quad_decimate = 1.0;  // apriltag: 1 keeps full resolution (small tags need it)
   int max_hamming = 1;         // apriltag: bit errors accepted per tag
   int min_corners = 8;         // fewer than this: not found
+  // AprilGrid: when the apriltag library misses tags of the board, look again for the missing
+  // ones. Under a strong lens distortion the library loses whole boards (tag edges bent away
+  // from its straight quad sides: the bits it samples drift off their cells); see
+  // tests/calib/calib_detect_test.cc for the figures.
+  bool second_look = true;
 };
 
 // `gray` is CV_8U.

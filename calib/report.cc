@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calib/camera_consistency.h"
 #include "calib/corners_vnl.h"
 #include "calib/optimization_inputs.h"
 #include "calib/pictures.h"
@@ -138,6 +139,23 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
   for (const RejectedImage& r : run.rejected)
     rejected.push_back({{"image", r.name}, {"reason", r.reason}});
   j["images_rejected"] = rejected;
+  j["images_excluded"] = run.excluded;  // by name or glob (--exclude, the app's checkboxes)
+  nlohmann::json splits = nlohmann::json::array();
+  for (const SplitTest& t : run.split_tests)
+    splits.push_back({{"split", t.how},
+                      {"group_a", t.group_a},
+                      {"group_b", t.group_b},
+                      {"joint_sigma_px", t.joint_sigma_px},
+                      {"split_sigma_px", t.split_sigma_px},
+                      {"ratio", t.ratio}});
+  j["one_camera"] = {
+      {"image_sizes", run.image_sizes},
+      {"split_tests", splits},
+      {"ratio_limit", kSplitSigmaRatio},
+      {"doubts", run.camera_doubts},
+      {"method",
+       "each split's two groups solved apart with the chosen model: a joint corner noise sigma "
+       "over ratio_limit times the pooled sigma of the separate fits says two cameras"}};
   j["per_image"] = per_image;
   nlohmann::json tried = nlohmann::json::array();
   for (const ModelTrial& t : run.choice.trials) tried.push_back(TrialJson(t));

@@ -10,6 +10,7 @@
 
 #include "tests/test_support.h"
 #include "ui/core/app_state.h"
+#include "ui/core/calibration_runner.h"
 #include "ui/core/colour_scale.h"
 #include "ui/core/group_colour.h"
 #include "ui/core/image_view.h"
@@ -266,6 +267,43 @@ TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {
   EXPECT_NE(bad.message().find("bad.json"), std::string::npos) << bad.message();
   std::ofstream(dir + "/scale.json") << R"({"fractions": [], "font_scale": 40})";
   EXPECT_FALSE(LoadLayoutFile(dir + "/scale.json", &fresh).ok());
+}
+
+// The calibration's default file: beside the project (named after the image folder), or
+// beside the image folder with no project; never inside the image folder.
+TEST(CalibrationSavePath, BesideTheProjectNeverInsideTheImages) {
+  EXPECT_EQ(DefaultCameraModelPath("/data/rig/cam0", "/work/proj/project.json"),
+            "/work/proj/cam0.cameramodel");
+  EXPECT_EQ(DefaultCameraModelPath("/data/rig/cam0/", "/work/proj/project.json"),
+            "/work/proj/cam0.cameramodel");
+  EXPECT_EQ(DefaultCameraModelPath("/data/rig/cam0", ""), "/data/rig/cam0.cameramodel");
+}
+
+// Attach to project: a version-1 project's camera, relative to its folder when below it;
+// undo restores the previous one; a version-2 project's chosen stream.
+TEST(CalibrationAttach, SetsTheProjectCameraAndUndoRestoresIt) {
+  AppState state;
+  EXPECT_FALSE(AttachCameraToProject("/p/cam.cameramodel", 0, &state).ok());  // no project
+  state.has_project = true;
+  state.project.file_path = "/p/project.json";
+  state.project.camera = "old/cameras.txt";
+  ASSERT_TRUE(AttachCameraToProject("/p/calib/cam0.cameramodel", 0, &state).ok());
+  EXPECT_EQ(state.project.camera, "calib/cam0.cameramodel");
+  EXPECT_TRUE(state.dirty);
+  ASSERT_TRUE(AttachCameraToProject("/elsewhere/cam1.cameramodel", 0, &state).ok());
+  EXPECT_EQ(state.project.camera, "/elsewhere/cam1.cameramodel");
+  ASSERT_TRUE(state.Undo());
+  ASSERT_TRUE(state.Undo());
+  EXPECT_EQ(state.project.camera, "old/cameras.txt");
+
+  state.project.fresco_version = 2;
+  state.project.camera.clear();
+  state.project.streams = {{"a/cameras.txt", "a/frames/", "a/images.txt"},
+                           {"b/cameras.txt", "b/frames/", "b/images.txt"}};
+  EXPECT_FALSE(AttachCameraToProject("/p/b.cameramodel", 2, &state).ok());
+  ASSERT_TRUE(AttachCameraToProject("/p/b.cameramodel", 1, &state).ok());
+  EXPECT_EQ(state.project.streams[1].camera, "b.cameramodel");
+  EXPECT_EQ(state.project.streams[0].camera, "a/cameras.txt");
 }
 
 }  // namespace

@@ -303,6 +303,24 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".report.json")));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".coverage.png")));
+
+  // The per-image checkbox: an excluded image leaves the views and the solve goes stale.
+  runner.Exclude("left03.jpg", true);
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_EQ(snap->run.views.size(), 12u);
+  ASSERT_EQ(snap->run.excluded.size(), 1u);
+  EXPECT_EQ(snap->run.excluded[0], "left03.jpg");
+  EXPECT_FALSE(snap->solved);
+  runner.Solve();
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  ASSERT_TRUE(snap->solved) << snap->status;
+  EXPECT_EQ(snap->run.Chosen().fit.views.size(), 12u);
+  runner.Exclude("left03.jpg", false);
+  runner.WaitIdle();
+  EXPECT_EQ(runner.Snapshot()->run.views.size(), 13u);
+  EXPECT_TRUE(runner.Snapshot()->run.excluded.empty());
 }
 
 // Every third image of aprilgrid-yac-mocap's cam0 (10 of 30): a real Kalibr AprilGrid.

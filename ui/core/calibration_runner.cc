@@ -3,8 +3,10 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "calib/camera_consistency.h"
 #include "calib/pictures.h"
 #include "calib/report.h"
+#include "ui/core/app_state.h"
 
 namespace fresco {
 
@@ -23,6 +25,9 @@ void CalibrationRunner::Detect(const calib::CalibrateRequest& request) {
 }
 void CalibrationRunner::Solve() { Post(Command::kSolve); }
 void CalibrationRunner::Save(const std::string& path) { Post(Command::kSave, {}, path); }
+void CalibrationRunner::Exclude(const std::string& name, bool excluded) {
+  Post(excluded ? Command::kExclude : Command::kInclude, {}, name);
+}
 
 void CalibrationRunner::Post(Command::Kind kind, const calib::CalibrateRequest& request,
                              const std::string& path) {
@@ -73,6 +78,8 @@ void CalibrationRunner::Loop() {
     if (command.kind == Command::kDetect) RunDetect(command.request);
     if (command.kind == Command::kSolve) RunSolve();
     if (command.kind == Command::kSave) RunSave(command.path);
+    if (command.kind == Command::kExclude || command.kind == Command::kInclude)
+      RunExclude(command.path, command.kind == Command::kExclude);
     working_.busy = false;
     Publish();
   }
@@ -88,7 +95,8 @@ void CalibrationRunner::UpdateReadiness() {
   working_.readiness = calib::AssessReadiness(run.views, run.width, run.height,
                                               working_.solved ? &run.seed
                                               : seeded        ? &seed
-                                                              : nullptr);
+                                                              : nullptr,
+                                              run.camera_doubts);
   if (!run.views.empty()) working_.coverage_picture = calib::DrawCoverage(run);
 }
 
@@ -116,17 +124,60 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
                       std::to_string(working_.images.size());
     Publish();
     if (cancel_) return;
-    image.used = calib::DetectImage(image.path, request, &working_.run);
+    image.excluded = calib::IsExcluded(image.name, request.exclude);
+    const size_t views_before = working_.run.views.size();
+    const bool found = calib::DetectImage(image.path, request, &working_.run);
     image.done = true;
-    if (image.used)
-      image.view = static_cast<int>(working_.run.views.size()) - 1;
-    else
+    if (found) {
+      image.corners = working_.run.views.back().corners;
+      working_.run.views.resize(views_before);  // RebuildViews adds it back unless excluded
+    } else {
       image.reason = working_.run.rejected.back().reason;
+    }
     ++working_.images_done;
+    RebuildViews();
     UpdateReadiness();
   }
   working_.status = "detected: board in " + std::to_string(working_.run.views.size()) + " of " +
                     std::to_string(working_.images.size()) + " images";
+  if (!working_.run.excluded.empty())
+    working_.status += " (" + std::to_string(working_.run.excluded.size()) + " excluded)";
+}
+
+void CalibrationRunner::RebuildViews() {
+  calib::CalibrationRun& run = working_.run;
+  run.views.clear();
+  run.excluded.clear();
+  for (CalibrationImage& image : working_.images) {
+    image.used = false;
+    image.view = -1;
+    if (image.excluded) {
+      run.excluded.push_back(image.name);
+      continue;
+    }
+    if (!image.done || !image.reason.empty()) continue;
+    image.used = true;
+    image.view = static_cast<int>(run.views.size());
+    run.views.push_back({image.name, image.corners});
+  }
+}
+
+void CalibrationRunner::RunExclude(const std::string& name, bool excluded) {
+  for (CalibrationImage& image : working_.images)
+    if (image.name == name) image.excluded = excluded;
+  RebuildViews();
+  if (working_.solved) {  // the solve was on other views: start its results over
+    working_.solved = false;
+    working_.run.choice = {};
+    working_.run.warnings.clear();
+    working_.run.split_tests.clear();
+    working_.run.camera_doubts = calib::ImageSizeDoubts(working_.run);
+    working_.residuals_picture = cv::Mat();
+    working_.uncertainty_picture = cv::Mat();
+  }
+  UpdateReadiness();
+  working_.status = (excluded ? "excluded " : "included ") + name + ": " +
+                    std::to_string(working_.run.views.size()) + " images used; solve again";
 }
 
 void CalibrationRunner::RunSolve() {
@@ -138,8 +189,8 @@ void CalibrationRunner::RunSolve() {
   run.warnings.clear();
   calib::CalibrateRequest request = working_.request;
   request.progress = [this](const std::string&, int done, int total, const std::string& what) {
-    working_.status = "solving " + std::to_string(done + 1) + "/" + std::to_string(total) + ": " +
-                      what;
+    working_.status =
+        "solving " + std::to_string(done + 1) + "/" + std::to_string(total) + ": " + what;
     Publish();
   };
   if (Status s = calib::SolveViews(request, &run); !s.ok()) {
@@ -170,6 +221,41 @@ void CalibrationRunner::RunSave(const std::string& path) {
   }
   working_.saved_path = path;
   working_.status = "saved " + path + " and " + calib::SiblingPath(path, ".report.json");
+}
+
+std::string DefaultCameraModelPath(const std::string& images_dir, const std::string& project_file) {
+  namespace fs = std::filesystem;
+  fs::path folder = fs::path(images_dir).lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();  // "dir/" -> "dir"
+  std::string name = folder.filename().string();
+  if (name.empty() || name == "." || name == "..") name = "camera";
+  const fs::path beside = project_file.empty() ? fs::absolute(folder).parent_path()
+                                               : fs::path(project_file).parent_path();
+  return (beside / (name + ".cameramodel")).string();
+}
+
+Status AttachCameraToProject(const std::string& cameramodel_path, int stream, AppState* state) {
+  namespace fs = std::filesystem;
+  if (!state->has_project) return Status::Error("no project open");
+  if (cameramodel_path.empty()) return Status::Error("save the calibration first");
+  const int streams = static_cast<int>(state->project.Streams().size());
+  if (state->project.fresco_version >= 2 && (stream < 0 || stream >= streams))
+    return Status::Error("the project has no stream " + std::to_string(stream));
+  const fs::path project_dir = fs::absolute(state->project.file_path).parent_path();
+  const fs::path model = fs::absolute(cameramodel_path).lexically_normal();
+  const fs::path relative = model.lexically_relative(project_dir);
+  const bool below = !relative.empty() && relative.begin()->string() != "..";
+  const std::string written = below ? relative.string() : model.string();
+  state->BeginEdit();
+  if (state->project.fresco_version >= 2) {
+    state->project.streams[stream].camera = written;
+    state->message = "streams[" + std::to_string(stream) + "].camera: " + written;
+  } else {
+    state->project.camera = written;
+    state->message = "camera: " + written;
+  }
+  state->message += " (from the calibration; undo restores the previous camera)";
+  return Status::Ok();
 }
 
 }  // namespace fresco

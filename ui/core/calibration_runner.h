@@ -22,9 +22,11 @@ namespace fresco {
 struct CalibrationImage {
   std::string path, name;
   bool done = false;  // detection ran
-  bool used = false;  // the board was found: run.views[view]
+  bool used = false;  // the board was found and the image is not excluded: run.views[view]
   int view = -1;
-  std::string reason;  // why rejected
+  std::string reason;     // why rejected
+  bool excluded = false;  // the operator's checkbox (or the request's exclude patterns)
+  std::vector<calib::CornerObservation> corners;  // the detection, kept while excluded
 };
 
 struct CalibrationSnapshot {
@@ -52,15 +54,17 @@ class CalibrationRunner {
   // Starts over on this folder and board (a detection under way stops after its image).
   void Detect(const calib::CalibrateRequest& request);
   void Solve();  // on the views detected so far, with the request's model
+  // Leaves image `name` out of (or puts it back into) the views; an earlier solve is stale.
+  void Exclude(const std::string& name, bool excluded);
   void Save(const std::string& cameramodel_path);
   void WaitIdle();  // tests, --screenshot
   std::shared_ptr<const CalibrationSnapshot> Snapshot() const;
 
  private:
   struct Command {
-    enum Kind { kDetect, kSolve, kSave, kQuit } kind = kQuit;
+    enum Kind { kDetect, kSolve, kSave, kExclude, kInclude, kQuit } kind = kQuit;
     calib::CalibrateRequest request;
-    std::string path;
+    std::string path;  // kSave: the file; kExclude / kInclude: the image name
   };
   void Post(Command::Kind kind, const calib::CalibrateRequest& request = {},
             const std::string& path = "");
@@ -68,6 +72,8 @@ class CalibrationRunner {
   void RunDetect(const calib::CalibrateRequest& request);
   void RunSolve();
   void RunSave(const std::string& path);
+  void RunExclude(const std::string& name, bool excluded);
+  void RebuildViews();  // run.views from the images used and not excluded
   void UpdateReadiness();
   void Publish();
 
@@ -80,5 +86,16 @@ class CalibrationRunner {
   CalibrationSnapshot working_;  // worker only
   std::thread thread_;
 };
+
+// Where Save proposes to write: beside the project (its folder, named after the image
+// folder: PROJECT_DIR/cam0.cameramodel), or with no project beside the image folder
+// (PARENT/cam0.cameramodel); never inside the image folder.
+std::string DefaultCameraModelPath(const std::string& images_dir, const std::string& project_file);
+
+// Points the open project's camera at `cameramodel_path` (relative to the project's folder
+// when it is below it): `camera` of a version-1 project, `streams[stream].camera` of a
+// version-2 one. Undo restores the previous camera.
+struct AppState;
+Status AttachCameraToProject(const std::string& cameramodel_path, int stream, AppState* state);
 
 }  // namespace fresco

@@ -1,6 +1,8 @@
 // Calibration (issue 8) for the operator: the folder, board and lens model; Detect, Solve and
-// Save; the "enough data yet?" light that follows the detections image by image; the images
-// (used, or rejected with the reason); the selected image with its detections; the coverage
+// Save (beside the project by default) and Attach to project; the "enough data yet?" light
+// that follows the detections image by image (never green for a folder that mixes cameras);
+// the images (used, rejected with the reason, or excluded by their checkbox); the selected
+// image with its detections; the coverage
 // map; per-image residuals, the models tried and the one chosen; the warnings.
 #include <algorithm>
 #include <cstdio>
@@ -43,7 +45,10 @@ void TrafficLight(const DataReadiness& r) {
               100 * calib::kMinCoverage,
               r.max_tilt_deg < 0 ? "?" : Format("%.0f deg", r.max_tilt_deg).c_str(),
               calib::kMinTiltDeg);
-  for (const std::string& reason : r.reasons) ImGui::BulletText("%s", reason.c_str());
+  for (const std::string& reason : r.reasons) {  // wrapped: a mixed-camera reason is long
+    ImGui::Bullet();
+    ImGui::TextWrapped("%s", reason.c_str());
+  }
 }
 
 class CalibrationPanel : public Panel {
@@ -112,11 +117,15 @@ class CalibrationPanel : public Panel {
     ImGui::SameLine();
     ImGui::BeginDisabled(snap.busy || !snap.solved);
     if (ImGui::Button("Save")) {
-      std::snprintf(save_path_, sizeof(save_path_), "%s/camera.cameramodel", folder_);
+      const std::string beside =
+          ui.state->has_project ? ui.state->project.file_path : std::string();
+      std::snprintf(save_path_, sizeof(save_path_), "%s",
+                    DefaultCameraModelPath(folder_, beside).c_str());
       ImGui::OpenPopup("Save calibration");
     }
     ImGui::EndDisabled();
     DrawSavePopup(ui);
+    DrawAttach(ui, snap);
     if (!snap.images.empty())
       ImGui::ProgressBar(
           snap.images_done / float(snap.images.size()), ImVec2(-1, 0),
@@ -130,8 +139,12 @@ class CalibrationPanel : public Panel {
     ImGui::Separator();
     ImGui::TextUnformatted("Enough data yet?");
     TrafficLight(snap.readiness);
+    if (!snap.run.camera_doubts.empty())
+      ImGui::TextColored(
+          ImVec4(1, 0.35f, 0.3f, 1),
+          "NOT ONE CAMERA? See the reasons above; untick the other camera's images.");
     ImGui::Separator();
-    DrawImageList(snap);
+    DrawImageList(ui, snap);
   }
 
   void StartDetect(UiContext& ui) {
@@ -157,20 +170,49 @@ class CalibrationPanel : public Panel {
     ImGui::EndPopup();
   }
 
-  void DrawImageList(const CalibrationSnapshot& snap) {
-    ImGui::Text("Images (%zu used, %zu rejected)", snap.run.views.size(), snap.run.rejected.size());
+  // "Attach to project": the saved .cameramodel becomes the open project's camera.
+  void DrawAttach(UiContext& ui, const CalibrationSnapshot& snap) {
+    if (snap.saved_path.empty() || !ui.state->has_project) return;
+    const bool v2 = ui.state->project.fresco_version >= 2;
+    if (v2) {
+      ImGui::SetNextItemWidth(80);
+      ImGui::InputInt("stream", &attach_stream_);
+      ImGui::SameLine();
+    }
+    if (ImGui::Button("Attach to project")) {
+      if (Status s = AttachCameraToProject(snap.saved_path, attach_stream_, ui.state); !s.ok())
+        ui.state->message = "error: " + s.message();
+      else
+        ApplyProject(ui);  // repaint through the new camera
+    }
+    if (ImGui::IsItemHovered())
+      ImGui::SetTooltip("the project's %s becomes %s (Ctrl+Z undoes)",
+                        v2 ? "streams[i].camera" : "camera", snap.saved_path.c_str());
+  }
+
+  void DrawImageList(UiContext& ui, const CalibrationSnapshot& snap) {
+    ImGui::Text("Images (%zu used, %zu rejected, %zu excluded)", snap.run.views.size(),
+                snap.run.rejected.size(), snap.run.excluded.size());
     if (!ImGui::BeginChild("images", ImVec2(0, 0), true)) {
       ImGui::EndChild();
       return;
     }
     for (int i = 0; i < static_cast<int>(snap.images.size()); ++i) {
       const CalibrationImage& image = snap.images[i];
-      const ImVec4 colour = !image.done  ? ImVec4(0.6f, 0.6f, 0.6f, 1)
-                            : image.used ? ImVec4(0.5f, 0.9f, 0.5f, 1)
-                                         : ImVec4(1, 0.5f, 0.4f, 1);
-      std::string label = image.name + (!image.done  ? "  ..."
-                                        : image.used ? "  used"
-                                                     : "  rejected");
+      bool use = !image.excluded;  // the operator's per-image choice
+      ImGui::BeginDisabled(snap.busy);
+      if (ImGui::Checkbox(("##use" + std::to_string(i)).c_str(), &use))
+        ui.calibration->Exclude(image.name, !use);
+      ImGui::EndDisabled();
+      if (ImGui::IsItemHovered()) ImGui::SetTooltip("use this image (untick to exclude it)");
+      ImGui::SameLine();
+      const ImVec4 colour = !image.done || image.excluded ? ImVec4(0.6f, 0.6f, 0.6f, 1)
+                            : image.used                  ? ImVec4(0.5f, 0.9f, 0.5f, 1)
+                                                          : ImVec4(1, 0.5f, 0.4f, 1);
+      std::string label = image.name + (image.excluded ? "  excluded"
+                                        : !image.done  ? "  ..."
+                                        : image.used   ? "  used"
+                                                       : "  rejected");
       if (image.used)
         label += " (" + std::to_string(snap.run.views[image.view].corners.size()) + " corners)";
       ImGui::PushStyleColor(ImGuiCol_Text, colour);
@@ -311,6 +353,8 @@ class CalibrationPanel : public Panel {
                {"images", std::to_string(snap.images.size())},
                {"views", std::to_string(snap.run.views.size())},
                {"rejected", std::to_string(snap.run.rejected.size())},
+               {"excluded", std::to_string(snap.run.excluded.size())},
+               {"camera_doubts", std::to_string(snap.run.camera_doubts.size())},
                {"readiness", kLevels[static_cast<int>(snap.readiness.level)]}};
     if (snap.solved) {
       report_["model"] = snap.run.Chosen().short_name;
@@ -326,7 +370,8 @@ class CalibrationPanel : public Panel {
   char folder_[1024] = "";
   char board_[256] = "";
   char save_path_[1100] = "";
-  int model_ = 0;  // 0 = auto, else LensModelShortNames()[model_ - 1]
+  int attach_stream_ = 0;  // version-2 projects: which stream's camera
+  int model_ = 0;          // 0 = auto, else LensModelShortNames()[model_ - 1]
   int selected_ = -1;
   int drawn_image_ = -1;
   uint64_t drawn_version_ = 0;
