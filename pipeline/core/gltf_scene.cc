@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <map>
 #include <set>
@@ -845,8 +846,7 @@ Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, S
 }
 
 Status ParseGltfScene(const std::string& bytes, const std::string& path,
-                      const std::string& base_dir, const SceneLoadOptions& options,
-                      Scene* scene) {
+                      const std::string& base_dir, const SceneLoadOptions& options, Scene* scene) {
   if (!(options.min_triangle_area_m2 >= 0.0)) {
     return Status::Error(path + ": min_triangle_area_m2 must be >= 0");
   }
@@ -865,8 +865,8 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
   const auto length = static_cast<unsigned int>(bytes.size());
   const bool parsed =
       binary ? io.LoadBinaryFromMemory(&model, &err, &warn,
-                                       reinterpret_cast<const unsigned char*>(bytes.data()),
-                                       length, base_dir)
+                                       reinterpret_cast<const unsigned char*>(bytes.data()), length,
+                                       base_dir)
              : io.LoadASCIIFromString(&model, &err, &warn, bytes.data(), length, base_dir);
   if (!parsed) {
     std::string why = OneLine(err);
@@ -913,6 +913,9 @@ class BinaryWriter {
     return static_cast<int>(views->size()) - 1;
   }
   const std::string& data() const { return data_; }
+  // Room for `bytes` in all. An upper bound costs no memory beyond what is written: the
+  // pages never written are never touched. It saves the copy each doubling would make.
+  void Reserve(size_t bytes) { data_.reserve(bytes); }
 
  private:
   std::string data_;
@@ -1023,6 +1026,10 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   }
   Json views = Json::array(), accessors = Json::array(), primitives = Json::array();
   BinaryWriter bin;
+  // At most a vertex per corner (position, uv) and an index, plus each view's alignment.
+  bin.Reserve(static_cast<size_t>(num_triangles) * 3 *
+                  (sizeof(Eigen::Vector3f) + sizeof(Eigen::Vector2f) + sizeof(uint32_t)) +
+              12 * primitive_triangles.size());
   std::vector<int> slot(num_vertices, -1);
   for (const std::vector<int>& run : primitive_triangles) {
     const int material = triangle_material(run[0]);
@@ -1039,9 +1046,13 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
     }
     std::sort(used.begin(), used.end());
     for (size_t i = 0; i < used.size(); ++i) slot[used[i]] = static_cast<int>(i);
+    // Split vertices are appended: room for a vertex per corner (untouched where unused).
+    const size_t max_vertices = has_uv ? 3 * run.size() : used.size();
     std::vector<Eigen::Vector3f> positions(used.size());
+    positions.reserve(max_vertices);
     for (size_t i = 0; i < used.size(); ++i) positions[i] = mesh.vertices[used[i]].cast<float>();
     std::vector<Eigen::Vector2f> uvs(used.size(), Eigen::Vector2f::Zero());
+    uvs.reserve(max_vertices);
     std::vector<char> uv_set(used.size(), 0);
     std::map<std::tuple<int, float, float>, int> splits;
     std::vector<uint32_t> indices;
@@ -1151,8 +1162,14 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
       if (!cv::imencode(".png", bgra, png)) {
         return fail("texture " + std::to_string(t) + ": PNG encoding failed");
       }
-      FRESCO_RETURN_IF_ERROR(
-          WriteFileAtomic(beside(png_name), std::string(png.begin(), png.end())));
+      bgra.release();
+      FRESCO_RETURN_IF_ERROR(WriteFileAtomicWith(beside(png_name), [&](const std::string& temp) {
+        std::ofstream file(temp, std::ios::binary);
+        file.write(reinterpret_cast<const char*>(png.data()),
+                   static_cast<std::streamsize>(png.size()));
+        file.close();
+        return file.good() ? Status::Ok() : Status::Error(temp + ": cannot write");
+      }));
       Json image = {{"uri", png_name}};
       if (!texture.name.empty()) image["name"] = texture.name;
       images.push_back(image);

@@ -177,11 +177,12 @@ struct GroupSpec {
 // which case exactly those groups are used (triangles in none are never painted); `edits`
 // then apply in order. `fresco group PROJECT.json --save` stores the automatic result.
 //
-// Charts (grouping.h): a triangle joins a chart when its normal is within `angle_deg` of the
-// chart's mean normal (a cone, so normal noise does not stop the growth) and the chart stays
-// under the largest buffer's texels; then charts smaller than `min_chart_texels` are merged
-// into a neighbour whose plane sees all their triangles with a texel stretch (1 / cos of the
-// angle to the plane) of at most `max_stretch`. min_chart_texels = 0: the paper's grouping.
+// Charts (charts.h): a triangle joins a chart when its normal, smoothed over its neighbours,
+// is within `angle_deg` of the chart's mean (a cone, so normal noise does not stop the
+// growth), the triangle faces the chart's plane and the chart stays under the largest
+// buffer's texels; then charts smaller than `min_chart_texels` are merged into a neighbour
+// whose plane all their triangles face, with a mean texel stretch (1 / cos of the angle to
+// the plane) of at most `max_stretch`. min_chart_texels = 0: the paper's grouping.
 struct GroupingOptions {
   double angle_deg = 20.0;
   int min_chart_texels = 256;

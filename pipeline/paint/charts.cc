@@ -1,6 +1,7 @@
 #include "pipeline/paint/charts.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <limits>
@@ -10,25 +11,83 @@
 namespace fresco {
 namespace {
 
+Eigen::Vector3d UnitOr(const Eigen::Vector3d& sum, const Eigen::Vector3d& fallback) {
+  const double n = sum.norm();
+  return n > 0 ? Eigen::Vector3d(sum / n) : fallback;
+}
+
 struct Chart {
   std::vector<int> triangles;
-  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();  // area-weighted
+  Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();  // area-weighted: the buffer's plane
+  Eigen::Vector3d smooth_sum = Eigen::Vector3d::Zero();  // the same of smoothed normals
   double area = 0.0;
   int worst = -1;  // its triangle furthest from its mean normal
   bool alive = true;
 
-  Eigen::Vector3d Normal() const {
-    const double n = normal_sum.norm();
-    return n > 0 ? Eigen::Vector3d(normal_sum / n) : Eigen::Vector3d::UnitZ();
-  }
+  Eigen::Vector3d Normal() const { return UnitOr(normal_sum, Eigen::Vector3d::UnitZ()); }
+  Eigen::Vector3d SmoothNormal() const { return UnitOr(smooth_sum, Normal()); }
 };
 
-// A triangle merged into a chart must face its plane at least this much (cos 84 degrees):
-// well away from edge-on, where its texels would fold or stretch without bound.
+// A triangle in a chart must face its plane at least this much (cos 84 degrees): well away
+// from edge-on, where its texels would fold or stretch without bound.
 constexpr double kMinMergeCos = 0.1;
 // A chart grown to the size limit still takes in its small neighbours up to this factor over
 // the limit (its buffer's texels then get at most 5 % coarser).
 constexpr double kMergeHeadroom = 1.1;
+// Normal smoothing for growth: rounds of averaging each triangle's normal with those of the
+// triangles around its vertices within 60 degrees of it (wider than the noise of a fused
+// mesh, narrower than a box's edge, which stays sharp).
+constexpr int kSmoothRounds = 3;
+constexpr float kSmoothCos = 0.5f;
+
+// (T) unit normals smoothed over the triangles sharing a vertex (welded), by area.
+std::vector<Eigen::Vector3f> SmoothNormals(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
+                                           const TriangleFacts& facts) {
+  const int n = mesh.NumTriangles();
+  const std::vector<int>& weld = adjacency.welded_vertex;
+  auto vertex_of = [&](int t, int k) {
+    const int v = mesh.triangles[t][k];
+    return v < static_cast<int>(weld.size()) ? weld[v] : v;
+  };
+  // Triangles around each vertex: around[start[v] .. start[v + 1]).
+  std::vector<int64_t> start(mesh.vertices.size() + 1, 0);
+  for (int t = 0; t < n; ++t)
+    for (int k = 0; k < 3; ++k) ++start[vertex_of(t, k) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<int> around(start.back());
+  {
+    std::vector<int64_t> fill(start.begin(), start.end() - 1);
+    for (int t = 0; t < n; ++t)
+      for (int k = 0; k < 3; ++k) around[fill[vertex_of(t, k)]++] = t;
+  }
+  std::vector<Eigen::Vector3f> smooth(n), next(n);
+  for (int t = 0; t < n; ++t) smooth[t] = facts.normals[t].cast<float>();
+  for (int round = 0; round < kSmoothRounds; ++round) {
+    for (int t = 0; t < n; ++t) {
+      Eigen::Vector3f sum = smooth[t] * static_cast<float>(facts.areas[t]);
+      for (int k = 0; k < 3; ++k) {
+        const int v = vertex_of(t, k);
+        for (int64_t i = start[v]; i < start[v + 1]; ++i) {
+          const int u = around[i];
+          if (u != t && smooth[u].dot(smooth[t]) >= kSmoothCos)
+            sum += smooth[u] * static_cast<float>(facts.areas[u]);
+        }
+      }
+      const float norm = sum.norm();
+      next[t] = norm > 0 ? Eigen::Vector3f(sum / norm) : smooth[t];
+    }
+    smooth.swap(next);
+  }
+  return smooth;
+}
+
+void AddTriangle(int t, const TriangleFacts& facts, const std::vector<Eigen::Vector3f>& smooth,
+                 Chart* chart) {
+  chart->triangles.push_back(t);
+  chart->normal_sum += facts.normals[t] * facts.areas[t];
+  chart->smooth_sum += smooth[t].cast<double>() * facts.areas[t];
+  chart->area += facts.areas[t];
+}
 
 }  // namespace
 
@@ -48,10 +107,14 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
   const std::vector<Eigen::Vector3d>& normals = facts.normals;
   const std::vector<double>& areas = facts.areas;
   const std::vector<int>& order = facts.by_decreasing_area;
+  const std::vector<Eigen::Vector3f> smooth = SmoothNormals(mesh, adjacency, facts);
+  auto smooth_dot = [&](int t, const Eigen::Vector3d& v) {
+    return smooth[t].cast<double>().dot(v);
+  };
 
-  // 1. Region growing, in rounds: a chart's mean normal moves as it grows, so triangles that
-  // end up beyond the stretch bound of the final mean leave it and seed charts of their own
-  // in the next round (the last round keeps what it grows).
+  // 1. Region growing, in rounds: a chart's mean normals move as it grows, so triangles that
+  // end up outside its bounds leave it and seed charts of their own in the next round; what
+  // is left after the last round becomes charts of one triangle (merged in step 2).
   std::vector<Chart> charts;
   std::vector<int> chart_of(n, -1);
   std::deque<int> queue;
@@ -63,57 +126,68 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
       const int c = static_cast<int>(charts.size());
       charts.emplace_back();
       Chart& chart = charts.back();
-      const Eigen::Vector3d seed_normal = normals[seed];
+      const Eigen::Vector3d seed_smooth = smooth[seed].cast<double>();
       chart_of[seed] = c;
       queue.assign(1, seed);
       while (!queue.empty()) {
         const int t = queue.front();
         queue.pop_front();
-        chart.triangles.push_back(t);
-        chart.normal_sum += normals[t] * areas[t];
-        chart.area += areas[t];
-        const Eigen::Vector3d mean = chart.Normal();
+        AddTriangle(t, facts, smooth, &chart);
+        const Eigen::Vector3d mean = chart.Normal(), cone = chart.SmoothNormal();
         for (int nb : adjacency.Neighbours(t)) {
           if (chart_of[nb] >= 0 || areas[nb] <= 0.0) continue;
-          if (normals[nb].dot(mean) < cos_cone || normals[nb].dot(seed_normal) < cos_stretch)
+          // The surface (smoothed) stays within the cone and the stretch bound of the seed;
+          // the triangle itself (noise and all) faces the plane: no fold.
+          if (smooth_dot(nb, cone) < cos_cone || smooth_dot(nb, seed_smooth) < cos_stretch ||
+              normals[nb].dot(mean) < kMinMergeCos)
             continue;
           if (chart.area + areas[nb] > max_area) continue;
           chart_of[nb] = c;
           queue.push_back(nb);
         }
       }
-      if (round + 1 < kRounds) {
-        const Eigen::Vector3d mean = chart.Normal();
-        auto beyond = [&](int t) { return normals[t].dot(mean) < cos_stretch; };
-        for (int t : chart.triangles) {
-          if (!beyond(t)) continue;
-          chart_of[t] = -1;
-          chart.normal_sum -= normals[t] * areas[t];
-          chart.area -= areas[t];
-          evicted = true;
-        }
-        chart.triangles.erase(std::remove_if(chart.triangles.begin(), chart.triangles.end(), beyond),
-                              chart.triangles.end());
+      const Eigen::Vector3d mean = chart.Normal(), cone = chart.SmoothNormal();
+      auto beyond = [&](int t) {
+        return normals[t].dot(mean) < kMinMergeCos || smooth_dot(t, cone) < cos_stretch;
+      };
+      for (int t : chart.triangles) {
+        if (!beyond(t)) continue;
+        chart_of[t] = -1;
+        chart.normal_sum -= normals[t] * areas[t];
+        chart.smooth_sum -= smooth[t].cast<double>() * areas[t];
+        chart.area -= areas[t];
+        evicted = true;
       }
-      if (chart.triangles.empty()) {  // cannot happen (the seed is within the bound), but
-        chart.alive = false;           // an empty chart must not be used
+      chart.triangles.erase(std::remove_if(chart.triangles.begin(), chart.triangles.end(), beyond),
+                            chart.triangles.end());
+      if (chart.triangles.empty()) {  // its seed faces away from what it grew
+        chart.alive = false;
         continue;
       }
-      const Eigen::Vector3d mean = chart.Normal();
-      chart.worst = *std::min_element(
-          chart.triangles.begin(), chart.triangles.end(),
-          [&](int a, int b) { return normals[a].dot(mean) < normals[b].dot(mean); });
     }
     if (!evicted) break;
+  }
+  for (int t : order) {
+    if (chart_of[t] >= 0 || areas[t] <= 0.0) continue;
+    chart_of[t] = static_cast<int>(charts.size());
+    charts.emplace_back();
+    AddTriangle(t, facts, smooth, &charts.back());
+  }
+  for (Chart& chart : charts) {
+    if (!chart.alive) continue;
+    const Eigen::Vector3d mean = chart.Normal();
+    chart.worst = *std::min_element(
+        chart.triangles.begin(), chart.triangles.end(),
+        [&](int a, int b) { return normals[a].dot(mean) < normals[b].dot(mean); });
   }
 
   // 2. Small charts into a neighbour, in passes (smallest first in each): a small chart that
   // took in a smaller one may be merged itself in the next pass.
   const bool merging = texel_area > 0 && options.min_chart_texels > 0;
+  const double min_area = options.min_chart_texels * texel_area;
   bool merged_any = merging;
   for (int pass = 0; pass < 8 && merged_any; ++pass) {
     merged_any = false;
-    const double min_area = options.min_chart_texels * texel_area;
     std::vector<int> by_area;
     for (int c = 0; c < static_cast<int>(charts.size()); ++c)
       if (charts[c].alive && charts[c].area < min_area) by_area.push_back(c);
@@ -134,10 +208,9 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
         if (small.area + big.area > kMergeHeadroom * max_area) continue;
         const Eigen::Vector3d merged = (small.normal_sum + big.normal_sum).normalized();
         if (!std::isfinite(merged.x())) continue;
-        // The larger chart keeps its worst triangle within the bound; the small chart's
-        // triangles must face the plane (no fold: at most kMaxMergeAngle away) and stretch
-        // within the bound on average (by area): a noise spike of one triangle steeper than
-        // the bound goes with its neighbours instead of staying a chart of its own.
+        // Every triangle faces the merged plane (no fold: at most 84 degrees away, the
+        // larger chart's worst one too), and the small chart's surface (smoothed normals)
+        // stretches within the bound on average (by area).
         bool ok = normals[big.worst].dot(merged) >= std::min(cos_stretch, kMinMergeCos);
         int worst = big.worst;
         double stretch_area = 0.0;
@@ -147,19 +220,54 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
             ok = false;
             break;
           }
-          stretch_area += areas[t] / c;
+          stretch_area += areas[t] / std::max(smooth_dot(t, merged), kMinMergeCos);
           if (c < normals[worst].dot(merged)) worst = t;
         }
         if (!ok || stretch_area > options.max_stretch * small.area) continue;
         for (int t : small.triangles) chart_of[t] = d;
         big.triangles.insert(big.triangles.end(), small.triangles.begin(), small.triangles.end());
         big.normal_sum += small.normal_sum;
+        big.smooth_sum += small.smooth_sum;
         big.area += small.area;
         big.worst = worst;
         small.alive = false;
         small.triangles.clear();
         merged_any = true;
         break;
+      }
+    }
+  }
+
+  // 3. What is still small faces away from every chart around it (a fold of the noise, a
+  // spike): triangle by triangle into shared charts, one per axis direction (+-x, +-y, +-z:
+  // the one the triangle faces most, within 55 degrees) and cell of space (as wide as the
+  // largest buffer), instead of a chart and a buffer each.
+  if (merging) {
+    const double cell_m =
+        scale.max_chart_texels > 0
+            ? std::sqrt(static_cast<double>(scale.max_chart_texels)) * scale.texel_size_m
+            : std::numeric_limits<double>::infinity();
+    std::map<std::array<int64_t, 4>, int> shared_chart;  // (axis, cell) -> chart
+    const int num_charts = static_cast<int>(charts.size());
+    for (int c = 0; c < num_charts; ++c) {
+      if (!charts[c].alive || charts[c].area >= min_area) continue;
+      std::vector<int> triangles = std::move(charts[c].triangles);
+      charts[c].alive = false;
+      for (int t : triangles) {
+        int axis = 0;
+        for (int a = 1; a < 6; ++a)
+          if ((a % 2 ? -1 : 1) * normals[t][a / 2] > (axis % 2 ? -1 : 1) * normals[t][axis / 2])
+            axis = a;
+        const Eigen::Vector3d centre =
+            (mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0;
+        std::array<int64_t, 4> key{axis, 0, 0, 0};
+        if (std::isfinite(cell_m))
+          for (int k = 0; k < 3; ++k)
+            key[k + 1] = static_cast<int64_t>(std::floor(centre[k] / cell_m));
+        auto [it, added] = shared_chart.emplace(key, static_cast<int>(charts.size()));
+        if (added) charts.emplace_back();
+        chart_of[t] = it->second;
+        AddTriangle(t, facts, smooth, &charts[it->second]);
       }
     }
   }
@@ -207,7 +315,8 @@ ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& group
       [](const BaseBufferGroup& g) -> const std::vector<int>& { return g.triangles; });
 }
 
-ChartStretch MeasureBufferStretch(const TriangleMesh& mesh, const std::vector<BaseBuffer>& buffers) {
+ChartStretch MeasureBufferStretch(const TriangleMesh& mesh,
+                                  const std::vector<BaseBuffer>& buffers) {
   return StretchOf(
       mesh, buffers, [](const BaseBuffer& b) { return b.normal; },
       [](const BaseBuffer& b) -> const std::vector<int>& { return b.triangles; });

@@ -1,17 +1,21 @@
 // Charts: the automatic grouping for meshes from photogrammetry and scanning, whose normals
 // are noisy at every triangle (the paper's neighbour-by-normal grouping, §3.6, degenerates to
-// one buffer per triangle there). Two steps:
-// 1. Region growing from the largest unassigned triangle; a neighbour joins when its normal
-//    is within `angle_deg` of the chart's area-weighted mean normal (a cone that follows the
-//    chart, not the seed, so noise averages out), within the stretch bound of the seed's
-//    normal (so a slowly curving surface cannot drift around), and while the chart's area
-//    stays under 4 x `max_chart_texels` texels (a bigger buffer gets coarser texels).
+// one buffer per triangle there). Three steps:
+// 1. Region growing from the largest unassigned triangle over normals smoothed for it (three
+//    rounds of averaging with the triangles around each vertex within 60 degrees: the noise
+//    averages out, a box's edge stays sharp). A neighbour joins when its smoothed normal is
+//    within `angle_deg` of the chart's mean smoothed normal (a cone that follows the chart)
+//    and within the stretch bound (1 / cos <= `max_stretch`) of the seed's (so a slowly
+//    curving surface cannot drift around), when the triangle itself, noise and all, faces
+//    the chart's plane (within 84 degrees: no fold), and while the chart's area stays under
+//    4 x `max_chart_texels` texels (a bigger buffer gets coarser texels).
 // 2. Charts under `min_chart_texels` are merged, smallest first, into the neighbour they
-//    share the most edges with, when the merged chart's plane sees the small chart's
-//    triangles with an area-weighted mean texel stretch 1 / cos(angle) of at most
-//    `max_stretch`, each of them within 84 degrees (no fold), and the larger chart's worst
-//    triangle still within the bound. (Single noise spikes steeper than the bound so join
-//    their neighbours: MeasureChartStretch reports the largest stretch as it is.)
+//    share the most edges with, when every triangle of both faces the merged chart's plane
+//    (within 84 degrees) and the small chart's smoothed normals stretch by at most
+//    `max_stretch` on average (by area).
+// 3. What is still small faces away from every chart around it (a fold of the fused surface,
+//    a noise spike): its triangles go to shared charts, one per axis direction (the one each
+//    triangle faces most, within 55 degrees) and cell of space as wide as the largest buffer.
 // The chart count then follows the surface's shape, not its triangle count. Charts that
 // would still fold in their plane are split when their buffers are built (base_buffer.h).
 #pragma once
