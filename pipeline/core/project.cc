@@ -308,18 +308,22 @@ void Fields(GroupingOptions& o, V& v) {
   v.Field("angle_deg", o.angle_deg,
           {.min = 0,
            .max = 180,
-           .help = "a neighbouring triangle joins a chart when its normal is within this of the "
-                   "chart's mean normal"});
+           .help = "a neighbouring triangle joins a chart when its normal, smoothed over its "
+                   "neighbours (noise averages out, sharp edges stay), is within this of the "
+                   "chart's mean; the triangle itself must face the chart's plane (no fold)"});
   v.Field("min_chart_texels", o.min_chart_texels,
           {.min = 0,
            .help = "smaller charts are merged into the neighbour they share most edges with, when "
-                   "its plane sees them with a stretch of at most `max_stretch`; 0 = the paper's "
-                   "grouping (§3.6)"});
+                   "its plane sees them with a mean stretch of at most `max_stretch` and every "
+                   "triangle faces it; what still remains smaller (triangles the noise folded "
+                   "over) goes to shared charts, one per axis direction and region; 0 = the "
+                   "paper's grouping (§3.6)"});
   v.Field("max_stretch", o.max_stretch,
           {.min = 1,
            .max = 100,
-           .help = "texel stretch (1 / cos of the angle to the chart's plane) allowed when merging "
-                   "small charts"});
+           .help = "texel stretch (1 / cos of the angle to the chart's plane, of the smoothed "
+                   "normals) allowed while a chart grows away from its seed and, on average, when "
+                   "merging small charts"});
   v.List("groups", o.groups);
   v.List("edits", o.edits);
 }
