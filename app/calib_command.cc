@@ -13,7 +13,9 @@
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
 #include "calib/report.h"
+#include "calib/sample_views.h"
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/cameramodel_io.h"
 #include "pipeline/core/image_io.h"
 
 namespace fresco {
@@ -23,7 +25,8 @@ using calib::BoardSpec;
 
 const char kUsage[] =
     "fresco calib solve IMAGES_DIR --board BOARD --out CAMERA.cameramodel [--model MODEL]\n"
-    "       fresco calib board BOARD --out BOARD.png [--dpi N]";
+    "       fresco calib board BOARD --out BOARD.png [--dpi N]\n"
+    "       fresco calib sample BOARD --out DIR [--views N] [--seed N] [--blur PX] [--noise GREY]";
 
 const char kSolveHelp[] =
     R"(Detects the board in every image of IMAGES_DIR (*.png *.jpg *.jpeg *.bmp *.tif), solves
@@ -64,8 +67,8 @@ int RunSolve(const CommandArgs& argv) {
   spec.max_positional = 1;
   spec.options = {"--board", "--out", "--model", "--corners-vnl"};
   spec.repeatable = {"--exclude"};
-  spec.switches = {"--no-pictures", "--no-cross-validation", "--all-halves", "--no-refine",
-                   "--no-second-look", "--quiet"};
+  spec.switches = {"--no-pictures", "--no-cross-validation", "--all-halves",
+                   "--no-refine",   "--no-second-look",      "--quiet"};
   spec.required = {"--board", "--out"};
   Args args;
   if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
@@ -200,6 +203,67 @@ int RunBoard(const CommandArgs& argv) {
   return kExitOk;
 }
 
+int RunSample(const CommandArgs& argv) {
+  ArgSpec spec;
+  spec.usage =
+      "fresco calib sample BOARD --out DIR [--views N] [--seed N] [--blur PX] [--noise GREY]";
+  spec.help =
+      "Makes sample calibration images to try calibration with: the AprilGrid BOARD (as\n"
+      "fresco calib board prints it) seen through a known lens with strong barrel distortion\n"
+      "(mrcal LENSMODEL_OPENCV4, 1024x768) from views that sweep the imager, borders and\n"
+      "corners included. Writes DIR/view_000.png ... and DIR/truth.cameramodel (the lens the\n"
+      "views were made with: compare what fresco calib solve finds against it).\n\n"
+      "  --views N      number of views (default 20)\n"
+      "  --seed N       the views' poses and noise (default 1)\n"
+      "  --blur PX      Gaussian blur sigma in pixels (default 0)\n"
+      "  --noise GREY   Gaussian noise sigma in grey levels (default 1)";
+  spec.min_positional = spec.max_positional = 1;
+  spec.options = {"--out", "--views", "--seed", "--blur", "--noise"};
+  spec.required = {"--out"};
+  Args args;
+  if (int code = ParseVerbArgs("calib sample", argv, spec, &args); code >= 0) return code;
+  BoardSpec board;
+  if (Status s = calib::ParseBoardSpec(args.positional[0], "BOARD", &board); !s.ok())
+    return InputError(s);
+  if (board.kind != calib::BoardKind::kAprilGrid)
+    return UsageError("calib sample", spec, "BOARD: sample views are made of AprilGrid boards");
+  int views = 20, seed = 1;
+  calib::SyntheticImageOptions options;
+  options.noise_px = 1;
+  std::string error;
+  if ((args.Has("--views") && !ParseInt(args.Get("--views"), "--views", &views, &error)) ||
+      (args.Has("--seed") && !ParseInt(args.Get("--seed"), "--seed", &seed, &error)) ||
+      (args.Has("--blur") &&
+       !ParseDouble(args.Get("--blur"), "--blur", &options.blur_sigma_px, &error)) ||
+      (args.Has("--noise") &&
+       !ParseDouble(args.Get("--noise"), "--noise", &options.noise_px, &error)))
+    return UsageError("calib sample", spec, error);
+  if (views < 1 || views > 1000 || options.blur_sigma_px < 0 || options.blur_sigma_px > 20 ||
+      options.noise_px < 0 || options.noise_px > 100)
+    return UsageError("calib sample", spec, "--views 1 to 1000, --blur 0 to 20, --noise 0 to 100");
+  const std::string out = args.Get("--out");
+  if (Status s = MakeDirectories(out); !s.ok()) return InputError(s);
+  const calib::SyntheticLens lens;
+  const calib::SyntheticImageRenderer renderer(board, lens, /*kalibr_squares=*/false);
+  const auto poses = calib::WholeBoardPoses(board, lens, views, static_cast<unsigned>(seed));
+  for (size_t v = 0; v < poses.size(); ++v) {
+    options.seed = static_cast<unsigned>(seed) * 1000 + static_cast<unsigned>(v);
+    const calib::SyntheticImage image = renderer.Render(poses[v], options);
+    char name[32];
+    std::snprintf(name, sizeof(name), "/view_%03zu.png", v);
+    if (Status s = WriteImageAtomic(out + name, image.gray); !s.ok()) return InputError(s);
+  }
+  LensModel model = LensModel::kPinhole;
+  LensModelFromName(lens.lensmodel, &model);
+  CameraModelFile truth;
+  truth.camera = Camera::FromParams(model, lens.width, lens.height, lens.intrinsics);
+  const std::string truth_path = out + "/truth.cameramodel";
+  if (Status s = WriteCameraModel(truth_path, truth); !s.ok()) return InputError(s);
+  std::cout << "wrote " << poses.size() << " views (" << lens.width << "x" << lens.height << ") to "
+            << out << " and the lens they were made with to " << truth_path << "\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 int RunVerbCalib(const CommandArgs& argv) {
@@ -210,6 +274,7 @@ int RunVerbCalib(const CommandArgs& argv) {
   const CommandArgs rest(argv.begin() + 1, argv.end());
   if (argv[0] == "solve") return RunSolve(rest);
   if (argv[0] == "board") return RunBoard(rest);
+  if (argv[0] == "sample") return RunSample(rest);
   std::cerr << "fresco calib: unknown sub-command '" << argv[0] << "'\nusage: " << kUsage << "\n";
   return kExitBadInput;
 }

@@ -9,7 +9,7 @@
 #include "calib/detect.h"
 #include "calib/detect_aruco.h"
 #include "tests/calib/synthetic_boards.h"
-#include "tests/calib/synthetic_images.h"
+#include "calib/sample_views.h"
 
 namespace fresco::calib::testing {
 namespace {

@@ -18,6 +18,7 @@
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
 #include "calib/lens_projection.h"
+#include "pipeline/core/cameramodel_io.h"
 #include "tests/calib/synthetic_boards.h"
 #include "tests/test_support.h"
 
@@ -181,6 +182,34 @@ TEST(CalibCommandTest, BoardCommandStatesItsSize) {
   EXPECT_NE(r.out.find("pattern 0.6"), std::string::npos) << r.out;
   const auto j = nlohmann::json::parse(fresco::testing::ReadText(dir + "/b.json"));
   EXPECT_NEAR(j["pattern_size_m"][0].get<double>(), 0.66, 0.01);  // whole pixels per bit
+}
+
+TEST(CalibCommandTest, SampleWritesViewsAndTheLensTheyWereMadeWith) {
+  const std::string dir = fresco::testing::MakeTempDir("calib_sample");
+  auto r = RunFresco({"calib", "sample", "chessboard:9x6:0.025", "--out", dir + "/chess"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("AprilGrid"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir + "/chess"));
+  r = RunFresco({"calib", "sample", "aprilgrid:6x6:0.088:0.3", "--out", dir + "/s", "--views",
+                 "3", "--blur", "0.5"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* name : {"view_000.png", "view_001.png", "view_002.png"}) {
+    const cv::Mat view = cv::imread(dir + "/s/" + name, cv::IMREAD_GRAYSCALE);
+    ASSERT_FALSE(view.empty()) << name;
+    EXPECT_EQ(view.cols, 1024);
+    EXPECT_EQ(view.rows, 768);
+    double lo = 0, hi = 0;  // a board: dark tags on white paper
+    cv::minMaxLoc(view, &lo, &hi);
+    EXPECT_LT(lo, 60) << name;
+    EXPECT_GT(hi, 200) << name;
+  }
+  EXPECT_FALSE(fs::exists(dir + "/s/view_003.png"));
+  CameraModelFile truth;
+  ASSERT_TRUE(ReadCameraModel(dir + "/s/truth.cameramodel", &truth).ok());
+  EXPECT_EQ(truth.camera.model, LensModel::kOpenCV4);
+  EXPECT_DOUBLE_EQ(truth.camera.fx, 480);
+  EXPECT_DOUBLE_EQ(truth.camera.k1, -0.25);
+  EXPECT_EQ(truth.camera.width, 1024);
 }
 
 // mrcal.projection_uncertainty (worst direction, python3-mrcal) of MODEL (relative to `dir`,

@@ -14,10 +14,9 @@
 
 #include "calib/detect.h"
 #include "calib/detect_aruco.h"
-#include "tests/calib/synthetic_images.h"
+#include "calib/sample_views.h"
 
 using namespace fresco::calib;
-using namespace fresco::calib::testing;
 
 int main(int argc, char** argv) {
   int views = 40;

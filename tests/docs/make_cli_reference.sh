@@ -45,6 +45,7 @@ block "fresco synth" synth
 block "fresco group" group
 block "fresco calib solve" calib solve
 block "fresco calib board" calib board
+block "fresco calib sample" calib sample
 block "fresco poses verify" poses verify
 block "fresco poses bootstrap" poses bootstrap
 block "fresco bench" bench

@@ -1,5 +1,5 @@
-// Synthetic calibration images for the detection tests: the printable board
-// (calib/board_image.h) seen through a known lens model (mrcal projection) from a known board
+// Synthetic calibration images (`fresco calib sample`, the detection tests): the printable
+// board (calib/board_image.h) seen through a known lens model (mrcal projection) from a known board
 // pose, anti-aliased (2 x 2 samples per pixel), optionally blurred and noisy, with the
 // true pixel of every corner. Views of a whole board that sweep the imager (its borders and
 // corners included, where a strong barrel distortion bends the tags most).
@@ -14,7 +14,7 @@
 
 #include "calib/board.h"
 
-namespace fresco::calib::testing {
+namespace fresco::calib {
 
 struct SyntheticLens {
   std::string lensmodel = "LENSMODEL_OPENCV4";
@@ -60,4 +60,4 @@ class SyntheticImageRenderer {
 std::vector<std::array<double, 6>> WholeBoardPoses(const BoardSpec& spec, const SyntheticLens& lens,
                                                    int count, unsigned seed);
 
-}  // namespace fresco::calib::testing
+}  // namespace fresco::calib

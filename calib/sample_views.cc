@@ -1,4 +1,4 @@
-#include "tests/calib/synthetic_images.h"
+#include "calib/sample_views.h"
 
 #include <cmath>
 #include <random>
@@ -9,7 +9,7 @@
 #include "calib/board_image.h"
 #include "calib/lens_projection.h"
 
-namespace fresco::calib::testing {
+namespace fresco::calib {
 namespace {
 
 constexpr int kSamples = 2;        // per pixel and axis
@@ -157,4 +157,4 @@ std::vector<std::array<double, 6>> WholeBoardPoses(const BoardSpec& spec, const 
   return poses;
 }
 
-}  // namespace fresco::calib::testing
+}  // namespace fresco::calib
