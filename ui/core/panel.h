@@ -63,7 +63,6 @@ struct UiContext {
   ViewportRenderer* viewport = nullptr;
   std::shared_ptr<const RunnerSnapshot> snapshot;  // this UI frame's view of the worker
   bool request_quit = false;
-  bool new_project_requested = false;  // File > New project...: the app frame opens the form
   PosesRunner* poses = nullptr;  // the COLMAP worker (Poses panel)
   // A project just opened: the worker's first snapshot after `opened_version` says whether
   // its files could be read (app_frame.cc turns a failure into one error).
@@ -71,6 +70,7 @@ struct UiContext {
   uint64_t opened_version = 0;
   // Where the tiled panels go (splitters, maximise); panels not in it float.
   TileLayout layout = DefaultTileLayout();
+  bool new_project_requested = false;  // File > New project...: the app frame opens the form
 };
 
 class Panel {
