@@ -3,7 +3,7 @@
 // paths relative to the project file, checks it as `fresco run` does when it loads one (the
 // JSON loader, then every file the project names: the same one-line "FILE: field: ..."
 // messages), writes nothing when a check fails, and otherwise saves it atomically and opens
-// it as File > Open does (recent list included).
+// it as Open does (the unsaved-changes prompt first; the recent list too).
 #include "ui/core/panel.h"  // imgui.h first: imgui_stdlib.h needs it
 
 #include <algorithm>
@@ -66,7 +66,10 @@ class NewProjectDialog : public Panel {
  public:
   NewProjectDialog() { open = false; }
   const char* Title() const override { return kNewProjectTitle; }
-  std::map<std::string, std::string> Report() const override { return {{"error", error_}}; }
+  std::map<std::string, std::string> Report() const override {
+    return {{"error", error_},       {"scene", form_.scene}, {"video", form_.video},
+            {"camera", form_.camera}, {"poses", form_.poses}, {"project file", form_.project_file}};
+  }
 
   void Draw(UiContext& ui) override {
     if (!BeginPanel(*this)) {
