@@ -1,6 +1,6 @@
 // The app's pure logic, no ImGui frame and no display: natural name order, stable group
 // colours, zoom and pan, window clamping, the input queue, pixel readouts, colour scales,
-// and the message when stored groups are split back apart.
+// the message when stored groups are split back apart, and New project on live sources.
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -19,6 +19,7 @@
 #include "ui/core/layout_file.h"
 #include "ui/core/natural_sort.h"
 #include "ui/core/zoom_pan.h"
+#include "ui/panels/panels.h"
 
 namespace fresco {
 namespace {
@@ -304,6 +305,34 @@ TEST(CalibrationAttach, SetsTheProjectCameraAndUndoRestoresIt) {
   ASSERT_TRUE(AttachCameraToProject("/p/b.cameramodel", 1, &state).ok());
   EXPECT_EQ(state.project.streams[1].camera, "b.cameramodel");
   EXPECT_EQ(state.project.streams[0].camera, "a/cameras.txt");
+}
+
+// New project with a live video and pose feed: stored as typed (nothing to open now), the
+// mesh and camera relative to the file; a second Create on the same path is refused.
+TEST(NewProject, LiveSourcesAreKeptAsTypedAndAnExistingFileIsNotReplaced) {
+  const std::string dir = testing::MakeTempDir("new-project");
+  NewProjectForm form;
+  form.scene = testing::SourceDir() + "/projects/cube-room/scene.gltf";
+  form.camera = testing::SourceDir() + "/projects/static-cam/cameras.txt";
+  form.video = "udp://127.0.0.1:5600";
+  form.poses = "tcp://127.0.0.1:7000";
+  form.project_file = dir + "/live/project.json";
+  Project made;
+  const Status s = BuildNewProject(form, &made);
+  ASSERT_TRUE(s.ok()) << s.message();
+  Project loaded;
+  ASSERT_TRUE(LoadProject(form.project_file, {}, &loaded).ok());
+  EXPECT_EQ(loaded, made);
+  EXPECT_EQ(loaded.video, form.video);
+  EXPECT_EQ(loaded.poses, form.poses);
+  EXPECT_NE(loaded.camera.front(), '/') << loaded.camera;
+  EXPECT_EQ(loaded.Resolve(loaded.camera), form.camera);
+  const std::string text = testing::ReadText(form.project_file);
+  const Status again = BuildNewProject(form, &made);
+  EXPECT_EQ(again.message(), form.project_file + ": exists already (open it with Open)");
+  EXPECT_EQ(testing::ReadText(form.project_file), text);
+  form.project_file.clear();
+  EXPECT_FALSE(BuildNewProject(form, &made).ok());
 }
 
 }  // namespace

@@ -2,7 +2,8 @@
 // worker: orbiting the 3D view never moves its window, title bars stay below the menu bar,
 // debug images zoom and read pixels, group colours stay put across grouping edits, a
 // missing video is one error, the seek slider, step back and F5 keep the frame, and a key
-// tap or a drag shorter than a frame still arrives (input_queue.h).
+// tap or a drag shorter than a frame still arrives (input_queue.h), and New project makes,
+// saves and opens a project or shows the command line's error and writes nothing.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -32,6 +33,7 @@ using testing::ImGuiHeadless;
 using testing::MakeTempDir;
 using testing::NullTextures;
 using testing::NullViewport;
+using testing::SourceDir;
 
 constexpr int kKeyF5 = 294, kKeyLeft = 263, kKeyRight = 262;  // GLFW's codes
 
@@ -437,6 +439,90 @@ TEST(UiInput, ADragWithinOneFrameStillOrbits) {
   push(InputEvent::Kind::kMouseButton, 0, 0, false);
   app.Drain(&queue);
   EXPECT_NEAR(Yaw(app), yaw - 0.4f * 50, 1e-3) << "the drag was lost";
+}
+
+// Keyboard navigation's activation of item `id` of `window` (a button presses, an input
+// takes the keys), as the next frame sees it.
+void Activate(App& app, const std::string& window, const char* id) {
+  ImGui::ActivateItem(App::Window(window)->GetID(id));
+  app.Frame();
+}
+
+// Types `text` into input `id` of `window`, then leaves it.
+void TypeInto(App& app, const std::string& window, const char* id, const std::string& text) {
+  ImGui::ActivateItem(App::Window(window)->GetID(id));
+  GImGui->NavNextActivateFlags = ImGuiActivateFlags_PreferInput;  // as the keyboard does
+  app.Frame();
+  EXPECT_EQ(ImGui::GetActiveID(), App::Window(window)->GetID(id)) << id;
+  ImGui::GetIO().AddInputCharactersUTF8(text.c_str());
+  app.Frame();
+  ImGui::ClearActiveID();
+  app.Frame();
+}
+
+// The New project form filled with the cube room's scene and the capture's camera, frames
+// and poses, `video` instead of the frames when given.
+void FillNewProject(App& app, const std::string& project_file, const std::string& video = "") {
+  Activate(app, "Project", "New");  // the Project panel's New opens the form
+  app.Frame();
+  ASSERT_TRUE(app.Find(kNewProjectTitle).open);
+  TypeInto(app, kNewProjectTitle, "##scene", SourceDir() + "/projects/cube-room/scene.gltf");
+  TypeInto(app, kNewProjectTitle, "##video", video.empty() ? app.dir + "/capture/frames/" : video);
+  TypeInto(app, kNewProjectTitle, "##camera", app.dir + "/capture/camera.cameramodel");
+  TypeInto(app, kNewProjectTitle, "##poses", app.dir + "/capture/sparse/images.txt");
+  TypeInto(app, kNewProjectTitle, "##project", project_file);
+}
+
+TEST(UiInput, NewProjectIsSavedWithRelativePathsAndOpened) {
+  App app(0);
+  const std::string file = app.dir + "/made/new.json";  // its folder is made too
+  FillNewProject(app, file);
+  Activate(app, kNewProjectTitle, "Create");
+  app.Frames(2);
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "error"), "");
+  ASSERT_TRUE(fs::exists(file));
+  Project made;
+  ASSERT_TRUE(LoadProject(file, {}, &made).ok());
+  EXPECT_EQ(made.video, "../capture/frames/") << "relative to the project file";
+  EXPECT_EQ(made.camera, "../capture/camera.cameramodel");
+  EXPECT_EQ(made.poses, "../capture/sparse/images.txt");
+  EXPECT_EQ(made.Resolve(made.scene),
+            fs::path(SourceDir() + "/projects/cube-room/scene.gltf").lexically_normal().string());
+  EXPECT_FALSE(app.Find(kNewProjectTitle).open) << "the form closes";
+  // Opened as File > Open opens: the app edits it, and it heads the recent list.
+  EXPECT_EQ(app.state.project.file_path, file);
+  EXPECT_EQ(app.state.project.video, made.video);
+  EXPECT_EQ(app.state.message, "opened " + file);
+  ASSERT_FALSE(app.state.recent.empty());
+  EXPECT_EQ(app.state.recent.front(), file);
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message.rfind("error: ", 0), std::string::npos) << app.state.message;
+}
+
+TEST(UiInput, NewProjectWithAMissingVideoShowsTheCommandLineErrorAndWritesNothing) {
+  App app(0);
+  const std::string file = app.dir + "/bad/new.json";
+  FillNewProject(app, file, app.dir + "/nowhere/");
+  Activate(app, kNewProjectTitle, "Create");
+  app.Frames(2);
+  const std::string error = app.ReportOf(kNewProjectTitle, "error");
+  EXPECT_EQ(error, file + ": video: '../nowhere/' does not exist (" + app.dir + "/nowhere/)");
+  EXPECT_FALSE(fs::exists(file)) << "nothing written";
+  EXPECT_FALSE(fs::exists(app.dir + "/bad")) << "no folder made";
+  EXPECT_TRUE(app.Find(kNewProjectTitle).open) << "the form stays, with the error";
+  EXPECT_EQ(app.state.project.file_path, app.dir + "/capture/project.json");
+  // The same project written by hand: `fresco run` stops on the same line.
+  fs::create_directories(app.dir + "/bad");
+  {
+    std::ofstream out(file);
+    out << "{\"fresco\": 1, \"scene\": \"" << SourceDir() << "/projects/cube-room/scene.gltf\", "
+        << "\"camera\": \"../capture/camera.cameramodel\", \"video\": \"../nowhere/\", "
+        << "\"poses\": \"../capture/sparse/images.txt\"}\n";
+  }
+  const auto run = testing::RunFresco({"run", file, "--out", app.dir + "/out"});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_EQ(run.err, "error: " + error + "\n");
 }
 
 }  // namespace

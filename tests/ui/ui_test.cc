@@ -238,7 +238,8 @@ TEST(UiScreenshot, XvfbScreenshotShowsEveryPanel) {
   ASSERT_GE(list["panels"].size(), 11u);
   for (const auto& panel : list["panels"]) {
     const std::string title = panel["title"];
-    if (title == kCalibrationPanelTitle || title == kPosesPanelTitle) {  // closed at first
+    if (title == kCalibrationPanelTitle || title == kPosesPanelTitle ||
+        title == kNewProjectTitle) {  // closed at first
       EXPECT_FALSE(panel["open"].get<bool>());
       continue;
     }
@@ -303,6 +304,20 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   EXPECT_TRUE(fs::exists(out));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".report.json")));
   EXPECT_TRUE(fs::exists(calib::SiblingPath(out, ".coverage.png")));
+  {  // New project offers the camera just saved.
+    UiContext ui;
+    ui.calibration = &runner;
+    ImGuiHeadless imgui;
+    std::unique_ptr<Panel> form;
+    for (auto& p : MakePanels())
+      if (std::string(p->Title()) == kNewProjectTitle) form = std::move(p);
+    ASSERT_TRUE(form);
+    ImGuiHeadless::DrawPanel(ui, *form, ImVec2(760, 300));
+    const std::string button = "Use the camera just calibrated: " + out;
+    ImGui::ActivateItem(ImGui::FindWindowByName(kNewProjectTitle)->GetID(button.c_str()));
+    ImGuiHeadless::DrawPanel(ui, *form, ImVec2(760, 300));
+    EXPECT_EQ(form->Report().at("camera"), out);
+  }
 
   // The per-image checkbox: an excluded image leaves the views and the solve goes stale.
   runner.Exclude("left03.jpg", true);

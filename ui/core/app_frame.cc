@@ -90,6 +90,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   AppState& state = *ui.state;
   if (!ImGui::BeginMainMenuBar()) return;
   if (ImGui::BeginMenu("File")) {
+    if (ImGui::MenuItem("New project...")) ui.new_project_requested = true;
     if (ImGui::MenuItem("Save", "Ctrl+S", false, state.has_project))
       if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
     if (ImGui::BeginMenu("Open recent", !state.recent.empty())) {
@@ -279,6 +280,11 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   CheckOpened(ui);
   HandleShortcuts(ui);
   DrawMenuBar(ui, panels);
+  if (ui.new_project_requested) {
+    for (auto& panel : panels)
+      if (std::string(panel->Title()) == kNewProjectTitle) panel->open = true;
+    ui.new_project_requested = false;
+  }
   const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);
   for (auto& panel : panels) {
     // A tiled panel without a tile is hidden behind a maximised one.

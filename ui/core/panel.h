@@ -70,6 +70,7 @@ struct UiContext {
   uint64_t opened_version = 0;
   // Where the tiled panels go (splitters, maximise); panels not in it float.
   TileLayout layout = DefaultTileLayout();
+  bool new_project_requested = false;  // File > New project...: the app frame opens the form
 };
 
 class Panel {

@@ -1,6 +1,7 @@
 // Every panel of the app, in the View menu's order, with where it starts in a 1600 x 1000
 // window (five columns, nothing overlapping; scaled to the real window): one line each.
-// Calibration and Poses are the exceptions: large windows over columns 2-5, closed at first.
+// Calibration and Poses are the exceptions: large windows over columns 2-5, closed at first;
+// New project is a form over the middle, closed until File > New project... opens it.
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -32,6 +33,7 @@ std::vector<std::unique_ptr<Panel>> MakePanels() {
   Add(&p, MakeGroupingPanel(), 1280, 20, 320, 955);
   Add(&p, MakeCalibrationPanel(), 320, 20, 1280, 955);
   Add(&p, MakePosesPanel(), 320, 20, 1280, 955);
+  Add(&p, MakeNewProjectDialog(), 360, 120, 760, 300);
   return p;
 }
 

@@ -27,6 +27,21 @@ inline constexpr const char* kCalibrationPanelTitle = "Calibration";
 // menu or by `fresco gui --poses`.
 std::unique_ptr<Panel> MakePosesPanel();
 inline constexpr const char* kPosesPanelTitle = "Poses";
+// New project (File > New project..., the Project panel's New): a form, closed until asked
+// for (UiContext::new_project_requested).
+std::unique_ptr<Panel> MakeNewProjectDialog();
+inline constexpr const char* kNewProjectTitle = "New project";
+
+// What the New project form asks for: paths as typed (absolute, or relative to the working
+// folder), URLs for live sources.
+struct NewProjectForm {
+  std::string scene, video, camera, poses;
+  std::string project_file;  // where to save it (must not exist yet)
+};
+// Builds the project (paths relative to the project file), checks it as `fresco run` does
+// when it loads one (the errors are its one-line "FILE: field: ..." messages) and saves it
+// atomically; on an error nothing is written.
+Status BuildNewProject(const NewProjectForm& form, Project* project);
 
 // Opens `path` (after the unsaved-changes prompt when the project has edits; the app frame
 // shows it) and restarts the pipeline on it.

@@ -1,4 +1,4 @@
-// Project: which project is open, save / save as / open another (with the unsaved-changes
+// Project: which project is open, save / save as / open another / a new one (with the unsaved-changes
 // prompt in the app frame), recent projects, undo and redo.
 #include "ui/core/panel.h"  // imgui.h first: imgui_stdlib.h needs it
 
@@ -33,6 +33,7 @@ class ProjectPanel : public Panel {
     ImGui::InputTextWithHint("##open", "project.json to open", &open_path_);
     ImGui::SameLine();
     if (ImGui::Button("Open") && !open_path_.empty()) RequestOpen(ui, open_path_);
+    if (ImGui::Button("New")) ui.new_project_requested = true;
     if (!state.recent.empty() && ImGui::TreeNode("Recent projects")) {
       for (const std::string& path : state.recent)
         if (ImGui::Selectable(path.c_str())) RequestOpen(ui, path);
