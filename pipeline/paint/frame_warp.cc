@@ -514,6 +514,10 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
     warped->valid.create(h, w, CV_8U);
     warped->quality.create(h, w, CV_32F);
     warped->valid.setTo(0);
+    // Defined where not valid too: refinement's matching windows and interpolation reach
+    // past the valid texels, and uninitialised memory made its results vary run to run.
+    warped->bgr.setTo(0);
+    warped->quality.setTo(0);
   } else if (!warped->valid_box.empty()) {
     // Valid texels lie inside valid_box (every writer keeps it so): clearing it clears all.
     warped->valid(warped->valid_box & cv::Rect(0, 0, w, h)).setTo(0);

@@ -49,7 +49,7 @@ struct WarpOptions {
 
 // The frame warped into one buffer's texel space (only the buffer's texels are written).
 struct WarpedBuffer {
-  cv::Mat bgr;      // CV_8UC3, buffer size
+  cv::Mat bgr;      // CV_8UC3, buffer size (where not valid: 0 or an earlier frame's colour)
   cv::Mat valid;    // CV_8U, 255 where the texel was seen and sampled
   cv::Mat quality;  // CV_32F, pixels per texel (min(f s cos / z, 1)) where valid
   int in_view = 0;  // texels that project inside the image, in front, not grazing

@@ -98,8 +98,11 @@ bool FitModel(MotionModel model, const std::vector<cv::Point2f>& from,
     rhs.at<double>(2 * i) = to[i].x - centre.x;
     rhs.at<double>(2 * i + 1) = to[i].y - centre.y;
   }
+  // Through the normal equations (k x k): OpenCV hands an SVD of 25 rows or more to LAPACK
+  // when built with it, whose last bits then depend on where its buffers lie in memory
+  // (refinement must give the same result every run); its own small SVD does not.
   cv::Mat p;
-  if (!cv::solve(A, rhs, p, cv::DECOMP_SVD)) return false;
+  if (!cv::solve(A, rhs, p, cv::DECOMP_SVD | cv::DECOMP_NORMAL)) return false;
   const double* q = p.ptr<double>();
   if (similarity)
     M = cv::Matx33d(q[0], -q[1], q[2], q[1], q[0], q[3], 0, 0, 1);

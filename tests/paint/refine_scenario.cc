@@ -23,7 +23,8 @@ Status MakeRefineScenario(int frames, double pose_noise_deg, RefineScenario* sce
 }
 
 Status PaintScenario(const RefineScenario& scenario, const std::vector<PosedImage>& given,
-                     const PipelineOptions& options, PaintedScenario* p) {
+                     const PipelineOptions& options, PaintedScenario* p,
+                     const std::function<void(const FrameReport&)>& each_frame) {
   const SynthCapture& capture = scenario.capture;
   PaintSessionInputs inputs;
   inputs.scene = &scenario.scene;
@@ -39,6 +40,7 @@ Status PaintScenario(const RefineScenario& scenario, const std::vector<PosedImag
     frame.bgr = capture.frames_bgr[i];
     p->session->PaintFrame(frame, capture.camera, given[i].cam_from_world, &report);
     p->total_ms += report.total_ms;
+    if (each_frame) each_frame(report);
     if (const StageReport* r = report.Stage("refine")) {
       p->refine_ms += r->wall_ms;
       if (r->metrics.at("inliers") > 0) {

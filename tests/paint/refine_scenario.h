@@ -4,6 +4,7 @@
 // against the true scene by virtual rephotography at the true poses.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -29,9 +30,11 @@ struct PaintedScenario {
   double refine_ms = 0, total_ms = 0;                // per frame: the refine stage, all
 };
 
-// Paints every frame from `given` poses (true_poses or given_poses of the capture).
+// Paints every frame from `given` poses (true_poses or given_poses of the capture);
+// `each_frame`, when given, sees every frame's report.
 Status PaintScenario(const RefineScenario& scenario, const std::vector<PosedImage>& given,
-                     const PipelineOptions& options, PaintedScenario* painted);
+                     const PipelineOptions& options, PaintedScenario* painted,
+                     const std::function<void(const FrameReport&)>& each_frame = nullptr);
 
 // Mean PSNR of the painted model against the original at the true poses (every 6th frame).
 double ScenarioPsnr(const RefineScenario& scenario, const Scene& painted);
