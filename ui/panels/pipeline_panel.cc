@@ -15,6 +15,10 @@ namespace {
 
 class PipelinePanel : public Panel {
  public:
+  PipelinePanel() = default;
+  PipelinePanel(const PipelinePanel&) = delete;  // settings_ points into edit_
+  PipelinePanel& operator=(const PipelinePanel&) = delete;
+
   const char* Title() const override { return "Pipeline"; }
 
   void Draw(UiContext& ui) override {
@@ -89,7 +93,9 @@ class PipelinePanel : public Panel {
     bool commit = false;
     std::string section;
     bool open = true;
-    for (const Setting& setting : DescribeSettings(&edit_)) {
+    // Bound to edit_'s fields once (the panel and edit_ stay put), not rebuilt every frame.
+    if (settings_.empty()) settings_ = DescribeSettings(&edit_);
+    for (const Setting& setting : settings_) {
       if (setting.key.compare(0, 9, "pipeline.") != 0) continue;
       if (setting.Section() != section) {
         if (!section.empty() && open && section != "pipeline") ImGui::TreePop();
@@ -137,6 +143,7 @@ class PipelinePanel : public Panel {
   bool slider_active_ = false;
   float slider_rect_[4] = {0, 0, 0, 0};
   Project edit_;  // its pipeline: the settings being edited
+  std::vector<Setting> settings_;  // edit_'s settings, bound to its fields
   LiveStatusSection live_;
 };
 
