@@ -26,6 +26,55 @@ void SetNormalCone(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   chunk->normal_sin = static_cast<float>(std::sin(half_angle));
 }
 
+// Marks a full tile whose stored points are affine in the texel coordinates (least squares
+// over the tile, every texel within one quantization step per axis), and whose normals are
+// all the same (BaseBuffer::Chunk::affine, uniform_normal).
+void SetAffineTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
+  const int tw = chunk->x1 - chunk->x0, th = chunk->y1 - chunk->y0;
+  if (chunk->end - chunk->begin != tw * th) return;
+  bool same_normal = true;
+  for (int k = chunk->begin + 1; k < chunk->end && same_normal; ++k)
+    same_normal = buffer.normal_qx[k] == buffer.normal_qx[chunk->begin] &&
+                  buffer.normal_qy[k] == buffer.normal_qy[chunk->begin] &&
+                  buffer.normal_qz[k] == buffer.normal_qz[chunk->begin];
+  if (same_normal) {
+    chunk->uniform_normal = true;
+    chunk->normal = buffer.Normal(chunk->begin);
+  }
+  if (tw != BaseBuffer::kTileTexels || th < 2) return;  // the kernel's layout: 16 columns
+  // Least squares of p = origin + col du + row dv over the full grid, in closed form (col
+  // and row are uncorrelated on a full grid: each slope is a plain regression).
+  const double mean_col = 0.5 * (tw - 1), mean_row = 0.5 * (th - 1);
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero(), by_col = Eigen::Vector3d::Zero(),
+                  by_row = Eigen::Vector3d::Zero();
+  for (int row = 0, k = chunk->begin; row < th; ++row)
+    for (int col = 0; col < tw; ++col, ++k) {
+      const Eigen::Vector3d p = buffer.PointIn(*chunk, k).cast<double>();
+      mean += p;
+      by_col += (col - mean_col) * p;
+      by_row += (row - mean_row) * p;
+    }
+  const double count = static_cast<double>(tw) * th;
+  mean /= count;
+  const double col_var = count * (static_cast<double>(tw) * tw - 1) / 12.0;
+  const double row_var = count * (static_cast<double>(th) * th - 1) / 12.0;
+  const Eigen::Vector3f du = (by_col / col_var).cast<float>();
+  const Eigen::Vector3f dv = (by_row / row_var).cast<float>();
+  const Eigen::Vector3f origin =
+      (mean - mean_col * by_col / col_var - mean_row * by_row / row_var).cast<float>();
+  // Within one quantization step per axis (and a float's rounding) of every stored point.
+  const Eigen::Array3f bound = chunk->point_step.array() + 1e-6f * chunk->bounds_max.cwiseAbs().array();
+  for (int row = 0, k = chunk->begin; row < th; ++row)
+    for (int col = 0; col < tw; ++col, ++k) {
+      const Eigen::Vector3f fit = origin + static_cast<float>(col) * du + static_cast<float>(row) * dv;
+      if (((fit - buffer.PointIn(*chunk, k)).cwiseAbs().array() > bound).any()) return;
+    }
+  chunk->affine = true;
+  chunk->affine_origin = origin;
+  chunk->affine_du = du;
+  chunk->affine_dv = dv;
+}
+
 // Closest point on triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5).
 Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
                                        const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
@@ -274,6 +323,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       }
       chunk.end = buffer.NumTexels();
       SetNormalCone(buffer, &chunk);
+      SetAffineTile(buffer, &chunk);
       if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
     }
   }

@@ -56,6 +56,16 @@ struct BaseBuffer {
     // the camera is culled whole.
     Eigen::Vector3f normal_axis = Eigen::Vector3f::Zero();
     float normal_cos = 0.0f, normal_sin = 1.0f;
+    // A full tile (every texel of its rectangle stored, row by row) whose points lie on one
+    // plane, affine in the texel coordinates to within one quantization step per axis:
+    //   point(col, row) = affine_origin + col * affine_du + row * affine_dv
+    // (col, row counted from x0, y0). The per-frame kernel then computes the points instead
+    // of reading them, and when every texel has the same normal (`uniform_normal`: stored
+    // as `normal`) reads no normal either: bandwidth the kernel would spend per texel.
+    bool affine = false, uniform_normal = false;
+    Eigen::Vector3f affine_origin = Eigen::Vector3f::Zero();
+    Eigen::Vector3f affine_du = Eigen::Vector3f::Zero(), affine_dv = Eigen::Vector3f::Zero();
+    Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // as stored (dequantized)
 
     // True only when every texel of the chunk faces away from `centre` (its stored normal n
     // and point p have n . (centre - p) < 0): conservative, from the box and the cone.

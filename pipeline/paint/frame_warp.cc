@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -123,7 +124,11 @@ struct ChunkProjection {
 // those and the rational denominator (k4..k6; most lenses have none: one division less).
 enum class LensTerms { kNone, kPolynomial, kRational };
 
-template <LensTerms kLens>
+// Where pass 1 takes each texel's point and normal: the stored (quantized) arrays, or a
+// full planar tile's plane and normal (BaseBuffer::Chunk::affine and uniform_normal).
+enum class TileSource { kStored, kAffine };
+
+template <LensTerms kLens, TileSource kTile>
 __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext& k,
                                                             const BaseBuffer& buffer,
                                                             const BaseBuffer::Chunk& chunk,
@@ -167,13 +172,8 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   const float tol_rel = k.tol_rel, tol_abs = k.tol_abs, slope_px = k.slope_px;
   constexpr float kEdgeSlackPx = 1.0f / 256;
   const float focal_texel = k.focal_texel;
-  for (int i = 0; i < n; ++i) {
-    const float X = bx + static_cast<float>(QX[i]) * sx;
-    const float Y = by + static_cast<float>(QY[i]) * sy;
-    const float Z = bz + static_cast<float>(QZ[i]) * sz;
-    const float NX = static_cast<float>(QNX[i]) * kInvNormal;
-    const float NY = static_cast<float>(QNY[i]) * kInvNormal;
-    const float NZ = static_cast<float>(QNZ[i]) * kInvNormal;
+  const auto project = [&](int i, float X, float Y, float Z, float NX, float NY,
+                           float NZ) __attribute__((always_inline)) {
     const float px = r00 * X + r01 * Y + r02 * Z + tx;
     const float py = r10 * X + r11 * Y + r12 * Z + ty;
     const float pz = r20 * X + r21 * Y + r22 * Z + tz;
@@ -224,22 +224,234 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
     tol[i] = pz * (tol_rel + slope_px * tan_view) + tol_abs;
     // Pixels per texel: f s cos(view) / z.
     quality[i] = std::min(1.0f, focal_texel * nd_safe / (std::sqrt(dd) * z_safe));
+  };
+  if constexpr (kTile == TileSource::kAffine) {
+    // Points from the tile's plane, the normal the tile's own (BaseBuffer::Chunk::affine:
+    // full tiles of kTileTexels columns, so texel i sits at column i % 16, row i / 16).
+    static_assert(BaseBuffer::kTileTexels == 16);
+    const float NX = chunk.normal.x(), NY = chunk.normal.y(), NZ = chunk.normal.z();
+    const float ax0 = chunk.affine_origin.x(), ay0 = chunk.affine_origin.y(),
+                az0 = chunk.affine_origin.z();
+    const float dux = chunk.affine_du.x(), duy = chunk.affine_du.y(), duz = chunk.affine_du.z();
+    const float dvx = chunk.affine_dv.x(), dvy = chunk.affine_dv.y(), dvz = chunk.affine_dv.z();
+    alignas(32) float PX[ChunkProjection::kMax], PY[ChunkProjection::kMax],
+        PZ[ChunkProjection::kMax];
+    for (int i = 0; i < n; ++i) {
+      const float c = static_cast<float>(i & 15), r = static_cast<float>(i >> 4);
+      PX[i] = ax0 + c * dux + r * dvx;
+      PY[i] = ay0 + c * duy + r * dvy;
+      PZ[i] = az0 + c * duz + r * dvz;
+    }
+    for (int i = 0; i < n; ++i) project(i, PX[i], PY[i], PZ[i], NX, NY, NZ);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      project(i, bx + static_cast<float>(QX[i]) * sx, by + static_cast<float>(QY[i]) * sy,
+              bz + static_cast<float>(QZ[i]) * sz, static_cast<float>(QNX[i]) * kInvNormal,
+              static_cast<float>(QNY[i]) * kInvNormal, static_cast<float>(QNZ[i]) * kInvNormal);
+    }
   }
 }
 
 __attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
-  ProjectChunkBody<LensTerms::kNone>(k, buffer, chunk, out);
+  if (chunk.affine && chunk.uniform_normal)
+    ProjectChunkBody<LensTerms::kNone, TileSource::kAffine>(k, buffer, chunk, out);
+  else
+    ProjectChunkBody<LensTerms::kNone, TileSource::kStored>(k, buffer, chunk, out);
 }
 
 __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
-  if (k.projector.rational)
-    ProjectChunkBody<LensTerms::kRational>(k, buffer, chunk, out);
-  else
-    ProjectChunkBody<LensTerms::kPolynomial>(k, buffer, chunk, out);
+  const bool affine = chunk.affine && chunk.uniform_normal;
+  if (k.projector.rational) {
+    if (affine)
+      ProjectChunkBody<LensTerms::kRational, TileSource::kAffine>(k, buffer, chunk, out);
+    else
+      ProjectChunkBody<LensTerms::kRational, TileSource::kStored>(k, buffer, chunk, out);
+  } else if (affine) {
+    ProjectChunkBody<LensTerms::kPolynomial, TileSource::kAffine>(k, buffer, chunk, out);
+  } else {
+    ProjectChunkBody<LensTerms::kPolynomial, TileSource::kStored>(k, buffer, chunk, out);
+  }
+}
+
+// Pass 2 for the common case (bilinear samples painted directly, a new sample replacing the
+// stored one), in three steps so that the arithmetic vectorizes: gather what each texel in
+// view reads (its four depths, its four pixels, the stored texel and quality; scalar loads,
+// which are faster than vector gathers), then the depth test, the bilinear blend and the
+// update rule over the gathered arrays (SIMD), then the stores. The figures and the texels
+// written are bit for bit those of the per-texel loop (the same float operations in the same
+// order; paint_in_warp_test checks it).
+struct PaintBatch {
+  static constexpr int kMax = ChunkProjection::kMax;
+  float d00[kMax], d10[kMax], d01[kMax], d11[kMax];     // depths around the sample
+  uint32_t p00[kMax], p10[kMax], p01[kMax], p11[kMax];  // the four pixels' BGR (low 24 bits)
+  uint32_t stored[kMax];                                // the stored BGRA
+  float stored_q[kMax];
+  uint32_t on_surface[kMax];
+  uint32_t out[kMax];  // what the stored texel and quality become
+  float out_q[kMax];
+  int32_t write[kMax];
+};
+
+struct PaintBatchSums {
+  int visible = 0, compared = 0, rejected = 0, written = 0,
+      newly_painted = 0;
+  int abs_grey_difference_sum = 0;  // at most 256 texels x 255
+};
+
+inline uint32_t Load32(const uint8_t* p) {
+  uint32_t v;
+  std::memcpy(&v, p, 4);
+  return v;
+}
+
+template <bool kDepth>
+__attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
+    int n, bool quality_policy, float keep, const ChunkProjection* __restrict proj,
+    PaintBatch* __restrict b) {
+  const float* __restrict d00 = b->d00;
+  const float* __restrict d10 = b->d10;
+  const float* __restrict d01 = b->d01;
+  const float* __restrict d11 = b->d11;
+  const uint32_t* __restrict p00 = b->p00;
+  const uint32_t* __restrict p10 = b->p10;
+  const uint32_t* __restrict p01 = b->p01;
+  const uint32_t* __restrict p11 = b->p11;
+  const uint32_t* __restrict stored = b->stored;
+  const float* __restrict stored_q = b->stored_q;
+  const uint32_t* __restrict on_surface = b->on_surface;
+  const float* __restrict z = proj->z;
+  const float* __restrict tol = proj->tol;
+  const float* __restrict ax = proj->ax;
+  const float* __restrict ay = proj->ay;
+  const float* __restrict quality = proj->quality;
+  uint32_t* __restrict out = b->out;
+  float* __restrict out_q = b->out_q;
+  int32_t* __restrict write_out = b->write;
+  const int by_quality = quality_policy;
+  int visible = 0, compared = 0, rejected = 0, written = 0, newly = 0, diff_sum = 0;
+  for (int j = 0; j < n; ++j) {
+    int ok = 1;
+    if constexpr (kDepth) {
+      const float zz = z[j], t = tol[j];
+      ok &= (std::abs(d00[j] - zz) <= t) & (std::abs(d10[j] - zz) <= t) &
+            (std::abs(d01[j] - zz) <= t) & (std::abs(d11[j] - zz) <= t);
+    }
+    const float fx = ax[j], fy = ay[j];
+    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
+                w11 = fx * fy;
+    uint32_t sample = 0xFF000000u;
+    int channel[3];
+    for (int c = 0; c < 3; ++c) {
+      const int shift = 8 * c;
+      const float s = w00 * static_cast<float>(static_cast<int>((p00[j] >> shift) & 255u)) +
+                      w10 * static_cast<float>(static_cast<int>((p10[j] >> shift) & 255u)) +
+                      w01 * static_cast<float>(static_cast<int>((p01[j] >> shift) & 255u)) +
+                      w11 * static_cast<float>(static_cast<int>((p11[j] >> shift) & 255u)) +
+                      0.5f;
+      channel[c] = static_cast<int>(s);
+      sample |= static_cast<uint32_t>(channel[c]) << shift;
+    }
+    const uint32_t old = stored[j];
+    const int has = (old >> 24) != 0;
+    const int new_grey = (29 * channel[0] + 150 * channel[1] + 77 * channel[2]) >> 8;
+    const int old_grey = (29 * static_cast<int>(old & 255u) +
+                          150 * static_cast<int>((old >> 8) & 255u) +
+                          77 * static_cast<int>((old >> 16) & 255u)) >>
+                         8;
+    const int d = new_grey - old_grey;
+    const int compare = ok & has;
+    diff_sum += compare * (d < 0 ? -d : d);
+    compared += compare;
+    const float q = quality[j], sq = stored_q[j];
+    const int reject = ok & by_quality & (q < sq * keep);
+    const int write = ok & (1 - reject);
+    visible += ok;
+    rejected += reject;
+    written += write;
+    newly += write & (1 - has) & static_cast<int>(on_surface[j]);
+    out[j] = write ? sample : old;
+    out_q[j] = write ? (by_quality ? std::max(sq, q) : q) : sq;
+    write_out[j] = write;
+  }
+  PaintBatchSums sums;
+  sums.visible = visible, sums.compared = compared, sums.rejected = rejected;
+  sums.written = written, sums.newly_painted = newly, sums.abs_grey_difference_sum = diff_sum;
+  return sums;
+}
+
+__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepth(
+    int n, bool quality_policy, float keep, const ChunkProjection* proj, PaintBatch* b) {
+  return PaintBatchBody<true>(n, quality_policy, keep, proj, b);
+}
+
+__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDepth(
+    int n, bool quality_policy, float keep, const ChunkProjection* proj, PaintBatch* b) {
+  return PaintBatchBody<false>(n, quality_policy, keep, proj, b);
+}
+
+bool AllInView(const ChunkProjection& proj, int n) {
+  int in_view = 0;
+  for (int i = 0; i < n; ++i) in_view += proj.code[i] == 2;
+  return in_view == n;
+}
+
+// Gathers what every texel of a projected chunk reads (all in view), runs the batch, stores
+// what it wrote.
+template <bool kDepth>
+void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
+                       const ChunkProjection& proj, Counts* counts) {
+  PaintBatch batch;
+  const int n = chunk.end - chunk.begin;
+  const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
+  const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
+  const uint8_t* const frame = k.frame->data;
+  const size_t frame_step = k.frame->step[0];
+  const uint8_t* const depth = k.depth->data;
+  const size_t depth_step = k.depth->step[0];
+  const uint8_t* const bgra = k.paint_bgra;
+  const float* const stored_quality = k.paint_quality;
+  for (int i = 0; i < n; ++i) {
+    const int x0 = proj.x0[i], y0 = proj.y0[i];
+    if constexpr (kDepth) {
+      const float* d0 = reinterpret_cast<const float*>(depth + y0 * depth_step) + x0;
+      const float* d1 =
+          reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
+      batch.d00[i] = d0[0], batch.d10[i] = d0[1], batch.d01[i] = d1[0], batch.d11[i] = d1[1];
+    }
+    // Pixel x0's BGR and the next one's (read from its red byte on: no byte past the pair).
+    const uint8_t* r0 = frame + y0 * frame_step + 3 * x0;
+    const uint8_t* r1 = r0 + frame_step;
+    batch.p00[i] = Load32(r0);
+    batch.p10[i] = Load32(r0 + 2) >> 8;
+    batch.p01[i] = Load32(r1);
+    batch.p11[i] = Load32(r1 + 2) >> 8;
+    const size_t idx = static_cast<size_t>(texel_index[i]);
+    batch.stored[i] = Load32(bgra + 4 * idx);
+    batch.stored_q[i] = stored_quality[idx];
+    batch.on_surface[i] = on_surface[i] != 0;
+  }
+  const bool by_quality = k.rule.policy == UpdatePolicy::kQuality;
+  const PaintBatchSums sums = kDepth ? PaintBatchDepth(n, by_quality, k.rule.keep, &proj, &batch)
+                                     : PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, &batch);
+  uint8_t* const out_bgra = k.paint_bgra;
+  float* const out_quality = k.paint_quality;
+  for (int i = 0; i < n; ++i) {
+    if (!batch.write[i]) continue;
+    const size_t idx = static_cast<size_t>(texel_index[i]);
+    std::memcpy(out_bgra + 4 * idx, &batch.out[i], 4);
+    out_quality[idx] = batch.out_q[i];
+  }
+  counts->in_view += n, counts->visible += sums.visible;
+  counts->occluded += n - sums.visible;
+  PaintUpdateStats stats;
+  stats.written = sums.written, stats.rejected = sums.rejected, stats.compared = sums.compared;
+  stats.abs_grey_difference_sum = sums.abs_grey_difference_sum;
+  stats.newly_painted = sums.newly_painted;
+  counts->paint.Add(stats);
 }
 
 // Pass 2, texel by texel for those in view: the depth test and the sample. Works on local
@@ -274,6 +486,12 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
   else
     ProjectChunkPinhole(k, *k.buffer, chunk, &proj);
 
+  if constexpr (kPaint && kMode == SamplingMode::kBilinear) {
+    // Chunks wholly in view (most, inside the frame); the rest texel by texel (below),
+    // which skips those out of view.
+    if (k.rule.weight == 256 && AllInView(proj, n))
+      return PaintChunkBatched<kDepth>(k, chunk, proj, counts);
+  }
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
   const float texel_size_m = static_cast<float>(k.buffer->texel_size_m);
