@@ -10,6 +10,7 @@
 
 #include "calib/detect_aruco.h"
 #include "calib/kalibr_tag_family.h"
+#include "calib/tags_around_found.h"
 
 namespace fresco::calib {
 namespace {
@@ -63,9 +64,10 @@ int RefineHalfWindow(const TagQuad& quad) {
   return std::clamp(static_cast<int>(shortest / 8), 2, 6);
 }
 
-// One run of the apriltag library: tags with ids < num_ids and at most max_hamming bit
-// errors; an id found twice is dropped (trust neither).
-std::vector<TagQuad> RunApriltag(const cv::Mat& gray, int num_ids, const DetectOptions& options) {
+}  // namespace
+
+std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
+                                        const DetectOptions& options) {
   KalibrTagFamily family;
   apriltag_detector_t* detector = apriltag_detector_create();
   apriltag_detector_add_family_bits(detector, family.get(), options.max_hamming);
@@ -96,6 +98,8 @@ std::vector<TagQuad> RunApriltag(const cv::Mat& gray, int num_ids, const DetectO
   return quads;
 }
 
+namespace {
+
 // Adds the quads of ids not in `found` yet; returns how many.
 int AddMissing(const std::vector<TagQuad>& quads, std::map<int, TagQuad>* found) {
   std::map<int, int> count_by_id;
@@ -111,7 +115,7 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   BoardDetection out;
   const int num_ids = spec.cols * spec.rows;
   std::map<int, TagQuad> found;
-  AddMissing(RunApriltag(gray, num_ids, options), &found);
+  AddMissing(DetectTagsApriltag(gray, num_ids, options), &found);
   if (options.second_look && static_cast<int>(found.size()) < num_ids) {
     // Second look for the missing tags. Kalibr prints a black square where the gaps between
     // tags cross; it touches the corners of 4 tags, so the library's segmentation merges the
@@ -123,10 +127,14 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       if (static_cast<int>(found.size()) >= num_ids) break;
       cv::Mat thinned;
       cv::dilate(gray, thinned, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(grow, grow)));
-      out.tags_second_look += AddMissing(RunApriltag(thinned, num_ids, options), &found);
+      out.tags_second_look += AddMissing(DetectTagsApriltag(thinned, num_ids, options), &found);
     }
     if (static_cast<int>(found.size()) < num_ids)
       out.tags_second_look += AddMissing(DetectTagsAruco(gray, num_ids), &found);
+    if (static_cast<int>(found.size()) < num_ids)
+      out.tags_second_look += FindTagsAroundFound(
+          gray, spec, [&](const cv::Mat& patch) { return DetectTagsApriltag(patch, num_ids, options); },
+          &found);
   }
   for (const auto& [id, quad] : found) {
     std::vector<cv::Point2f> corners;

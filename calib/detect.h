@@ -1,7 +1,8 @@
 // Board detection in one image: per-corner pixel observations with their corner ids
 // (calib/board.h), partial boards included. AprilGrid: the apriltag library (Kalibr's
 // tag36h11); when it misses some of the board's tags, a second look for the missing ones
-// (the apriltag library with blurred quads, then OpenCV's aruco); then optionally
+// (the apriltag library with blurred quads, then OpenCV's aruco, then around the tags found:
+// calib/tags_around_found.h); then optionally
 // cv::cornerSubPix on each tag corner, whichever detector found it. Chessboard: OpenCV's
 // findChessboardCornersSB, falling back to findChessboardCorners + cornerSubPix.
 // Pixel convention: (0,0) is the centre of the top-left pixel (apriltag, OpenCV and mrcal).
@@ -14,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/board.h"
+#include "calib/detect_aruco.h"
 
 namespace fresco::calib {
 
@@ -42,6 +44,11 @@ struct DetectOptions {
   // tests/calib/calib_detect_test.cc for the figures.
   bool second_look = true;
 };
+
+// One run of the apriltag library (Kalibr's tag36h11): tags with ids < num_ids and at most
+// options.max_hamming bit errors, unrefined; an id found twice is dropped (trust neither).
+std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
+                                        const DetectOptions& options = {});
 
 // `gray` is CV_8U.
 BoardDetection DetectBoard(const cv::Mat& gray, const BoardSpec& spec,
