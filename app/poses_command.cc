@@ -57,7 +57,8 @@ ArgSpec PosesArgSpec(const std::string& sub) {
   spec.required = {"--out"};
   if (sub == "verify") {
     spec.usage = "fresco poses verify PROJECT.json --out DIR [OPTIONS...]";
-    spec.options.insert({"--rotation-threshold-deg", "--position-threshold", "--window"});
+    spec.options.insert(
+        {"--rotation-threshold-deg", "--position-threshold", "--window", "--drift-neighbours"});
     spec.help = std::string(
                     "Runs COLMAP on the project's frames, aligns its reconstruction to the\n"
                     "project's poses (robust similarity; locally over windows of neighbouring\n"
@@ -67,7 +68,10 @@ ArgSpec PosesArgSpec(const std::string& sub) {
                     "  --rotation-threshold-deg X  flag above X degrees (default 0.5)\n"
                     "  --position-threshold F      flag above F x scene size (default 0.01)\n"
                     "  --window N                  local alignment over N frames (default 40;\n"
-                    "                              0 = one global alignment)\n") +
+                    "                              0 = one global alignment)\n"
+                    "  --drift-neighbours N        where the disagreement drifts along the\n"
+                    "                              sequence, judge each frame against N frames\n"
+                    "                              on each side (default 5; 0 = never)\n") +
                 kColmapOptionsHelp;
   } else {
     spec.usage =
@@ -206,6 +210,8 @@ int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
                                    &options.position_threshold_rel)) >= 0)
     return code;
   if ((code = IntOption(args, spec, "--window", 0, &options.window_frames)) >= 0) return code;
+  if ((code = IntOption(args, spec, "--drift-neighbours", 0, &options.drift_neighbours)) >= 0)
+    return code;
   if (Status s = options.Check(); !s.ok()) return UsageError(kVerb, spec, s.message());
 
   ProjectColmap colmap;

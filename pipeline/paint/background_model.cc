@@ -308,7 +308,11 @@ cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
 
 void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
                      PaintedBuffer* painted) {
-  if (frame.warming_up > 0) painted->quality(valid_box).setTo(0.0f, frame.warming(valid_box));
+  if (frame.warming_up == 0) return;
+  // Negated: the sign marks the sample provisional, the magnitude keeps its quality.
+  cv::Mat quality = painted->quality(valid_box);
+  const cv::Mat negated = -cv::abs(quality);
+  negated.copyTo(quality, frame.warming(valid_box));
 }
 
 }  // namespace fresco

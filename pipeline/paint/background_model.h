@@ -12,7 +12,8 @@
 //            divided by its global gain (median sample/background ratio: exposure changes).
 // Memory is fixed per texel (robust 24 bytes, average 8), whatever the video's length.
 // Texels still warming up (fewer samples than the model needs) paint provisionally: their
-// stored quality is reset so that the first trusted background sample replaces it.
+// stored quality is marked (negated) so that the first trusted background sample replaces it,
+// while among provisional samples the sharper ones are kept.
 // The mask is cleaned: foreground blobs smaller than `min_blob_texels` are dropped (noise),
 // the rest is dilated by `dilate_texels` (anti-aliased edges, shadows, the model's lag).
 #pragma once
@@ -97,8 +98,9 @@ class BufferBackground {
   std::vector<int> texel_at_;  // texel number k by buffer index, -1 for none (built by Move)
 };
 
-// Marks texels painted while warming up as provisional (stored quality 0), so that the
-// quality update policy lets the first trusted sample replace them. `valid_box`: bounds the
+// Marks texels painted while warming up as provisional (stored quality negated), so that the
+// first trusted sample replaces them, and provisional samples replace them only when sharp
+// enough (PaintBuffer's `warming`). `valid_box`: bounds the
 // texels sampled this frame (WarpedBuffer::valid_box).
 void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
                      PaintedBuffer* painted);

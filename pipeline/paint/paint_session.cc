@@ -330,7 +330,11 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
       const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
                                ? cv::Mat()
                                : background_frame_[b].foreground;
-      paint_stats[b] = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b]);
+      const cv::Mat warming = background_.empty() || background_frame_[b].warming_up == 0
+                                  ? cv::Mat()
+                                  : background_frame_[b].warming;
+      paint_stats[b] =
+          PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b], warming);
       if (!background_.empty())
         MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
     });

@@ -22,20 +22,34 @@ namespace {
 
 // Texels [begin, end) of one chunk.
 PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warped,
-                             const cv::Mat& mask, const TexelUpdateRule& rule, int begin, int end,
+                             const cv::Mat& mask, const cv::Mat& warming,
+                             const TexelUpdateRule& rule, int begin, int end,
                              PaintedBuffer* painted) {
   PaintUpdateStats stats;
   const uint8_t* valid = warped.valid.data;
   const uint8_t* src = warped.bgr.data;
   const float* quality = warped.quality.ptr<float>();
   const uint8_t* skip = mask.empty() ? nullptr : mask.data;
+  const uint8_t* provisional_sample = warming.empty() ? nullptr : warming.data;
   uint8_t* dst = painted->bgra.data;
   float* stored_quality = painted->quality.ptr<float>();
   for (int k = begin; k < end; ++k) {
     const int idx = buffer.texel_index[k];
     if (!valid[idx] || (skip && skip[idx])) continue;
+    const float stored = stored_quality[idx];
+    if (stored >= 0.0f) {
+      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
+                  dst + 4 * static_cast<size_t>(idx), stored_quality + idx, &stats);
+      continue;
+    }
+    // A provisional stored sample: against a trusted sample it counts as nothing; against
+    // another provisional one, by its quality.
+    float compared_with =
+        provisional_sample && provisional_sample[idx] ? -stored : 0.0f;
+    const int written_before = stats.written;
     UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
-                dst + 4 * static_cast<size_t>(idx), stored_quality + idx, &stats);
+                dst + 4 * static_cast<size_t>(idx), &compared_with, &stats);
+    if (stats.written > written_before) stored_quality[idx] = compared_with;
   }
   return stats;
 }
@@ -44,11 +58,11 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
 
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const PipelineOptions& options,
-                             PaintedBuffer* painted) {
+                             PaintedBuffer* painted, const cv::Mat& warming) {
   const TexelUpdateRule rule = TexelUpdateRule::From(options);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
-    stats = PaintTexels(buffer, warped, mask, rule, 0, buffer.NumTexels(), painted);
+    stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);
     painted->painted_surface_texels += stats.newly_painted;
     return stats;
   }
@@ -62,7 +76,7 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
         for (int c = range.start; c < range.end; ++c) {
           const BaseBuffer::Chunk& chunk = buffer.chunks[c];
           if (!warped.MayBeValid(chunk)) continue;
-          per_chunk[c] = PaintTexels(buffer, warped, mask, rule, chunk.begin, chunk.end, painted);
+          per_chunk[c] = PaintTexels(buffer, warped, mask, warming, rule, chunk.begin, chunk.end, painted);
         }
       },
       std::max(1, std::min(num_chunks, 16 * cv::getNumThreads())));

@@ -15,8 +15,13 @@ namespace fresco {
 void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted);
 
 // `mask` (CV_8U, optional): texels to leave alone (e.g. foreground) where non-zero.
+// `warming` (CV_8U, optional): texels whose sample this frame is provisional (the background
+// model is still warming up there). A stored sample that was provisional (its quality kept
+// negated: MarkProvisional) gives way to any trusted sample, and to a provisional one only
+// by the update rule's quality test, so that while a model warms up the sharper samples are
+// the ones shown.
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const PipelineOptions& options,
-                             PaintedBuffer* painted);
+                             PaintedBuffer* painted, const cv::Mat& warming = cv::Mat());
 
 }  // namespace fresco

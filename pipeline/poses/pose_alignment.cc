@@ -229,18 +229,24 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+Eigen::Matrix<double, 6, 1> DisagreementOf(const PosePair& pair, const Sim3d& world_from_colmap,
+                                           double rotation_deg, double position_m) {
+  const Rigid3d aligned = world_from_colmap.TransformPose(pair.colmap_cam_from_colmap);
+  const Eigen::AngleAxisd w(aligned.RotationMatrix().transpose() *
+                            pair.given_cam_from_world.RotationMatrix());
+  Eigen::Matrix<double, 6, 1> e;
+  e.head<3>() = w.angle() * w.axis() / (rotation_deg * M_PI / 180.0);
+  e.tail<3>() = (aligned.Centre() - pair.given_cam_from_world.Centre()) / position_m;
+  return e;
+}
+
 Disagreement MeasureDisagreement(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
                                  double rotation_deg, double position_m) {
   const int n = static_cast<int>(pairs.size());
   std::vector<Eigen::Matrix<double, 6, 1>> e(n);  // rotation, offset in threshold units
   std::vector<bool> beyond(n, false);
-  const double rotation_rad = rotation_deg * M_PI / 180.0;
   for (int i = 0; i < n; ++i) {
-    const Rigid3d aligned = world_from_colmap.TransformPose(pairs[i].colmap_cam_from_colmap);
-    const Eigen::AngleAxisd w(aligned.RotationMatrix().transpose() *
-                              pairs[i].given_cam_from_world.RotationMatrix());
-    e[i].head<3>() = w.angle() * w.axis() / rotation_rad;
-    e[i].tail<3>() = (aligned.Centre() - pairs[i].given_cam_from_world.Centre()) / position_m;
+    e[i] = DisagreementOf(pairs[i], world_from_colmap, rotation_deg, position_m);
     beyond[i] = e[i].head<3>().norm() > 1.0 || e[i].tail<3>().norm() > 1.0;
   }
   Disagreement d;

@@ -94,6 +94,11 @@ struct Disagreement {
   int first = -1, last = -1;  // pair indices of the first and last smooth frame
   bool Drifts() const { return smooth >= 3 && 2 * smooth >= disagreeing; }
 };
+// One frame's disagreement: the rotation (world side, as a rotation vector in units of
+// `rotation_deg`) and centre offset (in units of `position_m`) from the given pose to the
+// aligned COLMAP pose.
+Eigen::Matrix<double, 6, 1> DisagreementOf(const PosePair& pair, const Sim3d& world_from_colmap,
+                                           double rotation_deg, double position_m);
 Disagreement MeasureDisagreement(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
                                  double rotation_deg, double position_m);
 

@@ -11,6 +11,7 @@ Status VerifyOptions::Check() const {
   if (!(rotation_threshold_deg > 0)) return Status::Error("rotation_threshold_deg: must be > 0");
   if (!(position_threshold_rel > 0)) return Status::Error("position_threshold_rel: must be > 0");
   if (window_frames < 0) return Status::Error("window_frames: must be >= 0");
+  if (drift_neighbours < 0) return Status::Error("drift_neighbours: must be >= 0");
   if (window_frames > 0 && window_frames < 5) {
     return Status::Error("window_frames: must be 0 or >= 5");
   }
@@ -72,6 +73,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
   std::map<int, PoseAlignment> fits;  // by window start
+  std::vector<Eigen::Matrix<double, 6, 1>> disagreement(n);  // under each frame's own fit
   for (int k = 0; k < n; ++k) {
     int begin = 0, end = n;
     if (local) {
@@ -100,8 +102,43 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     v.inlier = fit.inliers[k - begin];
     v.flagged =
         e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
+    disagreement[k] = DisagreementOf(pairs[k], fit.world_from_colmap, out.rotation_threshold_deg,
+                                     out.position_threshold_m);
   }
   out.windows = static_cast<int>(fits.size());
+  if (options.drift_neighbours > 0 && out.disagreement.Drifts()) {
+    // Judged against the neighbours' disagreement (the frame itself left out), a robust line
+    // through them per component (Theil-Sen: the median slope, then the median intercept;
+    // exact on a steady drift, even at the sequence's ends): a drift is smooth, a wrong
+    // given pose stands out from its neighbours.
+    out.drift_followed = true;
+    const int h = options.drift_neighbours;
+    for (int k = 0; k < n; ++k) {
+      FrameVerdict& v = out.frames[frame_of_pair[k]];
+      if (!v.flagged) continue;
+      std::vector<int> around;
+      for (int j = std::max(0, k - h); j <= std::min(n - 1, k + h); ++j)
+        if (j != k) around.push_back(j);
+      if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
+      Eigen::Matrix<double, 6, 1> trend;
+      for (int c = 0; c < 6; ++c) {
+        std::vector<double> slopes, at_k;
+        for (size_t a = 0; a < around.size(); ++a)
+          for (size_t b = a + 1; b < around.size(); ++b)
+            slopes.push_back((disagreement[around[b]][c] - disagreement[around[a]][c]) /
+                             (around[b] - around[a]));
+        const double slope = Median(slopes);
+        for (int j : around) at_k.push_back(disagreement[j][c] + slope * (k - j));
+        trend[c] = Median(at_k);
+      }
+      const Eigen::Matrix<double, 6, 1> residual = disagreement[k] - trend;
+      if (residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0) {
+        v.flagged = false;
+        v.follows_drift = true;
+        ++out.following_drift;
+      }
+    }
+  }
   std::vector<double> rotations, positions;
   for (const FrameVerdict& v : out.frames) {
     if (!v.has_given || !v.registered) continue;
@@ -109,6 +146,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       ++out.flagged;
       continue;
     }
+    if (v.follows_drift) continue;  // beyond the thresholds: not agreeing, not flagged
     ++out.unflagged;
     rotations.push_back(v.rotation_error_deg);
     positions.push_back(v.position_error_m);
@@ -146,11 +184,20 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
   if (result.disagreement.Drifts()) {
     std::snprintf(text, sizeof(text),
                   "%d of the %d frames beyond the thresholds disagree smoothly along the "
-                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there, "
-                  "and flags in that stretch may be the reconstruction's.",
+                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there",
                   result.disagreement.smooth, result.disagreement.disagreeing,
                   result.drift_first.c_str(), result.drift_last.c_str());
-    notes.push_back(text);
+    std::string note = text;
+    if (result.drift_followed) {
+      std::snprintf(text, sizeof(text),
+                    ". Each frame was judged against its neighbours: %d disagree as they do "
+                    "(following the drift, not flagged), %d stand out (flagged).",
+                    result.following_drift, result.flagged);
+      note += text;
+    } else {
+      note += ", and flags in that stretch may be the reconstruction's.";
+    }
+    notes.push_back(note);
   }
   return notes;
 }

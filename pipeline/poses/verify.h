@@ -24,6 +24,12 @@ struct VerifyOptions {
   int window_frames = 40;
   // Frames within these fractions of the thresholds support the alignment fit.
   double inlier_fraction = 0.5;
+  // When the disagreement drifts smoothly along the sequence (COLMAP's reconstruction bends
+  // over a long walk), each frame is judged against its neighbours' disagreement (a robust
+  // line through the `drift_neighbours` frames on each side) instead of against none: a
+  // frame that disagrees as its neighbours do follows the drift and is not flagged; one that
+  // stands out from them is. 0 = never.
+  int drift_neighbours = 5;
   unsigned seed = 1;
 
   Status Check() const;
@@ -36,6 +42,7 @@ struct FrameVerdict {
   double rotation_error_deg = 0.0;  // when both
   double position_error_m = 0.0;
   bool flagged = false;
+  bool follows_drift = false;  // beyond the thresholds, but as its neighbours (not flagged)
   bool inlier = false;  // supported the (global or its local) alignment
 };
 
@@ -66,8 +73,12 @@ struct VerifyResult {
   // frame by frame.
   Disagreement disagreement;
   std::string drift_first, drift_last;
-  // Statistics of the unflagged frames (how well COLMAP and the poses agree); zero when
-  // `unflagged` is 0.
+  // The flags were judged against the drift (VerifyOptions::drift_neighbours), and how many
+  // frames beyond the thresholds were let through as following it.
+  bool drift_followed = false;
+  int following_drift = 0;
+  // Statistics of the unflagged frames that agree within the thresholds (those following a
+  // drift left out): how well COLMAP and the poses agree; zero when `unflagged` is 0.
   int unflagged = 0;
   double median_rotation_error_deg = 0.0, max_unflagged_rotation_error_deg = 0.0;
   double median_position_error_m = 0.0, max_unflagged_position_error_m = 0.0;

@@ -71,6 +71,7 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
       f["position_error_m"] = nullptr;
     }
     f["flagged"] = v.flagged;
+    f["follows_drift"] = v.follows_drift;
     frames.push_back(f);
   }
   const Sim3d& s = result.world_from_colmap;
@@ -105,7 +106,9 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
         {"smooth_frames", result.disagreement.smooth},
         {"disagreeing_frames", result.disagreement.disagreeing},
         {"first", result.drift_first},
-        {"last", result.drift_last}}},
+        {"last", result.drift_last},
+        {"followed", result.drift_followed},
+        {"following_frames", result.following_drift}}},
       {"notes", VerifyNotes(result)},
       {"agreement_unflagged",
        {{"frames", result.unflagged},

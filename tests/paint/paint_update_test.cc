@@ -1,7 +1,9 @@
 // The paint stage's update (pipeline/paint/paint_update.h) on a two-texel buffer: replace (the
-// paper's) or a running average with weight PipelineOptions::update_weight.
+// paper's) or a running average with weight PipelineOptions::update_weight; provisional
+// samples while the background model warms up.
 #include <gtest/gtest.h>
 
+#include "pipeline/paint/background_model.h"
 #include "pipeline/paint/paint_update.h"
 
 namespace fresco {
@@ -43,6 +45,37 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
   average.Paint(200, options);
   EXPECT_NEAR(average.Stored(), 144, 1);  // 125 + 0.25 * 75
   EXPECT_EQ(average.painted.painted_surface_texels, 2);
+}
+
+// While a texel's background model warms up its samples are provisional (MarkProvisional):
+// a later provisional sample replaces the stored one only when it is as sharp (the quality
+// rule), a trusted one whatever its quality.
+TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
+  PipelineOptions options;  // quality policy, slack 0.2
+  TwoTexels t;
+  const cv::Mat warming(1, 2, CV_8U, cv::Scalar(255));
+  BackgroundFrame frame;
+  frame.warming = warming;
+  frame.warming_up = 2;
+  const auto paint = [&](int grey, float quality, bool provisional) {
+    t.warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
+    t.warped.quality.setTo(quality);
+    PaintBuffer(t.buffer, t.warped, cv::Mat(), options, &t.painted,
+                provisional ? warming : cv::Mat());
+    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &t.painted);
+  };
+  paint(100, 1.0f, true);  // sharp, provisional
+  EXPECT_EQ(t.Stored(), 100);
+  EXPECT_LT(t.painted.quality.at<float>(0, 1), 0.0f);  // marked provisional
+  paint(150, 0.5f, true);  // blurrier, provisional: the sharper stays
+  EXPECT_EQ(t.Stored(), 100);
+  paint(160, 0.9f, true);  // nearly as sharp (within the slack): replaces
+  EXPECT_EQ(t.Stored(), 160);
+  paint(200, 0.3f, false);  // trusted, however blurry: replaces
+  EXPECT_EQ(t.Stored(), 200);
+  EXPECT_FLOAT_EQ(t.painted.quality.at<float>(0, 1), 0.3f);
+  paint(220, 0.1f, false);  // trusted against trusted: the quality rule
+  EXPECT_EQ(t.Stored(), 200);
 }
 
 }  // namespace

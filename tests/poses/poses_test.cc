@@ -406,6 +406,33 @@ TEST(Verify, AReconstructionThatDriftsIsToldFromWrongPoses) {
   EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& note) {
     return note.find("smoothly") != std::string::npos;
   }));
+  // Every frame disagrees as its neighbours do: none is flagged.
+  EXPECT_TRUE(result.drift_followed);
+  EXPECT_EQ(result.flagged, 0);
+  EXPECT_GE(result.following_drift, 10);
+
+  // Three given poses 3 deg off in the drifting stretch: exactly those are flagged, with the
+  // default local windows as with one global fit; without following the drift most of the
+  // stretch is.
+  std::vector<Rigid3d> given = truth;
+  const std::vector<int> wrong = {24, 29, 35};
+  for (int i : wrong)
+    given[i] = Perturbed(truth[i], 3.0, 0.0, Eigen::Vector3d(1, 0, 1).normalized());
+  std::vector<VerifyFrameInput> with_wrong;
+  for (int i = 0; i < n; ++i) with_wrong.push_back({std::to_string(i), &given[i], &drifting[i]});
+  for (int window : {0, 30}) {
+    VerifyOptions judged;
+    judged.window_frames = window;
+    VerifyResult r;
+    ASSERT_TRUE(VerifyPoses(with_wrong, 45.0, judged, &r).ok());
+    std::vector<int> flagged;
+    for (int i = 0; i < n; ++i)
+      if (r.frames[i].flagged) flagged.push_back(i);
+    EXPECT_EQ(flagged, wrong) << "window " << window;
+    judged.drift_neighbours = 0;
+    ASSERT_TRUE(VerifyPoses(with_wrong, 45.0, judged, &r).ok());
+    EXPECT_GT(r.flagged, 8) << "window " << window;
+  }
   const SyntheticColmap s(truth, drifting);
   BootstrapResult bootstrap;
   ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &bootstrap).ok());
@@ -497,6 +524,7 @@ TEST(Verify, LocalWindowsFollowScaleDriftThatAGlobalFitFlags) {
   for (int i = 0; i < n; ++i) inputs.push_back({std::to_string(i), &truth[i], &colmap[i]});
   VerifyOptions options;
   options.window_frames = 0;
+  options.drift_neighbours = 0;  // the windows alone (following the drift also clears it)
   VerifyResult global, local;
   ASSERT_TRUE(VerifyPoses(inputs, 6.0, options, &global).ok());
   EXPECT_GT(global.flagged, 10);
