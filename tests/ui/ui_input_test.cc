@@ -579,7 +579,7 @@ TEST(UiInput, APathEditOfTheOpenProjectIsSavedRepaintedAndUndone) {
   fs::copy(app.dir + "/capture/frames", app.dir + "/capture/frames-copy");
   app.ui.layout.ToggleMaximised("Project");  // room for the editor below the project's rows
   app.Frame();
-  Activate(app, "Project", "Paths (scene, video, camera, poses)");  // opens the editor
+  Activate(app, "Project", "Paths");  // opens the editor
   EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/capture/frames/");
   TypeInto(app, "Project", "##video", app.dir + "/capture/frames-copy/");
   Activate(app, "Project", "Apply and save");

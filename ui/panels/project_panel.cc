@@ -93,7 +93,7 @@ class ProjectPanel : public Panel {
     }
     if (state.has_unopened || show_paths_) ImGui::SetNextItemOpen(true);
     show_paths_ = false;
-    if (!ImGui::CollapsingHeader("Paths (scene, video, camera, poses)")) return;
+    if (!ImGui::CollapsingHeader("Paths")) return;
     ProjectPathFields(&paths_);
     ImGui::BeginDisabled(paths_ == shown_ && !state.has_unopened);
     if (ImGui::Button("Apply and save")) ApplyPaths(ui);
