@@ -3,7 +3,9 @@
 // debug images zoom and read pixels, group colours stay put across grouping edits, a
 // missing video is one error, the seek slider, step back and F5 keep the frame, and a key
 // tap or a drag shorter than a frame still arrives (input_queue.h), and New project makes,
-// saves and opens a project or shows the command line's error and writes nothing.
+// saves and opens a project or shows the command line's error and writes nothing, the
+// Project panel repairs a project whose video moved (or edits the open one's paths, undoably),
+// and dropped files fill the New project form or the path editor, or open a project.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -19,6 +21,7 @@
 #include "tests/ui/headless_ui.h"
 #include "ui/core/app_frame.h"
 #include "ui/core/calibration_runner.h"
+#include "ui/core/dropped_file.h"
 #include "ui/core/group_colour.h"
 #include "ui/core/image_view.h"
 #include "ui/core/input_queue.h"
@@ -523,6 +526,123 @@ TEST(UiInput, NewProjectWithAMissingVideoShowsTheCommandLineErrorAndWritesNothin
   const auto run = testing::RunFresco({"run", file, "--out", app.dir + "/out"});
   EXPECT_NE(run.exit_code, 0);
   EXPECT_EQ(run.err, "error: " + error + "\n");
+}
+
+// A copy of the capture opened in the app at frame 0, and beside it broken/: the same
+// capture whose frames were moved to broken/frames-moved/.
+std::string BrokenCopy(App& app) {
+  fs::copy(app.dir + "/capture", app.dir + "/broken", fs::copy_options::recursive);
+  fs::rename(app.dir + "/broken/frames", app.dir + "/broken/frames-moved");
+  return app.dir + "/broken/project.json";
+}
+
+TEST(UiInput, AProjectWithAMovedVideoIsRepairedInTheProjectPanelAndOpens) {
+  App app(0);
+  const std::string bad = BrokenCopy(app);
+  const std::string text = testing::ReadText(bad);
+  RequestOpen(app.ui, bad);
+  app.Frames(2);
+  EXPECT_EQ(app.state.message,
+            "error: " + bad + ": video: " + app.dir + "/broken/frames/ does not exist");
+  ASSERT_TRUE(app.state.has_unopened);
+  EXPECT_EQ(app.state.project.file_path, app.dir + "/capture/project.json") << "still open";
+  // The path editor shows the project that did not open, paths resolved.
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/broken/frames/");
+  EXPECT_EQ(app.ReportOf("Project", "camera"), app.dir + "/broken/camera.cameramodel");
+  TypeInto(app, "Project", "##video", app.dir + "/broken/nowhere/");
+  Activate(app, "Project", "Apply and save");
+  EXPECT_EQ(app.ReportOf("Project", "paths error"),
+            bad + ": video: 'nowhere/' does not exist (" + app.dir + "/broken/nowhere/)");
+  EXPECT_EQ(testing::ReadText(bad), text) << "nothing written";
+  TypeInto(app, "Project", "##video", app.dir + "/broken/frames-moved/");
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/broken/frames-moved/");
+  Activate(app, "Project", "Apply and save");
+  app.Frames(2);
+  EXPECT_EQ(app.ReportOf("Project", "paths error"), "");
+  EXPECT_FALSE(app.state.has_unopened);
+  EXPECT_EQ(app.state.project.file_path, bad) << "opened";
+  EXPECT_EQ(app.state.project.video, "frames-moved/");
+  EXPECT_EQ(app.state.message, "opened " + bad);
+  Project on_disk;
+  ASSERT_TRUE(LoadProject(bad, {}, &on_disk).ok());
+  EXPECT_EQ(on_disk.video, "frames-moved/");
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.message, "opened " + bad) << "the worker read it";
+  ASSERT_FALSE(app.state.recent.empty());
+  EXPECT_EQ(app.state.recent.front(), bad);
+}
+
+TEST(UiInput, APathEditOfTheOpenProjectIsSavedRepaintedAndUndone) {
+  App app(2);
+  const std::string file = app.dir + "/capture/project.json";
+  fs::copy(app.dir + "/capture/frames", app.dir + "/capture/frames-copy");
+  app.ui.layout.ToggleMaximised("Project");  // room for the editor below the project's rows
+  app.Frame();
+  Activate(app, "Project", "Paths");  // opens the editor
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/capture/frames/");
+  TypeInto(app, "Project", "##video", app.dir + "/capture/frames-copy/");
+  Activate(app, "Project", "Apply and save");
+  app.Frame();
+  EXPECT_EQ(app.ReportOf("Project", "paths error"), "");
+  Project on_disk;
+  ASSERT_TRUE(LoadProject(file, {}, &on_disk).ok());
+  EXPECT_EQ(on_disk.video, "frames-copy/");
+  EXPECT_EQ(app.state.project.video, "frames-copy/");
+  EXPECT_FALSE(app.state.dirty) << "saved";
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_LT(app.runner.Snapshot()->frame, 2) << "reopened: painting starts again";
+  EXPECT_EQ(app.state.message.rfind("error: ", 0), std::string::npos) << app.state.message;
+  // Undo: the old path is back in the app (and the editor), unsaved; the file keeps the new.
+  app.input.keys_down[kKeyLeftControl] = true;
+  app.Tap('Z');
+  app.input.keys_down[kKeyLeftControl] = false;
+  app.Frame();
+  EXPECT_EQ(app.state.project.video, "frames/");
+  EXPECT_TRUE(app.state.dirty);
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/capture/frames/");
+  ASSERT_TRUE(LoadProject(file, {}, &on_disk).ok());
+  EXPECT_EQ(on_disk.video, "frames-copy/");
+}
+
+TEST(UiInput, DroppedFilesFillTheNewProjectFormOrThePathEditorOrOpenAProject) {
+  App app(0);
+  const std::string capture = app.dir + "/capture";
+  // No form open: the open project's path editor takes a camera.
+  DropPaths(app.ui, {capture + "/sparse/cameras.txt"});
+  app.Frame();
+  EXPECT_EQ(app.ReportOf("Project", "camera"), capture + "/sparse/cameras.txt");
+  EXPECT_EQ(app.state.message, "dropped camera " + capture +
+                                   "/sparse/cameras.txt into Project (Apply and save keeps it)");
+  EXPECT_EQ(app.state.project.camera, "camera.cameramodel") << "not applied yet";
+  // The form open: it takes every field, the path editor nothing more.
+  Activate(app, "Project", "New");
+  app.Frame();
+  ASSERT_TRUE(app.Find(kNewProjectTitle).open);
+  const std::string scene = SourceDir() + "/projects/cube-room/scene.gltf";
+  DropPaths(app.ui, {scene, capture + "/frames", capture + "/camera.cameramodel",
+                     capture + "/sparse/images.txt"});
+  app.Frame();
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "scene"), scene);
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "video"), capture + "/frames/");
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "camera"), capture + "/camera.cameramodel");
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "poses"), capture + "/sparse/images.txt");
+  EXPECT_EQ(app.ReportOf("Project", "video"), capture + "/frames/") << "the editor unchanged";
+  // What it is not: one message naming the file, nothing else changes.
+  testing::WriteText(app.dir + "/notes.md", "notes\n");
+  DropPaths(app.ui, {app.dir + "/notes.md"});
+  app.Frame();
+  EXPECT_EQ(app.state.message.rfind("error: " + app.dir + "/notes.md: dropped, but it is not", 0),
+            0u)
+      << app.state.message;
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "scene"), scene);
+  // A project opens.
+  fs::copy(capture + "/project.json", capture + "/second.json");
+  DropPaths(app.ui, {capture + "/second.json"});
+  app.Frames(2);
+  EXPECT_EQ(app.state.project.file_path, capture + "/second.json");
+  EXPECT_EQ(app.state.message, "opened " + capture + "/second.json");
 }
 
 }  // namespace

@@ -25,9 +25,7 @@ void OpenNow(UiContext& ui, const std::string& path) {
     ui.state->message = "error: " + s.message();
     return;
   }
-  ui.runner->Restart(ui.state->project);
-  ui.open_pending = true;
-  ui.opened_version = ui.snapshot ? ui.snapshot->version : 0;
+  ReopenProject(ui);
 }
 
 // The worker could not read what the project names (a corrupt video or poses file): the
@@ -251,15 +249,22 @@ void DrawSplitters(TileLayout* layout, const std::vector<TileLayout::Splitter>& 
 
 void RequestOpen(UiContext& ui, const std::string& path) { ui.state->pending_open = path; }
 
+void ReopenProject(UiContext& ui) {
+  ui.runner->Restart(ui.state->project);
+  ui.open_pending = true;
+  ui.opened_version = ui.snapshot ? ui.snapshot->version : 0;
+}
+
 void UndoRedo(UiContext& ui, bool undo) {
   const GroupingOptions before = ui.state->project.grouping;
   const double texel_before = ui.state->project.pipeline.texel_size_m;
-  const std::string poses_before = ui.state->project.poses;
+  const ProjectPaths paths_before = EditablePaths(ui.state->project);
   if (!(undo ? ui.state->Undo() : ui.state->Redo())) return;
-  // A grouping or poses change (Poses panel) shows only once the session is rebuilt.
+  // A grouping, poses (Poses panel) or path (Project panel) change shows only once the
+  // session is rebuilt.
   if (!(before == ui.state->project.grouping) ||
       texel_before != ui.state->project.pipeline.texel_size_m ||
-      poses_before != ui.state->project.poses)
+      !(paths_before == EditablePaths(ui.state->project)))
     ApplyProject(ui);
 }
 
@@ -278,6 +283,7 @@ void ConfigureImGui(ImGuiIO* io) { io->ConfigWindowsMoveFromTitleBarOnly = true;
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   CheckOpened(ui);
+  PlaceDroppedPaths(ui, panels);
   HandleShortcuts(ui);
   DrawMenuBar(ui, panels);
   if (ui.new_project_requested) {

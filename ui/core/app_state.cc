@@ -48,12 +48,17 @@ Status CheckInputsExist(const Project& project) {
 
 Status AppState::Open(const std::string& path) {
   Project loaded;
+  has_unopened = false;
   FRESCO_RETURN_IF_ERROR(LoadProject(path, {}, &loaded));
   FRESCO_RETURN_IF_ERROR(CheckOneStream(loaded, "the app"));
   // The app edits one stream as version-1 keys: a version-2 file's one stream is saved back
   // as version 1 (the same project).
   loaded = loaded.ForStream(0);
-  FRESCO_RETURN_IF_ERROR(CheckInputsExist(loaded));
+  if (Status s = CheckInputsExist(loaded); !s.ok()) {
+    unopened = loaded;  // its paths can be repaired in the Project panel
+    has_unopened = true;
+    return s;
+  }
   project = loaded;
   has_project = true;
   dirty = false;
@@ -85,6 +90,27 @@ void AppState::BeginEdit() {
   if (undo.size() > kMaxUndo) undo.erase(undo.begin());
   redo.clear();
   dirty = true;
+}
+
+Status AppState::RepairPaths(const ProjectPaths& typed, std::string* file) {
+  if (!has_unopened && !has_project) return Status::Error("no project to repair");
+  *file = has_unopened ? unopened.file_path : project.file_path;
+  Project repaired;
+  FRESCO_RETURN_IF_ERROR(RepairProjectPaths(*file, typed, &repaired));
+  message = "saved the paths of " + *file;
+  if (has_unopened) {
+    has_unopened = false;
+    return Status::Ok();
+  }
+  const Project paths = repaired.ForStream(0);
+  const bool had_edits = dirty;  // the file now has these paths: no new unsaved edit
+  BeginEdit();
+  dirty = had_edits;
+  project.scene = paths.scene;
+  project.video = paths.video;
+  project.camera = paths.camera;
+  project.poses = paths.poses;
+  return Status::Ok();
 }
 
 bool AppState::Undo() {

@@ -9,6 +9,7 @@
 
 #include "pipeline/core/project.h"
 #include "pipeline/core/status.h"
+#include "ui/core/project_paths.h"
 
 namespace fresco {
 
@@ -28,8 +29,14 @@ struct AppState {
   std::string pending_open;
   bool pending_quit = false;
 
-  // Undo/redo over whole project snapshots (settings and grouping edits).
+  // Undo/redo over whole project snapshots (settings, grouping and path edits).
   std::vector<Project> undo, redo;
+
+  // The project that did not open because a file it names is missing (the last Open's, as
+  // its file reads; cleared by the next Open): the Project panel edits its paths, and
+  // RepairPaths writes them, after which it opens.
+  Project unopened;
+  bool has_unopened = false;
 
   // Opens a project (errors leave the current one as it was).
   Status Open(const std::string& path);
@@ -37,6 +44,12 @@ struct AppState {
   Status Save(const std::string& path = "");
   // Call before changing `project`: records an undo step and marks the project dirty.
   void BeginEdit();
+  // Writes `typed` as the scene, video, camera and poses of the project that did not open
+  // (when there is one) or of the open project, checked as `fresco run` loads a project and
+  // atomically, every other key of the file unchanged (RepairProjectPaths); on an error
+  // nothing changes. The open project's paths change as an undoable edit (its other unsaved
+  // edits stay unsaved); a project that did not open is then ready to Open (`*file`).
+  Status RepairPaths(const ProjectPaths& typed, std::string* file);
   bool Undo();
   bool Redo();
 

@@ -16,6 +16,7 @@
 
 #include "ui/core/app_state.h"
 #include "ui/core/calibration_runner.h"
+#include "ui/core/dropped_file.h"
 #include "ui/core/orbit_frame.h"
 #include "ui/core/pipeline_runner.h"
 #include "ui/core/poses_runner.h"
@@ -70,7 +71,8 @@ struct UiContext {
   uint64_t opened_version = 0;
   // Where the tiled panels go (splitters, maximise); panels not in it float.
   TileLayout layout = DefaultTileLayout();
-  bool new_project_requested = false;  // File > New project...: the app frame opens the form
+  bool new_project_requested = false;      // File > New project...: the app frame opens the form
+  std::vector<std::string> dropped_paths;  // dropped on the window (DropPaths), not yet placed
 };
 
 class Panel {
@@ -80,6 +82,9 @@ class Panel {
   virtual void Draw(UiContext& ui) = 0;
   // What the panel shows, for `fresco gui --screenshot`'s FILE.json (name -> value).
   virtual std::map<std::string, std::string> Report() const { return {}; }
+  // A scene, video, camera or poses file dropped on the window for this panel's path fields
+  // (PlaceDroppedPaths): true when the panel took it.
+  virtual bool AcceptDrop(const DroppedFile&) { return false; }
   bool open = true;
   // Where a floating panel starts, in a 1600 x 1000 window (scaled to the real size).
   ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -17,6 +19,7 @@
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/image_io.h"
 #include "ui/core/app_frame.h"
+#include "ui/core/dropped_file.h"
 #include "ui/core/input_queue.h"
 #include "ui/core/layout_file.h"
 #include "ui/gl/gl.h"
@@ -116,29 +119,42 @@ void StartPoses(const GuiOptions& options, UiContext& ui,
   ui.runner->WaitIdle();
 }
 
+// What the window's callbacks collect between frames (its user pointer).
+struct WindowEvents {
+  InputQueue input;
+  std::vector<std::string> dropped;  // files dropped on the window, for DropPaths
+};
+
+WindowEvents* Events(GLFWwindow* window) {
+  return static_cast<WindowEvents*>(glfwGetWindowUserPointer(window));
+}
+
 // GLFW's callbacks queue the keyboard and the mouse (input_queue.h) so that a tap or a
-// drag shorter than a frame is still seen; focus, cursor enter and text go to ImGui's
-// backend as before.
-void InstallQueuedInput(GLFWwindow* window, InputQueue* queue) {
-  glfwSetWindowUserPointer(window, queue);
+// drag shorter than a frame is still seen, and the files dropped on the window; focus,
+// cursor enter and text go to ImGui's backend as before.
+void InstallQueuedInput(GLFWwindow* window, WindowEvents* events) {
+  glfwSetWindowUserPointer(window, events);
+  glfwSetDropCallback(window, [](GLFWwindow* w, int count, const char** paths) {
+    for (int i = 0; i < count; ++i) Events(w)->dropped.emplace_back(paths[i]);
+  });
   glfwSetCursorPosCallback(window, [](GLFWwindow* w, double x, double y) {
     InputEvent e;
     e.kind = InputEvent::Kind::kMouseMove;
     e.x = static_cast<float>(x), e.y = static_cast<float>(y);
-    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+    Events(w)->input.Push(e);
   });
   glfwSetMouseButtonCallback(window, [](GLFWwindow* w, int button, int action, int) {
     InputEvent e;
     e.kind = InputEvent::Kind::kMouseButton;
     e.code = button;
     e.down = action == GLFW_PRESS;
-    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+    Events(w)->input.Push(e);
   });
   glfwSetScrollCallback(window, [](GLFWwindow* w, double dx, double dy) {
     InputEvent e;
     e.kind = InputEvent::Kind::kWheel;
     e.x = static_cast<float>(dx), e.y = static_cast<float>(dy);
-    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+    Events(w)->input.Push(e);
   });
   glfwSetKeyCallback(window, [](GLFWwindow* w, int key, int, int action, int) {
     if (action == GLFW_REPEAT) return;  // ImGui makes its own repeats from the held key
@@ -146,7 +162,7 @@ void InstallQueuedInput(GLFWwindow* window, InputQueue* queue) {
     e.kind = InputEvent::Kind::kKey;
     e.code = key;
     e.down = action == GLFW_PRESS;
-    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+    Events(w)->input.Push(e);
   });
   glfwSetCursorEnterCallback(window, [](GLFWwindow* w, int entered) {
     ImGui_ImplGlfw_CursorEnterCallback(w, entered);
@@ -154,7 +170,7 @@ void InstallQueuedInput(GLFWwindow* window, InputQueue* queue) {
     InputEvent e;  // the mouse left the window: nothing hovered
     e.kind = InputEvent::Kind::kMouseMove;
     e.x = e.y = -FLT_MAX;
-    static_cast<InputQueue*>(glfwGetWindowUserPointer(w))->Push(e);
+    Events(w)->input.Push(e);
   });
   glfwSetWindowFocusCallback(window, ImGui_ImplGlfw_WindowFocusCallback);
   glfwSetCharCallback(window, ImGui_ImplGlfw_CharCallback);
@@ -173,7 +189,10 @@ int RunGuiApp(const GuiOptions& options) {
   if (!options.project.empty()) {
     if (Status s = state.Open(options.project); !s.ok()) {
       std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      return 2;
+      // A file it names is missing: the app starts with the Project panel's path editor on
+      // it. Unattended (a screenshot run) it exits as the command line does.
+      if (!state.has_unopened || screenshot) return 2;
+      state.message = "error: " + s.message();
     }
   }
   glfwSetErrorCallback([](int code, const char* text) {
@@ -208,9 +227,9 @@ int RunGuiApp(const GuiOptions& options) {
   ImGui::StyleColorsDark();
   ConfigureImGui(&io);
   ImGui_ImplGlfw_InitForOpenGL(window, false);
-  InputQueue input_queue;
+  WindowEvents events;
   InputState input;
-  InstallQueuedInput(window, &input_queue);
+  InstallQueuedInput(window, &events);
   ImGui_ImplOpenGL3_Init("#version 330 core");
 
   int code = 0;
@@ -257,9 +276,11 @@ int RunGuiApp(const GuiOptions& options) {
         state.pending_quit = true;
       }
       ui.snapshot = runner.Snapshot();
+      DropPaths(ui, events.dropped);
+      events.dropped.clear();
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
-      input_queue.NextFrame(&input);  // this frame's share of the queued input
+      events.input.NextFrame(&input);  // this frame's share of the queued input
       CopyToImGui(input, &io);
       if (screenshot) io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);  // no hover effects in pictures
       ImGui::NewFrame();

@@ -21,7 +21,9 @@ struct GuiOptions {
   std::string poses, poses_out, poses_model;
 };
 
-// Returns the process exit code (0 ok, 1 no display / GL failure, 2 bad project).
+// Returns the process exit code (0 ok, 1 no display / GL failure, 2 bad project). A project
+// that names a missing file is not bad input here: the app starts with the Project panel's
+// path editor on it.
 int RunGuiApp(const GuiOptions& options);
 
 }  // namespace fresco

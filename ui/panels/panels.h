@@ -6,10 +6,12 @@
 #include <string>
 
 #include "ui/core/panel.h"
+#include "ui/core/project_paths.h"
 
 namespace fresco {
 
 std::unique_ptr<Panel> MakeProjectPanel();
+inline constexpr const char* kProjectPanelTitle = "Project";
 std::unique_ptr<Panel> MakePipelinePanel();
 std::unique_ptr<Panel> MakeViewportPanel();
 std::unique_ptr<Panel> MakeGroupingPanel();
@@ -34,8 +36,7 @@ inline constexpr const char* kNewProjectTitle = "New project";
 
 // What the New project form asks for: paths as typed (absolute, or relative to the working
 // folder), URLs for live sources.
-struct NewProjectForm {
-  std::string scene, video, camera, poses;
+struct NewProjectForm : ProjectPaths {
   std::string project_file;  // where to save it (must not exist yet)
 };
 // Builds the project (paths relative to the project file), checks it as `fresco run` does
@@ -46,6 +47,9 @@ Status BuildNewProject(const NewProjectForm& form, Project* project);
 // Opens `path` (after the unsaved-changes prompt when the project has edits; the app frame
 // shows it) and restarts the pipeline on it.
 void RequestOpen(UiContext& ui, const std::string& path);
+// Restarts the pipeline on the open project as it is now (its files just changed): the
+// worker's first snapshot says whether they could be read, as after Open.
+void ReopenProject(UiContext& ui);
 // Restarts the pipeline with the project as edited (settings and grouping).
 void ApplyProject(UiContext& ui);
 // Undo (or redo) one edit; restarts the pipeline when the grouping or the poses changed.
