@@ -12,6 +12,8 @@
 #     (objdump NEEDED, resolved with ldd, owned per `dpkg -S`), and every package it names is
 #     one apt knows: `apt-get install --simulate` of the .deb resolves on this machine.
 # Exits 77 (CTest: skipped) with a message when the Debian tools are missing (not Debian).
+# cpack first brings the build up to date (its preinstall step builds `all`): after the full
+# build that CI and .ci/test make, nothing.
 #
 # Usage: bash tests/package/check_deb.sh BUILD_DIR CPACK [GUI=ON|OFF]
 set -euo pipefail
