@@ -64,6 +64,7 @@ def main():
     files = ORDER + sorted(f for f in os.listdir(guide) if f.endswith(".md") and f not in ORDER)
     scratch = tempfile.mkdtemp(prefix="fresco-guide-")
     errors, ran, skipped = [], 0, 0
+    started = time.time()
     try:
         shutil.copytree(os.path.join(ROOT, "projects"), os.path.join(scratch, "projects"),
                         symlinks=True)
@@ -104,7 +105,7 @@ def main():
     for e in errors:
         print("FAIL " + e)
     print(f"run_guide_commands: {ran} blocks run, {skipped} skipped (each with its reason), "
-          f"{len(errors)} problems")
+          f"{len(errors)} problems, {time.time() - started:.0f} s")
     return 1 if errors else 0
 
 
