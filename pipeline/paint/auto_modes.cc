@@ -55,14 +55,17 @@ void RefineAutoDecider::Start(bool enabled) {
 }
 
 bool RefineAutoDecider::AddFrame(int frame_number, double misalignment_px) {
-  if (!deciding() || !(misalignment_px >= 0)) return false;
-  samples_.push_back(misalignment_px);
-  decision_.frames_measured = static_cast<int>(samples_.size());
-  std::vector<double> sorted = samples_;
-  std::sort(sorted.begin(), sorted.end());
-  const size_t n = sorted.size();
-  decision_.evidence = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
-  if (decision_.frames_measured < kRefineAutoFrames) return false;
+  if (!deciding()) return false;
+  if (misalignment_px >= 0) {
+    samples_.push_back(misalignment_px);
+    decision_.frames_measured = static_cast<int>(samples_.size());
+    std::vector<double> sorted = samples_;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t n = sorted.size();
+    decision_.evidence = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+  }
+  if (decision_.frames_measured < kRefineAutoFrames && frame_number < kRefineAutoLastFrame)
+    return false;
   decision_.state = decision_.evidence > decision_.threshold ? AutoDecision::State::kOn
                                                              : AutoDecision::State::kOff;
   decision_.decided_at_frame = frame_number;
@@ -75,9 +78,12 @@ void RefineAutoDecider::DecideOff(int frame_number) {
   decision_.decided_at_frame = frame_number;
 }
 
-void BackgroundAutoDecider::Start(bool enabled, int warmup_frames) {
+void BackgroundAutoDecider::Start(bool enabled, int warmup_frames, int expected_frames) {
   decision_ = AutoDecision();
   warmup_frames_ = warmup_frames;
+  last_frames_ = expected_frames > 0 ? std::clamp(expected_frames / 3, kBackgroundAutoFrames,
+                                                  kBackgroundAutoMaxFrames)
+                                     : kBackgroundAutoMaxFrames;
   trusted_ = masked_ = 0;
   if (!enabled) return;
   decision_.state = AutoDecision::State::kDeciding;
@@ -92,8 +98,9 @@ bool BackgroundAutoDecider::AddFrame(int frame_number, long long observed, long 
   ++decision_.frames_measured;
   if (trusted_ > 0) decision_.evidence = static_cast<double>(masked_) / trusted_;
   if (decision_.frames_measured < kBackgroundAutoFrames) return false;
-  decision_.state = decision_.evidence > decision_.threshold ? AutoDecision::State::kOn
-                                                             : AutoDecision::State::kOff;
+  const bool on = decision_.evidence > decision_.threshold;
+  if (!on && decision_.frames_measured < last_frames_) return false;
+  decision_.state = on ? AutoDecision::State::kOn : AutoDecision::State::kOff;
   decision_.decided_at_frame = frame_number;
   return true;
 }

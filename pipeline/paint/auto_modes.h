@@ -9,9 +9,10 @@
 //               refines every later frame; below, refinement stops (no further cost).
 //   background  The robust model runs from the start (masking as `robust` does). Once its
 //               texels have warmed up, the foreground it finds among the texels it trusts is
-//               counted over `kBackgroundAutoFrames` frames: a fraction above
-//               `kBackgroundAutoThreshold` (movers, or misaligned samples it keeps out) keeps
-//               it; below, the model is dropped and painting continues as `off`.
+//               counted frame by frame: once a fraction above `kBackgroundAutoThreshold`
+//               (movers, or misaligned samples it keeps out) is seen after
+//               `kBackgroundAutoFrames` frames, it stays; if none by a third of the capture,
+//               the model is dropped and painting continues as `off`.
 #pragma once
 
 #include <string>
@@ -25,8 +26,15 @@ namespace fresco {
 // (docs/results.md, "Evaluation suite").
 constexpr double kRefineAutoThresholdPx = 0.6;
 constexpr int kRefineAutoFrames = 6;
+// Refinement decides by this frame whatever it measured (off without a measurement: frames
+// too small or too plain to register).
+constexpr int kRefineAutoLastFrame = 20;
 constexpr double kBackgroundAutoThreshold = 0.01;
+// The background decides on as soon as the fraction exceeds the threshold after this many
+// frames, off when it has not after a third of the expected frames (at least this many, at
+// most kBackgroundAutoMaxFrames): movers may enter late.
 constexpr int kBackgroundAutoFrames = 8;
+constexpr int kBackgroundAutoMaxFrames = 60;
 
 // {"refine": D, "background": D} as JSON text, D = {"decision", "evidence", "threshold",
 // "frames_measured", "decided_at_frame"} or null when that mode is not auto (metrics.json,
@@ -54,8 +62,9 @@ class RefineAutoDecider {
 // Collects the background evidence frame by frame and decides once.
 class BackgroundAutoDecider {
  public:
-  // `warmup_frames`: the model's warm-up; evidence counts from then on.
-  void Start(bool enabled, int warmup_frames);
+  // `warmup_frames`: the model's warm-up; evidence counts from then on. `expected_frames`:
+  // the frames the capture promises (0: unknown).
+  void Start(bool enabled, int warmup_frames, int expected_frames);
   // One frame's counts over the buffers seen: texels observed, still warming up, masked.
   // Returns true when this frame decided.
   bool AddFrame(int frame_number, long long observed, long long warming, long long masked);
@@ -64,7 +73,7 @@ class BackgroundAutoDecider {
 
  private:
   AutoDecision decision_;
-  int warmup_frames_ = 0;
+  int warmup_frames_ = 0, last_frames_ = kBackgroundAutoMaxFrames;
   long long trusted_ = 0, masked_ = 0;
 };
 

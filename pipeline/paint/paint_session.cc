@@ -100,6 +100,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->options_ = inputs.pipeline;
   s->requested_refine_ = inputs.pipeline.refine.mode;
   s->requested_background_ = inputs.pipeline.background.mode;
+  s->expected_frames_ = static_cast<int>(inputs.expected_poses.size());
   s->options_.background.warmup_frames = EffectiveWarmupFrames(inputs);
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
@@ -151,7 +152,7 @@ void PaintSession::StartAutoModes() {
   options_.refine.mode = refine_auto ? RefineMode::kRobust : requested_refine_;
   options_.background.mode = background_auto ? BackgroundMode::kRobust : requested_background_;
   refine_auto_.Start(refine_auto);
-  background_auto_.Start(background_auto, options_.background.warmup_frames);
+  background_auto_.Start(background_auto, options_.background.warmup_frames, expected_frames_);
   if (refine_auto && options_.select.enabled && options_.update == UpdatePolicy::kQuality) {
     refine_auto_.DecideOff(0);  // view selection runs without refinement (SelectActive)
     options_.refine.mode = RefineMode::kOff;

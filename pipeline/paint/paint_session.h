@@ -159,6 +159,7 @@ class PaintSession {
   PipelineOptions options_;
   RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)
   BackgroundMode requested_background_ = BackgroundMode::kOff;
+  int expected_frames_ = 0;  // the poses the inputs promised (0: unknown)
   RefineAutoDecider refine_auto_;
   BackgroundAutoDecider background_auto_;
   double texel_size_m_ = 0.0;
