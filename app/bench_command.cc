@@ -20,6 +20,7 @@
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
+#include "pipeline/paint/auto_modes.h"
 #include "pipeline/paint/rephotography.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
@@ -195,6 +196,8 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   row["one_minus_ncc"] = scored > 0 ? ncc / scored : 1.0;
   row["completeness"] = held_out.empty() ? 0.0 : completeness / held_out.size();
   row["coverage"] = session->Coverage();
+  // What the `auto` modes decided, with their evidence (null for a mode not auto).
+  if (!naive) row["auto"] = nlohmann::json::parse(AutoDecisionsJson(session->auto_decisions()));
   if (truth_scored > 0) {
     row["truth"] = {{"psnr_db", truth_psnr / truth_scored},
                     {"one_minus_ncc", truth_ncc / truth_scored}};

@@ -162,6 +162,8 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   metrics["stage_metrics"] = nlohmann::json::object();
   for (const auto& [stage, by_key] : stats.MeanStageMetrics())
     for (const auto& [key, mean] : by_key) metrics["stage_metrics"][stage][key] = mean;
+  // What the `auto` modes decided, with their evidence (null for a mode not auto).
+  metrics["auto"] = nlohmann::json::parse(AutoDecisionsJson(session->auto_decisions()));
   metrics["texels"] = session->NumSurfaceTexels();
   metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
   metrics["coverage"] = session->Coverage();

@@ -65,6 +65,7 @@ const std::vector<std::pair<RefineMode, std::string>>& RefineModeNames() {
       {RefineMode::kOff, "off"},
       {RefineMode::kPaper, "paper"},
       {RefineMode::kRobust, "robust"},
+      {RefineMode::kAuto, "auto"},
   };
   return names;
 }
@@ -84,6 +85,7 @@ const std::vector<std::pair<BackgroundMode, std::string>>& BackgroundModeNames()
       {BackgroundMode::kOff, "off"},
       {BackgroundMode::kAverage, "average"},
       {BackgroundMode::kRobust, "robust"},
+      {BackgroundMode::kAuto, "auto"},
   };
   return names;
 }
@@ -111,7 +113,10 @@ template <class V>
 void Fields(RefineOptions& o, V& v) {
   v.Enum("mode", o.mode, RefineModeNames(),
          "`paper`: Harris corners, SSD search, affine fit (the paper's §3.5); `robust`: tracked "
-         "corners, RANSAC and model selection");
+         "corners, RANSAC and model selection; `auto` (the default): the first frames' "
+         "misalignment to the buffers is measured without correcting, and `robust` refines the "
+         "rest of the capture only when its median exceeds what perfect poses give (0.6 "
+         "texels); the decision and its evidence are in the refine stage's report");
   v.Enum("max_model", o.max_model, RefineModelNames(),
          "the most general 2D motion `robust` may choose (simpler ones win when the evidence does "
          "not need more)");
@@ -152,7 +157,11 @@ void Fields(RefineOptions& o, V& v) {
 template <class V>
 void Fields(BackgroundOptions& o, V& v) {
   v.Enum("mode", o.mode, BackgroundModeNames(),
-         "`average` is the paper's (§3.4); `robust` follows changes and exposure");
+         "`average` is the paper's (§3.4); `robust` follows changes and exposure; `auto` (the "
+         "default): `robust` learns from the start and keeps masking only when the texels it "
+         "trusts show enough foreground (moving objects or misaligned samples) once warmed up, "
+         "else it is dropped; the decision and its evidence are in the background stage's "
+         "report");
   v.Field(
       "training_frames", o.training_frames,
       {.min = 1, .max = 250, .help = "`average`: samples averaged per texel before it segments"});
@@ -210,8 +219,9 @@ void Fields(SelectOptions& o, V& v) {
            "score every view of a texel and keep the better one, and match exposures (below): for "
            "real photos with changing exposure (on the Sceaux castle photos +0.9 to 1.1 dB and 1 - "
            "NCC 0.07 lower, at 2-4 times the warp stage's cost); it runs with `update: quality` "
-           "and `refine.mode: off` (refinement moves the buffers to the frames and needs them to "
-           "take new samples); it also caps the background model's warm-up at a third of the "
+           "and `refine.mode` `off` or `auto` (which then decides off: refinement moves the "
+           "buffers to the frames and needs them to take new samples); it also caps the background "
+           "model's warm-up at a third of the "
            "capture's frames. Off (the default): `update` and `quality_slack` alone decide"});
   v.Field("exposure", o.exposure,
           {.help = "per frame, a gain per colour channel against what the buffers already hold "

@@ -29,19 +29,22 @@ struct OcclusionOptions {
   bool operator==(const OcclusionOptions&) const = default;
 };
 
-// Texture alignment refinement (paper §3.5, refine_alignment.h).
-enum class RefineMode { kOff, kPaper, kRobust };
+// Texture alignment refinement (paper §3.5, refine_alignment.h). kAuto: measures the
+// misalignment between the first frames and the buffers without correcting, then refines
+// (`robust`) for the rest of the capture only when it exceeds what perfect poses give
+// (auto_modes.h).
+enum class RefineMode { kOff, kPaper, kRobust, kAuto };
 // The most general 2D motion model refinement may choose (model selection picks simpler
 // ones when the evidence does not need more).
 enum class RefineModelLimit { kTranslation, kSimilarity, kAffine, kHomography };
 struct RefineOptions {
-  RefineMode mode = RefineMode::kOff;
+  RefineMode mode = RefineMode::kAuto;
   RefineModelLimit max_model = RefineModelLimit::kHomography;
-  int max_corners = 150;      // corners tracked per buffer and frame
-  int search_px = 12;         // largest correction looked for, texels (else: no correction)
-  int window_px = 7;          // matching window half-size, texels
-  int pyramid_levels = 3;     // coarse-to-fine levels (robust mode)
-  double ransac_px = 1.5;     // inlier threshold, texels
+  int max_corners = 150;           // corners tracked per buffer and frame
+  int search_px = 12;              // largest correction looked for, texels (else: no correction)
+  int window_px = 7;               // matching window half-size, texels
+  int pyramid_levels = 3;          // coarse-to-fine levels (robust mode)
+  double ransac_px = 1.5;          // inlier threshold, texels
   double max_scale_change = 0.05;  // a fit that scales or shears more is refused
   // Corrections smaller than this (largest displacement over the region, texels) are
   // measured but not applied: registration noise applied frame after frame random-walks
@@ -70,11 +73,13 @@ struct RefineOptions {
 // samples, then image subtraction with a fixed `average_threshold`. kRobust: two colour
 // modes per texel with weights over a sliding window (background = the heavier mode, so
 // it converges to what the texel shows most of the time, whatever came first), an adaptive
-// per-texel noise threshold and a per-frame global gain (exposure) estimate.
-enum class BackgroundMode { kOff, kAverage, kRobust };
+// per-texel noise threshold and a per-frame global gain (exposure) estimate. kAuto: the
+// robust model learns from the start, and what it finds over the first frames decides
+// whether it keeps masking or is dropped (auto_modes.h).
+enum class BackgroundMode { kOff, kAverage, kRobust, kAuto };
 
 struct BackgroundOptions {
-  BackgroundMode mode = BackgroundMode::kRobust;
+  BackgroundMode mode = BackgroundMode::kAuto;
   // kAverage: samples averaged per texel before it segments (at most 250), and the
   // foreground threshold on the largest channel difference, grey levels.
   int training_frames = 20;
@@ -122,7 +127,7 @@ struct AtlasOptions {
 struct SelectOptions {
   bool enabled = false;  // off: the quality policy alone (`update`, `quality_slack`); on costs
                          // 2-4 times the warp stage (real photos: docs/results.md)
-  bool exposure = true;         // divide out each frame's gain against the buffers
+  bool exposure = true;  // divide out each frame's gain against the buffers
   double switch_margin = 0.25;  // a painted texel switches frame when the score is this much better
   double region_weight = 0.5;   // 0: the texel's own score; 1: the frame's median over the buffer
   double edge_px = 6.0;         // texels seen within this many pixels of a depth discontinuity
@@ -142,9 +147,9 @@ struct PipelineOptions {
   // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
   // below 1 = running average, which averages out the frames' residual misalignment).
   double update_weight = 1.0;
-  int max_frames = 0;          // 0 = all frames
-  int threads = 0;             // 0 = all cores
-  bool debug_images = false;   // write per-stage debug images (costs time)
+  int max_frames = 0;         // 0 = all frames
+  int threads = 0;            // 0 = all cores
+  bool debug_images = false;  // write per-stage debug images (costs time)
   OcclusionOptions occlusion;
   RefineOptions refine;
   BackgroundOptions background;
@@ -210,12 +215,12 @@ struct LiveOptions {
   // No frame for this long: the stream has ended (after `reconnects` reopen attempts).
   double read_timeout_s = 3.0;
   int reconnects = 0;
-  bool stream_clock = true;  // frame times from the stream's timestamps (else arrival)
+  bool stream_clock = true;        // frame times from the stream's timestamps (else arrival)
   double connect_timeout_s = 5.0;  // the pose feed must accept the connection within this
   // A pose feed that drops is reconnected with backoff; no connection for this long (wall
   // seconds) ends it with an error (0: keep trying).
   double pose_reconnect_give_up_s = 60.0;
-  double pose_wait_s = 0.5;  // a frame waits this long for the tracker to reach its time
+  double pose_wait_s = 0.5;     // a frame waits this long for the tracker to reach its time
   double max_pose_gap_s = 0.5;  // no pose is interpolated between samples further apart
   // A frame this far before the first pose or after the last still gets one, extrapolated.
   double max_pose_extrapolate_s = 0.02;
@@ -261,7 +266,7 @@ struct Project {
   std::string camera;
   std::string video;
   std::string poses;
-  double time_offset_s = 0.0;  // tracker clock minus video clock (live/TUM matching)
+  double time_offset_s = 0.0;       // tracker clock minus video clock (live/TUM matching)
   std::vector<StreamSpec> streams;  // version 2 only
   PipelineOptions pipeline;
   GroupingOptions grouping;

@@ -97,6 +97,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
   FRESCO_RETURN_IF_ERROR(read_status);
   result->paint_fps = paint_seconds > 0 ? result->painted_frames / paint_seconds : 0.0;
   result->coverage = session->Coverage();
+  result->decisions = session->auto_decisions();
   result->has_movers = !plan.movers.empty();
   result->holdout_frames = static_cast<int>(held_out.size());
 

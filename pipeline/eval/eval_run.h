@@ -10,6 +10,7 @@
 
 #include "pipeline/core/status.h"
 #include "pipeline/eval/eval_suite.h"
+#include "pipeline/paint/stage_report.h"
 
 namespace fresco {
 
@@ -37,8 +38,9 @@ struct CaptureEval {
   double truth_psnr_db = 0;  // at the true poses against the clean scene
   double truth_one_minus_ncc = 0;
   bool has_movers = false;
-  double mover_leak = 0;  // painted pixels showing a mover / painted pixels (truth views)
-  double coverage = 0;    // on-surface texels painted
+  double mover_leak = 0;    // painted pixels showing a mover / painted pixels (truth views)
+  double coverage = 0;      // on-surface texels painted
+  AutoDecisions decisions;  // what the `auto` modes decided, with their evidence
 };
 
 // Generates (or finds current) and evaluates one capture.

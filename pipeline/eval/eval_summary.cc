@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/paint/auto_modes.h"
+
 namespace fresco {
 namespace {
 
@@ -78,6 +80,14 @@ std::vector<FamilySummary> SummarizeByFamily(const std::vector<CaptureEval>& res
   return out;
 }
 
+// "on 1.84" for the text table; "-" when not auto.
+std::string DecisionCell(const AutoDecision& d) {
+  if (!d.is_auto()) return "-";
+  char cell[48];
+  std::snprintf(cell, sizeof cell, "%s %.3g", d.StateName(), d.evidence);
+  return cell;
+}
+
 std::string EvalToJson(const std::vector<std::string>& settings,
                        const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families) {
@@ -100,6 +110,7 @@ std::string EvalToJson(const std::vector<std::string>& settings,
         {"coverage", c.coverage},
         {"truth", {{"psnr_db", c.truth_psnr_db}, {"one_minus_ncc", c.truth_one_minus_ncc}}}};
     row["mover_leak"] = c.has_movers ? json(c.mover_leak) : json(nullptr);
+    row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
     root["captures"].push_back(row);
   }
   root["families"] = json::array();
@@ -121,14 +132,17 @@ std::string EvalToText(const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families) {
   std::string out =
       "| capture | family | truth PSNR dB | truth 1-NCC | rephoto PSNR dB | rephoto 1-NCC | "
-      "mover leak % | coverage % | paint fps |\n|---|---|---|---|---|---|---|---|---|\n";
+      "mover leak % | coverage % | paint fps | auto refine (misalignment, texels) | auto "
+      "background (foreground fraction) |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   char line[400];
   for (const CaptureEval& c : results) {
     char leak[32] = "-";
     if (c.has_movers) std::snprintf(leak, sizeof leak, "%.3f", 100 * c.mover_leak);
-    std::snprintf(line, sizeof line, "| %s | %s | %.2f | %.4f | %.2f | %.4f | %s | %.1f | %.0f |\n",
-                  c.name.c_str(), c.family.c_str(), c.truth_psnr_db, c.truth_one_minus_ncc,
-                  c.psnr_db, c.one_minus_ncc, leak, 100 * c.coverage, c.paint_fps);
+    std::snprintf(
+        line, sizeof line, "| %s | %s | %.2f | %.4f | %.2f | %.4f | %s | %.1f | %.0f | %s | %s |\n",
+        c.name.c_str(), c.family.c_str(), c.truth_psnr_db, c.truth_one_minus_ncc, c.psnr_db,
+        c.one_minus_ncc, leak, 100 * c.coverage, c.paint_fps,
+        DecisionCell(c.decisions.refine).c_str(), DecisionCell(c.decisions.background).c_str());
     out += line;
   }
   out +=

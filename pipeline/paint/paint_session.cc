@@ -98,6 +98,9 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   std::unique_ptr<PaintSession> s(new PaintSession());
   s->scene_ = inputs.scene;
   s->options_ = inputs.pipeline;
+  s->requested_refine_ = inputs.pipeline.refine.mode;
+  s->requested_background_ = inputs.pipeline.background.mode;
+  s->expected_frames_ = static_cast<int>(inputs.expected_poses.size());
   s->options_.background.warmup_frames = EffectiveWarmupFrames(inputs);
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
@@ -127,12 +130,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
-  if (inputs.pipeline.background.mode != BackgroundMode::kOff) {
-    s->background_.resize(s->set_.buffers.size());
-    s->background_frame_.resize(s->set_.buffers.size());
-    for (size_t b = 0; b < s->set_.buffers.size(); ++b)
-      s->background_[b].Init(s->set_.buffers[b], s->options_.background);
-  }
+  s->StartAutoModes();
   *session = std::move(s);
   return Status::Ok();
 }
@@ -141,11 +139,58 @@ void PaintSession::ResetPainting() {
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     InitPaintedBuffer(set_.buffers[b], &painted_[b]);
     InitRefineAnchor(set_.buffers[b], &anchors_[b]);
-    if (!background_.empty()) background_[b].Init(set_.buffers[b], options_.background);
   }
+  StartAutoModes();
   frames_seen_ = 0;
   exposure_gain_sum_ = exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
   exposure_frames_ = 0;
+}
+
+void PaintSession::StartAutoModes() {
+  const bool refine_auto = requested_refine_ == RefineMode::kAuto;
+  const bool background_auto = requested_background_ == BackgroundMode::kAuto;
+  options_.refine.mode = refine_auto ? RefineMode::kRobust : requested_refine_;
+  options_.background.mode = background_auto ? BackgroundMode::kRobust : requested_background_;
+  refine_auto_.Start(refine_auto);
+  background_auto_.Start(background_auto, options_.background.warmup_frames, expected_frames_);
+  if (refine_auto && options_.select.enabled && options_.update == UpdatePolicy::kQuality) {
+    refine_auto_.DecideOff(0);  // view selection runs without refinement (SelectActive)
+    options_.refine.mode = RefineMode::kOff;
+  }
+  background_.clear();
+  background_frame_.clear();
+  if (options_.background.mode != BackgroundMode::kOff) {
+    background_.resize(set_.buffers.size());
+    background_frame_.resize(set_.buffers.size());
+    for (size_t b = 0; b < set_.buffers.size(); ++b)
+      background_[b].Init(set_.buffers[b], options_.background);
+  }
+}
+
+void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
+                                   const std::vector<bool>& seen, FrameReport* report) {
+  if (refine_auto_.AddFrame(frame_number, misalignment_px) &&
+      refine_auto_.decision().state == AutoDecision::State::kOff)
+    options_.refine.mode = RefineMode::kOff;  // no further cost
+  if (background_auto_.deciding() && !background_.empty()) {
+    long long observed = 0, warming = 0, masked = 0;
+    for (size_t b = 0; b < seen.size(); ++b) {
+      if (!seen[b]) continue;
+      observed += background_frame_[b].observed;
+      warming += background_frame_[b].warming_up;
+      masked += background_frame_[b].masked;
+    }
+    if (background_auto_.AddFrame(frame_number, observed, warming, masked) &&
+        background_auto_.decision().state == AutoDecision::State::kOff) {
+      options_.background.mode = BackgroundMode::kOff;  // painting continues as `off`
+      background_.clear();
+      background_frame_.clear();
+    }
+  }
+  report->decisions = auto_decisions();
+  if (StageReport* refine = report->Stage("refine")) report->decisions.refine.PutInto(refine);
+  if (StageReport* background = report->Stage("background"))
+    report->decisions.background.PutInto(background);
 }
 
 const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
@@ -297,9 +342,12 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   // 3. refine
   frame_camera_ = &camera;
   frame_cam_from_local_ = cam_from_local;
+  double measured_misalignment_px = -1;  // refine.mode auto, deciding
   if (options_.refine.mode != RefineMode::kOff) {
-    if (frame_number % options_.refine.every_n_frames == 0) {
-      report->stages.push_back(RefineAlignment(seen, debug, &report->refine));
+    const bool measure_only = refine_auto_.deciding();
+    if (measure_only || frame_number % options_.refine.every_n_frames == 0) {
+      report->stages.push_back(RefineAlignment(seen, debug, measure_only, &report->refine));
+      if (measure_only) measured_misalignment_px = frame_misalignment_px_;
     } else {  // not registered this frame: it only fills what the buffers lack
       for (size_t b = 0; b < set_.buffers.size(); ++b)
         if (seen[b]) KeepOutOfPainted(b, warped_[b].valid_box);
@@ -356,6 +404,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   paint_report.metrics["coverage"] = Coverage();
   paint_report.wall_ms = MsSince(start);
   report->stages.push_back(std::move(paint_report));
+  UpdateAutoModes(frame_number, measured_misalignment_px, seen, report);
   report->painted = true;
   report->total_ms = MsSince(frame_start);
 }
@@ -435,7 +484,7 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
 }
 
 void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
-                                      const std::vector<size_t>& fresh,
+                                      const std::vector<size_t>& fresh, bool measure_only,
                                       std::vector<BufferRefinement>* results, StageReport* report) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<PoseMatch> matches;
@@ -454,7 +503,7 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
   report->metrics["pose_model_" + pose.model] = 1;
   report->notes["pose"] = pose.applied ? pose.model : "no pose correction: " + pose.fallback;
   if (pose.inliers > 0) frame_misalignment_px_ = pose.residual_before_px;
-  if (!pose.applied) return;  // the buffers keep their own 2D estimates
+  if (!pose.applied || measure_only) return;  // the buffers keep their own 2D estimates
   const Rigid3d corrected = pose.delta * frame_cam_from_local_;
   results->resize(todo.size() + fresh.size());
   for (size_t i = 0; i < results->size(); ++i) {
@@ -478,7 +527,7 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
 }
 
 StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug,
-                                          RefineFigures* figures) {
+                                          bool measure_only, RefineFigures* figures) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "refine";
@@ -509,9 +558,9 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   };
   if (options_.refine.pose) {  // every buffer's matches first, then one pose for all
     for_each_buffer(&PaintSession::EstimateBuffer);
-    CorrectThroughPose(todo, fresh, &results, &report);
+    CorrectThroughPose(todo, fresh, measure_only, &results, &report);
     if (results.size() > todo.size()) todo.insert(todo.end(), fresh.begin(), fresh.end());
-    for_each_buffer(&PaintSession::FinishBuffer);
+    if (!measure_only) for_each_buffer(&PaintSession::FinishBuffer);
   } else {  // each buffer on its own; the frame's misalignment pooled over their inliers
     for_each_buffer(&PaintSession::EstimateBuffer);
     double sum_sq = 0;
@@ -521,7 +570,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
       pooled += r.estimate.inliers;
     }
     if (pooled > 0) frame_misalignment_px_ = std::sqrt(sum_sq / pooled);
-    for_each_buffer(&PaintSession::FinishBuffer);
+    if (!measure_only) for_each_buffer(&PaintSession::FinishBuffer);
   }
 
   int refined = 0, fell_back = 0, corners = 0, matches = 0, inliers = 0, ambiguous = 0, moved = 0,
@@ -540,7 +589,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     corners += e.corners, matches += e.matches, inliers += e.inliers, ambiguous += e.ambiguous;
     before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
     after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
-    if (e.applied) {
+    if (e.applied && !measure_only) {
       ++refined;
       ++models[MotionModelName(e.model)];
       correction = std::max(correction, e.correction_px);
@@ -578,6 +627,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   for (const auto& [reason, n] : reasons)
     why += (why.empty() ? "" : "; ") + reason + " x" + std::to_string(n);
   if (!why.empty()) report.notes["not refined"] = why;
+  if (measure_only) report.notes["not refined"] = "measured only (refine.mode auto, deciding)";
   report.wall_ms = MsSince(start);
   return report;
 }

@@ -28,15 +28,16 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/core/video_source.h"
+#include "pipeline/paint/auto_modes.h"
 #include "pipeline/paint/background_model.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/refine_alignment.h"
 #include "pipeline/paint/refine_anchor.h"
-#include "pipeline/paint/texture_atlas.h"
 #include "pipeline/paint/refine_pose.h"
 #include "pipeline/paint/stage_report.h"
+#include "pipeline/paint/texture_atlas.h"
 #include "pipeline/render/rasterizer.h"
 
 namespace fresco {
@@ -86,7 +87,13 @@ class PaintSession {
 
   // Debug images on or off from the next frame on (the app asks only for frames it shows).
   void set_debug_images(bool on) { options_.debug_images = on; }
+  // The options in force: `auto` modes show what they resolved to so far (refine.mode
+  // robust or off, background.mode robust or off; robust while deciding).
   const PipelineOptions& options() const { return options_; }
+  // What the `auto` modes decided so far, and on what evidence (auto_modes.h).
+  AutoDecisions auto_decisions() const {
+    return {refine_auto_.decision(), background_auto_.decision()};
+  }
 
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
@@ -116,7 +123,16 @@ class PaintSession {
                      const std::function<void(size_t)>& fn) const;
   // The refinement stage over the buffers seen this frame (re-warps warped_); its typed
   // figures go to `figures` too.
-  StageReport RefineAlignment(const std::vector<bool>& seen, bool debug, RefineFigures* figures);
+  // `measure_only` (refine.mode auto, deciding): registers and measures the misalignment
+  // but corrects nothing.
+  StageReport RefineAlignment(const std::vector<bool>& seen, bool debug, bool measure_only,
+                              RefineFigures* figures);
+  // (Re)starts the `auto` modes: what they run while deciding, and their deciders.
+  void StartAutoModes();
+  // Feeds this frame's evidence (misalignment_px: measured by refinement this frame, texels;
+  // < 0 none) to the deciders, applies a decision taken and shows the state in `report`.
+  void UpdateAutoModes(int frame_number, double misalignment_px, const std::vector<bool>& seen,
+                       FrameReport* report);
   struct BufferRefinement;
   // Clears the frame's valid texels of buffer `b` (within `roi`) where the buffer is painted.
   void KeepOutOfPainted(size_t b, const cv::Rect& roi);
@@ -127,7 +143,8 @@ class PaintSession {
   // Replaces the buffers' estimates by what one correction of the frame's pose implies
   // (refine_pose.h); `fresh`: buffers seen but never painted, which get it too.
   void CorrectThroughPose(const std::vector<size_t>& todo, const std::vector<size_t>& fresh,
-                          std::vector<BufferRefinement>* results, StageReport* report);
+                          bool measure_only, std::vector<BufferRefinement>* results,
+                          StageReport* report);
   // The background stage over the buffers seen this frame (fills background_frame_).
   StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
   // The exposure and select stages (select_stages.cc) over the buffers seen this frame.
@@ -140,6 +157,11 @@ class PaintSession {
 
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
+  RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)
+  BackgroundMode requested_background_ = BackgroundMode::kOff;
+  int expected_frames_ = 0;  // the poses the inputs promised (0: unknown)
+  RefineAutoDecider refine_auto_;
+  BackgroundAutoDecider background_auto_;
   double texel_size_m_ = 0.0;
   BaseBufferSet set_;
   TextureAtlas atlas_;  // where each buffer goes in PaintedScene()

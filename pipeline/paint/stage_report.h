@@ -18,10 +18,10 @@
 namespace fresco {
 
 struct StageReport {
-  std::string name;                        // "depth", "warp", "paint", ...
+  std::string name;  // "depth", "warp", "paint", ...
   double wall_ms = 0.0;
-  std::map<std::string, double> metrics;   // e.g. {"texels_visible", 12345}
-  std::map<std::string, cv::Mat> images;   // debug images (BGR or gray), only when asked
+  std::map<std::string, double> metrics;     // e.g. {"texels_visible", 12345}
+  std::map<std::string, cv::Mat> images;     // debug images (BGR or gray), only when asked
   std::map<std::string, std::string> notes;  // words: chosen model, why no correction, ...
 };
 
@@ -51,15 +51,62 @@ struct RefineFigures {
   }
 };
 
+// What an `auto` mode (refine.mode, background.mode) decided and on what evidence
+// (auto_modes.h): the figure measured on the capture itself, the threshold it was compared
+// with and the frames it was measured over. Deciding until the decision point, then fixed
+// for the rest of the session.
+struct AutoDecision {
+  enum class State { kNotAuto, kDeciding, kOn, kOff };
+  State state = State::kNotAuto;
+  double evidence = std::numeric_limits<double>::quiet_NaN();
+  double threshold = std::numeric_limits<double>::quiet_NaN();
+  int frames_measured = 0;
+  int decided_at_frame = -1;  // the session's frame number where it was decided; -1: not yet
+
+  bool is_auto() const { return state != State::kNotAuto; }
+  // "deciding" | "on" | "off" ("" when the mode is not auto).
+  const char* StateName() const {
+    switch (state) {
+      case State::kDeciding:
+        return "deciding";
+      case State::kOn:
+        return "on";
+      case State::kOff:
+        return "off";
+      default:
+        return "";
+    }
+  }
+  // One line for people: "on: 1.84 > 0.6 over 6 frames (decided at frame 7)" (the figure's
+  // meaning is the mode's: AutoDecisions); "" when not auto.
+  std::string Describe() const;
+  // Shows it in a stage's metrics (auto_decision: 0 deciding, 1 on, -1 off; auto_evidence,
+  // auto_threshold) and notes (auto: Describe()).
+  void PutInto(StageReport* stage) const {
+    if (!is_auto()) return;
+    stage->metrics["auto_decision"] =
+        state == State::kOn ? 1.0 : (state == State::kOff ? -1.0 : 0.0);
+    stage->metrics["auto_evidence"] = evidence;
+    stage->metrics["auto_threshold"] = threshold;
+    stage->notes["auto"] = Describe();
+  }
+};
+
+struct AutoDecisions {
+  AutoDecision refine;      // evidence: median misalignment of the first frames, texels
+  AutoDecision background;  // evidence: foreground fraction of the warmed-up texels
+};
+
 struct FrameReport {
   int frame = -1;
   std::string name;
-  bool painted = false;          // false when skipped (no pose, update_every, ...)
-  std::string skipped_reason;    // why not painted
+  bool painted = false;        // false when skipped (no pose, update_every, ...)
+  std::string skipped_reason;  // why not painted
   std::vector<StageReport> stages;
   double total_ms = 0.0;
-  PaintFigures paint;    // when painted
-  RefineFigures refine;  // when the refine stage ran (Stage("refine") != nullptr)
+  PaintFigures paint;       // when painted
+  RefineFigures refine;     // when the refine stage ran (Stage("refine") != nullptr)
+  AutoDecisions decisions;  // the `auto` modes' state after this frame
 
   StageReport* Stage(const std::string& name) {
     for (auto& s : stages)

@@ -172,10 +172,12 @@ TEST_F(EvalCiTest, EveryCaptureIsScoredAgainstTheTruth) {
                Get("defaults", "ci-room-clean").generated);
 }
 
-// On perfect poses the defaults (background robust) may cost little against painting
-// without a background model.
+// On perfect poses the defaults (background and refinement `auto`) may cost little against
+// painting without a background model, and refinement decides off: the poses are right.
 TEST_F(EvalCiTest, DefaultsOnPerfectPosesAreWithinHalfADecibelOfBackgroundOff) {
   for (const char* capture : {"ci-room-clean", "ci-street-clean", "ci-facade-clean"}) {
+    const AutoDecision& refine = Get("defaults", capture).decisions.refine;
+    EXPECT_EQ(refine.state, AutoDecision::State::kOff) << capture << ": " << refine.Describe();
     EXPECT_GT(Get("defaults", capture).truth_psnr_db,
               Get("background off", capture).truth_psnr_db - 0.5)
         << capture;
@@ -200,6 +202,9 @@ TEST_F(EvalCiTest, BackgroundModelKeepsMoversOut) {
   const CaptureEval& robust = Get("defaults", "ci-room-movers");
   const CaptureEval& off = Get("background off", "ci-room-movers");
   ASSERT_TRUE(robust.has_movers);
+  // The defaults' background `auto` sees the movers and keeps the model on.
+  EXPECT_EQ(robust.decisions.background.state, AutoDecision::State::kOn)
+      << robust.decisions.background.Describe();
   // Measured: 4.84 % without the model, 0.137 % with it.
   EXPECT_GT(off.mover_leak, 0.02);  // the movers do leak without the model
   EXPECT_LT(robust.mover_leak, 0.003);

@@ -33,36 +33,6 @@ namespace {
 
 Scene Room() { return testing::RoomScene(); }
 
-SynthOptions MoverCapture(int frames, double exposure_jitter) {
-  SynthOptions o = testing::HandheldRoomCapture(frames, 0.5);
-  o.turns = 0.5;
-  o.look_at_target = false;
-  o.tilt_deg = 20;
-  // The paper's fig. 6: objects moving in front of the walls while the camera looks around.
-  auto mover = [](MoverShape shape, double radius_m, cv::Vec3b rgb, Eigen::Vector3d start,
-                  Eigen::Vector3d end, double period_frames, double phase) {
-    MoverOptions m;
-    m.shape = shape;
-    m.radius_m = radius_m;
-    m.rgb = rgb;
-    m.start = start;
-    m.end = end;
-    m.period_frames = period_frames;
-    m.phase = phase;
-    m.spin_deg_per_frame = shape == MoverShape::kBox ? 4.0 : 0.0;
-    return m;
-  };
-  o.movers = {
-      mover(MoverShape::kSphere, 0.25, {255, 220, 0}, {-1.4, 1.2, 1.3}, {1.4, 1.2, 1.3}, 24, 0),
-      mover(MoverShape::kBox, 0.2, {220, 40, 30}, {1.3, 0.8, -1.4}, {1.3, 0.8, 1.4}, 30, 0.3),
-      mover(MoverShape::kSphere, 0.2, {40, 80, 230}, {-1.3, 1.9, -1.3}, {1.3, 1.9, -1.3}, 20, 0.6),
-      mover(MoverShape::kBox, 0.25, {30, 160, 60}, {-1.3, 0.6, 1.2}, {-1.3, 0.6, -1.2}, 28, 0.1),
-  };
-  o.exposure_jitter = exposure_jitter;
-  o.seed = 5;
-  return o;
-}
-
 struct MoverFigures {
   long long painted = 0;        // on-surface texels painted at the end
   long long painted_mover = 0;  // ... whose colour came from a mover
@@ -176,9 +146,11 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
   const double exposure_jitter = GetParam();
   const Scene scene = Room();
   SynthCapture capture;
-  ASSERT_TRUE(SynthesizeCapture(scene, MoverCapture(150, exposure_jitter), &capture).ok());
+  ASSERT_TRUE(
+      SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, exposure_jitter), &capture).ok());
   ASSERT_GE(capture.movers.size(), 3u);
   PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;  // perfect poses: the background models alone
   std::map<BackgroundMode, MoverFigures> figures;
   for (BackgroundMode mode :
        {BackgroundMode::kOff, BackgroundMode::kAverage, BackgroundMode::kRobust}) {
@@ -252,6 +224,7 @@ cv::Mat LearnBackground(const std::string& video, BackgroundMode mode, const std
   inputs.scene = &scene;
   inputs.pipeline.texel_size_m = s;
   inputs.pipeline.background.mode = mode;
+  inputs.pipeline.refine.mode = RefineMode::kOff;  // a static camera: nothing to align
   std::unique_ptr<PaintSession> session;
   EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
   FrameReport report;

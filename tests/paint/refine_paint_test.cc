@@ -24,6 +24,7 @@ class RefinePainting : public ::testing::Test {
     ASSERT_TRUE(MakeRefineScenario(300, 0.5, scenario_).ok());
     PipelineOptions options;
     options.background.mode = BackgroundMode::kOff;  // measure refinement alone
+    options.refine.mode = RefineMode::kOff;
     perfect_ = new PaintedScenario;
     ASSERT_TRUE(PaintScenario(*scenario_, scenario_->capture.true_poses, options, perfect_).ok());
     perfect_psnr_ = ScenarioPsnr(*scenario_, perfect_->scene);
@@ -64,6 +65,7 @@ TEST_F(RefinePainting, AnchoredRobustRefinementRecoversMostOfThePsnrLostToPoseNo
   const std::vector<PosedImage>& noisy_poses = scenario_->capture.given_poses;
   PipelineOptions options;
   options.background.mode = BackgroundMode::kOff;
+  options.refine.mode = RefineMode::kOff;
   const Row noisy = Measure("0.5 deg noise, no refine", noisy_poses, options, 0);  // recovers 0
   const double noisy_psnr = noisy.psnr;
   std::printf("perfect poses: PSNR %.2f dB\n", perfect_psnr_);

@@ -91,6 +91,7 @@ TEST(ViewSelect, ExposureChangesPaintOneConsistentTexture) {
 
   PipelineOptions off;
   off.background.mode = BackgroundMode::kOff;  // the gain alone, not the background model's
+  off.refine.mode = RefineMode::kOff;
   off.select.enabled = false;
   PipelineOptions no_exposure = off;
   no_exposure.select.enabled = true;
@@ -156,9 +157,11 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
     }
     return psnr;
   };
-  PipelineOptions off;
+  PipelineOptions off;  // the robust background model, no refinement
+  off.background.mode = BackgroundMode::kRobust;
+  off.refine.mode = RefineMode::kOff;
   off.select.enabled = false;
-  PipelineOptions on;
+  PipelineOptions on = off;
   on.select.enabled = true;
   double ncc_off = 0, ncc_on = 0;
   const double psnr_off = score(off, &ncc_off);

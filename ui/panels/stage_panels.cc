@@ -44,11 +44,18 @@ class StagePanel : public Panel {
     const StageReport* stage = nullptr;
     for (const StageReport& s : snap.report.stages)
       if (s.name == stage_) stage = &s;
+    // An `auto` mode that decided off drops its stage: say why.
+    const AutoDecision* decision = stage_ == "refine"       ? &snap.report.decisions.refine
+                                   : stage_ == "background" ? &snap.report.decisions.background
+                                                            : nullptr;
     if (!stage) {
-      ImGui::TextDisabled(
-          "%s", !snap.report.skipped_reason.empty() ? snap.report.skipped_reason.c_str()
-                : snap.report.stages.empty()        ? "no frame painted yet"
-                                             : "stage not running (off in the pipeline settings)");
+      const bool decided_off = decision && decision->is_auto() && !snap.report.stages.empty();
+      ImGui::TextDisabled("%s", !snap.report.skipped_reason.empty()
+                                    ? snap.report.skipped_reason.c_str()
+                                : snap.report.stages.empty() ? "no frame painted yet"
+                                : decided_off ? "stage not running: mode auto decided off"
+                                              : "stage not running (off in the pipeline settings)");
+      if (decided_off) ImGui::TextWrapped("auto: %s", decision->Describe().c_str());
       ImGui::End();
       return;
     }

@@ -1,0 +1,108 @@
+#include "pipeline/paint/auto_modes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+namespace fresco {
+
+std::string AutoDecision::Describe() const {
+  if (!is_auto()) return "";
+  char line[160];
+  if (!std::isfinite(evidence)) {
+    std::snprintf(line, sizeof line, "%s: no evidence yet%s", StateName(),
+                  state == State::kOff ? " (view selection runs without refinement)" : "");
+    if (state == State::kDeciding) std::snprintf(line, sizeof line, "deciding: no evidence yet");
+    return line;
+  }
+  const char* relation = evidence > threshold ? ">" : "<=";
+  if (state == State::kDeciding)
+    std::snprintf(line, sizeof line, "deciding: %.3g %s %.3g over %d frames so far", evidence,
+                  relation, threshold, frames_measured);
+  else
+    std::snprintf(line, sizeof line, "%s: %.3g %s %.3g over %d frames (decided at frame %d)",
+                  StateName(), evidence, relation, threshold, frames_measured, decided_at_frame);
+  return line;
+}
+
+namespace {
+
+nlohmann::json DecisionJson(const AutoDecision& d) {
+  if (!d.is_auto()) return nullptr;
+  return {{"decision", d.StateName()},
+          {"evidence", std::isfinite(d.evidence) ? nlohmann::json(d.evidence) : nullptr},
+          {"threshold", d.threshold},
+          {"frames_measured", d.frames_measured},
+          {"decided_at_frame", d.decided_at_frame}};
+}
+
+}  // namespace
+
+std::string AutoDecisionsJson(const AutoDecisions& decisions) {
+  const nlohmann::json j = {{"refine", DecisionJson(decisions.refine)},
+                            {"background", DecisionJson(decisions.background)}};
+  return j.dump();
+}
+
+void RefineAutoDecider::Start(bool enabled) {
+  decision_ = AutoDecision();
+  samples_.clear();
+  if (!enabled) return;
+  decision_.state = AutoDecision::State::kDeciding;
+  decision_.threshold = kRefineAutoThresholdPx;
+}
+
+bool RefineAutoDecider::AddFrame(int frame_number, double misalignment_px) {
+  if (!deciding()) return false;
+  if (misalignment_px >= 0) {
+    samples_.push_back(misalignment_px);
+    decision_.frames_measured = static_cast<int>(samples_.size());
+    std::vector<double> sorted = samples_;
+    std::sort(sorted.begin(), sorted.end());
+    const size_t n = sorted.size();
+    decision_.evidence = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
+  }
+  if (decision_.frames_measured < kRefineAutoFrames && frame_number < kRefineAutoLastFrame)
+    return false;
+  decision_.state = decision_.evidence > decision_.threshold ? AutoDecision::State::kOn
+                                                             : AutoDecision::State::kOff;
+  decision_.decided_at_frame = frame_number;
+  return true;
+}
+
+void RefineAutoDecider::DecideOff(int frame_number) {
+  if (!deciding()) return;
+  decision_.state = AutoDecision::State::kOff;
+  decision_.decided_at_frame = frame_number;
+}
+
+void BackgroundAutoDecider::Start(bool enabled, int warmup_frames, int expected_frames) {
+  decision_ = AutoDecision();
+  warmup_frames_ = warmup_frames;
+  last_frames_ = expected_frames > 0 ? std::clamp(expected_frames / 3, kBackgroundAutoFrames,
+                                                  kBackgroundAutoMaxFrames)
+                                     : kBackgroundAutoMaxFrames;
+  trusted_ = masked_ = 0;
+  if (!enabled) return;
+  decision_.state = AutoDecision::State::kDeciding;
+  decision_.threshold = kBackgroundAutoThreshold;
+}
+
+bool BackgroundAutoDecider::AddFrame(int frame_number, long long observed, long long warming,
+                                     long long masked) {
+  if (!deciding() || frame_number < warmup_frames_) return false;
+  trusted_ += std::max(0LL, observed - warming);
+  masked_ += masked;
+  ++decision_.frames_measured;
+  if (trusted_ > 0) decision_.evidence = static_cast<double>(masked_) / trusted_;
+  if (decision_.frames_measured < kBackgroundAutoFrames) return false;
+  const bool on = decision_.evidence > decision_.threshold;
+  if (!on && decision_.frames_measured < last_frames_) return false;
+  decision_.state = on ? AutoDecision::State::kOn : AutoDecision::State::kOff;
+  decision_.decided_at_frame = frame_number;
+  return true;
+}
+
+}  // namespace fresco

@@ -1,0 +1,80 @@
+// The `auto` value of refine.mode and background.mode: model only what the capture needs,
+// decided from evidence measured on the capture itself (never from any ground truth), at a
+// fixed decision point so the same input always gives the same result.
+//
+//   refinement  While deciding, each frame is registered to what the buffers hold but not
+//               corrected (painting is what `off` paints). After `kRefineAutoFrames` frames
+//               with a measurement, the median of their misalignment (the pose fit's RMS over
+//               its inliers, texels) is compared with `kRefineAutoThresholdPx`: above, `robust`
+//               refines every later frame; below, refinement stops (no further cost).
+//   background  The robust model runs from the start (masking as `robust` does). Once its
+//               texels have warmed up, the foreground it finds among the texels it trusts is
+//               counted frame by frame: once a fraction above `kBackgroundAutoThreshold`
+//               (movers, or misaligned samples it keeps out) is seen after
+//               `kBackgroundAutoFrames` frames, it stays; if none by a third of the capture,
+//               the model is dropped and painting continues as `off`.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/paint/stage_report.h"
+
+namespace fresco {
+
+// Perfect poses measure 0.15-0.45 texels of misalignment, 0.5 degree of pose noise about 2
+// (docs/results.md, "Evaluation suite").
+constexpr double kRefineAutoThresholdPx = 0.6;
+constexpr int kRefineAutoFrames = 6;
+// Refinement decides by this frame whatever it measured (off without a measurement: frames
+// too small or too plain to register).
+constexpr int kRefineAutoLastFrame = 20;
+constexpr double kBackgroundAutoThreshold = 0.01;
+// The background decides on as soon as the fraction exceeds the threshold after this many
+// frames, off when it has not after a third of the expected frames (at least this many, at
+// most kBackgroundAutoMaxFrames): movers may enter late.
+constexpr int kBackgroundAutoFrames = 8;
+constexpr int kBackgroundAutoMaxFrames = 60;
+
+// {"refine": D, "background": D} as JSON text, D = {"decision", "evidence", "threshold",
+// "frames_measured", "decided_at_frame"} or null when that mode is not auto (metrics.json,
+// eval.json).
+std::string AutoDecisionsJson(const AutoDecisions& decisions);
+
+// Collects the refinement evidence frame by frame and decides once.
+class RefineAutoDecider {
+ public:
+  // `enabled`: the mode is auto (else the decision stays kNotAuto).
+  void Start(bool enabled);
+  // One frame's misalignment to the buffers, texels (< 0: could not tell; not counted).
+  // `frame_number`: the session's frame count. Returns true when this frame decided.
+  bool AddFrame(int frame_number, double misalignment_px);
+  // Decides now (off) without evidence, e.g. when view selection excludes refinement.
+  void DecideOff(int frame_number);
+  const AutoDecision& decision() const { return decision_; }
+  bool deciding() const { return decision_.state == AutoDecision::State::kDeciding; }
+
+ private:
+  AutoDecision decision_;
+  std::vector<double> samples_;
+};
+
+// Collects the background evidence frame by frame and decides once.
+class BackgroundAutoDecider {
+ public:
+  // `warmup_frames`: the model's warm-up; evidence counts from then on. `expected_frames`:
+  // the frames the capture promises (0: unknown).
+  void Start(bool enabled, int warmup_frames, int expected_frames);
+  // One frame's counts over the buffers seen: texels observed, still warming up, masked.
+  // Returns true when this frame decided.
+  bool AddFrame(int frame_number, long long observed, long long warming, long long masked);
+  const AutoDecision& decision() const { return decision_; }
+  bool deciding() const { return decision_.state == AutoDecision::State::kDeciding; }
+
+ private:
+  AutoDecision decision_;
+  int warmup_frames_ = 0, last_frames_ = kBackgroundAutoMaxFrames;
+  long long trusted_ = 0, masked_ = 0;
+};
+
+}  // namespace fresco

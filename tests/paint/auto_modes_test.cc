@@ -1,0 +1,142 @@
+// The `auto` modes (pipeline/paint/auto_modes.h) against ground truth: the synthetic capture
+// knows whether its poses carry noise and whether anything moves, the session does not.
+//   refinement  the refinement scenario's room (tests/paint/refine_scenario.h), 60 frames,
+//               painted at the true poses (auto must decide off and paint exactly what `off`
+//               paints) and at poses with 0.5 degree of rotation noise (auto must decide on
+//               and recover most of what `robust` recovers).
+//   background  the background test's room with movers going back and forth in front of the
+//               walls (decide on) and the same capture without them (decide off).
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/paint/auto_modes.h"
+#include "tests/paint/refine_scenario.h"
+#include "tests/paint/room_capture.h"
+#include "tests/paint/synth_session.h"
+
+namespace fresco::testing {
+namespace {
+
+using State = AutoDecision::State;
+
+PipelineOptions RefineOnly(RefineMode mode) {
+  PipelineOptions options;
+  options.background.mode = BackgroundMode::kOff;  // refinement alone
+  options.refine.mode = mode;
+  return options;
+}
+
+// Paints the scenario and returns the last frame's decisions.
+AutoDecisions Paint(const RefineScenario& scenario, const std::vector<PosedImage>& poses,
+                    const PipelineOptions& options, PaintedScenario* painted) {
+  AutoDecisions last;
+  EXPECT_TRUE(PaintScenario(scenario, poses, options, painted, [&](const FrameReport& r) {
+                last = r.decisions;
+              }).ok());
+  return last;
+}
+
+bool SameBuffers(const PaintSession& a, const PaintSession& b) {
+  if (a.painted().size() != b.painted().size()) return false;
+  for (size_t i = 0; i < a.painted().size(); ++i)
+    if (cv::norm(a.painted()[i].bgra, b.painted()[i].bgra, cv::NORM_INF) != 0) return false;
+  return true;
+}
+
+TEST(AutoRefine, OffOnPerfectPosesOnWithPoseNoise) {
+  RefineScenario scenario;
+  ASSERT_TRUE(MakeRefineScenario(60, 0.5, &scenario).ok());
+  const std::vector<PosedImage>& truth = scenario.capture.true_poses;
+  const std::vector<PosedImage>& noisy = scenario.capture.given_poses;
+
+  PaintedScenario off, automatic;
+  Paint(scenario, truth, RefineOnly(RefineMode::kOff), &off);
+  const AutoDecision perfect =
+      Paint(scenario, truth, RefineOnly(RefineMode::kAuto), &automatic).refine;
+  std::printf("perfect poses: auto %s\n", perfect.Describe().c_str());
+  EXPECT_EQ(perfect.state, State::kOff);
+  EXPECT_EQ(perfect.frames_measured, kRefineAutoFrames);
+  EXPECT_LT(perfect.evidence, kRefineAutoThresholdPx);
+  // Measuring corrects nothing: what auto paints is what off paints, texel for texel.
+  EXPECT_TRUE(SameBuffers(*automatic.session, *off.session));
+
+  PaintedScenario noisy_off, noisy_robust, noisy_auto;
+  Paint(scenario, noisy, RefineOnly(RefineMode::kOff), &noisy_off);
+  Paint(scenario, noisy, RefineOnly(RefineMode::kRobust), &noisy_robust);
+  const AutoDecision with_noise =
+      Paint(scenario, noisy, RefineOnly(RefineMode::kAuto), &noisy_auto).refine;
+  std::printf("0.5 deg of noise: auto %s\n", with_noise.Describe().c_str());
+  EXPECT_EQ(with_noise.state, State::kOn);
+  EXPECT_GT(with_noise.evidence, 2 * kRefineAutoThresholdPx);
+  const double psnr_off = ScenarioPsnr(scenario, noisy_off.scene);
+  const double psnr_robust = ScenarioPsnr(scenario, noisy_robust.scene);
+  const double psnr_auto = ScenarioPsnr(scenario, noisy_auto.scene);
+  const double psnr_perfect = ScenarioPsnr(scenario, off.scene);
+  std::printf("truth PSNR: perfect poses %.2f dB; noisy: off %.2f, robust %.2f, auto %.2f dB\n",
+              psnr_perfect, psnr_off, psnr_robust, psnr_auto);
+  // Auto refines all but its first frames: it keeps most of robust's gain.
+  ASSERT_GT(psnr_robust, psnr_off + 1.0);
+  EXPECT_GT(psnr_auto - psnr_off, 0.6 * (psnr_robust - psnr_off));
+}
+
+// The background test's room with movers (40 frames), or the same without them.
+SynthOptions RoomWithMovers(bool movers) {
+  SynthOptions o = RoomCaptureWithMovers(40, 0.0);
+  if (!movers) o.movers.clear();
+  return o;
+}
+
+AutoDecision BackgroundDecision(bool movers) {
+  const Scene scene = RoomScene();
+  SynthCapture capture;
+  EXPECT_TRUE(SynthesizeCapture(scene, RoomWithMovers(movers), &capture).ok());
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kAuto;
+  std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
+  FrameReport report;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    PaintCaptureFrame(session.get(), capture, i, &report);
+  // The options in force show what it resolved to.
+  EXPECT_EQ(session->options().background.mode, report.decisions.background.state == State::kOn
+                                                    ? BackgroundMode::kRobust
+                                                    : BackgroundMode::kOff);
+  std::printf("%s: background auto %s\n", movers ? "movers" : "no movers",
+              report.decisions.background.Describe().c_str());
+  return report.decisions.background;
+}
+
+TEST(AutoBackground, OnWithMoversOffWithout) {
+  const AutoDecision with_movers = BackgroundDecision(true);
+  EXPECT_EQ(with_movers.state, State::kOn);
+  EXPECT_EQ(with_movers.frames_measured, kBackgroundAutoFrames);
+  const AutoDecision without = BackgroundDecision(false);
+  EXPECT_EQ(without.state, State::kOff);
+  EXPECT_GT(without.frames_measured, kBackgroundAutoFrames);  // movers could still come
+  EXPECT_LT(without.evidence, with_movers.evidence / 3);
+}
+
+TEST(AutoDecisionReport, ShowsEvidenceAndThreshold) {
+  RefineAutoDecider decider;
+  decider.Start(true);
+  for (int f = 1; f < kRefineAutoFrames; ++f) EXPECT_FALSE(decider.AddFrame(f, 2.0));
+  EXPECT_FALSE(decider.AddFrame(kRefineAutoFrames, -1));  // no measurement: not counted
+  EXPECT_EQ(decider.decision().state, State::kDeciding);
+  EXPECT_TRUE(decider.AddFrame(kRefineAutoFrames + 1, 0.1));
+  EXPECT_EQ(decider.decision().state, State::kOn);  // median of five 2.0 and one 0.1
+  EXPECT_DOUBLE_EQ(decider.decision().evidence, 2.0);
+  StageReport stage;
+  decider.decision().PutInto(&stage);
+  EXPECT_EQ(stage.metrics.at("auto_decision"), 1.0);
+  EXPECT_EQ(stage.metrics.at("auto_threshold"), kRefineAutoThresholdPx);
+  EXPECT_EQ(stage.notes.at("auto"), "on: 2 > 0.6 over 6 frames (decided at frame 7)");
+  const std::string json = AutoDecisionsJson({decider.decision(), AutoDecision()});
+  EXPECT_NE(json.find("\"decision\":\"on\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"background\":null"), std::string::npos) << json;
+}
+
+}  // namespace
+}  // namespace fresco::testing
