@@ -228,7 +228,7 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"tolerance_m\"",     "\"max_view_angle_deg\"",
                           "\"grouping\"",        "\"angle_deg\"",
                           "\"edits\"",           "\"truth\"",
-                          "\"background\"",      "\"mode\": \"robust\"",
+                          "\"background\"",      "\"mode\": \"auto\"",
                           "\"window_frames\"",   "\"dilate_texels\"",
                           "\"atlas\"",           "\"page_size\"",
                           "\"select\"",          "\"switch_margin\"",

@@ -202,7 +202,9 @@ TEST(Refine, ExtremesFallBackToNoCorrectionAndSaySo) {
   EXPECT_FALSE(e.applied);
   EXPECT_EQ(e.fallback, "too little painted overlap");
   // Off.
-  e = EstimateRefinement(w.bgr, w.valid, buffer, RefineOptions());
+  RefineOptions off;
+  off.mode = RefineMode::kOff;
+  e = EstimateRefinement(w.bgr, w.valid, buffer, off);
   EXPECT_EQ(e.fallback, "off");
 }
 
