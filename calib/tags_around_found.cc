@@ -93,11 +93,13 @@ int FindTagsAroundFound(const cv::Mat& gray, const BoardSpec& spec, const TagDet
                         std::map<int, TagQuad>* found) {
   const int num_ids = spec.cols * spec.rows;
   int added = 0;
-  std::vector<bool> tried_with(num_ids, false);  // tried with the neighbours found so far
+  // How many found neighbours each missing tag was last tried with: found tags only grow, so
+  // the same count is the same neighbours, the same homography and the same answer.
+  std::vector<int> tried_with(num_ids, 0);
   for (int round = 0; round < kMaxRounds && static_cast<int>(found->size()) < num_ids; ++round) {
     std::map<int, TagQuad> new_tags;
     for (int id = 0; id < num_ids; ++id) {
-      if (found->count(id) || tried_with[id]) continue;
+      if (found->count(id)) continue;
       const int col = id % spec.cols, row = id / spec.cols;
       std::vector<cv::Point2f> board, image;
       int tags = 0;
@@ -115,8 +117,8 @@ int FindTagsAroundFound(const cv::Mat& gray, const BoardSpec& spec, const TagDet
                                static_cast<float>(it->second.p[k].y()));
           }
         }
-      if (tags < kMinNeighbourTags) continue;
-      tried_with[id] = true;
+      if (tags < kMinNeighbourTags || tags == tried_with[id]) continue;
+      tried_with[id] = tags;
       const cv::Mat h = cv::findHomography(board, image, 0);
       if (h.empty()) continue;
       TagQuad quad;
@@ -129,8 +131,6 @@ int FindTagsAroundFound(const cv::Mat& gray, const BoardSpec& spec, const TagDet
     if (new_tags.empty()) break;
     added += static_cast<int>(new_tags.size());
     found->insert(new_tags.begin(), new_tags.end());
-    // Tags not found yet are tried again with the new neighbours.
-    std::fill(tried_with.begin(), tried_with.end(), false);
   }
   return added;
 }
