@@ -29,6 +29,15 @@ void SetNormalCone(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
 // Marks a full tile whose stored points are affine in the texel coordinates (least squares
 // over the tile, every texel within one quantization step per axis), and whose normals are
 // all the same (BaseBuffer::Chunk::affine, uniform_normal).
+void SetFullTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
+  const int tw = chunk->x1 - chunk->x0, th = chunk->y1 - chunk->y0;
+  if (chunk->end - chunk->begin != tw * th) return;
+  for (int row = 0, k = chunk->begin; row < th; ++row)
+    for (int col = 0; col < tw; ++col, ++k)
+      if (buffer.texel_index[k] != (chunk->y0 + row) * buffer.width + chunk->x0 + col) return;
+  chunk->full = true;
+}
+
 void SetAffineTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   const int tw = chunk->x1 - chunk->x0, th = chunk->y1 - chunk->y0;
   if (chunk->end - chunk->begin != tw * th) return;
@@ -323,6 +332,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       }
       chunk.end = buffer.NumTexels();
       SetNormalCone(buffer, &chunk);
+      SetFullTile(buffer, &chunk);
       SetAffineTile(buffer, &chunk);
       if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
     }

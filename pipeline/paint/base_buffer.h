@@ -63,6 +63,9 @@ struct BaseBuffer {
     // of reading them, and when every texel has the same normal (`uniform_normal`: stored
     // as `normal`) reads no normal either: bandwidth the kernel would spend per texel.
     bool affine = false, uniform_normal = false;
+    // Every texel of the rectangle stored, row by row (texel begin + r * (x1 - x0) + c is
+    // column x0 + c of row y0 + r): a row of the tile is a run of the buffer's row.
+    bool full = false;
     Eigen::Vector3f affine_origin = Eigen::Vector3f::Zero();
     Eigen::Vector3f affine_du = Eigen::Vector3f::Zero(), affine_dv = Eigen::Vector3f::Zero();
     Eigen::Vector3f normal = Eigen::Vector3f::Zero();  // as stored (dequantized)

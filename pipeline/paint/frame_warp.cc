@@ -328,13 +328,14 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
   const float* __restrict ax = proj->ax;
   const float* __restrict ay = proj->ay;
   const float* __restrict quality = proj->quality;
+  const int32_t* __restrict code = proj->code;
   uint32_t* __restrict out = b->out;
   float* __restrict out_q = b->out_q;
   int32_t* __restrict write_out = b->write;
   const int by_quality = quality_policy;
   int visible = 0, compared = 0, rejected = 0, written = 0, newly = 0, diff_sum = 0;
   for (int j = 0; j < n; ++j) {
-    int ok = 1;
+    int ok = code[j] == 2;  // in view (the others read pixel (0, 0) and are left alone)
     if constexpr (kDepth) {
       const float zz = z[j], t = tol[j];
       ok &= (std::abs(d00[j] - zz) <= t) & (std::abs(d10[j] - zz) <= t) &
@@ -393,17 +394,21 @@ __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDep
   return PaintBatchBody<false>(n, quality_policy, keep, proj, b);
 }
 
-bool AllInView(const ChunkProjection& proj, int n) {
-  int in_view = 0;
-  for (int i = 0; i < n; ++i) in_view += proj.code[i] == 2;
-  return in_view == n;
+// How many texels of a projected chunk are in view (code 2) and how many grazing (code 1).
+void CountCodes(const ChunkProjection& proj, int n, int* in_view, int* grazing) {
+  int view = 0, graze = 0;
+  for (int i = 0; i < n; ++i) {
+    view += proj.code[i] == 2;
+    graze += proj.code[i] == 1;
+  }
+  *in_view = view, *grazing = graze;
 }
 
-// Gathers what every texel of a projected chunk reads (all in view), runs the batch, stores
-// what it wrote.
+// Gathers what every texel of a projected chunk reads, runs the batch, stores what it wrote.
+// Texels out of view (`in_view` of the chunk's `n` are in view) are masked in the batch.
 template <bool kDepth>
 void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
-                       const ChunkProjection& proj, Counts* counts) {
+                       const ChunkProjection& proj, int in_view, int grazing, Counts* counts) {
   PaintBatch batch;
   const int n = chunk.end - chunk.begin;
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
@@ -414,6 +419,23 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   const size_t depth_step = k.depth->step[0];
   const uint8_t* const bgra = k.paint_bgra;
   const float* const stored_quality = k.paint_quality;
+  // A full tile's rows are runs of the buffer's rows: its stored texels are read and written
+  // a row at a time. Otherwise texel by texel through texel_index.
+  const int tile_w = chunk.x1 - chunk.x0;
+  const size_t buffer_w = static_cast<size_t>(k.buffer->width);
+  if (chunk.full) {
+    for (int r = 0, i = 0; r < chunk.y1 - chunk.y0; ++r, i += tile_w) {
+      const size_t idx = static_cast<size_t>(chunk.y0 + r) * buffer_w + chunk.x0;
+      std::memcpy(&batch.stored[i], bgra + 4 * idx, 4 * tile_w);
+      std::memcpy(&batch.stored_q[i], stored_quality + idx, sizeof(float) * tile_w);
+    }
+  } else {
+    for (int i = 0; i < n; ++i) {
+      const size_t idx = static_cast<size_t>(texel_index[i]);
+      batch.stored[i] = Load32(bgra + 4 * idx);
+      batch.stored_q[i] = stored_quality[idx];
+    }
+  }
   for (int i = 0; i < n; ++i) {
     const int x0 = proj.x0[i], y0 = proj.y0[i];
     if constexpr (kDepth) {
@@ -429,9 +451,6 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
     batch.p10[i] = Load32(r0 + 2) >> 8;
     batch.p01[i] = Load32(r1);
     batch.p11[i] = Load32(r1 + 2) >> 8;
-    const size_t idx = static_cast<size_t>(texel_index[i]);
-    batch.stored[i] = Load32(bgra + 4 * idx);
-    batch.stored_q[i] = stored_quality[idx];
     batch.on_surface[i] = on_surface[i] != 0;
   }
   const bool by_quality = k.rule.policy == UpdatePolicy::kQuality;
@@ -439,14 +458,24 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
                                      : PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, &batch);
   uint8_t* const out_bgra = k.paint_bgra;
   float* const out_quality = k.paint_quality;
-  for (int i = 0; i < n; ++i) {
-    if (!batch.write[i]) continue;
-    const size_t idx = static_cast<size_t>(texel_index[i]);
-    std::memcpy(out_bgra + 4 * idx, &batch.out[i], 4);
-    out_quality[idx] = batch.out_q[i];
+  if (chunk.full) {
+    // Unwritten texels keep what they held (out and out_q are the stored values there), so
+    // whole rows are written back; no other thread touches this tile.
+    for (int r = 0, i = 0; r < chunk.y1 - chunk.y0; ++r, i += tile_w) {
+      const size_t idx = static_cast<size_t>(chunk.y0 + r) * buffer_w + chunk.x0;
+      std::memcpy(out_bgra + 4 * idx, &batch.out[i], 4 * tile_w);
+      std::memcpy(out_quality + idx, &batch.out_q[i], sizeof(float) * tile_w);
+    }
+  } else {
+    for (int i = 0; i < n; ++i) {
+      if (!batch.write[i]) continue;
+      const size_t idx = static_cast<size_t>(texel_index[i]);
+      std::memcpy(out_bgra + 4 * idx, &batch.out[i], 4);
+      out_quality[idx] = batch.out_q[i];
+    }
   }
-  counts->in_view += n, counts->visible += sums.visible;
-  counts->occluded += n - sums.visible;
+  counts->in_view += in_view, counts->visible += sums.visible;
+  counts->occluded += in_view - sums.visible, counts->grazing += grazing;
   PaintUpdateStats stats;
   stats.written = sums.written, stats.rejected = sums.rejected, stats.compared = sums.compared;
   stats.abs_grey_difference_sum = sums.abs_grey_difference_sum;
@@ -487,10 +516,17 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     ProjectChunkPinhole(k, *k.buffer, chunk, &proj);
 
   if constexpr (kPaint && kMode == SamplingMode::kBilinear) {
-    // Chunks wholly in view (most, inside the frame); the rest texel by texel (below),
-    // which skips those out of view.
-    if (k.rule.weight == 256 && AllInView(proj, n))
-      return PaintChunkBatched<kDepth>(k, chunk, proj, counts);
+    // The whole chunk as a batch, texels out of view masked (a chunk with none in view
+    // is only counted).
+    if (k.rule.weight == 256) {
+      int in_view, grazing;
+      CountCodes(proj, n, &in_view, &grazing);
+      if (in_view == 0) {
+        counts->grazing += grazing;
+        return;
+      }
+      return PaintChunkBatched<kDepth>(k, chunk, proj, in_view, grazing, counts);
+    }
   }
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
@@ -599,10 +635,13 @@ ChunkKernel SelectKernel(bool distorted, bool depth, SamplingMode mode) {
 }  // namespace
 
 NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
+  // The image border unprojected: its corners for a pinhole (straight edges), 256 samples per
+  // side for a lens with distortion (a few pixels apart: between them a smooth lens's border
+  // bulges by far less than the margin below).
+  const int steps = camera.HasDistortion() ? 256 : 1;
   NormalizedBounds b;
   b.x_min = b.y_min = std::numeric_limits<float>::max();
   b.x_max = b.y_max = -std::numeric_limits<float>::max();
-  const int steps = 32;
   for (int s = 0; s <= steps; ++s) {
     const double a = static_cast<double>(s) / steps;
     const Eigen::Vector2d border[4] = {{a * (camera.width - 1), 0.0},
@@ -618,8 +657,9 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
       b.y_max = std::max(b.y_max, static_cast<float>(n.y()));
     }
   }
-  // The border's extreme need not be at a sample (barrel distortion bulges): 10 % margin.
-  const float mx = 0.1f * (b.x_max - b.x_min), my = 0.1f * (b.y_max - b.y_min);
+  // A margin of 1 % and two pixels: rounding, the texels' 1/256 px edge slack, the bulge.
+  const float mx = 0.01f * (b.x_max - b.x_min) + static_cast<float>(2.0 / camera.fx);
+  const float my = 0.01f * (b.y_max - b.y_min) + static_cast<float>(2.0 / camera.fy);
   b.x_min -= mx, b.x_max += mx, b.y_min -= my, b.y_max += my;
   b.valid = true;
   return b;

@@ -27,6 +27,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include <opencv2/core/utility.hpp>
 
@@ -375,6 +376,44 @@ bool PolygonSlabRange(const TriangleSetup& s, const TrianglePolygon& poly, doubl
   return true;
 }
 
+// The nearest hit per sample as the largest inverse depth, for samples one thread owns:
+// RasterizeDepth's record. Its rows are scanned by MaxInverseDepthRow (below), which does for a
+// row of columns at once what the call operator does for one sample.
+struct NearestInverseDepth {
+  float* inv;       // the inverse depths so far (0: no hit)
+  double inv_near;  // hits nearer than the near plane are dropped
+  void operator()(int, int sample, float, float, double inv_z, const TriangleSetup&) const {
+    const float inv_zf = static_cast<float>(inv_z);
+    if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near) inv[sample] = inv_zf;
+  }
+};
+
+// The columns [c0, c1] of one sample row, `inv_row` its inverse depths: the inside test and the
+// nearest-hit update of ScanGridTriangle with NearestInverseDepth, branch-free so that it
+// vectorizes (the same float and double operations in the same order: the same result).
+__attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
+    const float* __restrict col_x, int c0, int c1, float y, const TriangleSetup& s,
+    double inv_near, float* __restrict inv_row) {
+  const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
+  const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
+  const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
+  const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
+  const float w0y = e01 * y, w1y = e11 * y, w2y = e21 * y;
+  const double iy = ib * static_cast<double>(y);
+  for (int c = c0; c <= c1; ++c) {
+    const float x = col_x[c];
+    const float w0 = e00 * x + w0y + e02;
+    const float w1 = e10 * x + w1y + e12;
+    const float w2 = e20 * x + w2y + e22;
+    const double inv_z = ia * static_cast<double>(x) + iy + ic;
+    const float inv_zf = static_cast<float>(inv_z);
+    const float current = inv_row[c];
+    const bool hit = !(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f) & (inv_zf > current) &
+                     (inv_z > 0.0) & (inv_z <= inv_near);
+    inv_row[c] = hit ? inv_zf : current;
+  }
+}
+
 }  // namespace
 
 // Scans one triangle over the grid's sample rows [row_lo, row_hi): per row, the columns
@@ -415,6 +454,11 @@ void ScanGridTriangle(const Table& t, const TriangleSetup& s, int tri, int row_l
       c1 = t.FirstColAbove(c0, s.col1 + 1, hi) - 1;
     }
     const size_t row_sample = static_cast<size_t>(r) * t.width;
+    if constexpr (std::is_same_v<Record, NearestInverseDepth>) {
+      if (c0 <= c1) MaxInverseDepthRow(t.col_x.data(), c0, c1, y, s, record.inv_near,
+                                       record.inv + row_sample);
+      continue;
+    }
     for (int c = c0; c <= c1; ++c) {
       const float x = t.col_x[c];
       const float w0 = e00 * x + e01 * y + e02;
@@ -750,11 +794,7 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   float* inv = depth->ptr<float>();
   const double inv_near = 1.0 / options_.near_m;
   // The nearest hit so far, where one thread owns the sample.
-  const auto exclusive_record = [&](int, int sample, float, float, double inv_z,
-                                    const TriangleSetup&) {
-    const float inv_zf = static_cast<float>(inv_z);
-    if (inv_zf > inv[sample] && inv_z > 0.0 && inv_z <= inv_near) inv[sample] = inv_zf;
-  };
+  const NearestInverseDepth exclusive_record{inv, inv_near};
   if (rays_->grid) {
     // Triangles scanned by whichever thread set them up: a sample may be hit from two
     // threads at once, so the maximum is taken atomically (and is still order-independent).
