@@ -337,6 +337,19 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
     }
   }
+  const int num_chunks = static_cast<int>(buffer.chunks.size());
+  for (int first = 0; first < num_chunks; first += BaseBuffer::kChunksPerGroup) {
+    BaseBuffer::ChunkGroup group;
+    group.first = first;
+    group.last = std::min(num_chunks, first + BaseBuffer::kChunksPerGroup);
+    group.bounds_min = buffer.chunks[first].bounds_min;
+    group.bounds_max = buffer.chunks[first].bounds_max;
+    for (int c = first + 1; c < group.last; ++c) {
+      group.bounds_min = group.bounds_min.cwiseMin(buffer.chunks[c].bounds_min);
+      group.bounds_max = group.bounds_max.cwiseMax(buffer.chunks[c].bounds_max);
+    }
+    buffer.chunk_groups.push_back(group);
+  }
   return buffer;
 }
 

@@ -75,6 +75,15 @@ struct BaseBuffer {
     bool FacesAwayFrom(const Eigen::Vector3f& centre) const;
   };
   std::vector<Chunk> chunks;
+  // Runs of kChunksPerGroup consecutive chunks (a strip of tiles) with their bounds: a frame
+  // culls a whole run with one test. Empty for a buffer built by hand: chunks are then
+  // tested one by one.
+  struct ChunkGroup {
+    int first = 0, last = 0;  // chunks [first, last)
+    Eigen::Vector3f bounds_min = Eigen::Vector3f::Zero(), bounds_max = Eigen::Vector3f::Zero();
+  };
+  std::vector<ChunkGroup> chunk_groups;
+  static constexpr int kChunksPerGroup = 16;
   static constexpr int kTileTexels = 16;
   int num_surface_texels = 0;
   Eigen::Vector3d bounds_min = Eigen::Vector3d::Zero(), bounds_max = Eigen::Vector3d::Zero();

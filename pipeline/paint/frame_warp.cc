@@ -404,6 +404,30 @@ void CountCodes(const ChunkProjection& proj, int n, int* in_view, int* grazing) 
   *in_view = view, *grazing = graze;
 }
 
+// A full tile's rows between the buffer (texels and qualities, rows `buffer_w` long) and a
+// batch's arrays (the tile's texels row by row). Full-width tiles copy rows of a constant
+// size: a few vector moves each.
+template <bool kToBuffer>
+void CopyTileRows(const BaseBuffer::Chunk& chunk, int buffer_w, uint8_t* bgra, float* quality,
+                  uint32_t* texels, float* qualities) {
+  const auto copy = [&](auto width) {
+    for (int r = 0, i = 0; r < chunk.y1 - chunk.y0; ++r, i += width) {
+      const size_t idx = static_cast<size_t>(chunk.y0 + r) * buffer_w + chunk.x0;
+      if constexpr (kToBuffer) {
+        std::memcpy(bgra + 4 * idx, texels + i, 4 * width);
+        std::memcpy(quality + idx, qualities + i, sizeof(float) * width);
+      } else {
+        std::memcpy(texels + i, bgra + 4 * idx, 4 * width);
+        std::memcpy(qualities + i, quality + idx, sizeof(float) * width);
+      }
+    }
+  };
+  if (chunk.x1 - chunk.x0 == BaseBuffer::kTileTexels)
+    copy(std::integral_constant<int, BaseBuffer::kTileTexels>());
+  else
+    copy(chunk.x1 - chunk.x0);
+}
+
 // Gathers what every texel of a projected chunk reads, runs the batch, stores what it wrote.
 // Texels out of view (`in_view` of the chunk's `n` are in view) are masked in the batch.
 template <bool kDepth>
@@ -421,14 +445,9 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   const float* const stored_quality = k.paint_quality;
   // A full tile's rows are runs of the buffer's rows: its stored texels are read and written
   // a row at a time. Otherwise texel by texel through texel_index.
-  const int tile_w = chunk.x1 - chunk.x0;
-  const size_t buffer_w = static_cast<size_t>(k.buffer->width);
   if (chunk.full) {
-    for (int r = 0, i = 0; r < chunk.y1 - chunk.y0; ++r, i += tile_w) {
-      const size_t idx = static_cast<size_t>(chunk.y0 + r) * buffer_w + chunk.x0;
-      std::memcpy(&batch.stored[i], bgra + 4 * idx, 4 * tile_w);
-      std::memcpy(&batch.stored_q[i], stored_quality + idx, sizeof(float) * tile_w);
-    }
+    CopyTileRows</*kToBuffer=*/false>(chunk, k.buffer->width, k.paint_bgra, k.paint_quality,
+                                      batch.stored, batch.stored_q);
   } else {
     for (int i = 0; i < n; ++i) {
       const size_t idx = static_cast<size_t>(texel_index[i]);
@@ -461,11 +480,8 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   if (chunk.full) {
     // Unwritten texels keep what they held (out and out_q are the stored values there), so
     // whole rows are written back; no other thread touches this tile.
-    for (int r = 0, i = 0; r < chunk.y1 - chunk.y0; ++r, i += tile_w) {
-      const size_t idx = static_cast<size_t>(chunk.y0 + r) * buffer_w + chunk.x0;
-      std::memcpy(out_bgra + 4 * idx, &batch.out[i], 4 * tile_w);
-      std::memcpy(out_quality + idx, &batch.out_q[i], sizeof(float) * tile_w);
-    }
+    CopyTileRows</*kToBuffer=*/true>(chunk, k.buffer->width, out_bgra, out_quality, batch.out,
+                                     batch.out_q);
   } else {
     for (int i = 0; i < n; ++i) {
       if (!batch.write[i]) continue;
@@ -710,35 +726,53 @@ bool UsesDepth(const FrameView& view, const WarpOptions& options) {
 }
 
 // Every chunk of the buffer that is not culled, through `kernel`, in parallel; the counts
-// summed (integers: the same whatever the order) and the tiles with visible texels.
+// summed (integers: the same whatever the order) and the tiles with visible texels. Runs of
+// chunks (BaseBuffer::chunk_groups) outside the view are culled whole first.
 Counts RunChunks(const KernelContext& k, ChunkKernel kernel, cv::Rect* visible_box) {
   const BaseBuffer& buffer = *k.buffer;
   std::mutex mutex;
   Counts total;
   cv::Rect box;
   const int num_chunks = static_cast<int>(buffer.chunks.size());
-  const double stripes = std::max(1, std::min(num_chunks, 16 * cv::getNumThreads()));
+  const bool grouped = !buffer.chunk_groups.empty();
+  const int num_items = grouped ? static_cast<int>(buffer.chunk_groups.size()) : num_chunks;
+  const double stripes = std::max(1, std::min(num_items, 16 * cv::getNumThreads()));
   cv::parallel_for_(
-      cv::Range(0, num_chunks),
+      cv::Range(0, num_items),
       [&](const cv::Range& range) {
         Counts n;
         cv::Rect range_box;
-        for (int c = range.start; c < range.end; ++c) {
-          const BaseBuffer::Chunk& chunk = buffer.chunks[c];
-          if (ChunkOutsideView(k, chunk)) {
-            ++n.culled;
+        const auto run = [&](int first, int last) {
+          for (int c = first; c < last; ++c) {
+            const BaseBuffer::Chunk& chunk = buffer.chunks[c];
+            if (ChunkOutsideView(k, chunk)) {
+              ++n.culled;
+              continue;
+            }
+            if (chunk.FacesAwayFrom(k.centre)) {  // every texel back-facing
+              ++n.culled;
+              n.grazing += chunk.end - chunk.begin;
+              continue;
+            }
+            n.tested += chunk.end - chunk.begin;
+            const int visible_before = n.visible;
+            kernel(k, chunk, &n);
+            if (n.visible > visible_before)
+              range_box |= cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0, chunk.y1 - chunk.y0);
+          }
+        };
+        for (int item = range.start; item < range.end; ++item) {
+          if (!grouped) {
+            run(item, item + 1);
             continue;
           }
-          if (chunk.FacesAwayFrom(k.centre)) {  // every texel back-facing
-            ++n.culled;
-            n.grazing += chunk.end - chunk.begin;
+          const BaseBuffer::ChunkGroup& group = buffer.chunk_groups[item];
+          if (BoxOutsideView<float>(group.bounds_min, group.bounds_max, k.R, k.t, k.bounds,
+                                    k.near_m)) {
+            n.culled += group.last - group.first;
             continue;
           }
-          n.tested += chunk.end - chunk.begin;
-          const int visible_before = n.visible;
-          kernel(k, chunk, &n);
-          if (n.visible > visible_before)
-            range_box |= cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0, chunk.y1 - chunk.y0);
+          run(group.first, group.last);
         }
         const std::lock_guard<std::mutex> lock(mutex);
         box |= range_box;
