@@ -414,6 +414,32 @@ __attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
   }
 }
 
+// The same for a bucket's rays (a lens with distortion: rays off a grid), `best` their nearest
+// inverse depths so far (kept per bucket row, written to the samples once the row is done, so
+// that this loop has no scattered reads or writes); `inside` when the bucket lies wholly
+// inside the triangle (no edge tests).
+__attribute__((target_clones("avx2", "default"))) void MaxInverseDepthBucket(
+    const float* __restrict xs, const float* __restrict ys, int n, bool inside,
+    const TriangleSetup& s, double inv_near, float* __restrict best) {
+  const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
+  const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
+  const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
+  const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
+  const int all_inside = inside;
+  for (int k = 0; k < n; ++k) {
+    const float x = xs[k], y = ys[k];
+    const float w0 = e00 * x + e01 * y + e02;
+    const float w1 = e10 * x + e11 * y + e12;
+    const float w2 = e20 * x + e21 * y + e22;
+    const double inv_z = ia * static_cast<double>(x) + ib * static_cast<double>(y) + ic;
+    const float inv_zf = static_cast<float>(inv_z);
+    const float current = best[k];
+    const int hit = (all_inside | (!(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f))) &
+                    (inv_zf > current) & (inv_z > 0.0) & (inv_z <= inv_near);
+    best[k] = hit ? inv_zf : current;
+  }
+}
+
 }  // namespace
 
 // Scans one triangle over the grid's sample rows [row_lo, row_hi): per row, the columns
@@ -656,9 +682,16 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
     return;
   }
 
+  // RasterizeDepth: a bucket row's rays are consecutive; their nearest hits are kept in a
+  // local array while the row's triangles are scanned, then written to their samples.
+  constexpr bool kDepthOnly = std::is_same_v<Record, NearestInverseDepth>;
   cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
+    thread_local std::vector<float> row_best;
     for (int row = range.start; row < range.end; ++row) {
       const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
+      const int row_begin = t.bucket_start[row * t.cols];
+      const int row_end = t.bucket_start[(row + 1) * t.cols];
+      if constexpr (kDepthOnly) row_best.assign(row_end - row_begin, 0.0f);
       for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
         const int slot = row_triangles[j];
         const TriangleSetup& s = setups[slot];
@@ -698,6 +731,11 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
             inside = inside && w_min > tolerance;
           }
           if (outside) continue;
+          if constexpr (kDepthOnly) {
+            MaxInverseDepthBucket(t.xs.data() + begin, t.ys.data() + begin, end - begin, inside,
+                                  s, record.inv_near, row_best.data() + (begin - row_begin));
+            continue;
+          }
           if (inside) {
             for (int k = begin; k < end; ++k) {
               const float x = t.xs[k], y = t.ys[k];
@@ -714,6 +752,9 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
             record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
           }
         }
+      }
+      if constexpr (kDepthOnly) {  // each sample's ray lies in one bucket: plain stores
+        for (int k = row_begin; k < row_end; ++k) record.inv[t.sample[k]] = row_best[k - row_begin];
       }
     }
   });
