@@ -70,6 +70,7 @@ struct KernelContext {
   float focal_texel;  // focal * texel size: pixels per texel at z = 1 m, head-on
   const cv::Mat* frame;
   const cv::Mat* depth;
+  int32_t frame_step, depth_step;  // bytes per row of each
   const std::vector<cv::Mat>* pyramid;
   uint8_t* out_bgr;
   uint8_t* out_valid;
@@ -114,8 +115,9 @@ struct ChunkProjection {
   static constexpr int kMax = BaseBuffer::kTileTexels * BaseBuffer::kTileTexels;
   float u[kMax], v[kMax], z[kMax], tol[kMax], quality[kMax];
   // Bilinear footprint: top-left pixel (x0, y0), with x0 + 1 and y0 + 1 inside the image,
+  // as byte offsets into the frame (y0 * step + 3 x0) and the depth map (y0 * step + 4 x0),
   // and the fractions towards the next pixel.
-  int32_t x0[kMax], y0[kMax];
+  int32_t frame_at[kMax], depth_at[kMax];
   float ax[kMax], ay[kMax];
   int32_t code[kMax];
 };
@@ -149,8 +151,9 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   float* __restrict tol = out->tol;
   float* __restrict quality = out->quality;
   int32_t* __restrict code = out->code;
-  int32_t* __restrict x0 = out->x0;
-  int32_t* __restrict y0 = out->y0;
+  int32_t* __restrict frame_at = out->frame_at;
+  int32_t* __restrict depth_at = out->depth_at;
+  const int32_t frame_step = k.frame_step, depth_step = k.depth_step;
   float* __restrict ax = out->ax;
   float* __restrict ay = out->ay;
 
@@ -212,8 +215,8 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
     const float uc = std::min(std::max(u[i], 0.0f), max_u_in);
     const float vc = std::min(std::max(v[i], 0.0f), max_v_in);
     const int xi = static_cast<int>(uc), yi = static_cast<int>(vc);
-    x0[i] = xi;
-    y0[i] = yi;
+    frame_at[i] = yi * frame_step + 3 * xi;
+    depth_at[i] = yi * depth_step + 4 * xi;
     ax[i] = uc - static_cast<float>(xi);
     ay[i] = vc - static_cast<float>(yi);
     zo[i] = pz;
@@ -290,7 +293,6 @@ struct PaintBatch {
   uint32_t p00[kMax], p10[kMax], p01[kMax], p11[kMax];  // the four pixels' BGR (low 24 bits)
   uint32_t stored[kMax];                                // the stored BGRA
   float stored_q[kMax];
-  uint32_t on_surface[kMax];
   uint32_t out[kMax];  // what the stored texel and quality become
   float out_q[kMax];
   int32_t write[kMax];
@@ -311,7 +313,7 @@ inline uint32_t Load32(const uint8_t* p) {
 template <bool kDepth>
 __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
     int n, bool quality_policy, float keep, const ChunkProjection* __restrict proj,
-    PaintBatch* __restrict b) {
+    const uint8_t* __restrict on_surface, PaintBatch* __restrict b) {
   const float* __restrict d00 = b->d00;
   const float* __restrict d10 = b->d10;
   const float* __restrict d01 = b->d01;
@@ -322,7 +324,6 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
   const uint32_t* __restrict p11 = b->p11;
   const uint32_t* __restrict stored = b->stored;
   const float* __restrict stored_q = b->stored_q;
-  const uint32_t* __restrict on_surface = b->on_surface;
   const float* __restrict z = proj->z;
   const float* __restrict tol = proj->tol;
   const float* __restrict ax = proj->ax;
@@ -373,7 +374,7 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
     visible += ok;
     rejected += reject;
     written += write;
-    newly += write & (1 - has) & static_cast<int>(on_surface[j]);
+    newly += write & (1 - has) & static_cast<int>(on_surface[j] != 0);
     out[j] = write ? sample : old;
     out_q[j] = write ? (by_quality ? std::max(sq, q) : q) : sq;
     write_out[j] = write;
@@ -385,13 +386,15 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
 }
 
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepth(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj, PaintBatch* b) {
-  return PaintBatchBody<true>(n, quality_policy, keep, proj, b);
+    int n, bool quality_policy, float keep, const ChunkProjection* proj,
+    const uint8_t* on_surface, PaintBatch* b) {
+  return PaintBatchBody<true>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDepth(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj, PaintBatch* b) {
-  return PaintBatchBody<false>(n, quality_policy, keep, proj, b);
+    int n, bool quality_policy, float keep, const ChunkProjection* proj,
+    const uint8_t* on_surface, PaintBatch* b) {
+  return PaintBatchBody<false>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 // How many texels of a projected chunk are in view (code 2) and how many grazing (code 1).
@@ -456,25 +459,24 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
     }
   }
   for (int i = 0; i < n; ++i) {
-    const int x0 = proj.x0[i], y0 = proj.y0[i];
     if constexpr (kDepth) {
-      const float* d0 = reinterpret_cast<const float*>(depth + y0 * depth_step) + x0;
+      const float* d0 = reinterpret_cast<const float*>(depth + proj.depth_at[i]);
       const float* d1 =
           reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
       batch.d00[i] = d0[0], batch.d10[i] = d0[1], batch.d01[i] = d1[0], batch.d11[i] = d1[1];
     }
     // Pixel x0's BGR and the next one's (read from its red byte on: no byte past the pair).
-    const uint8_t* r0 = frame + y0 * frame_step + 3 * x0;
+    const uint8_t* r0 = frame + proj.frame_at[i];
     const uint8_t* r1 = r0 + frame_step;
     batch.p00[i] = Load32(r0);
     batch.p10[i] = Load32(r0 + 2) >> 8;
     batch.p01[i] = Load32(r1);
     batch.p11[i] = Load32(r1 + 2) >> 8;
-    batch.on_surface[i] = on_surface[i] != 0;
   }
   const bool by_quality = k.rule.policy == UpdatePolicy::kQuality;
-  const PaintBatchSums sums = kDepth ? PaintBatchDepth(n, by_quality, k.rule.keep, &proj, &batch)
-                                     : PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, &batch);
+  const PaintBatchSums sums =
+      kDepth ? PaintBatchDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
+             : PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch);
   uint8_t* const out_bgra = k.paint_bgra;
   float* const out_quality = k.paint_quality;
   if (chunk.full) {
@@ -574,8 +576,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
       if constexpr (kMode == SamplingMode::kNearest) {
         ok = std::abs(depth_at(static_cast<int>(u + 0.5f), static_cast<int>(v + 0.5f)) - z) <= tol;
       } else {
-        const float* d0 =
-            reinterpret_cast<const float*>(depth + proj.y0[i] * depth_step) + proj.x0[i];
+        const float* d0 = reinterpret_cast<const float*>(depth + proj.depth_at[i]);
         const float* d1 =
             reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
         ok = std::abs(d0[0] - z) <= tol && std::abs(d0[1] - z) <= tol &&
@@ -594,7 +595,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
           frame + static_cast<int>(v + 0.5f) * frame_step + 3 * static_cast<int>(u + 0.5f);
       sample[0] = src[0], sample[1] = src[1], sample[2] = src[2];
     } else if constexpr (kMode == SamplingMode::kBilinear) {
-      const uint8_t* r0 = frame + proj.y0[i] * frame_step + 3 * proj.x0[i];
+      const uint8_t* r0 = frame + proj.frame_at[i];
       const uint8_t* r1 = r0 + frame_step;
       const float fx = proj.ax[i], fy = proj.ay[i];
       const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
@@ -712,6 +713,8 @@ KernelContext MakeContext(const BaseBuffer& buffer, const FrameView& view,
       .focal_texel = static_cast<float>(focal * buffer.texel_size_m),
       .frame = view.frame_bgr,
       .depth = use_depth ? view.depth : view.frame_bgr,
+      .frame_step = static_cast<int32_t>(view.frame_bgr->step[0]),
+      .depth_step = static_cast<int32_t>((use_depth ? view.depth : view.frame_bgr)->step[0]),
       .pyramid = &view.pyramid,
       .out_bgr = nullptr,
       .out_valid = nullptr,
