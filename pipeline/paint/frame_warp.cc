@@ -70,6 +70,7 @@ struct KernelContext {
   float focal_texel;  // focal * texel size: pixels per texel at z = 1 m, head-on
   const cv::Mat* frame;
   const cv::Mat* depth;
+  const cv::Mat* depth_range;      // or null (FrameView::depth_range)
   int32_t frame_step, depth_step;  // bytes per row of each
   const std::vector<cv::Mat>* pyramid;
   uint8_t* out_bgr;
@@ -290,6 +291,7 @@ __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
 struct PaintBatch {
   static constexpr int kMax = ChunkProjection::kMax;
   float d00[kMax], d10[kMax], d01[kMax], d11[kMax];     // depths around the sample
+  float range[2 * kMax];  // or their least and greatest (FrameView::depth_range)
   uint32_t p00[kMax], p10[kMax], p01[kMax], p11[kMax];  // the four pixels' BGR (low 24 bits)
   uint32_t stored[kMax];                                // the stored BGRA
   float stored_q[kMax];
@@ -310,7 +312,8 @@ inline uint32_t Load32(const uint8_t* p) {
   return v;
 }
 
-template <bool kDepth>
+// kDepth: 0 no occlusion test, 1 the four depths, 2 their range.
+template <int kDepth>
 __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
     int n, bool quality_policy, float keep, const ChunkProjection* __restrict proj,
     const uint8_t* __restrict on_surface, PaintBatch* __restrict b) {
@@ -318,6 +321,7 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
   const float* __restrict d10 = b->d10;
   const float* __restrict d01 = b->d01;
   const float* __restrict d11 = b->d11;
+  const float* __restrict range = b->range;
   const uint32_t* __restrict p00 = b->p00;
   const uint32_t* __restrict p10 = b->p10;
   const uint32_t* __restrict p01 = b->p01;
@@ -337,10 +341,15 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
   int visible = 0, compared = 0, rejected = 0, written = 0, newly = 0, diff_sum = 0;
   for (int j = 0; j < n; ++j) {
     int ok = code[j] == 2;  // in view (the others read pixel (0, 0) and are left alone)
-    if constexpr (kDepth) {
+    if constexpr (kDepth == 1) {
       const float zz = z[j], t = tol[j];
       ok &= (std::abs(d00[j] - zz) <= t) & (std::abs(d10[j] - zz) <= t) &
             (std::abs(d01[j] - zz) <= t) & (std::abs(d11[j] - zz) <= t);
+    } else if constexpr (kDepth == 2) {
+      // |d - z| <= t for all four <=> max - z <= t and z - min <= t (rounding is monotonic;
+      // an infinite depth fails both ways).
+      const float zz = z[j], t = tol[j];
+      ok &= (range[2 * j + 1] - zz <= t) & (zz - range[2 * j] <= t);
     }
     const float fx = ax[j], fy = ay[j];
     const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
@@ -388,13 +397,19 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepth(
     int n, bool quality_policy, float keep, const ChunkProjection* proj,
     const uint8_t* on_surface, PaintBatch* b) {
-  return PaintBatchBody<true>(n, quality_policy, keep, proj, on_surface, b);
+  return PaintBatchBody<1>(n, quality_policy, keep, proj, on_surface, b);
+}
+
+__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepthRange(
+    int n, bool quality_policy, float keep, const ChunkProjection* proj,
+    const uint8_t* on_surface, PaintBatch* b) {
+  return PaintBatchBody<2>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDepth(
     int n, bool quality_policy, float keep, const ChunkProjection* proj,
     const uint8_t* on_surface, PaintBatch* b) {
-  return PaintBatchBody<false>(n, quality_policy, keep, proj, on_surface, b);
+  return PaintBatchBody<0>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 // How many texels of a projected chunk are in view (code 2) and how many grazing (code 1).
@@ -458,8 +473,13 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
       batch.stored_q[i] = stored_quality[idx];
     }
   }
+  // The occlusion test's depths: one pair of the range map (8 bytes per pixel: at twice the
+  // depth map's offset) or the four depths.
+  const uint8_t* const range = k.depth_range ? k.depth_range->data : nullptr;
   for (int i = 0; i < n; ++i) {
-    if constexpr (kDepth) {
+    if (kDepth && range) {
+      std::memcpy(&batch.range[2 * i], range + 2 * static_cast<size_t>(proj.depth_at[i]), 8);
+    } else if constexpr (kDepth) {
       const float* d0 = reinterpret_cast<const float*>(depth + proj.depth_at[i]);
       const float* d1 =
           reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
@@ -475,8 +495,9 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   }
   const bool by_quality = k.rule.policy == UpdatePolicy::kQuality;
   const PaintBatchSums sums =
-      kDepth ? PaintBatchDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
-             : PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch);
+      !kDepth  ? PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
+      : range ? PaintBatchDepthRange(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
+               : PaintBatchDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch);
   uint8_t* const out_bgra = k.paint_bgra;
   float* const out_quality = k.paint_quality;
   if (chunk.full) {
@@ -682,6 +703,28 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
   return b;
 }
 
+void DepthRange2x2(const cv::Mat& depth, cv::Mat* range) {
+  const int w = depth.cols, h = depth.rows;
+  range->create(h, w, CV_32FC2);
+  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+    for (int y = rows.start; y < rows.end; ++y) {
+      const float* __restrict d0 = depth.ptr<float>(y);
+      const float* __restrict d1 = depth.ptr<float>(std::min(y + 1, h - 1));
+      float* __restrict out = range->ptr<float>(y);
+      for (int x = 0; x + 1 < w; ++x) {
+        const float lo0 = std::min(d0[x], d0[x + 1]), lo1 = std::min(d1[x], d1[x + 1]);
+        const float hi0 = std::max(d0[x], d0[x + 1]), hi1 = std::max(d1[x], d1[x + 1]);
+        out[2 * x] = std::min(lo0, lo1);
+        out[2 * x + 1] = std::max(hi0, hi1);
+      }
+      if (w > 0) {
+        out[2 * (w - 1)] = std::min(d0[w - 1], d1[w - 1]);
+        out[2 * (w - 1) + 1] = std::max(d0[w - 1], d1[w - 1]);
+      }
+    }
+  });
+}
+
 bool BoundsOutsideView(const Eigen::Vector3d& bounds_min, const Eigen::Vector3d& bounds_max,
                        const FrameView& view, double near_m) {
   return BoxOutsideView<double>(bounds_min, bounds_max, view.cam_from_local.RotationMatrix(),
@@ -713,6 +756,12 @@ KernelContext MakeContext(const BaseBuffer& buffer, const FrameView& view,
       .focal_texel = static_cast<float>(focal * buffer.texel_size_m),
       .frame = view.frame_bgr,
       .depth = use_depth ? view.depth : view.frame_bgr,
+      .depth_range = use_depth && view.depth_range && view.depth->isContinuous() &&
+                             view.depth_range->isContinuous() &&
+                             view.depth_range->size() == view.depth->size() &&
+                             view.depth_range->type() == CV_32FC2
+                         ? view.depth_range
+                         : nullptr,
       .frame_step = static_cast<int32_t>(view.frame_bgr->step[0]),
       .depth_step = static_cast<int32_t>((use_depth ? view.depth : view.frame_bgr)->step[0]),
       .pyramid = &view.pyramid,

@@ -30,6 +30,12 @@ struct NormalizedBounds {
 };
 NormalizedBounds ComputeNormalizedBounds(const Camera& camera);
 
+// Per pixel (x, y) of a continuous CV_32F depth map, the least and greatest depth of its 2x2
+// block (x..x+1, y..y+1), as CV_32FC2 of the same size (the last row and column: their own
+// depth). The bilinear occlusion test (every one of the four depths within tolerance of the
+// texel's) is the same test on the pair.
+void DepthRange2x2(const cv::Mat& depth, cv::Mat* range);
+
 // What every buffer of one frame shares.
 struct FrameView {
   const Camera* camera = nullptr;
@@ -37,6 +43,10 @@ struct FrameView {
   Eigen::Vector3d centre_local = Eigen::Vector3d::Zero();  // camera centre, local coords
   const cv::Mat* frame_bgr = nullptr;                      // CV_8UC3, camera size
   const cv::Mat* depth = nullptr;  // CV_32F camera z per pixel, or null (no occlusion)
+  // Optional, with `depth` (continuous): CV_32FC2, per pixel (x, y) the least and greatest
+  // depth of pixels x..x+1 by y..y+1 (DepthRange2x2): the bilinear occlusion test reads one
+  // pair instead of four depths.
+  const cv::Mat* depth_range = nullptr;
   std::vector<cv::Mat> pyramid;    // level 0 = frame; filled for SamplingMode::kArea
   NormalizedBounds bounds;         // for chunk culling (computed when not valid)
 };

@@ -301,6 +301,11 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   const bool paint_in_warp = background_.empty() && options_.refine.mode == RefineMode::kOff &&
                              !SelectActive(options_) && !debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);
+  if (paint_in_warp && view.depth && !in_frustum.empty() &&
+      options_.sampling == SamplingMode::kBilinear) {
+    DepthRange2x2(depth_, &depth_range_);  // one pair per texel instead of four depths
+    view.depth_range = &depth_range_;
+  }
   std::vector<PaintUpdateStats> paint_stats(set_.buffers.size());
   ForEachBuffer(in_frustum, false, [&](size_t b) {
     if (paint_in_warp)

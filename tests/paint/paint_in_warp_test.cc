@@ -3,9 +3,13 @@
 // the other: the same texels, colours, stored qualities and figures, bit for bit, for every
 // sampling mode, both update policies, a running average and a distorted lens.
 #include <gtest/gtest.h>
+#include <algorithm>
+#include <limits>
 #include <opencv2/core.hpp>
 
+#include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/paint/room_capture.h"
@@ -97,6 +101,63 @@ TEST(PaintInWarp, PaintsWhatTheTwoStagesPaint) {
       }
     }
   }
+}
+
+// Boxes on a ground seen from an orbit: boxes hide one another and the ground, so the
+// occlusion test decides (painting during the warp reads each pixel's 2x2 depth range,
+// the separate warp the four depths: the same test).
+TEST(PaintInWarp, PaintsWhatTheTwoStagesPaintWhereBoxesHideEachOther) {
+  BlocksOptions blocks;
+  blocks.seed = 3;
+  Scene scene;
+  ASSERT_TRUE(MakeBlocksScene(blocks, &scene).ok());
+  for (const LensModel lens : {LensModel::kPinhole, LensModel::kOpenCV8}) {
+    SynthOptions o;
+    o.frames = 6;
+    o.width = 160, o.height = 120;
+    o.lens = lens;
+    o.path = CameraPathKind::kOrbit;
+    o.target = Eigen::Vector3d(0, 0.3 * blocks.max_height_m, 0);
+    o.radius_m = 0.6 * blocks.ground_m;
+    o.height_m = 0.3 * blocks.ground_m;
+    o.turns = 0.3;
+    o.seed = 7;
+    SynthCapture capture;
+    ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
+    PipelineOptions options;
+    options.background.mode = BackgroundMode::kOff;
+    options.refine.mode = RefineMode::kOff;
+    options.select.enabled = false;
+    const Painted fused = Paint(scene, capture, options, false);
+    const Painted separate = Paint(scene, capture, options, true);
+    double occluded = 0;
+    for (const FrameReport& r : fused.reports) occluded += r.Stage("warp")->metrics.at("texels_occluded");
+    EXPECT_GT(occluded, 1000) << "lens " << static_cast<int>(lens) << ": nothing hidden";
+    ExpectSame(fused, separate, "blocks, lens " + std::to_string(static_cast<int>(lens)));
+  }
+}
+
+// The 2x2 range against the four depths, with pixels where nothing was hit (infinite).
+TEST(DepthRange2x2, LeastAndGreatestOfEachTwoByTwoBlock) {
+  cv::Mat depth(7, 9, CV_32F);
+  cv::RNG rng(3);
+  rng.fill(depth, cv::RNG::UNIFORM, 0.5, 9.0);
+  depth.at<float>(2, 3) = std::numeric_limits<float>::infinity();
+  depth.at<float>(6, 8) = std::numeric_limits<float>::infinity();
+  cv::Mat range;
+  DepthRange2x2(depth, &range);
+  ASSERT_EQ(range.type(), CV_32FC2);
+  ASSERT_EQ(range.size(), depth.size());
+  for (int y = 0; y < depth.rows; ++y)
+    for (int x = 0; x < depth.cols; ++x) {
+      const int x1 = std::min(x + 1, depth.cols - 1), y1 = std::min(y + 1, depth.rows - 1);
+      const float d[4] = {depth.at<float>(y, x), depth.at<float>(y, x1), depth.at<float>(y1, x),
+                          depth.at<float>(y1, x1)};
+      EXPECT_EQ(range.at<cv::Vec2f>(y, x)[0], *std::min_element(d, d + 4)) << x << "," << y;
+      EXPECT_EQ(range.at<cv::Vec2f>(y, x)[1], *std::max_element(d, d + 4)) << x << "," << y;
+    }
+  EXPECT_TRUE(std::isinf(range.at<cv::Vec2f>(2, 2)[1]));  // the block holding (3, 2)
+  EXPECT_FALSE(std::isinf(range.at<cv::Vec2f>(2, 2)[0]));
 }
 
 }  // namespace
