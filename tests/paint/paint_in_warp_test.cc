@@ -39,6 +39,16 @@ Painted Paint(const Scene& scene, const SynthCapture& capture, const PipelineOpt
   return out;
 }
 
+// No stage between the warp and the paint stage (no background model, refinement, exposure
+// or view selection): the case in which the warp paints.
+PipelineOptions NoStageBetween() {
+  PipelineOptions options;
+  options.background.mode = BackgroundMode::kOff;
+  options.refine.mode = RefineMode::kOff;
+  options.select.enabled = false;
+  return options;
+}
+
 void ExpectSame(const Painted& a, const Painted& b, const std::string& what) {
   ASSERT_EQ(a.buffers.size(), b.buffers.size());
   long long painted_texels = 0;
@@ -77,10 +87,7 @@ TEST(PaintInWarp, PaintsWhatTheTwoStagesPaint) {
     synth.seed = 5;
     SynthCapture capture;
     ASSERT_TRUE(SynthesizeCapture(scene, synth, &capture).ok());
-    PipelineOptions options;
-    options.background.mode = BackgroundMode::kOff;
-    options.refine.mode = RefineMode::kOff;
-    options.select.enabled = false;
+    PipelineOptions options = NoStageBetween();
     for (const SamplingMode sampling :
          {SamplingMode::kNearest, SamplingMode::kBilinear, SamplingMode::kArea}) {
       options.sampling = sampling;
@@ -124,14 +131,12 @@ TEST(PaintInWarp, PaintsWhatTheTwoStagesPaintWhereBoxesHideEachOther) {
     o.seed = 7;
     SynthCapture capture;
     ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
-    PipelineOptions options;
-    options.background.mode = BackgroundMode::kOff;
-    options.refine.mode = RefineMode::kOff;
-    options.select.enabled = false;
+    PipelineOptions options = NoStageBetween();
     const Painted fused = Paint(scene, capture, options, false);
     const Painted separate = Paint(scene, capture, options, true);
     double occluded = 0;
-    for (const FrameReport& r : fused.reports) occluded += r.Stage("warp")->metrics.at("texels_occluded");
+    for (const FrameReport& r : fused.reports)
+      occluded += r.Stage("warp")->metrics.at("texels_occluded");
     EXPECT_GT(occluded, 1000) << "lens " << static_cast<int>(lens) << ": nothing hidden";
     ExpectSame(fused, separate, "blocks, lens " + std::to_string(static_cast<int>(lens)));
   }
