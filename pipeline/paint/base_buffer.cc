@@ -26,9 +26,7 @@ void SetNormalCone(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   chunk->normal_sin = static_cast<float>(std::sin(half_angle));
 }
 
-// Marks a full tile whose stored points are affine in the texel coordinates (least squares
-// over the tile, every texel within one quantization step per axis), and whose normals are
-// all the same (BaseBuffer::Chunk::affine, uniform_normal).
+// Marks a tile whose rectangle is stored whole, row by row (BaseBuffer::Chunk::full).
 void SetFullTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   const int tw = chunk->x1 - chunk->x0, th = chunk->y1 - chunk->y0;
   if (chunk->end - chunk->begin != tw * th) return;
@@ -38,6 +36,9 @@ void SetFullTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   chunk->full = true;
 }
 
+// Marks a full tile whose stored points are affine in the texel coordinates (least squares
+// over the tile, every texel within one quantization step per axis), and whose normals are
+// all the same (BaseBuffer::Chunk::affine, uniform_normal).
 void SetAffineTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   const int tw = chunk->x1 - chunk->x0, th = chunk->y1 - chunk->y0;
   if (chunk->end - chunk->begin != tw * th) return;
