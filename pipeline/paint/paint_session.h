@@ -57,10 +57,10 @@ class PaintSession {
   // Groups the mesh, builds the base buffers. Errors name the grouping edit or setting.
   static Status Create(const PaintSessionInputs& inputs, std::unique_ptr<PaintSession>* session);
 
-  // Builds what painting through `camera` needs once (its depth rasterizer's ray table, its
-  // frustum bounds), so that the first frame through it costs what the others do. Optional:
-  // PaintFrame builds it on first use.
-  void PrepareCamera(const Camera& camera) { CacheFor(camera); }
+  // Builds what painting through `camera` needs once (its depth rasterizer's ray table and
+  // the mesh's culling clusters, its frustum bounds), so that the first frame through it
+  // costs what the others do. Optional: PaintFrame builds it on first use.
+  void PrepareCamera(const Camera& camera) { CacheFor(camera).rasterizer->Prepare(scene_->mesh); }
 
   // Paints one frame seen from `cam_from_world` through `camera`. Fills `report`.
   void PaintFrame(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,

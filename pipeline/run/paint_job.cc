@@ -21,6 +21,11 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   load_options.open_video = !result->live;  // a live video opens after the pose feed connects
   FRESCO_RETURN_IF_ERROR(
       OpenPaintSession(project, load_options, &result->captures, &result->session));
+  // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
+  // here, the first frame costs what the others do (a few photos of a large mesh would
+  // otherwise show a painting rate set by the first frame).
+  for (const Capture& capture : result->captures)
+    for (const auto& [id, camera] : capture.cameras) result->session->PrepareCamera(camera);
   if (result->live) {
     PaintJob& j = *result;
     FRESCO_RETURN_IF_ERROR(OpenLiveInputs(project.ForStream(0), j.captures[0], *j.session,
