@@ -531,6 +531,10 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
   report->metrics["pose_ms"] = MsSince(start);
 }
 
+// Refinement measuring for its `auto` decision registers at most about this many texels a
+// frame (the largest buffers seen, whole).
+constexpr long long kMeasureTexels = 300000;
+
 StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool debug,
                                           bool measure_only, RefineFigures* figures) {
   const auto start = std::chrono::steady_clock::now();
@@ -543,6 +547,18 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
       todo.push_back(b);
     else if (seen[b])
       fresh.push_back(b);
+  }
+  if (measure_only) {
+    // Measuring needs a sample, not every buffer: the largest regions seen, up to about a
+    // 640x480 frame's texels (a photo of a large mesh sees several times that).
+    std::stable_sort(todo.begin(), todo.end(), [&](size_t a, size_t b) {
+      return warped_[a].valid_box.area() > warped_[b].valid_box.area();
+    });
+    long long area = 0;
+    size_t kept = 0;
+    while (kept < todo.size() && area < kMeasureTexels) area += warped_[todo[kept++]].valid_box.area();
+    todo.resize(kept);
+    std::sort(todo.begin(), todo.end());
   }
   // Buffers are independent: one per thread, the largest regions first so that the threads
   // finish together (longest processing time first).
