@@ -5,13 +5,23 @@ Every ```bash / ```sh block in the guide is preceded by a marker that says what 
 
     <!-- doc-test: run -->                the block runs (bash -e) and must exit 0
     <!-- doc-test: output "TEXT" -->      the block runs (no -e); its output must contain TEXT
-    <!-- doc-test: skip: REASON -->       not run here; REASON says why (and what covers it)
+    <!-- doc-test: run given: SETUP -->   SETUP (shell) first makes what the block says is the
+                                          reader's own (a capture, photos, control points) from
+                                          bundled, synthetic or ../shared/data files; then the
+                                          block runs (bash -e) and must exit 0
+    <!-- doc-test: mirror: T1, T2: WHY --> not run here (WHY: a window, two programs at once,
+                                          minutes); the tests T1, T2 (GoogleTest Suite.Name or
+                                          CTest names) do what it does, and must exist
+    <!-- doc-test: skip: REASON -->       not run and not mirrored; REASON says why
 
 A block without a marker fails this test: a new command in the guide has to say whether it
 runs. Blocks run in a scratch folder holding copies of projects/ and docs/images/ (so the
-guide's relative paths and outputs work without touching the repository) and `build/app/fresco`
-pointing at the program under test; the files run in the order below, the blocks of a file in
-their order (later blocks use earlier outputs, as a reader would).
+guide's relative paths and outputs work without touching the repository), `build/app/fresco`
+pointing at the program under test and, beside it, `../shared` when the repository has it
+(the bundled projects that paint real data name it so); a block whose SETUP or code names
+`shared/data` is skipped, saying so, when that folder is absent. The files run in the order
+below, the blocks of a file in their order (later blocks use earlier outputs, as a reader
+would).
 
 Usage: run_guide_commands.py FRESCO [--list]
 """
@@ -25,7 +35,24 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ORDER = ["painting.md", "automation.md", "calibration.md", "poses.md", "live.md"]
-MARKER = re.compile(r"<!--\s*doc-test:\s*(run|output\s+\"([^\"]*)\"|skip:\s*(.+?))\s*-->")
+MARKER = re.compile(r"<!--\s*doc-test:\s*(run given:\s*(.+?)|run|output\s+\"([^\"]*)\"|"
+                    r"mirror:\s*(.+?)|skip:\s*(.+?))\s*-->")
+SHARED = os.path.join(os.path.dirname(ROOT), "shared")
+TEST_NAME = re.compile(r"^\s*(?:TEST|TEST_F|TEST_P)\(\s*(\w+)\s*,\s*(\w+)\s*\)", re.M)
+CTEST_NAME = re.compile(r"add_test\(\s*NAME\s+(\w+)|fresco_add_test\(\s*(\w+)")
+
+
+def known_tests():
+    """GoogleTest Suite.Name of every test in tests/, and every CTest name in its CMakeLists."""
+    names = set()
+    for folder, _, files in os.walk(os.path.join(ROOT, "tests")):
+        for f in files:
+            text = open(os.path.join(folder, f), errors="replace").read()
+            if f.endswith(".cc"):
+                names.update(f"{a}.{b}" for a, b in TEST_NAME.findall(text))
+            elif f == "CMakeLists.txt":
+                names.update(a or b for a, b in CTEST_NAME.findall(text))
+    return names
 
 
 def blocks(path):
@@ -46,12 +73,16 @@ def blocks(path):
             m = MARKER.search(lines[k]) if k >= 0 else None
             if not m:
                 out.append((start + 1, None, None, code))
+            elif m.group(2) is not None:
+                out.append((start + 1, "given", m.group(2), code))
             elif m.group(1) == "run":
                 out.append((start + 1, "run", None, code))
-            elif m.group(2) is not None:
-                out.append((start + 1, "output", m.group(2), code))
+            elif m.group(3) is not None:
+                out.append((start + 1, "output", m.group(3), code))
+            elif m.group(4) is not None:
+                out.append((start + 1, "mirror", m.group(4), code))
             else:
-                out.append((start + 1, "skip", m.group(3), code))
+                out.append((start + 1, "skip", m.group(5), code))
             i = j + 1
         else:
             i += 1
@@ -62,8 +93,16 @@ def main():
     fresco = os.path.realpath(sys.argv[1])
     guide = os.path.join(ROOT, "docs", "guide")
     files = ORDER + sorted(f for f in os.listdir(guide) if f.endswith(".md") and f not in ORDER)
-    scratch = tempfile.mkdtemp(prefix="fresco-guide-")
-    errors, ran, skipped = [], 0, 0
+    # The scratch repository sits in a folder of its own, with ../shared beside it when the
+    # repository has one (project files name ../../../shared/data).
+    outer = tempfile.mkdtemp(prefix="fresco-guide-")
+    scratch = os.path.join(outer, "main")
+    os.makedirs(scratch)
+    has_shared = os.path.isdir(os.path.join(SHARED, "data"))
+    if has_shared:
+        os.symlink(SHARED, os.path.join(outer, "shared"))
+    tests = known_tests()
+    errors, ran, mirrored, skipped = [], 0, 0, 0
     started = time.time()
     try:
         shutil.copytree(os.path.join(ROOT, "projects"), os.path.join(scratch, "projects"),
@@ -86,26 +125,43 @@ def main():
                     skipped += 1
                     print(f"skip {where}: {arg}")
                     continue
+                if kind == "mirror":
+                    names = [n.strip() for n in arg.split(":")[0].split(",")]
+                    missing = [n for n in names if n not in tests]
+                    if missing:
+                        errors.append(f"{where}: mirrored by tests that do not exist: "
+                                      f"{', '.join(missing)}")
+                    mirrored += 1
+                    print(f"mirror {where}: {', '.join(names)}")
+                    continue
+                setup = arg if kind == "given" else ""
+                if "shared/data" in setup + code and not has_shared:
+                    skipped += 1
+                    print(f"skip {where}: needs ../shared/data beside the repository (absent)")
+                    continue
                 if "--list" in sys.argv:
                     print(f"run  {where}")
                     continue
-                script = ("set -e\n" if kind == "run" else "") + code + "\n"
+                script = ("set -e\n" if kind in ("run", "given") else "") + code + "\n"
+                if setup:
+                    script = "set -e\n" + setup + "\n" + script
                 start = time.time()
                 r = subprocess.run(["bash", "-c", script], cwd=scratch, capture_output=True,
                                    text=True, timeout=600)
                 output = r.stdout + r.stderr
                 ran += 1
                 print(f"run  {where}: exit {r.returncode} in {time.time() - start:.1f} s")
-                if kind == "run" and r.returncode != 0:
+                if kind in ("run", "given") and r.returncode != 0:
                     errors.append(f"{where}: exit {r.returncode}\n{code}\n--- output:\n{output[-2000:]}")
                 if kind == "output" and arg not in output:
                     errors.append(f"{where}: output lacks '{arg}'\n{code}\n--- output:\n{output[-2000:]}")
     finally:
-        shutil.rmtree(scratch, ignore_errors=True)
+        shutil.rmtree(outer, ignore_errors=True)
     for e in errors:
         print("FAIL " + e)
-    print(f"run_guide_commands: {ran} blocks run, {skipped} skipped (each with its reason), "
-          f"{len(errors)} problems, {time.time() - started:.0f} s")
+    print(f"run_guide_commands: {ran} blocks run, {mirrored} mirrored by tests, {skipped} "
+          f"skipped (each with its reason), {len(errors)} problems, "
+          f"{time.time() - started:.0f} s")
     return 1 if errors else 0
 
 
