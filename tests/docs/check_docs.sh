@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Keeps the documentation from rotting. Checks, over README.md, CHANGELOG.md and docs/**/*.md:
 #   - README.md is at most 200 lines (the front door stays short);
+#   - every package the README's `apt install` line names is one .ci/setup installs;
 #   - no issue numbers in user-facing text ("issue 6", "(issue 12)");
 #   - every relative link and picture resolves, and every #anchor names a heading;
 #   - every `fresco VERB [SUBVERB]` in code exists, and every --option written after it is
@@ -49,6 +50,20 @@ def err(msg):
 n = len(open("README.md").read().splitlines())
 if n > 200:
     err(f"README.md: {n} lines (at most 200)")
+
+# The README's build dependencies (its `apt install` line) are all installed by .ci/setup,
+# which CI and the quick start run: a package named only in the README would go untested.
+readme = open("README.md").read()
+apt = re.search(r"apt install ((?:[^\n]*\\\n)*[^\n]*)", readme)
+setup = open(".ci/setup").read()
+listed = re.search(r"PACKAGES=\((.*?)\)", setup, re.S)
+if not apt or not listed:
+    err("README.md / .ci/setup: the apt install line or the PACKAGES list is missing")
+else:
+    wanted = set(apt.group(1).replace("\\", " ").split())
+    missing = sorted(wanted - set(listed.group(1).split()))
+    if missing:
+        err(f"README.md: apt install names packages .ci/setup does not install: {', '.join(missing)}")
 
 def slug(heading):  # GitHub's anchor for a heading
     s = heading.strip().lower()

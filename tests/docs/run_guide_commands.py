@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
-"""Runs the commands of the user guide (docs/guide/*.md), so the guide cannot rot.
+"""Runs the commands of the documentation (the user guide docs/guide/*.md, then README.md and
+the rest of docs/), so the docs cannot rot.
 
-Every ```bash / ```sh block in the guide is preceded by a marker that says what to do with it:
+Every ```bash / ```sh block is preceded by a marker that says what to do with it:
 
     <!-- doc-test: run -->                the block runs (bash -e) and must exit 0
     <!-- doc-test: output "TEXT" -->      the block runs (no -e); its output must contain TEXT
@@ -92,7 +93,13 @@ def blocks(path):
 def main():
     fresco = os.path.realpath(sys.argv[1])
     guide = os.path.join(ROOT, "docs", "guide")
-    files = ORDER + sorted(f for f in os.listdir(guide) if f.endswith(".md") and f not in ORDER)
+    files = [os.path.join("docs", "guide", f) for f in
+             ORDER + sorted(f for f in os.listdir(guide) if f.endswith(".md") and f not in ORDER)]
+    # Then the README and the rest of docs/ (results, reference, architecture, contract).
+    files += ["README.md"] + sorted(
+        os.path.relpath(os.path.join(folder, f), ROOT)
+        for folder in (os.path.join(ROOT, "docs"), os.path.join(ROOT, "docs", "reference"))
+        for f in os.listdir(folder) if f.endswith(".md"))
     # The scratch repository sits in a folder of its own, with ../shared beside it when the
     # repository has one (project files name ../../../shared/data).
     outer = tempfile.mkdtemp(prefix="fresco-guide-")
@@ -112,11 +119,11 @@ def main():
         os.makedirs(os.path.join(scratch, "build", "app"))
         os.symlink(fresco, os.path.join(scratch, "build", "app", "fresco"))
         for name in files:
-            path = os.path.join(guide, name)
+            path = os.path.join(ROOT, name)
             if not os.path.exists(path):
                 continue
             for line, kind, arg, code in blocks(path):
-                where = f"docs/guide/{name}:{line}"
+                where = f"{name}:{line}"
                 if kind is None:
                     errors.append(f"{where}: a command block without a doc-test marker "
                                   "(<!-- doc-test: run --> or <!-- doc-test: skip: REASON -->)")
