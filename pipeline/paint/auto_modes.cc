@@ -64,7 +64,13 @@ bool RefineAutoDecider::AddFrame(int frame_number, double misalignment_px) {
     const size_t n = sorted.size();
     decision_.evidence = n % 2 ? sorted[n / 2] : 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]);
   }
-  if (decision_.frames_measured < kRefineAutoFrames && frame_number < kRefineAutoLastFrame)
+  // Frames that could not be registered to what is painted (too different: photos far
+  // apart, plain texture) give nothing to measure, nor would they be corrected: stop paying
+  // for the registration once the first frames have all been such.
+  const bool nothing_to_measure =
+      decision_.frames_measured == 0 && frame_number >= kRefineAutoNoEvidenceFrame;
+  if (decision_.frames_measured < kRefineAutoFrames && frame_number < kRefineAutoLastFrame &&
+      !nothing_to_measure)
     return false;
   decision_.state = decision_.evidence > decision_.threshold ? AutoDecision::State::kOn
                                                              : AutoDecision::State::kOff;

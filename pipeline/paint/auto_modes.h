@@ -6,7 +6,8 @@
 //               corrected (painting is what `off` paints). After `kRefineAutoFrames` frames
 //               with a measurement, the median of their misalignment (the pose fit's RMS over
 //               its inliers, texels) is compared with `kRefineAutoThresholdPx`: above, `robust`
-//               refines every later frame; below, refinement stops (no further cost).
+//               refines every later frame; below, refinement stops (no further cost). It
+//               stops too when none of the first frames could be registered at all.
 //   background  The robust model runs from the start (masking as `robust` does). Once its
 //               texels have warmed up, the foreground it finds among the texels it trusts is
 //               counted frame by frame: once a fraction above `kBackgroundAutoThreshold`
@@ -29,6 +30,10 @@ constexpr int kRefineAutoFrames = 6;
 // Refinement decides by this frame whatever it measured (off without a measurement: frames
 // too small or too plain to register).
 constexpr int kRefineAutoLastFrame = 20;
+// ... and off by this frame when no frame so far gave a measurement (the frames cannot be
+// registered to what is painted: on the suite's captures every frame from the second on
+// measures; 10 photos of a castle 8-30 degrees apart measured 0 or 1).
+constexpr int kRefineAutoNoEvidenceFrame = 4;
 constexpr double kBackgroundAutoThreshold = 0.01;
 // The background decides on as soon as the fraction exceeds the threshold after this many
 // frames, off when it has not after a third of the expected frames (at least this many, at

@@ -119,6 +119,21 @@ TEST(AutoBackground, OnWithMoversOffWithout) {
   EXPECT_LT(without.evidence, with_movers.evidence / 3);
 }
 
+TEST(AutoRefine, FramesThatCannotBeRegisteredDecideOffEarly) {
+  RefineAutoDecider decider;
+  decider.Start(true);
+  for (int f = 1; f < kRefineAutoNoEvidenceFrame; ++f) EXPECT_FALSE(decider.AddFrame(f, -1));
+  EXPECT_TRUE(decider.AddFrame(kRefineAutoNoEvidenceFrame, -1));
+  EXPECT_EQ(decider.decision().state, State::kOff);
+  EXPECT_EQ(decider.decision().frames_measured, 0);
+  // One measurement early on keeps it deciding to the usual count.
+  RefineAutoDecider measured;
+  measured.Start(true);
+  EXPECT_FALSE(measured.AddFrame(1, 2.0));
+  for (int f = 2; f <= kRefineAutoNoEvidenceFrame + 1; ++f) EXPECT_FALSE(measured.AddFrame(f, -1));
+  EXPECT_EQ(measured.decision().state, State::kDeciding);
+}
+
 TEST(AutoDecisionReport, ShowsEvidenceAndThreshold) {
   RefineAutoDecider decider;
   decider.Start(true);
