@@ -7,6 +7,11 @@
 #include <unordered_set>
 
 namespace fresco {
+
+// A triangle steeper than this to its buffer's plane (cos 84 degrees: its texels stretched
+// more than 10 times across it) is moved out of the buffer as a fold is, into a chart of its
+// own plane: the bound charts grow and merge under (charts.cc), kept after fold splits too.
+constexpr double kMinPlaneCos = 0.1;
 namespace {
 
 // The cone holding the chunk's stored normals (as the warp dequantizes them), with a margin
@@ -194,7 +199,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   for (int li = 0; li < num_local; ++li) {
     const int t = triangles[li];
     const Eigen::Vector3d& nt = normal_of[li];
-    if (nt.dot(n) < 1e-3) {  // edge-on or back-facing in this projection: cannot serve it
+    if (nt.dot(n) < kMinPlaneCos) {  // near edge-on or back-facing: cannot serve it well
       is_folded[li] = 1;
       continue;
     }

@@ -49,7 +49,7 @@ struct ChartStretch {
 ChartStretch MeasureChartStretch(const TriangleMesh& mesh, const Grouping& grouping);
 // The same, each triangle against the plane its base buffer actually projects it onto (what
 // `metrics.json` reports): after fold splits a triangle facing away from its chart's plane
-// has moved to a buffer of its own, so this is finite (at most 1000: BuildBaseBuffers moves
+// has moved to a buffer of its own, so this is finite (at most 10: BuildBaseBuffers moves
 // out anything steeper).
 ChartStretch MeasureBufferStretch(const TriangleMesh& mesh, const std::vector<BaseBuffer>& buffers);
 
