@@ -556,7 +556,8 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     });
     long long area = 0;
     size_t kept = 0;
-    while (kept < todo.size() && area < kMeasureTexels) area += warped_[todo[kept++]].valid_box.area();
+    while (kept < todo.size() && area < kMeasureTexels)
+      area += warped_[todo[kept++]].valid_box.area();
     todo.resize(kept);
     std::sort(todo.begin(), todo.end());
   }

@@ -47,8 +47,8 @@ constexpr const char* kCaptureSpecs[] = {
         "frames": 30, "size": [640, 480], "lens": "opencv8", "seed": 17})"};
 constexpr int kNumCaptures = sizeof(kCaptureSpecs) / sizeof(kCaptureSpecs[0]);
 constexpr const char* kCaptureNames[kNumCaptures] = {
-    "street_opencv5",          "room_pinhole",        "blocks_opencv8",
-    "heldout_street_opencv5",  "heldout_room_opencv4", "heldout_blocks_pinhole",
+    "street_opencv5",         "room_pinhole",         "blocks_opencv8",
+    "heldout_street_opencv5", "heldout_room_opencv4", "heldout_blocks_pinhole",
     "heldout_facade_opencv8"};
 
 struct Capture {
@@ -167,10 +167,9 @@ void BM_Remap(benchmark::State& state) {
 // --benchmark_filter=/[3-6]/ runs just the held-out captures.
 const bool kRegistered = [] {
   for (int i = 0; i < kNumCaptures; ++i) {
-    benchmark::RegisterBenchmark("BM_Paint", BM_Paint)->Arg(i)->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark("BM_Remap", BM_Remap)->Arg(i)->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    for (auto* b : {benchmark::RegisterBenchmark("BM_Paint", BM_Paint),
+                    benchmark::RegisterBenchmark("BM_Remap", BM_Remap)})
+      b->Arg(i)->Unit(benchmark::kMillisecond)->UseRealTime();
   }
   return true;
 }();
