@@ -7,11 +7,6 @@
 #include <unordered_set>
 
 namespace fresco {
-
-// A triangle steeper than this to its buffer's plane (cos 84 degrees: its texels stretched
-// more than 10 times across it) is moved out of the buffer as a fold is, into a chart of its
-// own plane: the bound charts grow and merge under (charts.cc), kept after fold splits too.
-constexpr double kMinPlaneCos = 0.1;
 namespace {
 
 // The cone holding the chunk's stored normals (as the warp dequantizes them), with a margin

@@ -17,6 +17,12 @@
 
 namespace fresco {
 
+// A triangle must face the plane its texels lie in at least this much (cos 84 degrees: its
+// texels stretched at most 10 times across it). Charts grow and merge under this bound
+// (charts.cc), and a buffer moves out any triangle steeper to its plane, as it moves out a
+// fold (BuildBaseBuffers).
+constexpr double kMinPlaneCos = 0.1;
+
 struct BaseBuffer {
   int id = -1;
   std::vector<int> triangles;

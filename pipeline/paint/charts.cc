@@ -28,9 +28,6 @@ struct Chart {
   Eigen::Vector3d SmoothNormal() const { return UnitOr(smooth_sum, Normal()); }
 };
 
-// A triangle in a chart must face its plane at least this much (cos 84 degrees): well away
-// from edge-on, where its texels would fold or stretch without bound.
-constexpr double kMinMergeCos = 0.1;
 // A chart grown to the size limit still takes in its small neighbours up to this factor over
 // the limit (its buffer's texels then get at most 5 % coarser).
 constexpr double kMergeHeadroom = 1.1;
@@ -139,7 +136,7 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
           // The surface (smoothed) stays within the cone and the stretch bound of the seed;
           // the triangle itself (noise and all) faces the plane: no fold.
           if (smooth_dot(nb, cone) < cos_cone || smooth_dot(nb, seed_smooth) < cos_stretch ||
-              normals[nb].dot(mean) < kMinMergeCos)
+              normals[nb].dot(mean) < kMinPlaneCos)
             continue;
           if (chart.area + areas[nb] > max_area) continue;
           chart_of[nb] = c;
@@ -148,7 +145,7 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
       }
       const Eigen::Vector3d mean = chart.Normal(), cone = chart.SmoothNormal();
       auto beyond = [&](int t) {
-        return normals[t].dot(mean) < kMinMergeCos || smooth_dot(t, cone) < cos_stretch;
+        return normals[t].dot(mean) < kMinPlaneCos || smooth_dot(t, cone) < cos_stretch;
       };
       for (int t : chart.triangles) {
         if (!beyond(t)) continue;
@@ -211,16 +208,16 @@ Grouping ComputeCharts(const TriangleMesh& mesh, const MeshAdjacency& adjacency,
         // Every triangle faces the merged plane (no fold: at most 84 degrees away, the
         // larger chart's worst one too), and the small chart's surface (smoothed normals)
         // stretches within the bound on average (by area).
-        bool ok = normals[big.worst].dot(merged) >= std::min(cos_stretch, kMinMergeCos);
+        bool ok = normals[big.worst].dot(merged) >= std::min(cos_stretch, kMinPlaneCos);
         int worst = big.worst;
         double stretch_area = 0.0;
         for (int t : small.triangles) {
           const double c = normals[t].dot(merged);
-          if (c < kMinMergeCos) {
+          if (c < kMinPlaneCos) {
             ok = false;
             break;
           }
-          stretch_area += areas[t] / std::max(smooth_dot(t, merged), kMinMergeCos);
+          stretch_area += areas[t] / std::max(smooth_dot(t, merged), kMinPlaneCos);
           if (c < normals[worst].dot(merged)) worst = t;
         }
         if (!ok || stretch_area > options.max_stretch * small.area) continue;

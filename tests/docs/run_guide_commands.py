@@ -149,9 +149,8 @@ def main():
                 if "--list" in sys.argv:
                     print(f"run  {where}")
                     continue
-                script = ("set -e\n" if kind in ("run", "given") else "") + code + "\n"
-                if setup:
-                    script = "set -e\n" + setup + "\n" + script
+                script = (("set -e\n" if kind in ("run", "given") else "") +
+                          (setup + "\n" if setup else "") + code + "\n")
                 start = time.time()
                 r = subprocess.run(["bash", "-c", script], cwd=scratch, capture_output=True,
                                    text=True, timeout=600)
