@@ -8,28 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 namespace fresco {
-namespace {
-
-constexpr float kMeanScale = 64.0f;  // fixed point of RobustTexel::mean
-constexpr float kMaxMean = 65535.0f / kMeanScale;
-
-uint16_t ToFixed(float value) {
-  return static_cast<uint16_t>(std::clamp(value, 0.0f, kMaxMean) * kMeanScale + 0.5f);
-}
-
-uint16_t ToVar4(float var) { return static_cast<uint16_t>(std::min(var * 4.0f, 65535.0f) + 0.5f); }
-
-// Mean squared channel difference between a sample and a fixed-point mean.
-float Distance2(const float x[3], const uint16_t mean[3]) {
-  float d = 0;
-  for (int c = 0; c < 3; ++c) {
-    const float e = x[c] - mean[c] * (1.0f / kMeanScale);
-    d += e * e;
-  }
-  return d * (1.0f / 3.0f);
-}
-
-}  // namespace
+namespace {}  // namespace
 
 float GainHistogram::MedianGain(long long min_samples) const {
   if (count < min_samples) return 1.0f;
@@ -49,20 +28,21 @@ struct BufferBackground::ChunkStats {
 
 void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& options) {
   options_ = options;
-  robust_.clear();
+  robust_.Clear();
   average_.clear();
-  if (options.mode == BackgroundMode::kRobust) robust_.assign(buffer.NumTexels(), RobustTexel{});
+  if (options.mode == BackgroundMode::kRobust) robust_.Assign(buffer.NumTexels());
   if (options.mode == BackgroundMode::kAverage) average_.assign(buffer.NumTexels(), AverageTexel{});
   raw_ = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   raw_set_.assign(buffer.chunks.size(), 0);
 }
 
 namespace {
-template <class Texel>
-void MoveTexels(const BaseBuffer& buffer, const std::vector<int>& texel_at, const cv::Rect& roi,
-                const cv::Mat& field, std::vector<Texel>* texels) {
-  if (texels->empty()) return;
-  std::vector<std::pair<int, Texel>> moved;  // written after all are read
+// The texel pairs (k, from) by which a field moves texels: the texel at q (in `roi`) takes
+// the state of the texel nearest to q + field(q - roi.tl()), when there is one.
+std::vector<std::pair<int, int>> MovedTexels(const BaseBuffer& buffer,
+                                             const std::vector<int>& texel_at, const cv::Rect& roi,
+                                             const cv::Mat& field) {
+  std::vector<std::pair<int, int>> moved;
   for (int y = roi.y; y < roi.br().y; ++y) {
     const cv::Vec2f* f = field.ptr<cv::Vec2f>(y - roi.y);
     for (int x = roi.x; x < roi.br().x; ++x) {
@@ -72,10 +52,10 @@ void MoveTexels(const BaseBuffer& buffer, const std::vector<int>& texel_at, cons
       if (k < 0 || (sx == x && sy == y)) continue;
       if (sx < 0 || sy < 0 || sx >= buffer.width || sy >= buffer.height) continue;
       const int from = texel_at[static_cast<size_t>(sy) * buffer.width + sx];
-      if (from >= 0) moved.emplace_back(k, (*texels)[from]);
+      if (from >= 0) moved.emplace_back(k, from);
     }
   }
-  for (const auto& [k, texel] : moved) (*texels)[k] = texel;
+  return moved;
 }
 }  // namespace
 
@@ -84,8 +64,12 @@ void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const
     texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
     for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
   }
-  MoveTexels(buffer, texel_at_, roi, field, &robust_);
-  MoveTexels(buffer, texel_at_, roi, field, &average_);
+  const std::vector<std::pair<int, int>> moved = MovedTexels(buffer, texel_at_, roi, field);
+  if (!robust_.empty()) robust_.Move(moved);
+  std::vector<AverageTexel> read(moved.size());  // all read before any is written
+  if (average_.empty()) return;
+  for (size_t i = 0; i < moved.size(); ++i) read[i] = average_[moved[i].second];
+  for (size_t i = 0; i < moved.size(); ++i) average_[moved[i].first] = read[i];
 }
 
 void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
@@ -98,9 +82,9 @@ void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuff
     if (!warped.MayBeValid(chunk)) continue;
     for (int k = (chunk.begin + 3) / 4 * 4; k < chunk.end; k += 4) {  // every 4th texel
       const int idx = buffer.texel_index[k];
-      const RobustTexel& t = robust_[k];
-      if (!valid[idx] || t.samples == 0) continue;
-      const float model = (t.mean[0][0] + t.mean[0][1] + t.mean[0][2]) * (1.0f / kMeanScale);
+      if (!valid[idx] || robust_.samples[k] == 0) continue;
+      const float model = (robust_.mean[0][0][k] + robust_.mean[0][1][k] + robust_.mean[0][2][k]) *
+                          (1.0f / kRobustMeanScale);
       const float sample = static_cast<float>(src[idx][0] + src[idx][1] + src[idx][2]);
       if (model < 30.0f || sample < 30.0f) continue;  // too dark for a ratio
       const int bin = static_cast<int>((std::log2(sample / model) + 2.0f) * kBinsPerLog2);
@@ -118,89 +102,69 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
   uint8_t* raw = raw_.data;
   uint8_t* warming = frame->warming.data;
   uint8_t* difference = debug ? frame->difference.data : nullptr;
-  const bool robust = options_.mode == BackgroundMode::kRobust;
-  const float inv_gain = 1.0f / gain;
-  const float k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
-  const float min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
-  const float threshold = static_cast<float>(options_.average_threshold);
-  const int window = options_.window_frames;
-  for (int k = chunk.begin; k < chunk.end; ++k) {
-    const int idx = buffer.texel_index[k];
-    if (!valid[idx]) {
-      raw[idx] = warming[idx] = 0;
-      continue;
-    }
-    ++stats->observed;
-    const cv::Vec3b s = src[idx];
-    bool foreground = false, warm_up = false;
-    float distance2 = 0;
-    if (robust) {
-      RobustTexel& t = robust_[k];
-      const float x[3] = {s[0] * inv_gain, s[1] * inv_gain, s[2] * inv_gain};
-      const float alpha = 1.0f / static_cast<float>(std::min<int>(t.samples + 1, window));
-      const float var = std::max(t.var4 * 0.25f, min_var);
-      // The sample's mode: the background if close enough, else the candidate, else it
-      // replaces the candidate.
-      int match = -1;
-      distance2 = t.samples > 0 ? Distance2(x, t.mean[0]) : 1e30f;
-      if (distance2 <= k2 * var) {
-        match = 0;
-      } else if (t.weight[1] > 0 && Distance2(x, t.mean[1]) <= k2 * var) {
-        match = 1;
+  // The samples of a run of texels gathered (robust: divided by the gain), then classified
+  // together (a chunk is one run: at most a tile's texels).
+  constexpr int kMax = BaseBuffer::kTileTexels * BaseBuffer::kTileTexels;
+  alignas(32) float x[3][kMax];
+  alignas(32) uint8_t sampled[kMax], foreground[kMax], warm_up[kMax];
+  alignas(32) float distance2[kMax];
+  for (int begin = chunk.begin; begin < chunk.end; begin += kMax) {
+    const int n = std::min(kMax, chunk.end - begin);
+    const int32_t* index = buffer.texel_index.data() + begin;
+    if (options_.mode == BackgroundMode::kRobust) {
+      const float inv_gain = 1.0f / gain;
+      for (int i = 0; i < n; ++i) {
+        const int idx = index[i];
+        const cv::Vec3b s = src[idx];
+        sampled[i] = valid[idx] != 0;
+        for (int c = 0; c < 3; ++c) x[c][i] = s[c] * inv_gain;
       }
-      t.weight[0] *= 1.0f - alpha;
-      t.weight[1] *= 1.0f - alpha;
-      if (match >= 0) {
-        float& w = t.weight[match];
-        w += alpha;
-        const float rho = std::min(1.0f, alpha / w);
-        for (int c = 0; c < 3; ++c) {
-          const float m = t.mean[match][c] * (1.0f / kMeanScale);
-          t.mean[match][c] = ToFixed(m + rho * (x[c] - m));
-        }
-        if (match == 0) t.var4 = ToVar4(var + rho * (distance2 - var));
-      } else {
-        for (int c = 0; c < 3; ++c) t.mean[1][c] = ToFixed(x[c]);
-        t.weight[1] = alpha;
-        match = 1;
-      }
-      bool flipped = false;
-      if (t.weight[1] >= t.weight[0]) {  // the candidate now explains more: it is background
-        std::swap(t.mean[0], t.mean[1]);
-        std::swap(t.weight[0], t.weight[1]);
-        t.var4 = ToVar4(min_var);
-        match = 1 - match;
-        flipped = t.samples > 0;
-      }
-      if (t.samples < 65535) ++t.samples;
-      foreground = match != 0;
-      // A texel whose background just changed holds a stale paint: provisional too.
-      warm_up = t.samples < options_.warmup_frames || flipped;
+      RobustUpdateParams params;
+      params.k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
+      params.min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
+      params.window = options_.window_frames;
+      params.warmup = options_.warmup_frames;
+      UpdateRobustTexels(params, begin, n, x[0], x[1], x[2], sampled, &robust_, foreground, warm_up,
+                         distance2);
     } else {
-      AverageTexel& t = average_[k];
-      if (t.count < options_.training_frames) {  // training: learn, paint provisionally
-        for (int c = 0; c < 3; ++c) t.sum[c] += s[c];
-        ++t.count;
-        warm_up = true;
-      } else {
-        float largest = 0;
-        for (int c = 0; c < 3; ++c) {
-          const float e = s[c] - static_cast<float>(t.sum[c]) / t.count;
-          largest = std::max(largest, std::abs(e));
-          distance2 += e * e * (1.0f / 3.0f);
+      const float threshold = static_cast<float>(options_.average_threshold);
+      for (int i = 0; i < n; ++i) {
+        const int idx = index[i];
+        sampled[i] = valid[idx] != 0;
+        foreground[i] = warm_up[i] = 0;
+        distance2[i] = 0;
+        if (!sampled[i]) continue;
+        const cv::Vec3b s = src[idx];
+        AverageTexel& t = average_[begin + i];
+        if (t.count < options_.training_frames) {  // training: learn, paint provisionally
+          for (int c = 0; c < 3; ++c) t.sum[c] += s[c];
+          ++t.count;
+          warm_up[i] = 1;
+        } else {
+          float largest = 0;
+          for (int c = 0; c < 3; ++c) {
+            const float e = s[c] - static_cast<float>(t.sum[c]) / t.count;
+            largest = std::max(largest, std::abs(e));
+            distance2[i] += e * e * (1.0f / 3.0f);
+          }
+          foreground[i] = largest > threshold;
         }
-        foreground = largest > threshold;
       }
     }
-    raw[idx] = foreground ? 255 : 0;
-    warming[idx] = warm_up ? 255 : 0;
-    stats->warming += warm_up;
-    if (difference) difference[idx] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2));
-    if (foreground) {
-      ++stats->foreground;
-      const int x = idx % buffer.width, y = idx / buffer.width;
-      stats->x_min = std::min(stats->x_min, x), stats->x_max = std::max(stats->x_max, x);
-      stats->y_min = std::min(stats->y_min, y), stats->y_max = std::max(stats->y_max, y);
+    for (int i = 0; i < n; ++i) {
+      const int idx = index[i];
+      raw[idx] = foreground[i] ? 255 : 0;
+      warming[idx] = warm_up[i] ? 255 : 0;
+      if (!sampled[i]) continue;
+      ++stats->observed;
+      stats->warming += warm_up[i];
+      if (difference) difference[idx] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2[i]));
+      if (foreground[i]) {
+        ++stats->foreground;
+        const int tx = idx % buffer.width, ty = idx / buffer.width;
+        stats->x_min = std::min(stats->x_min, tx), stats->x_max = std::max(stats->x_max, tx);
+        stats->y_min = std::min(stats->y_min, ty), stats->y_max = std::max(stats->y_max, ty);
+      }
     }
   }
 }
@@ -256,20 +220,18 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
   // Only chunks that may hold valid texels; a skipped chunk's raw foreground from an earlier
   // frame is cleared (Clean reads raw_ around this frame's foreground).
   std::vector<ChunkStats> stats(buffer.chunks.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(buffer.chunks.size())),
-                    [&](const cv::Range& range) {
-                      for (int c = range.start; c < range.end; ++c) {
-                        const BaseBuffer::Chunk& chunk = buffer.chunks[c];
-                        if (warped.MayBeValid(chunk)) {
-                          Classify(buffer, warped, gain, debug, chunk, &stats[c], frame);
-                        } else if (raw_set_[c]) {
-                          raw_(cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0,
-                                        chunk.y1 - chunk.y0))
-                              .setTo(0);
-                        }
-                        raw_set_[c] = stats[c].foreground > 0;
-                      }
-                    });
+  cv::parallel_for_(
+      cv::Range(0, static_cast<int>(buffer.chunks.size())), [&](const cv::Range& range) {
+        for (int c = range.start; c < range.end; ++c) {
+          const BaseBuffer::Chunk& chunk = buffer.chunks[c];
+          if (warped.MayBeValid(chunk)) {
+            Classify(buffer, warped, gain, debug, chunk, &stats[c], frame);
+          } else if (raw_set_[c]) {
+            raw_(cv::Rect(chunk.x0, chunk.y0, chunk.x1 - chunk.x0, chunk.y1 - chunk.y0)).setTo(0);
+          }
+          raw_set_[c] = stats[c].foreground > 0;
+        }
+      });
   ChunkStats total;
   for (const ChunkStats& s : stats) {
     total.observed += s.observed, total.foreground += s.foreground, total.warming += s.warming;
@@ -294,9 +256,8 @@ cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
   cv::Vec3b* out = image.ptr<cv::Vec3b>();
   for (int k = 0; k < buffer.NumTexels(); ++k) {
     cv::Vec3b& px = out[buffer.texel_index[k]];
-    if (!robust_.empty() && robust_[k].samples > 0) {
-      for (int c = 0; c < 3; ++c)
-        px[c] = cv::saturate_cast<uint8_t>(robust_[k].mean[0][c] * (1.0f / kMeanScale));
+    if (!robust_.empty() && robust_.samples[k] > 0) {
+      for (int c = 0; c < 3; ++c) px[c] = cv::saturate_cast<uint8_t>(robust_.Mean(k, c));
     } else if (!average_.empty() && average_[k].count > 0) {
       for (int c = 0; c < 3; ++c)
         px[c] =

@@ -28,6 +28,7 @@
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/paint/paint_update.h"
+#include "pipeline/paint/robust_texels.h"
 
 namespace fresco {
 
@@ -72,13 +73,8 @@ class BufferBackground {
   // is one.
   void Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field);
 
-  // Per-texel state (by texel number k, not buffer index). Means are fixed point (x 64).
-  struct RobustTexel {
-    uint16_t mean[2][3];  // mode 0 = background, mode 1 = candidate
-    uint16_t var4;        // background noise variance per channel, grey levels^2 x 4
-    uint16_t samples;     // samples seen (saturates at 65535)
-    float weight[2];      // fraction of the recent samples each mode explains
-  };
+  // Per-texel state of the average model (by texel number k, not buffer index); the robust
+  // model's is RobustTexels.
   struct AverageTexel {
     uint16_t sum[3];  // sum of the training samples
     uint16_t count;   // training samples so far
@@ -91,7 +87,7 @@ class BufferBackground {
   void Clean(const cv::Rect& roi, BackgroundFrame* frame);
 
   BackgroundOptions options_;
-  std::vector<RobustTexel> robust_;
+  RobustTexels robust_;
   std::vector<AverageTexel> average_;
   cv::Mat raw_;  // CV_8U: this frame's foreground before cleaning
   std::vector<uint8_t> raw_set_;  // per chunk: raw_ may hold foreground there

@@ -6,6 +6,9 @@
 //                          skips the rest, so texels of the buffer per second is higher
 //   BM_DepthRaster         the occlusion stage's depth map, depth only and full
 //   BM_DecodeFrame         decoding one PNG frame, as written by `fresco synth` and before
+//   BM_BackgroundUpdate    the robust background model's update (classify, learn, clean) of
+//                          the wall's warped samples, a cycle of 8 frames with noise, an
+//                          exposure change and a square mover
 //   build/tests/paint_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 #include <opencv2/core/utility.hpp>
@@ -13,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/png_encode.h"
+#include "pipeline/paint/background_model.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
 #include "pipeline/render/rasterizer.h"
@@ -162,6 +166,55 @@ BENCHMARK(BM_DecodeFrame)
     ->Arg(0)
     ->Arg(1)
     ->ArgName("fast")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+void BM_BackgroundUpdate(benchmark::State& state) {
+  static Fixture* f = new Fixture(1280, 720, LensModel::kPinhole, 3.8);
+  const int threads = static_cast<int>(state.range(0));
+  const BaseBuffer& buffer = f->set.buffers[0];
+  FrameView view;
+  view.camera = &f->camera;
+  view.cam_from_local = CamFromLocal(f->scene, f->cam_from_world);
+  view.centre_local = view.cam_from_local.Centre();
+  view.depth = &f->depth;
+  view.bounds = ComputeNormalizedBounds(f->camera);
+  // 8 frames: sensor noise (sigma 3), every 4th brighter by 10 %, a 200 x 200 px square
+  // crossing the view; warped once, outside the timing.
+  std::vector<WarpedBuffer> warped(8);
+  cv::RNG rng(7);
+  for (int i = 0; i < 8; ++i) {
+    cv::Mat noise(f->frame.size(), CV_16SC3), frame;
+    rng.fill(noise, cv::RNG::NORMAL, 0, 3);
+    f->frame.convertTo(frame, CV_16SC3, i % 4 == 3 ? 1.1 : 1.0);
+    cv::Mat(frame + noise).convertTo(frame, CV_8UC3);
+    cv::rectangle(frame, cv::Rect(100 + 120 * i, 260, 200, 200), cv::Scalar(40, 200, 90), -1);
+    view.frame_bgr = &frame;
+    WarpFrameToBuffer(buffer, view, WarpOptions(), &warped[i]);
+  }
+  BackgroundOptions options;
+  options.mode = BackgroundMode::kRobust;
+  BufferBackground model;
+  model.Init(buffer, options);
+  BackgroundFrame frame;
+  cv::setNumThreads(threads);
+  long long observed = 0, masked = 0;
+  int i = 0;
+  for (auto _ : state) {
+    model.Update(buffer, warped[i % 8], i % 4 == 3 ? 1.1f : 1.0f, false, &frame);
+    observed += frame.observed;
+    masked += frame.masked;
+    ++i;
+  }
+  cv::setNumThreads(-1);
+  state.counters["texels_per_s"] =
+      benchmark::Counter(static_cast<double>(observed), benchmark::Counter::kIsRate);
+  state.counters["masked_fraction"] = static_cast<double>(masked) / std::max(1LL, observed);
+}
+BENCHMARK(BM_BackgroundUpdate)
+    ->Arg(1)
+    ->Arg(2)
+    ->ArgName("threads")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
