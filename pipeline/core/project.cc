@@ -31,18 +31,6 @@ constexpr int kProjectVersion = 2;  // the newest this Fresco reads
 // Version-1 keys that version 2 replaces by `streams`.
 constexpr const char* kStreamKeys[] = {"camera", "video", "poses", "time_offset_s"};
 
-// What a field accepts beyond its type. Numbers: [min, max] (min exclusive when asked);
-// strings: non-empty, or one of `choices`.
-struct Rule {
-  bool required = false;
-  bool non_empty = false;
-  double min = -kInf;
-  bool min_exclusive = false;
-  double max = kInf;
-  std::vector<std::string> choices = {};
-  const char* help = "";  // what the setting does (fresco settings, the app, the docs)
-};
-
 const std::vector<std::pair<SamplingMode, std::string>>& SamplingNames() {
   static const std::vector<std::pair<SamplingMode, std::string>> names = {
       {SamplingMode::kNearest, "nearest"},
@@ -60,201 +48,7 @@ const std::vector<std::pair<UpdatePolicy, std::string>>& UpdatePolicyNames() {
   return names;
 }
 
-const std::vector<std::pair<RefineMode, std::string>>& RefineModeNames() {
-  static const std::vector<std::pair<RefineMode, std::string>> names = {
-      {RefineMode::kOff, "off"},
-      {RefineMode::kPaper, "paper"},
-      {RefineMode::kRobust, "robust"},
-      {RefineMode::kAuto, "auto"},
-  };
-  return names;
-}
-
-const std::vector<std::pair<RefineModelLimit, std::string>>& RefineModelNames() {
-  static const std::vector<std::pair<RefineModelLimit, std::string>> names = {
-      {RefineModelLimit::kTranslation, "translation"},
-      {RefineModelLimit::kSimilarity, "similarity"},
-      {RefineModelLimit::kAffine, "affine"},
-      {RefineModelLimit::kHomography, "homography"},
-  };
-  return names;
-}
-
-const std::vector<std::pair<BackgroundMode, std::string>>& BackgroundModeNames() {
-  static const std::vector<std::pair<BackgroundMode, std::string>> names = {
-      {BackgroundMode::kOff, "off"},
-      {BackgroundMode::kAverage, "average"},
-      {BackgroundMode::kRobust, "robust"},
-      {BackgroundMode::kAuto, "auto"},
-  };
-  return names;
-}
-
 // ---- The fields, each listed once. ----------------------------------------------------------
-
-template <class V>
-void Fields(OcclusionOptions& o, V& v) {
-  v.Field("enabled", o.enabled, {.help = "test every texel against the video camera's depth map"});
-  v.Field(
-      "tolerance_rel", o.tolerance_rel,
-      {.min = 0,
-       .help =
-           "a texel is visible when its depth is within this fraction of the rendered depth ..."});
-  v.Field("tolerance_m", o.tolerance_m, {.min = 0, .help = "... plus this many metres"});
-  v.Field("max_view_angle_deg", o.max_view_angle_deg,
-          {.min = 0,
-           .min_exclusive = true,
-           .max = 90,
-           .help = "texels seen at more than this angle from the surface normal (or from behind) "
-                   "are not painted"});
-}
-
-template <class V>
-void Fields(RefineOptions& o, V& v) {
-  v.Enum("mode", o.mode, RefineModeNames(),
-         "`paper`: Harris corners, SSD search, affine fit (the paper's §3.5); `robust`: tracked "
-         "corners, RANSAC and model selection; `auto` (the default): the first frames' "
-         "misalignment to the buffers is measured without correcting, and `robust` refines the "
-         "rest of the capture only when its median exceeds what perfect poses give (0.6 "
-         "texels); the decision and its evidence are in the refine stage's report");
-  v.Enum("max_model", o.max_model, RefineModelNames(),
-         "the most general 2D motion `robust` may choose (simpler ones win when the evidence does "
-         "not need more)");
-  v.Field("max_corners", o.max_corners, {.min = 3, .help = "corners tracked per buffer and frame"});
-  v.Field("search_px", o.search_px,
-          {.min = 1, .help = "largest correction looked for, texels (larger: no correction)"});
-  v.Field("window_px", o.window_px,
-          {.min = 1, .max = 64, .help = "matching window half-size, texels"});
-  v.Field("pyramid_levels", o.pyramid_levels,
-          {.min = 0, .max = 8, .help = "coarse-to-fine levels (`robust`)"});
-  v.Field("ransac_px", o.ransac_px,
-          {.min = 0, .min_exclusive = true, .help = "inlier threshold, texels"});
-  v.Field("max_scale_change", o.max_scale_change,
-          {.min = 0,
-           .min_exclusive = true,
-           .max = 1,
-           .help = "a fit that scales or shears more is refused"});
-  v.Field("min_inliers", o.min_inliers, {.min = 3, .help = "fewer inliers: no correction"});
-  v.Field("min_correction_px", o.min_correction_px,
-          {.min = 0, .help = "dead band: smaller corrections are measured but not applied"});
-  v.Field("every_n_frames", o.every_n_frames,
-          {.min = 1,
-           .help = "register every N-th frame; the others only fill texels the buffers lack"});
-  v.Field("anchor", o.anchor,
-          {.help = "consensus anchoring: move a buffer back by the mean of the corrections the "
-                   "frames ask for"});
-  v.Field("pose", o.pose,
-          {.help = "correct the frame's camera pose from the matches of all its buffers together, "
-                   "instead of one homography per buffer"});
-  v.Field("anchor_min_frames", o.anchor_min_frames,
-          {.min = 2, .help = "frames that must agree before a buffer is moved"});
-  v.Field("anchor_window_frames", o.anchor_window_frames,
-          {.min = 0, .help = "anchor samples fade with this time constant, frames (0 = never)"});
-  v.Field("anchor_step_px", o.anchor_step_px,
-          {.min = 0, .help = "a buffer is moved when the agreed offset exceeds this, texels"});
-}
-
-template <class V>
-void Fields(BackgroundOptions& o, V& v) {
-  v.Enum("mode", o.mode, BackgroundModeNames(),
-         "`average` is the paper's (§3.4); `robust` follows changes and exposure; `auto` (the "
-         "default): `robust` learns from the start and keeps masking only when the texels it "
-         "trusts show enough foreground (moving objects or misaligned samples) once warmed up, "
-         "else it is dropped; the decision and its evidence are in the background stage's "
-         "report");
-  v.Field(
-      "training_frames", o.training_frames,
-      {.min = 1, .max = 250, .help = "`average`: samples averaged per texel before it segments"});
-  v.Field("average_threshold", o.average_threshold,
-          {.min = 0,
-           .help = "`average`: foreground beyond this largest-channel difference, grey levels"});
-  v.Field("warmup_frames", o.warmup_frames,
-          {.min = 1,
-           .help = "`robust`: samples before a texel's model is trusted (until then it paints "
-                   "provisionally)"});
-  v.Field("window_frames", o.window_frames,
-          {.min = 2,
-           .max = 65535,
-           .help = "`robust`: learning window in samples: an object that stops for about half of "
-                   "it becomes background"});
-  v.Field(
-      "sigma_threshold", o.sigma_threshold,
-      {.min = 0,
-       .min_exclusive = true,
-       .help = "`robust`: foreground beyond this many standard deviations of the texel's noise"});
-  v.Field("min_sigma", o.min_sigma,
-          {.min = 0,
-           .min_exclusive = true,
-           .max = 100,
-           .help = "`robust`: the noise is never counted below this many grey levels"});
-  v.Field("normalize_gain", o.normalize_gain,
-          {.help = "`robust`: divide each frame by its global gain (exposure changes)"});
-  v.Field("min_blob_texels", o.min_blob_texels,
-          {.min = 0, .help = "mask cleaning: smaller foreground blobs are noise"});
-  v.Field("dilate_texels", o.dilate_texels,
-          {.min = 0,
-           .max = 64,
-           .help = "mask cleaning: the remaining foreground grows by this margin"});
-}
-
-template <class V>
-void Fields(AtlasOptions& o, V& v) {
-  v.Field("page_size", o.page_size,
-          {.min = 256,
-           .max = 8192,
-           .help = "charts are packed into texture pages of at most this size (8192 is what "
-                   "viewers and GPUs take)"});
-  v.Field("padding_texels", o.padding_texels,
-          {.min = 0,
-           .max = 32,
-           .help = "edge texels repeated around each chart, so bilinear sampling and the first "
-                   "mipmap levels never mix two charts"});
-}
-
-template <class V>
-void Fields(SelectOptions& o, V& v) {
-  v.Field(
-      "enabled", o.enabled,
-      {.help =
-           "score every view of a texel and keep the better one, and match exposures (below): for "
-           "real photos with changing exposure (on the Sceaux castle photos +0.9 to 1.1 dB and 1 - "
-           "NCC 0.07 lower, at 2-4 times the warp stage's cost); it runs with `update: quality` "
-           "and `refine.mode` `off` or `auto` (which then decides off: refinement moves the "
-           "buffers to the frames and needs them to take new samples); it also caps the background "
-           "model's warm-up at a third of the "
-           "capture's frames. Off (the default): `update` and `quality_slack` alone decide"});
-  v.Field("exposure", o.exposure,
-          {.help = "per frame, a gain per colour channel against what the buffers already hold "
-                   "(the median ratio over the texels both have) is divided out before painting: "
-                   "one consistent exposure, set by the first frames"});
-  v.Field("switch_margin", o.switch_margin,
-          {.min = 0,
-           .max = 10,
-           .help = "a painted texel takes a new frame's sample only when that view scores this "
-                   "much better (0.25: 25 %): fewer switches between frames, fewer seams"});
-  v.Field("region_weight", o.region_weight,
-          {.min = 0,
-           .max = 1,
-           .help = "a view's score blends the texel's own (pixels per texel times the cosine of "
-                   "the view angle) with the frame's median over the chart: 0 per texel, 1 per "
-                   "chart (a chart tends to keep one frame)"});
-  v.Field("edge_px", o.edge_px,
-          {.min = 0,
-           .max = 100,
-           .help = "texels seen within this many pixels of a depth discontinuity of the frame (a "
-                   "silhouette, where a slightly wrong mesh samples the background) ..."});
-  v.Field("edge_penalty", o.edge_penalty,
-          {.min = 0,
-           .max = 1,
-           .help = "... score this times less: they fill texels no better view has painted, and "
-                   "the next good view replaces them"});
-  v.Field("edge_depth_rel", o.edge_depth_rel,
-          {.min = 0,
-           .min_exclusive = true,
-           .max = 10,
-           .help = "neighbouring pixels whose depths differ by this fraction of the nearer one "
-                   "make a discontinuity (surface beside no surface always does)"});
-}
 
 template <class V>
 void Fields(PipelineOptions& o, V& v) {
@@ -428,21 +222,18 @@ void Fields(Project& p, V& v) {
 }
 
 // A new member must be added to its Fields() above (read and written) and to the test's
-// NonDefaultProject(); then update the size here. (x86-64 Linux sizes.)
-static_assert(sizeof(void*) != 8 || sizeof(OcclusionOptions) == 32, "see Fields(OcclusionOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(RefineOptions) == 80, "see Fields(RefineOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(BackgroundOptions) == 56,
-              "see Fields(BackgroundOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(AtlasOptions) == 8, "see Fields(AtlasOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(SelectOptions) == 48, "see Fields(SelectOptions)");
-static_assert(sizeof(void*) != 8 || sizeof(PipelineOptions) == 288, "see Fields(PipelineOptions)");
+// NonDefaultProject(); then update the size here. (x86-64 Linux sizes.) The stages' settings
+// (PipelineOptions and the option structs in their stage headers) need neither: settings_test
+// checks that every byte of them is a listed field or padding, and sets every listed setting
+// away from its default for the round trip.
+static_assert(sizeof(void*) != 8 || sizeof(Project) - sizeof(PipelineOptions) == 424,
+              "see Fields(Project)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingEdit) == 96, "see Fields(GroupingEdit)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupSpec) == 32, "see Fields(GroupSpec)");
 static_assert(sizeof(void*) != 8 || sizeof(GroupingOptions) == 72, "see Fields(GroupingOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(TruthFiles) == 32, "see Fields(TruthFiles)");
 static_assert(sizeof(void*) != 8 || sizeof(LiveOptions) == 120, "see Fields(LiveOptions)");
 static_assert(sizeof(void*) != 8 || sizeof(StreamSpec) == 112, "see Fields(StreamSpec)");
-static_assert(sizeof(void*) != 8 || sizeof(Project) == 712, "see Fields(Project)");
 
 // ---- Writing. -------------------------------------------------------------------------------
 
@@ -1149,6 +940,41 @@ class SettingsCollector {
 };
 
 }  // namespace
+
+namespace {
+// Where the listed fields of a struct are, byte by byte (ListedFieldBytes).
+struct FieldBytesCollector {
+  const char* base;
+  std::vector<std::pair<size_t, size_t>>* spans;
+  template <class T>
+  void Field(const char*, T& value, const Rule& = {}) {
+    Add(value);
+  }
+  template <class E>
+  void Enum(const char*, E& value, const std::vector<std::pair<E, std::string>>&, const char*) {
+    Add(value);
+  }
+  template <class T>
+  void Object(const char*, T& value) {
+    Fields(value, *this);
+  }
+  template <class T>
+  void List(const char*, std::vector<T>& values) {
+    Add(values);
+  }
+  template <class T>
+  void Add(const T& value) {
+    spans->emplace_back(reinterpret_cast<const char*>(&value) - base, sizeof(T));
+  }
+};
+}  // namespace
+
+std::vector<std::pair<size_t, size_t>> ListedFieldBytes(PipelineOptions* options) {
+  std::vector<std::pair<size_t, size_t>> spans;
+  FieldBytesCollector collector{reinterpret_cast<const char*>(options), &spans};
+  Fields(*options, collector);
+  return spans;
+}
 
 std::vector<Setting> DescribeSettings(Project* project) {
   std::vector<Setting> settings;

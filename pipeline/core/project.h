@@ -9,6 +9,11 @@
 #include <vector>
 
 #include "pipeline/core/status.h"
+#include "pipeline/paint/atlas_options.h"
+#include "pipeline/paint/background_options.h"
+#include "pipeline/paint/occlusion_options.h"
+#include "pipeline/paint/refine_options.h"
+#include "pipeline/paint/select_options.h"
 
 namespace fresco {
 
@@ -16,126 +21,6 @@ enum class SamplingMode { kNearest, kBilinear, kArea };
 // kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
 // when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
 enum class UpdatePolicy { kLatest, kQuality };
-
-struct OcclusionOptions {
-  bool enabled = true;
-  // A texel is visible when its depth is within this fraction of the rendered depth
-  // (relative tolerance, scales with depth) plus `tolerance_m`.
-  double tolerance_rel = 0.01;
-  double tolerance_m = 0.002;
-  // Texels seen at more than this angle from the surface normal are not painted.
-  double max_view_angle_deg = 80.0;
-
-  bool operator==(const OcclusionOptions&) const = default;
-};
-
-// Texture alignment refinement (paper §3.5, refine_alignment.h). kAuto: measures the
-// misalignment between the first frames and the buffers without correcting, then refines
-// (`robust`) for the rest of the capture only when it exceeds what perfect poses give
-// (auto_modes.h).
-enum class RefineMode { kOff, kPaper, kRobust, kAuto };
-// The most general 2D motion model refinement may choose (model selection picks simpler
-// ones when the evidence does not need more).
-enum class RefineModelLimit { kTranslation, kSimilarity, kAffine, kHomography };
-struct RefineOptions {
-  RefineMode mode = RefineMode::kAuto;
-  RefineModelLimit max_model = RefineModelLimit::kHomography;
-  int max_corners = 150;           // corners tracked per buffer and frame
-  int search_px = 12;              // largest correction looked for, texels (else: no correction)
-  int window_px = 7;               // matching window half-size, texels
-  int pyramid_levels = 3;          // coarse-to-fine levels (robust mode)
-  double ransac_px = 1.5;          // inlier threshold, texels
-  double max_scale_change = 0.05;  // a fit that scales or shears more is refused
-  // Corrections smaller than this (largest displacement over the region, texels) are
-  // measured but not applied: registration noise applied frame after frame random-walks
-  // the buffer away from the model.
-  double min_correction_px = 0.25;
-  int min_inliers = 10;
-  // Register every Nth frame only (1 = every frame); the others only fill texels the
-  // buffers lack (unregistered, they would overwrite registered texels with their error).
-  int every_n_frames = 1;
-  // Consensus anchoring (refine_anchor.h): move a buffer back by the mean of the corrections
-  // it asked for, once anchor_min_frames agree on a move larger than anchor_step_px texels.
-  bool anchor = true;
-  // Correct the frame's pose from the matches of every buffer together, and derive each
-  // buffer's correction from it (refine_pose.h), instead of one homography per buffer.
-  bool pose = true;
-  int anchor_min_frames = 3;
-  int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
-  double anchor_step_px = 0.1;
-
-  bool operator==(const RefineOptions&) const = default;
-};
-
-// Selective painting (paper §3.4): a per-texel background model in base-buffer space (so it
-// works for moving cameras); texels whose sample differs from it are foreground and are not
-// painted. kAverage: the paper's linear average of each texel's first `training_frames`
-// samples, then image subtraction with a fixed `average_threshold`. kRobust: two colour
-// modes per texel with weights over a sliding window (background = the heavier mode, so
-// it converges to what the texel shows most of the time, whatever came first), an adaptive
-// per-texel noise threshold and a per-frame global gain (exposure) estimate. kAuto: the
-// robust model learns from the start, and what it finds over the first frames decides
-// whether it keeps masking or is dropped (auto_modes.h).
-enum class BackgroundMode { kOff, kAverage, kRobust, kAuto };
-
-struct BackgroundOptions {
-  BackgroundMode mode = BackgroundMode::kAuto;
-  // kAverage: samples averaged per texel before it segments (at most 250), and the
-  // foreground threshold on the largest channel difference, grey levels.
-  int training_frames = 20;
-  double average_threshold = 30.0;
-  // kRobust: a texel's samples before its model is trusted. Until then what it paints is
-  // provisional (any later background sample replaces it, whatever its quality).
-  int warmup_frames = 8;
-  // kRobust: the learning window in samples: weights follow the last ~N samples, so an
-  // object that stops for ~N/2 of them becomes background, and the background it hid comes
-  // back ~N/2 samples after it leaves; lighting drift is followed too. Measured (README):
-  // 40 beats 100 and 300 on the static-camera clips, where people stand for a long time.
-  int window_frames = 40;
-  // kRobust: foreground beyond `sigma_threshold` standard deviations of the texel's noise
-  // (RMS over channels), the noise never counted below `min_sigma` grey levels.
-  double sigma_threshold = 3.0;
-  double min_sigma = 6.0;
-  // kRobust: divide each frame by its global gain (median sample/background ratio).
-  bool normalize_gain = true;
-  // Mask cleaning (both models): foreground blobs smaller than this are background
-  // (noise), and the rest is dilated by this margin (blurred edges, shadows).
-  int min_blob_texels = 12;
-  int dilate_texels = 2;
-
-  bool operator==(const BackgroundOptions&) const = default;
-};
-
-// The painted model's texture atlas (pipeline/paint/texture_atlas.h): base buffers packed
-// into pages of at most page_size x page_size texels, each with padding_texels of its edge
-// repeated around it.
-struct AtlasOptions {
-  int page_size = 4096;
-  int padding_texels = 4;
-
-  bool operator==(const AtlasOptions&) const = default;
-};
-
-// View selection and colour consistency for real photos (pipeline/paint/view_select.h), the
-// `select` stage between background and paint: per frame a gain per colour channel,
-// estimated against what the buffers already hold (median ratio over the texels both have)
-// and divided out before painting; a score per texel (pixels per texel times the cosine of
-// the view angle, uncapped, blended with the frame's median score over the buffer so that a
-// region keeps one frame), much lower where the texel is seen near a depth discontinuity of
-// the frame's depth map (silhouettes: where a mesh a few pixels off paints background); a
-// painted texel takes a new frame's sample only when it scores clearly better.
-struct SelectOptions {
-  bool enabled = false;  // off: the quality policy alone (`update`, `quality_slack`); on costs
-                         // 2-4 times the warp stage (real photos: docs/results.md)
-  bool exposure = true;  // divide out each frame's gain against the buffers
-  double switch_margin = 0.25;  // a painted texel switches frame when the score is this much better
-  double region_weight = 0.5;   // 0: the texel's own score; 1: the frame's median over the buffer
-  double edge_px = 6.0;         // texels seen within this many pixels of a depth discontinuity
-  double edge_penalty = 0.1;    // ... have their score multiplied by this
-  double edge_depth_rel = 0.05;  // neighbouring pixels whose depths differ by this fraction
-
-  bool operator==(const SelectOptions&) const = default;
-};
 
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
@@ -307,6 +192,11 @@ std::string SamplingModeName(SamplingMode mode);
 std::string BackgroundModeName(BackgroundMode mode);  // "off" | "average" | "robust"
 // Parses "nearest" | "bilinear" | "area". Returns false for other names.
 bool SamplingModeFromName(const std::string& name, SamplingMode* mode);
+
+// The bytes of `options` that its listed fields hold (offset, size): what the project file
+// reads and writes of it. A test checks that every other byte is padding, so that a member
+// left out of its struct's Fields() list cannot go unnoticed.
+std::vector<std::pair<size_t, size_t>> ListedFieldBytes(PipelineOptions* options);
 
 // Ok when the project has one video stream; else an error "FILE: streams: N video streams,
 // but WHO reads one (fresco run paints several)" for code that reads a single stream.

@@ -5,10 +5,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <gmock/gmock.h>
@@ -51,6 +53,39 @@ std::string ParseError(const std::string& text, const std::vector<std::string>& 
   return status.message();
 }
 
+// Every setting whose key starts with `prefix` moved off its default, within its range: a
+// setting added to a stage's header is covered by the round trips below with no edit here.
+void MoveSettingsOffTheirDefaults(Project* p, const std::string& prefix) {
+  for (Setting& s : DescribeSettings(p)) {
+    if (s.key.rfind(prefix, 0) != 0) continue;
+    const auto in_range = [&](double v) {
+      return (s.min_exclusive ? v > s.min : v >= s.min) && v <= s.max;
+    };
+    switch (s.kind) {
+      case Setting::Kind::kBool:
+        *s.flag = !*s.flag;
+        break;
+      case Setting::Kind::kInt:
+        *s.integer += in_range(*s.integer + 1) ? 1 : -1;
+        break;
+      case Setting::Kind::kNumber: {
+        const double v = *s.number;
+        double moved = v != 0 ? 0.75 * v : 0.5;
+        if (!in_range(moved)) moved = std::isfinite(s.max) ? 0.5 * (v + s.max) : v + 0.5;
+        *s.number = moved;
+        break;
+      }
+      case Setting::Kind::kChoice:
+        s.set_choice((s.get_choice() + 1) % static_cast<int>(s.choices.size()));
+        break;
+      case Setting::Kind::kText:
+        break;
+    }
+    if (s.kind == Setting::Kind::kInt) EXPECT_TRUE(in_range(*s.integer)) << s.key;
+    if (s.kind == Setting::Kind::kNumber) EXPECT_TRUE(in_range(*s.number)) << s.key;
+  }
+}
+
 // A project with every setting away from its default.
 Project NonDefaultProject() {
   Project p;
@@ -76,58 +111,11 @@ Project NonDefaultProject() {
   p.live.offset_track_every_frames = 45;
   p.live.offset_track_search_s = 0.25;
   p.live.offset_track_min_gain = 0.2;
-  p.pipeline.sampling = SamplingMode::kArea;
-  p.pipeline.texel_size_m = 0.0123456789012345;
-  p.pipeline.max_buffer_texels = 4096;
-  p.pipeline.update_every = 20;
-  p.pipeline.update = UpdatePolicy::kLatest;
-  p.pipeline.quality_slack = 0.35;
-  p.pipeline.update_weight = 0.4;
-  p.pipeline.max_frames = 300;
-  p.pipeline.threads = 2;
-  p.pipeline.debug_images = true;
-  p.pipeline.occlusion.enabled = false;
-  p.pipeline.occlusion.tolerance_rel = 0.05;
-  p.pipeline.occlusion.tolerance_m = 0.01;
-  p.pipeline.occlusion.max_view_angle_deg = 75.5;
-  p.pipeline.refine.mode = RefineMode::kPaper;
-  p.pipeline.refine.max_model = RefineModelLimit::kAffine;
-  p.pipeline.refine.max_corners = 77;
-  p.pipeline.refine.search_px = 9;
-  p.pipeline.refine.window_px = 5;
-  p.pipeline.refine.pyramid_levels = 2;
-  p.pipeline.refine.ransac_px = 0.75;
-  p.pipeline.refine.max_scale_change = 0.02;
-  p.pipeline.refine.min_inliers = 8;
-  p.pipeline.refine.every_n_frames = 3;
-  p.pipeline.refine.min_correction_px = 0.5;
-  p.pipeline.refine.anchor = false;
-  p.pipeline.refine.pose = false;
-  p.pipeline.refine.anchor_min_frames = 6;
-  p.pipeline.refine.anchor_window_frames = 40;
-  p.pipeline.refine.anchor_step_px = 0.5;
-  p.pipeline.background.mode = BackgroundMode::kAverage;
-  p.pipeline.background.training_frames = 33;
-  p.pipeline.background.average_threshold = 21.5;
-  p.pipeline.background.warmup_frames = 4;
-  p.pipeline.background.window_frames = 500;
-  p.pipeline.background.sigma_threshold = 2.5;
-  p.pipeline.background.min_sigma = 4.5;
-  p.pipeline.background.normalize_gain = false;
-  p.pipeline.background.min_blob_texels = 40;
-  p.pipeline.background.dilate_texels = 5;
+  MoveSettingsOffTheirDefaults(&p, "pipeline.");
+  p.pipeline.texel_size_m = 0.0123456789012345;  // a double that needs all its digits
   p.grouping.angle_deg = 12.5;
   p.grouping.min_chart_texels = 77;
   p.grouping.max_stretch = 1.5;
-  p.pipeline.atlas.page_size = 2048;
-  p.pipeline.atlas.padding_texels = 6;
-  p.pipeline.select.enabled = true;
-  p.pipeline.select.exposure = false;
-  p.pipeline.select.switch_margin = 0.5;
-  p.pipeline.select.region_weight = 0.25;
-  p.pipeline.select.edge_px = 3.0;
-  p.pipeline.select.edge_penalty = 0.5;
-  p.pipeline.select.edge_depth_rel = 0.1;
   GroupingEdit merge;
   merge.op = "merge";
   merge.groups = {3, 4, 7};
@@ -154,8 +142,7 @@ Project NonDefaultProjectV2() {
   p.time_offset_s = 0;
   p.streams = {
       StreamSpec{"a/cameras.txt", "a/frames/", "a/images.txt", 0.25, 12.5},
-      StreamSpec{"b/camera.cameramodel", "udp://127.0.0.1:5001", "tcp://127.0.0.1:6001", -0.5,
-                 30}};
+      StreamSpec{"b/camera.cameramodel", "udp://127.0.0.1:5001", "tcp://127.0.0.1:6001", -0.5, 30}};
   return p;
 }
 
@@ -218,21 +205,37 @@ TEST(ProjectTest, SaveThenLoadGivesTheSameProject) {
 
 TEST(ProjectTest, SavedFileListsEverySetting) {
   const std::string text = ProjectToJsonText(Project());
-  for (const char* key : {"\"fresco\": 1",       "\"scene\"",
-                          "\"time_offset_s\"",   "\"sampling\": \"bilinear\"",
-                          "\"texel_size_m\"",    "\"max_buffer_texels\"",
-                          "\"update_every\": 1", "\"update\": \"quality\"",
-                          "\"quality_slack\"",   "\"update_weight\"", "\"max_frames\"",
-                          "\"threads\"",         "\"debug_images\"",
-                          "\"occlusion\"",       "\"tolerance_rel\"",
-                          "\"tolerance_m\"",     "\"max_view_angle_deg\"",
-                          "\"grouping\"",        "\"angle_deg\"",
-                          "\"edits\"",           "\"truth\"",
-                          "\"background\"",      "\"mode\": \"auto\"",
-                          "\"window_frames\"",   "\"dilate_texels\"",
-                          "\"atlas\"",           "\"page_size\"",
-                          "\"select\"",          "\"switch_margin\"",
-                          "\"min_chart_texels\"", "\"max_stretch\""}) {
+  for (const char* key : {"\"fresco\": 1",
+                          "\"scene\"",
+                          "\"time_offset_s\"",
+                          "\"sampling\": \"bilinear\"",
+                          "\"texel_size_m\"",
+                          "\"max_buffer_texels\"",
+                          "\"update_every\": 1",
+                          "\"update\": \"quality\"",
+                          "\"quality_slack\"",
+                          "\"update_weight\"",
+                          "\"max_frames\"",
+                          "\"threads\"",
+                          "\"debug_images\"",
+                          "\"occlusion\"",
+                          "\"tolerance_rel\"",
+                          "\"tolerance_m\"",
+                          "\"max_view_angle_deg\"",
+                          "\"grouping\"",
+                          "\"angle_deg\"",
+                          "\"edits\"",
+                          "\"truth\"",
+                          "\"background\"",
+                          "\"mode\": \"auto\"",
+                          "\"window_frames\"",
+                          "\"dilate_texels\"",
+                          "\"atlas\"",
+                          "\"page_size\"",
+                          "\"select\"",
+                          "\"switch_margin\"",
+                          "\"min_chart_texels\"",
+                          "\"max_stretch\""}) {
     EXPECT_THAT(text, HasSubstr(key));
   }
   // Pretty: one key per line.
@@ -660,6 +663,32 @@ TEST(Settings, EverySettingRoundTripsThroughSetWithinItsRangeAndNoFurther) {
     ++checked;
   }
   EXPECT_GE(checked, 60);
+}
+
+// A member added to a stage's settings but left out of its Fields() list would be neither read
+// nor written (and no test above would see it): every byte of the pipeline's settings must be
+// a listed field or padding. A byte that is neither changes operator== when flipped.
+TEST(Settings, EveryMemberOfThePipelineSettingsIsListed) {
+  PipelineOptions options;
+  const std::vector<std::pair<size_t, size_t>> spans = ListedFieldBytes(&options);
+  std::vector<bool> listed(sizeof(PipelineOptions), false);
+  for (const auto& [offset, size] : spans) {
+    ASSERT_LE(offset + size, sizeof(PipelineOptions));
+    for (size_t i = offset; i < offset + size; ++i) listed[i] = true;
+  }
+  static_assert(std::is_trivially_copyable_v<PipelineOptions>);
+  for (size_t i = 0; i < sizeof(PipelineOptions); ++i) {
+    if (listed[i]) continue;
+    PipelineOptions flipped;
+    std::memcpy(static_cast<void*>(&flipped), &options, sizeof(options));
+    reinterpret_cast<unsigned char*>(&flipped)[i] ^= 1;  // a bool stays a bool
+    EXPECT_TRUE(flipped == options) << "byte " << i << " of PipelineOptions is a member that "
+                                    << "no Fields() list names";
+  }
+  // The check can fail: a listed byte flipped is a different setting.
+  PipelineOptions flipped = options;
+  reinterpret_cast<unsigned char*>(&flipped)[spans.back().first] ^= 1;
+  EXPECT_FALSE(flipped == options);
 }
 
 TEST(Settings, TableRowsShowDefaultRangeAndHelp) {
