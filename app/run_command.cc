@@ -2,6 +2,7 @@
 // paints every frame, writes DIR/painted.gltf, DIR/metrics.json and (opt-in) DIR/stages/.
 #include <sys/resource.h>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -175,13 +176,19 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                        {"max_stretch", stretch.max},
                        {"mean_stretch", stretch.mean}};
   metrics["triangles"] = scene.mesh.NumTriangles();
-  // Per stream, in the project's order: its video and what came of its frames.
+  // Per stream, in the project's order: its video, what came of its frames and the fraction
+  // of its samples its background model masked (null when the background stage saw none).
   nlohmann::json streams = nlohmann::json::array();
-  for (size_t i = 0; i < specs.size(); ++i)
-    streams.push_back({{"video", specs[i].video},
-                       {"frames", stats.streams[i].frames},
-                       {"frames_painted", stats.streams[i].painted},
-                       {"frames_without_pose", stats.streams[i].without_pose}});
+  for (size_t i = 0; i < specs.size(); ++i) {
+    const StreamRunStats& stream = stats.streams[i];
+    const double masked = stream.MaskedFraction();
+    streams.push_back(
+        {{"video", specs[i].video},
+         {"frames", stream.frames},
+         {"frames_painted", stream.painted},
+         {"frames_without_pose", stream.without_pose},
+         {"masked_fraction", std::isnan(masked) ? nlohmann::json() : nlohmann::json(masked)}});
+  }
   metrics["streams"] = streams;
   nlohmann::json buffers = nlohmann::json::array();
   for (size_t b = 0; b < session->buffers().size(); ++b) {

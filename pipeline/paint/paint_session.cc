@@ -160,11 +160,21 @@ void PaintSession::StartAutoModes() {
   background_.clear();
   background_frame_.clear();
   if (options_.background.mode != BackgroundMode::kOff) {
-    background_.resize(set_.buffers.size());
     background_frame_.resize(set_.buffers.size());
-    for (size_t b = 0; b < set_.buffers.size(); ++b)
-      background_[b].Init(set_.buffers[b], options_.background);
+    StreamBackground(0);  // every project has a stream 0: its set-up is not the first frame's
   }
+}
+
+std::vector<BufferBackground>& PaintSession::StreamBackground(int stream) {
+  if (stream < 0) throw std::invalid_argument("PaintSession: stream " + std::to_string(stream));
+  if (background_.size() <= static_cast<size_t>(stream)) background_.resize(stream + 1);
+  std::vector<BufferBackground>& models = background_[stream];
+  if (models.empty()) {
+    models.resize(set_.buffers.size());
+    for (size_t b = 0; b < set_.buffers.size(); ++b)
+      models[b].Init(set_.buffers[b], options_.background);
+  }
+  return models;
 }
 
 void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
@@ -172,7 +182,7 @@ void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
   if (refine_auto_.AddFrame(frame_number, misalignment_px) &&
       refine_auto_.decision().state == AutoDecision::State::kOff)
     options_.refine.mode = RefineMode::kOff;  // no further cost
-  if (background_auto_.deciding() && !background_.empty()) {
+  if (background_auto_.deciding() && options_.background.mode != BackgroundMode::kOff) {
     long long observed = 0, warming = 0, masked = 0;
     for (size_t b = 0; b < seen.size(); ++b) {
       if (!seen[b]) continue;
@@ -232,13 +242,14 @@ void PaintSession::ForEachBuffer(const std::vector<size_t>& todo, bool serial,
 }
 
 void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
-                              const Rigid3d& cam_from_world, FrameReport* report) {
+                              const Rigid3d& cam_from_world, int stream, FrameReport* report) {
   const auto frame_start = std::chrono::steady_clock::now();
   report->frame = frame.index;
   report->name = frame.name;
   report->stages.clear();
   report->paint = PaintFigures();
   report->refine = RefineFigures();
+  report->background = BackgroundFigures();
   const int frame_number = frames_seen_++;
   if (options_.update_every > 1 && frame_number % options_.update_every != 0) {
     report->painted = false;
@@ -298,8 +309,9 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   // When no stage looks at the warped samples before the paint stage (no background
   // model, no refinement, no exposure or view selection, no debug images), the warp paints
   // them directly: the same texels, without writing and reading back the warped images.
-  const bool paint_in_warp = background_.empty() && options_.refine.mode == RefineMode::kOff &&
-                             !SelectActive(options_) && !debug;
+  const bool background = options_.background.mode != BackgroundMode::kOff;
+  const bool paint_in_warp =
+      !background && options_.refine.mode == RefineMode::kOff && !SelectActive(options_) && !debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);
   if (paint_in_warp && view.depth && !in_frustum.empty() &&
       options_.sampling == SamplingMode::kBilinear) {
@@ -364,7 +376,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   if (select && options_.select.exposure) report->stages.push_back(CorrectExposure(Indices(seen)));
 
   // 4. background
-  if (!background_.empty()) report->stages.push_back(SegmentForeground(seen, debug));
+  if (background)
+    report->stages.push_back(SegmentForeground(seen, stream, debug, &report->background));
 
   // 4b. select
   if (select) report->stages.push_back(SelectViewsStage(Indices(seen)));
@@ -380,16 +393,15 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
     paint_report.notes["painted"] = "during the warp (no stage between them)";
   } else {
     ForEachBuffer(seen_list, false, [&](size_t b) {
-      const cv::Mat mask = background_.empty() || background_frame_[b].masked == 0
+      const cv::Mat mask = !background || background_frame_[b].masked == 0
                                ? cv::Mat()
                                : background_frame_[b].foreground;
-      const cv::Mat warming = background_.empty() || background_frame_[b].warming_up == 0
+      const cv::Mat warming = !background || background_frame_[b].warming_up == 0
                                   ? cv::Mat()
                                   : background_frame_[b].warming;
       paint_stats[b] =
           PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b], warming);
-      if (!background_.empty())
-        MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
+      if (background) MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
     });
   }
   for (size_t b : seen_list) {
@@ -466,8 +478,11 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
         cv::Rect(0, 0, w.valid.cols, w.valid.rows);
     MoveWarpedImages(move, within, &w.bgr, &w.valid, &w.quality);
     w.valid_box = within;  // valid texels may have moved by up to the margin
+    // Every stream's model of the buffer moves with it (a stream's set made later starts
+    // in the moved buffer).
     if (!background_.empty() && TakeBackgroundMove(&anchors_[b], &move))
-      background_[b].Move(set_.buffers[b], move.roi, move.field);
+      for (std::vector<BufferBackground>& models : background_)
+        if (!models.empty()) models[b].Move(set_.buffers[b], move.roi, move.field);
     r->moved = true;
   }
   r->anchor_ms = MsSince(t0);
@@ -654,23 +669,25 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   return report;
 }
 
-StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool debug) {
+StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
+                                            BackgroundFigures* figures) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "background";
+  std::vector<BufferBackground>& models = StreamBackground(stream);
   float gain = 1.0f;
   if (options_.background.mode == BackgroundMode::kRobust && options_.background.normalize_gain) {
     // One histogram per buffer seen, in parallel, summed in buffer order (integer counts:
     // the same whatever the threads).
     const std::vector<size_t> seen_buffers = Indices(seen);
     std::vector<GainHistogram> per_buffer(seen_buffers.size());
-    cv::parallel_for_(
-        cv::Range(0, static_cast<int>(seen_buffers.size())), [&](const cv::Range& range) {
-          for (int i = range.start; i < range.end; ++i) {
-            const size_t b = seen_buffers[i];
-            background_[b].AccumulateGain(set_.buffers[b], warped_[b], &per_buffer[i]);
-          }
-        });
+    cv::parallel_for_(cv::Range(0, static_cast<int>(seen_buffers.size())),
+                      [&](const cv::Range& range) {
+                        for (int i = range.start; i < range.end; ++i) {
+                          const size_t b = seen_buffers[i];
+                          models[b].AccumulateGain(set_.buffers[b], warped_[b], &per_buffer[i]);
+                        }
+                      });
     GainHistogram histogram;
     for (const GainHistogram& h : per_buffer) {
       for (int i = 0; i < GainHistogram::kBins; ++i) histogram.bins[i] += h.bins[i];
@@ -681,7 +698,7 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool 
   long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
   const std::vector<size_t> seen_list = Indices(seen);
   ForEachBuffer(seen_list, false, [&](size_t b) {
-    background_[b].Update(set_.buffers[b], warped_[b], gain, debug, &background_frame_[b]);
+    models[b].Update(set_.buffers[b], warped_[b], gain, debug, &background_frame_[b]);
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];
@@ -689,16 +706,16 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool 
     warming += frame.warming_up, blobs += frame.blobs_removed;
     if (debug) {
       const std::string suffix = "_b" + std::to_string(b);
-      report.images["model" + suffix] = background_[b].Image(set_.buffers[b]);
+      report.images["model" + suffix] = models[b].Image(set_.buffers[b]);
       report.images["difference" + suffix] = frame.difference;
       report.images["foreground" + suffix] = frame.foreground;
     }
   }
   report.metrics["gain"] = gain;
-  report.metrics["texels_observed"] = static_cast<double>(observed);
+  figures->texels_observed = observed;
+  figures->texels_masked = masked;
+  figures->PutInto(&report);
   report.metrics["texels_foreground_raw"] = static_cast<double>(raw);
-  report.metrics["texels_masked"] = static_cast<double>(masked);
-  report.metrics["masked_fraction"] = observed > 0 ? static_cast<double>(masked) / observed : 0.0;
   report.metrics["texels_warming_up"] = static_cast<double>(warming);
   report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
   report.metrics["blobs_removed"] = static_cast<double>(blobs);
@@ -706,8 +723,10 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, bool 
   return report;
 }
 
-cv::Mat PaintSession::BackgroundImage(size_t b) const {
-  return b < background_.size() ? background_[b].Image(set_.buffers[b]) : cv::Mat();
+cv::Mat PaintSession::BackgroundImage(size_t b, int stream) const {
+  if (stream < 0 || static_cast<size_t>(stream) >= background_.size()) return cv::Mat();
+  const std::vector<BufferBackground>& models = background_[stream];
+  return b < models.size() ? models[b].Image(set_.buffers[b]) : cv::Mat();
 }
 
 long long PaintSession::NumSurfaceTexels() const {

@@ -63,8 +63,16 @@ class PaintSession {
   void PrepareCamera(const Camera& camera) { CacheFor(camera).rasterizer->Prepare(scene_->mesh); }
 
   // Paints one frame seen from `cam_from_world` through `camera`. Fills `report`.
+  // `stream`: the video stream it comes from (index into Project::Streams()); the background
+  // stage classifies it against that stream's own models (stream 0's made with the session,
+  // another stream's when its first frame reaches the stage), so that cameras of different
+  // sharpness or colour do not take each other's samples for foreground. Without it: stream 0.
   void PaintFrame(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
-                  FrameReport* report);
+                  int stream, FrameReport* report);
+  void PaintFrame(const Frame& frame, const Camera& camera, const Rigid3d& cam_from_world,
+                  FrameReport* report) {
+    PaintFrame(frame, camera, cam_from_world, 0, report);
+  }
 
   // The naive baseline `fresco bench` measures against (paints the same buffers): full
   // depth render, every texel projected one at a time, cv::remap per buffer, latest wins.
@@ -104,8 +112,9 @@ class PaintSession {
   long long NumPaintedSurfaceTexels() const;
   double Coverage() const;
   double default_texel_size_m() const { return texel_size_m_; }
-  // The background model's current estimate of buffer `b` (CV_8UC3; empty when off).
-  cv::Mat BackgroundImage(size_t b) const;
+  // The background model's current estimate of buffer `b` as stream `stream` learned it
+  // (CV_8UC3; empty when off or when that stream has painted no frame yet).
+  cv::Mat BackgroundImage(size_t b, int stream = 0) const;
 
  private:
   PaintSession() = default;
@@ -145,8 +154,12 @@ class PaintSession {
   void CorrectThroughPose(const std::vector<size_t>& todo, const std::vector<size_t>& fresh,
                           bool measure_only, std::vector<BufferRefinement>* results,
                           StageReport* report);
-  // The background stage over the buffers seen this frame (fills background_frame_).
-  StageReport SegmentForeground(const std::vector<bool>& seen, bool debug);
+  // The background stage over the buffers seen this frame, against stream `stream`'s models
+  // (fills background_frame_ and `figures`).
+  StageReport SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
+                                BackgroundFigures* figures);
+  // Stream `stream`'s background models, one per buffer, initialized on first use.
+  std::vector<BufferBackground>& StreamBackground(int stream);
   // The exposure and select stages (select_stages.cc) over the buffers seen this frame.
   StageReport CorrectExposure(const std::vector<size_t>& seen);
   StageReport SelectViewsStage(const std::vector<size_t>& seen);
@@ -167,11 +180,13 @@ class PaintSession {
   TextureAtlas atlas_;  // where each buffer goes in PaintedScene()
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
-  std::vector<RefineAnchor> anchors_;              // per buffer (refinement on)
-  std::vector<BufferBackground> background_;       // per buffer (mode != off)
+  std::vector<RefineAnchor> anchors_;  // per buffer (refinement on)
+  // Per stream, per buffer (mode != off): the background models. A stream's set is empty
+  // until its first frame reaches the background stage (stream 0's is made up front).
+  std::vector<std::vector<BufferBackground>> background_;
   std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;
-  cv::Mat depth_;  // the current frame's depth map from the video camera (reused)
+  cv::Mat depth_;        // the current frame's depth map from the video camera (reused)
   cv::Mat depth_range_;  // its 2x2 least and greatest depths, when the warp paints (reused)
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;

@@ -51,6 +51,20 @@ struct RefineFigures {
   }
 };
 
+// The background stage's figures read back as data (when the stage ran): per-stream
+// statistics (paint_run.h) sum them over a stream's frames.
+struct BackgroundFigures {
+  long long texels_observed = 0;  // texels sampled this frame in the buffers seen
+  long long texels_masked = 0;    // ... masked as foreground (after cleaning)
+
+  void PutInto(StageReport* background) const {
+    background->metrics["texels_observed"] = static_cast<double>(texels_observed);
+    background->metrics["texels_masked"] = static_cast<double>(texels_masked);
+    background->metrics["masked_fraction"] =
+        texels_observed > 0 ? static_cast<double>(texels_masked) / texels_observed : 0.0;
+  }
+};
+
 // What an `auto` mode (refine.mode, background.mode) decided and on what evidence
 // (auto_modes.h): the figure measured on the capture itself, the threshold it was compared
 // with and the frames it was measured over. Deciding until the decision point, then fixed
@@ -104,9 +118,10 @@ struct FrameReport {
   std::string skipped_reason;  // why not painted
   std::vector<StageReport> stages;
   double total_ms = 0.0;
-  PaintFigures paint;       // when painted
-  RefineFigures refine;     // when the refine stage ran (Stage("refine") != nullptr)
-  AutoDecisions decisions;  // the `auto` modes' state after this frame
+  PaintFigures paint;            // when painted
+  RefineFigures refine;          // when the refine stage ran (Stage("refine") != nullptr)
+  BackgroundFigures background;  // when the background stage ran (else zeros)
+  AutoDecisions decisions;       // the `auto` modes' state after this frame
 
   StageReport* Stage(const std::string& name) {
     for (auto& s : stages)

@@ -73,10 +73,13 @@ void PaintRun::Paint(const RunFrame& frame, FrameReport* report) {
   if (options_.naive)
     session_->PaintFrameNaive(f, *frame.camera, frame.posed.cam_from_world, report);
   else
-    session_->PaintFrame(f, *frame.camera, frame.posed.cam_from_world, report);
+    session_->PaintFrame(f, *frame.camera, frame.posed.cam_from_world, frame.stream, report);
   if (!report->painted) return;
   ++stats_.frames_painted;
-  ++stats_.streams[frame.stream].painted;
+  StreamRunStats& stream = stats_.streams[frame.stream];
+  ++stream.painted;
+  stream.texels_observed += report->background.texels_observed;
+  stream.texels_masked += report->background.texels_masked;
   for (const StageReport& stage : report->stages) {
     stats_.stage_ms_sum[stage.name] += stage.wall_ms;
     for (const auto& [key, value] : stage.metrics) {

@@ -16,6 +16,7 @@
 
 #include <chrono>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -46,11 +47,19 @@ struct RunFrame : SourcedFrame {
   int counter = -1;  // 0-based position among the frames this run read (all streams)
 };
 
-// Frames read, painted and without a pose, of one stream.
+// Frames read, painted and without a pose, of one stream; what its background stage saw.
 struct StreamRunStats {
   int frames = 0;
   int painted = 0;
   int without_pose = 0;
+  // Summed over the stream's painted frames (BackgroundFigures; 0 when the stage was off).
+  long long texels_observed = 0;  // texels the background stage classified
+  long long texels_masked = 0;    // ... masked as foreground
+  // texels_masked / texels_observed; NaN when the background stage saw none.
+  double MaskedFraction() const {
+    return texels_observed > 0 ? static_cast<double>(texels_masked) / texels_observed
+                               : std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 struct PaintRunStats {

@@ -12,9 +12,6 @@
 #include <map>
 
 #include <gtest/gtest.h>
-
-#include "tests/paint/room_capture.h"
-#include "tests/paint/synth_session.h"
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/video_source.h"
@@ -24,6 +21,8 @@
 #include "pipeline/synth/movers.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/paint/room_capture.h"
+#include "tests/paint/synth_session.h"
 #include "tests/test_support.h"
 
 namespace fresco {
@@ -147,7 +146,8 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
   const Scene scene = Room();
   SynthCapture capture;
   ASSERT_TRUE(
-      SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, exposure_jitter), &capture).ok());
+      SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, exposure_jitter), &capture)
+          .ok());
   ASSERT_GE(capture.movers.size(), 3u);
   PipelineOptions options;
   options.refine.mode = RefineMode::kOff;  // perfect poses: the background models alone
@@ -174,6 +174,50 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
 INSTANTIATE_TEST_SUITE_P(Exposure, MoversTest, ::testing::Values(0.0, 0.08), [](const auto& info) {
   return info.param == 0.0 ? std::string("Steady") : std::string("Jitter");
 });
+
+// Several streams painting one model: each stream's frames are classified against its own
+// background models, so a camera that sees the surface differently (here the same frames,
+// half as bright, as a second stream) neither teaches nor is judged by another's model.
+TEST(StreamBackground, EachStreamLearnsOnlyFromItsOwnFrames) {
+  const Scene scene = Room();
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(12, 0.0), &capture).ok());
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.select.enabled = false;  // the exposure stage would adapt frames to the buffers
+  options.background.mode = BackgroundMode::kRobust;
+  std::unique_ptr<PaintSession> alone = testing::SessionForCapture(scene, capture, options);
+  std::unique_ptr<PaintSession> both = testing::SessionForCapture(scene, capture, options);
+  ASSERT_TRUE(alone && both);
+  const size_t nb = both->buffers().size();
+  for (size_t b = 0; b < nb; ++b) EXPECT_TRUE(both->BackgroundImage(b, 1).empty());
+  FrameReport report;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
+    const Rigid3d& cam_from_world = capture.true_poses[i].cam_from_world;
+    testing::PaintCaptureFrame(alone.get(), capture, i, &report);
+    Frame frame;
+    frame.index = static_cast<int>(i);
+    frame.bgr = capture.frames_bgr[i];
+    both->PaintFrame(frame, capture.camera, cam_from_world, 0, &report);
+    frame.bgr = capture.frames_bgr[i] * 0.5;
+    both->PaintFrame(frame, capture.camera, cam_from_world, 1, &report);
+  }
+  // Stream 0's models are what they are without stream 1, bit for bit; stream 1's learned
+  // its own, darker frames.
+  double mean0 = 0, mean1 = 0;
+  for (size_t b = 0; b < nb; ++b) {
+    const cv::Mat model = alone->BackgroundImage(b);
+    const cv::Mat model0 = both->BackgroundImage(b, 0), model1 = both->BackgroundImage(b, 1);
+    ASSERT_EQ(model0.size(), model.size());
+    ASSERT_EQ(model1.size(), model.size());
+    EXPECT_EQ(cv::norm(model0, model, cv::NORM_INF), 0.0) << "buffer " << b;
+    mean0 += cv::sum(model0)[0] + cv::sum(model0)[1] + cv::sum(model0)[2];
+    mean1 += cv::sum(model1)[0] + cv::sum(model1)[1] + cv::sum(model1)[2];
+  }
+  EXPECT_TRUE(both->BackgroundImage(0, 2).empty());
+  EXPECT_GT(mean0, 0);
+  EXPECT_NEAR(mean1 / mean0, 0.5, 0.05);
+}
 
 // ---- Real static-camera video. ---------------------------------------------------------------
 
