@@ -3,7 +3,8 @@
 // `colmap` program (tests that need it skip with a message when it is absent): a project made
 // from a synthetic capture without poses opens, with poses.txt beside it close to the truth,
 // while the app keeps drawing frames; a bootstrap that fails (COLMAP missing, cancelled,
-// nothing to place it with) leaves one error and nothing written.
+// too few frames registered, nothing to place it with, poses that do not fit) leaves one
+// error and nothing written.
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -212,6 +213,99 @@ TEST(UiInputBootstrap, AFailedBootstrapLeavesNothingBehind) {
             "bootstrap with COLMAP: /nonexistent/colmap: program not found on PATH "
             "(install Debian's `colmap` package, or pass its path); no project was written");
   ExpectNothingWritten(app, folder, workspace);
+}
+
+// The run's outcomes without COLMAP (a snapshot as the runner publishes it), on the cube-room
+// capture: FinishNewProjectBootstrap writes both files or neither.
+struct Finished {
+  Finished() : dir(testing::MakeTempDir("bootstrap-finish")) {
+    fs::copy(testing::Capture(), dir + "/capture", fs::copy_options::recursive);
+    testing::WriteText(dir + "/control.txt",
+                       "a 0 0 0 000000.png 10 10 000001.png 12 10\n"
+                       "b 1 0 0 000000.png 50 10 000001.png 52 10\n"
+                       "c 0 1 0 000000.png 10 50 000001.png 12 50\n");
+    typed.scene = testing::SourceDir() + "/projects/cube-room/scene.gltf";
+    typed.video = dir + "/capture/frames/";
+    typed.camera = dir + "/capture/camera.cameramodel";
+    options.control_points = dir + "/control.txt";
+  }
+  // Prepared for DIR/made/new.json; `done` as after a run that posed every frame from `poses`.
+  void Prepare(const std::string& poses) {
+    ASSERT_TRUE(PrepareNewProjectBootstrap(typed, dir + "/made/new.json", options, &boot).ok());
+    EXPECT_TRUE(fs::is_directory(boot.workspace));
+    EXPECT_FALSE(fs::exists(dir + "/made")) << "nothing written beside the project yet";
+    done.has_request = done.reconstructed = done.bootstrapped = true;
+    done.request = boot.request;
+    done.frames = done.registered = 12;
+    done.aligned_with = "control_points";
+    done.bootstrap_poses = poses;
+  }
+  std::string dir;
+  ProjectPaths typed;
+  NewProjectBootstrapOptions options;
+  NewProjectBootstrap boot;
+  PosesSnapshot done;
+};
+
+TEST(NewProjectBootstrap, PlacedPosesAreWrittenBesideTheProjectWhichPointsAtThem) {
+  Finished f;
+  f.Prepare(f.dir + "/capture/sparse/images.txt");
+  Project project;
+  std::string summary;
+  const Status s = FinishNewProjectBootstrap(f.boot, f.done, &project, &summary);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(project.file_path, f.dir + "/made/new.json");
+  EXPECT_EQ(project.poses, "poses.txt");
+  EXPECT_EQ(testing::ReadText(f.dir + "/made/poses.txt"),
+            testing::ReadText(f.dir + "/capture/sparse/images.txt"));
+  EXPECT_EQ(summary,
+            "12 of 12 frames posed by COLMAP in 0 s, placed on the mesh by control points");
+  EXPECT_FALSE(fs::exists(f.boot.workspace));
+  Project loaded;
+  ASSERT_TRUE(LoadProject(f.dir + "/made/new.json", {}, &loaded).ok());
+  EXPECT_EQ(loaded.video, "../capture/frames/");
+  // A second bootstrap into the same folder: its poses.txt is taken.
+  const Status again =
+      PrepareNewProjectBootstrap(f.typed, f.dir + "/made/other.json", f.options, &f.boot);
+  EXPECT_EQ(again.message(), f.dir +
+                                 "/made/poses.txt: exists already (the bootstrapped poses go "
+                                 "there): save the project in another folder");
+}
+
+TEST(NewProjectBootstrap, TooFewFramesRegisteredIsOneErrorAndKeepsOnlyCOLMAPsLog) {
+  Finished f;
+  f.Prepare("");
+  const std::string log = f.boot.workspace + "/colmap/logs/03_mapper.log";
+  f.done.reconstructed = f.done.bootstrapped = false;
+  f.done.status = "error: colmap registered only 2 of 12 images (at least 3 needed); see " + log;
+  Project project;
+  std::string summary;
+  const Status s = FinishNewProjectBootstrap(f.boot, f.done, &project, &summary);
+  EXPECT_EQ(s.message(),
+            "bootstrap with COLMAP: colmap registered only 2 of 12 images (at least "
+            "3 needed); see " +
+                log + "; no project was written");
+  EXPECT_FALSE(fs::exists(f.dir + "/made"));
+  EXPECT_TRUE(fs::is_directory(f.boot.workspace)) << "kept: the error names its log";
+  DiscardNewProjectBootstrap(f.boot);
+  EXPECT_FALSE(fs::exists(f.boot.workspace));
+}
+
+TEST(NewProjectBootstrap, PosesThatDoNotFitTheFramesWriteNothing) {
+  Finished f;
+  PosedImage stray;
+  stray.image_id = stray.camera_id = 1;
+  stray.name = "nope.png";
+  const std::string poses = testing::MakeTempDir("bootstrap-stray") + "/images.txt";
+  ASSERT_TRUE(WriteColmapImages(poses, {stray}).ok());
+  f.Prepare(poses);
+  Project project;
+  std::string summary;
+  const Status s = FinishNewProjectBootstrap(f.boot, f.done, &project, &summary);
+  EXPECT_NE(s.message().find("nope.png"), std::string::npos) << s.message();
+  EXPECT_FALSE(fs::exists(f.dir + "/made"))
+      << "the poses written first are removed, and the folder";
+  EXPECT_FALSE(fs::exists(f.boot.workspace));
 }
 
 }  // namespace
