@@ -139,14 +139,17 @@ TEST(UiInputBootstrap, NewProjectBootstrappedWithColmapOpensWithPosesCloseToTheT
   EXPECT_EQ(made.video, "../blocks/frames/");
   EXPECT_FALSE(app.Find(kNewProjectTitle).open) << "the form closes";
   EXPECT_EQ(app.state.project.file_path, file);
-  EXPECT_EQ(app.state.message, "opened " + file);
+  EXPECT_EQ(app.state.message, "opened " + file + "; poses: " + summary) << "the status bar";
   app.runner.WaitIdle();
   app.Frames(2);
   EXPECT_EQ(app.state.message.rfind("error: ", 0), std::string::npos) << app.state.message;
   EXPECT_EQ(app.runner.Snapshot()->status.rfind("error", 0), std::string::npos)
       << app.runner.Snapshot()->status;
 
-  // Its poses against the truth (the same bounds as `fresco poses bootstrap`'s test).
+  // Its poses against the truth. COLMAP is not deterministic: over 8 runs the worst frame was
+  // 0.10-0.21 deg and 0.8-1.8 cm off (of an 8.6 m scene); the bounds leave room for that and
+  // stay under the verification's flags (0.5 deg, 1 % of the scene). Poses misplaced by the
+  // form (unaligned, another frame's) would be off by degrees and metres.
   std::vector<PosedImage> got;
   ASSERT_TRUE(ReadColmapImages(app.dir + "/made/poses.txt", &got).ok());
   const testing::PoseErrors e = testing::CompareWithTruth(got, truth);
@@ -154,8 +157,8 @@ TEST(UiInputBootstrap, NewProjectBootstrappedWithColmapOpensWithPosesCloseToTheT
   std::cout << "poses.txt against the truth: " << e.posed << " posed, max " << e.max_rotation_deg
             << " deg, " << e.max_position_m << " m of a " << scene_size_m << " m scene\n";
   EXPECT_EQ(e.posed, kFrames);
-  EXPECT_LT(e.max_rotation_deg, 0.2);
-  EXPECT_LT(e.max_position_m, 0.01 * scene_size_m);
+  EXPECT_LT(e.max_rotation_deg, 0.35);
+  EXPECT_LT(e.max_position_m, 0.005 * scene_size_m);
 }
 
 TEST(UiInputBootstrap, AFailedBootstrapLeavesNothingBehind) {

@@ -189,6 +189,7 @@ class NewProjectDialog : public Panel {
       return false;
     }
     Opened(ui, project.file_path);
+    ui.state->pending_open_note = "poses: " + summary_;
     return true;
   }
 
