@@ -17,10 +17,11 @@
 
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
+#include "pipeline/core/run_process.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/poses/bootstrap.h"
-#include "pipeline/core/run_process.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/poses/colmap_capture.h"
 #include "tests/poses/perturbed_pose.h"
 #include "tests/test_support.h"
 
@@ -28,17 +29,12 @@ namespace fresco {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::ControlPointsText;
 using testing::MakeTempDir;
 using testing::Perturbed;
 using testing::ReadText;
 using testing::RunFresco;
 using testing::WriteText;
-
-#define FRESCO_REQUIRE_COLMAP()                                                   \
-  do {                                                                            \
-    if (FindProgram("colmap").empty())                                            \
-      GTEST_SKIP() << "`colmap` is not on PATH (Debian package colmap): skipped"; \
-  } while (0)
 
 constexpr int kFrames = 16;
 // Frames with injected errors: 1 deg, 2 % of the scene size, and both.
@@ -53,15 +49,9 @@ class PosesColmapTest : public ::testing::Test {
     if (FindProgram("colmap").empty()) return;
     dir_ = new std::string(MakeTempDir("poses-colmap"));
     const std::string capture = Capture();
-    const auto r = RunFresco({"synth", "--scene", "builtin:blocks", "--out", capture, "--frames",
-                              std::to_string(kFrames), "--size", "480x360", "--supersample", "2",
-                              "--seed", "3", "--path", "orbit", "--set", "path.turns=0.5"});
+    const auto r = testing::SynthBlocks(capture, kFrames);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    Scene scene;
-    ASSERT_TRUE(LoadGltfScene(capture + "/scene.gltf", SceneLoadOptions(), &scene).ok());
-    Eigen::Vector3d lo, hi;
-    scene.Bounds(&lo, &hi);
-    scene_size_m_ = (hi - lo).norm();
+    scene_size_m_ = testing::SceneSizeM(capture);
     std::vector<PosedImage> poses;
     ASSERT_TRUE(ReadColmapImages(capture + "/truth/images.txt", &poses).ok());
     ASSERT_EQ(poses.size(), static_cast<size_t>(kFrames));
@@ -98,17 +88,10 @@ class PosesColmapTest : public ::testing::Test {
                               double* position_m) {
     std::vector<PosedImage> got;
     ASSERT_TRUE(ReadColmapImages(dir + "/sparse/images.txt", &got).ok());
-    std::map<std::string, PosedImage> truth;
-    for (const PosedImage& t : Truth()) truth[t.name] = t;
-    *posed = static_cast<int>(got.size());
-    *rotation_deg = *position_m = 0.0;
-    for (const PosedImage& g : got) {
-      ASSERT_TRUE(truth.count(g.name)) << g.name;
-      const Rigid3d& t = truth[g.name].cam_from_world;
-      *rotation_deg =
-          std::max(*rotation_deg, RotationDifferenceDeg(g.cam_from_world.rotation, t.rotation));
-      *position_m = std::max(*position_m, (g.cam_from_world.Centre() - t.Centre()).norm());
-    }
+    const testing::PoseErrors e = testing::CompareWithTruth(got, Truth());
+    *posed = e.posed;
+    *rotation_deg = e.max_rotation_deg;
+    *position_m = e.max_position_m;
   }
   static std::string* dir_;
   static testing::CommandResult* verify_;
@@ -190,39 +173,6 @@ TEST_F(PosesColmapTest, BootstrapFromRoughPosesIsCloseToTheTruth) {
   EXPECT_GE(b["inliers"].get<int>(), kFrames - 5);
 }
 
-// Control points: NAME X Y Z (`written`) then (IMAGE U V) in 2-3 frames where the true
-// point (`world`) projects.
-std::string ControlPointsText(const std::vector<Eigen::Vector3d>& world,
-                              const std::vector<Eigen::Vector3d>& written,
-                              const std::vector<PosedImage>& truth, const Camera& camera,
-                              int* points) {
-  std::string text = "# name X Y Z image u v ...\n";
-  *points = 0;
-  for (size_t k = 0; k < world.size(); ++k) {
-    char head[128];
-    std::snprintf(head, sizeof(head), "p%zu %.6f %.6f %.6f", k, written[k].x(), written[k].y(),
-                  written[k].z());
-    std::string line = head;
-    int seen = 0;
-    for (int i = static_cast<int>(k) % 3; i < kFrames && seen < 3; i += 5) {
-      Eigen::Vector2d px;
-      if (!camera.Project(truth[i].cam_from_world * world[k], &px)) continue;
-      if (px.x() < 0 || px.y() < 0 || px.x() > camera.width - 1 || px.y() > camera.height - 1)
-        continue;
-      char obs[96];
-      std::snprintf(obs, sizeof(obs), " %s %.4f %.4f", truth[i].name.c_str(), px.x(), px.y());
-      line += obs;
-      ++seen;
-    }
-    if (seen >= 2) {
-      text += line;
-      text += '\n';
-      ++*points;
-    }
-  }
-  return text;
-}
-
 TEST_F(PosesColmapTest, BootstrapFromControlPointsWithoutPoses) {
   // A copy of the project whose poses file holds no poses; 5 control points (on the ground
   // and above it) seen in 2-3 frames each (pixels: true projections).
@@ -234,8 +184,7 @@ TEST_F(PosesColmapTest, BootstrapFromControlPointsWithoutPoses) {
     ASSERT_TRUE(ReadColmapCameras(Capture() + "/sparse/cameras.txt", &cameras).ok());
     camera = cameras.begin()->second;
   }
-  const std::vector<Eigen::Vector3d> world = {
-      {-1.5, 0.0, -1.0}, {1.5, 0.0, -1.2}, {1.2, 0.0, 1.5}, {-1.0, 1.0, 0.5}, {0.3, 1.5, -0.2}};
+  const std::vector<Eigen::Vector3d> world = testing::BlocksControlPoints();
   int points = 0;
   const std::string text = ControlPointsText(world, world, Truth(), camera, &points);
   ASSERT_GE(points, 3) << text;

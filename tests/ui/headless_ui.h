@@ -150,6 +150,17 @@ struct HeadlessApp {
     input.mouse_down[0] = false;
     Frame();
   }
+  Panel& Find(const std::string& title) {
+    for (auto& p : panels)
+      if (title == p->Title()) return *p;
+    ADD_FAILURE() << "no panel " << title;
+    return *panels.front();
+  }
+  std::string ReportOf(const std::string& title, const std::string& key) {
+    const auto report = Find(title).Report();
+    const auto it = report.find(key);
+    return it == report.end() ? "" : it->second;
+  }
   static ImGuiWindow* Window(const std::string& title) {
     ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
     EXPECT_NE(w, nullptr) << title;
@@ -166,5 +177,25 @@ struct HeadlessApp {
   std::vector<std::unique_ptr<Panel>> panels;
   InputState input;
 };
+
+// Keyboard navigation's activation of item `id` of `window` (a button presses, an input
+// takes the keys), as the next frame sees it.
+inline void Activate(HeadlessApp& app, const std::string& window, const char* id) {
+  ImGui::ActivateItem(HeadlessApp::Window(window)->GetID(id));
+  app.Frame();
+}
+
+// Types `text` into input `id` of `window`, then leaves it.
+inline void TypeInto(HeadlessApp& app, const std::string& window, const char* id,
+                     const std::string& text) {
+  ImGui::ActivateItem(HeadlessApp::Window(window)->GetID(id));
+  GImGui->NavNextActivateFlags = ImGuiActivateFlags_PreferInput;  // as the keyboard does
+  app.Frame();
+  EXPECT_EQ(ImGui::GetActiveID(), HeadlessApp::Window(window)->GetID(id)) << id;
+  ImGui::GetIO().AddInputCharactersUTF8(text.c_str());
+  app.Frame();
+  ImGui::ClearActiveID();
+  app.Frame();
+}
 
 }  // namespace fresco::testing

@@ -31,12 +31,14 @@ namespace fresco {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::Activate;
 using testing::Capture;
 using testing::ImGuiHeadless;
 using testing::MakeTempDir;
 using testing::NullTextures;
 using testing::NullViewport;
 using testing::SourceDir;
+using testing::TypeInto;
 
 constexpr int kKeyF5 = 294, kKeyLeft = 263, kKeyRight = 262;  // GLFW's codes
 
@@ -57,17 +59,6 @@ struct App : testing::HeadlessApp {
     Frame();
     input.keys_down[key] = false;
     Frame();
-  }
-  Panel& Find(const std::string& title) {
-    for (auto& p : panels)
-      if (title == p->Title()) return *p;
-    ADD_FAILURE() << "no panel " << title;
-    return *panels.front();
-  }
-  std::string ReportOf(const std::string& title, const std::string& key) {
-    const auto report = Find(title).Report();
-    const auto it = report.find(key);
-    return it == report.end() ? "" : it->second;
   }
   std::string dir;
 };
@@ -442,25 +433,6 @@ TEST(UiInput, ADragWithinOneFrameStillOrbits) {
   push(InputEvent::Kind::kMouseButton, 0, 0, false);
   app.Drain(&queue);
   EXPECT_NEAR(Yaw(app), yaw - 0.4f * 50, 1e-3) << "the drag was lost";
-}
-
-// Keyboard navigation's activation of item `id` of `window` (a button presses, an input
-// takes the keys), as the next frame sees it.
-void Activate(App& app, const std::string& window, const char* id) {
-  ImGui::ActivateItem(App::Window(window)->GetID(id));
-  app.Frame();
-}
-
-// Types `text` into input `id` of `window`, then leaves it.
-void TypeInto(App& app, const std::string& window, const char* id, const std::string& text) {
-  ImGui::ActivateItem(App::Window(window)->GetID(id));
-  GImGui->NavNextActivateFlags = ImGuiActivateFlags_PreferInput;  // as the keyboard does
-  app.Frame();
-  EXPECT_EQ(ImGui::GetActiveID(), App::Window(window)->GetID(id)) << id;
-  ImGui::GetIO().AddInputCharactersUTF8(text.c_str());
-  app.Frame();
-  ImGui::ClearActiveID();
-  app.Frame();
 }
 
 // The New project form filled with the cube room's scene and the capture's camera, frames

@@ -21,10 +21,13 @@ constexpr float kMinFontScale = 0.75f, kMaxFontScale = 2.0f;
 bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
 
 void OpenNow(UiContext& ui, const std::string& path) {
+  const std::string note = std::move(ui.state->pending_open_note);
+  ui.state->pending_open_note.clear();
   if (Status s = ui.state->Open(path); !s.ok()) {
     ui.state->message = "error: " + s.message();
     return;
   }
+  if (!note.empty()) ui.state->message += "; " + note;
   ReopenProject(ui);
 }
 
@@ -73,6 +76,7 @@ void DrawUnsavedPrompt(UiContext& ui) {
     ImGui::SameLine();
     if (ImGui::Button("Cancel")) {
       state.pending_open.clear();
+      state.pending_open_note.clear();
       state.pending_quit = false;
       ImGui::CloseCurrentPopup();
     }

@@ -27,6 +27,8 @@ struct AppState {
 
   // Actions waiting for the unsaved-changes prompt: a project to open, or quitting.
   std::string pending_open;
+  // Said after "opened PENDING_OPEN" once it opens (how a new project's poses were made).
+  std::string pending_open_note;
   bool pending_quit = false;
 
   // Undo/redo over whole project snapshots (settings, grouping and path edits).

@@ -125,5 +125,8 @@ void SameLineIfFits(float next_width);
 float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
+// A COLMAP run under way (PosesRunner): a bar over its steps, with the step's name and
+// elapsed seconds; nothing when the worker is idle.
+void ColmapProgressBar(const PosesSnapshot& snap);
 
 }  // namespace fresco

@@ -1,4 +1,6 @@
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "ui/core/layout.h"
 #include "ui/core/panel.h"
@@ -116,6 +118,19 @@ void ShowMetrics(const std::map<std::string, double>& metrics) {
   }
   ImGui::PopTextWrapPos();
   ImGui::EndTable();
+}
+
+void ColmapProgressBar(const PosesSnapshot& snap) {
+  if (!snap.busy) return;
+  const auto now = std::chrono::steady_clock::now();
+  const double seconds =
+      std::chrono::duration<double>(now - (snap.steps > 0 ? snap.step_started : snap.started))
+          .count();
+  char text[160];
+  std::snprintf(text, sizeof(text), "%s%s%.0f s", snap.steps > 0 ? snap.step_name.c_str() : "",
+                snap.steps > 0 ? ", " : "", seconds);
+  const float fraction = snap.steps > 0 ? (snap.step - 1) / float(snap.steps) : 0.0f;
+  ImGui::ProgressBar(fraction, ImVec2(-1, 0), text);
 }
 
 }  // namespace fresco

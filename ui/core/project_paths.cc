@@ -44,13 +44,30 @@ ProjectPaths EditablePaths(const Project& project) {
   return paths;
 }
 
-Status CheckAsRunLoads(const std::string& text, const std::string& file, Project* parsed) {
+Status CheckAsRunLoads(const std::string& text, const std::string& file, Project* parsed,
+                       bool require_poses) {
   FRESCO_RETURN_IF_ERROR(ParseProject(text, file, {}, parsed));
   FRESCO_RETURN_IF_ERROR(CheckOneStream(*parsed, "the app"));
   CaptureLoadOptions options;
   options.open_video = !IsUrlOrDevice(parsed->Streams()[0].video);
+  options.require_poses = require_poses;
   Capture capture;
   return LoadCapture(*parsed, options, &capture);
+}
+
+Status CheckNewProject(const ProjectPaths& typed, const std::string& project_file,
+                       bool require_poses, Project* parsed) {
+  if (project_file.empty()) return Status::Error("project file: no path to save to");
+  std::error_code ec;
+  const fs::path file = fs::absolute(project_file, ec).lexically_normal();
+  if (fs::exists(file, ec))
+    return Status::Error(file.string() + ": exists already (open it with Open)");
+  Project built;
+  built.scene = PathRelativeTo(typed.scene, file.string());
+  built.camera = PathRelativeTo(typed.camera, file.string());
+  built.video = PathRelativeTo(typed.video, file.string());
+  built.poses = PathRelativeTo(typed.poses, file.string());
+  return CheckAsRunLoads(ProjectToJsonText(built), file.string(), parsed, require_poses);
 }
 
 Status RepairProjectPaths(const std::string& file, const ProjectPaths& typed, Project* repaired) {

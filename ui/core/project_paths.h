@@ -33,8 +33,16 @@ ProjectPaths EditablePaths(const Project& project);
 // The checks `fresco run` makes on loading a project whose text is `text` and whose file is
 // `file`: the JSON loader, one video stream, then every file the project names (as
 // LoadCapture reads them; a live video is not opened). The errors are the CLI's one-line
-// "FILE: field: ..." messages.
-Status CheckAsRunLoads(const std::string& text, const std::string& file, Project* parsed);
+// "FILE: field: ..." messages. `require_poses` false: a poses file may hold none (poses about
+// to be bootstrapped with COLMAP, as `fresco poses` reads a project).
+Status CheckAsRunLoads(const std::string& text, const std::string& file, Project* parsed,
+                       bool require_poses = true);
+
+// The project the New project form makes from `typed`, to be saved as `project_file` (which
+// must not exist yet): its paths relative to that file, checked as CheckAsRunLoads checks.
+// Writes nothing; `parsed->file_path` is the absolute, normalised project file.
+Status CheckNewProject(const ProjectPaths& typed, const std::string& project_file,
+                       bool require_poses, Project* parsed);
 
 // Repairs the project file `file` (absolute) in place: its scene, video, camera and poses
 // become `typed` (relative to the file, as PathRelativeTo writes them; a version-2 file's

@@ -33,7 +33,7 @@ std::vector<std::unique_ptr<Panel>> MakePanels() {
   Add(&p, MakeGroupingPanel(), 1280, 20, 320, 955);
   Add(&p, MakeCalibrationPanel(), 320, 20, 1280, 955);
   Add(&p, MakePosesPanel(), 320, 20, 1280, 955);
-  Add(&p, MakeNewProjectDialog(), 360, 120, 760, 300);
+  Add(&p, MakeNewProjectDialog(), 360, 120, 760, 470);  // tall enough for a bootstrap's fields
   return p;
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "ui/core/new_project_bootstrap.h"
 #include "ui/core/panel.h"
 #include "ui/core/project_paths.h"
 
@@ -38,6 +39,10 @@ inline constexpr const char* kNewProjectTitle = "New project";
 // folder), URLs for live sources.
 struct NewProjectForm : ProjectPaths {
   std::string project_file;  // where to save it (must not exist yet)
+  // Poses bootstrapped with COLMAP (new_project_bootstrap.h) instead of read from `poses`,
+  // which then holds optional rough poses that place them.
+  bool bootstrap = false;
+  NewProjectBootstrapOptions colmap;
 };
 // Builds the project (paths relative to the project file), checks it as `fresco run` does
 // when it loads one (the errors are its one-line "FILE: field: ..." messages) and saves it

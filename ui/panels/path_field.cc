@@ -32,15 +32,22 @@ bool PathField(const char* label, const char* id, const char* hint, std::string*
 }
 
 bool ProjectPathFields(ProjectPaths* paths) {
+  const bool changed = SceneVideoCameraFields(paths);
+  return PosesField(&paths->poses) || changed;
+}
+
+bool SceneVideoCameraFields(ProjectPaths* paths) {
   bool changed = PathField("Scene", "##scene", "mesh: scene.gltf, .glb, .ply or .obj",
                            &paths->scene, {".gltf", ".glb", ".ply", ".obj"});
   changed |= PathField("Video", "##video", "video file, frame folder/ or live URL (udp://...)",
                        &paths->video, {".mp4", ".mkv", ".avi", ".mov", ".webm"});
   changed |= PathField("Camera", "##camera", ".cameramodel or COLMAP cameras.txt", &paths->camera,
                        {".cameramodel", ".txt"});
-  changed |= PathField("Poses", "##poses", "COLMAP images.txt, TUM file, or tcp:// live feed",
-                       &paths->poses, {".txt", ".tum"});
   return changed;
+}
+
+bool PosesField(std::string* poses, const char* hint) {
+  return PathField("Poses", "##poses", hint, poses, {".txt", ".tum"});
 }
 
 }  // namespace fresco

@@ -17,5 +17,10 @@ bool PathField(const char* label, const char* id, const char* hint, std::string*
 // scene, video, camera and poses). Returns true when one changed.
 struct ProjectPaths;
 bool ProjectPathFields(ProjectPaths* paths);
+// The scene, video and camera fields of ProjectPathFields, and its poses field (with another
+// hint: the New project form's rough poses for a bootstrap).
+bool SceneVideoCameraFields(ProjectPaths* paths);
+bool PosesField(std::string* poses,
+                const char* hint = "COLMAP images.txt, TUM file, or tcp:// live feed");
 
 }  // namespace fresco

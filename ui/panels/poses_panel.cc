@@ -28,10 +28,6 @@ std::string Format(const char* format, double value) {
   return buffer;
 }
 
-double Seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
 // One error along the sequence: a point per frame (red when flagged, grey ticks where COLMAP
 // registered nothing or there is no given pose), the threshold dashed, the selected frame
 // and the pipeline's current frame as vertical lines. Returns the frame clicked, else -1.
@@ -224,13 +220,7 @@ class PosesPanel : public Panel {
     } else if (ImGui::Button("Cancel")) {
       ui.poses->Cancel();
     }
-    if (snap.busy) {
-      const float fraction = snap.steps > 0 ? (snap.step - 1) / float(snap.steps) : 0.0f;
-      const std::string text =
-          snap.steps > 0 ? snap.step_name + ", " + Format("%.0f s", Seconds(snap.step_started))
-                         : Format("%.0f s", Seconds(snap.started));
-      ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
-    }
+    ColmapProgressBar(snap);
     if (snap.status.rfind("error", 0) == 0)
       ImGui::TextColored(ImVec4(1, 0.4f, 0.4f, 1), "%s", snap.status.c_str());
     else
