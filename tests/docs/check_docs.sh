@@ -7,7 +7,8 @@
 #   - every `fresco VERB [SUBVERB]` in code exists, and every --option written after it is
 #     one that verb's --help lists;
 #   - docs/reference/cli.md is exactly what tests/docs/make_cli_reference.sh writes now;
-#   - every key the project-file reader accepts (pipeline/core/project.cc, Fields()) is in
+#   - every key the project-file reader accepts (Fields() in pipeline/core/project.cc and the
+#     stages' pipeline/paint/*_options.h) is in
 #     docs/reference/project-file.md, and every key that page's tables name is accepted;
 #   - every settings row there is the one `fresco settings --markdown` makes (default, range
 #     and meaning from the declarations);
@@ -167,9 +168,12 @@ for path in files:
             for code in re.findall(r"`([^`]*fresco [^`]*)`", line):
                 check_command(path, i, code)
 
-# Project-file keys: the reader's Fields() against docs/reference/project-file.md.
-header = open("pipeline/core/project.h").read()
-source = open("pipeline/core/project.cc").read()
+# Project-file keys: the reader's Fields() (project.cc, and the stages' settings headers)
+# against docs/reference/project-file.md.
+import glob
+stage_headers = "".join(open(f).read() for f in sorted(glob.glob("pipeline/paint/*_options.h")))
+header = open("pipeline/core/project.h").read() + stage_headers
+source = open("pipeline/core/project.cc").read() + stage_headers
 member_type = {}
 for t, name in re.findall(r"^\s+(?:std::vector<)?(\w+)>? (\w+)(?: = [^;]*)?;", header, re.M):
     member_type[name] = t
@@ -187,7 +191,7 @@ def walk(t, prefix):
             keys.add(path_)
 walk("Project", "")
 if len(keys) < 50:
-    err(f"read only {len(keys)} project keys from pipeline/core/project.cc: update this check")
+    err(f"read only {len(keys)} project keys from project.cc and the settings headers: update this check")
 ref = open("docs/reference/project-file.md").read()
 documented = set(re.findall(r"`([a-z_]+(?:\[\])?(?:\.[a-z_]+(?:\[\])?)*)`", ref))
 skip = {"streams", "pipeline", "grouping", "truth", "live"}
