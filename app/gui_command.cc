@@ -44,9 +44,8 @@ int RunGuiCommand(const CommandArgs& argv) {
       "  --poses-model DIR  use an earlier COLMAP text model (OUT/colmap/sparse_txt/0) instead\n"
       "                     of running COLMAP";
   spec.max_positional = 1;
-  spec.options = {"--screenshot",   "--frames", "--size",        "--calib-images",
-                  "--board",        "--model",  "--poses",       "--poses-out",
-                  "--poses-model"};
+  spec.options = {"--screenshot", "--frames", "--size",      "--calib-images", "--board",
+                  "--model",      "--poses",  "--poses-out", "--poses-model"};
   Args args;
   if (int code = ParseVerbArgs("gui", argv, spec, &args); code >= 0) return code;
   GuiOptions options;
@@ -76,16 +75,17 @@ int RunGuiCommand(const CommandArgs& argv) {
     const auto& names = calib::LensModelShortNames();
     if (options.calib_model != "auto" &&
         std::find(names.begin(), names.end(), options.calib_model) == names.end())
-      return UsageError("gui", spec, "--model: '" + options.calib_model +
-                                         "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
+      return UsageError("gui", spec,
+                        "--model: '" + options.calib_model +
+                            "' is not auto, pinhole, opencv4, opencv5, opencv8 or splined");
   }
   options.poses = args.Get("--poses");
   options.poses_out = args.Get("--poses-out");
   options.poses_model = args.Get("--poses-model");
   if (args.Has("--poses") && options.poses != "verify" && options.poses != "bootstrap")
-    return UsageError("gui", spec,
-                      std::string("--poses: expected verify or bootstrap, got '") + options.poses +
-                          "'");
+    return UsageError(
+        "gui", spec,
+        std::string("--poses: expected verify or bootstrap, got '") + options.poses + "'");
   if (options.poses.empty() && (args.Has("--poses-out") || args.Has("--poses-model")))
     return UsageError("gui", spec, "--poses-out and --poses-model go with --poses");
   if (!options.poses.empty() && options.project.empty())
@@ -99,7 +99,6 @@ int RunGuiCommand(const CommandArgs& argv) {
   if (!options.project.empty()) {  // bad input is exit 2 before any window opens
     Project project;
     if (Status s = LoadProject(options.project, {}, &project); !s.ok()) return InputError(s);
-    if (Status s = CheckOneStream(project, "fresco gui"); !s.ok()) return InputError(s);
   }
   return RunGuiApp(options);
 }

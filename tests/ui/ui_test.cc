@@ -97,6 +97,76 @@ TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   EXPECT_EQ(runner.Snapshot()->stage_ms.at("warp").size(), 3u);
 }
 
+// A project with two streams (a fixed wide-lens camera and a hand-held one): the app paints
+// both, as `fresco run` does (the same coverage), counts its frames over both, keeps each
+// stream's camera and path for the 3D view and each stream's latest frame for the Input
+// frame panel.
+TEST(UiHeadless, ATwoStreamProjectPaintsBothStreamsAsTheRunDoes) {
+  const std::string dir = testing::MakeTempDir("ui-streams");
+  testing::WriteText(dir + "/spec.json", R"({
+    "scene": "builtin:cube-room", "size": [160, 120], "frames": 12, "seed": 3,
+    "streams": [
+      {"name": "fixed", "path": {"kind": "fixed"}, "lens": "opencv5", "hfov_deg": 80,
+       "frames": 4},
+      {"name": "hand", "path": {"kind": "handheld", "turns": 0.5, "start_deg": 200},
+       "lens": "pinhole", "size": [200, 150]}]})");
+  const auto synth = RunFresco({"synth", dir + "/spec.json", "--out", dir + "/capture"});
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  const std::string project = dir + "/capture/project.json";
+  const auto run = RunFresco({"run", project, "--out", dir + "/out", "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const double run_coverage =
+      nlohmann::json::parse(ReadText(dir + "/out/metrics.json"))["coverage"].get<double>();
+
+  AppState state;
+  const Status opened = state.Open(project);
+  ASSERT_TRUE(opened.ok()) << opened.message();
+  PipelineRunner runner;
+  runner.Restart(state.project);
+  runner.WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> snap = runner.Snapshot();
+  ASSERT_TRUE(snap->geometry);
+  ASSERT_EQ(snap->geometry->stream_cameras.size(), 2u);
+  EXPECT_EQ(snap->geometry->stream_cameras[0].width, 160);
+  EXPECT_EQ(snap->geometry->stream_cameras[1].width, 200);
+  EXPECT_EQ(snap->geometry->stream_paths[0].size(), 4u);
+  EXPECT_EQ(snap->geometry->stream_paths[1].size(), 12u);
+  EXPECT_EQ(snap->geometry->num_frames, 16);
+  runner.Seek(15);  // the last frame of the two streams (counted over both)
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_EQ(snap->frame, 15);
+  EXPECT_EQ(snap->run.frames_painted, 16);
+  ASSERT_EQ(snap->run.streams.size(), 2u);
+  EXPECT_EQ(snap->run.streams[0].painted, 4);
+  EXPECT_EQ(snap->run.streams[1].painted, 12);
+  ASSERT_EQ(snap->stream_frames.size(), 2u);
+  const int width = snap->stream == 0 ? 160 : 200;  // the shown frame is its stream's latest
+  EXPECT_EQ(snap->frame_bgr.cols, width);
+  EXPECT_EQ(snap->stream_frames[snap->stream].cols, width);
+  EXPECT_EQ(snap->frame_name.rfind("stream " + std::to_string(snap->stream) + " ", 0), 0u)
+      << snap->frame_name;
+  EXPECT_DOUBLE_EQ(snap->coverage, run_coverage) << "the app paints what fresco run paints";
+  // Back to the first frame read: the fixed camera's (both streams start at time 0; the
+  // first stream first).
+  runner.Seek(0);
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_EQ(snap->stream, 0);
+  EXPECT_EQ(snap->frame_bgr.cols, 160);
+  // The panels draw it (the Input frame panel offers each stream's latest frame).
+  NullTextures textures;
+  NullViewport viewport;
+  UiContext ui{&state, &runner, nullptr, &textures, &viewport, snap, false};
+  ImGuiHeadless imgui;
+  auto panels = MakePanels();
+  for (auto& panel : panels) panel->open = true;
+  for (int i = 0; i < 2; ++i) imgui.Frame(ui, panels);
+  for (const auto& panel : panels)
+    if (std::string(panel->Title()) == "Input frame")
+      EXPECT_EQ(panel->Report().at("stream"), "latest");
+}
+
 // Endless live streams (issue 11): the per-frame histories keep only the latest frames.
 TEST(UiHeadless, PerFrameHistoriesAreBounded) {
   AppState state;

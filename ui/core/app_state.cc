@@ -29,7 +29,7 @@ Status Apply(const std::vector<GroupSpec>& current, const GroupingEdit& edit, in
 // The files the project names must exist before the app calls it opened: a missing video
 // is one clear error naming the project, the key and the path (live sources and built-in
 // scenes are not files).
-Status CheckInputsExist(const Project& project) {
+Status CheckInputsExist(const Project& project, const std::string& key_prefix = "") {
   const std::pair<const char*, const std::string*> inputs[] = {{"scene", &project.scene},
                                                                {"camera", &project.camera},
                                                                {"video", &project.video},
@@ -39,7 +39,9 @@ Status CheckInputsExist(const Project& project) {
     const std::string path = project.Resolve(*value);
     std::error_code ec;
     if (!std::filesystem::exists(path, ec))
-      return Status::Error(project.file_path + ": " + key + ": " + path + " does not exist");
+      return Status::Error(project.file_path + ": " +
+                           (std::string(key) == "scene" ? "" : key_prefix) + key + ": " + path +
+                           " does not exist");
   }
   return Status::Ok();
 }
@@ -50,15 +52,21 @@ Status AppState::Open(const std::string& path) {
   Project loaded;
   has_unopened = false;
   FRESCO_RETURN_IF_ERROR(LoadProject(path, {}, &loaded));
-  FRESCO_RETURN_IF_ERROR(CheckOneStream(loaded, "the app"));
-  // The app edits one stream as version-1 keys: a version-2 file's one stream is saved back
-  // as version 1 (the same project).
-  loaded = loaded.ForStream(0);
-  if (Status s = CheckInputsExist(loaded); !s.ok()) {
-    unopened = loaded;  // its paths can be repaired in the Project panel
-    has_unopened = true;
-    return s;
+  // One stream is edited as version-1 keys: a version-2 file's one stream is saved back as
+  // version 1 (the same project). Several streams paint and are saved as they are; their
+  // paths are edited in the file.
+  const size_t streams = loaded.Streams().size();
+  if (streams == 1) {
+    loaded = loaded.ForStream(0);
+    if (Status s = CheckInputsExist(loaded); !s.ok()) {
+      unopened = loaded;  // its paths can be repaired in the Project panel
+      has_unopened = true;
+      return s;
+    }
   }
+  for (size_t i = 0; streams > 1 && i < streams; ++i)
+    FRESCO_RETURN_IF_ERROR(CheckInputsExist(loaded.ForStream(static_cast<int>(i)),
+                                            "streams[" + std::to_string(i) + "]."));
   project = loaded;
   has_project = true;
   dirty = false;

@@ -22,15 +22,17 @@ namespace fresco {
 
 struct PipelineRunner::Session {
   Project project;
-  Capture capture;
+  // One capture per stream (Project::Streams(); the scene in [0]). A live project has one.
+  std::vector<Capture> captures;
   std::unique_ptr<PaintSession> paint;
   std::unique_ptr<LiveSession> live;  // live sources (reads capture and paint: after them)
   // The painting job (pipeline/run): the capture's frames read ahead, or the live session's
   // (reads the above: after them), judged and counted as `fresco run` does.
   std::unique_ptr<PosedFrameSource> source;
   std::unique_ptr<PaintRun> run;
-  std::unique_ptr<Renderer> review;  // half-size renderer for the misalignment review
-  Camera review_camera;
+  // Per stream: a half-size renderer through the stream's first camera, for the
+  // misalignment review (null when it could not be made).
+  std::vector<std::unique_ptr<Renderer>> review;
   int next_frame = 0;  // index of the next frame to read (live: frames taken so far)
   bool ended = false;
   std::string end_message;  // the status once ended ("end of video", "error: ...")
@@ -112,8 +114,16 @@ void PipelineRunner::OpenSession(const Project& project) {
   const bool live = IsLiveProject(project);
   CaptureLoadOptions load_options;
   load_options.open_video = !live;  // a live video opens after the pose feed connects
-  if (Status st = OpenPaintSession(project, load_options, &s->capture, &s->paint); !st.ok()) {
+  // Every stream of a file project paints, as `fresco run` paints them; live: one stream.
+  if (Status st = CheckOneStream(project, "the app's live painting"); live && !st.ok()) {
     working_.status = "error: " + st.message();
+    return;
+  }
+  const Status opened =
+      live ? OpenPaintSession(project, load_options, &s->captures.emplace_back(), &s->paint)
+           : OpenPaintSession(project, load_options, &s->captures, &s->paint);
+  if (!opened.ok()) {
+    working_.status = "error: " + opened.message();
     return;
   }
   if (live) {
@@ -124,20 +134,22 @@ void PipelineRunner::OpenSession(const Project& project) {
     l.poses = project.Resolve(project.poses);
     working_.status = "connecting to " + l.video + " and " + l.poses;
     Publish(false);  // opening waits for the sources (up to their timeouts)
-    if (Status st = LiveSession::Open(project, s->capture, *s->paint, &s->live); !st.ok()) {
+    if (Status st = LiveSession::Open(project, s->captures[0], *s->paint, &s->live); !st.ok()) {
       working_.status = "error: " + st.message();
       l.state = "error";
       l.problem = working_.status;
       return;
     }
   }
-  const StreamSpec stream = project.Streams()[0];  // the capture's (one stream)
-  const FrameOrigin origin{project.Resolve(stream.video), project.Resolve(stream.poses)};
-  if (live)
+  if (live) {
+    const StreamSpec stream = project.Streams()[0];
+    const FrameOrigin origin{project.Resolve(stream.video), project.Resolve(stream.poses)};
     s->source = std::make_unique<LiveSessionSource>(s->live.get(), options_.live_poll_ms, origin);
-  else
-    s->source =
-        std::make_unique<FileFrameSource>(project, std::vector<const Capture*>{&s->capture});
+  } else {
+    std::vector<const Capture*> streams;
+    for (const Capture& c : s->captures) streams.push_back(&c);
+    s->source = std::make_unique<FileFrameSource>(project, streams);
+  }
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   s->run = std::make_unique<PaintRun>(s->paint.get(), s->source.get(), run_options);
@@ -148,18 +160,29 @@ void PipelineRunner::OpenSession(const Project& project) {
   geometry->buffer_of_triangle = s->paint->grouping().group_of_triangle;
   for (const BaseBuffer& b : s->paint->buffers())
     geometry->buffer_texels.push_back(b.num_surface_texels);
-  for (const PosedImage& p : s->capture.poses) geometry->path.push_back(p.cam_from_world);
-  geometry->camera = s->capture.cameras.begin()->second;
-  geometry->num_frames = live ? -1 : s->capture.video->FrameCount();
+  for (const Capture& c : s->captures) {
+    std::vector<Rigid3d>& path = geometry->stream_paths.emplace_back();
+    for (const PosedImage& p : c.poses) path.push_back(p.cam_from_world);
+    geometry->stream_cameras.push_back(c.cameras.begin()->second);
+  }
+  geometry->path = geometry->stream_paths[0];
+  geometry->camera = geometry->stream_cameras[0];
+  geometry->num_frames = 0;
+  for (const Capture& c : s->captures)
+    geometry->num_frames = live || geometry->num_frames < 0 || c.video->FrameCount() < 0
+                               ? -1
+                               : geometry->num_frames + c.video->FrameCount();
   geometry->texel_size_m = s->paint->default_texel_size_m();
   geometry->folds_split = s->paint->folds_split();
   working_.geometry = geometry;
-  if (options_.misalignment) {
-    s->review_camera = HalfSize(geometry->camera);
+  working_.stream_frames.assign(s->captures.size(), cv::Mat());
+  for (const Camera& camera : geometry->stream_cameras) {
+    std::unique_ptr<Renderer>& review = s->review.emplace_back();
+    if (!options_.misalignment) continue;
     try {
-      s->review = std::make_unique<Renderer>(s->review_camera, RenderOptions());
+      review = std::make_unique<Renderer>(HalfSize(camera), RenderOptions());
     } catch (const std::exception&) {
-      s->review.reset();
+      review.reset();
     }
   }
   working_.status = "paused";
@@ -183,10 +206,17 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   }
   const PosedFrame& posed = f.posed;
   const Frame& frame = posed.frame;
-  working_.frame = frame.index;
-  working_.frame_name = frame.name;
+  // Several streams: frames are counted over all of them, as seeking counts them.
+  working_.frame = s.captures.size() > 1 ? f.counter : frame.index;
+  working_.frame_name =
+      s.captures.size() > 1 ? "stream " + std::to_string(f.stream) + " " + frame.name : frame.name;
   working_.has_pose = posed.has_pose;
-  if (show) working_.frame_bgr = frame.bgr.clone();
+  working_.stream = f.stream;
+  if (show) {
+    working_.frame_bgr = frame.bgr.clone();
+    if (static_cast<size_t>(f.stream) < working_.stream_frames.size())
+      working_.stream_frames[f.stream] = working_.frame_bgr;
+  }
   if (f.fate != FrameFate::kPaint) {  // no pose (the app holds no frame out)
     working_.report = FrameReport();
     working_.report.frame = frame.index;
@@ -200,9 +230,11 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   }
   working_.cam_from_world = posed.cam_from_world;
   // Review: the painted model, as it stands before this frame, seen from this frame.
-  if (show && s.review && s.paint->NumPaintedSurfaceTexels() > 0) {
+  Renderer* review =
+      static_cast<size_t>(f.stream) < s.review.size() ? s.review[f.stream].get() : nullptr;
+  if (show && review && s.paint->NumPaintedSurfaceTexels() > 0) {
     RenderOutput out;
-    s.review->Render(s.paint->PaintedSceneByBuffer(), posed.cam_from_world, &out);
+    review->Render(s.paint->PaintedSceneByBuffer(), posed.cam_from_world, &out);
     cv::Mat small, rephoto, grey_frame, grey_rephoto, diff;
     cv::resize(frame.bgr, small, out.rgba.size(), 0, 0, cv::INTER_AREA);
     cv::cvtColor(out.rgba, rephoto, cv::COLOR_RGBA2BGR);

@@ -43,7 +43,11 @@ struct SessionGeometry {
   std::vector<int> buffer_texels;       // on-surface texels per buffer
   std::vector<Rigid3d> path;            // cam_from_world of every posed frame, in order
   Camera camera;                        // the first camera (frustum drawing, preview)
-  int num_frames = 0;                   // frames in the video when known, else -1 (live)
+  // Per stream (Project::Streams(); `path` and `camera` are stream 0's): its posed frames'
+  // cam_from_world in order, and its first camera.
+  std::vector<std::vector<Rigid3d>> stream_paths;
+  std::vector<Camera> stream_cameras;
+  int num_frames = 0;  // frames of all streams when known, else -1 (live)
   double texel_size_m = 0;
   int folds_split = 0;
 };
@@ -61,8 +65,10 @@ struct RunnerSnapshot {
   std::string frame_name;
   bool has_pose = false;
   Rigid3d cam_from_world;
-  cv::Mat frame_bgr;                                    // the input frame
-  FrameReport report;                                   // stages with metrics and debug images
+  cv::Mat frame_bgr;                   // the input frame
+  int stream = 0;                      // ... its stream
+  std::vector<cv::Mat> stream_frames;  // per stream, its latest input frame shown (or empty)
+  FrameReport report;                  // stages with metrics and debug images
   std::shared_ptr<const std::vector<cv::Mat>> painted;  // per buffer BGRA (alpha 0 = never)
   uint64_t painted_version = 0;
   double coverage = 0;

@@ -385,7 +385,10 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   // The frame's projection for the preview: pixel * z = K [R|t] x_local (pinhole part).
   const Rigid3d cam_from_local = CamFromLocal(scene, snapshot.cam_from_world);
   Eigen::Matrix4f frame_from_local = Eigen::Matrix4f::Zero();
-  const Camera& cam = geo.camera;
+  // The current frame's camera (its stream's, when the project has several).
+  const Camera& cam = static_cast<size_t>(snapshot.stream) < geo.stream_cameras.size()
+                          ? geo.stream_cameras[snapshot.stream]
+                          : geo.camera;
   Eigen::Matrix3d K;
   K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
   frame_from_local.block<3, 3>(0, 0) = (K * cam_from_local.RotationMatrix()).cast<float>();
@@ -432,10 +435,20 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
     lines.push_back({{a.x(), a.y(), a.z()}, {r, g, bl}});
     lines.push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
   };
-  if (view->show_path)
-    for (const std::vector<Rigid3d>* path : {&geo.path, &snapshot.live_path})
-      for (size_t i = 1; i < path->size(); ++i)
-        add(centre_of((*path)[i - 1]), centre_of((*path)[i]), 0.6f, 0.6f, 0.65f);
+  if (view->show_path) {
+    // Each stream's path (stream 0 grey, the others in their own hues), and the live one.
+    static constexpr float kStreamColours[][3] = {
+        {0.6f, 0.6f, 0.65f}, {0.3f, 0.75f, 1.0f}, {1.0f, 0.45f, 0.8f}, {0.45f, 0.95f, 0.45f}};
+    std::vector<const std::vector<Rigid3d>*> paths = {&snapshot.live_path};
+    if (geo.stream_paths.empty()) paths.push_back(&geo.path);
+    for (const std::vector<Rigid3d>& path : geo.stream_paths) paths.push_back(&path);
+    for (size_t p = 0; p < paths.size(); ++p) {
+      const float* colour = kStreamColours[p == 0 ? 0 : (p - 1) % 4];
+      for (size_t i = 1; i < paths[p]->size(); ++i)
+        add(centre_of((*paths[p])[i - 1]), centre_of((*paths[p])[i]), colour[0], colour[1],
+            colour[2]);
+    }
+  }
   if (view->show_frustum && snapshot.has_pose) {
     const Rigid3d local_from_cam = cam_from_local.Inverse();
     const float depth = 0.25f * radius;

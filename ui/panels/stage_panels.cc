@@ -111,19 +111,40 @@ class InputFramePanel : public Panel {
       return;
     }
     const RunnerSnapshot& snap = *ui.snapshot;
+    const int streams = static_cast<int>(snap.stream_frames.size());
+    if (streams > 1) {  // several cameras: the latest frame painted, or one stream's latest
+      ImGui::RadioButton("latest", &shown_, -1);
+      for (int i = 0; i < streams; ++i) {
+        ImGui::SameLine();
+        ImGui::RadioButton(("stream " + std::to_string(i)).c_str(), &shown_, i);
+      }
+      shown_ = std::clamp(shown_, -1, streams - 1);
+    } else {
+      shown_ = -1;
+    }
     ImGui::Text("%s %s%s", FrameLabel(snap).c_str(), snap.frame_name.c_str(),
                 snap.has_pose ? "" : " (no pose)");
-    view_.Draw(ui, "input", snap.frame_bgr, snap.version);
+    const bool latest = shown_ < 0 || shown_ == snap.stream;
+    if (latest) {
+      view_.Draw(ui, "input", snap.frame_bgr, snap.version);
+    } else if (snap.stream_frames[shown_].empty()) {
+      ImGui::TextDisabled("stream %d: no frame of it shown yet", shown_);
+    } else {
+      ImGui::TextDisabled("stream %d: its latest frame shown", shown_);
+      view_.Draw(ui, "input", snap.stream_frames[shown_], snap.version);
+    }
     ImGui::End();
   }
   std::map<std::string, std::string> Report() const override {
     std::map<std::string, std::string> report;
     view_.ReportInto(&report);
+    report["stream"] = shown_ < 0 ? "latest" : std::to_string(shown_);
     return report;
   }
 
  private:
   ImageView view_;
+  int shown_ = -1;  // the stream whose latest frame is shown; -1: the latest of any stream
 };
 
 class PaintedBuffersPanel : public Panel {
