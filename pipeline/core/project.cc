@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/setting_rule.h"
 #include "pipeline/core/settings.h"
 
 namespace fresco {
@@ -31,8 +32,8 @@ constexpr int kProjectVersion = 2;  // the newest this Fresco reads
 // Version-1 keys that version 2 replaces by `streams`.
 constexpr const char* kStreamKeys[] = {"camera", "video", "poses", "time_offset_s"};
 
-const std::vector<std::pair<SamplingMode, std::string>>& SamplingNames() {
-  static const std::vector<std::pair<SamplingMode, std::string>> names = {
+const EnumNames<SamplingMode>& SamplingNames() {
+  static const EnumNames<SamplingMode> names = {
       {SamplingMode::kNearest, "nearest"},
       {SamplingMode::kBilinear, "bilinear"},
       {SamplingMode::kArea, "area"},
@@ -40,8 +41,8 @@ const std::vector<std::pair<SamplingMode, std::string>>& SamplingNames() {
   return names;
 }
 
-const std::vector<std::pair<UpdatePolicy, std::string>>& UpdatePolicyNames() {
-  static const std::vector<std::pair<UpdatePolicy, std::string>> names = {
+const EnumNames<UpdatePolicy>& UpdatePolicyNames() {
+  static const EnumNames<UpdatePolicy> names = {
       {UpdatePolicy::kLatest, "latest"},
       {UpdatePolicy::kQuality, "quality"},
   };
@@ -246,8 +247,7 @@ class JsonWriter {
     (*object_)[key] = value;
   }
   template <class E>
-  void Enum(const char* key, const E& value, const std::vector<std::pair<E, std::string>>& names,
-            const char* /*help*/ = "") {
+  void Enum(const char* key, const E& value, const EnumNames<E>& names, const char* /*help*/ = "") {
     for (const auto& [e, name] : names) {
       if (e == value) (*object_)[key] = name;
     }
@@ -406,8 +406,7 @@ class JsonReader {
   }
 
   template <class E>
-  void Enum(const char* key, E& value, const std::vector<std::pair<E, std::string>>& names,
-            const char* /*help*/ = "") {
+  void Enum(const char* key, E& value, const EnumNames<E>& names, const char* /*help*/ = "") {
     const Json* j = Find(key, {});
     if (!j) return;
     std::vector<std::string> choices;
@@ -900,8 +899,7 @@ class SettingsCollector {
   }
   void Field(const char*, std::vector<int>&, const Rule& = {}) {}  // lists: not a setting
   template <class E>
-  void Enum(const char* key, E& value, const std::vector<std::pair<E, std::string>>& names,
-            const char* help = "") {
+  void Enum(const char* key, E& value, const EnumNames<E>& names, const char* help = "") {
     Setting& s = Add(key, Setting::Kind::kChoice, Rule{.help = help});
     for (const auto& entry : names) s.choices.push_back(entry.second);
     s.get_choice = [&value, &names] {
@@ -951,7 +949,7 @@ struct FieldBytesCollector {
     Add(value);
   }
   template <class E>
-  void Enum(const char*, E& value, const std::vector<std::pair<E, std::string>>&, const char*) {
+  void Enum(const char*, E& value, const EnumNames<E>&, const char*) {
     Add(value);
   }
   template <class T>

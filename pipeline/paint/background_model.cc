@@ -8,7 +8,6 @@
 #include <opencv2/imgproc.hpp>
 
 namespace fresco {
-namespace {}  // namespace
 
 float GainHistogram::MedianGain(long long min_samples) const {
   if (count < min_samples) return 1.0f;
@@ -66,8 +65,8 @@ void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const
   }
   const std::vector<std::pair<int, int>> moved = MovedTexels(buffer, texel_at_, roi, field);
   if (!robust_.empty()) robust_.Move(moved);
-  std::vector<AverageTexel> read(moved.size());  // all read before any is written
   if (average_.empty()) return;
+  std::vector<AverageTexel> read(moved.size());  // all read before any is written
   for (size_t i = 0; i < moved.size(); ++i) read[i] = average_[moved[i].second];
   for (size_t i = 0; i < moved.size(); ++i) average_[moved[i].first] = read[i];
 }
@@ -108,22 +107,22 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
   alignas(32) float x[3][kMax];
   alignas(32) uint8_t sampled[kMax], foreground[kMax], warm_up[kMax];
   alignas(32) float distance2[kMax];
+  RobustUpdateParams params;
+  params.k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
+  params.min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
+  params.window = options_.window_frames;
+  params.warmup = options_.warmup_frames;
+  const float inv_gain = 1.0f / gain;
   for (int begin = chunk.begin; begin < chunk.end; begin += kMax) {
     const int n = std::min(kMax, chunk.end - begin);
     const int32_t* index = buffer.texel_index.data() + begin;
     if (options_.mode == BackgroundMode::kRobust) {
-      const float inv_gain = 1.0f / gain;
       for (int i = 0; i < n; ++i) {
         const int idx = index[i];
         const cv::Vec3b s = src[idx];
         sampled[i] = valid[idx] != 0;
         for (int c = 0; c < 3; ++c) x[c][i] = s[c] * inv_gain;
       }
-      RobustUpdateParams params;
-      params.k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
-      params.min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
-      params.window = options_.window_frames;
-      params.warmup = options_.warmup_frames;
       UpdateRobustTexels(params, begin, n, x[0], x[1], x[2], sampled, &robust_, foreground, warm_up,
                          distance2);
     } else {

@@ -51,8 +51,8 @@ struct BackgroundOptions {
   bool operator==(const BackgroundOptions&) const = default;
 };
 
-inline const std::vector<std::pair<BackgroundMode, std::string>>& BackgroundModeNames() {
-  static const std::vector<std::pair<BackgroundMode, std::string>> names = {
+inline const EnumNames<BackgroundMode>& BackgroundModeNames() {
+  static const EnumNames<BackgroundMode> names = {
       {BackgroundMode::kOff, "off"},
       {BackgroundMode::kAverage, "average"},
       {BackgroundMode::kRobust, "robust"},

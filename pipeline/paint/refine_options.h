@@ -50,8 +50,8 @@ struct RefineOptions {
   bool operator==(const RefineOptions&) const = default;
 };
 
-inline const std::vector<std::pair<RefineMode, std::string>>& RefineModeNames() {
-  static const std::vector<std::pair<RefineMode, std::string>> names = {
+inline const EnumNames<RefineMode>& RefineModeNames() {
+  static const EnumNames<RefineMode> names = {
       {RefineMode::kOff, "off"},
       {RefineMode::kPaper, "paper"},
       {RefineMode::kRobust, "robust"},
@@ -60,8 +60,8 @@ inline const std::vector<std::pair<RefineMode, std::string>>& RefineModeNames() 
   return names;
 }
 
-inline const std::vector<std::pair<RefineModelLimit, std::string>>& RefineModelNames() {
-  static const std::vector<std::pair<RefineModelLimit, std::string>> names = {
+inline const EnumNames<RefineModelLimit>& RefineModelNames() {
+  static const EnumNames<RefineModelLimit> names = {
       {RefineModelLimit::kTranslation, "translation"},
       {RefineModelLimit::kSimilarity, "similarity"},
       {RefineModelLimit::kAffine, "affine"},

@@ -66,6 +66,17 @@ struct Lanes {
   float* distance2;
 };
 
+// The same places, `i` texels on.
+[[gnu::always_inline]] inline Lanes At(const Lanes& l, int i) {
+  Lanes at = l;
+  for (auto& mode : at.mean)
+    for (auto*& channel : mode) channel += i;
+  at.var4 += i, at.samples += i, at.weight[0] += i, at.weight[1] += i;
+  for (auto*& channel : at.x) channel += i;
+  at.valid += i, at.foreground += i, at.warming += i, at.distance2 += i;
+  return at;
+}
+
 template <class V>
 [[gnu::always_inline]] inline V Load(const void* p) {
   V v;
@@ -168,52 +179,47 @@ __attribute__((target_clones("avx2", "default"))) void UpdateRobustTexels(
     const RobustUpdateParams& params, int begin, int n, const float* x0, const float* x1,
     const float* x2, const uint8_t* valid, RobustTexels* texels, uint8_t* foreground,
     uint8_t* warming, float* distance2) {
-  Lanes l;
+  // Where the run's state, samples and results are; then 8 texels at a time from there.
+  Lanes run;
+  for (int m = 0; m < 2; ++m)
+    for (int c = 0; c < 3; ++c) run.mean[m][c] = texels->mean[m][c].data() + begin;
+  run.var4 = texels->var4.data() + begin;
+  run.samples = texels->samples.data() + begin;
+  run.weight[0] = texels->weight[0].data() + begin;
+  run.weight[1] = texels->weight[1].data() + begin;
+  run.x[0] = x0, run.x[1] = x1, run.x[2] = x2;
+  run.valid = valid;
+  run.foreground = foreground, run.warming = warming, run.distance2 = distance2;
   int i = 0;
-  for (; i + kLanes <= n; i += kLanes) {
-    const int k = begin + i;
-    for (int m = 0; m < 2; ++m)
-      for (int c = 0; c < 3; ++c) l.mean[m][c] = texels->mean[m][c].data() + k;
-    l.var4 = texels->var4.data() + k;
-    l.samples = texels->samples.data() + k;
-    l.weight[0] = texels->weight[0].data() + k;
-    l.weight[1] = texels->weight[1].data() + k;
-    l.x[0] = x0 + i, l.x[1] = x1 + i, l.x[2] = x2 + i;
-    l.valid = valid + i;
-    l.foreground = foreground + i, l.warming = warming + i, l.distance2 = distance2 + i;
-    UpdateLanes(params, l);
-  }
+  for (; i + kLanes <= n; i += kLanes) UpdateLanes(params, At(run, i));
   const int rest = n - i;
   if (rest == 0) return;
   // The last texels in lanes of their own (unsampled lanes change nothing).
+  const Lanes from = At(run, i);
   uint16_t mean[2][3][kLanes] = {}, var4[kLanes] = {}, samples[kLanes] = {};
   float weight[2][kLanes] = {}, x[3][kLanes] = {}, d2[kLanes];
   uint8_t sampled[kLanes] = {}, fg[kLanes], warm[kLanes];
-  const int k = begin + i;
-  for (int j = 0; j < rest; ++j) {
-    for (int m = 0; m < 2; ++m)
-      for (int c = 0; c < 3; ++c) mean[m][c][j] = texels->mean[m][c][k + j];
-    var4[j] = texels->var4[k + j];
-    samples[j] = texels->samples[k + j];
-    weight[0][j] = texels->weight[0][k + j];
-    weight[1][j] = texels->weight[1][k + j];
-    x[0][j] = x0[i + j], x[1][j] = x1[i + j], x[2][j] = x2[i + j];
-    sampled[j] = valid[i + j];
-  }
+  Lanes tail;
   for (int m = 0; m < 2; ++m)
-    for (int c = 0; c < 3; ++c) l.mean[m][c] = mean[m][c];
-  l.var4 = var4, l.samples = samples, l.weight[0] = weight[0], l.weight[1] = weight[1];
-  l.x[0] = x[0], l.x[1] = x[1], l.x[2] = x[2];
-  l.valid = sampled, l.foreground = fg, l.warming = warm, l.distance2 = d2;
-  UpdateLanes(params, l);
+    for (int c = 0; c < 3; ++c) tail.mean[m][c] = mean[m][c];
+  tail.var4 = var4, tail.samples = samples, tail.weight[0] = weight[0], tail.weight[1] = weight[1];
+  tail.x[0] = x[0], tail.x[1] = x[1], tail.x[2] = x[2];
+  tail.valid = sampled, tail.foreground = fg, tail.warming = warm, tail.distance2 = d2;
   for (int j = 0; j < rest; ++j) {
     for (int m = 0; m < 2; ++m)
-      for (int c = 0; c < 3; ++c) texels->mean[m][c][k + j] = mean[m][c][j];
-    texels->var4[k + j] = var4[j];
-    texels->samples[k + j] = samples[j];
-    texels->weight[0][k + j] = weight[0][j];
-    texels->weight[1][k + j] = weight[1][j];
-    foreground[i + j] = fg[j], warming[i + j] = warm[j], distance2[i + j] = d2[j];
+      for (int c = 0; c < 3; ++c) mean[m][c][j] = from.mean[m][c][j];
+    var4[j] = from.var4[j], samples[j] = from.samples[j];
+    weight[0][j] = from.weight[0][j], weight[1][j] = from.weight[1][j];
+    for (int c = 0; c < 3; ++c) x[c][j] = from.x[c][j];
+    sampled[j] = from.valid[j];
+  }
+  UpdateLanes(params, tail);
+  for (int j = 0; j < rest; ++j) {
+    for (int m = 0; m < 2; ++m)
+      for (int c = 0; c < 3; ++c) from.mean[m][c][j] = mean[m][c][j];
+    from.var4[j] = var4[j], from.samples[j] = samples[j];
+    from.weight[0][j] = weight[0][j], from.weight[1][j] = weight[1][j];
+    from.foreground[j] = fg[j], from.warming[j] = warm[j], from.distance2[j] = d2[j];
   }
 }
 

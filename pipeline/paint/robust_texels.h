@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace fresco {
@@ -19,8 +20,6 @@ struct RobustTexels {
   std::vector<uint16_t> var4;        // background noise variance per channel, grey levels^2 x 4
   std::vector<uint16_t> samples;     // samples seen (saturates at 65535)
   std::vector<float> weight[2];      // fraction of the recent samples each mode explains
-
-  static constexpr int kBytesPerTexel = 8 * 2 + 2 * 4;
 
   void Assign(int texels);  // every texel unseen
   void Clear();

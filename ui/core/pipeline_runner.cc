@@ -115,9 +115,11 @@ void PipelineRunner::OpenSession(const Project& project) {
   CaptureLoadOptions load_options;
   load_options.open_video = !live;  // a live video opens after the pose feed connects
   // Every stream of a file project paints, as `fresco run` paints them; live: one stream.
-  if (Status st = CheckOneStream(project, "the app's live painting"); live && !st.ok()) {
-    working_.status = "error: " + st.message();
-    return;
+  if (live) {
+    if (Status st = CheckOneStream(project, "the app's live painting"); !st.ok()) {
+      working_.status = "error: " + st.message();
+      return;
+    }
   }
   const Status opened =
       live ? OpenPaintSession(project, load_options, &s->captures.emplace_back(), &s->paint)
@@ -140,8 +142,6 @@ void PipelineRunner::OpenSession(const Project& project) {
       l.problem = working_.status;
       return;
     }
-  }
-  if (live) {
     const StreamSpec stream = project.Streams()[0];
     const FrameOrigin origin{project.Resolve(stream.video), project.Resolve(stream.poses)};
     s->source = std::make_unique<LiveSessionSource>(s->live.get(), options_.live_poll_ms, origin);
@@ -167,11 +167,11 @@ void PipelineRunner::OpenSession(const Project& project) {
   }
   geometry->path = geometry->stream_paths[0];
   geometry->camera = geometry->stream_cameras[0];
-  geometry->num_frames = 0;
-  for (const Capture& c : s->captures)
-    geometry->num_frames = live || geometry->num_frames < 0 || c.video->FrameCount() < 0
-                               ? -1
-                               : geometry->num_frames + c.video->FrameCount();
+  geometry->num_frames = live ? -1 : 0;  // a live video is not open yet, and has no end
+  for (size_t i = 0; !live && i < s->captures.size() && geometry->num_frames >= 0; ++i) {
+    const int frames = s->captures[i].video->FrameCount();
+    geometry->num_frames = frames < 0 ? -1 : geometry->num_frames + frames;
+  }
   geometry->texel_size_m = s->paint->default_texel_size_m();
   geometry->folds_split = s->paint->folds_split();
   working_.geometry = geometry;
