@@ -53,7 +53,9 @@ ArgSpec RunSpec() {
       "Several streams (\"fresco\": 2, `streams`): their frames paint one model, interleaved\n"
       "by frame index (frame 0 of each stream, then frame 1 of each, ...); a stream that\n"
       "ends early leaves the others going on. pipeline.max_frames counts frames of all\n"
-      "streams. Live sources need a project with one stream.";
+      "streams. When a stream is live, frames are painted as they arrive, the streams\n"
+      "taken in turn (none starves another), and metrics.json has a \"live\" object per\n"
+      "live stream in \"streams\". --record needs a project with one stream.";
   spec.min_positional = spec.max_positional = 1;
   spec.options = {"--out", "--record"};
   spec.repeatable = {"--set"};
@@ -209,7 +211,14 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                       {"page_sizes", pages},
                       {"occupancy", atlas.Occupancy()},
                       {"padding_texels", atlas.padding}};
-  if (job.live) metrics["live"] = LiveMetrics(job.live_inputs, recorded_frames);
+  // Live streams: each its sources' state, in "streams"; the first also as "live" (what a
+  // project with one stream has always had).
+  for (size_t i = 0; i < job.live_inputs.size(); ++i) {
+    if (!job.live_inputs[i].frames) continue;
+    const nlohmann::json live = LiveMetrics(job.live_inputs[i], recorded_frames);
+    metrics["streams"][i]["live"] = live;
+    if (!metrics.contains("live")) metrics["live"] = live;
+  }
   return metrics;
 }
 
@@ -244,15 +253,15 @@ int RunVerbRun(const CommandArgs& argv) {
 
   const bool live = IsLiveProject(project);
   const std::vector<StreamSpec> specs = project.Streams();
-  if (live && specs.size() > 1)
-    return InputError(Status::Error(project_path +
-                                    ": streams: live sources need a project with "
-                                    "one stream (this one has " +
-                                    std::to_string(specs.size()) + ")"));
   const std::string record_dir = args.Get("--record");
   if (!record_dir.empty() && !live)
     return InputError(Status::Error(std::string("--record: only for live sources (") +
                                     project_path + " replays files already)"));
+  if (!record_dir.empty() && specs.size() > 1)
+    return InputError(Status::Error(project_path +
+                                    ": streams: --record records a project with one stream "
+                                    "(this one has " +
+                                    std::to_string(specs.size()) + ")"));
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   std::unique_ptr<PaintJob> job;
@@ -310,8 +319,8 @@ int RunVerbRun(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
     return InterruptExitCode();
   }
-  const LiveInputs& live_inputs = job->live_inputs;
   if (!record_dir.empty()) {
+    const LiveInputs& live_inputs = job->live_inputs[0];
     const std::vector<TimedPose> tracker =
         live_inputs.feed ? live_inputs.feed->AllPoses()
                          : std::vector<TimedPose>(live_inputs.track->samples().begin(),

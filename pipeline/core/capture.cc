@@ -170,7 +170,8 @@ Status LoadCapture(const Project& project, const CaptureLoadOptions& options, Ca
   FRESCO_RETURN_IF_ERROR(CheckCameras(stream, result));
   IndexPoseNames(&result);
 
-  if (options.open_video) {
+  const bool live = IsUrlOrDevice(stream.video) || IsUrlOrDevice(stream.poses);
+  if (options.open_video && (options.open_live_video || !live)) {
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(stream.video), &result.video));
     FRESCO_RETURN_IF_ERROR(MatchFolderFrames(stream, &result));
   }

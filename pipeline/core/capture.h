@@ -39,6 +39,10 @@ struct Capture {
 struct CaptureLoadOptions {
   bool load_scene = true;
   bool open_video = true;
+  // With open_video: also a live stream's video (one whose video or poses are live: a
+  // camera, a stream URL or a pose feed). False: only file streams open theirs (a live
+  // video opens after its pose feed connects: live_input.h).
+  bool open_live_video = true;
   // When false, a poses file that holds no poses is accepted (`fresco poses bootstrap` makes
   // the poses for such a project).
   bool require_poses = true;

@@ -1,43 +1,76 @@
 #include "pipeline/run/paint_job.h"
 
+#include <future>
+
 #include "pipeline/paint/open_project.h"
 #include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/live_frame_source.h"
+#include "pipeline/run/merged_frame_source.h"
 
 namespace fresco {
+
+bool IsLiveStream(const Project& project, int index) {
+  return IsLiveProject(project.ForStream(index));
+}
 
 Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                     std::unique_ptr<PaintJob>* job) {
   if (!options.one_stream_for.empty())
     FRESCO_RETURN_IF_ERROR(CheckOneStream(project, options.one_stream_for));
   auto result = std::make_unique<PaintJob>();
-  result->live = IsLiveProject(project);
+  PaintJob& j = *result;
+  j.live = IsLiveProject(project);
   const std::vector<StreamSpec> specs = project.Streams();
-  if (result->live && specs.size() > 1) {
-    return Status::Error(project.file_path + ": streams: live sources need a project with " +
-                         "one stream (this one has " + std::to_string(specs.size()) + ")");
-  }
+  const int num_streams = static_cast<int>(specs.size());
   CaptureLoadOptions load_options;
-  load_options.open_video = !result->live;  // a live video opens after the pose feed connects
-  FRESCO_RETURN_IF_ERROR(
-      OpenPaintSession(project, load_options, &result->captures, &result->session));
+  load_options.open_live_video = false;  // a live video opens after its pose feed connects
+  FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).
-  for (const Capture& capture : result->captures)
-    for (const auto& [id, camera] : capture.cameras) result->session->PrepareCamera(camera);
-  if (result->live) {
-    PaintJob& j = *result;
-    FRESCO_RETURN_IF_ERROR(OpenLiveInputs(project.ForStream(0), j.captures[0], *j.session,
-                                          options.keep_tracker_poses, &j.live_inputs));
-    j.source = std::make_unique<LiveFrameSource>(
-        &j.live_inputs,
-        FrameOrigin{project.Resolve(specs[0].video), project.Resolve(specs[0].poses)});
-  } else {
+  for (const Capture& capture : j.captures)
+    for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
+  if (!j.live) {
     std::vector<const Capture*> streams;
-    for (const Capture& capture : result->captures) streams.push_back(&capture);
-    result->source = std::make_unique<FileFrameSource>(project, streams);
+    for (const Capture& capture : j.captures) streams.push_back(&capture);
+    j.source = std::make_unique<FileFrameSource>(project, streams);
+    *job = std::move(result);
+    return Status::Ok();
   }
+  // Live streams connect at once (each waits for its sources, up to their timeouts).
+  j.live_inputs.resize(num_streams);
+  std::vector<std::future<Status>> opened(num_streams);
+  for (int s = 0; s < num_streams; ++s) {
+    if (!IsLiveStream(project, s)) continue;
+    opened[s] = std::async(std::launch::async, [&, s] {
+      return OpenLiveInputs(project.ForStream(s), j.captures[s], *j.session,
+                            options.keep_tracker_poses, &j.live_inputs[s]);
+    });
+  }
+  Status first_error;
+  for (int s = 0; s < num_streams; ++s) {
+    if (!opened[s].valid()) continue;
+    const Status status = opened[s].get();
+    if (first_error.ok() && !status.ok())  // several streams: which one
+      first_error = num_streams == 1 ? status
+                                     : Status::Error(project.file_path + ": streams[" +
+                                                     std::to_string(s) + "]: " + status.message());
+  }
+  if (!first_error.ok()) return first_error;
+  std::vector<std::unique_ptr<PosedFrameSource>> sources;
+  for (int s = 0; s < num_streams; ++s) {
+    const Project one = project.ForStream(s);
+    const FrameOrigin origin{project.Resolve(specs[s].video), project.Resolve(specs[s].poses)};
+    if (j.live_inputs[s].frames)
+      sources.push_back(std::make_unique<LiveFrameSource>(&j.live_inputs[s], origin));
+    else
+      sources.push_back(
+          std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&j.captures[s]}));
+  }
+  if (num_streams == 1)
+    j.source = std::move(sources[0]);
+  else
+    j.source = std::make_unique<MergedFrameSource>(std::move(sources));
   *job = std::move(result);
   return Status::Ok();
 }

@@ -1,7 +1,8 @@
 // A project opened for painting, ready for a PaintRun (paint_run.h): every stream's capture
 // (scene, cameras, poses, video), the PaintSession over the scene, and the source of its
 // posed frames: files read ahead (file_frame_source.h), or the live inputs
-// (live_frame_source.h) for a live project. `fresco run` and `fresco bench` open their
+// (live_frame_source.h) for a live stream; several streams of which one is live are merged as
+// their frames arrive (merged_frame_source.h). `fresco run` and `fresco bench` open their
 // projects this way; the app opens the same captures and source for file projects.
 #pragma once
 
@@ -26,18 +27,22 @@ struct PaintJobOptions {
 };
 
 struct PaintJob {
-  bool live = false;
+  bool live = false;              // some stream is live
   std::vector<Capture> captures;  // one per stream (Project::Streams()); the scene in [0]
   std::unique_ptr<PaintSession> session;
-  LiveInputs live_inputs;  // live projects only
+  // One per stream; a file stream's is empty (no frames).
+  std::vector<LiveInputs> live_inputs;
   std::unique_ptr<PosedFrameSource> source;
 
   const Scene& scene() const { return captures[0].scene; }
 };
 
+// True when stream `index` of `project` is live (its video or its poses).
+bool IsLiveStream(const Project& project, int index);
+
 // Loads and checks every input, builds the session and opens the source (live sources
-// connect here). Errors are bad input (exit 2), naming the file and field. A live project
-// needs one stream.
+// connect here, all streams at once). Errors are bad input (exit 2), naming the file and
+// field.
 Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                     std::unique_ptr<PaintJob>* job);
 

@@ -390,9 +390,9 @@ TEST_F(StreamsTest, BadStreamsExit2NamingTheStream) {
   cases.push_back({"top-level camera in version 2",
                    {"run", project, "--out", out, "--set", "camera=a/camera.cameramodel"},
                    {"streams.json", "camera: not allowed in version 2"}});
-  cases.push_back({"live source among several streams",
+  cases.push_back({"live video among several streams, poses without times",
                    {"run", project, "--out", out, "--set", "streams.1.video=udp://127.0.0.1:5999"},
-                   {"streams.json", "streams", "one stream"}});
+                   {"streams.json: streams[1]: ", "b/images.txt", "matched to poses by time"}});
   cases.push_back({"bench reads one stream",
                    {"bench", project, "--out", out},
                    {"streams.json", "streams: 2 video streams", "fresco bench"}});

@@ -90,12 +90,13 @@ inline bool StreamFrames(const std::string& frames_dir, int port, double rate,
   return std::system(FfmpegStreamCommand(frames_dir, url, rate, pad_frames).c_str()) == 0;
 }
 
-// A hand-held capture of the cube room (`fresco synth`, 160x120, seed 3) in DIR; returns
-// its true poses in frame order (empty on failure).
-inline std::vector<PosedImage> MakeStreamCapture(const std::string& dir, int frames) {
-  const CommandResult synth =
-      RunFresco({"synth", "--scene", "builtin:cube-room", "--out", dir, "--frames",
-                 std::to_string(frames), "--size", "160x120", "--supersample", "1", "--seed", "3"});
+// A hand-held capture of the cube room (`fresco synth`, 160x120, seed 3 unless told) in
+// DIR; returns its true poses in frame order (empty on failure).
+inline std::vector<PosedImage> MakeStreamCapture(const std::string& dir, int frames,
+                                                 int seed = 3) {
+  const CommandResult synth = RunFresco({"synth", "--scene", "builtin:cube-room", "--out", dir,
+                                         "--frames", std::to_string(frames), "--size", "160x120",
+                                         "--supersample", "1", "--seed", std::to_string(seed)});
   EXPECT_EQ(synth.exit_code, 0) << synth.err;
   std::vector<PosedImage> truth;
   bool is_tum = false;

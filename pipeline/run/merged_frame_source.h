@@ -1,0 +1,60 @@
+// Several streams' frames as they arrive: what a project with live streams paints from (one
+// live camera and one file stream, or several live cameras). Each stream has its own source
+// (a LiveFrameSource or a one-stream FileFrameSource) read on its own thread into a slot
+// that holds one frame; Next hands out a waiting frame, taking the streams in turn among
+// those that have one, so a stream that delivers often cannot starve a slower one. While a
+// stream's frame waits in its slot, its live queue goes on filling (and drops its oldest
+// frames when the painter is slower than the camera: live_frames.h), so every stream is
+// painted at its share of the painter's rate.
+//
+// The run ends when every stream has ended, or at the first error of any stream (a frame
+// that does not decode, a pose feed that failed): the error names the stream's file or
+// address as the stream's own source names it.
+#pragma once
+
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pipeline/run/posed_frame_source.h"
+
+namespace fresco {
+
+class MergedFrameSource : public PosedFrameSource {
+ public:
+  // `streams[i]`: stream i's own source (it reports its frames as stream 0).
+  explicit MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams);
+  ~MergedFrameSource() override;
+  MergedFrameSource(const MergedFrameSource&) = delete;
+  MergedFrameSource& operator=(const MergedFrameSource&) = delete;
+
+  FrameRead Next(SourcedFrame* frame, Status* status) override;
+  int NumStreams() const override { return static_cast<int>(streams_.size()); }
+  const FrameOrigin& Origin(int stream) const override { return streams_[stream]->Origin(0); }
+  int FrameCount() const override;
+  // Each stream's end ("stream 1: live video ended: ..."), "; "-separated.
+  std::string EndReason() const override;
+  void Stop() override;
+
+ private:
+  struct Slot {
+    SourcedFrame frame;
+    bool full = false;
+    bool ended = false;
+    Status status;  // the stream's error, when it ended with one
+  };
+  void Pump(int stream);
+
+  std::vector<std::unique_ptr<PosedFrameSource>> streams_;
+  std::vector<Slot> slots_;
+  std::vector<std::thread> pumps_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  bool stopping_ = false;
+  int next_ = 0;  // the stream to look at first
+};
+
+}  // namespace fresco
