@@ -1,17 +1,18 @@
-// The painting pipeline, stage by stage, behind one facade. Stages in order, per frame:
-//   1. depth   render the model's depth from the video camera (§3.3; renderer's raster path)
+// The painting pipeline, stage by stage, behind one facade. Stages in order, per frame (the
+// list is paint_stages.h; each stage in its own file):
+//   1. depth   render the model's depth from the video camera (§3.3)     -> depth_stage.cc
 //   2. warp    per texel: project, reject grazing/back-facing, occlusion test, sample
-//              (eq. 1-4, §3.2, §3.3)        -> frame_warp.h
+//              (eq. 1-4, §3.2, §3.3)                      -> warp_stage.cc, frame_warp.h
 //   3. refine  per buffer: register the warped frame to what the buffer holds in 2D and
-//              warp it again (§3.5; off unless pipeline.refine.mode)   -> refine_alignment.h
+//              warp it again (§3.5; pipeline.refine.mode) -> refine_stage.cc, refine_alignment.h
 //   3b. exposure  divide out the frame's gain against the buffers (pipeline.select.exposure)
-//                                                                         -> exposure_gain.h
+//                                                      -> select_stages.cc, exposure_gain.h
 //   4. background  per texel: compare with the texel's background model, mask foreground
-//              (moving objects), learn (§3.4)                            -> background_model.h
+//              (moving objects), learn (§3.4)     -> background_stage.cc, background_model.h
 //   4b. select  view score per texel (resolution, angle, depth edges); painted texels keep
-//              a better stored sample (pipeline.select)                  -> view_select.h
+//              a better stored sample (pipeline.select)  -> select_stages.cc, view_select.h
 //   5. paint   update the persistent base buffers where not masked (eq. 4, update policy)
-//                                                                         -> paint_update.h
+//                                                         -> paint_stage.cc, paint_update.h
 // Set-up (once): grouping (§3.6) -> grouping.h, base buffers and texel model points (eq. 2)
 // -> base_buffer.h. Each stage reports wall time, metrics and (when asked) debug images in a
 // FrameReport that the CLI and the GUI both consume.
@@ -32,6 +33,7 @@
 #include "pipeline/paint/background_model.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
+#include "pipeline/paint/paint_stages.h"
 #include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/refine_alignment.h"
 #include "pipeline/paint/refine_anchor.h"
@@ -50,6 +52,27 @@ struct PaintSessionInputs {
   // automatic texel size (about one texel per pixel at the typical distance).
   std::vector<Rigid3d> expected_poses;
   const Camera* typical_camera = nullptr;
+};
+
+// One frame on its way through the stages (paint_stages.h): what they hand each other.
+struct FrameWork {
+  const Frame* frame = nullptr;
+  const Camera* camera = nullptr;
+  Rigid3d cam_from_local;
+  int stream = 0;
+  int number = 0;      // frames this session saw before this one
+  bool debug = false;  // debug images asked
+  FrameReport* report = nullptr;
+  // From the warp stage on: the view, the buffers in the frustum, the buffers seen (some
+  // texel visible), whether the warp painted them itself (no stage between them looks at
+  // the samples), and each buffer's paint statistics.
+  FrameView view;
+  std::vector<size_t> in_frustum;
+  std::vector<bool> seen;
+  bool paint_in_warp = false;
+  std::vector<PaintUpdateStats> paint_stats;
+  // refine.mode auto, deciding: the misalignment refinement measured this frame (< 0: none).
+  double measured_misalignment_px = -1;
 };
 
 class PaintSession {
@@ -118,6 +141,10 @@ class PaintSession {
 
  private:
   PaintSession() = default;
+  // The stages, one member each (paint_stages.h): `void DepthStage(FrameWork*)`, ...
+#define FRESCO_DECLARE_STAGE(Name) void Name##Stage(FrameWork* work);
+  FRESCO_PAINT_STAGES(FRESCO_DECLARE_STAGE)
+#undef FRESCO_DECLARE_STAGE
   // Per distinct camera: its depth rasterizer and its frustum bounds (built once).
   struct CameraCache {
     Camera camera;

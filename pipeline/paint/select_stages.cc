@@ -1,22 +1,25 @@
-// PaintSession's exposure and select stages (exposure_gain.h, view_select.h): kept apart from
-// paint_session.cc, which runs them.
+// The exposure and select stages (paint_stages.h; exposure_gain.h, view_select.h), with
+// pipeline.select on: the frame's gain against what the buffers hold divided out, and a view
+// score per texel so that painted texels keep a better stored sample.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "pipeline/paint/exposure_gain.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/stage_clock.h"
 #include "pipeline/paint/view_select.h"
 
 namespace fresco {
-namespace {
 
-double MsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
+void PaintSession::ExposureStage(FrameWork* work) {
+  if (SelectActive(options_) && options_.select.exposure)
+    work->report->stages.push_back(CorrectExposure(Indices(work->seen)));
 }
 
-}  // namespace
+void PaintSession::SelectStage(FrameWork* work) {
+  if (SelectActive(options_)) work->report->stages.push_back(SelectViewsStage(Indices(work->seen)));
+}
 
 StageReport PaintSession::CorrectExposure(const std::vector<size_t>& seen) {
   const auto start = std::chrono::steady_clock::now();

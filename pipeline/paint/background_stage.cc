@@ -1,0 +1,76 @@
+// The background stage (paint_stages.h): each visible texel compared with its background
+// model, learned from this stream's earlier frames; movers masked out of painting (§3.4,
+// background_model.h). Off with pipeline.background.mode off.
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/stage_clock.h"
+
+namespace fresco {
+
+void PaintSession::BackgroundStage(FrameWork* work) {
+  if (options_.background.mode == BackgroundMode::kOff) return;
+  work->report->stages.push_back(
+      SegmentForeground(work->seen, work->stream, work->debug, &work->report->background));
+}
+
+StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
+                                            BackgroundFigures* figures) {
+  const auto start = std::chrono::steady_clock::now();
+  StageReport report;
+  report.name = "background";
+  std::vector<BufferBackground>& models = StreamBackground(stream);
+  float gain = 1.0f;
+  if (options_.background.mode == BackgroundMode::kRobust && options_.background.normalize_gain) {
+    // One histogram per buffer seen, in parallel, summed in buffer order (integer counts:
+    // the same whatever the threads).
+    const std::vector<size_t> seen_buffers = Indices(seen);
+    std::vector<GainHistogram> per_buffer(seen_buffers.size());
+    cv::parallel_for_(cv::Range(0, static_cast<int>(seen_buffers.size())),
+                      [&](const cv::Range& range) {
+                        for (int i = range.start; i < range.end; ++i) {
+                          const size_t b = seen_buffers[i];
+                          models[b].AccumulateGain(set_.buffers[b], warped_[b], &per_buffer[i]);
+                        }
+                      });
+    GainHistogram histogram;
+    for (const GainHistogram& h : per_buffer) {
+      for (int i = 0; i < GainHistogram::kBins; ++i) histogram.bins[i] += h.bins[i];
+      histogram.count += h.count;
+    }
+    gain = histogram.MedianGain();
+  }
+  long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
+  const std::vector<size_t> seen_list = Indices(seen);
+  ForEachBuffer(seen_list, false, [&](size_t b) {
+    models[b].Update(set_.buffers[b], warped_[b], gain, debug, &background_frame_[b]);
+  });
+  for (size_t b : seen_list) {
+    const BackgroundFrame& frame = background_frame_[b];
+    observed += frame.observed, raw += frame.foreground_raw, masked += frame.masked;
+    warming += frame.warming_up, blobs += frame.blobs_removed;
+    if (debug) {
+      const std::string suffix = "_b" + std::to_string(b);
+      report.images["model" + suffix] = models[b].Image(set_.buffers[b]);
+      report.images["difference" + suffix] = frame.difference;
+      report.images["foreground" + suffix] = frame.foreground;
+    }
+  }
+  report.metrics["gain"] = gain;
+  figures->texels_observed = observed;
+  figures->texels_masked = masked;
+  figures->PutInto(&report);
+  report.metrics["texels_foreground_raw"] = static_cast<double>(raw);
+  report.metrics["texels_warming_up"] = static_cast<double>(warming);
+  report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
+  report.metrics["blobs_removed"] = static_cast<double>(blobs);
+  report.wall_ms = MsSince(start);
+  return report;
+}
+
+}  // namespace fresco
