@@ -1,9 +1,12 @@
 #include "pipeline/run/merged_frame_source.h"
 
+#include <chrono>
+
 namespace fresco {
 
-MergedFrameSource::MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams)
-    : streams_(std::move(streams)), slots_(streams_.size()) {
+MergedFrameSource::MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams,
+                                     int poll_ms)
+    : streams_(std::move(streams)), slots_(streams_.size()), poll_ms_(poll_ms) {
   for (size_t s = 0; s < streams_.size(); ++s)
     pumps_.emplace_back([this, s] { Pump(static_cast<int>(s)); });
 }
@@ -21,8 +24,8 @@ void MergedFrameSource::Pump(int stream) {
     Status status;
     FrameRead read = source.Next(&frame, &status);
     std::unique_lock<std::mutex> lock(mutex_);
-    if (read == FrameRead::kWaiting) continue;
-    if (read == FrameRead::kEnded || stopping_) {
+    if (read == FrameRead::kWaiting && !stopping_) continue;  // a polled source: ask again
+    if (read != FrameRead::kFrame || stopping_) {
       slot.ended = true;
       slot.status = status;
       changed_.notify_all();
@@ -46,6 +49,7 @@ void MergedFrameSource::Pump(int stream) {
 FrameRead MergedFrameSource::Next(SourcedFrame* frame, Status* status) {
   std::unique_lock<std::mutex> lock(mutex_);
   const int n = static_cast<int>(slots_.size());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(poll_ms_);
   for (;;) {
     if (stopping_) return FrameRead::kEnded;
     bool all_ended = true;
@@ -69,7 +73,10 @@ FrameRead MergedFrameSource::Next(SourcedFrame* frame, Status* status) {
       all_ended = all_ended && slot.ended;
     }
     if (all_ended) return FrameRead::kEnded;
-    changed_.wait(lock);
+    if (poll_ms_ < 0)
+      changed_.wait(lock);
+    else if (changed_.wait_until(lock, deadline) == std::cv_status::timeout)
+      return FrameRead::kWaiting;
   }
 }
 

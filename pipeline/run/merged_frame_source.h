@@ -25,8 +25,11 @@ namespace fresco {
 
 class MergedFrameSource : public PosedFrameSource {
  public:
-  // `streams[i]`: stream i's own source (it reports its frames as stream 0).
-  explicit MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams);
+  // `streams[i]`: stream i's own source (it reports its frames as stream 0). `poll_ms` >= 0:
+  // Next waits at most that long for a frame and then says kWaiting (the app's worker,
+  // which has commands to answer meanwhile); < 0: Next waits for a frame or the end.
+  explicit MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams,
+                             int poll_ms = -1);
   ~MergedFrameSource() override;
   MergedFrameSource(const MergedFrameSource&) = delete;
   MergedFrameSource& operator=(const MergedFrameSource&) = delete;
@@ -55,6 +58,7 @@ class MergedFrameSource : public PosedFrameSource {
   std::condition_variable changed_;
   bool stopping_ = false;
   int next_ = 0;  // the stream to look at first
+  int poll_ms_ = -1;
 };
 
 }  // namespace fresco

@@ -7,8 +7,10 @@
 #include <sys/socket.h>
 
 #include <cmath>
+#include <future>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -170,6 +172,83 @@ TEST(UiLive, PaintsAStreamShowsItsStateAndRecordsASessionThatReplays) {
               100 * common);
   EXPECT_GT(psnr, 45.0);
   EXPECT_GT(common, 0.999);
+}
+
+// Two cameras live (UDP video and a TCP tracker each): the app paints both streams' frames
+// into one model, as `fresco run` paints both from their files (the same coverage), shows
+// each stream's latest input, and says that recording needs one stream.
+TEST(UiLive, TwoLiveStreamsPaintOneModelAsTheRunDoes) {
+  if (!testing::HaveFfmpeg())
+    GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
+  const std::string dir = testing::MakeTempDir("ui_live_two");
+  const int frames = 60;
+  const std::string names[2] = {"a", "b"};
+  std::vector<PosedImage> truth[2];
+  int ports[2];
+  testing::PoseServer servers[2];
+  std::thread trackers[2];
+  Json live_streams = Json::array(), file_streams = Json::array();
+  for (int s = 0; s < 2; ++s) {
+    const std::string capture = dir + "/" + names[s];
+    truth[s] = testing::MakeStreamCapture(capture, frames, s == 0 ? 3 : 8);
+    ASSERT_EQ(truth[s].size(), static_cast<size_t>(frames));
+    ports[s] = testing::FreeLoopbackPort(SOCK_DGRAM);
+    trackers[s] = std::thread(testing::ServeTrack, &servers[s], truth[s], kFps, kOffsetS);
+    live_streams.push_back({{"camera", capture + "/camera.cameramodel"},
+                            {"video", "udp://127.0.0.1:" + std::to_string(ports[s])},
+                            {"poses", servers[s].Address()},
+                            {"time_offset_s", kOffsetS}});
+    file_streams.push_back({{"camera", capture + "/camera.cameramodel"},
+                            {"video", capture + "/frames/"},
+                            {"poses", capture + "/sparse/images.txt"}});
+  }
+  const Json project = {
+      {"fresco", 2},
+      {"scene", dir + "/a/scene.gltf"},
+      {"streams", live_streams},
+      {"pipeline", {{"texel_size_m", 0.02}}},
+      {"live", {{"open_timeout_s", 30}, {"read_timeout_s", 2}, {"queue_frames", 200}}}};
+  testing::WriteText(dir + "/live.json", project.dump(2));
+  Json files = project;
+  files["streams"] = file_streams;
+  files.erase("live");
+  testing::WriteText(dir + "/files.json", files.dump(2));
+
+  AppState state;
+  ASSERT_TRUE(state.Open(dir + "/live.json").ok());
+  PipelineRunner runner;
+  runner.Restart(state.project);  // connects to both trackers, then waits for the streams
+  runner.Play();
+  std::vector<std::future<int>> senders;
+  for (int s = 0; s < 2; ++s)
+    senders.push_back(std::async(std::launch::async, [&, s] {
+      if (!testing::WaitUdpPortBound(ports[s])) return -1;
+      return testing::StreamFrames(dir + "/" + names[s] + "/frames", ports[s], 1.0, 2) ? 0 : 1;
+    }));
+  for (int s = 0; s < 2; ++s) EXPECT_EQ(senders[s].get(), 0) << "stream " << s;
+  runner.WaitIdle();  // stops playing when both videos ended
+  for (std::thread& tracker : trackers) tracker.join();
+  const auto live = runner.Snapshot();
+  std::printf("app, two live streams: %zu frames painted, coverage %.4f, status '%s'\n",
+              live->frames_painted.size(), live->coverage, live->status.c_str());
+  ASSERT_TRUE(live->live.active);
+  EXPECT_EQ(live->live.streams, 2);
+  EXPECT_EQ(live->run.streams.size(), 2u);
+  for (int s = 0; s < 2 && live->run.streams.size() == 2; ++s) {
+    EXPECT_EQ(live->run.streams[s].painted, frames) << "stream " << s;
+    EXPECT_FALSE(live->stream_frames[s].empty()) << "stream " << s << "'s input";
+  }
+  EXPECT_EQ(static_cast<int>(live->frames_painted.size()), 2 * frames);
+  EXPECT_THAT(live->status, HasSubstr("stream 0: live video ended"));
+  EXPECT_THAT(live->status, HasSubstr("stream 1: live video ended"));
+  const auto report = DrawPanels(&state, &runner);
+  EXPECT_EQ(report.count("live.state"), 1u);
+
+  const testing::CommandResult run =
+      testing::RunFresco({"run", dir + "/files.json", "--out", dir + "/out", "--quiet"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const Json metrics = Json::parse(testing::ReadText(dir + "/out/metrics.json"));
+  EXPECT_NEAR(live->coverage, metrics["coverage"].get<double>(), 0.001);
 }
 
 TEST(UiLive, DeadSourcesAreReportedAndTheRunnerKeepsWorking) {

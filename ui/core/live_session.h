@@ -28,6 +28,9 @@ namespace fresco {
 // What the Pipeline panel and the status bar show about live sources (RunnerSnapshot::live).
 struct LiveStatus {
   bool active = false;       // the project's sources are live
+  // Streams in the project (Project::Streams()); with several, the figures below are the
+  // first live stream's and recording is not offered.
+  int streams = 1;
   std::string video, poses;  // the addresses (or files) as resolved
   // "connecting", "waiting for frames", "receiving", "stalled", "ended", "error".
   std::string state;

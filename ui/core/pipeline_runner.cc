@@ -16,16 +16,21 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/frame_policy.h"
+#include "pipeline/run/merged_frame_source.h"
+#include "pipeline/run/paint_job.h"
 #include "ui/core/live_session_source.h"
 
 namespace fresco {
 
 struct PipelineRunner::Session {
   Project project;
-  // One capture per stream (Project::Streams(); the scene in [0]). A live project has one.
+  // One capture per stream (Project::Streams(); the scene in [0]).
   std::vector<Capture> captures;
   std::unique_ptr<PaintSession> paint;
-  std::unique_ptr<LiveSession> live;  // live sources (reads capture and paint: after them)
+  // Per stream, its live sources (null for a file stream; they read capture and paint:
+  // after them); `live` is the first live stream's, whose state the Pipeline panel shows.
+  std::vector<std::unique_ptr<LiveSession>> lives;
+  LiveSession* live = nullptr;
   // The painting job (pipeline/run): the capture's frames read ahead, or the live session's
   // (reads the above: after them), judged and counted as `fresco run` does.
   std::unique_ptr<PosedFrameSource> source;
@@ -113,38 +118,51 @@ void PipelineRunner::OpenSession(const Project& project) {
   s->project = project;
   const bool live = IsLiveProject(project);
   CaptureLoadOptions load_options;
-  load_options.open_video = !live;  // a live video opens after the pose feed connects
-  // Every stream of a file project paints, as `fresco run` paints them; live: one stream.
-  if (live) {
-    if (Status st = CheckOneStream(project, "the app's live painting"); !st.ok()) {
-      working_.status = "error: " + st.message();
-      return;
-    }
-  }
-  const Status opened =
-      live ? OpenPaintSession(project, load_options, &s->captures.emplace_back(), &s->paint)
-           : OpenPaintSession(project, load_options, &s->captures, &s->paint);
-  if (!opened.ok()) {
+  load_options.open_live_video = false;  // a live video opens after its pose feed connects
+  // Every stream paints, as `fresco run` paints them.
+  if (const Status opened = OpenPaintSession(project, load_options, &s->captures, &s->paint);
+      !opened.ok()) {
     working_.status = "error: " + opened.message();
     return;
   }
+  const std::vector<StreamSpec> specs = project.Streams();
+  const int num_streams = static_cast<int>(specs.size());
   if (live) {
+    int first = 0;
+    while (!IsLiveStream(project, first)) ++first;
     LiveStatus& l = working_.live;
     l.active = true;
     l.state = "connecting";
-    l.video = project.Resolve(project.video);
-    l.poses = project.Resolve(project.poses);
+    l.video = project.Resolve(specs[first].video);
+    l.poses = project.Resolve(specs[first].poses);
     working_.status = "connecting to " + l.video + " and " + l.poses;
     Publish(false);  // opening waits for the sources (up to their timeouts)
-    if (Status st = LiveSession::Open(project, s->captures[0], *s->paint, &s->live); !st.ok()) {
-      working_.status = "error: " + st.message();
-      l.state = "error";
-      l.problem = working_.status;
-      return;
+    std::vector<std::unique_ptr<PosedFrameSource>> sources;
+    s->lives.resize(num_streams);
+    for (int i = 0; i < num_streams; ++i) {
+      const Project one = project.ForStream(i);
+      const FrameOrigin origin{project.Resolve(specs[i].video), project.Resolve(specs[i].poses)};
+      if (!IsLiveStream(project, i)) {
+        sources.push_back(
+            std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&s->captures[i]}));
+        continue;
+      }
+      if (Status st = LiveSession::Open(one, s->captures[i], *s->paint, &s->lives[i]); !st.ok()) {
+        working_.status =
+            "error: " + (num_streams > 1 ? "streams[" + std::to_string(i) + "]: " : "") +
+            st.message();
+        l.state = "error";
+        l.problem = working_.status;
+        return;
+      }
+      sources.push_back(std::make_unique<LiveSessionSource>(s->lives[i].get(),
+                                                            options_.live_poll_ms, origin));
     }
-    const StreamSpec stream = project.Streams()[0];
-    const FrameOrigin origin{project.Resolve(stream.video), project.Resolve(stream.poses)};
-    s->source = std::make_unique<LiveSessionSource>(s->live.get(), options_.live_poll_ms, origin);
+    s->live = s->lives[first].get();
+    if (num_streams == 1)
+      s->source = std::move(sources[0]);
+    else
+      s->source = std::make_unique<MergedFrameSource>(std::move(sources), options_.live_poll_ms);
   } else {
     std::vector<const Capture*> streams;
     for (const Capture& c : s->captures) streams.push_back(&c);
@@ -224,7 +242,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     return Painted::kFrame;
   }
   if (s.live) {
-    s.live->Record(posed);
+    if (s.captures.size() == 1) s.live->Record(posed);
     working_.live_path.push_back(posed.cam_from_world);
     TrimHistory(RunnerSnapshot::kLivePathFrames, &working_.live_path);
   }
@@ -280,7 +298,8 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
 }
 
 void PipelineRunner::SetRecording(const std::string& dir) {
-  if (!session_ || !session_->live) return;  // the panel offers Record for live sources only
+  // The panel offers Record for live sources of a project with one stream only.
+  if (!session_ || !session_->live || session_->captures.size() > 1) return;
   LiveSession& live = *session_->live;
   std::string recorded;
   if (dir.empty()) {
@@ -300,6 +319,7 @@ void PipelineRunner::Publish(bool with_painted) {
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
       working_.live.frames_painted = session_->run->stats().frames_painted;
+      working_.live.streams = static_cast<int>(session_->captures.size());
       if (!session_->ended) working_.status += " (live: " + working_.live.state + ")";
     }
   }

@@ -103,6 +103,27 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
                 live.offset_track_last_s, live.offset_track_last_applied ? "applied" : "kept");
   if (!live.problem.empty()) WrappedColored(kBad, live.problem);
 
+  if (live.streams > 1) {
+    ImGui::TextWrapped("%d streams painting: the figures above are the first live stream's "
+                       "(each stream's are in fresco run's metrics.json); recording needs a "
+                       "project with one stream.",
+                       live.streams);
+  } else {
+    DrawRecording(ui, live);
+  }
+
+  report_["live.state"] = live.state;
+  report_["live.poses_state"] = pose_state;
+  report_["live.frames_received"] = std::to_string(live.frames_received);
+  report_["live.frames_dropped"] = std::to_string(live.frames_dropped);
+  report_["live.frames_painted"] = std::to_string(live.frames_painted);
+  report_["live.pose_lag"] = lag;
+  report_["live.time_offset"] = offset;
+  report_["live.problem"] = live.problem;
+  report_["live.recording"] = live.recording ? live.record_dir : "";
+}
+
+void LiveStatusSection::DrawRecording(UiContext& ui, const LiveStatus& live) {
   // Record toggle: the worker's state is the truth; a click asks it to change.
   bool recording = live.recording;
   if (ImGui::Checkbox("Record", &recording)) {
@@ -124,16 +145,6 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
     if (ImGui::Button("Open the recording")) RequestOpen(ui, live.recorded_project);
   }
   if (!live.record_error.empty()) WrappedColored(kBad, "recording failed: " + live.record_error);
-
-  report_["live.state"] = live.state;
-  report_["live.poses_state"] = pose_state;
-  report_["live.frames_received"] = std::to_string(live.frames_received);
-  report_["live.frames_dropped"] = std::to_string(live.frames_dropped);
-  report_["live.frames_painted"] = std::to_string(live.frames_painted);
-  report_["live.pose_lag"] = lag;
-  report_["live.time_offset"] = offset;
-  report_["live.problem"] = live.problem;
-  report_["live.recording"] = live.recording ? live.record_dir : "";
 }
 
 }  // namespace fresco

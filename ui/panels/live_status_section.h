@@ -19,6 +19,8 @@ class LiveStatusSection {
   const std::map<std::string, std::string>& report() const { return report_; }
 
  private:
+  // The Record toggle and the recording's state (a project with one stream).
+  void DrawRecording(UiContext& ui, const LiveStatus& live);
   std::string record_dir_;
   std::map<std::string, std::string> report_;
 };
