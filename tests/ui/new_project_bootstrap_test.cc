@@ -205,6 +205,24 @@ TEST(UiInputBootstrap, AFailedBootstrapLeavesNothingBehind) {
     EXPECT_EQ(app.ReportOf(kNewProjectTitle, "error"),
               "bootstrap with COLMAP: cancelled; no project was written");
     ExpectNothingWritten(app, folder, workspace);
+
+    // Hidden from the View menu while COLMAP runs (the menu item clears the panel's `open`):
+    // as closing it, that cancels the run, and the form comes back saying so; nothing goes
+    // on unseen.
+    Activate(app, kNewProjectTitle, "Create");
+    ASSERT_EQ(app.ReportOf(kNewProjectTitle, "running"), "yes");
+    const std::string hidden_workspace = app.ReportOf(kNewProjectTitle, "workspace");
+    Panel* form = nullptr;
+    for (auto& panel : app.panels)
+      if (std::string(panel->Title()) == kNewProjectTitle) form = panel.get();
+    ASSERT_NE(form, nullptr);
+    form->open = false;
+    app.FramesWhileRunning(60);
+    EXPECT_TRUE(form->open);
+    EXPECT_EQ(app.ReportOf(kNewProjectTitle, "running"), "no");
+    EXPECT_EQ(app.ReportOf(kNewProjectTitle, "error"),
+              "bootstrap with COLMAP: cancelled; no project was written");
+    ExpectNothingWritten(app, folder, hidden_workspace);
   }
 
   // COLMAP missing: one error naming the program.

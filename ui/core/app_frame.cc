@@ -298,7 +298,8 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);
   for (auto& panel : panels) {
     // A tiled panel without a tile is hidden behind a maximised one.
-    if (panel->open && (panel->tiled || !ui.layout.Contains(panel->Title()))) panel->Draw(ui);
+    if ((panel->open || panel->Busy()) && (panel->tiled || !ui.layout.Contains(panel->Title())))
+      panel->Draw(ui);
     if (panel->maximise_requested) ui.layout.ToggleMaximised(panel->Title());
     panel->maximise_requested = false;
   }

@@ -85,6 +85,11 @@ class Panel {
   // A scene, video, camera or poses file dropped on the window for this panel's path fields
   // (PlaceDroppedPaths): true when the panel took it.
   virtual bool AcceptDrop(const DroppedFile&) { return false; }
+  // Work under way that hiding the panel must not leave running unseen (a COLMAP run): the
+  // app frame draws a busy panel even when hidden from the View menu, and the panel decides
+  // what hiding means (the New project form: as closing it, it cancels the run and shows
+  // that it did).
+  virtual bool Busy() const { return false; }
   bool open = true;
   // Where a floating panel starts, in a 1600 x 1000 window (scaled to the real size).
   ImVec2 default_pos = ImVec2(0, 20), default_size = ImVec2(400, 300);

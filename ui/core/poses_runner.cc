@@ -1,5 +1,7 @@
 #include "ui/core/poses_runner.h"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <filesystem>
 
@@ -37,8 +39,18 @@ void PosesRunner::Run(const PosesRequest& request) {
 
 void PosesRunner::Cancel() {
   std::lock_guard<std::mutex> lock(mutex_);
-  queue_.clear();
   cancel_ = true;
+  if (queue_.empty()) return;
+  // A request the worker has not started yet ends here: its snapshot says it was cancelled
+  // (a caller waiting for the request to finish must see it finish).
+  auto cancelled = std::make_shared<PosesSnapshot>(*snapshot_);
+  cancelled->version = snapshot_->version + 1;
+  cancelled->has_request = true;
+  cancelled->request = queue_.back();
+  cancelled->busy = false;
+  cancelled->status = "cancelled";
+  snapshot_ = std::move(cancelled);
+  queue_.clear();
 }
 
 void PosesRunner::WaitIdle() {
@@ -79,7 +91,8 @@ void PosesRunner::Loop() {
 }
 
 void PosesRunner::RunOnce(const PosesRequest& request) {
-  const uint64_t version = working_.version;
+  // Versions only grow (a cancel of a queued request publishes one from another thread).
+  const uint64_t version = std::max(working_.version, Snapshot()->version);
   working_ = PosesSnapshot();
   working_.version = version;
   working_.has_request = true;

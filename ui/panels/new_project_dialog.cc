@@ -56,6 +56,8 @@ class NewProjectDialog : public Panel {
             {"bootstrapped", summary_}};
   }
 
+  bool Busy() const override { return runner_ != nullptr; }
+
   bool AcceptDrop(const DroppedFile& file) override {
     if (runner_) return false;  // the form is fixed while COLMAP runs
     std::string* field = FieldFor(file.kind, &form_);
@@ -65,11 +67,15 @@ class NewProjectDialog : public Panel {
 
   void Draw(UiContext& ui) override {
     if (PollBootstrap(ui)) return;  // the bootstrapped project was just made, the form closed
+    if (!open && runner_) {  // hidden (View menu) while COLMAP runs: as closing it, below
+      runner_->Cancel();
+      open = true;
+    }
     if (!BeginPanel(*this)) {
       ImGui::End();
       return;
     }
-    if (!open && runner_) {  // closed while COLMAP runs: stop it, show that it stopped
+    if (!open && runner_) {  // closed or hidden while COLMAP runs: stop it, show that it stopped
       runner_->Cancel();
       open = true;
     }
