@@ -393,6 +393,11 @@ TEST_F(StreamsTest, BadStreamsExit2NamingTheStream) {
   cases.push_back({"live video among several streams, poses without times",
                    {"run", project, "--out", out, "--set", "streams.1.video=udp://127.0.0.1:5999"},
                    {"streams.json: streams[1]: ", "b/images.txt", "matched to poses by time"}});
+  cases.push_back({"recording several streams",
+                   {"run", project, "--out", out, "--set", "streams.1.video=udp://127.0.0.1:5999",
+                    "--record", out + "/recorded"},
+                   {"streams.json: streams: --record records a project with one stream",
+                    "(this one has 2)"}});
   cases.push_back({"bench reads one stream",
                    {"bench", project, "--out", out},
                    {"streams.json", "streams: 2 video streams", "fresco bench"}});
