@@ -131,7 +131,8 @@ TEST(UiLive, PaintsAStreamShowsItsStateAndRecordsASessionThatReplays) {
   EXPECT_GT(painted, frames / 2);
   EXPECT_EQ(static_cast<int>(live->frames_painted.size()), painted);
   EXPECT_EQ(l.frames_painted, painted);
-  EXPECT_EQ(static_cast<int>(live->live_path.size()), painted);  // the 3D view's path
+  ASSERT_EQ(live->live_paths.size(), 1u);  // the 3D view's path
+  EXPECT_EQ(static_cast<int>(live->live_paths[0].size()), painted);
   EXPECT_GT(live->coverage, 0.5);
   // The recording stopped with the stream and wrote a project.
   EXPECT_FALSE(l.recording);
@@ -234,9 +235,11 @@ TEST(UiLive, TwoLiveStreamsPaintOneModelAsTheRunDoes) {
   ASSERT_TRUE(live->live.active);
   EXPECT_EQ(live->live.streams, 2);
   EXPECT_EQ(live->run.streams.size(), 2u);
+  ASSERT_EQ(live->live_paths.size(), 2u);  // each stream's path in the 3D view, apart
   for (int s = 0; s < 2 && live->run.streams.size() == 2; ++s) {
     EXPECT_EQ(live->run.streams[s].painted, frames) << "stream " << s;
     EXPECT_FALSE(live->stream_frames[s].empty()) << "stream " << s << "'s input";
+    EXPECT_EQ(static_cast<int>(live->live_paths[s].size()), frames) << "stream " << s;
   }
   EXPECT_EQ(static_cast<int>(live->frames_painted.size()), 2 * frames);
   EXPECT_THAT(live->status, HasSubstr("stream 0: live video ended"));

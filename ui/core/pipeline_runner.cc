@@ -243,8 +243,11 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   }
   if (s.live) {
     if (s.captures.size() == 1) s.live->Record(posed);
-    working_.live_path.push_back(posed.cam_from_world);
-    TrimHistory(RunnerSnapshot::kLivePathFrames, &working_.live_path);
+    if (working_.live_paths.size() <= static_cast<size_t>(f.stream))
+      working_.live_paths.resize(f.stream + 1);
+    std::vector<Rigid3d>& path = working_.live_paths[f.stream];
+    path.push_back(posed.cam_from_world);
+    TrimHistory(RunnerSnapshot::kLivePathFrames, &path);
   }
   working_.cam_from_world = posed.cam_from_world;
   // Review: the painted model, as it stands before this frame, seen from this frame.

@@ -89,9 +89,16 @@ struct RunnerSnapshot {
   cv::Mat rephoto_bgr, difference_heat;
   // Live sources (active for a live project): state, counts, offset, recording.
   LiveStatus live;
-  // The poses of the latest frames painted live (up to 2 * kLivePathFrames): the path the
-  // 3D view draws when the poses come from a feed (geometry->path is empty then).
-  std::vector<Rigid3d> live_path;
+  // Per stream, the poses of its latest frames painted live (up to 2 * kLivePathFrames): the
+  // paths the 3D view draws when the poses come from a feed (the geometry's are empty then).
+  std::vector<std::vector<Rigid3d>> live_paths;
+  // The first stream's live path that has poses (empty when none has).
+  const std::vector<Rigid3d>& FirstLivePath() const {
+    static const std::vector<Rigid3d> kNone;
+    for (const std::vector<Rigid3d>& path : live_paths)
+      if (!path.empty()) return path;
+    return kNone;
+  }
   static constexpr size_t kLivePathFrames = 1000;
 };
 

@@ -354,8 +354,8 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   const float pitch = view->pitch_deg * static_cast<float>(M_PI) / 180;
   const Eigen::Vector3f target(view->target[0], view->target[1], view->target[2]);
   if (view->orbit_geometry_version != snapshot.geometry_version &&
-      (!geo.path.empty() || !snapshot.live_path.empty())) {
-    view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.live_path : geo.path);
+      (!geo.path.empty() || !snapshot.FirstLivePath().empty())) {
+    view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.FirstLivePath() : geo.path);
     view->orbit_geometry_version = snapshot.geometry_version;
   }
   const Eigen::Vector3f eye =
@@ -436,17 +436,18 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
     lines.push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
   };
   if (view->show_path) {
-    // Each stream's path (stream 0 grey, the others in their own hues), and the live one.
+    // Each stream's path, given and live (stream 0 grey, the others in their own hues).
     static constexpr float kStreamColours[][3] = {
         {0.6f, 0.6f, 0.65f}, {0.3f, 0.75f, 1.0f}, {1.0f, 0.45f, 0.8f}, {0.45f, 0.95f, 0.45f}};
-    std::vector<const std::vector<Rigid3d>*> paths = {&snapshot.live_path};
-    if (geo.stream_paths.empty()) paths.push_back(&geo.path);
-    for (const std::vector<Rigid3d>& path : geo.stream_paths) paths.push_back(&path);
-    for (size_t p = 0; p < paths.size(); ++p) {
-      const float* colour = kStreamColours[p == 0 ? 0 : (p - 1) % 4];
-      for (size_t i = 1; i < paths[p]->size(); ++i)
-        add(centre_of((*paths[p])[i - 1]), centre_of((*paths[p])[i]), colour[0], colour[1],
-            colour[2]);
+    std::vector<std::pair<const std::vector<Rigid3d>*, size_t>> paths;  // (path, stream)
+    if (geo.stream_paths.empty()) paths.push_back({&geo.path, 0});
+    for (size_t s = 0; s < geo.stream_paths.size(); ++s) paths.push_back({&geo.stream_paths[s], s});
+    for (size_t s = 0; s < snapshot.live_paths.size(); ++s)
+      paths.push_back({&snapshot.live_paths[s], s});
+    for (const auto& [path, stream] : paths) {
+      const float* colour = kStreamColours[stream % 4];
+      for (size_t i = 1; i < path->size(); ++i)
+        add(centre_of((*path)[i - 1]), centre_of((*path)[i]), colour[0], colour[1], colour[2]);
     }
   }
   if (view->show_frustum && snapshot.has_pose) {
