@@ -39,7 +39,7 @@ struct LiveStatus {
   std::string problem;
   long long frames_received = 0, frames_dropped = 0, frames_delivered = 0;
   long long frames_without_pose = 0;
-  long long frames_painted = 0;  // by the app (set by PipelineRunner)
+  long long frames_painted = 0;  // of this stream, by the app (set by PipelineRunner)
   int queue_capacity = 0, queue_high_water = 0, video_reopens = 0;
   double seconds_since_frame = -1;  // wall time since the last frame arrived (-1: none yet)
   std::string video_clock;

@@ -31,6 +31,7 @@ struct PipelineRunner::Session {
   // after them); `live` is the first live stream's, whose state the Pipeline panel shows.
   std::vector<std::unique_ptr<LiveSession>> lives;
   LiveSession* live = nullptr;
+  int live_stream = 0;  // the stream `live` belongs to
   // The painting job (pipeline/run): the capture's frames read ahead, or the live session's
   // (reads the above: after them), judged and counted as `fresco run` does.
   std::unique_ptr<PosedFrameSource> source;
@@ -159,6 +160,7 @@ void PipelineRunner::OpenSession(const Project& project) {
                                                             options_.live_poll_ms, origin));
     }
     s->live = s->lives[first].get();
+    s->live_stream = first;
     if (num_streams == 1)
       s->source = std::move(sources[0]);
     else
@@ -321,7 +323,8 @@ void PipelineRunner::Publish(bool with_painted) {
     if (seek_target_ >= 0 && !session_->ended) working_.status = "seeking";
     if (session_->live) {
       working_.live = session_->live->CurrentStatus();
-      working_.live.frames_painted = session_->run->stats().frames_painted;
+      // The figures are the first live stream's: so is the count of frames painted.
+      working_.live.frames_painted = session_->run->stats().streams[session_->live_stream].painted;
       working_.live.streams = static_cast<int>(session_->captures.size());
       if (!session_->ended) working_.status += " (live: " + working_.live.state + ")";
     }

@@ -12,14 +12,7 @@ build/app/fresco synth --scene builtin:cube-room --out "$dir/synth" --frames 300
     --size 320x240 --seed 3
 # The tracker's poses: synth's true poses (COLMAP images.txt, world to camera) as TUM lines
 # (camera to world: q inverted, centre = -R^T t), frame i stamped i / 30 + 0.2 s.
-awk -v fps=30 -v off=0.2 '
-/^#/ || NF < 10 { next }
-{ w = $2; x = -$3; y = -$4; z = -$5; tx = $6; ty = $7; tz = $8
-  cx = y*tz - z*ty; cy = z*tx - x*tz; cz = x*ty - y*tx
-  dx = y*cz - z*cy; dy = z*cx - x*cz; dz = x*cy - y*cx
-  n = $10; sub(/\.png$/, "", n)
-  printf "%.9f %.12f %.12f %.12f %.15f %.15f %.15f %.15f\n", n / fps + off,
-         -(tx + 2*w*cx + 2*dx), -(ty + 2*w*cy + 2*dy), -(tz + 2*w*cz + 2*dz), x, y, z, w }' \
+awk -v fps=30 -v off=0.2 -f ui/doc/tum_from_colmap.awk \
     "$dir/synth/truth/images.txt" | sort -n > "$dir/tracker.tum"
 cat > "$dir/live.json" <<'EOF'
 {"fresco": 1, "scene": "synth/scene.gltf", "camera": "synth/camera.cameramodel",
@@ -27,19 +20,7 @@ cat > "$dir/live.json" <<'EOF'
  "pipeline": {"texel_size_m": 0.02}, "live": {"estimate_offset": true, "queue_frames": 8}}
 EOF
 # The tracker (waits for the app's connection, then for it to open the video port).
-python3 - "$dir/tracker.tum" <<'EOF' &
-import socket, sys, time
-server = socket.create_server(("127.0.0.1", 9000))
-conn, _ = server.accept()
-while ":1388 " not in open("/proc/net/udp").read():
-    time.sleep(0.05)
-try:
-    for line in open(sys.argv[1]):
-        conn.sendall(line.encode())
-        time.sleep(1 / 30)
-except BrokenPipeError:  # the app took its screenshot and quit
-    pass
-EOF
+python3 ui/doc/serve_tum.py "$dir/tracker.tum" 9000 5000 &
 sleep 0.5
 xvfb-run -a -s "-screen 0 1600x1000x24" build/app/fresco gui "$dir/live.json" \
     --screenshot "$dir/live.png" --frames 90 &
