@@ -1,12 +1,10 @@
 // The background stage (paint_stages.h): each visible texel compared with its background
 // model, learned from this stream's earlier frames; movers masked out of painting (§3.4,
 // background_model.h). Off with pipeline.background.mode off.
-#include <algorithm>
 #include <chrono>
 #include <string>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/stage_clock.h"

@@ -10,7 +10,6 @@
 #include <string>
 
 #include <opencv2/core/utility.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/stage_clock.h"
