@@ -108,4 +108,10 @@ void MergedFrameSource::Stop() {
   for (const auto& stream : streams_) stream->Stop();
 }
 
+std::unique_ptr<PosedFrameSource> JoinStreamSources(
+    std::vector<std::unique_ptr<PosedFrameSource>> sources, int poll_ms) {
+  if (sources.size() == 1) return std::move(sources[0]);
+  return std::make_unique<MergedFrameSource>(std::move(sources), poll_ms);
+}
+
 }  // namespace fresco

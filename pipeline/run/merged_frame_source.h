@@ -61,4 +61,9 @@ class MergedFrameSource : public PosedFrameSource {
   int poll_ms_ = -1;
 };
 
+// The source of a run over several streams: `sources[i]` is stream i's own source. One
+// source is returned as it is; several are merged (MergedFrameSource, with `poll_ms`).
+std::unique_ptr<PosedFrameSource> JoinStreamSources(
+    std::vector<std::unique_ptr<PosedFrameSource>> sources, int poll_ms = -1);
+
 }  // namespace fresco

@@ -67,10 +67,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
       sources.push_back(
           std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&j.captures[s]}));
   }
-  if (num_streams == 1)
-    j.source = std::move(sources[0]);
-  else
-    j.source = std::make_unique<MergedFrameSource>(std::move(sources));
+  j.source = JoinStreamSources(std::move(sources));
   *job = std::move(result);
   return Status::Ok();
 }

@@ -266,49 +266,27 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
     GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
   const std::string dir = testing::MakeTempDir("live_two");
   const int frames = 150;
-  const std::string names[2] = {"a", "b"};
-  std::vector<PosedImage> truth[2];
-  int ports[2];
-  for (int s = 0; s < 2; ++s) {
-    truth[s] = testing::MakeStreamCapture(dir + "/" + names[s], frames, s == 0 ? 3 : 8);
-    ASSERT_EQ(truth[s].size(), static_cast<size_t>(frames));
-    ports[s] = testing::FreeLoopbackPort(SOCK_DGRAM);
-  }
+  const testing::TwoStreamCaptures c = testing::MakeTwoStreamCaptures(dir, frames);
   // The project over both streams, video and poses from `video(s)` and `poses(s)`.
   const auto two_streams = [&](auto video, auto poses, const Json& live) {
     Json streams = Json::array();
     for (int s = 0; s < 2; ++s)
-      streams.push_back({{"camera", dir + "/" + names[s] + "/camera.cameramodel"},
+      streams.push_back({{"camera", c.dir[s] + "/camera.cameramodel"},
                          {"video", video(s)},
                          {"poses", poses(s)},
                          {"time_offset_s", kOffsetS}});
     return Json{{"fresco", 2},
-                {"scene", dir + "/a/scene.gltf"},
+                {"scene", c.dir[0] + "/scene.gltf"},
                 {"streams", streams},
                 {"pipeline", {{"texel_size_m", 0.02}}},
                 {"live", live}};
   };
-  const auto udp = [&](int s) { return "udp://127.0.0.1:" + std::to_string(ports[s]); };
-  // Sends each stream once Fresco listens on its port (OpenCV opens one stream at a time:
-  // the second port opens once the first stream's packets came); returns when both are sent.
-  const auto send_both = [&](double rate, int pad_frames) {
-    std::vector<std::future<int>> senders;
-    for (int s = 0; s < 2; ++s) {
-      senders.push_back(std::async(std::launch::async, [&, s] {
-        if (!testing::WaitUdpPortBound(ports[s])) return -1;
-        return std::system(testing::FfmpegStreamCommand(dir + "/" + names[s] + "/frames",
-                                                        udp(s) + "?pkt_size=1316", rate,
-                                                        pad_frames)
-                               .c_str());
-      }));
-    }
-    for (int s = 0; s < 2; ++s) EXPECT_EQ(senders[s].get(), 0) << "sending " << udp(s);
-  };
+  const auto udp = [&](int s) { return c.Udp(s); };
 
   testing::PoseServer servers[2];
   std::thread trackers[2];
   for (int s = 0; s < 2; ++s)
-    trackers[s] = std::thread(testing::ServeTrack, &servers[s], truth[s], kFps, kOffsetS);
+    trackers[s] = std::thread(testing::ServeTrack, &servers[s], c.truth[s], kFps, kOffsetS);
   const Json live_project = two_streams(
       udp, [&](int s) { return servers[s].Address(); },
       Json{{"open_timeout_s", 30}, {"read_timeout_s", 2}, {"queue_frames", 200}});
@@ -316,7 +294,7 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
   auto run = std::async(std::launch::async, [&] {
     return testing::RunFresco({"run", dir + "/live.json", "--out", dir + "/live_out", "--quiet"});
   });
-  send_both(1.0, kUdpPadFrames);
+  testing::SendTwoStreams(c, 1.0, kUdpPadFrames);
   const testing::CommandResult live = run.get();
   for (std::thread& tracker : trackers) tracker.join();
   ASSERT_EQ(live.exit_code, 0) << live.err;
@@ -333,8 +311,8 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
   EXPECT_EQ(metrics["live"], metrics["streams"][0]["live"]);
 
   const Json file_project = two_streams(
-      [&](int s) { return dir + "/" + names[s] + "/frames/"; },
-      [&](int s) { return dir + "/" + names[s] + "/sparse/images.txt"; }, Json::object());
+      [&](int s) { return c.dir[s] + "/frames/"; },
+      [&](int s) { return c.dir[s] + "/sparse/images.txt"; }, Json::object());
   testing::WriteText(dir + "/files.json", file_project.dump(2));
   const testing::CommandResult replay =
       testing::RunFresco({"run", dir + "/files.json", "--out", dir + "/file_out", "--quiet"});
@@ -355,7 +333,7 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
   }
   std::vector<Rigid3d> views;
   for (int s = 0; s < 2; ++s)
-    for (int i = 0; i < frames; i += 5) views.push_back(truth[s][i].cam_from_world);
+    for (int i = 0; i < frames; i += 5) views.push_back(c.truth[s][i].cam_from_world);
   double truth_live = 0, truth_files = 0;
   TruthPsnr(dir + "/a/scene.gltf", dir + "/live_out/painted.gltf", dir + "/file_out/painted.gltf",
             camera, views, &truth_live, &truth_files);
@@ -370,18 +348,18 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
   // Faster than the painter: queues of 4, both streams at 20 times their rate, poses from
   // the files (TUM, matched by time).
   for (int s = 0; s < 2; ++s) {
-    std::ofstream tum(dir + "/" + names[s] + "/poses.tum");
+    std::ofstream tum(c.dir[s] + "/poses.tum");
     for (int i = 0; i < frames; ++i)
-      tum << testing::TumLine(i / kFps + kOffsetS, truth[s][i].cam_from_world.Inverse());
+      tum << testing::TumLine(i / kFps + kOffsetS, c.truth[s][i].cam_from_world.Inverse());
   }
   const Json fast_project = two_streams(
-      udp, [&](int s) { return dir + "/" + names[s] + "/poses.tum"; },
+      udp, [&](int s) { return c.dir[s] + "/poses.tum"; },
       Json{{"open_timeout_s", 30}, {"read_timeout_s", 2}, {"queue_frames", 4}});
   testing::WriteText(dir + "/fast.json", fast_project.dump(2));
   auto fast_run = std::async(std::launch::async, [&] {
     return testing::RunFresco({"run", dir + "/fast.json", "--out", dir + "/fast_out", "--quiet"});
   });
-  send_both(20.0, 0);
+  testing::SendTwoStreams(c, 20.0, 0);
   const testing::CommandResult fast = fast_run.get();
   ASSERT_EQ(fast.exit_code, 0) << fast.err;
   const Json fast_metrics = ReadJson(dir + "/fast_out/metrics.json");
@@ -399,7 +377,7 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
 
   // One stream from files, the other live (the contract's example): both painted whole.
   Json mixed = two_streams(
-      udp, [&](int s) { return dir + "/" + names[s] + "/poses.tum"; },
+      udp, [&](int s) { return c.dir[s] + "/poses.tum"; },
       Json{{"open_timeout_s", 30}, {"read_timeout_s", 2}, {"queue_frames", 200}});
   mixed["streams"][0]["video"] = dir + "/a/frames/";
   mixed["streams"][0]["poses"] = dir + "/a/sparse/images.txt";
@@ -407,11 +385,8 @@ TEST(LiveStreamTest, TwoLiveStreamsPaintOneModelLikeTheirFileReplay) {
   auto mixed_run = std::async(std::launch::async, [&] {
     return testing::RunFresco({"run", dir + "/mixed.json", "--out", dir + "/mixed_out", "--quiet"});
   });
-  ASSERT_TRUE(testing::WaitUdpPortBound(ports[1])) << "fresco never opened " << udp(1);
-  EXPECT_EQ(std::system(testing::FfmpegStreamCommand(dir + "/b/frames", udp(1) + "?pkt_size=1316",
-                                                     1.0, kUdpPadFrames)
-                            .c_str()),
-            0);
+  ASSERT_TRUE(testing::WaitUdpPortBound(c.port[1])) << "fresco never opened " << udp(1);
+  EXPECT_TRUE(testing::StreamFrames(c.dir[1] + "/frames", c.port[1], 1.0, kUdpPadFrames));
   const testing::CommandResult mixed_result = mixed_run.get();
   ASSERT_EQ(mixed_result.exit_code, 0) << mixed_result.err;
   const Json mixed_metrics = ReadJson(dir + "/mixed_out/metrics.json");

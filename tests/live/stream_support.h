@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <string>
 #include <thread>
 #include <vector>
@@ -104,6 +105,45 @@ inline std::vector<PosedImage> MakeStreamCapture(const std::string& dir, int fra
   std::sort(truth.begin(), truth.end(),
             [](const PosedImage& a, const PosedImage& b) { return a.name < b.name; });
   return truth;
+}
+
+// Two hand-held captures of the room for the two-camera tests (MakeStreamCapture): DIR/a
+// (seed 3) and DIR/b (seed 8), each with its true poses and a free loopback UDP port for its
+// video.
+struct TwoStreamCaptures {
+  std::string dir[2];
+  std::vector<PosedImage> truth[2];
+  int port[2] = {0, 0};
+  std::string Udp(int s) const { return "udp://127.0.0.1:" + std::to_string(port[s]); }
+};
+inline TwoStreamCaptures MakeTwoStreamCaptures(const std::string& dir, int frames) {
+  TwoStreamCaptures c;
+  for (int s = 0; s < 2; ++s) {
+    c.dir[s] = dir + (s == 0 ? "/a" : "/b");
+    c.truth[s] = MakeStreamCapture(c.dir[s], frames, s == 0 ? 3 : 8);
+    EXPECT_EQ(c.truth[s].size(), static_cast<size_t>(frames)) << c.dir[s];
+    c.port[s] = FreeLoopbackPort(SOCK_DGRAM);
+  }
+  return c;
+}
+
+// Sends both captures' frames (StreamFrames), each once Fresco listens on its port (OpenCV
+// opens one stream at a time: the second port opens once the first stream's packets came);
+// returns when both are sent, true when both were.
+inline bool SendTwoStreams(const TwoStreamCaptures& c, double rate, int pad_frames) {
+  std::future<bool> sent[2];
+  for (int s = 0; s < 2; ++s)
+    sent[s] = std::async(std::launch::async, [&c, s, rate, pad_frames] {
+      return WaitUdpPortBound(c.port[s]) &&
+             StreamFrames(c.dir[s] + "/frames", c.port[s], rate, pad_frames);
+    });
+  bool ok = true;
+  for (int s = 0; s < 2; ++s) {
+    const bool one = sent[s].get();
+    EXPECT_TRUE(one) << "sending " << c.Udp(s);
+    ok = ok && one;
+  }
+  return ok;
 }
 
 // A live project over the capture in CAPTURE_DIR: video from VIDEO (StreamProject:

@@ -7,7 +7,6 @@
 #include <sys/socket.h>
 
 #include <cmath>
-#include <future>
 #include <string>
 #include <thread>
 #include <vector>
@@ -183,25 +182,19 @@ TEST(UiLive, TwoLiveStreamsPaintOneModelAsTheRunDoes) {
     GTEST_SKIP() << "the ffmpeg program is not installed (apt-get install ffmpeg)";
   const std::string dir = testing::MakeTempDir("ui_live_two");
   const int frames = 60;
-  const std::string names[2] = {"a", "b"};
-  std::vector<PosedImage> truth[2];
-  int ports[2];
+  const testing::TwoStreamCaptures c = testing::MakeTwoStreamCaptures(dir, frames);
   testing::PoseServer servers[2];
   std::thread trackers[2];
   Json live_streams = Json::array(), file_streams = Json::array();
   for (int s = 0; s < 2; ++s) {
-    const std::string capture = dir + "/" + names[s];
-    truth[s] = testing::MakeStreamCapture(capture, frames, s == 0 ? 3 : 8);
-    ASSERT_EQ(truth[s].size(), static_cast<size_t>(frames));
-    ports[s] = testing::FreeLoopbackPort(SOCK_DGRAM);
-    trackers[s] = std::thread(testing::ServeTrack, &servers[s], truth[s], kFps, kOffsetS);
-    live_streams.push_back({{"camera", capture + "/camera.cameramodel"},
-                            {"video", "udp://127.0.0.1:" + std::to_string(ports[s])},
+    trackers[s] = std::thread(testing::ServeTrack, &servers[s], c.truth[s], kFps, kOffsetS);
+    live_streams.push_back({{"camera", c.dir[s] + "/camera.cameramodel"},
+                            {"video", c.Udp(s)},
                             {"poses", servers[s].Address()},
                             {"time_offset_s", kOffsetS}});
-    file_streams.push_back({{"camera", capture + "/camera.cameramodel"},
-                            {"video", capture + "/frames/"},
-                            {"poses", capture + "/sparse/images.txt"}});
+    file_streams.push_back({{"camera", c.dir[s] + "/camera.cameramodel"},
+                            {"video", c.dir[s] + "/frames/"},
+                            {"poses", c.dir[s] + "/sparse/images.txt"}});
   }
   const Json project = {
       {"fresco", 2},
@@ -220,13 +213,7 @@ TEST(UiLive, TwoLiveStreamsPaintOneModelAsTheRunDoes) {
   PipelineRunner runner;
   runner.Restart(state.project);  // connects to both trackers, then waits for the streams
   runner.Play();
-  std::vector<std::future<int>> senders;
-  for (int s = 0; s < 2; ++s)
-    senders.push_back(std::async(std::launch::async, [&, s] {
-      if (!testing::WaitUdpPortBound(ports[s])) return -1;
-      return testing::StreamFrames(dir + "/" + names[s] + "/frames", ports[s], 1.0, 2) ? 0 : 1;
-    }));
-  for (int s = 0; s < 2; ++s) EXPECT_EQ(senders[s].get(), 0) << "stream " << s;
+  testing::SendTwoStreams(c, 1.0, 2);
   runner.WaitIdle();  // stops playing when both videos ended
   for (std::thread& tracker : trackers) tracker.join();
   const auto live = runner.Snapshot();

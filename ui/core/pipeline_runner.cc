@@ -161,10 +161,7 @@ void PipelineRunner::OpenSession(const Project& project) {
     }
     s->live = s->lives[first].get();
     s->live_stream = first;
-    if (num_streams == 1)
-      s->source = std::move(sources[0]);
-    else
-      s->source = std::make_unique<MergedFrameSource>(std::move(sources), options_.live_poll_ms);
+    s->source = JoinStreamSources(std::move(sources), options_.live_poll_ms);
   } else {
     std::vector<const Capture*> streams;
     for (const Capture& c : s->captures) streams.push_back(&c);
