@@ -5,7 +5,8 @@
 #include <cmath>
 #include <utility>
 
-#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/foreground_blobs.h"
 
 namespace fresco {
 
@@ -169,31 +170,9 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
 }
 
 void BufferBackground::Clean(const cv::Rect& roi, BackgroundFrame* frame) {
-  cv::Mat raw = raw_(roi);
-  cv::Mat kept = raw;
-  if (options_.min_blob_texels > 1) {
-    cv::Mat labels, stats, centroids;
-    const int n = cv::connectedComponentsWithStats(raw, labels, stats, centroids, 8, CV_32S);
-    std::vector<uint8_t> keep(n, 0);
-    for (int i = 1; i < n; ++i) {
-      keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= options_.min_blob_texels ? 255 : 0;
-      frame->blobs_removed += keep[i] == 0;
-    }
-    kept = cv::Mat(raw.size(), CV_8U);
-    for (int y = 0; y < raw.rows; ++y) {
-      const int* l = labels.ptr<int>(y);
-      uint8_t* out = kept.ptr<uint8_t>(y);
-      for (int x = 0; x < raw.cols; ++x) out[x] = keep[l[x]];
-    }
-  }
-  cv::Mat out = frame->foreground(roi);
-  if (options_.dilate_texels > 0) {
-    const int r = options_.dilate_texels;
-    cv::dilate(kept, out,
-               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
-  } else {
-    kept.copyTo(out);
-  }
+  cv::Mat out = frame->foreground(roi);  // all zero: cleared for this frame
+  frame->blobs_removed +=
+      CleanForeground(raw_(roi), options_.min_blob_texels, options_.dilate_texels, &out);
 }
 
 void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
