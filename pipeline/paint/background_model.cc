@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 
@@ -114,15 +115,36 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
   params.window = options_.window_frames;
   params.warmup = options_.warmup_frames;
   const float inv_gain = 1.0f / gain;
+  // A full tile's texels are runs of the buffer's rows (BaseBuffer::Chunk::full): read and
+  // written a row at a time; otherwise one at a time through texel_index.
+  const int tile_w = chunk.x1 - chunk.x0;
+  const auto row_of = [&](int r) {
+    return static_cast<size_t>(chunk.y0 + r) * buffer.width + chunk.x0;
+  };
   for (int begin = chunk.begin; begin < chunk.end; begin += kMax) {
     const int n = std::min(kMax, chunk.end - begin);
     const int32_t* index = buffer.texel_index.data() + begin;
+    const bool rows = chunk.full && n == chunk.end - chunk.begin;
     if (options_.mode == BackgroundMode::kRobust) {
-      for (int i = 0; i < n; ++i) {
-        const int idx = index[i];
-        const cv::Vec3b s = src[idx];
-        sampled[i] = valid[idx] != 0;
-        for (int c = 0; c < 3; ++c) x[c][i] = s[c] * inv_gain;
+      if (rows) {
+        for (int r = 0, i = 0; i < n; ++r, i += tile_w) {
+          const size_t row = row_of(r);
+          const uint8_t* v = valid + row;
+          const uint8_t* p = src[0].val + 3 * row;
+          for (int c = 0; c < tile_w; ++c) {
+            sampled[i + c] = v[c] != 0;
+            x[0][i + c] = p[3 * c] * inv_gain;
+            x[1][i + c] = p[3 * c + 1] * inv_gain;
+            x[2][i + c] = p[3 * c + 2] * inv_gain;
+          }
+        }
+      } else {
+        for (int i = 0; i < n; ++i) {
+          const int idx = index[i];
+          const cv::Vec3b s = src[idx];
+          sampled[i] = valid[idx] != 0;
+          for (int c = 0; c < 3; ++c) x[c][i] = s[c] * inv_gain;
+        }
       }
       UpdateRobustTexels(params, begin, n, x[0], x[1], x[2], sampled, &robust_, foreground, warm_up,
                          distance2);
@@ -151,20 +173,37 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
         }
       }
     }
+    // foreground and warm_up are 0 or 1, and 0 where not sampled.
+    int observed = 0, warm = 0, fore = 0;
     for (int i = 0; i < n; ++i) {
-      const int idx = index[i];
-      raw[idx] = foreground[i] ? 255 : 0;
-      warming[idx] = warm_up[i] ? 255 : 0;
-      if (!sampled[i]) continue;
-      ++stats->observed;
-      stats->warming += warm_up[i];
-      if (difference) difference[idx] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2[i]));
-      if (foreground[i]) {
-        ++stats->foreground;
-        const int tx = idx % buffer.width, ty = idx / buffer.width;
-        stats->x_min = std::min(stats->x_min, tx), stats->x_max = std::max(stats->x_max, tx);
-        stats->y_min = std::min(stats->y_min, ty), stats->y_max = std::max(stats->y_max, ty);
+      observed += sampled[i];
+      warm += warm_up[i];
+      fore += foreground[i];
+      foreground[i] = static_cast<uint8_t>(-foreground[i]);  // 0 or 255
+      warm_up[i] = static_cast<uint8_t>(-warm_up[i]);
+    }
+    if (rows) {
+      for (int r = 0, i = 0; i < n; ++r, i += tile_w) {
+        std::memcpy(raw + row_of(r), foreground + i, tile_w);
+        std::memcpy(warming + row_of(r), warm_up + i, tile_w);
       }
+    } else {
+      for (int i = 0; i < n; ++i) {
+        raw[index[i]] = foreground[i];
+        warming[index[i]] = warm_up[i];
+      }
+    }
+    if (difference) {
+      for (int i = 0; i < n; ++i)
+        if (sampled[i])
+          difference[index[i]] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2[i]));
+    }
+    stats->observed += observed, stats->warming += warm, stats->foreground += fore;
+    // The foreground's bounds, to the tile (Clean works on a region around them: a larger
+    // one holds the same foreground and gives the same mask).
+    if (fore > 0) {
+      stats->x_min = std::min(stats->x_min, chunk.x0), stats->x_max = std::max(stats->x_max, chunk.x1 - 1);
+      stats->y_min = std::min(stats->y_min, chunk.y0), stats->y_max = std::max(stats->y_max, chunk.y1 - 1);
     }
   }
 }
