@@ -64,6 +64,22 @@ int RefineHalfWindow(const TagQuad& quad) {
   return std::clamp(static_cast<int>(shortest / 8), 2, 6);
 }
 
+// The tag's corners moved onto the image's saddles (cornerSubPix). A corner whose start lies
+// too far from its saddle is left where it started (OpenCV keeps the start when the estimate
+// leaves its window): such a start came from a tag outline traced under strong distortion or
+// on a thinned image, and lies 2-8 px off. Those corners are left out (`refined` false): a
+// corner fewer costs the solve little, one several pixels off biases it. (Retrying them from
+// where the tag's other corners put them recovered a third of them, but one in six of those
+// settled on the wrong saddle.)
+void RefineTagCorners(const cv::Mat& gray, const TagQuad& quad, std::vector<cv::Point2f>* corners,
+                      bool refined[4]) {
+  const int half = RefineHalfWindow(quad);
+  const std::vector<cv::Point2f> start = *corners;
+  cv::cornerSubPix(gray, *corners, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 40, 1e-3));
+  for (int k = 0; k < 4; ++k) refined[k] = (*corners)[k] != start[k];
+}
+
 }  // namespace
 
 std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
@@ -140,13 +156,11 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
     std::vector<cv::Point2f> corners;
     for (int k = 0; k < 4; ++k)
       corners.emplace_back(static_cast<float>(quad.p[k].x()), static_cast<float>(quad.p[k].y()));
-    if (options.refine_tag_corners) {
-      const int half = RefineHalfWindow(quad);
-      cv::cornerSubPix(gray, corners, cv::Size(half, half), cv::Size(-1, -1),
-                       cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 40, 1e-3));
-    }
+    bool refined[4] = {true, true, true, true};
+    if (options.refine_tag_corners) RefineTagCorners(gray, quad, &corners, refined);
     for (int k = 0; k < 4; ++k)
-      out.corners.push_back({id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
+      if (refined[k])
+        out.corners.push_back({id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
     ++out.tags;
   }
   std::sort(out.corners.begin(), out.corners.end(),

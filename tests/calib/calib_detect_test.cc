@@ -68,8 +68,9 @@ std::vector<SyntheticImage> Views(double blur_sigma_px, int count) {
 
 // Measured on these 12 views (seed 11), apriltag alone / with the second look (retries, aruco,
 // then around the tags found): sharp: recall 0.347 / 0.917, 12 / 12 boards; blur 1 px: recall
-// 0.079 / 0.641, 4 / 10 boards; median corner error 0.08 and 0.04 px. (Before the look around
-// found tags: 0.731 and 0.595.)
+// 0.079 / 0.641, 4 / 10 boards; median corner error 0.08 and 0.04 px, rms 0.131 and 0.065 px.
+// (Before the look around found tags: recall 0.731 and 0.595; before corners that do not
+// settle on a saddle were left out: rms 0.349 and 0.126 px.)
 TEST(AprilGridRecallTest, SecondLookKeepsBoardsUnderStrongBarrelDistortion) {
   const BoardSpec spec = Spec("aprilgrid:6x6:0.088:0.3");
   for (double blur : {0.0, 1.0}) {
@@ -88,7 +89,7 @@ TEST(AprilGridRecallTest, SecondLookKeepsBoardsUnderStrongBarrelDistortion) {
     EXPECT_GE(recall_after, blur > 0 ? 0.62 : 0.85) << blur;
     EXPECT_GE(after.views_found, 10) << blur;
     EXPECT_LT(after.median_corner_px, 0.3) << blur;
-    EXPECT_LT(after.corner_rms_px, 0.8) << blur;
+    EXPECT_LT(after.corner_rms_px, 0.2) << blur;
   }
 }
 

@@ -74,7 +74,9 @@ int main(int argc, char** argv) {
       sq_error += e * e;
       max_error = std::max(max_error, e);
       if (verbose && e > 1.5)
-        std::printf("  view %zu corner %d (tag %d): error %.2f px\n", v, c.id, c.id / 4, e);
+        std::printf("  view %zu corner %d (tag %d): error %.2f px (found %.1f %.1f, true %.1f %.1f)\n",
+                    v, c.id, c.id / 4, e, c.pixel.x(), c.pixel.y(), image.truth[c.id].x(),
+                    image.truth[c.id].y());
       ++corners;
     }
     const std::vector<TagQuad> quads = DetectTagsAruco(image.gray, spec.cols * spec.rows);
@@ -96,9 +98,9 @@ int main(int argc, char** argv) {
   std::printf("%zu views (blur %.2f px, noise %.1f): tags in view %d\n", poses.size(),
               image_options.blur_sigma_px, image_options.noise_px, in_view);
   std::printf(
-      "%-10s recall %.3f (%d tags), views with a board %d, corner error rms %.3f px, "
-      "max %.3f px\n",
-      single ? "apriltag" : "fresco", ours / double(in_view), ours, views_ok,
+      "%-10s recall %.3f (%d tags, %d corners), views with a board %d, corner error rms %.3f "
+      "px, max %.3f px\n",
+      single ? "apriltag" : "fresco", ours / double(in_view), ours, corners, views_ok,
       std::sqrt(sq_error / std::max(1, corners)), max_error);
   std::printf(
       "%-10s recall %.3f (%d tags), views with >= 2 tags %d, corner error rms %.3f px "
