@@ -129,6 +129,9 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
     if (options.progress) options.progress(step.name, index, total_steps);
     std::vector<std::string> argv = {program};
     argv.insert(argv.end(), step.args.begin(), step.args.end());
+    // COLMAP's own log (glog) into the step's log with its output, not into files of its
+    // own in /tmp (a dozen per run, never removed).
+    argv.insert(argv.begin() + 2, {"--log_to_stderr", "1"});
     std::string line;
     for (const std::string& a : argv) {
       if (!line.empty()) line += ' ';

@@ -7,9 +7,11 @@
 // COLMAP runs once for the synthetic suite (by the verify run); the bootstrap tests reuse its
 // reconstruction (--colmap-model).
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <regex>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -62,8 +64,18 @@ class PosesColmapTest : public ::testing::Test {
           Perturbed(poses[i].cam_from_world, rotation, position, Eigen::Vector3d(1, -2, 0.5 + i));
     }
     ASSERT_TRUE(WriteColmapImages(capture + "/sparse/images.txt", poses).ok());
+    // A temporary folder of the run's own: where COLMAP's log would go were it not kept in the
+    // workspace (ColmapLogsStayInTheWorkspace).
+    fs::create_directories(TempFolder());
+    const char* tmpdir = std::getenv("TMPDIR");
+    const std::string saved = tmpdir ? tmpdir : "";
+    setenv("TMPDIR", TempFolder().c_str(), 1);
     verify_ = new testing::CommandResult(
         RunFresco({"poses", "verify", Project(), "--out", VerifyDir(), "--threads", "2"}));
+    if (tmpdir)
+      setenv("TMPDIR", saved.c_str(), 1);
+    else
+      unsetenv("TMPDIR");
   }
   static void TearDownTestSuite() {
     delete dir_;
@@ -77,6 +89,7 @@ class PosesColmapTest : public ::testing::Test {
   static std::string Capture() { return *dir_ + "/capture"; }
   static std::string Project() { return Capture() + "/project.json"; }
   static std::string VerifyDir() { return *dir_ + "/verify"; }
+  static std::string TempFolder() { return *dir_ + "/tmp"; }
   static std::string ColmapModel() { return VerifyDir() + "/colmap/sparse_txt/0"; }
   static std::vector<PosedImage> Truth() {
     std::vector<PosedImage> truth;
@@ -142,6 +155,20 @@ TEST_F(PosesColmapTest, VerifyFlagsEveryInjectedErrorAndNoCleanFrame) {
   EXPECT_NE(ReadText(out + "/colmap/commands.txt").find("--SiftExtraction.use_gpu 0"),
             std::string::npos);
   EXPECT_TRUE(fs::is_regular_file(out + "/colmap/logs/03_mapper.log"));
+}
+
+// COLMAP logs through glog, which writes files of its own into the temporary folder (a dozen
+// a run, never removed) unless told to log to stderr: its log goes into the workspace's step
+// logs instead.
+TEST_F(PosesColmapTest, ColmapLogsStayInTheWorkspace) {
+  int colmap_files = 0;
+  for (const auto& entry : fs::directory_iterator(TempFolder()))
+    colmap_files += entry.path().filename().string().rfind("colmap", 0) == 0;
+  EXPECT_EQ(colmap_files, 0) << "COLMAP wrote logs into " << TempFolder();
+  const std::string mapper_log = ReadText(VerifyDir() + "/colmap/logs/03_mapper.log");
+  // glog's lines: "[IWEF]yyyymmdd hh:mm:ss.uuuuuu threadid file:line] msg".
+  const std::regex glog_line(R"((^|\n)[IWEF]\d{8} \d\d:\d\d:\d\d\.\d+ +\d+ [^ \n]+:\d+\] )");
+  EXPECT_TRUE(std::regex_search(mapper_log, glog_line)) << mapper_log.substr(0, 2000);
 }
 
 TEST_F(PosesColmapTest, BootstrapFromRoughPosesIsCloseToTheTruth) {
