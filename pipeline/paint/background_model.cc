@@ -130,7 +130,7 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
         for (int r = 0, i = 0; i < n; ++r, i += tile_w) {
           const size_t row = row_of(r);
           const uint8_t* v = valid + row;
-          const uint8_t* p = src[0].val + 3 * row;
+          const uint8_t* p = warped.bgr.data + 3 * row;
           for (int c = 0; c < tile_w; ++c) {
             sampled[i + c] = v[c] != 0;
             x[0][i + c] = p[3 * c] * inv_gain;
