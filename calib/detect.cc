@@ -149,7 +149,8 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       out.tags_second_look += AddMissing(DetectTagsAruco(gray, num_ids), &found);
     if (static_cast<int>(found.size()) < num_ids)
       out.tags_second_look += FindTagsAroundFound(
-          gray, spec, [&](const cv::Mat& patch) { return DetectTagsApriltag(patch, num_ids, options); },
+          gray, spec,
+          [&](const cv::Mat& patch) { return DetectTagsApriltag(patch, num_ids, options); },
           &found);
   }
   for (const auto& [id, quad] : found) {

@@ -6,7 +6,6 @@
 #include <cstring>
 #include <utility>
 
-
 #include "pipeline/paint/foreground_blobs.h"
 
 namespace fresco {
@@ -202,8 +201,10 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
     // The foreground's bounds, to the tile (Clean works on a region around them: a larger
     // one holds the same foreground and gives the same mask).
     if (fore > 0) {
-      stats->x_min = std::min(stats->x_min, chunk.x0), stats->x_max = std::max(stats->x_max, chunk.x1 - 1);
-      stats->y_min = std::min(stats->y_min, chunk.y0), stats->y_max = std::max(stats->y_max, chunk.y1 - 1);
+      stats->x_min = std::min(stats->x_min, chunk.x0);
+      stats->x_max = std::max(stats->x_max, chunk.x1 - 1);
+      stats->y_min = std::min(stats->y_min, chunk.y0);
+      stats->y_max = std::max(stats->y_max, chunk.y1 - 1);
     }
   }
 }

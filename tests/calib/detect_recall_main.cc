@@ -74,9 +74,10 @@ int main(int argc, char** argv) {
       sq_error += e * e;
       max_error = std::max(max_error, e);
       if (verbose && e > 1.5)
-        std::printf("  view %zu corner %d (tag %d): error %.2f px (found %.1f %.1f, true %.1f %.1f)\n",
-                    v, c.id, c.id / 4, e, c.pixel.x(), c.pixel.y(), image.truth[c.id].x(),
-                    image.truth[c.id].y());
+        std::printf(
+            "  view %zu corner %d (tag %d): error %.2f px (found %.1f %.1f, true %.1f %.1f)\n", v,
+            c.id, c.id / 4, e, c.pixel.x(), c.pixel.y(), image.truth[c.id].x(),
+            image.truth[c.id].y());
       ++corners;
     }
     const std::vector<TagQuad> quads = DetectTagsAruco(image.gray, spec.cols * spec.rows);

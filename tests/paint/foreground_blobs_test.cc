@@ -30,8 +30,9 @@ cv::Mat Reference(const cv::Mat& raw, int min_blob, int dilate, int* dropped) {
   }
   if (dilate <= 0) return kept;
   cv::Mat out;
-  cv::dilate(kept, out,
-             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * dilate + 1, 2 * dilate + 1)));
+  cv::dilate(
+      kept, out,
+      cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * dilate + 1, 2 * dilate + 1)));
   return out;
 }
 
@@ -51,7 +52,8 @@ TEST(CleanForeground, MatchesOpenCvComponentsAndDilation) {
          std::vector<std::pair<double, double>>{{0.0, 0.93}, {1.0, 0.58}, {1.5, 0.54}, {2.5, 0.52}})
       for (const int min_blob : {1, 2, 12, 40})
         for (const int dilate : {0, 1, 2, 3, 5}) {
-          const cv::Mat raw = RandomMask(37 + 11 * static_cast<int>(seed), 61, sigma, threshold, seed);
+          const cv::Mat raw =
+              RandomMask(37 + 11 * static_cast<int>(seed), 61, sigma, threshold, seed);
           int expected_dropped = 0;
           const cv::Mat expected = Reference(raw, min_blob, dilate, &expected_dropped);
           cv::Mat out = cv::Mat::zeros(raw.size(), CV_8U);
@@ -87,7 +89,7 @@ TEST(CleanForeground, WorksOnARegionOfALargerImage) {
 TEST(CleanForeground, DiagonalNeighboursAreOneBlob) {
   cv::Mat raw = cv::Mat::zeros(8, 8, CV_8U);
   for (int i = 0; i < 6; ++i) raw.at<uint8_t>(i, i) = 255;  // one diagonal line of 6
-  raw.at<uint8_t>(7, 0) = 255;                               // and a lone texel
+  raw.at<uint8_t>(7, 0) = 255;                              // and a lone texel
   cv::Mat out = cv::Mat::zeros(raw.size(), CV_8U);
   EXPECT_EQ(CleanForeground(raw, 6, 0, &out), 1);  // the lone texel only
   EXPECT_EQ(cv::countNonZero(out), 6);
