@@ -72,9 +72,12 @@ int CleanForeground(const cv::Mat& raw, int min_blob_texels, int dilate_texels, 
       for (int q = p; q < p_end && runs[q].x0 <= runs[c].x1 + 1; ++q) Unite(parent, q, c);
     }
   }
+  // Each run's blob (its root), found once; the blobs' areas summed at their roots.
   std::vector<int> area(runs.size(), 0);
-  for (size_t i = 0; i < runs.size(); ++i)
-    area[Root(parent, static_cast<int>(i))] += runs[i].x1 - runs[i].x0 + 1;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    parent[i] = Root(parent, static_cast<int>(i));
+    area[parent[i]] += runs[i].x1 - runs[i].x0 + 1;
+  }
   int dropped = 0;
   for (size_t i = 0; i < runs.size(); ++i)
     if (parent[i] == static_cast<int>(i) && area[i] < min_blob_texels) ++dropped;
@@ -93,7 +96,7 @@ int CleanForeground(const cv::Mat& raw, int min_blob_texels, int dilate_texels, 
     }
   }
   for (size_t i = 0; i < runs.size(); ++i) {
-    if (area[Root(parent, static_cast<int>(i))] < min_blob_texels) continue;
+    if (area[parent[i]] < min_blob_texels) continue;
     const Run& run = runs[i];
     for (int dy = -r; dy <= r; ++dy) {
       const int y = run.row + dy, hw = half_width[dy + r];

@@ -1,7 +1,6 @@
 #include "ui/core/poses_runner.h"
 
 #include <algorithm>
-
 #include <cstdio>
 #include <filesystem>
 
