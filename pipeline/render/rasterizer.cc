@@ -22,9 +22,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -70,6 +72,9 @@ struct TraversalScratch {
   std::vector<TrianglePolygon> polygons;
 };
 thread_local TraversalScratch traversal_scratch;
+// RasterizeDepth's spare inverse-depth buffers on a grid (InverseDepthShards), per calling
+// thread: ~4 bytes a sample for each thread beyond the first.
+thread_local std::deque<std::vector<float>> depth_shard_spares;
 
 // Triangles per cluster: 128 consecutive triangles of a photogrammetry mesh lie close
 // together, so a cluster's box is small and culls well.
@@ -388,12 +393,80 @@ struct NearestInverseDepth {
   }
 };
 
+// RasterizeDepth's record on a grid of rays, where each triangle is scanned by the thread that
+// set it up, so two threads may hit the same sample. Rather than an atomic maximum per hit,
+// each task (a run of clusters) takes an inverse-depth buffer of its own while it runs (the
+// output first, then zeroed spares kept by the calling thread, at most one per thread at a
+// time) and RasterizeDepth takes the maximum over them at the end: the same depth map as one
+// buffer, as a maximum does not depend on the order, and the rows scan vectorized.
+class InverseDepthShards {
+ public:
+  InverseDepthShards(float* output, size_t samples, double inv_near,
+                     std::deque<std::vector<float>>* spares)
+      : output_(output), samples_(samples), inv_near_(inv_near), spares_(spares) {}
+  // A buffer no other task writes until it is released.
+  NearestInverseDepth Acquire() const {
+    std::vector<float>* spare = nullptr;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!free_.empty()) {
+        float* buffer = free_.back();
+        free_.pop_back();
+        return {buffer, inv_near_};
+      }
+      if (!output_taken_) {
+        output_taken_ = true;
+        return {output_, inv_near_};
+      }
+      if (used_spares_ == spares_->size()) spares_->emplace_back();
+      spare = &(*spares_)[used_spares_++];  // a deque: stays put while others are added
+    }
+    spare->assign(samples_, 0.0f);  // outside the lock: the other tasks go on
+    std::lock_guard<std::mutex> lock(mutex_);
+    used_.push_back(spare->data());
+    return {spare->data(), inv_near_};
+  }
+  void Release(float* buffer) const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    free_.push_back(buffer);
+  }
+  // The spares written besides the output (call once the traversal is done).
+  const std::vector<float*>& Spares() const { return used_; }
+
+ private:
+  float* output_;
+  size_t samples_;
+  double inv_near_;
+  std::deque<std::vector<float>>* spares_;
+  mutable std::mutex mutex_;
+  mutable std::vector<float*> free_, used_;
+  mutable bool output_taken_ = false;
+  mutable size_t used_spares_ = 0;
+};
+
+// The record a task of the direct traversal uses: the traversal's record itself, or for
+// InverseDepthShards a buffer held for the task's lifetime.
+template <class Record>
+struct TaskRecord {
+  explicit TaskRecord(const Record& r) : record(r) {}
+  const Record& record;
+};
+template <>
+struct TaskRecord<InverseDepthShards> {
+  explicit TaskRecord(const InverseDepthShards& s) : shards(s), record(s.Acquire()) {}
+  ~TaskRecord() { shards.Release(record.inv); }
+  TaskRecord(const TaskRecord&) = delete;
+  TaskRecord& operator=(const TaskRecord&) = delete;
+  const InverseDepthShards& shards;
+  const NearestInverseDepth record;
+};
+
 // The columns [c0, c1] of one sample row, `inv_row` its inverse depths: the inside test and the
 // nearest-hit update of ScanGridTriangle with NearestInverseDepth, branch-free so that it
 // vectorizes (the same float and double operations in the same order: the same result).
 __attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
-    const float* __restrict col_x, int c0, int c1, float y, const TriangleSetup& s,
-    double inv_near, float* __restrict inv_row) {
+    const float* __restrict col_x, int c0, int c1, float y, const TriangleSetup& s, double inv_near,
+    float* __restrict inv_row) {
   const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
   const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
   const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
@@ -408,8 +481,8 @@ __attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
     const double inv_z = ia * static_cast<double>(x) + iy + ic;
     const float inv_zf = static_cast<float>(inv_z);
     const float current = inv_row[c];
-    const bool hit = !(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f) & (inv_zf > current) &
-                     (inv_z > 0.0) & (inv_z <= inv_near);
+    const bool hit = !(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f) & (inv_zf > current) & (inv_z > 0.0) &
+                     (inv_z <= inv_near);
     inv_row[c] = hit ? inv_zf : current;
   }
 }
@@ -434,8 +507,8 @@ __attribute__((target_clones("avx2", "default"))) void MaxInverseDepthBucket(
     const double inv_z = ia * static_cast<double>(x) + ib * static_cast<double>(y) + ic;
     const float inv_zf = static_cast<float>(inv_z);
     const float current = best[k];
-    const int hit = (all_inside | (!(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f))) &
-                    (inv_zf > current) & (inv_z > 0.0) & (inv_z <= inv_near);
+    const int hit = (all_inside | (!(w0 < 0.f) & !(w1 < 0.f) & !(w2 < 0.f))) & (inv_zf > current) &
+                    (inv_z > 0.0) & (inv_z <= inv_near);
     best[k] = hit ? inv_zf : current;
   }
 }
@@ -481,8 +554,8 @@ void ScanGridTriangle(const Table& t, const TriangleSetup& s, int tri, int row_l
     }
     const size_t row_sample = static_cast<size_t>(r) * t.width;
     if constexpr (std::is_same_v<Record, NearestInverseDepth>) {
-      if (c0 <= c1) MaxInverseDepthRow(t.col_x.data(), c0, c1, y, s, record.inv_near,
-                                       record.inv + row_sample);
+      if (c0 <= c1)
+        MaxInverseDepthRow(t.col_x.data(), c0, c1, y, s, record.inv_near, record.inv + row_sample);
       continue;
     }
     for (int c = c0; c <= c1; ++c) {
@@ -564,6 +637,8 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   // would otherwise leave one thread scanning the whole image). Per cluster, in order.
   std::vector<std::vector<std::pair<int, TriangleSetup>>> large(kDirect ? num_clusters : 0);
   cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
+    std::optional<TaskRecord<Record>> task;  // direct: the record this task scans with
+    if constexpr (kDirect) task.emplace(record);
     for (int c = range.start; c < range.end; ++c) {
       const int first = c * kClusterTriangles;
       for (int slot = slot_start[c]; slot < slot_start[c + 1]; ++slot) {
@@ -624,7 +699,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           if (samples > kLargeTriangleSamples)
             large[c].emplace_back(tri, s);
           else
-            ScanGridTriangle(t, s, tri, 0, t.height, record);
+            ScanGridTriangle(t, s, tri, 0, t.height, task->record);
         }
       }
     }
@@ -641,123 +716,128 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           if (setup.row0 >= band_hi || setup.row1 < band_lo) continue;
           if (band_record)
             ScanGridTriangle(t, setup, tri, band_lo, band_hi, *band_record);
-          else
+          else if constexpr (!std::is_same_v<Record, InverseDepthShards>)
             ScanGridTriangle(t, setup, tri, band_lo, band_hi, record);
         }
       }
     });
     return;
-  }
+  } else {  // binned
 
-  // Set-ups per bucket row (grid: per band of kBandRows sample rows), in ascending triangle
-  // order (counting sort).
-  const int num_bins = t.grid ? (t.height + kBandRows - 1) / kBandRows : t.rows;
-  const int bin_div = t.grid ? kBandRows : 1;
-  std::vector<int> row_start(num_bins + 1, 0);
-  for (int slot = 0; slot < num_slots; ++slot) {
-    const TriangleSetup& s = setups[slot];
-    if (s.num_poly == 0) continue;
-    for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) ++row_start[r + 1];
-  }
-  for (int r = 0; r < num_bins; ++r) row_start[r + 1] += row_start[r];
-  std::vector<int> row_triangles(row_start[num_bins]);
-  {
-    std::vector<int> fill(row_start.begin(), row_start.end() - 1);
+    // Set-ups per bucket row (grid: per band of kBandRows sample rows), in ascending triangle
+    // order (counting sort).
+    const int num_bins = t.grid ? (t.height + kBandRows - 1) / kBandRows : t.rows;
+    const int bin_div = t.grid ? kBandRows : 1;
+    std::vector<int> row_start(num_bins + 1, 0);
     for (int slot = 0; slot < num_slots; ++slot) {
       const TriangleSetup& s = setups[slot];
       if (s.num_poly == 0) continue;
-      for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) row_triangles[fill[r]++] = slot;
+      for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) ++row_start[r + 1];
     }
-  }
-
-  if (t.grid) {
-    cv::parallel_for_(cv::Range(0, num_bins), [&](const cv::Range& range) {
-      for (int band = range.start; band < range.end; ++band) {
-        const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
-        for (int j = row_start[band]; j < row_start[band + 1]; ++j)
-          ScanGridTriangle(t, setups[row_triangles[j]], triangle_of_slot[row_triangles[j]], band_lo,
-                           band_hi, record);
-      }
-    });
-    return;
-  }
-
-  // RasterizeDepth: a bucket row's rays are consecutive; their nearest hits are kept in a
-  // local array while the row's triangles are scanned, then written to their samples.
-  constexpr bool kDepthOnly = std::is_same_v<Record, NearestInverseDepth>;
-  cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
-    thread_local std::vector<float> row_best;
-    for (int row = range.start; row < range.end; ++row) {
-      const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
-      const int row_begin = t.bucket_start[row * t.cols];
-      const int row_end = t.bucket_start[(row + 1) * t.cols];
-      if constexpr (kDepthOnly) row_best.assign(row_end - row_begin, 0.0f);
-      for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
-        const int slot = row_triangles[j];
+    for (int r = 0; r < num_bins; ++r) row_start[r + 1] += row_start[r];
+    std::vector<int> row_triangles(row_start[num_bins]);
+    {
+      std::vector<int> fill(row_start.begin(), row_start.end() - 1);
+      for (int slot = 0; slot < num_slots; ++slot) {
         const TriangleSetup& s = setups[slot];
-        const int tri = triangle_of_slot[slot];
-        int col0 = s.col0, col1 = s.col1;
-        if (s.row0 != s.row1 && col0 != col1) {
-          // Tighten to the polygon's extent within this bucket row.
-          const double m = 1e-6 + 1e-7 * std::max(std::abs(slab_lo), std::abs(slab_hi));
-          double xlo, xhi;
-          if (!PolygonSlabRange(s, polygons[slot], slab_lo - m, slab_hi + m, &xlo, &xhi)) continue;
-          const double mx = 1e-6 + 1e-7 * std::max(std::abs(xlo), std::abs(xhi));
-          col0 = std::max(col0, t.Col(xlo - mx));
-          col1 = std::min(col1, t.Col(xhi + mx));
+        if (s.num_poly == 0) continue;
+        for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) row_triangles[fill[r]++] = slot;
+      }
+    }
+
+    if (t.grid) {
+      cv::parallel_for_(cv::Range(0, num_bins), [&](const cv::Range& range) {
+        for (int band = range.start; band < range.end; ++band) {
+          const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
+          for (int j = row_start[band]; j < row_start[band + 1]; ++j)
+            ScanGridTriangle(t, setups[row_triangles[j]], triangle_of_slot[row_triangles[j]],
+                             band_lo, band_hi, record);
         }
-        const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
-        const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
-        const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
-        const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
-        for (int col = col0; col <= col1; ++col) {
-          const int bucket = row * t.cols + col;
-          const int begin = t.bucket_start[bucket], end = t.bucket_start[bucket + 1];
-          if (begin == end) continue;
-          // The bucket's rectangle (every ray of the bucket is inside it, up to rounding)
-          // against each edge: entirely outside one edge -> skip the bucket; well inside all
-          // three -> every ray hits the plane inside the triangle, skip the edge tests.
-          const double bx0 = t.x0 + col * t.cell_w, bx1 = bx0 + t.cell_w;
-          bool outside = false, inside = true;
-          for (int i = 0; i < 3 && !outside; ++i) {
-            const double ex = s.edge[i][0], ey = s.edge[i][1], ez = s.edge[i][2];
-            const double w_max = ex * (ex > 0 ? bx1 : bx0) + ey * (ey > 0 ? slab_hi : slab_lo) + ez;
-            const double w_min = ex * (ex > 0 ? bx0 : bx1) + ey * (ey > 0 ? slab_lo : slab_hi) + ez;
-            const double tolerance =
-                1e-6 * (std::abs(ex) * std::max({std::abs(bx0), std::abs(bx1), 1.0}) +
-                        std::abs(ey) * std::max({std::abs(slab_lo), std::abs(slab_hi), 1.0}) +
-                        std::abs(ez));
-            outside = w_max < -tolerance;
-            inside = inside && w_min > tolerance;
+      });
+      return;
+    }
+
+    // RasterizeDepth: a bucket row's rays are consecutive; their nearest hits are kept in a
+    // local array while the row's triangles are scanned, then written to their samples.
+    constexpr bool kDepthOnly = std::is_same_v<Record, NearestInverseDepth>;
+    cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
+      thread_local std::vector<float> row_best;
+      for (int row = range.start; row < range.end; ++row) {
+        const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
+        const int row_begin = t.bucket_start[row * t.cols];
+        const int row_end = t.bucket_start[(row + 1) * t.cols];
+        if constexpr (kDepthOnly) row_best.assign(row_end - row_begin, 0.0f);
+        for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
+          const int slot = row_triangles[j];
+          const TriangleSetup& s = setups[slot];
+          const int tri = triangle_of_slot[slot];
+          int col0 = s.col0, col1 = s.col1;
+          if (s.row0 != s.row1 && col0 != col1) {
+            // Tighten to the polygon's extent within this bucket row.
+            const double m = 1e-6 + 1e-7 * std::max(std::abs(slab_lo), std::abs(slab_hi));
+            double xlo, xhi;
+            if (!PolygonSlabRange(s, polygons[slot], slab_lo - m, slab_hi + m, &xlo, &xhi))
+              continue;
+            const double mx = 1e-6 + 1e-7 * std::max(std::abs(xlo), std::abs(xhi));
+            col0 = std::max(col0, t.Col(xlo - mx));
+            col1 = std::min(col1, t.Col(xhi + mx));
           }
-          if (outside) continue;
-          if constexpr (kDepthOnly) {
-            MaxInverseDepthBucket(t.xs.data() + begin, t.ys.data() + begin, end - begin, inside,
-                                  s, record.inv_near, row_best.data() + (begin - row_begin));
-            continue;
-          }
-          if (inside) {
+          const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
+          const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
+          const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
+          const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
+          for (int col = col0; col <= col1; ++col) {
+            const int bucket = row * t.cols + col;
+            const int begin = t.bucket_start[bucket], end = t.bucket_start[bucket + 1];
+            if (begin == end) continue;
+            // The bucket's rectangle (every ray of the bucket is inside it, up to rounding)
+            // against each edge: entirely outside one edge -> skip the bucket; well inside all
+            // three -> every ray hits the plane inside the triangle, skip the edge tests.
+            const double bx0 = t.x0 + col * t.cell_w, bx1 = bx0 + t.cell_w;
+            bool outside = false, inside = true;
+            for (int i = 0; i < 3 && !outside; ++i) {
+              const double ex = s.edge[i][0], ey = s.edge[i][1], ez = s.edge[i][2];
+              const double w_max =
+                  ex * (ex > 0 ? bx1 : bx0) + ey * (ey > 0 ? slab_hi : slab_lo) + ez;
+              const double w_min =
+                  ex * (ex > 0 ? bx0 : bx1) + ey * (ey > 0 ? slab_lo : slab_hi) + ez;
+              const double tolerance =
+                  1e-6 * (std::abs(ex) * std::max({std::abs(bx0), std::abs(bx1), 1.0}) +
+                          std::abs(ey) * std::max({std::abs(slab_lo), std::abs(slab_hi), 1.0}) +
+                          std::abs(ez));
+              outside = w_max < -tolerance;
+              inside = inside && w_min > tolerance;
+            }
+            if (outside) continue;
+            if constexpr (kDepthOnly) {
+              MaxInverseDepthBucket(t.xs.data() + begin, t.ys.data() + begin, end - begin, inside,
+                                    s, record.inv_near, row_best.data() + (begin - row_begin));
+              continue;
+            }
+            if (inside) {
+              for (int k = begin; k < end; ++k) {
+                const float x = t.xs[k], y = t.ys[k];
+                record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
+              }
+              continue;
+            }
             for (int k = begin; k < end; ++k) {
               const float x = t.xs[k], y = t.ys[k];
+              const float w0 = e00 * x + e01 * y + e02;
+              const float w1 = e10 * x + e11 * y + e12;
+              const float w2 = e20 * x + e21 * y + e22;
+              if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
               record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
             }
-            continue;
-          }
-          for (int k = begin; k < end; ++k) {
-            const float x = t.xs[k], y = t.ys[k];
-            const float w0 = e00 * x + e01 * y + e02;
-            const float w1 = e10 * x + e11 * y + e12;
-            const float w2 = e20 * x + e21 * y + e22;
-            if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
-            record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
           }
         }
+        if constexpr (kDepthOnly) {  // each sample's ray lies in one bucket: plain stores
+          for (int k = row_begin; k < row_end; ++k)
+            record.inv[t.sample[k]] = row_best[k - row_begin];
+        }
       }
-      if constexpr (kDepthOnly) {  // each sample's ray lies in one bucket: plain stores
-        for (int k = row_begin; k < row_end; ++k) record.inv[t.sample[k]] = row_best[k - row_begin];
-      }
-    }
-  });
+    });
+  }
 }
 
 void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
@@ -820,7 +900,10 @@ void Rasterizer::Rasterize(const TriangleMesh& mesh, const Rigid3d& cam_from_loc
   });
 }
 
-void Rasterizer::ReleaseThreadScratch() { traversal_scratch = TraversalScratch(); }
+void Rasterizer::ReleaseThreadScratch() {
+  traversal_scratch = TraversalScratch();
+  depth_shard_spares.clear();
+}
 
 void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                                 cv::Mat* depth) const {
@@ -834,30 +917,24 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   });
   float* inv = depth->ptr<float>();
   const double inv_near = 1.0 / options_.near_m;
+  std::vector<float*> spares;  // grid: inverse depths written besides `inv`
   // The nearest hit so far, where one thread owns the sample.
   const NearestInverseDepth exclusive_record{inv, inv_near};
-  if (rays_->grid) {
-    // Triangles scanned by whichever thread set them up: a sample may be hit from two
-    // threads at once, so the maximum is taken atomically (and is still order-independent).
-    // The large triangles come after, one thread per band of rows: the plain maximum.
-    Traverse<true>(
-        mesh, cam_from_local,
-        [&](int, int sample, float, float, double inv_z, const TriangleSetup&) {
-          if (!(inv_z > 0.0 && inv_z <= inv_near)) return;
-          const float inv_zf = static_cast<float>(inv_z);
-          std::atomic_ref<float> cell(inv[sample]);
-          float current = cell.load(std::memory_order_relaxed);
-          while (inv_zf > current &&
-                 !cell.compare_exchange_weak(current, inv_zf, std::memory_order_relaxed)) {
-          }
-        },
-        &exclusive_record);
-  } else {
+  if (!rays_->grid) {
     Traverse<false>(mesh, cam_from_local, exclusive_record);
+  } else {
+    // Triangles scanned by whichever thread set them up, each task into a buffer of its own;
+    // the large triangles after, one thread per band of rows, into the output.
+    const InverseDepthShards shards(inv, t.by_sample.size(), inv_near, &depth_shard_spares);
+    Traverse<true>(mesh, cam_from_local, shards, &exclusive_record);
+    spares = shards.Spares();
   }
   cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       float* d = depth->ptr<float>(r);
+      const size_t row = static_cast<size_t>(r) * t.width;
+      for (const float* spare : spares)
+        for (int c = 0; c < t.width; ++c) d[c] = std::max(d[c], spare[row + c]);
       for (int c = 0; c < t.width; ++c)
         d[c] = d[c] > 0.0f ? 1.0f / d[c] : std::numeric_limits<float>::infinity();
     }

@@ -619,8 +619,9 @@ TEST(RasterizerTest, RaysTheLensCannotUnprojectNeverHit) {
 // Many overlapping random triangles: two renders are bit-identical, and identical with one
 // thread and with the default thread count.
 // Through a distorted lens (rays in buckets) and a pinhole (rays on a grid, depth scanned
-// directly with an atomic maximum), full and depth-only: bit-identical every run, on any
-// number of threads, with exact depth ties (coplanar duplicates) resolved the same way.
+// directly, each task into an inverse-depth buffer of its own, merged by maximum), full and
+// depth-only: bit-identical every run, on any number of threads, with exact depth ties
+// (coplanar duplicates) resolved the same way.
 void ExpectDeterministicAcrossRunsAndThreads(const Camera& camera) {
   TriangleMesh mesh;
   std::mt19937 rng(11);
