@@ -445,20 +445,34 @@ class InverseDepthShards {
 };
 
 // The record a task of the direct traversal uses: the traversal's record itself, or for
-// InverseDepthShards a buffer held for the task's lifetime.
+// InverseDepthShards a buffer taken when the task first scans a triangle (a task that scans
+// none, as where every triangle is large, takes none) and held until the task ends.
 template <class Record>
-struct TaskRecord {
-  explicit TaskRecord(const Record& r) : record(r) {}
-  const Record& record;
+class TaskRecord {
+ public:
+  explicit TaskRecord(const Record& r) : record_(r) {}
+  const Record& Get() { return record_; }
+
+ private:
+  const Record& record_;
 };
 template <>
-struct TaskRecord<InverseDepthShards> {
-  explicit TaskRecord(const InverseDepthShards& s) : shards(s), record(s.Acquire()) {}
-  ~TaskRecord() { shards.Release(record.inv); }
+class TaskRecord<InverseDepthShards> {
+ public:
+  explicit TaskRecord(const InverseDepthShards& s) : shards_(s) {}
+  ~TaskRecord() {
+    if (record_) shards_.Release(record_->inv);
+  }
   TaskRecord(const TaskRecord&) = delete;
   TaskRecord& operator=(const TaskRecord&) = delete;
-  const InverseDepthShards& shards;
-  const NearestInverseDepth record;
+  const NearestInverseDepth& Get() {
+    if (!record_) record_ = shards_.Acquire();
+    return *record_;
+  }
+
+ private:
+  const InverseDepthShards& shards_;
+  std::optional<NearestInverseDepth> record_;
 };
 
 // The columns [c0, c1] of one sample row, `inv_row` its inverse depths: the inside test and the
@@ -699,7 +713,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           if (samples > kLargeTriangleSamples)
             large[c].emplace_back(tri, s);
           else
-            ScanGridTriangle(t, s, tri, 0, t.height, task->record);
+            ScanGridTriangle(t, s, tri, 0, t.height, task->Get());
         }
       }
     }
