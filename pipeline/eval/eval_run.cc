@@ -9,6 +9,7 @@
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
 #include "pipeline/eval/eval_score.h"
+#include "pipeline/eval/mover_provenance.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/rephotography.h"
 #include "pipeline/synth/synth_writer.h"
@@ -69,6 +70,8 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
   std::unique_ptr<PaintSession> session;
   FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, &loaded, &session));
 
+  // Where movers pass, which painted texels took their colour from one.
+  std::unique_ptr<MoverProvenance> provenance;
   std::vector<HeldOut> held_out;
   std::vector<PaintedFrameCentre> painted_frames;
   double paint_seconds = 0;
@@ -87,10 +90,18 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
       held_out.push_back({frame, pose->cam_from_world, k->second});
       continue;
     }
+    const Camera& camera = *loaded.CameraFor(*pose);
+    if (!plan.movers.empty() && !provenance)
+      provenance =
+          std::make_unique<MoverProvenance>(job.scene, plan.movers, loaded.scene, camera, *session);
+    if (provenance) provenance->BeforeFrame(*session);
     const auto start = Clock::now();
-    session->PaintFrame(frame, *loaded.CameraFor(*pose), pose->cam_from_world, &report);
+    session->PaintFrame(frame, camera, pose->cam_from_world, &report);
     paint_seconds += SecondsSince(start);
     if (!report.painted) continue;
+    if (provenance)
+      provenance->AfterFrame(*session, k->second, plan.true_poses[k->second].cam_from_world,
+                             pose->cam_from_world);
     ++result->painted_frames;
     painted_frames.push_back({k->second, plan.true_poses[k->second].cam_from_world.Centre()});
   }
@@ -102,11 +113,19 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
   result->holdout_frames = static_cast<int>(held_out.size());
 
   const Scene painted = session->PaintedScene();
+  Scene mover_texels;
+  if (provenance) {
+    mover_texels = session->PaintedScene(provenance->MaskImages(*session));
+    const MoverProvenance::Figures f = provenance->Count(*session);
+    result->mover_texels = f.mover_fraction();
+    result->mover_dominated_texels = f.painted > 0 ? double(f.mover_dominated) / f.painted : 0.0;
+    result->open_coverage = f.open_coverage();
+  }
   const Renderer painted_renderer(plan.camera, RenderOptions());
   RenderOptions clean_options;
   clean_options.raster.supersample = job.options.supersample;
   const Renderer clean_renderer(plan.camera, clean_options);
-  long long painted_pixels = 0, leak_pixels = 0;
+  long long painted_pixels = 0, leak_pixels = 0, region_error_pixels = 0;
   int scored = 0, truth_scored = 0;
   for (const HeldOut& h : held_out) {
     if (options.stop && options.stop()) return Status::Error(dir + ": interrupted");
@@ -127,6 +146,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     in.movers = &plan.movers;
     in.painted_frames = &painted_frames;
     in.leak_threshold = options.leak_threshold;
+    in.mover_texels = provenance ? &mover_texels : nullptr;
     const TruthViewScore t = ScoreTruthView(in);
     if (t.painted_pixels > 0) {
       result->truth_psnr_db += t.psnr_db, result->truth_one_minus_ncc += t.one_minus_ncc;
@@ -134,11 +154,14 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     }
     painted_pixels += t.painted_pixels;
     leak_pixels += t.leak_pixels;
+    region_error_pixels += t.region_error_pixels;
   }
   if (scored > 0) result->psnr_db /= scored, result->one_minus_ncc /= scored;
   if (truth_scored > 0)
     result->truth_psnr_db /= truth_scored, result->truth_one_minus_ncc /= truth_scored;
   result->mover_leak = painted_pixels > 0 ? double(leak_pixels) / painted_pixels : 0.0;
+  result->mover_region_error =
+      painted_pixels > 0 ? double(region_error_pixels) / painted_pixels : 0.0;
   return Status::Ok();
 }
 

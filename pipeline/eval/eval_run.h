@@ -38,7 +38,14 @@ struct CaptureEval {
   double truth_psnr_db = 0;  // at the true poses against the clean scene
   double truth_one_minus_ncc = 0;
   bool has_movers = false;
-  double mover_leak = 0;    // painted pixels showing a mover / painted pixels (truth views)
+  double mover_leak = 0;  // painted pixels showing a mover / painted pixels (truth views)
+  // Painted pixels off by more than the leak threshold where a mover passed / painted pixels
+  // (truth views): the movers and any other error there.
+  double mover_region_error = 0;
+  // Texel space (MoverProvenance): painted on-surface texels whose colour came from a mover,
+  // those of them seen with a mover at least as often as without, and the texels seen
+  // mover-free at least once that are painted (fractions).
+  double mover_texels = 0, mover_dominated_texels = 0, open_coverage = 0;
   double coverage = 0;      // on-surface texels painted
   AutoDecisions decisions;  // what the `auto` modes decided, with their evidence
 };

@@ -75,8 +75,15 @@ TruthViewScore ScoreTruthView(const TruthViewInputs& in) {
       if (!normalized.allFinite()) continue;
       const double z = painted.depth.at<float>(y, x);
       const Eigen::Vector3d point = world_from_cam * (z * normalized.homogeneous());
-      score.leak_pixels += HiddenByAMover(point, in);
+      score.region_error_pixels += HiddenByAMover(point, in);
     }
+  }
+  if (in.mover_texels) {
+    RenderOutput movers;
+    in.painted_renderer->Render(*in.mover_texels, in.true_cam_from_world, &movers);
+    cv::Mat shows;
+    cv::extractChannel(movers.rgba, shows, 0);
+    score.leak_pixels = cv::countNonZero((shows >= 128) & mask);
   }
   return score;
 }

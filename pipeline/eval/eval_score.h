@@ -7,10 +7,12 @@
 //   truth          the painted model rendered at the TRUE pose against the static scene
 //                  rendered there with the frame's exposure gain (no movers): how close the
 //                  painted texture is to the true one where it is seen;
-//   mover leak     of the painted pixels in that truth view, those that are off the clean
-//                  render by more than `leak_threshold` levels (any channel) at a surface
-//                  point that a mover hid from the camera in at least one painted frame:
-//                  painted pixels showing a mover.
+//   mover leak     of the painted pixels in that truth view, those whose colour came from a
+//                  mover (the texels MoverProvenance followed, rendered as a texture);
+//   mover region error  of the painted pixels, those off the clean render by more than
+//                  `leak_threshold` levels (any channel) at a surface point that a mover hid
+//                  from the camera in at least one painted frame (movers, and any other error
+//                  there: misalignment, exposure).
 #pragma once
 
 #include <vector>
@@ -43,13 +45,16 @@ struct TruthViewInputs {
   const std::vector<MoverOptions>* movers = nullptr;
   const std::vector<PaintedFrameCentre>* painted_frames = nullptr;
   double leak_threshold = 40.0;  // levels (0..255), largest channel difference
+  // The painted scene with MoverProvenance::MaskImages as its texture, or null.
+  const Scene* mover_texels = nullptr;
 };
 
 struct TruthViewScore {
   double psnr_db = 0;        // painted vs clean, where both show the surface and it is painted
   double one_minus_ncc = 0;  // the same pixels, gain- and offset-invariant
   long long painted_pixels = 0;
-  long long leak_pixels = 0;  // painted pixels showing a mover
+  long long leak_pixels = 0;          // painted pixels showing a mover (with mover_texels)
+  long long region_error_pixels = 0;  // painted pixels off where a mover passed
 };
 
 TruthViewScore ScoreTruthView(const TruthViewInputs& inputs);

@@ -110,6 +110,11 @@ std::string EvalToJson(const std::vector<std::string>& settings,
         {"coverage", c.coverage},
         {"truth", {{"psnr_db", c.truth_psnr_db}, {"one_minus_ncc", c.truth_one_minus_ncc}}}};
     row["mover_leak"] = c.has_movers ? json(c.mover_leak) : json(nullptr);
+    if (c.has_movers)
+      row["movers"] = {{"region_error", c.mover_region_error},
+                       {"texels", c.mover_texels},
+                       {"dominated_texels", c.mover_dominated_texels},
+                       {"open_coverage", c.open_coverage}};
     row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
     root["captures"].push_back(row);
   }

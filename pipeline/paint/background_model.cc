@@ -113,6 +113,7 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
   params.min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
   params.window = options_.window_frames;
   params.warmup = options_.warmup_frames;
+  params.majority = static_cast<float>(options_.majority);
   const float inv_gain = 1.0f / gain;
   // A full tile's texels are runs of the buffer's rows (BaseBuffer::Chunk::full): read and
   // written a row at a time; otherwise one at a time through texel_index.

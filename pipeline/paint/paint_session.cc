@@ -278,10 +278,14 @@ static Scene UnpaintedCopy(const Scene& scene) {
 }
 
 Scene PaintSession::PaintedScene() const {
-  Scene out = UnpaintedCopy(*scene_);
-  const TriangleMesh& mesh = scene_->mesh;
   std::vector<cv::Mat> images(painted_.size());
   for (size_t b = 0; b < painted_.size(); ++b) images[b] = AtMeanExposure(painted_[b].bgra);
+  return PaintedScene(images);
+}
+
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& images) const {
+  Scene out = UnpaintedCopy(*scene_);
+  const TriangleMesh& mesh = scene_->mesh;
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
     texture.name = "page_" + std::to_string(page);

@@ -111,6 +111,9 @@ class PaintSession {
   // (texture_atlas.h), one base-colour texture and material per page (alpha 0 where never
   // painted), and new UVs into them: what `fresco run` writes.
   Scene PaintedScene() const;
+  // The same with other images in the buffers' places (one CV_8UC4 BGRA image per buffer, of
+  // its size): e.g. a mask of the texels that show something, rendered in any view.
+  Scene PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const;
   // The same with one texture and material per buffer (material b + 1 = buffer b, material 0
   // for triangles in no buffer): the per-buffer view the app and debug images use.
   Scene PaintedSceneByBuffer() const;

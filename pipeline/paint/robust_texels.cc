@@ -163,9 +163,13 @@ template <class V>
   StoreShorts(l.var4, sampled ? (flip ? min_var4 : v4) : o_var4);
   StoreShorts(l.samples, sampled ? after : seen);
   // Foreground: the sample is not (after a flip: no longer) the background's.
-  const Ints foreground = sampled & (match0 == flip);
+  // Undecided: the background explains too small a share of the recent samples (the texel
+  // shows two things about equally often, e.g. a slow mover over it for as long as not).
+  // The model neither masks nor trusts such a sample: it paints provisionally.
+  const Ints undecided = (flip ? u1 : u0) < params.majority;
+  const Ints foreground = sampled & (match0 == flip) & ~undecided;
   // A texel whose background just changed holds a stale paint: provisional too.
-  const Ints warming = sampled & ((after < params.warmup) | (flip & (seen > 0)));
+  const Ints warming = sampled & ((after < params.warmup) | (flip & (seen > 0)) | undecided);
   Store(l.foreground, __builtin_convertvector(foreground & 1, Bytes));
   Store(l.warming, __builtin_convertvector(warming & 1, Bytes));
   Store(l.distance2, d0);

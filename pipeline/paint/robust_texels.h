@@ -35,12 +35,15 @@ struct RobustUpdateParams {
   float min_var = 36.0f;  // min_sigma^2
   int window = 40;        // window_frames
   int warmup = 8;         // warmup_frames
+  float majority = 0.6f;  // majority
 };
 
 // Classifies and learns the samples of texels [begin, begin + n): `x` holds each channel's
 // samples already divided by the frame's gain, `valid` 1 where the texel was sampled (the
 // others keep their state). Out, per texel: `foreground` 1 when the sample is not the
-// background mode, `warming` 1 while the model is warming up or just changed its background,
+// background mode (and the background is decided: it explains at least `majority` of the
+// recent samples), `warming` 1 while the model is warming up, just changed its background
+// or is undecided,
 // `distance2` the squared RMS channel distance to the background before the update (1e30
 // for a texel never seen).
 void UpdateRobustTexels(const RobustUpdateParams& params, int begin, int n, const float* x0,

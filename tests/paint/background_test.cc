@@ -1,8 +1,9 @@
 // Selective painting (paper §3.4) against ground truth.
 // Synthetic: a hand-held capture inside the room with moving spheres and boxes. For every
 // frame the test knows which pixels show a mover (the movers' triangle ids), warps that
-// mask into the base buffers like the frame, and follows which texels each frame writes:
-// at the end it knows, for every painted texel, whether its colour came from a mover.
+// mask into the base buffers like the frame, and follows which texels each frame writes
+// (MoverProvenance, as `fresco eval` does): at the end it knows, for every painted texel,
+// whether its colour came from a mover.
 // Real: two static-camera clips (Intel IoT devkit sample videos, CC BY 4.0) painted onto a
 // plane filling the view, so the painted buffer is the learned background image; it is
 // scored against the clips' empty frames with the background-estimation metrics AGE, pEPs
@@ -15,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/video_source.h"
+#include "pipeline/eval/mover_provenance.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/render/rasterizer.h"
 #include "pipeline/render/renderer.h"
@@ -32,102 +34,29 @@ namespace {
 
 Scene Room() { return testing::RoomScene(); }
 
-struct MoverFigures {
-  long long painted = 0;        // on-surface texels painted at the end
-  long long painted_mover = 0;  // ... whose colour came from a mover
-  // ... of which seen with a mover on them at least as often as without (no per-texel
-  // model can tell those: the limit)
-  long long mover_dominated = 0;
-  long long open = 0;          // on-surface texels seen at least once with no mover on them
-  long long open_painted = 0;  // ... painted at the end
-  double mover_fraction() const { return painted > 0 ? double(painted_mover) / painted : 0.0; }
-  double open_coverage() const { return open > 0 ? double(open_painted) / open : 0.0; }
+struct MoverFigures : MoverProvenance::Figures {
   double masked_fraction = 0;  // mean of the background stage's masked_fraction
 };
 
+// Paints the capture (true poses) and follows which painted texels took a mover's colour.
 MoverFigures PaintWithMovers(const Scene& scene, const SynthCapture& capture,
                              const PipelineOptions& options) {
   std::unique_ptr<PaintSession> session = testing::SessionForCapture(scene, capture, options);
-  const std::vector<BaseBuffer>& buffers = session->buffers();
-  const size_t nb = buffers.size();
-  // Per buffer: does the stored sample show a mover; was the texel ever seen mover-free;
-  // how often it was seen with and without a mover on it.
-  std::vector<cv::Mat> shows_mover(nb), open(nb), n_mover(nb), n_open(nb);
-  for (size_t b = 0; b < nb; ++b) {
-    shows_mover[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_8U);
-    open[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_8U);
-    n_mover[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_16U);
-    n_open[b] = cv::Mat::zeros(buffers[b].height, buffers[b].width, CV_16U);
-  }
-  MoverScene movers(scene, capture.movers);
-  RasterOptions raster_options;
-  raster_options.near_m = 1e-3;
-  const Rasterizer raster(capture.camera, raster_options);
-  WarpOptions warp_options;
-  warp_options.sampling = options.sampling;
-  warp_options.occlusion = options.occlusion;
+  MoverProvenance provenance(scene, capture.movers, scene, capture.camera, *session);
   MoverFigures figures;
   FrameReport report;
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
     const Rigid3d& cam_from_world = capture.true_poses[i].cam_from_world;
-    // Which pixels show a mover (one pixel of margin: the frames are anti-aliased).
-    movers.SetFrame(static_cast<int>(i));
-    RasterOutput with_movers, static_scene;
-    raster.Rasterize(movers.scene().mesh, CamFromLocal(movers.scene(), cam_from_world),
-                     &with_movers);
-    raster.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world), &static_scene);
-    cv::Mat mover_px = with_movers.triangle_id >= movers.FirstMoverTriangle();
-    cv::dilate(mover_px, mover_px, cv::Mat::ones(3, 3, CV_8U));
-    cv::Mat mover_bgr;
-    cv::cvtColor(mover_px, mover_bgr, cv::COLOR_GRAY2BGR);
-    FrameView view;
-    view.camera = &capture.camera;
-    view.cam_from_local = CamFromLocal(scene, cam_from_world);
-    view.centre_local = view.cam_from_local.Centre();
-    view.frame_bgr = &mover_bgr;
-    view.depth = &static_scene.depth;
-    view.bounds = ComputeNormalizedBounds(capture.camera);
-    std::vector<cv::Mat> before(nb);
-    for (size_t b = 0; b < nb; ++b) before[b] = session->painted()[b].bgra.clone();
+    provenance.BeforeFrame(*session);
     Frame frame;
     frame.index = static_cast<int>(i);
     frame.bgr = capture.frames_bgr[i];
     session->PaintFrame(frame, capture.camera, cam_from_world, &report);
     if (const StageReport* stage = report.Stage("background"))
       figures.masked_fraction += stage->metrics.at("masked_fraction") / capture.frames_bgr.size();
-    for (size_t b = 0; b < nb; ++b) {
-      WarpedBuffer warped;
-      WarpFrameToBuffer(buffers[b], view, warp_options, &warped);
-      if (warped.visible == 0) continue;
-      std::vector<cv::Mat> mover_ch;
-      cv::split(warped.bgr, mover_ch);
-      const cv::Mat mover_texel = mover_ch[0] > 0;
-      cv::Mat diff;
-      cv::absdiff(before[b], session->painted()[b].bgra, diff);
-      cv::Mat written;
-      cv::transform(diff, written, cv::Matx14f(1, 1, 1, 1));
-      written = written > 0;
-      mover_texel.copyTo(shows_mover[b], written);
-      open[b].setTo(255, warped.valid & ~mover_texel);
-      cv::add(n_mover[b], 1, n_mover[b], warped.valid & mover_texel);
-      cv::add(n_open[b], 1, n_open[b], warped.valid & ~mover_texel);
-    }
+    provenance.AfterFrame(*session, static_cast<int>(i), cam_from_world, cam_from_world);
   }
-  for (size_t b = 0; b < nb; ++b) {
-    const BaseBuffer& buffer = buffers[b];
-    const cv::Vec4b* bgra = session->painted()[b].bgra.ptr<cv::Vec4b>();
-    for (int k = 0; k < buffer.NumTexels(); ++k) {
-      if (!buffer.on_surface[k]) continue;
-      const int idx = buffer.texel_index[k];
-      const bool painted = bgra[idx][3] == 255;
-      figures.painted += painted;
-      figures.painted_mover += painted && shows_mover[b].data[idx];
-      figures.mover_dominated += painted && shows_mover[b].data[idx] &&
-                                 n_mover[b].ptr<uint16_t>()[idx] >= n_open[b].ptr<uint16_t>()[idx];
-      figures.open += open[b].data[idx] != 0;
-      figures.open_painted += painted && open[b].data[idx];
-    }
-  }
+  static_cast<MoverProvenance::Figures&>(figures) = provenance.Count(*session);
   return figures;
 }
 

@@ -1,0 +1,108 @@
+#include "pipeline/eval/mover_provenance.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/frame_warp.h"
+#include "pipeline/render/renderer.h"
+
+namespace fresco {
+
+MoverProvenance::MoverProvenance(const Scene& world_scene, const std::vector<MoverOptions>& movers,
+                                 const Scene& painted_scene, const Camera& camera,
+                                 const PaintSession& session)
+    : painted_scene_(painted_scene),
+      camera_(camera),
+      movers_(world_scene, movers),
+      raster_(camera, RasterOptions()),
+      bounds_(ComputeNormalizedBounds(camera)) {
+  const std::vector<BaseBuffer>& buffers = session.buffers();
+  for (const BaseBuffer& buffer : buffers) {
+    shows_mover_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
+    n_mover_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
+    n_open_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
+  }
+  before_.resize(buffers.size());
+}
+
+void MoverProvenance::BeforeFrame(const PaintSession& session) {
+  for (size_t b = 0; b < before_.size(); ++b) session.painted()[b].bgra.copyTo(before_[b]);
+}
+
+void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
+                                 const Rigid3d& true_cam_from_world,
+                                 const Rigid3d& given_cam_from_world) {
+  // The pixels showing a mover, with a pixel of margin (the frames are anti-aliased).
+  movers_.SetFrame(frame);
+  RasterOutput with_movers;
+  raster_.Rasterize(movers_.scene().mesh, CamFromLocal(movers_.scene(), true_cam_from_world),
+                    &with_movers);
+  cv::Mat mover_px = with_movers.triangle_id >= movers_.FirstMoverTriangle();
+  cv::dilate(mover_px, mover_px, cv::Mat::ones(3, 3, CV_8U));
+  cv::Mat mover_bgr;
+  cv::cvtColor(mover_px, mover_bgr, cv::COLOR_GRAY2BGR);
+  // Warped as the painter warped the frame: its given pose, its depth test.
+  FrameView view;
+  view.camera = &camera_;
+  view.cam_from_local = CamFromLocal(painted_scene_, given_cam_from_world);
+  view.centre_local = view.cam_from_local.Centre();
+  view.frame_bgr = &mover_bgr;
+  cv::Mat depth;
+  raster_.RasterizeDepth(painted_scene_.mesh, view.cam_from_local, &depth);
+  view.depth = &depth;
+  view.bounds = bounds_;
+  WarpOptions warp_options;
+  warp_options.sampling = session.options().sampling;
+  warp_options.occlusion = session.options().occlusion;
+  const std::vector<BaseBuffer>& buffers = session.buffers();
+  for (size_t b = 0; b < buffers.size(); ++b) {
+    WarpedBuffer warped;
+    WarpFrameToBuffer(buffers[b], view, warp_options, &warped);
+    if (warped.visible == 0) continue;
+    cv::Mat mover_texel;
+    cv::extractChannel(warped.bgr, mover_texel, 0);
+    mover_texel = mover_texel > 0;
+    cv::Mat diff, written;
+    cv::absdiff(before_[b], session.painted()[b].bgra, diff);
+    cv::transform(diff, written, cv::Matx14f(1, 1, 1, 1));
+    written = written > 0;
+    mover_texel.copyTo(shows_mover_[b], written);
+    cv::add(n_mover_[b], 1, n_mover_[b], warped.valid & mover_texel);
+    cv::add(n_open_[b], 1, n_open_[b], warped.valid & ~mover_texel);
+  }
+}
+
+MoverProvenance::Figures MoverProvenance::Count(const PaintSession& session) const {
+  Figures f;
+  const std::vector<BaseBuffer>& buffers = session.buffers();
+  for (size_t b = 0; b < buffers.size(); ++b) {
+    const BaseBuffer& buffer = buffers[b];
+    const cv::Vec4b* bgra = session.painted()[b].bgra.ptr<cv::Vec4b>();
+    const uint16_t* n_mover = n_mover_[b].ptr<uint16_t>();
+    const uint16_t* n_open = n_open_[b].ptr<uint16_t>();
+    for (int k = 0; k < buffer.NumTexels(); ++k) {
+      if (!buffer.on_surface[k]) continue;
+      const int idx = buffer.texel_index[k];
+      const bool painted = bgra[idx][3] == 255;
+      const bool mover = painted && shows_mover_[b].data[idx];
+      f.painted += painted;
+      f.painted_mover += mover;
+      f.mover_dominated += mover && n_mover[idx] >= n_open[idx];
+      f.open += n_open[idx] > 0;
+      f.open_painted += painted && n_open[idx] > 0;
+    }
+  }
+  return f;
+}
+
+std::vector<cv::Mat> MoverProvenance::MaskImages(const PaintSession& session) const {
+  std::vector<cv::Mat> images(shows_mover_.size());
+  for (size_t b = 0; b < images.size(); ++b) {
+    cv::Mat alpha;
+    cv::extractChannel(session.painted()[b].bgra, alpha, 3);
+    const cv::Mat& m = shows_mover_[b];
+    cv::merge(std::vector<cv::Mat>{m, m, m, alpha}, images[b]);
+  }
+  return images;
+}
+
+}  // namespace fresco
