@@ -166,6 +166,9 @@ void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
       options_.background.mode = BackgroundMode::kOff;  // painting continues as `off`
       background_.clear();
       background_frame_.clear();
+      // What the model left provisional is kept by its quality from now on, as in `off`
+      // (provisional, any later sample would replace it, however blurred).
+      for (PaintedBuffer& painted : painted_) cv::absdiff(painted.quality, 0, painted.quality);
     }
   }
   report->decisions = auto_decisions();

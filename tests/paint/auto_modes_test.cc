@@ -106,6 +106,14 @@ AutoDecision BackgroundDecision(bool movers) {
                                                     : BackgroundMode::kOff);
   std::printf("%s: background auto %s\n", movers ? "movers" : "no movers",
               report.decisions.background.Describe().c_str());
+  // Dropped: nothing it painted stays provisional (which any later sample would replace,
+  // however blurred); every painted texel is kept by its quality, as in `off`.
+  if (report.decisions.background.state == State::kOff) {
+    int provisional = 0;
+    for (const PaintedBuffer& painted : session->painted())
+      provisional += cv::countNonZero(painted.quality < 0);
+    EXPECT_EQ(provisional, 0);
+  }
   return report.decisions.background;
 }
 
