@@ -49,7 +49,8 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
 
 // While a texel's background model warms up its samples are provisional (MarkProvisional):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
-// rule), a trusted one whatever its quality.
+// rule), a trusted one that shows something else whatever its quality; a trusted one that
+// agrees with it (no channel 24 levels off) by the quality rule, and then it is trusted.
 TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   PipelineOptions options;  // quality policy, slack 0.2
   TwoTexels t;
@@ -67,7 +68,7 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   paint(100, 1.0f, true);  // sharp, provisional
   EXPECT_EQ(t.Stored(), 100);
   EXPECT_LT(t.painted.quality.at<float>(0, 1), 0.0f);  // marked provisional
-  paint(150, 0.5f, true);  // blurrier, provisional: the sharper stays
+  paint(150, 0.5f, true);                              // blurrier, provisional: the sharper stays
   EXPECT_EQ(t.Stored(), 100);
   paint(160, 0.9f, true);  // nearly as sharp (within the slack): replaces
   EXPECT_EQ(t.Stored(), 160);
@@ -76,6 +77,21 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   EXPECT_FLOAT_EQ(t.painted.quality.at<float>(0, 1), 0.3f);
   paint(220, 0.1f, false);  // trusted against trusted: the quality rule
   EXPECT_EQ(t.Stored(), 200);
+
+  TwoTexels agreeing;
+  const auto paint_agreeing = [&](int grey, float quality, bool provisional) {
+    agreeing.warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
+    agreeing.warped.quality.setTo(quality);
+    PaintBuffer(agreeing.buffer, agreeing.warped, cv::Mat(), options, &agreeing.painted,
+                provisional ? warming : cv::Mat());
+    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &agreeing.painted);
+  };
+  paint_agreeing(100, 1.0f, true);   // sharp, provisional
+  paint_agreeing(120, 0.3f, false);  // trusted, blurrier, agrees (20 levels): the sharper stays
+  EXPECT_EQ(agreeing.Stored(), 100);
+  EXPECT_FLOAT_EQ(agreeing.painted.quality.at<float>(0, 1), 1.0f);  // now trusted
+  paint_agreeing(160, 0.3f, true);  // provisional, blurrier: against a trusted one, kept out
+  EXPECT_EQ(agreeing.Stored(), 100);
 }
 
 }  // namespace
