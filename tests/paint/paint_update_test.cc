@@ -58,12 +58,15 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   BackgroundFrame frame;
   frame.warming = warming;
   frame.warming_up = 2;
-  const auto paint = [&](int grey, float quality, bool provisional) {
-    t.warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
-    t.warped.quality.setTo(quality);
-    PaintBuffer(t.buffer, t.warped, cv::Mat(), options, &t.painted,
+  const auto paint_into = [&](TwoTexels* into, int grey, float quality, bool provisional) {
+    into->warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
+    into->warped.quality.setTo(quality);
+    PaintBuffer(into->buffer, into->warped, cv::Mat(), options, &into->painted,
                 provisional ? warming : cv::Mat());
-    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &t.painted);
+    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &into->painted);
+  };
+  const auto paint = [&](int grey, float quality, bool provisional) {
+    paint_into(&t, grey, quality, provisional);
   };
   paint(100, 1.0f, true);  // sharp, provisional
   EXPECT_EQ(t.Stored(), 100);
@@ -80,11 +83,7 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
 
   TwoTexels agreeing;
   const auto paint_agreeing = [&](int grey, float quality, bool provisional) {
-    agreeing.warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
-    agreeing.warped.quality.setTo(quality);
-    PaintBuffer(agreeing.buffer, agreeing.warped, cv::Mat(), options, &agreeing.painted,
-                provisional ? warming : cv::Mat());
-    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &agreeing.painted);
+    paint_into(&agreeing, grey, quality, provisional);
   };
   paint_agreeing(100, 1.0f, true);   // sharp, provisional
   paint_agreeing(120, 0.3f, false);  // trusted, blurrier, agrees (20 levels): the sharper stays
