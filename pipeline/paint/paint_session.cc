@@ -286,13 +286,13 @@ Scene PaintSession::PaintedScene() const {
   return PaintedScene(images);
 }
 
-Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& images) const {
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
   Scene out = UnpaintedCopy(*scene_);
   const TriangleMesh& mesh = scene_->mesh;
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
     texture.name = "page_" + std::to_string(page);
-    cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), images), texture.rgba,
+    cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), buffer_bgra), texture.rgba,
                  cv::COLOR_BGRA2RGBA);
     texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
     out.textures.push_back(texture);
