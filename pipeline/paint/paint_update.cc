@@ -20,13 +20,6 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
 
 namespace {
 
-// A provisional sample and a trusted one agree (show the same thing) when no channel differs
-// by more than this, grey levels. Then the first trusted sample after a model's warm-up no
-// longer replaces a sharper provisional one: on a clean orbit of the blocks the warm-up cost
-// 0.37 dB against no model (24.65 against 25.02 dB with warmup_frames 1), 0.24 dB of which
-// this wins back (docs/results.md, "Evaluation suite").
-constexpr int kAgreeLevels = 24;
-
 // Texels [begin, end) of one chunk.
 PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const cv::Mat& warming,
@@ -49,20 +42,13 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
                   dst + 4 * static_cast<size_t>(idx), stored_quality + idx, &stats);
       continue;
     }
-    // A provisional stored sample: against another provisional one, by its quality; against a
-    // trusted sample it counts as nothing, unless the two agree (then the provisional one
-    // showed the background too, and the sharper of the two is kept, trusted).
-    const uint8_t* sample = src + 3 * static_cast<size_t>(idx);
-    uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
-    const bool trusted_sample = !(provisional_sample && provisional_sample[idx]);
-    const bool agrees = trusted_sample && texel[3] != 0 &&
-                        std::abs(sample[0] - texel[0]) <= kAgreeLevels &&
-                        std::abs(sample[1] - texel[1]) <= kAgreeLevels &&
-                        std::abs(sample[2] - texel[2]) <= kAgreeLevels;
-    float compared_with = trusted_sample && !agrees ? 0.0f : -stored;
+    // A provisional stored sample: against a trusted sample it counts as nothing; against
+    // another provisional one, by its quality.
+    float compared_with = provisional_sample && provisional_sample[idx] ? -stored : 0.0f;
     const int written_before = stats.written;
-    UpdateTexel(rule, sample, quality[idx], buffer.on_surface[k], texel, &compared_with, &stats);
-    if (stats.written > written_before || agrees) stored_quality[idx] = compared_with;
+    UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
+                dst + 4 * static_cast<size_t>(idx), &compared_with, &stats);
+    if (stats.written > written_before) stored_quality[idx] = compared_with;
   }
   return stats;
 }

@@ -17,10 +17,9 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted);
 // `mask` (CV_8U, optional): texels to leave alone (e.g. foreground) where non-zero.
 // `warming` (CV_8U, optional): texels whose sample this frame is provisional (the background
 // model is still warming up there). A stored sample that was provisional (its quality kept
-// negated: MarkProvisional) gives way to a trusted sample that shows something else (a channel
-// more than 24 levels off), to one that agrees with it and to a provisional one only by the
-// update rule's quality test (an agreeing trusted sample makes it trusted), so that while a
-// model warms up the sharper samples are the ones shown and kept.
+// negated: MarkProvisional) gives way to any trusted sample, and to a provisional one only
+// by the update rule's quality test, so that while a model warms up the sharper samples are
+// the ones shown.
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const PipelineOptions& options,
                              PaintedBuffer* painted, const cv::Mat& warming = cv::Mat());

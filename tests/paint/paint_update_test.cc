@@ -49,8 +49,8 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
 
 // While a texel's background model warms up its samples are provisional (MarkProvisional):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
-// rule), a trusted one that shows something else whatever its quality; a trusted one that
-// agrees with it (no channel 24 levels off) by the quality rule, and then it is trusted.
+// rule), a trusted one whatever its quality, even one showing nearly the same (per-texel
+// agreement tests left a patchwork of two photos on the real castle photos).
 TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   PipelineOptions options;  // quality policy, slack 0.2
   TwoTexels t;
@@ -81,16 +81,11 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   paint(220, 0.1f, false);  // trusted against trusted: the quality rule
   EXPECT_EQ(t.Stored(), 200);
 
-  TwoTexels agreeing;
-  const auto paint_agreeing = [&](int grey, float quality, bool provisional) {
-    paint_into(&agreeing, grey, quality, provisional);
-  };
-  paint_agreeing(100, 1.0f, true);   // sharp, provisional
-  paint_agreeing(120, 0.3f, false);  // trusted, blurrier, agrees (20 levels): the sharper stays
-  EXPECT_EQ(agreeing.Stored(), 100);
-  EXPECT_FLOAT_EQ(agreeing.painted.quality.at<float>(0, 1), 1.0f);  // now trusted
-  paint_agreeing(160, 0.3f, true);  // provisional, blurrier: against a trusted one, kept out
-  EXPECT_EQ(agreeing.Stored(), 100);
+  TwoTexels near;  // a trusted sample 20 levels off, blurrier: still replaces
+  paint_into(&near, 100, 1.0f, true);
+  paint_into(&near, 120, 0.3f, false);
+  EXPECT_EQ(near.Stored(), 120);
+  EXPECT_FLOAT_EQ(near.painted.quality.at<float>(0, 1), 0.3f);
 }
 
 }  // namespace
