@@ -176,8 +176,8 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   const float tol_rel = k.tol_rel, tol_abs = k.tol_abs, slope_px = k.slope_px;
   constexpr float kEdgeSlackPx = 1.0f / 256;
   const float focal_texel = k.focal_texel;
-  const auto project = [&](int i, float X, float Y, float Z, float NX, float NY,
-                           float NZ) __attribute__((always_inline)) {
+  const auto project = [&](int i, float X, float Y, float Z, float NX, float NY, float NZ)
+      __attribute__((always_inline)) {
     const float px = r00 * X + r01 * Y + r02 * Z + tx;
     const float py = r10 * X + r11 * Y + r12 * Z + ty;
     const float pz = r20 * X + r21 * Y + r22 * Z + tz;
@@ -290,7 +290,7 @@ __attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
 // order; paint_in_warp_test checks it).
 struct PaintBatch {
   static constexpr int kMax = ChunkProjection::kMax;
-  float d00[kMax], d10[kMax], d01[kMax], d11[kMax];     // depths around the sample
+  float d00[kMax], d10[kMax], d01[kMax], d11[kMax];  // depths around the sample
   float range[2 * kMax];  // or their least and greatest (FrameView::depth_range)
   uint32_t p00[kMax], p10[kMax], p01[kMax], p11[kMax];  // the four pixels' BGR (low 24 bits)
   uint32_t stored[kMax];                                // the stored BGRA
@@ -301,8 +301,7 @@ struct PaintBatch {
 };
 
 struct PaintBatchSums {
-  int visible = 0, compared = 0, rejected = 0, written = 0,
-      newly_painted = 0;
+  int visible = 0, compared = 0, rejected = 0, written = 0, newly_painted = 0;
   int abs_grey_difference_sum = 0;  // at most 256 texels x 255
 };
 
@@ -312,67 +311,69 @@ inline uint32_t Load32(const uint8_t* p) {
   return v;
 }
 
-// kDepth: 0 no occlusion test, 1 the four depths, 2 their range.
+// Texel j of a batch: whether it is in view and passes the occlusion test. kDepth: 0 no
+// occlusion test, 1 the four depths, 2 their range.
+template <int kDepth>
+__attribute__((always_inline)) inline int BatchVisible(int j,
+                                                       const ChunkProjection* __restrict proj,
+                                                       const PaintBatch* __restrict b) {
+  int ok = proj->code[j] == 2;  // in view (the others read pixel (0, 0) and are left alone)
+  if constexpr (kDepth == 1) {
+    const float zz = proj->z[j], t = proj->tol[j];
+    ok &= (std::abs(b->d00[j] - zz) <= t) & (std::abs(b->d10[j] - zz) <= t) &
+          (std::abs(b->d01[j] - zz) <= t) & (std::abs(b->d11[j] - zz) <= t);
+  } else if constexpr (kDepth == 2) {
+    // |d - z| <= t for all four <=> max - z <= t and z - min <= t (rounding is monotonic;
+    // an infinite depth fails both ways).
+    const float zz = proj->z[j], t = proj->tol[j];
+    ok &= (b->range[2 * j + 1] - zz <= t) & (zz - b->range[2 * j] <= t);
+  }
+  return ok;
+}
+
+// Texel j's bilinear sample, BGR in the low 24 bits (alpha 255), and its channels.
+__attribute__((always_inline)) inline uint32_t BatchBilinear(int j,
+                                                             const ChunkProjection* __restrict proj,
+                                                             const PaintBatch* __restrict b,
+                                                             int channel[3]) {
+  const float fx = proj->ax[j], fy = proj->ay[j];
+  const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy, w11 = fx * fy;
+  uint32_t sample = 0xFF000000u;
+  for (int c = 0; c < 3; ++c) {
+    const int shift = 8 * c;
+    const float s = w00 * static_cast<float>(static_cast<int>((b->p00[j] >> shift) & 255u)) +
+                    w10 * static_cast<float>(static_cast<int>((b->p10[j] >> shift) & 255u)) +
+                    w01 * static_cast<float>(static_cast<int>((b->p01[j] >> shift) & 255u)) +
+                    w11 * static_cast<float>(static_cast<int>((b->p11[j] >> shift) & 255u)) + 0.5f;
+    channel[c] = static_cast<int>(s);
+    sample |= static_cast<uint32_t>(channel[c]) << shift;
+  }
+  return sample;
+}
+
 template <int kDepth>
 __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
     int n, bool quality_policy, float keep, const ChunkProjection* __restrict proj,
     const uint8_t* __restrict on_surface, PaintBatch* __restrict b) {
-  const float* __restrict d00 = b->d00;
-  const float* __restrict d10 = b->d10;
-  const float* __restrict d01 = b->d01;
-  const float* __restrict d11 = b->d11;
-  const float* __restrict range = b->range;
-  const uint32_t* __restrict p00 = b->p00;
-  const uint32_t* __restrict p10 = b->p10;
-  const uint32_t* __restrict p01 = b->p01;
-  const uint32_t* __restrict p11 = b->p11;
   const uint32_t* __restrict stored = b->stored;
   const float* __restrict stored_q = b->stored_q;
-  const float* __restrict z = proj->z;
-  const float* __restrict tol = proj->tol;
-  const float* __restrict ax = proj->ax;
-  const float* __restrict ay = proj->ay;
   const float* __restrict quality = proj->quality;
-  const int32_t* __restrict code = proj->code;
   uint32_t* __restrict out = b->out;
   float* __restrict out_q = b->out_q;
   int32_t* __restrict write_out = b->write;
   const int by_quality = quality_policy;
   int visible = 0, compared = 0, rejected = 0, written = 0, newly = 0, diff_sum = 0;
   for (int j = 0; j < n; ++j) {
-    int ok = code[j] == 2;  // in view (the others read pixel (0, 0) and are left alone)
-    if constexpr (kDepth == 1) {
-      const float zz = z[j], t = tol[j];
-      ok &= (std::abs(d00[j] - zz) <= t) & (std::abs(d10[j] - zz) <= t) &
-            (std::abs(d01[j] - zz) <= t) & (std::abs(d11[j] - zz) <= t);
-    } else if constexpr (kDepth == 2) {
-      // |d - z| <= t for all four <=> max - z <= t and z - min <= t (rounding is monotonic;
-      // an infinite depth fails both ways).
-      const float zz = z[j], t = tol[j];
-      ok &= (range[2 * j + 1] - zz <= t) & (zz - range[2 * j] <= t);
-    }
-    const float fx = ax[j], fy = ay[j];
-    const float w00 = (1 - fx) * (1 - fy), w10 = fx * (1 - fy), w01 = (1 - fx) * fy,
-                w11 = fx * fy;
-    uint32_t sample = 0xFF000000u;
+    const int ok = BatchVisible<kDepth>(j, proj, b);
     int channel[3];
-    for (int c = 0; c < 3; ++c) {
-      const int shift = 8 * c;
-      const float s = w00 * static_cast<float>(static_cast<int>((p00[j] >> shift) & 255u)) +
-                      w10 * static_cast<float>(static_cast<int>((p10[j] >> shift) & 255u)) +
-                      w01 * static_cast<float>(static_cast<int>((p01[j] >> shift) & 255u)) +
-                      w11 * static_cast<float>(static_cast<int>((p11[j] >> shift) & 255u)) +
-                      0.5f;
-      channel[c] = static_cast<int>(s);
-      sample |= static_cast<uint32_t>(channel[c]) << shift;
-    }
+    const uint32_t sample = BatchBilinear(j, proj, b, channel);
     const uint32_t old = stored[j];
     const int has = (old >> 24) != 0;
     const int new_grey = (29 * channel[0] + 150 * channel[1] + 77 * channel[2]) >> 8;
-    const int old_grey = (29 * static_cast<int>(old & 255u) +
-                          150 * static_cast<int>((old >> 8) & 255u) +
-                          77 * static_cast<int>((old >> 16) & 255u)) >>
-                         8;
+    const int old_grey =
+        (29 * static_cast<int>(old & 255u) + 150 * static_cast<int>((old >> 8) & 255u) +
+         77 * static_cast<int>((old >> 16) & 255u)) >>
+        8;
     const int d = new_grey - old_grey;
     const int compare = ok & has;
     diff_sum += compare * (d < 0 ? -d : d);
@@ -394,21 +395,54 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
   return sums;
 }
 
+// The samples alone (the warped buffer that later stages read): b->out[j] the sample, b->write[j]
+// whether texel j is visible. Returns how many are.
+template <int kDepth>
+__attribute__((always_inline)) inline int SampleBatchBody(int n,
+                                                          const ChunkProjection* __restrict proj,
+                                                          PaintBatch* __restrict b) {
+  int visible = 0;
+  for (int j = 0; j < n; ++j) {
+    const int ok = BatchVisible<kDepth>(j, proj, b);
+    int channel[3];
+    b->out[j] = BatchBilinear(j, proj, b, channel);
+    b->write[j] = ok;
+    visible += ok;
+  }
+  return visible;
+}
+
+__attribute__((target_clones("avx2", "default"))) int SampleBatchDepth(int n,
+                                                                       const ChunkProjection* proj,
+                                                                       PaintBatch* b) {
+  return SampleBatchBody<1>(n, proj, b);
+}
+
+__attribute__((target_clones("avx2", "default"))) int SampleBatchDepthRange(
+    int n, const ChunkProjection* proj, PaintBatch* b) {
+  return SampleBatchBody<2>(n, proj, b);
+}
+
+__attribute__((target_clones("avx2", "default"))) int SampleBatchNoDepth(
+    int n, const ChunkProjection* proj, PaintBatch* b) {
+  return SampleBatchBody<0>(n, proj, b);
+}
+
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepth(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj,
-    const uint8_t* on_surface, PaintBatch* b) {
+    int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
+    PaintBatch* b) {
   return PaintBatchBody<1>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepthRange(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj,
-    const uint8_t* on_surface, PaintBatch* b) {
+    int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
+    PaintBatch* b) {
   return PaintBatchBody<2>(n, quality_policy, keep, proj, on_surface, b);
 }
 
 __attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDepth(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj,
-    const uint8_t* on_surface, PaintBatch* b) {
+    int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
+    PaintBatch* b) {
   return PaintBatchBody<0>(n, quality_policy, keep, proj, on_surface, b);
 }
 
@@ -446,6 +480,35 @@ void CopyTileRows(const BaseBuffer::Chunk& chunk, int buffer_w, uint8_t* bgra, f
     copy(chunk.x1 - chunk.x0);
 }
 
+// What every texel of a projected chunk reads: the occlusion test's depths (one pair of the
+// range map, 8 bytes per pixel at twice the depth map's offset, or the four depths) and the
+// four pixels around its sample.
+template <bool kDepth>
+void GatherBatch(const KernelContext& k, const ChunkProjection& proj, int n, PaintBatch* b) {
+  const uint8_t* const frame = k.frame->data;
+  const size_t frame_step = k.frame->step[0];
+  const uint8_t* const depth = k.depth->data;
+  const size_t depth_step = k.depth->step[0];
+  const uint8_t* const range = k.depth_range ? k.depth_range->data : nullptr;
+  for (int i = 0; i < n; ++i) {
+    if (kDepth && range) {
+      std::memcpy(&b->range[2 * i], range + 2 * static_cast<size_t>(proj.depth_at[i]), 8);
+    } else if constexpr (kDepth) {
+      const float* d0 = reinterpret_cast<const float*>(depth + proj.depth_at[i]);
+      const float* d1 =
+          reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
+      b->d00[i] = d0[0], b->d10[i] = d0[1], b->d01[i] = d1[0], b->d11[i] = d1[1];
+    }
+    // Pixel x0's BGR and the next one's (read from its red byte on: no byte past the pair).
+    const uint8_t* r0 = frame + proj.frame_at[i];
+    const uint8_t* r1 = r0 + frame_step;
+    b->p00[i] = Load32(r0);
+    b->p10[i] = Load32(r0 + 2) >> 8;
+    b->p01[i] = Load32(r1);
+    b->p11[i] = Load32(r1 + 2) >> 8;
+  }
+}
+
 // Gathers what every texel of a projected chunk reads, runs the batch, stores what it wrote.
 // Texels out of view (`in_view` of the chunk's `n` are in view) are masked in the batch.
 template <bool kDepth>
@@ -455,10 +518,6 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   const int n = chunk.end - chunk.begin;
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
-  const uint8_t* const frame = k.frame->data;
-  const size_t frame_step = k.frame->step[0];
-  const uint8_t* const depth = k.depth->data;
-  const size_t depth_step = k.depth->step[0];
   const uint8_t* const bgra = k.paint_bgra;
   const float* const stored_quality = k.paint_quality;
   // A full tile's rows are runs of the buffer's rows: its stored texels are read and written
@@ -473,31 +532,12 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
       batch.stored_q[i] = stored_quality[idx];
     }
   }
-  // The occlusion test's depths: one pair of the range map (8 bytes per pixel: at twice the
-  // depth map's offset) or the four depths.
-  const uint8_t* const range = k.depth_range ? k.depth_range->data : nullptr;
-  for (int i = 0; i < n; ++i) {
-    if (kDepth && range) {
-      std::memcpy(&batch.range[2 * i], range + 2 * static_cast<size_t>(proj.depth_at[i]), 8);
-    } else if constexpr (kDepth) {
-      const float* d0 = reinterpret_cast<const float*>(depth + proj.depth_at[i]);
-      const float* d1 =
-          reinterpret_cast<const float*>(reinterpret_cast<const uint8_t*>(d0) + depth_step);
-      batch.d00[i] = d0[0], batch.d10[i] = d0[1], batch.d01[i] = d1[0], batch.d11[i] = d1[1];
-    }
-    // Pixel x0's BGR and the next one's (read from its red byte on: no byte past the pair).
-    const uint8_t* r0 = frame + proj.frame_at[i];
-    const uint8_t* r1 = r0 + frame_step;
-    batch.p00[i] = Load32(r0);
-    batch.p10[i] = Load32(r0 + 2) >> 8;
-    batch.p01[i] = Load32(r1);
-    batch.p11[i] = Load32(r1 + 2) >> 8;
-  }
+  GatherBatch<kDepth>(k, proj, n, &batch);
   const bool by_quality = k.rule.policy == UpdatePolicy::kQuality;
   const PaintBatchSums sums =
-      !kDepth  ? PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
-      : range ? PaintBatchDepthRange(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
-               : PaintBatchDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch);
+      !kDepth         ? PaintBatchNoDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
+      : k.depth_range ? PaintBatchDepthRange(n, by_quality, k.rule.keep, &proj, on_surface, &batch)
+                      : PaintBatchDepth(n, by_quality, k.rule.keep, &proj, on_surface, &batch);
   uint8_t* const out_bgra = k.paint_bgra;
   float* const out_quality = k.paint_quality;
   if (chunk.full) {
@@ -520,6 +560,33 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   stats.abs_grey_difference_sum = sums.abs_grey_difference_sum;
   stats.newly_painted = sums.newly_painted;
   counts->paint.Add(stats);
+}
+
+// Pass 2 when later stages read the warped samples (no painting here): the batch's depth
+// test and bilinear sample, then each visible texel's sample, quality and valid flag stored.
+// The same samples, to the bit, as the texel-by-texel loop.
+template <bool kDepth>
+void SampleChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
+                        const ChunkProjection& proj, int in_view, int grazing, Counts* counts) {
+  PaintBatch batch;
+  const int n = chunk.end - chunk.begin;
+  GatherBatch<kDepth>(k, proj, n, &batch);
+  const int visible = !kDepth         ? SampleBatchNoDepth(n, &proj, &batch)
+                      : k.depth_range ? SampleBatchDepthRange(n, &proj, &batch)
+                                      : SampleBatchDepth(n, &proj, &batch);
+  const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
+  for (int i = 0; i < n; ++i) {
+    if (!batch.write[i]) continue;
+    const size_t idx = static_cast<size_t>(texel_index[i]);
+    uint8_t* out = k.out_bgr + 3 * idx;
+    const uint32_t sample = batch.out[i];
+    out[0] = static_cast<uint8_t>(sample), out[1] = static_cast<uint8_t>(sample >> 8);
+    out[2] = static_cast<uint8_t>(sample >> 16);
+    k.out_valid[idx] = 255;
+    k.out_quality[idx] = proj.quality[i];
+  }
+  counts->in_view += in_view, counts->visible += visible;
+  counts->occluded += in_view - visible, counts->grazing += grazing;
 }
 
 // Pass 2, texel by texel for those in view: the depth test and the sample. Works on local
@@ -566,6 +633,15 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
       }
       return PaintChunkBatched<kDepth>(k, chunk, proj, in_view, grazing, counts);
     }
+  }
+  if constexpr (!kPaint && kMode == SamplingMode::kBilinear) {
+    int in_view, grazing;
+    CountCodes(proj, n, &in_view, &grazing);
+    if (in_view == 0) {
+      counts->grazing += grazing;
+      return;
+    }
+    return SampleChunkBatched<kDepth>(k, chunk, proj, in_view, grazing, counts);
   }
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
@@ -635,8 +711,7 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
     }
     if constexpr (kPaint) {
       UpdateTexel(k.rule, sample, proj.quality[i], on_surface[i] != 0,
-                  k.paint_bgra + 4 * static_cast<size_t>(idx), k.paint_quality + idx,
-                  &paint_stats);
+                  k.paint_bgra + 4 * static_cast<size_t>(idx), k.paint_quality + idx, &paint_stats);
     } else {
       uint8_t* out = k.out_bgr + 3 * static_cast<size_t>(idx);
       out[0] = sample[0], out[1] = sample[1], out[2] = sample[2];
@@ -666,8 +741,10 @@ ChunkKernel SelectForMode(SamplingMode mode) {
 template <bool kPaint>
 ChunkKernel SelectKernel(bool distorted, bool depth, SamplingMode mode) {
   if (distorted)
-    return depth ? SelectForMode<true, true, kPaint>(mode) : SelectForMode<true, false, kPaint>(mode);
-  return depth ? SelectForMode<false, true, kPaint>(mode) : SelectForMode<false, false, kPaint>(mode);
+    return depth ? SelectForMode<true, true, kPaint>(mode)
+                 : SelectForMode<true, false, kPaint>(mode);
+  return depth ? SelectForMode<false, true, kPaint>(mode)
+               : SelectForMode<false, false, kPaint>(mode);
 }
 
 }  // namespace
@@ -851,8 +928,8 @@ void SetCounts(const Counts& n, WarpedBuffer* warped) {
 void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const WarpOptions& options,
                        WarpedBuffer* warped) {
   const int w = buffer.width, h = buffer.height;
-  const bool fresh = warped->bgr.rows != h || warped->bgr.cols != w ||
-                     warped->valid.size() != warped->bgr.size();
+  const bool fresh =
+      warped->bgr.rows != h || warped->bgr.cols != w || warped->valid.size() != warped->bgr.size();
   if (fresh) {
     warped->bgr.create(h, w, CV_8UC3);
     warped->valid.create(h, w, CV_8U);
@@ -871,9 +948,9 @@ void WarpFrameToBuffer(const BaseBuffer& buffer, const FrameView& view, const Wa
   k.out_bgr = warped->bgr.data;
   k.out_valid = warped->valid.data;
   k.out_quality = warped->quality.ptr<float>();
-  const Counts n = RunChunks(
-      k, SelectKernel<false>(view.camera->HasDistortion(), use_depth, options.sampling),
-      &warped->valid_box);
+  const Counts n =
+      RunChunks(k, SelectKernel<false>(view.camera->HasDistortion(), use_depth, options.sampling),
+                &warped->valid_box);
   SetCounts(n, warped);
 }
 
@@ -886,9 +963,9 @@ PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& v
   k.paint_quality = painted->quality.ptr<float>();
   k.rule = rule;
   cv::Rect visible_box;
-  const Counts n = RunChunks(
-      k, SelectKernel<true>(view.camera->HasDistortion(), use_depth, options.sampling),
-      &visible_box);
+  const Counts n =
+      RunChunks(k, SelectKernel<true>(view.camera->HasDistortion(), use_depth, options.sampling),
+                &visible_box);
   SetCounts(n, counts);
   painted->painted_surface_texels += n.paint.newly_painted;
   return n.paint;
