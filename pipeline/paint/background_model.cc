@@ -286,13 +286,4 @@ cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {
   return image;
 }
 
-void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
-                     PaintedBuffer* painted) {
-  if (frame.warming_up == 0) return;
-  // Negated: the sign marks the sample provisional, the magnitude keeps its quality.
-  cv::Mat quality = painted->quality(valid_box);
-  const cv::Mat negated = -cv::abs(quality);
-  negated.copyTo(quality, frame.warming(valid_box));
-}
-
 }  // namespace fresco

@@ -27,7 +27,6 @@
 #include "pipeline/core/project.h"
 #include "pipeline/paint/base_buffer.h"
 #include "pipeline/paint/frame_warp.h"
-#include "pipeline/paint/paint_update.h"
 #include "pipeline/paint/robust_texels.h"
 
 namespace fresco {
@@ -89,16 +88,9 @@ class BufferBackground {
   BackgroundOptions options_;
   RobustTexels robust_;
   std::vector<AverageTexel> average_;
-  cv::Mat raw_;  // CV_8U: this frame's foreground before cleaning
+  cv::Mat raw_;                   // CV_8U: this frame's foreground before cleaning
   std::vector<uint8_t> raw_set_;  // per chunk: raw_ may hold foreground there
-  std::vector<int> texel_at_;  // texel number k by buffer index, -1 for none (built by Move)
+  std::vector<int> texel_at_;     // texel number k by buffer index, -1 for none (built by Move)
 };
-
-// Marks texels painted while warming up as provisional (stored quality negated), so that the
-// first trusted sample replaces them, and provisional samples replace them only when sharp
-// enough (PaintBuffer's `warming`). `valid_box`: bounds the
-// texels sampled this frame (WarpedBuffer::valid_box).
-void MarkProvisional(const BackgroundFrame& frame, const cv::Rect& valid_box,
-                     PaintedBuffer* painted);
 
 }  // namespace fresco

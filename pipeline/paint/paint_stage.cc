@@ -30,7 +30,6 @@ void PaintSession::PaintStage(FrameWork* work) {
                                   : background_frame_[b].warming;
       work->paint_stats[b] =
           PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b], warming);
-      if (background) MarkProvisional(background_frame_[b], warped_[b].valid_box, &painted_[b]);
     });
   }
   for (size_t b : seen) {

@@ -35,20 +35,25 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
   float* stored_quality = painted->quality.ptr<float>();
   for (int k = begin; k < end; ++k) {
     const int idx = buffer.texel_index[k];
-    if (!valid[idx] || (skip && skip[idx])) continue;
-    const float stored = stored_quality[idx];
-    if (stored >= 0.0f) {
-      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
-                  dst + 4 * static_cast<size_t>(idx), stored_quality + idx, &stats);
-      continue;
+    const bool provisional = provisional_sample && provisional_sample[idx];
+    if (valid[idx] && !(skip && skip[idx])) {
+      const float stored = stored_quality[idx];
+      uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
+      if (stored >= 0.0f) {
+        UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
+                    texel, stored_quality + idx, &stats);
+      } else {
+        // A provisional stored sample: against a trusted sample it counts as nothing; against
+        // another provisional one, by its quality.
+        float compared_with = provisional ? -stored : 0.0f;
+        const int written_before = stats.written;
+        UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
+                    texel, &compared_with, &stats);
+        if (stats.written > written_before) stored_quality[idx] = compared_with;
+      }
     }
-    // A provisional stored sample: against a trusted sample it counts as nothing; against
-    // another provisional one, by its quality.
-    float compared_with = provisional_sample && provisional_sample[idx] ? -stored : 0.0f;
-    const int written_before = stats.written;
-    UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
-                dst + 4 * static_cast<size_t>(idx), &compared_with, &stats);
-    if (stats.written > written_before) stored_quality[idx] = compared_with;
+    // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
+    if (provisional) stored_quality[idx] = -std::abs(stored_quality[idx]);
   }
   return stats;
 }

@@ -3,7 +3,6 @@
 // samples while the background model warms up.
 #include <gtest/gtest.h>
 
-#include "pipeline/paint/background_model.h"
 #include "pipeline/paint/paint_update.h"
 
 namespace fresco {
@@ -47,7 +46,7 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
   EXPECT_EQ(average.painted.painted_surface_texels, 2);
 }
 
-// While a texel's background model warms up its samples are provisional (MarkProvisional):
+// While a texel's background model warms up its samples are provisional (PaintBuffer's `warming`):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
 // rule), a trusted one whatever its quality, even one showing nearly the same (per-texel
 // agreement tests left a patchwork of two photos on the real castle photos).
@@ -55,15 +54,11 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   PipelineOptions options;  // quality policy, slack 0.2
   TwoTexels t;
   const cv::Mat warming(1, 2, CV_8U, cv::Scalar(255));
-  BackgroundFrame frame;
-  frame.warming = warming;
-  frame.warming_up = 2;
   const auto paint_into = [&](TwoTexels* into, int grey, float quality, bool provisional) {
     into->warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar(grey, grey, grey));
     into->warped.quality.setTo(quality);
     PaintBuffer(into->buffer, into->warped, cv::Mat(), options, &into->painted,
                 provisional ? warming : cv::Mat());
-    if (provisional) MarkProvisional(frame, cv::Rect(0, 0, 2, 1), &into->painted);
   };
   const auto paint = [&](int grey, float quality, bool provisional) {
     paint_into(&t, grey, quality, provisional);
