@@ -10,6 +10,11 @@
 
 namespace fresco {
 
+int GainStride(long long visible) {
+  constexpr long long kSamples = 65536;
+  return 4 * static_cast<int>(std::max(1LL, visible / (4 * kSamples)));
+}
+
 float GainHistogram::MedianGain(long long min_samples) const {
   if (count < min_samples) return 1.0f;
   long long seen = 0;
@@ -73,14 +78,14 @@ void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const
 }
 
 void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
-                                      GainHistogram* histogram) const {
+                                      int stride, GainHistogram* histogram) const {
   if (robust_.empty()) return;
   const uint8_t* valid = warped.valid.data;
   const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
   constexpr float kBinsPerLog2 = GainHistogram::kBins / 4.0f;
   for (const BaseBuffer::Chunk& chunk : buffer.chunks) {
     if (!warped.MayBeValid(chunk)) continue;
-    for (int k = (chunk.begin + 3) / 4 * 4; k < chunk.end; k += 4) {  // every 4th texel
+    for (int k = (chunk.begin + stride - 1) / stride * stride; k < chunk.end; k += stride) {
       const int idx = buffer.texel_index[k];
       if (!valid[idx] || robust_.samples[k] == 0) continue;
       const float model = (robust_.mean[0][0][k] + robust_.mean[0][1][k] + robust_.mean[0][2][k]) *

@@ -45,6 +45,11 @@ struct BackgroundFrame {
 
 // Histogram of log2(sample / background) grey ratios over all buffers of a frame, for the
 // frame's global gain (exposure) estimate.
+// Every how many texels a frame's gain is sampled when `visible` texels are seen: every 4th,
+// and on large meshes so that about 65,536 are (a median over more moves by less than a bin;
+// on the refined Sceaux mesh every 4th texel took 3-4 ms a frame).
+int GainStride(long long visible);
+
 struct GainHistogram {
   static constexpr int kBins = 512;  // log2 ratio in [-2, 2): 0.0078 per bin (0.5 %)
   std::array<int, kBins> bins = {};
@@ -58,8 +63,9 @@ struct GainHistogram {
 class BufferBackground {
  public:
   void Init(const BaseBuffer& buffer, const BackgroundOptions& options);
-  // Adds this buffer's samples (every 4th texel with a model) to the gain histogram.
-  void AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped,
+  // Adds this buffer's samples (every `stride`th texel with a model, GainStride) to the gain
+  // histogram.
+  void AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped, int stride,
                       GainHistogram* histogram) const;
   // Classifies the warped samples, updates the model with them, cleans the mask.
   // `gain`: the frame's exposure relative to the model (robust mode; 1 = none).

@@ -28,14 +28,17 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
     // One histogram per buffer seen, in parallel, summed in buffer order (integer counts:
     // the same whatever the threads).
     const std::vector<size_t> seen_buffers = Indices(seen);
+    long long visible = 0;
+    for (size_t b : seen_buffers) visible += warped_[b].visible;
+    const int stride = GainStride(visible);
     std::vector<GainHistogram> per_buffer(seen_buffers.size());
-    cv::parallel_for_(cv::Range(0, static_cast<int>(seen_buffers.size())),
-                      [&](const cv::Range& range) {
-                        for (int i = range.start; i < range.end; ++i) {
-                          const size_t b = seen_buffers[i];
-                          models[b].AccumulateGain(set_.buffers[b], warped_[b], &per_buffer[i]);
-                        }
-                      });
+    cv::parallel_for_(
+        cv::Range(0, static_cast<int>(seen_buffers.size())), [&](const cv::Range& range) {
+          for (int i = range.start; i < range.end; ++i) {
+            const size_t b = seen_buffers[i];
+            models[b].AccumulateGain(set_.buffers[b], warped_[b], stride, &per_buffer[i]);
+          }
+        });
     GainHistogram histogram;
     for (const GainHistogram& h : per_buffer) {
       for (int i = 0; i < GainHistogram::kBins; ++i) histogram.bins[i] += h.bins[i];
