@@ -350,7 +350,9 @@ void CheckUnionAndOverlapAccuracy(const std::vector<std::string>& sets) {
     const double alone = one[k].stats.streams[0].MaskedFraction();
     const double together = both.stats.streams[k].MaskedFraction();
     std::printf("%s: masked %.4f alone, %.4f with both streams\n", kStreams[k], alone, together);
-    if (!std::isnan(alone)) EXPECT_LE(together, alone + 0.01) << kStreams[k];
+    if (!std::isnan(alone)) {
+      EXPECT_LE(together, alone + 0.01) << kStreams[k];
+    }
   }
   const double u = static_cast<double>(union_texels);
   std::printf(

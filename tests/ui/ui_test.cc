@@ -162,9 +162,11 @@ TEST(UiHeadless, ATwoStreamProjectPaintsBothStreamsAsTheRunDoes) {
   auto panels = MakePanels();
   for (auto& panel : panels) panel->open = true;
   for (int i = 0; i < 2; ++i) imgui.Frame(ui, panels);
-  for (const auto& panel : panels)
-    if (std::string(panel->Title()) == "Input frame")
+  for (const auto& panel : panels) {
+    if (std::string(panel->Title()) == "Input frame") {
       EXPECT_EQ(panel->Report().at("stream"), "latest");
+    }
+  }
 }
 
 // Endless live streams (issue 11): the per-frame histories keep only the latest frames.

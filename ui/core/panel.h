@@ -71,8 +71,8 @@ struct UiContext {
   uint64_t opened_version = 0;
   // Where the tiled panels go (splitters, maximise); panels not in it float.
   TileLayout layout = DefaultTileLayout();
-  bool new_project_requested = false;      // File > New project...: the app frame opens the form
-  std::vector<std::string> dropped_paths;  // dropped on the window (DropPaths), not yet placed
+  bool new_project_requested = false;  // File > New project...: the app frame opens the form
+  std::vector<std::string> dropped_paths = {};  // dropped on the window (DropPaths), not yet placed
 };
 
 class Panel {
