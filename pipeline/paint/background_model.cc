@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "pipeline/paint/foreground_blobs.h"
+#include "pipeline/paint/foreground_grow.h"
 
 namespace fresco {
 
@@ -65,10 +66,7 @@ std::vector<std::pair<int, int>> MovedTexels(const BaseBuffer& buffer,
 }  // namespace
 
 void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field) {
-  if (texel_at_.empty()) {
-    texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
-    for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
-  }
+  BuildTexelAt(buffer);
   const std::vector<std::pair<int, int>> moved = MovedTexels(buffer, texel_at_, roi, field);
   if (!robust_.empty()) robust_.Move(moved);
   if (average_.empty()) return;
@@ -222,7 +220,7 @@ void BufferBackground::Clean(const cv::Rect& roi, BackgroundFrame* frame) {
 }
 
 void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
-                              bool debug, BackgroundFrame* frame) {
+                              bool debug, bool grow, BackgroundFrame* frame) {
   // The images are reused from frame to frame (no allocation, no page faults per frame),
   // except when debugging: then the stage's report holds them and each frame gets its own.
   const auto clear = [&](cv::Mat* image) {
@@ -272,7 +270,30 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
                                 cv::Point(total.x_max + pad + 1, total.y_max + pad + 1)) &
                        cv::Rect(0, 0, buffer.width, buffer.height);
   Clean(roi, frame);
+  const int reach = options_.grow_reach_texels;
+  if (grow && options_.grow_levels > 0 && reach > 0) {
+    // From the flagged texels that survived the cleaning (not its dilation ring), by colour;
+    // then cleaned again. raw_ stays this frame's classification.
+    const cv::Rect wide =
+        cv::Rect(roi.x - reach, roi.y - reach, roi.width + 2 * reach, roi.height + 2 * reach) &
+        cv::Rect(0, 0, buffer.width, buffer.height);
+    cv::Mat grown = raw_(wide) & frame->foreground(wide);
+    if (GrowForegroundByColour(warped.bgr(wide), warped.valid(wide),
+                               static_cast<int>(options_.grow_levels), reach, &grown) > 0) {
+      cv::Mat out = frame->foreground(wide);
+      out.setTo(0);
+      CleanForeground(grown, options_.min_blob_texels, options_.dilate_texels, &out);
+      frame->masked = cv::countNonZero(out & warped.valid(wide));
+      return;
+    }
+  }
   frame->masked = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
+}
+
+void BufferBackground::BuildTexelAt(const BaseBuffer& buffer) {
+  if (!texel_at_.empty()) return;
+  texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
+  for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
 }
 
 cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {

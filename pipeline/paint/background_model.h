@@ -68,9 +68,10 @@ class BufferBackground {
   void AccumulateGain(const BaseBuffer& buffer, const WarpedBuffer& warped, int stride,
                       GainHistogram* histogram) const;
   // Classifies the warped samples, updates the model with them, cleans the mask.
-  // `gain`: the frame's exposure relative to the model (robust mode; 1 = none).
+  // `gain`: the frame's exposure relative to the model (robust mode; 1 = none). `grow`: the
+  // foreground then grows by colour (BackgroundOptions::grow, resolved by the caller).
   void Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
-              BackgroundFrame* frame);
+              bool grow, BackgroundFrame* frame);
   // The background estimate (CV_8UC3, buffer size, black where never seen).
   cv::Mat Image(const BaseBuffer& buffer) const;
   // Moves the model with its buffer (refine_anchor.h): the texel at q (in `roi`) takes the
@@ -90,13 +91,14 @@ class BufferBackground {
   void Classify(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
                 const BaseBuffer::Chunk& chunk, ChunkStats* stats, BackgroundFrame* frame);
   void Clean(const cv::Rect& roi, BackgroundFrame* frame);
+  void BuildTexelAt(const BaseBuffer& buffer);
 
   BackgroundOptions options_;
   RobustTexels robust_;
   std::vector<AverageTexel> average_;
   cv::Mat raw_;                   // CV_8U: this frame's foreground before cleaning
   std::vector<uint8_t> raw_set_;  // per chunk: raw_ may hold foreground there
-  std::vector<int> texel_at_;     // texel number k by buffer index, -1 for none (built by Move)
+  std::vector<int> texel_at_;     // texel number k by buffer index, -1 for none (when needed)
 };
 
 }  // namespace fresco

@@ -2,6 +2,7 @@
 // model, learned from this stream's earlier frames; movers masked out of painting (§3.4,
 // background_model.h). Off with pipeline.background.mode off.
 #include <chrono>
+#include <cmath>
 #include <string>
 
 #include <opencv2/core/utility.hpp>
@@ -48,8 +49,16 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   }
   long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
   const std::vector<size_t> seen_list = Indices(seen);
+  // Growing by colour spreads whatever was flagged: misaligned edges too. `auto` grows once
+  // the refinement's `auto` has measured the frames and found them aligned (not when it
+  // decided off for want of a measurement, as with a few photos far apart).
+  const GrowMode grow_mode = options_.background.grow;
+  const AutoDecision& aligned = refine_auto_.decision();
+  const bool grow = grow_mode == GrowMode::kOn ||
+                    (grow_mode == GrowMode::kAuto && aligned.state == AutoDecision::State::kOff &&
+                     aligned.frames_measured > 0 && std::isfinite(aligned.evidence));
   ForEachBuffer(seen_list, false, [&](size_t b) {
-    models[b].Update(set_.buffers[b], warped_[b], gain, debug, &background_frame_[b]);
+    models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &background_frame_[b]);
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];
@@ -70,6 +79,7 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   report.metrics["texels_warming_up"] = static_cast<double>(warming);
   report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
   report.metrics["blobs_removed"] = static_cast<double>(blobs);
+  report.metrics["grown"] = grow ? 1.0 : 0.0;
   report.wall_ms = MsSince(start);
   return report;
 }

@@ -134,8 +134,8 @@ void BM_DecodeFrame(benchmark::State& state) {
   static const cv::Mat frame = [] {
     Scene scene;
     if (!MakeCubeRoomScene(CubeRoomOptions(), &scene).ok()) return cv::Mat();
-    const Camera camera = Camera::FromParams(LensModel::kPinhole, 1280, 720,
-                                             {914.0, 914.0, 639.5, 359.5});
+    const Camera camera =
+        Camera::FromParams(LensModel::kPinhole, 1280, 720, {914.0, 914.0, 639.5, 359.5});
     // World y up; the camera looks level along world +z turned 40 deg, 10 deg down.
     const Eigen::Quaterniond world_from_cam =
         Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())) *
@@ -201,7 +201,7 @@ void BM_BackgroundUpdate(benchmark::State& state) {
   long long observed = 0, masked = 0;
   int i = 0;
   for (auto _ : state) {
-    model.Update(buffer, warped[i % 8], i % 4 == 3 ? 1.1f : 1.0f, false, &frame);
+    model.Update(buffer, warped[i % 8], i % 4 == 3 ? 1.1f : 1.0f, false, false, &frame);
     observed += frame.observed;
     masked += frame.masked;
     ++i;

@@ -81,8 +81,12 @@ void MoveSettingsOffTheirDefaults(Project* p, const std::string& prefix) {
       case Setting::Kind::kText:
         break;
     }
-    if (s.kind == Setting::Kind::kInt) EXPECT_TRUE(in_range(*s.integer)) << s.key;
-    if (s.kind == Setting::Kind::kNumber) EXPECT_TRUE(in_range(*s.number)) << s.key;
+    if (s.kind == Setting::Kind::kInt) {
+      EXPECT_TRUE(in_range(*s.integer)) << s.key;
+    }
+    if (s.kind == Setting::Kind::kNumber) {
+      EXPECT_TRUE(in_range(*s.number)) << s.key;
+    }
   }
 }
 
