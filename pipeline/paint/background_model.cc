@@ -66,7 +66,10 @@ std::vector<std::pair<int, int>> MovedTexels(const BaseBuffer& buffer,
 }  // namespace
 
 void BufferBackground::Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field) {
-  BuildTexelAt(buffer);
+  if (texel_at_.empty()) {
+    texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
+    for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
+  }
   const std::vector<std::pair<int, int>> moved = MovedTexels(buffer, texel_at_, roi, field);
   if (!robust_.empty()) robust_.Move(moved);
   if (average_.empty()) return;
@@ -288,12 +291,6 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
     }
   }
   frame->masked = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
-}
-
-void BufferBackground::BuildTexelAt(const BaseBuffer& buffer) {
-  if (!texel_at_.empty()) return;
-  texel_at_.assign(static_cast<size_t>(buffer.width) * buffer.height, -1);
-  for (int k = 0; k < buffer.NumTexels(); ++k) texel_at_[buffer.texel_index[k]] = k;
 }
 
 cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {

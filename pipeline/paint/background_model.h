@@ -45,11 +45,6 @@ struct BackgroundFrame {
 
 // Histogram of log2(sample / background) grey ratios over all buffers of a frame, for the
 // frame's global gain (exposure) estimate.
-// Every how many texels a frame's gain is sampled when `visible` texels are seen: every 4th,
-// and on large meshes so that about 65,536 are (a median over more moves by less than a bin;
-// on the refined Sceaux mesh every 4th texel took 3-4 ms a frame).
-int GainStride(long long visible);
-
 struct GainHistogram {
   static constexpr int kBins = 512;  // log2 ratio in [-2, 2): 0.0078 per bin (0.5 %)
   std::array<int, kBins> bins = {};
@@ -57,6 +52,11 @@ struct GainHistogram {
   // The median ratio, or 1 when fewer than `min_samples` samples were seen.
   float MedianGain(long long min_samples = 256) const;
 };
+
+// Every how many texels a frame's gain is sampled when `visible` texels are seen: every 4th,
+// and on large meshes so that about 65,536 are (a median over more moves by less than a bin;
+// on the refined Sceaux mesh every 4th texel took 3-4 ms a frame).
+int GainStride(long long visible);
 
 // The background model of one base buffer. Init once, then per frame (optionally)
 // AccumulateGain over all buffers, then Update with the frame's gain.
@@ -91,14 +91,13 @@ class BufferBackground {
   void Classify(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
                 const BaseBuffer::Chunk& chunk, ChunkStats* stats, BackgroundFrame* frame);
   void Clean(const cv::Rect& roi, BackgroundFrame* frame);
-  void BuildTexelAt(const BaseBuffer& buffer);
 
   BackgroundOptions options_;
   RobustTexels robust_;
   std::vector<AverageTexel> average_;
   cv::Mat raw_;                   // CV_8U: this frame's foreground before cleaning
   std::vector<uint8_t> raw_set_;  // per chunk: raw_ may hold foreground there
-  std::vector<int> texel_at_;     // texel number k by buffer index, -1 for none (when needed)
+  std::vector<int> texel_at_;     // texel number k by buffer index, -1 for none (built by Move)
 };
 
 }  // namespace fresco
