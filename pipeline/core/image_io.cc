@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/jpeg_decode.h"
 
 namespace fresco {
 
@@ -89,6 +90,7 @@ Status ReadImage(const std::string& path, cv::Mat* image, int flags) {
   std::string bytes;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &bytes));
   FRESCO_RETURN_IF_ERROR(CheckImageBytes(path, bytes));
+  if (flags == cv::IMREAD_COLOR && DecodeJpegBgr(bytes, image)) return Status::Ok();
   try {
     *image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), flags);
   } catch (const cv::Exception& e) {
