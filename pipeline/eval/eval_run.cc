@@ -32,6 +32,28 @@ struct HeldOut {
 
 }  // namespace
 
+// The references for EvalOptions::recovery: the capture painted again with refinement off,
+// and at the true poses.
+static Status PaintReferences(const EvalSuite& suite, const SuiteCapture& capture,
+                              const EvalOptions& options, CaptureEval* result) {
+  EvalOptions reference = options;
+  reference.recovery = false;
+  reference.progress = nullptr;
+  reference.overrides.push_back("pipeline.refine.mode=off");
+  CaptureEval unrefined;
+  FRESCO_RETURN_IF_ERROR(EvaluateCapture(suite, capture, reference, &unrefined));
+  result->unrefined_truth_psnr_db = unrefined.truth_psnr_db;
+  if (!result->noisy_poses) return Status::Ok();
+  reference.overrides = options.overrides;
+  reference.true_poses = true;
+  CaptureEval perfect;
+  FRESCO_RETURN_IF_ERROR(EvaluateCapture(suite, capture, reference, &perfect));
+  result->true_pose_truth_psnr_db = perfect.truth_psnr_db;
+  const double lost = perfect.truth_psnr_db - unrefined.truth_psnr_db;
+  if (lost >= 0.5) result->recovered = (result->truth_psnr_db - unrefined.truth_psnr_db) / lost;
+  return Status::Ok();
+}
+
 Status EvalOptions::Check() const {
   if (cache_dir.empty()) return Status::Error("cache: no folder for the captures");
   if (holdout < 2) return Status::Error("holdout: must be >= 2");
@@ -90,18 +112,23 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
       held_out.push_back({frame, pose->cam_from_world, k->second});
       continue;
     }
+    const Rigid3d& true_pose = plan.true_poses[k->second].cam_from_world;
+    // Beyond what writing the poses as text rounds off (a micrometre, a microradian).
+    if ((true_pose.Centre() - pose->cam_from_world.Centre()).norm() > 1e-6 ||
+        true_pose.rotation.angularDistance(pose->cam_from_world.rotation) > 1e-6)
+      result->noisy_poses = true;
+    const Rigid3d& painted_pose = options.true_poses ? true_pose : pose->cam_from_world;
     const Camera& camera = *loaded.CameraFor(*pose);
     if (!plan.movers.empty() && !provenance)
       provenance =
           std::make_unique<MoverProvenance>(job.scene, plan.movers, loaded.scene, camera, *session);
     if (provenance) provenance->BeforeFrame(*session);
     const auto start = Clock::now();
-    session->PaintFrame(frame, camera, pose->cam_from_world, &report);
+    session->PaintFrame(frame, camera, painted_pose, &report);
     paint_seconds += SecondsSince(start);
     if (!report.painted) continue;
     if (provenance)
-      provenance->AfterFrame(*session, k->second, plan.true_poses[k->second].cam_from_world,
-                             pose->cam_from_world);
+      provenance->AfterFrame(*session, k->second, true_pose, painted_pose);
     ++result->painted_frames;
     painted_frames.push_back({k->second, plan.true_poses[k->second].cam_from_world.Centre()});
   }
@@ -162,6 +189,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
   result->mover_leak = painted_pixels > 0 ? double(leak_pixels) / painted_pixels : 0.0;
   result->mover_region_error =
       painted_pixels > 0 ? double(region_error_pixels) / painted_pixels : 0.0;
+  if (options.recovery) FRESCO_RETURN_IF_ERROR(PaintReferences(suite, capture, options, result));
   return Status::Ok();
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,11 +15,17 @@
 
 namespace fresco {
 
+inline constexpr double kNoFigure = std::numeric_limits<double>::quiet_NaN();
+
 struct EvalOptions {
   std::vector<std::string> overrides;  // project settings "KEY=VALUE" (as `fresco run --set`)
   std::string cache_dir;               // captures are written to CACHE/NAME/
   int holdout = 10;                    // every N-th frame is held out of painting (>= 2)
   double leak_threshold = 40.0;        // levels; see TruthViewInputs::leak_threshold
+  bool true_poses = false;             // paint at the true poses instead of the given ones
+  // Also paint each capture as references for what refinement recovers: at the given poses
+  // with refinement off, and (where the given poses are noisy) at the true poses.
+  bool recovery = false;
   // Progress: (captures done, total, a line about the capture just started or finished).
   std::function<void(int done, int total, const std::string& line)> progress;
   std::function<bool()> stop;  // checked between frames; true: stop with an error
@@ -47,6 +54,13 @@ struct CaptureEval {
   // mover-free at least once that are painted (fractions).
   double mover_texels = 0, mover_dominated_texels = 0, open_coverage = 0;
   double coverage = 0;      // on-surface texels painted
+  bool noisy_poses = false;  // the given poses differ from the true ones
+  // With EvalOptions::recovery (NaN otherwise): truth PSNR with refinement off at the given
+  // poses, with the setting at the true poses (noisy captures only), and the share of the
+  // PSNR lost to pose noise that the setting recovers (where at least 0.5 dB is lost).
+  double unrefined_truth_psnr_db = kNoFigure;
+  double true_pose_truth_psnr_db = kNoFigure;
+  double recovered = kNoFigure;
   AutoDecisions decisions;  // what the `auto` modes decided, with their evidence
 };
 

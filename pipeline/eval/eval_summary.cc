@@ -1,6 +1,7 @@
 #include "pipeline/eval/eval_summary.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 
@@ -20,12 +21,13 @@ double Median(std::vector<double> v) {
 }
 
 // `higher_is_worse`: the worst is the largest value.
+// Over the captures where the figure is a number (NaN: not measured there).
 FigureSpread Spread(const std::vector<const CaptureEval*>& group,
                     const std::function<double(const CaptureEval&)>& figure, bool higher_is_worse,
                     bool movers_only = false) {
   std::vector<double> values;
   for (const CaptureEval* c : group)
-    if (!movers_only || c->has_movers) values.push_back(figure(*c));
+    if ((!movers_only || c->has_movers) && std::isfinite(figure(*c))) values.push_back(figure(*c));
   FigureSpread s;
   s.count = static_cast<int>(values.size());
   if (values.empty()) return s;
@@ -53,6 +55,14 @@ FamilySummary Summarize(const std::string& family, const std::vector<const Captu
       group, [](const CaptureEval& c) { return c.paint_fps; }, false);
   f.coverage = Spread(
       group, [](const CaptureEval& c) { return c.coverage; }, false);
+  f.recovered = Spread(
+      group, [](const CaptureEval& c) { return c.recovered; }, false);
+  f.exact_poses_gain_db = Spread(
+      group,
+      [](const CaptureEval& c) {
+        return c.noisy_poses ? kNoFigure : c.truth_psnr_db - c.unrefined_truth_psnr_db;
+      },
+      false);
   return f;
 }
 
@@ -116,6 +126,13 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                        {"dominated_texels", c.mover_dominated_texels},
                        {"open_coverage", c.open_coverage}};
     row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
+    row["noisy_poses"] = c.noisy_poses;
+    if (std::isfinite(c.unrefined_truth_psnr_db)) {
+      const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+      row["refinement"] = {{"unrefined_truth_psnr_db", number(c.unrefined_truth_psnr_db)},
+                           {"true_poses_truth_psnr_db", number(c.true_pose_truth_psnr_db)},
+                           {"recovered", number(c.recovered)}};
+    }
     root["captures"].push_back(row);
   }
   root["families"] = json::array();
@@ -128,7 +145,9 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                                 {"one_minus_ncc", SpreadJson(f.one_minus_ncc)},
                                 {"mover_leak", SpreadJson(f.mover_leak)},
                                 {"paint_fps", SpreadJson(f.paint_fps)},
-                                {"coverage", SpreadJson(f.coverage)}});
+                                {"coverage", SpreadJson(f.coverage)},
+                                {"recovered", SpreadJson(f.recovered)},
+                                {"exact_poses_gain_db", SpreadJson(f.exact_poses_gain_db)}});
   }
   return root.dump(2) + "\n";
 }
@@ -161,6 +180,36 @@ std::string EvalToText(const std::vector<CaptureEval>& results,
     std::snprintf(line, sizeof line, "| %s | %d | %.2f / %.2f | %.2f / %.2f | %s | %.0f / %.0f |\n",
                   f.family.c_str(), f.captures, f.truth_psnr_db.median, f.truth_psnr_db.worst,
                   f.psnr_db.median, f.psnr_db.worst, leak, f.paint_fps.median, f.paint_fps.worst);
+    out += line;
+  }
+  bool references = false;
+  for (const CaptureEval& c : results) references |= std::isfinite(c.unrefined_truth_psnr_db);
+  if (!references) return out;
+  out +=
+      "\n| capture | truth PSNR dB | refinement off | true poses | recovered % |\n"
+      "|---|---|---|---|---|\n";
+  for (const CaptureEval& c : results) {
+    char perfect[32] = "-", recovered[32] = "-";
+    if (std::isfinite(c.true_pose_truth_psnr_db))
+      std::snprintf(perfect, sizeof perfect, "%.2f", c.true_pose_truth_psnr_db);
+    if (std::isfinite(c.recovered))
+      std::snprintf(recovered, sizeof recovered, "%.0f", 100 * c.recovered);
+    std::snprintf(line, sizeof line, "| %s | %.2f | %.2f | %s | %s |\n", c.name.c_str(),
+                  c.truth_psnr_db, c.unrefined_truth_psnr_db, perfect, recovered);
+    out += line;
+  }
+  out +=
+      "\n| family | recovered % median / worst (noisy poses) | dB against refinement off "
+      "median / worst (exact poses) |\n|---|---|---|\n";
+  for (const FamilySummary& f : families) {
+    char recovered[48] = "-", gain[48] = "-";
+    if (f.recovered.count > 0)
+      std::snprintf(recovered, sizeof recovered, "%.0f / %.0f (%d)", 100 * f.recovered.median,
+                    100 * f.recovered.worst, f.recovered.count);
+    if (f.exact_poses_gain_db.count > 0)
+      std::snprintf(gain, sizeof gain, "%+.2f / %+.2f (%d)", f.exact_poses_gain_db.median,
+                    f.exact_poses_gain_db.worst, f.exact_poses_gain_db.count);
+    std::snprintf(line, sizeof line, "| %s | %s | %s |\n", f.family.c_str(), recovered, gain);
     out += line;
   }
   return out;

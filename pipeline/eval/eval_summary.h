@@ -20,6 +20,10 @@ struct FamilySummary {
   int captures = 0;
   FigureSpread truth_psnr_db, truth_one_minus_ncc, psnr_db, one_minus_ncc, mover_leak, paint_fps,
       coverage;
+  // With EvalOptions::recovery: the share of the PSNR lost to pose noise that is recovered
+  // (noisy captures), and truth PSNR against refinement off on captures with exact poses (dB;
+  // the worst is the lowest).
+  FigureSpread recovered, exact_poses_gain_db;
 };
 
 // Families in order of first appearance, then "all".
@@ -30,7 +34,8 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                        const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families);
 
-// Per capture one line, then per family median and worst (Markdown table).
+// Per capture one line, then per family median and worst (Markdown tables); with
+// EvalOptions::recovery also what refinement recovers.
 std::string EvalToText(const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families);
 

@@ -113,6 +113,55 @@ TEST(EvalSummaryTest, MedianAndWorstPerFamily) {
   EXPECT_TRUE(j["families"][1]["mover_leak"].is_null());
 }
 
+// --recovery: the references are painted, and what refinement recovers of the PSNR lost to
+// pose noise is a fraction between them; a capture with exact poses gets no true-pose
+// reference.
+TEST(EvalRecoveryTest, ReferencesBracketTheRefinedPainting) {
+  EvalSuite suite;
+  const Status loaded = LoadText(
+      R"({"fresco_eval_suite": 1,
+          "defaults": {"size": [160, 120], "supersample": 2, "lens": "pinhole", "hfov_deg": 70},
+          "captures": [
+            {"name": "rot", "family": "room",
+             "synth": {"scene": "builtin:cube-room", "path": {"kind": "handheld", "turns": 0.5},
+                       "frames": 40, "seed": 1, "pose_noise_deg": 0.5}},
+            {"name": "exact", "family": "room",
+             "synth": {"scene": "builtin:cube-room", "path": {"kind": "handheld", "turns": 0.5},
+                       "frames": 20, "seed": 1}}]})",
+      &suite);
+  ASSERT_TRUE(loaded.ok()) << loaded.message();
+  EvalOptions options;
+  options.cache_dir = MakeTempDir("eval-recovery");
+  options.overrides = {"pipeline.refine.mode=robust"};
+  options.holdout = 5;
+  options.recovery = true;
+  std::vector<CaptureEval> r;
+  const Status s = EvaluateSuite(suite, options, &r);
+  ASSERT_TRUE(s.ok()) << s.message();
+  ASSERT_EQ(r.size(), 2u);
+  std::printf("rot: refined %.2f, off %.2f, true poses %.2f dB, recovered %.2f\n",
+              r[0].truth_psnr_db, r[0].unrefined_truth_psnr_db, r[0].true_pose_truth_psnr_db,
+              r[0].recovered);
+  EXPECT_TRUE(r[0].noisy_poses);
+  EXPECT_GT(r[0].true_pose_truth_psnr_db, r[0].unrefined_truth_psnr_db + 3);
+  ASSERT_TRUE(std::isfinite(r[0].recovered));
+  EXPECT_NEAR(r[0].recovered,
+              (r[0].truth_psnr_db - r[0].unrefined_truth_psnr_db) /
+                  (r[0].true_pose_truth_psnr_db - r[0].unrefined_truth_psnr_db),
+              1e-12);
+  EXPECT_GT(r[0].recovered, 0.1);  // refinement helps on a room with rotation noise
+  EXPECT_FALSE(r[1].noisy_poses);
+  EXPECT_TRUE(std::isfinite(r[1].unrefined_truth_psnr_db));
+  EXPECT_TRUE(std::isnan(r[1].true_pose_truth_psnr_db));
+  EXPECT_TRUE(std::isnan(r[1].recovered));
+  const std::vector<FamilySummary> f = SummarizeByFamily(r);
+  EXPECT_EQ(f.back().recovered.count, 1);
+  EXPECT_EQ(f.back().exact_poses_gain_db.count, 1);
+  const nlohmann::json j = nlohmann::json::parse(EvalToJson({}, r, f));
+  EXPECT_DOUBLE_EQ(j["captures"][0]["refinement"]["recovered"].get<double>(), r[0].recovered);
+  EXPECT_TRUE(j["captures"][1]["refinement"]["recovered"].is_null());
+}
+
 // The CI subset, painted once per setting (shared by the tests below).
 class EvalCiTest : public ::testing::Test {
  protected:
