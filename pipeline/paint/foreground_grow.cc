@@ -1,5 +1,6 @@
 #include "pipeline/paint/foreground_grow.h"
 
+#include <cstdint>
 #include <cstdlib>
 #include <vector>
 
@@ -9,36 +10,51 @@ int GrowForegroundByColour(const cv::Mat& bgr, const cv::Mat& valid, int levels,
                            cv::Mat* foreground) {
   if (levels <= 0 || reach <= 0 || foreground->empty()) return 0;
   const int w = foreground->cols, h = foreground->rows;
-  // Breadth first from every flagged texel at once; each added texel remembers its seed's
+  CV_Assert(w <= 65535 && h <= 65535 && bgr.size() == foreground->size() &&
+            valid.size() == foreground->size());
+  // Breadth first from every flagged texel at once; each added texel carries its seed's
   // colour (so the flag does not drift along a gradient) and its distance.
   struct Item {
-    int x, y, seed_x, seed_y, steps;
+    uint16_t x, y;
+    uint8_t b, g, r;
+    int steps;
   };
   std::vector<Item> queue;
+  queue.reserve(1024);
   for (int y = 0; y < h; ++y) {
-    const uint8_t* r = foreground->ptr<uint8_t>(y);
+    const uint8_t* flags = foreground->ptr<uint8_t>(y);
+    const uint8_t* colour = bgr.ptr<uint8_t>(y);
     for (int x = 0; x < w; ++x)
-      if (r[x]) queue.push_back({x, y, x, y, 0});
+      if (flags[x])
+        queue.push_back({static_cast<uint16_t>(x), static_cast<uint16_t>(y), colour[3 * x],
+                         colour[3 * x + 1], colour[3 * x + 2], 0});
   }
+  uint8_t* const flag0 = foreground->data;
+  const uint8_t* const valid0 = valid.data;
+  const uint8_t* const bgr0 = bgr.data;
+  const size_t flag_step = foreground->step, valid_step = valid.step, bgr_step = bgr.step;
   int added = 0;
-  constexpr int kDx[4] = {1, -1, 0, 0}, kDy[4] = {0, 0, 1, -1};
+  // Neighbours in the order +x, -x, +y, -y (the order decides which seed claims a texel).
   for (size_t head = 0; head < queue.size(); ++head) {
     const Item item = queue[head];
     if (item.steps >= reach) continue;
-    const cv::Vec3b seed = bgr.at<cv::Vec3b>(item.seed_y, item.seed_x);
-    for (int d = 0; d < 4; ++d) {
-      const int x = item.x + kDx[d], y = item.y + kDy[d];
-      if (x < 0 || y < 0 || x >= w || y >= h) continue;
-      uint8_t& flag = foreground->at<uint8_t>(y, x);
-      if (flag || !valid.at<uint8_t>(y, x)) continue;
-      const cv::Vec3b s = bgr.at<cv::Vec3b>(y, x);
-      if (std::abs(s[0] - seed[0]) > levels || std::abs(s[1] - seed[1]) > levels ||
-          std::abs(s[2] - seed[2]) > levels)
-        continue;
-      flag = 255;
+    const auto visit = [&](int x, int y) {
+      uint8_t* flag = flag0 + y * flag_step + x;
+      if (*flag || !valid0[y * valid_step + x]) return;
+      const uint8_t* s = bgr0 + y * bgr_step + 3 * x;
+      if (std::abs(s[0] - item.b) > levels || std::abs(s[1] - item.g) > levels ||
+          std::abs(s[2] - item.r) > levels)
+        return;
+      *flag = 255;
       ++added;
-      queue.push_back({x, y, item.seed_x, item.seed_y, item.steps + 1});
-    }
+      queue.push_back({static_cast<uint16_t>(x), static_cast<uint16_t>(y), item.b, item.g, item.r,
+                       item.steps + 1});
+    };
+    const int x = item.x, y = item.y;
+    if (x + 1 < w) visit(x + 1, y);
+    if (x > 0) visit(x - 1, y);
+    if (y + 1 < h) visit(x, y + 1);
+    if (y > 0) visit(x, y - 1);
   }
   return added;
 }
