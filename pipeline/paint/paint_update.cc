@@ -16,9 +16,70 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->quality.create(buffer.height, buffer.width, CV_32F);
   painted->quality.setTo(0);
   painted->painted_surface_texels = 0;
+  painted->texel_kind = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+  for (int k = 0; k < buffer.NumTexels(); ++k)
+    painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
 }
 
 namespace {
+
+// One texel (rectangle index `idx`).
+[[gnu::always_inline]] inline void PaintTexel(int idx, bool on_surface, const uint8_t* valid,
+                                              const uint8_t* src, const float* quality,
+                                              const uint8_t* skip,
+                                              const uint8_t* provisional_sample,
+                                              const TexelUpdateRule& rule, uint8_t* dst,
+                                              float* stored_quality, PaintUpdateStats* stats) {
+  const bool provisional = provisional_sample && provisional_sample[idx];
+  if (valid[idx] && !(skip && skip[idx])) {
+    const float stored = stored_quality[idx];
+    uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
+    if (stored >= 0.0f) {
+      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], on_surface, texel,
+                  stored_quality + idx, stats);
+    } else {
+      // A provisional stored sample: against a trusted sample it counts as nothing; against
+      // another provisional one, by its quality.
+      float compared_with = provisional ? -stored : 0.0f;
+      const int written_before = stats->written;
+      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], on_surface, texel,
+                  &compared_with, stats);
+      if (stats->written > written_before) stored_quality[idx] = compared_with;
+    }
+  }
+  // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
+  if (provisional) stored_quality[idx] = -std::abs(stored_quality[idx]);
+}
+
+// Rows [y0, y1) of the warped box `box`, left to right: every array is read and written in
+// the rectangle's order, one stream each, which the hardware prefetches (a tile at a time
+// they were 16 streams per array). Texels outside the buffer and those not seen this frame
+// have `valid` and `warming` 0 and are left alone, as the texel order would leave them; so are
+// the rectangle's texels that are not the buffer's (refinement may warp `valid` onto them).
+PaintUpdateStats PaintRows(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
+                           const TexelUpdateRule& rule, const cv::Rect& box, int y0, int y1,
+                           PaintedBuffer* painted) {
+  PaintUpdateStats stats;
+  const uint8_t* valid = warped.valid.data;
+  const uint8_t* src = warped.bgr.data;
+  const float* quality = warped.quality.ptr<float>();
+  const uint8_t* skip = mask.empty() ? nullptr : mask.data;
+  const uint8_t* provisional_sample = warming.empty() ? nullptr : warming.data;
+  const uint8_t* kind = painted->texel_kind.data;
+  uint8_t* dst = painted->bgra.data;
+  float* stored_quality = painted->quality.ptr<float>();
+  const int width = warped.valid.cols;
+  for (int y = y0; y < y1; ++y) {
+    const int row = y * width;
+    for (int idx = row + box.x; idx < row + box.x + box.width; ++idx) {
+      if (kind[idx] == 0 || (!valid[idx] && !(provisional_sample && provisional_sample[idx])))
+        continue;
+      PaintTexel(idx, kind[idx] == 2, valid, src, quality, skip, provisional_sample, rule, dst,
+                 stored_quality, &stats);
+    }
+  }
+  return stats;
+}
 
 // Texels [begin, end) of one chunk.
 PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warped,
@@ -33,28 +94,9 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
   const uint8_t* provisional_sample = warming.empty() ? nullptr : warming.data;
   uint8_t* dst = painted->bgra.data;
   float* stored_quality = painted->quality.ptr<float>();
-  for (int k = begin; k < end; ++k) {
-    const int idx = buffer.texel_index[k];
-    const bool provisional = provisional_sample && provisional_sample[idx];
-    if (valid[idx] && !(skip && skip[idx])) {
-      const float stored = stored_quality[idx];
-      uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
-      if (stored >= 0.0f) {
-        UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
-                    texel, stored_quality + idx, &stats);
-      } else {
-        // A provisional stored sample: against a trusted sample it counts as nothing; against
-        // another provisional one, by its quality.
-        float compared_with = provisional ? -stored : 0.0f;
-        const int written_before = stats.written;
-        UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], buffer.on_surface[k],
-                    texel, &compared_with, &stats);
-        if (stats.written > written_before) stored_quality[idx] = compared_with;
-      }
-    }
-    // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
-    if (provisional) stored_quality[idx] = -std::abs(stored_quality[idx]);
-  }
+  for (int k = begin; k < end; ++k)
+    PaintTexel(buffer.texel_index[k], buffer.on_surface[k] != 0, valid, src, quality, skip,
+               provisional_sample, rule, dst, stored_quality, &stats);
   return stats;
 }
 
@@ -67,6 +109,28 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
     stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);
+    painted->painted_surface_texels += stats.newly_painted;
+    return stats;
+  }
+  if (painted->texel_kind.size() == painted->bgra.size() && warped.valid.isContinuous() &&
+      painted->bgra.isContinuous()) {
+    // Row by row over the box the warp wrote, in bands of rows in parallel (disjoint texels),
+    // reduced in band order (deterministic).
+    const cv::Rect box = warped.valid_box & cv::Rect(0, 0, buffer.width, buffer.height);
+    constexpr int kBandRows = 16;
+    const int bands = (box.height + kBandRows - 1) / kBandRows;
+    std::vector<PaintUpdateStats> per_band(std::max(bands, 0));
+    cv::parallel_for_(
+        cv::Range(0, std::max(bands, 0)),
+        [&](const cv::Range& range) {
+          for (int i = range.start; i < range.end; ++i) {
+            const int y0 = box.y + i * kBandRows;
+            per_band[i] = PaintRows(warped, mask, warming, rule, box, y0,
+                                    std::min(y0 + kBandRows, box.br().y), painted);
+          }
+        },
+        std::max(1, bands));
+    for (const PaintUpdateStats& s : per_band) stats.Add(s);
     painted->painted_surface_texels += stats.newly_painted;
     return stats;
   }

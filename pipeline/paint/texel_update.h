@@ -15,9 +15,13 @@
 namespace fresco {
 
 struct PaintedBuffer {
-  cv::Mat bgra;     // CV_8UC4, alpha 255 where painted, 0 where never painted
-  cv::Mat quality;  // CV_32F, quality of the stored sample (pixels per texel)
+  cv::Mat bgra;                    // CV_8UC4, alpha 255 where painted, 0 where never painted
+  cv::Mat quality;                 // CV_32F, quality of the stored sample (pixels per texel)
   int painted_surface_texels = 0;  // on-surface texels painted at least once
+  // CV_8U, per texel of the rectangle: 0 not one of the buffer's texels, 1 in the gutter, 2 on
+  // the surface (BaseBuffer::texel_index and on_surface in the rectangle's layout), for
+  // updates that walk the rectangle row by row (InitPaintedBuffer).
+  cv::Mat texel_kind;
 };
 
 struct PaintUpdateStats {
@@ -45,8 +49,7 @@ struct TexelUpdateRule {
     TexelUpdateRule rule;
     rule.policy = options.update;
     rule.keep = static_cast<float>(1.0 - options.quality_slack);
-    rule.weight =
-        std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
+    rule.weight = std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
     return rule;
   }
 };
