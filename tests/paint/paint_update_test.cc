@@ -1,6 +1,8 @@
 // The paint stage's update (pipeline/paint/paint_update.h) on a two-texel buffer: replace (the
 // paper's) or a running average with weight PipelineOptions::update_weight; provisional
 // samples while the background model warms up.
+#include <random>
+
 #include <gtest/gtest.h>
 
 #include "pipeline/paint/paint_update.h"
@@ -81,6 +83,78 @@ TEST(PaintUpdate, ProvisionalSamplesKeepTheSharperAndGiveWayToTrustedOnes) {
   paint_into(&near, 120, 0.3f, false);
   EXPECT_EQ(near.Stored(), 120);
   EXPECT_FLOAT_EQ(near.painted.quality.at<float>(0, 1), 0.3f);
+}
+
+// The update walks each rectangle row by row when InitPaintedBuffer has laid out which texels
+// are the buffer's; the texel order (tile by tile through texel_index) must give the same
+// texels, qualities and figures, frame after frame, with masks, provisional samples, and
+// valid flags on rectangle texels that are not the buffer's (refinement warps `valid`).
+TEST(PaintUpdate, RowByRowEqualsTheTexelOrder) {
+  BaseBuffer buffer;
+  buffer.width = 40, buffer.height = 24;
+  std::mt19937 rng(3);
+  const auto coin = [&](int percent) { return static_cast<int>(rng() % 100) < percent; };
+  cv::Mat member(buffer.height, buffer.width, CV_8U);
+  for (int y = 0; y < buffer.height; ++y)
+    for (int x = 0; x < buffer.width; ++x) member.at<uint8_t>(y, x) = x + y > 6 && x < 37;
+  for (int ty = 0; ty < buffer.height; ty += 16) {
+    for (int tx = 0; tx < buffer.width; tx += 16) {
+      BaseBuffer::Chunk chunk;
+      chunk.x0 = tx, chunk.y0 = ty;
+      chunk.x1 = std::min(tx + 16, buffer.width), chunk.y1 = std::min(ty + 16, buffer.height);
+      chunk.begin = buffer.NumTexels();
+      for (int y = chunk.y0; y < chunk.y1; ++y)
+        for (int x = chunk.x0; x < chunk.x1; ++x)
+          if (member.at<uint8_t>(y, x)) {
+            buffer.texel_index.push_back(y * buffer.width + x);
+            buffer.on_surface.push_back(coin(80));
+          }
+      chunk.end = buffer.NumTexels();
+      buffer.chunks.push_back(chunk);
+    }
+  }
+  PaintedBuffer rows, texels;
+  InitPaintedBuffer(buffer, &rows);
+  InitPaintedBuffer(buffer, &texels);
+  ASSERT_EQ(cv::countNonZero(rows.texel_kind), buffer.NumTexels());
+  texels.texel_kind.release();  // the texel order
+  PipelineOptions options;
+  for (int frame = 0; frame < 12; ++frame) {
+    WarpedBuffer warped;
+    warped.bgr.create(buffer.height, buffer.width, CV_8UC3);
+    cv::randu(warped.bgr, cv::Scalar::all(0), cv::Scalar::all(256));
+    warped.valid = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    warped.quality.create(buffer.height, buffer.width, CV_32F);
+    cv::randu(warped.quality, 0.1, 1.0);
+    cv::Mat mask = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    cv::Mat warming = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
+    // A window of the rectangle in view; inside it most texels valid, including texels that
+    // are not the buffer's.
+    const cv::Rect view(static_cast<int>(rng() % 12), static_cast<int>(rng() % 8),
+                        20 + static_cast<int>(rng() % 9), 12 + static_cast<int>(rng() % 5));
+    for (int y = view.y; y < view.br().y; ++y)
+      for (int x = view.x; x < view.br().x; ++x) {
+        warped.valid.at<uint8_t>(y, x) = coin(85) ? 255 : 0;
+        mask.at<uint8_t>(y, x) = coin(10) ? 255 : 0;
+        warming.at<uint8_t>(y, x) = frame < 6 && coin(50) ? 255 : 0;
+      }
+    warped.valid_box = view;
+    const PaintUpdateStats a = PaintBuffer(buffer, warped, mask, options, &rows, warming);
+    const PaintUpdateStats b = PaintBuffer(buffer, warped, mask, options, &texels, warming);
+    EXPECT_EQ(a.written, b.written) << frame;
+    EXPECT_EQ(a.rejected, b.rejected) << frame;
+    EXPECT_EQ(a.compared, b.compared) << frame;
+    EXPECT_EQ(a.abs_grey_difference_sum, b.abs_grey_difference_sum) << frame;
+    EXPECT_EQ(a.newly_painted, b.newly_painted) << frame;
+    EXPECT_GT(a.written, 50) << frame;
+    ASSERT_EQ(cv::norm(rows.bgra, texels.bgra, cv::NORM_INF), 0.0) << frame;
+    ASSERT_EQ(cv::norm(rows.quality, texels.quality, cv::NORM_INF), 0.0) << frame;
+  }
+  EXPECT_EQ(rows.painted_surface_texels, texels.painted_surface_texels);
+  // Rectangle texels that are not the buffer's were never painted, valid or not.
+  cv::Mat alpha;
+  cv::extractChannel(rows.bgra, alpha, 3);
+  EXPECT_EQ(cv::countNonZero(alpha & (member == 0)), 0);
 }
 
 }  // namespace
