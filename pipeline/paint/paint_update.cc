@@ -23,32 +23,49 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
 
 namespace {
 
+// The arrays one frame's update reads and writes, all in the rectangle's layout.
+struct PaintArrays {
+  const uint8_t* valid;
+  const uint8_t* src;
+  const float* quality;
+  const uint8_t* skip;         // null: no mask
+  const uint8_t* provisional;  // null: no sample is provisional
+  uint8_t* dst;
+  float* stored_quality;
+
+  PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
+              PaintedBuffer* painted)
+      : valid(warped.valid.data),
+        src(warped.bgr.data),
+        quality(warped.quality.ptr<float>()),
+        skip(mask.empty() ? nullptr : mask.data),
+        provisional(warming.empty() ? nullptr : warming.data),
+        dst(painted->bgra.data),
+        stored_quality(painted->quality.ptr<float>()) {}
+};
+
 // One texel (rectangle index `idx`).
-[[gnu::always_inline]] inline void PaintTexel(int idx, bool on_surface, const uint8_t* valid,
-                                              const uint8_t* src, const float* quality,
-                                              const uint8_t* skip,
-                                              const uint8_t* provisional_sample,
-                                              const TexelUpdateRule& rule, uint8_t* dst,
-                                              float* stored_quality, PaintUpdateStats* stats) {
-  const bool provisional = provisional_sample && provisional_sample[idx];
-  if (valid[idx] && !(skip && skip[idx])) {
-    const float stored = stored_quality[idx];
-    uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
+[[gnu::always_inline]] inline void PaintTexel(const PaintArrays& a, int idx, bool on_surface,
+                                              const TexelUpdateRule& rule,
+                                              PaintUpdateStats* stats) {
+  const bool provisional = a.provisional && a.provisional[idx];
+  if (a.valid[idx] && !(a.skip && a.skip[idx])) {
+    const float stored = a.stored_quality[idx];
+    uint8_t* texel = a.dst + 4 * static_cast<size_t>(idx);
+    const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
     if (stored >= 0.0f) {
-      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], on_surface, texel,
-                  stored_quality + idx, stats);
+      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, a.stored_quality + idx, stats);
     } else {
       // A provisional stored sample: against a trusted sample it counts as nothing; against
       // another provisional one, by its quality.
       float compared_with = provisional ? -stored : 0.0f;
       const int written_before = stats->written;
-      UpdateTexel(rule, src + 3 * static_cast<size_t>(idx), quality[idx], on_surface, texel,
-                  &compared_with, stats);
-      if (stats->written > written_before) stored_quality[idx] = compared_with;
+      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, &compared_with, stats);
+      if (stats->written > written_before) a.stored_quality[idx] = compared_with;
     }
   }
   // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
-  if (provisional) stored_quality[idx] = -std::abs(stored_quality[idx]);
+  if (provisional) a.stored_quality[idx] = -std::abs(a.stored_quality[idx]);
 }
 
 // Rows [y0, y1) of the warped box `box`, left to right: every array is read and written in
@@ -60,22 +77,14 @@ PaintUpdateStats PaintRows(const WarpedBuffer& warped, const cv::Mat& mask, cons
                            const TexelUpdateRule& rule, const cv::Rect& box, int y0, int y1,
                            PaintedBuffer* painted) {
   PaintUpdateStats stats;
-  const uint8_t* valid = warped.valid.data;
-  const uint8_t* src = warped.bgr.data;
-  const float* quality = warped.quality.ptr<float>();
-  const uint8_t* skip = mask.empty() ? nullptr : mask.data;
-  const uint8_t* provisional_sample = warming.empty() ? nullptr : warming.data;
+  const PaintArrays a(warped, mask, warming, painted);
   const uint8_t* kind = painted->texel_kind.data;
-  uint8_t* dst = painted->bgra.data;
-  float* stored_quality = painted->quality.ptr<float>();
   const int width = warped.valid.cols;
   for (int y = y0; y < y1; ++y) {
     const int row = y * width;
     for (int idx = row + box.x; idx < row + box.x + box.width; ++idx) {
-      if (kind[idx] == 0 || (!valid[idx] && !(provisional_sample && provisional_sample[idx])))
-        continue;
-      PaintTexel(idx, kind[idx] == 2, valid, src, quality, skip, provisional_sample, rule, dst,
-                 stored_quality, &stats);
+      if (kind[idx] == 0 || (!a.valid[idx] && !(a.provisional && a.provisional[idx]))) continue;
+      PaintTexel(a, idx, kind[idx] == 2, rule, &stats);
     }
   }
   return stats;
@@ -87,16 +96,9 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
                              const TexelUpdateRule& rule, int begin, int end,
                              PaintedBuffer* painted) {
   PaintUpdateStats stats;
-  const uint8_t* valid = warped.valid.data;
-  const uint8_t* src = warped.bgr.data;
-  const float* quality = warped.quality.ptr<float>();
-  const uint8_t* skip = mask.empty() ? nullptr : mask.data;
-  const uint8_t* provisional_sample = warming.empty() ? nullptr : warming.data;
-  uint8_t* dst = painted->bgra.data;
-  float* stored_quality = painted->quality.ptr<float>();
+  const PaintArrays a(warped, mask, warming, painted);
   for (int k = begin; k < end; ++k)
-    PaintTexel(buffer.texel_index[k], buffer.on_surface[k] != 0, valid, src, quality, skip,
-               provisional_sample, rule, dst, stored_quality, &stats);
+    PaintTexel(a, buffer.texel_index[k], buffer.on_surface[k] != 0, rule, &stats);
   return stats;
 }
 
