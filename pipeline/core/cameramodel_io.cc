@@ -25,8 +25,8 @@ namespace {
 
 struct Value {
   enum Kind { kString, kScalar, kList, kDict } kind = kScalar;
-  std::string text;                                   // kString: contents; kScalar: token
-  std::vector<Value> items;                           // kList
+  std::string text;          // kString: contents; kScalar: token
+  std::vector<Value> items;  // kList
   // kDict, in file order, each with its `key` (not a vector of pairs: a pair of an
   // incomplete type is ill-formed, and clang's libstdc++ checks refuse it).
   std::vector<Value> fields;
@@ -296,7 +296,12 @@ std::string NumberList(const std::vector<double>& values) {
 Status ParseCameraModel(const std::string& text, const std::string& name, CameraModelFile* model) {
   LensModel lens_model = LensModel::kPinhole;
   FRESCO_RETURN_IF_ERROR(Diagnose(text, name, &lens_model));
-  MrcalModelPtr parsed(mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size())));
+  // libmrcal's reader skips a '#' comment up to its newline without looking at the length:
+  // a file ending in a comment with no newline made it read past the end. One more newline
+  // changes nothing else.
+  const std::string terminated = text + '\n';
+  MrcalModelPtr parsed(
+      mrcal_read_cameramodel_string(terminated.c_str(), static_cast<int>(terminated.size())));
   if (!parsed)
     return Status::Error(name + ": libmrcal could not parse the model (its reason is on stderr)");
   if (parsed->lensmodel.type != mrcal_lensmodel_type_from_name(LensModelName(lens_model).c_str()))

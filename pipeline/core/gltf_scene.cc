@@ -835,6 +835,46 @@ std::string_view GltfJson(const std::string& bytes, bool binary) {
   return std::string_view(bytes).substr(20, length);
 }
 
+// tinygltf hands an image stored in a bufferView to the image loader without checking that
+// the view lies inside its buffer: a GLB whose JSON declares a buffer shorter than the view
+// made stb_image read past the end. While parsing, only images read from a URI (whole files
+// or data URIs, in bounds) are decoded; the others are decoded by DecodeBufferViewImages.
+bool DecodeUriImagesOnly(tinygltf::Image* image, int index, std::string* err, std::string* warn,
+                         int width, int height, const unsigned char* bytes, int size, void*) {
+  if (image->bufferView != -1) return true;
+  return tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, nullptr);
+}
+
+// Decodes the images stored in bufferViews once each view is known to lie in its buffer
+// (tinygltf has checked that the view and buffer indices exist).
+Status DecodeBufferViewImages(const std::string& path, tinygltf::Model* model) {
+  for (size_t i = 0; i < model->images.size(); ++i) {
+    tinygltf::Image& image = model->images[i];
+    if (image.bufferView == -1) continue;
+    const tinygltf::BufferView& view = model->bufferViews[static_cast<size_t>(image.bufferView)];
+    const tinygltf::Buffer& buffer = model->buffers[static_cast<size_t>(view.buffer)];
+    const std::string where = path + ": images[" + std::to_string(i) + "]: bufferViews[" +
+                              std::to_string(image.bufferView) + "]";
+    const size_t size = buffer.data.size();
+    if (view.byteOffset > size || view.byteLength > size - view.byteOffset) {
+      return Status::Error(where + " (bytes " + std::to_string(view.byteOffset) + " + " +
+                           std::to_string(view.byteLength) + ") runs past the end of buffers[" +
+                           std::to_string(view.buffer) + "] (" + std::to_string(size) + " bytes)");
+    }
+    if (view.byteLength > static_cast<size_t>(std::numeric_limits<int>::max())) {
+      return Status::Error(where + ": image larger than 2 GB");
+    }
+    std::string err, warn;
+    if (!tinygltf::LoadImageData(&image, static_cast<int>(i), &err, &warn, image.width,
+                                 image.height, buffer.data.data() + view.byteOffset,
+                                 static_cast<int>(view.byteLength), nullptr)) {
+      std::string why = OneLine(err);
+      return Status::Error(where + ": cannot decode the image" + (why.empty() ? "" : ": " + why));
+    }
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status LoadGltfScene(const std::string& path, const SceneLoadOptions& options, Scene* scene) {
@@ -854,6 +894,7 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
     return Status::Error(path + ": larger than 4 GB, which tinygltf cannot read");
   }
   tinygltf::TinyGLTF io;
+  io.SetImageLoader(DecodeUriImagesOnly, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   const bool binary = HasGlbMagic(bytes);
@@ -874,6 +915,7 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
     return Status::Error(path + ": cannot parse " + (binary ? "GLB" : "glTF") + ": " +
                          (why.empty() ? "unknown error" : why));
   }
+  FRESCO_RETURN_IF_ERROR(DecodeBufferViewImages(path, &model));
   Scene loaded;
   loaded.source_path = path;
   for (const std::string& line : Lines(warn)) loaded.warnings.push_back(line);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/cameramodel_io.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "pipeline/core/scene.h"
@@ -55,8 +56,8 @@ TEST(FuzzRegressionTest, DeeplyNestedGltfJsonIsAnError) {
     SCOPED_TRACE(binary ? "GLB" : "glTF");
     const std::string json = GltfWithExtras(Nested("[", "]", 200000));
     Scene scene;
-    const Status status = ParseGltfScene(binary ? Glb(json) : json, "deep.gltf", "",
-                                         SceneLoadOptions(), &scene);
+    const Status status =
+        ParseGltfScene(binary ? Glb(json) : json, "deep.gltf", "", SceneLoadOptions(), &scene);
     ASSERT_FALSE(status.ok());
     EXPECT_THAT(status.message(), HasSubstr("deep.gltf: cannot parse "));
     EXPECT_THAT(status.message(), HasSubstr("JSON nested more than 128 levels deep"));
@@ -97,10 +98,9 @@ TEST(FuzzRegressionTest, HugeAccessorWithoutBufferViewIsAnError) {
 // file, the primitive and the attribute.
 TEST(FuzzRegressionTest, NonFiniteUvIsAnError) {
   std::string bytes;
-  ASSERT_TRUE(
-      ReadFileToString(testing::SourceDir() + "/tests/fuzz/seeds/gltf/found-nonfinite-uv.glb",
-                       &bytes)
-          .ok());
+  ASSERT_TRUE(ReadFileToString(
+                  testing::SourceDir() + "/tests/fuzz/seeds/gltf/found-nonfinite-uv.glb", &bytes)
+                  .ok());
   Scene scene;
   const Status status = ParseGltfScene(bytes, "found.glb", "", SceneLoadOptions(), &scene);
   ASSERT_FALSE(status.ok());
@@ -123,6 +123,53 @@ TEST(FuzzRegressionTest, NumberOverflowInProjectIsAnError) {
     EXPECT_THAT(status.message(), HasSubstr("number overflow"));
     EXPECT_EQ(status.message().find('\n'), std::string::npos);
   }
+}
+
+// A GLB image in a bufferView that runs past its buffer (the JSON declares a shorter buffer
+// than the view needs): tinygltf handed stb_image the view unchecked and it read past the end
+// of the buffer (ASan). Now an error naming the image and the view; with the buffer's true
+// length the same file loads, its 2x2 texture decoded from the view.
+TEST(FuzzRegressionTest, ImageViewPastItsBufferIsAnError) {
+  std::string bytes;
+  ASSERT_TRUE(
+      ReadFileToString(
+          testing::SourceDir() + "/tests/fuzz/seeds/gltf/found-image-view-past-buffer.glb", &bytes)
+          .ok());
+  Scene scene;
+  const Status status = ParseGltfScene(bytes, "found.glb", "", SceneLoadOptions(), &scene);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(),
+            "found.glb: images[0]: bufferViews[3] (bytes 68 + 75) runs past the end of "
+            "buffers[0] (100 bytes)");
+
+  const std::string declared = "\"byteLength\":100}", whole = "\"byteLength\":144}";
+  const size_t at = bytes.find(declared);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, declared.size(), whole);
+  const Status fixed = ParseGltfScene(bytes, "fixed.glb", "", SceneLoadOptions(), &scene);
+  ASSERT_TRUE(fixed.ok()) << fixed.message();
+  ASSERT_EQ(scene.textures.size(), 1u);
+  EXPECT_EQ(scene.textures[0].rgba.size(), cv::Size(2, 2));
+  EXPECT_EQ(scene.textures[0].rgba.at<cv::Vec4b>(0, 1), cv::Vec4b(0, 255, 0, 255));
+}
+
+// A .cameramodel whose last line is a comment with no newline: libmrcal's reader ran past
+// the end of the text looking for the newline (ASan). It reads like the same file without
+// the comment.
+TEST(FuzzRegressionTest, CommentAtTheEndOfACameraModelIsRead) {
+  std::string text;
+  ASSERT_TRUE(ReadFileToString(testing::SourceDir() +
+                                   "/tests/fuzz/seeds/cameramodel/found-comment-at-end.cameramodel",
+                               &text)
+                  .ok());
+  ASSERT_NE(text.back(), '\n');
+  CameraModelFile with_comment, without;
+  const Status status = ParseCameraModel(text, "found.cameramodel", &with_comment);
+  ASSERT_TRUE(status.ok()) << status.message();
+  const std::string plain = text.substr(0, text.rfind('#'));
+  ASSERT_TRUE(ParseCameraModel(plain, "plain.cameramodel", &without).ok());
+  EXPECT_EQ(with_comment.camera.Params(), without.camera.Params());
+  EXPECT_EQ(with_comment.camera.width, 1280);
 }
 
 // The in-memory readers give what the file readers give.
