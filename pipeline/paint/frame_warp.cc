@@ -256,7 +256,7 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
   }
 }
 
-__attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void ProjectChunkPinhole(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
   if (chunk.affine && chunk.uniform_normal)
@@ -265,7 +265,7 @@ __attribute__((target_clones("avx2", "default"))) void ProjectChunkPinhole(
     ProjectChunkBody<LensTerms::kNone, TileSource::kStored>(k, buffer, chunk, out);
 }
 
-__attribute__((target_clones("avx2", "default"))) void ProjectChunkDistorted(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void ProjectChunkDistorted(
     const KernelContext& k, const BaseBuffer& buffer, const BaseBuffer::Chunk& chunk,
     ChunkProjection* out) {
   const bool affine = chunk.affine && chunk.uniform_normal;
@@ -412,37 +412,36 @@ __attribute__((always_inline)) inline int SampleBatchBody(int n,
   return visible;
 }
 
-__attribute__((target_clones("avx2", "default"))) int SampleBatchDepth(int n,
-                                                                       const ChunkProjection* proj,
-                                                                       PaintBatch* b) {
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) int SampleBatchDepth(
+    int n, const ChunkProjection* proj, PaintBatch* b) {
   return SampleBatchBody<1>(n, proj, b);
 }
 
-__attribute__((target_clones("avx2", "default"))) int SampleBatchDepthRange(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) int SampleBatchDepthRange(
     int n, const ChunkProjection* proj, PaintBatch* b) {
   return SampleBatchBody<2>(n, proj, b);
 }
 
-__attribute__((target_clones("avx2", "default"))) int SampleBatchNoDepth(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) int SampleBatchNoDepth(
     int n, const ChunkProjection* proj, PaintBatch* b) {
   return SampleBatchBody<0>(n, proj, b);
 }
 
-__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepth(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) PaintBatchSums PaintBatchDepth(
     int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
     PaintBatch* b) {
   return PaintBatchBody<1>(n, quality_policy, keep, proj, on_surface, b);
 }
 
-__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchDepthRange(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
-    PaintBatch* b) {
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) PaintBatchSums
+PaintBatchDepthRange(int n, bool quality_policy, float keep, const ChunkProjection* proj,
+                     const uint8_t* on_surface, PaintBatch* b) {
   return PaintBatchBody<2>(n, quality_policy, keep, proj, on_surface, b);
 }
 
-__attribute__((target_clones("avx2", "default"))) PaintBatchSums PaintBatchNoDepth(
-    int n, bool quality_policy, float keep, const ChunkProjection* proj, const uint8_t* on_surface,
-    PaintBatch* b) {
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) PaintBatchSums
+PaintBatchNoDepth(int n, bool quality_policy, float keep, const ChunkProjection* proj,
+                  const uint8_t* on_surface, PaintBatch* b) {
   return PaintBatchBody<0>(n, quality_policy, keep, proj, on_surface, b);
 }
 
@@ -780,25 +779,31 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera) {
   return b;
 }
 
+namespace {
+
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void DepthRangeRow(
+    const float* __restrict d0, const float* __restrict d1, int w, float* __restrict out) {
+  for (int x = 0; x + 1 < w; ++x) {
+    const float lo0 = std::min(d0[x], d0[x + 1]), lo1 = std::min(d1[x], d1[x + 1]);
+    const float hi0 = std::max(d0[x], d0[x + 1]), hi1 = std::max(d1[x], d1[x + 1]);
+    out[2 * x] = std::min(lo0, lo1);
+    out[2 * x + 1] = std::max(hi0, hi1);
+  }
+  if (w > 0) {
+    out[2 * (w - 1)] = std::min(d0[w - 1], d1[w - 1]);
+    out[2 * (w - 1) + 1] = std::max(d0[w - 1], d1[w - 1]);
+  }
+}
+
+}  // namespace
+
 void DepthRange2x2(const cv::Mat& depth, cv::Mat* range) {
   const int w = depth.cols, h = depth.rows;
   range->create(h, w, CV_32FC2);
   cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
-    for (int y = rows.start; y < rows.end; ++y) {
-      const float* __restrict d0 = depth.ptr<float>(y);
-      const float* __restrict d1 = depth.ptr<float>(std::min(y + 1, h - 1));
-      float* __restrict out = range->ptr<float>(y);
-      for (int x = 0; x + 1 < w; ++x) {
-        const float lo0 = std::min(d0[x], d0[x + 1]), lo1 = std::min(d1[x], d1[x + 1]);
-        const float hi0 = std::max(d0[x], d0[x + 1]), hi1 = std::max(d1[x], d1[x + 1]);
-        out[2 * x] = std::min(lo0, lo1);
-        out[2 * x + 1] = std::max(hi0, hi1);
-      }
-      if (w > 0) {
-        out[2 * (w - 1)] = std::min(d0[w - 1], d1[w - 1]);
-        out[2 * (w - 1) + 1] = std::max(d0[w - 1], d1[w - 1]);
-      }
-    }
+    for (int y = rows.start; y < rows.end; ++y)
+      DepthRangeRow(depth.ptr<float>(y), depth.ptr<float>(std::min(y + 1, h - 1)), w,
+                    range->ptr<float>(y));
   });
 }
 

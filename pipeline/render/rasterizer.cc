@@ -527,7 +527,7 @@ class TaskRecord<InverseDepthShards> {
   }
 }
 
-__attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void MaxInverseDepthRow(
     const float* __restrict col_x, int c0, int c1, float y, const TriangleSetup& s, double inv_near,
     float* __restrict inv_row) {
   MaxInverseDepthRowBody(col_x, c0, c1, y, s, inv_near, inv_row);
@@ -550,7 +550,7 @@ __attribute__((target_clones("avx2", "default"))) void MaxInverseDepthRow(
 // inverse depths so far (kept per bucket row, written to the samples once the row is done, so
 // that this loop has no scattered reads or writes); `inside` when the bucket lies wholly
 // inside the triangle (no edge tests).
-__attribute__((target_clones("avx2", "default"))) void MaxInverseDepthBucket(
+__attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void MaxInverseDepthBucket(
     const float* __restrict xs, const float* __restrict ys, int n, bool inside,
     const TriangleSetup& s, double inv_near, float* __restrict best) {
   const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
