@@ -89,6 +89,19 @@ const Capture& TheCapture(int which) {
   return *captures[which];
 }
 
+// Paints the capture's frames in order at their true poses; `each` sees every frame's report.
+template <class EachReport>
+void PaintAllFrames(const Capture& c, PaintSession* session, EachReport each) {
+  FrameReport report;
+  for (size_t i = 0; i < c.capture.frames_bgr.size(); ++i) {
+    Frame frame;
+    frame.index = static_cast<int>(i);
+    frame.bgr = c.capture.frames_bgr[i];
+    session->PaintFrame(frame, c.capture.camera, c.capture.true_poses[i].cam_from_world, &report);
+    each(report);
+  }
+}
+
 void BM_Paint(benchmark::State& state) {
   const Capture& c = TheCapture(static_cast<int>(state.range(0)));
   state.SetLabel(kCaptureNames[state.range(0)]);
@@ -105,18 +118,13 @@ void BM_Paint(benchmark::State& state) {
     session->PrepareCamera(c.capture.camera);
     texels = session->NumSurfaceTexels();
     state.ResumeTiming();
-    FrameReport report;
-    for (size_t i = 0; i < c.capture.frames_bgr.size(); ++i) {
-      Frame frame;
-      frame.index = static_cast<int>(i);
-      frame.bgr = c.capture.frames_bgr[i];
-      session->PaintFrame(frame, c.capture.camera, c.capture.true_poses[i].cam_from_world, &report);
+    PaintAllFrames(c, session.get(), [&](const FrameReport& report) {
       for (const StageReport& stage : report.stages) stage_ms[stage.name] += stage.wall_ms;
       const StageReport* warp = report.Stage("warp");
       tested += warp->metrics.at("texels_tested");
       in_view += warp->metrics.at("texels_in_view");
       ++frames;
-    }
+    });
     state.PauseTiming();  // tearing the session down is not painting
     session.reset();
     state.ResumeTiming();
@@ -202,14 +210,8 @@ void BM_PaintVsRemap(benchmark::State& state) {
   for (auto _ : state) {
     std::unique_ptr<PaintSession> session = c.Session();
     session->PrepareCamera(c.capture.camera);
-    FrameReport report;
     Clock::time_point start = Clock::now();
-    for (size_t i = 0; i < c.capture.frames_bgr.size(); ++i) {
-      Frame frame;
-      frame.index = static_cast<int>(i);
-      frame.bgr = c.capture.frames_bgr[i];
-      session->PaintFrame(frame, c.capture.camera, c.capture.true_poses[i].cam_from_world, &report);
-    }
+    PaintAllFrames(c, session.get(), [](const FrameReport&) {});
     paint_ms.push_back(ms_since(start));
     start = Clock::now();
     RemapAll(c, maps, &out);
