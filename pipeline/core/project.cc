@@ -91,6 +91,7 @@ void Fields(PipelineOptions& o, V& v) {
   v.Object("background", o.background);
   v.Object("atlas", o.atlas);
   v.Object("select", o.select);
+  v.Object("layers", o.layers);
 }
 
 template <class V>

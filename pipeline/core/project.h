@@ -11,6 +11,7 @@
 #include "pipeline/core/status.h"
 #include "pipeline/paint/atlas_options.h"
 #include "pipeline/paint/background_options.h"
+#include "pipeline/paint/layers_options.h"
 #include "pipeline/paint/occlusion_options.h"
 #include "pipeline/paint/refine_options.h"
 #include "pipeline/paint/select_options.h"
@@ -40,6 +41,7 @@ struct PipelineOptions {
   BackgroundOptions background;
   AtlasOptions atlas;
   SelectOptions select;
+  ViewLayerOptions layers;
 
   bool operator==(const PipelineOptions&) const = default;
 };

@@ -101,6 +101,11 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
+  if (!mesh.vertices.empty()) {
+    Eigen::Vector3d lo = mesh.vertices[0], hi = mesh.vertices[0];
+    for (const Eigen::Vector3d& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    s->scene_centre_ = 0.5 * (lo + hi);
+  }
   s->StartAutoModes();
   *session = std::move(s);
   return Status::Ok();
@@ -111,6 +116,7 @@ void PaintSession::ResetPainting() {
     InitPaintedBuffer(set_.buffers[b], &painted_[b]);
     InitRefineAnchor(set_.buffers[b], &anchors_[b]);
   }
+  layers_.clear();
   StartAutoModes();
   frames_seen_ = 0;
   exposure_gain_sum_ = exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
@@ -317,6 +323,16 @@ Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const 
     }
   }
   return out;
+}
+
+std::vector<ViewLayerScene> PaintSession::LayerScenes() const {
+  std::vector<ViewLayerScene> scenes;
+  for (const ViewLayer& layer : layers_) {
+    std::vector<cv::Mat> images(layer.painted.size());
+    for (size_t b = 0; b < images.size(); ++b) images[b] = AtMeanExposure(layer.painted[b].bgra);
+    scenes.push_back({PaintedScene(images), layer.Centre() + scene_->origin_in_world});
+  }
+  return scenes;
 }
 
 Scene PaintSession::PaintedSceneByBuffer() const {

@@ -40,7 +40,9 @@
 #include "pipeline/paint/refine_pose.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/paint/texture_atlas.h"
+#include "pipeline/paint/view_layers.h"
 #include "pipeline/render/rasterizer.h"
+#include "pipeline/render/view_dependent_render.h"
 
 namespace fresco {
 
@@ -118,6 +120,10 @@ class PaintSession {
   // for triangles in no buffer): the per-buffer view the app and debug images use.
   Scene PaintedSceneByBuffer() const;
   const TextureAtlas& atlas() const { return atlas_; }
+  // The view-dependent layers (pipeline.layers; view_layers.h), as PaintedScene() makes the
+  // base texture, each with its frames' mean camera centre (world); empty when off.
+  std::vector<ViewLayerScene> LayerScenes() const;
+  const std::vector<ViewLayer>& view_layers() const { return layers_; }
 
   // Debug images on or off from the next frame on (the app asks only for frames it shows).
   void set_debug_images(bool on) { options_.debug_images = on; }
@@ -210,7 +216,9 @@ class PaintSession {
   TextureAtlas atlas_;  // where each buffer goes in PaintedScene()
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
-  std::vector<RefineAnchor> anchors_;  // per buffer (refinement on)
+  std::vector<RefineAnchor> anchors_;                       // per buffer (refinement on)
+  std::vector<ViewLayer> layers_;                           // pipeline.layers (layers_stage.cc)
+  Eigen::Vector3d scene_centre_ = Eigen::Vector3d::Zero();  // the mesh's box centre (local)
   // Per stream, per buffer (mode != off): the background models. A stream's set is empty
   // until its first frame reaches the background stage (stream 0's is made up front).
   std::vector<std::vector<BufferBackground>> background_;

@@ -10,11 +10,12 @@
 // below where it belongs in the order.
 #pragma once
 
-#define FRESCO_PAINT_STAGES(STAGE)                                                       \
-  STAGE(Depth)      /* depth_stage.cc: the model's depth from the frame's camera (§3.3) */ \
-  STAGE(Warp)       /* warp_stage.cc: each texel projected, tested and sampled (§3.2) */   \
-  STAGE(Refine)     /* refine_stage.cc: registered to what the buffers hold (§3.5) */      \
-  STAGE(Exposure)   /* select_stages.cc: the frame's gain against the buffers */           \
-  STAGE(Background) /* background_stage.cc: movers masked (§3.4) */                        \
-  STAGE(Select)     /* select_stages.cc: painted texels keep a better stored sample */     \
+#define FRESCO_PAINT_STAGES(STAGE)                                                           \
+  STAGE(Depth)      /* depth_stage.cc: the model's depth from the frame's camera (§3.3) */  \
+  STAGE(Warp)       /* warp_stage.cc: each texel projected, tested and sampled (§3.2) */    \
+  STAGE(Refine)     /* refine_stage.cc: registered to what the buffers hold (§3.5) */       \
+  STAGE(Exposure)   /* select_stages.cc: the frame's gain against the buffers */             \
+  STAGE(Background) /* background_stage.cc: movers masked (§3.4) */                         \
+  STAGE(Layers)     /* layers_stage.cc: the view-dependent layer of the frame's direction */ \
+  STAGE(Select)     /* select_stages.cc: painted texels keep a better stored sample */       \
   STAGE(Paint)      /* paint_stage.cc: the base buffers updated (eq. 4) */

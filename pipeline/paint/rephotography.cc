@@ -10,11 +10,9 @@ namespace fresco {
 
 namespace {
 
-// Renders and scores; `both` and `rendered_bgr`: the compared pixels and the render.
-RephotoScore Score(const Renderer& renderer, const Scene& painted, const Rigid3d& cam_from_world,
-                   const cv::Mat& frame_bgr, cv::Mat* both_out, cv::Mat* rendered_out) {
-  RenderOutput out;
-  renderer.Render(painted, cam_from_world, &out);
+// Scores a render; `both` and `rendered_bgr`: the compared pixels and the render.
+RephotoScore Score(const RenderOutput& out, const cv::Mat& frame_bgr, cv::Mat* both_out,
+                   cv::Mat* rendered_out) {
   cv::Mat alpha, rendered_bgr;
   cv::extractChannel(out.rgba, alpha, 3);
   cv::cvtColor(out.rgba, rendered_bgr, cv::COLOR_RGBA2BGR);
@@ -24,8 +22,7 @@ RephotoScore Score(const Renderer& renderer, const Scene& painted, const Rigid3d
   *rendered_out = rendered_bgr;
   RephotoScore score;
   score.pixels = cv::countNonZero(both);
-  score.completeness =
-      static_cast<double>(score.pixels) / std::max(1, cv::countNonZero(surface));
+  score.completeness = static_cast<double>(score.pixels) / std::max(1, cv::countNonZero(surface));
   if (score.pixels > 0) {
     score.psnr_db = PsnrDb(frame_bgr, rendered_bgr, both);
     score.one_minus_ncc = OneMinusNcc(frame_bgr, rendered_bgr, both);
@@ -37,15 +34,23 @@ RephotoScore Score(const Renderer& renderer, const Scene& painted, const Rigid3d
 
 RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr) {
+  RenderOutput out;
+  renderer.Render(painted, cam_from_world, &out);
   cv::Mat both, rendered_bgr;
-  return Score(renderer, painted, cam_from_world, frame_bgr, &both, &rendered_bgr);
+  return Score(out, frame_bgr, &both, &rendered_bgr);
 }
 
 RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr,
                           RephotoView* view) {
-  const RephotoScore score =
-      Score(renderer, painted, cam_from_world, frame_bgr, &view->compared, &view->rendered_bgr);
+  RenderOutput out;
+  renderer.Render(painted, cam_from_world, &out);
+  return ScoreRendered(out, frame_bgr, view);
+}
+
+RephotoScore ScoreRendered(const RenderOutput& rendered, const cv::Mat& frame_bgr,
+                           RephotoView* view) {
+  const RephotoScore score = Score(rendered, frame_bgr, &view->compared, &view->rendered_bgr);
   view->rendered_bgr.setTo(cv::Scalar::all(0), view->compared == 0);
   view->local_one_minus_ncc =
       score.pixels > 0 ? LocalOneMinusNcc(frame_bgr, view->rendered_bgr, view->compared) : 0.0;

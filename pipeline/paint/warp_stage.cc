@@ -50,7 +50,7 @@ void PaintSession::WarpStage(FrameWork* work) {
   // them directly: the same texels, without writing and reading back the warped images.
   work->paint_in_warp = options_.background.mode == BackgroundMode::kOff &&
                         options_.refine.mode == RefineMode::kOff && !SelectActive(options_) &&
-                        !work->debug;
+                        options_.layers.count == 0 && !work->debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);
   if (work->paint_in_warp && view.depth && !in_frustum.empty() &&
       options_.sampling == SamplingMode::kBilinear) {

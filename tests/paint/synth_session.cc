@@ -25,4 +25,17 @@ void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_
   session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, report);
 }
 
+SynthOptions BlocksHalfOrbit(const BlocksOptions& blocks, int frames, int seed) {
+  SynthOptions o;
+  o.frames = frames;
+  o.width = 320, o.height = 240;
+  o.path = CameraPathKind::kOrbit;
+  o.target = Eigen::Vector3d(0, 0.3 * blocks.max_height_m, 0);
+  o.radius_m = 0.6 * blocks.ground_m;
+  o.height_m = 0.5 * blocks.ground_m;
+  o.turns = 0.5;
+  o.seed = seed;
+  return o;
+}
+
 }  // namespace fresco::testing

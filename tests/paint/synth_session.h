@@ -8,6 +8,7 @@
 
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
 
 namespace fresco::testing {
@@ -20,5 +21,9 @@ std::unique_ptr<PaintSession> SessionForCapture(const Scene& scene, const SynthC
 // Paints the capture's frame `i` at its true pose.
 void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_t i,
                        FrameReport* report);
+
+// Half a turn (320x240) around the blocks scene `blocks`, looking at 0.3 of its tallest box's
+// height from 0.6 of its ground's size away and half of it up.
+SynthOptions BlocksHalfOrbit(const BlocksOptions& blocks, int frames, int seed);
 
 }  // namespace fresco::testing

@@ -125,16 +125,8 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   Scene mesh = truth;
   for (Eigen::Vector3d& v : mesh.mesh.vertices)
     if (v.y() > 1e-6) v += Eigen::Vector3d(0.05, 0, 0.0);  // the boxes; the ground stays
-  SynthOptions o;
-  o.frames = 30;
-  o.width = 320, o.height = 240;
-  o.path = CameraPathKind::kOrbit;
-  o.target = Eigen::Vector3d(0, 0.3 * blocks.max_height_m, 0);
-  o.radius_m = 0.6 * blocks.ground_m;
-  o.height_m = 0.5 * blocks.ground_m;
-  o.turns = 0.5;
+  SynthOptions o = testing::BlocksHalfOrbit(blocks, 30, 7);
   o.exposure_jitter = 0.2;
-  o.seed = 7;
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(truth, o, &capture).ok());
 
