@@ -25,6 +25,7 @@
 #include "pipeline/core/poses.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/render/renderer.h"
+#include "pipeline/render/view_dependent_render.h"
 
 namespace fresco {
 
@@ -38,8 +39,9 @@ constexpr double kMaxSamplesPerImage = 1 << 26;
 const char kHelp[] =
     R"(Renders MODEL (glTF 2.0 .gltf/.glb, PLY .ply or OBJ .obj) through CAMERA at every pose of
 POSES and writes DIR/NAME.png per pose: 8-bit RGBA at the camera's image size, alpha 255
-where a surface with texture alpha >= 0.5 is seen and 0 elsewhere. Deterministic, CPU only,
-no display.
+where a surface with texture alpha >= 0.5 is seen and 0 elsewhere. A model painted with
+view-dependent layers (pipeline.layers) shows, per pixel, the layers whose photos were taken
+nearest the pose. Deterministic, CPU only, no display.
 
   CAMERA   an mrcal .cameramodel or a COLMAP cameras.txt (each image uses its CAMERA_ID;
            a single camera serves every pose)
@@ -55,6 +57,8 @@ options:
                        (0 = no surface, 65535 = 65.535 m or farther)
   --ids                also write DIR/NAME.ids.png: 8-bit RGBA, triangle id + 1 as
                        R + 256 G + 65536 B (0 = no surface), alpha 255 where a surface is seen
+  --single-texture     a model with view-dependent layers: show its base-colour texture
+                       only, as other viewers do
   --quiet              no progress on stderr)";
 
 // DIR-relative output path for a COLMAP image NAME: extension replaced by `suffix`.
@@ -142,7 +146,7 @@ int RunVerbRender(const CommandArgs& args) {
   spec.min_positional = 1;
   spec.max_positional = 1;
   spec.options = {"--camera", "--poses", "--out", "--supersample", "--filter", "--near"};
-  spec.switches = {"--depth", "--ids", "--cull-back-faces", "--quiet"};
+  spec.switches = {"--depth", "--ids", "--cull-back-faces", "--single-texture", "--quiet"};
   spec.required = {"--camera", "--poses", "--out"};
   Args parsed;
   int code = ParseVerbArgs("render", args, spec, &parsed);
@@ -181,6 +185,7 @@ int RunVerbRender(const CommandArgs& args) {
   options.raster.cull_back_faces = parsed.Switch("--cull-back-faces");
   const bool write_depth = parsed.Switch("--depth");
   const bool write_ids = parsed.Switch("--ids");
+  const bool view_layers = !parsed.Switch("--single-texture");
   const int n = options.raster.supersample;
 
   // Cameras.
@@ -274,7 +279,10 @@ int RunVerbRender(const CommandArgs& args) {
     std::unique_ptr<Renderer>& renderer = renderers[job.camera_id];
     if (!renderer) renderer = std::make_unique<Renderer>(cameras.at(job.camera_id), options);
     RenderOutput out;
-    renderer->Render(scene, job.pose->cam_from_world, &out);
+    if (view_layers)
+      RenderViewDependent(*renderer, scene, job.pose->cam_from_world, &out);
+    else
+      renderer->Render(scene, job.pose->cam_from_world, &out);
     const std::string base = (fs::path(out_dir) / job.relative).string();
     cv::Mat bgra;
     cv::cvtColor(out.rgba, bgra, cv::COLOR_RGBA2BGRA);

@@ -28,6 +28,9 @@
 namespace fresco {
 namespace {
 
+// Fresco's own extension for view-dependent layers (scene.h, ViewLayerTextures).
+constexpr const char* kViewLayersExtension = "FRESCO_view_layers";
+
 namespace fs = std::filesystem;
 
 // Joins the non-empty lines of `text` with "; " (tinygltf reports several lines).
@@ -230,7 +233,8 @@ class GltfLoader {
       }
     }
     for (const std::string& ext : model_.extensionsUsed) {
-      if (ext != "KHR_mesh_quantization" && ext != "KHR_materials_unlit") {
+      if (ext != "KHR_mesh_quantization" && ext != "KHR_materials_unlit" &&
+          ext != kViewLayersExtension) {
         scene_.warnings.push_back("glTF extension " + ext + " ignored");
       }
     }
@@ -290,6 +294,70 @@ class GltfLoader {
 
  private:
   Status Error(const std::string& what) const { return Status::Error(path_ + ": " + what); }
+
+  // The FRESCO_view_layers extension's layers, textures as glTF texture indices; none (and a
+  // warning) when it is malformed.
+  void ReadViewLayers(std::vector<ViewLayerTextures>* layers) {
+    const auto ext = model_.extensions.find(kViewLayersExtension);
+    if (ext == model_.extensions.end()) return;
+    const auto drop = [&](const std::string& why) {
+      layers->clear();
+      scene_.warnings.push_back(std::string("extensions.") + kViewLayersExtension + ": " + why +
+                                "; view layers ignored");
+    };
+    const tinygltf::Value& value = ext->second;
+    if (!value.IsObject() || !value.Has("layers") || !value.Get("layers").IsArray())
+      return drop("expected {\"layers\": [...]}");
+    const tinygltf::Value& list = value.Get("layers");
+    const int num_textures = static_cast<int>(model_.textures.size());
+    for (size_t k = 0; k < list.ArrayLen(); ++k) {
+      const tinygltf::Value& layer = list.Get(static_cast<int>(k));
+      const std::string where = "layers[" + std::to_string(k) + "]";
+      if (!layer.IsObject() || !layer.Has("centre") || !layer.Has("textures"))
+        return drop(where + ": expected {\"centre\": [x, y, z], \"textures\": [...]}");
+      const tinygltf::Value& centre = layer.Get("centre");
+      const tinygltf::Value& textures = layer.Get("textures");
+      if (!centre.IsArray() || centre.ArrayLen() != 3 || !textures.IsArray() ||
+          textures.ArrayLen() != model_.materials.size())
+        return drop(where + ": centre needs 3 numbers and textures one entry per material");
+      ViewLayerTextures out;
+      for (int i = 0; i < 3; ++i) {
+        if (!centre.Get(i).IsNumber()) return drop(where + ".centre: not a number");
+        out.centre_world[i] = centre.Get(i).GetNumberAsDouble();
+      }
+      if (!out.centre_world.allFinite()) return drop(where + ".centre: not finite");
+      for (size_t m = 0; m < textures.ArrayLen(); ++m) {
+        const tinygltf::Value& t = textures.Get(static_cast<int>(m));
+        const double index = t.IsNumber() ? t.GetNumberAsDouble() : -2.0;
+        if (index != std::floor(index) || index < -1 || index >= num_textures)
+          return drop(where + ".textures[" + std::to_string(m) + "]: not -1 or a texture index");
+        out.material_texture.push_back(static_cast<int>(index));
+      }
+      layers->push_back(std::move(out));
+    }
+  }
+
+  // The layers' glTF texture indices mapped to Scene::textures, into scene_.view_layers; a
+  // texture that could not be read drops the layers (with a warning).
+  void MapViewLayers(const std::map<int, int>& scene_texture,
+                     const std::map<int, std::string>& texture_problem,
+                     std::vector<ViewLayerTextures>* layers) {
+    for (ViewLayerTextures& layer : *layers)
+      for (int& t : layer.material_texture) {
+        if (t < 0) continue;
+        const auto found = scene_texture.find(t);
+        if (found == scene_texture.end()) {
+          const auto problem = texture_problem.find(t);
+          scene_.warnings.push_back(
+              std::string("extensions.") + kViewLayersExtension + ": " +
+              (problem != texture_problem.end() ? problem->second : "a texture is missing") +
+              "; view layers ignored");
+          return;
+        }
+        t = found->second;
+      }
+    scene_.view_layers = std::move(*layers);
+  }
 
   std::string MeshName(int mesh) const {
     const std::string& name = model_.meshes[mesh].name;
@@ -711,6 +779,11 @@ class GltfLoader {
         referenced.insert(material.pbrMetallicRoughness.baseColorTexture.index);
       }
     }
+    std::vector<ViewLayerTextures> layers;  // glTF texture indices until mapped below
+    ReadViewLayers(&layers);
+    for (const ViewLayerTextures& layer : layers)
+      for (int t : layer.material_texture)
+        if (t >= 0) referenced.insert(t);
     std::map<int, int> scene_texture;  // glTF texture -> Scene::textures index
     std::map<int, std::string> texture_problem;
     for (int t : referenced) {
@@ -772,11 +845,13 @@ class GltfLoader {
       }
       scene_.materials.push_back(std::move(out));
     }
+    MapViewLayers(scene_texture, texture_problem, &layers);
     if (needs_default) {
       const int default_material = static_cast<int>(scene_.materials.size());
       Material white;
       white.name = "default";
       scene_.materials.push_back(white);
+      for (ViewLayerTextures& layer : scene_.view_layers) layer.material_texture.push_back(-1);
       for (int& m : mesh.material) {
         if (m < 0) m = default_material;
       }
@@ -1023,6 +1098,18 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
       return fail("material " + std::to_string(m) + ": base_color_factor is not finite");
     }
   }
+  for (size_t k = 0; k < scene.view_layers.size(); ++k) {
+    const ViewLayerTextures& layer = scene.view_layers[k];
+    if (layer.material_texture.size() != scene.materials.size() ||
+        !layer.centre_world.allFinite()) {
+      return fail("view layer " + std::to_string(k) +
+                  ": needs a finite centre and a texture entry per material");
+    }
+    for (int t : layer.material_texture)
+      if (t < -1 || t >= static_cast<int>(scene.textures.size()))
+        return fail("view layer " + std::to_string(k) + ": texture " + std::to_string(t) +
+                    " out of range (" + std::to_string(scene.textures.size()) + " textures)");
+  }
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     const cv::Mat& rgba = scene.textures[t].rgba;
     if (rgba.empty() || rgba.type() != CV_8UC4) {
@@ -1224,6 +1311,16 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
     root["images"] = images;
     root["samplers"] = samplers;
     root["textures"] = textures;
+  }
+
+  if (!scene.view_layers.empty()) {
+    Json layers = Json::array();
+    for (const ViewLayerTextures& layer : scene.view_layers) {
+      const Eigen::Vector3d& c = layer.centre_world;
+      layers.push_back({{"centre", {c.x(), c.y(), c.z()}}, {"textures", layer.material_texture}});
+    }
+    root["extensionsUsed"] = Json::array({kViewLayersExtension});
+    root["extensions"][kViewLayersExtension] = {{"layers", layers}};
   }
 
   // Dependencies first, the .gltf last: a reader never sees a .gltf whose files are missing.

@@ -71,10 +71,19 @@ struct MeshAdjacency {
 };
 MeshAdjacency ComputeAdjacency(const TriangleMesh& mesh, double weld_tolerance_m = 1e-6);
 
+// A view-dependent layer (pipeline.layers): the texture each material shows a viewer near the
+// layer's cameras. Renderers that know layers blend them by the viewer's direction
+// (view_dependent_render.h); others show the materials' base-colour textures.
+struct ViewLayerTextures {
+  Eigen::Vector3d centre_world = Eigen::Vector3d::Zero();  // mean camera centre of its frames
+  std::vector<int> material_texture;  // per material: index into Scene::textures, -1 none
+};
+
 struct Scene {
   TriangleMesh mesh;
   std::vector<Material> materials;  // at least one (a default white material)
   std::vector<Texture> textures;
+  std::vector<ViewLayerTextures> view_layers;  // none unless painted with pipeline.layers
   Eigen::Vector3d origin_in_world = Eigen::Vector3d::Zero();
   std::string source_path;
   // Filled by the loaders (informational; not written by SaveGltfScene).
@@ -125,8 +134,11 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
 // texels exactly; vertices are stored as float relative to the origin (exact when they are
 // floats), one vertex set per run of triangles with equal material and UV presence (a vertex
 // with different UVs on different corners is duplicated). With recentre, the reloaded origin
-// is the bounding-box centre. Textures no material uses are written but not loaded back, and
-// an empty texture name comes back as the PNG's file name.
+// is the bounding-box centre. Textures no material or layer uses are written but not loaded
+// back, and an empty texture name comes back as the PNG's file name. View-dependent layers go
+// in the file's `FRESCO_view_layers` extension (extensionsUsed, not required: other viewers
+// show the base-colour textures): {"layers": [{"centre": [x, y, z] (world), "textures": [per
+// material a texture index or -1]}]}; a malformed one is dropped with a warning on loading.
 Status SaveGltfScene(const Scene& scene, const std::string& path);
 
 }  // namespace fresco

@@ -289,7 +289,26 @@ static Scene UnpaintedCopy(const Scene& scene) {
 Scene PaintSession::PaintedScene() const {
   std::vector<cv::Mat> images(painted_.size());
   for (size_t b = 0; b < painted_.size(); ++b) images[b] = AtMeanExposure(painted_[b].bgra);
-  return PaintedScene(images);
+  Scene scene = PaintedScene(images);
+  // Each layer's pages after the base pages; material page + 1 shows page `page`.
+  for (const ViewLayer& layer : layers_) {
+    ViewLayerTextures textures;
+    textures.centre_world = scene_->WorldFromLocal(layer.Centre());
+    textures.material_texture.assign(scene.materials.size(), -1);
+    for (size_t b = 0; b < images.size(); ++b) images[b] = AtMeanExposure(layer.painted[b].bgra);
+    for (size_t page = 0; page < atlas_.pages.size(); ++page) {
+      Texture texture;
+      texture.name =
+          "layer_" + std::to_string(scene.view_layers.size()) + "_page_" + std::to_string(page);
+      cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), images), texture.rgba,
+                   cv::COLOR_BGRA2RGBA);
+      texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
+      textures.material_texture[page + 1] = static_cast<int>(scene.textures.size());
+      scene.textures.push_back(std::move(texture));
+    }
+    scene.view_layers.push_back(std::move(textures));
+  }
+  return scene;
 }
 
 Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
@@ -323,16 +342,6 @@ Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const 
     }
   }
   return out;
-}
-
-std::vector<ViewLayerScene> PaintSession::LayerScenes() const {
-  std::vector<ViewLayerScene> scenes;
-  for (const ViewLayer& layer : layers_) {
-    std::vector<cv::Mat> images(layer.painted.size());
-    for (size_t b = 0; b < images.size(); ++b) images[b] = AtMeanExposure(layer.painted[b].bgra);
-    scenes.push_back({PaintedScene(images), layer.Centre() + scene_->origin_in_world});
-  }
-  return scenes;
 }
 
 Scene PaintSession::PaintedSceneByBuffer() const {

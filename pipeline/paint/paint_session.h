@@ -42,7 +42,6 @@
 #include "pipeline/paint/texture_atlas.h"
 #include "pipeline/paint/view_layers.h"
 #include "pipeline/render/rasterizer.h"
-#include "pipeline/render/view_dependent_render.h"
 
 namespace fresco {
 
@@ -111,7 +110,8 @@ class PaintSession {
 
   // The scene's geometry with the painted buffers packed into texture atlas pages
   // (texture_atlas.h), one base-colour texture and material per page (alpha 0 where never
-  // painted), and new UVs into them: what `fresco run` writes.
+  // painted), and new UVs into them: what `fresco run` writes. With view-dependent layers
+  // (pipeline.layers), each layer's pages too (Scene::view_layers).
   Scene PaintedScene() const;
   // The same with other images in the buffers' places (one CV_8UC4 BGRA image per buffer, of
   // its size): e.g. a mask of the texels that show something, rendered in any view.
@@ -120,9 +120,8 @@ class PaintSession {
   // for triangles in no buffer): the per-buffer view the app and debug images use.
   Scene PaintedSceneByBuffer() const;
   const TextureAtlas& atlas() const { return atlas_; }
-  // The view-dependent layers (pipeline.layers; view_layers.h), as PaintedScene() makes the
-  // base texture, each with its frames' mean camera centre (world); empty when off.
-  std::vector<ViewLayerScene> LayerScenes() const;
+  // The view-dependent layers (pipeline.layers; view_layers.h) as they are painted; in
+  // PaintedScene() they follow the base pages as textures of their own (Scene::view_layers).
   const std::vector<ViewLayer>& view_layers() const { return layers_; }
 
   // Debug images on or off from the next frame on (the app asks only for frames it shows).

@@ -7,15 +7,25 @@
 
 namespace fresco {
 
-void RenderViewDependent(const Renderer& renderer, const Scene& base,
-                         const std::vector<ViewLayerScene>& layers, const Rigid3d& cam_from_world,
-                         RenderOutput* output) {
-  renderer.Render(base, cam_from_world, output);
+void RenderViewDependent(const Renderer& renderer, const Scene& scene,
+                         const Rigid3d& cam_from_world, RenderOutput* output) {
+  renderer.Render(scene, cam_from_world, output);
+  const std::vector<ViewLayerTextures>& layers = scene.view_layers;
   if (layers.empty()) return;
+  // Each layer: the scene with its materials showing the layer's textures (transparent where
+  // the layer has none).
+  Scene layer_scene = scene;
+  layer_scene.view_layers.clear();
   std::vector<cv::Mat> rgba(layers.size());
   for (size_t k = 0; k < layers.size(); ++k) {
+    for (size_t m = 0; m < layer_scene.materials.size(); ++m) {
+      const int t = m < layers[k].material_texture.size() ? layers[k].material_texture[m] : -1;
+      layer_scene.materials[m] = scene.materials[m];
+      layer_scene.materials[m].base_color_texture = t;
+      if (t < 0) layer_scene.materials[m].base_color_factor[3] = 0;
+    }
     RenderOutput out;
-    renderer.Render(layers[k].scene, cam_from_world, &out);
+    renderer.Render(layer_scene, cam_from_world, &out);
     rgba[k] = out.rgba;
   }
   const Rigid3d world_from_cam = cam_from_world.Inverse();

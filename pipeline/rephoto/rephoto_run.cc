@@ -82,7 +82,7 @@ Status ScoreOneOut(const Project& project, const PosedFrameId& id, const Rephoto
   const Scene painted = job->session->PaintedScene();
   const Renderer renderer(*camera, RenderOptions());
   RenderOutput rendered;
-  RenderViewDependent(renderer, painted, job->session->LayerScenes(), cam_from_world, &rendered);
+  RenderViewDependent(renderer, painted, cam_from_world, &rendered);
   RephotoView view;
   const RephotoScore score = ScoreRendered(rendered, photo, &view);
   result->name = id.name;

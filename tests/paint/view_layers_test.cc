@@ -4,11 +4,14 @@
 // One texture shows one look everywhere; the layers show each side its own.
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
+#include "pipeline/core/image_metrics.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/rephotography.h"
 #include "pipeline/paint/view_layers.h"
@@ -16,6 +19,7 @@
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/paint/synth_session.h"
+#include "tests/test_support.h"
 
 namespace fresco {
 namespace {
@@ -79,21 +83,22 @@ TwoLookCapture MakeTwoLookCapture(bool two_looks) {
 }
 
 // Paints every frame but the held-out ones; the rephoto PSNR at each held-out frame.
+// `painted_out`: the painted scene (when not null).
 std::vector<double> HeldOutPsnr(const TwoLookCapture& c, const PipelineOptions& options,
-                                size_t* layers) {
+                                size_t* layers, Scene* painted_out = nullptr) {
   std::unique_ptr<PaintSession> session = testing::SessionForCapture(c.scene, c.capture, options);
   FrameReport report;
   for (size_t i = 0; i < c.capture.frames_bgr.size(); ++i)
     if (!c.held_out.count(static_cast<int>(i)))
       testing::PaintCaptureFrame(session.get(), c.capture, i, &report);
   *layers = session->view_layers().size();
-  const Scene base = session->PaintedScene();
-  const std::vector<ViewLayerScene> layer_scenes = session->LayerScenes();
+  const Scene painted = session->PaintedScene();
+  if (painted_out) *painted_out = painted;
   const Renderer renderer(c.capture.camera, RenderOptions());
   std::vector<double> psnr;
   for (int i : c.held_out) {
     RenderOutput out;
-    RenderViewDependent(renderer, base, layer_scenes, c.capture.true_poses[i].cam_from_world, &out);
+    RenderViewDependent(renderer, painted, c.capture.true_poses[i].cam_from_world, &out);
     RephotoView view;
     psnr.push_back(ScoreRendered(out, c.capture.frames_bgr[i], &view).psnr_db);
   }
@@ -130,6 +135,61 @@ TEST(ViewLayers, EachSideOfAnOrbitKeepsItsOwnLook) {
     const double ideal = one_look[k] - 20 * std::log10(frame < 18 ? 1.3 : 0.7);
     EXPECT_GT(views[k], single[k] + 5.0);
     EXPECT_GT(views[k], ideal - 2.0);
+  }
+}
+
+// painted.gltf keeps the layers (the FRESCO_view_layers extension): loaded back, the model
+// renders as it did before it was written, and a viewer without layers sees the base texture.
+TEST(ViewLayers, LayersSurviveTheGltfRoundTrip) {
+  const TwoLookCapture c = MakeTwoLookCapture(true);
+  PipelineOptions layered;
+  layered.background.mode = BackgroundMode::kOff;
+  layered.refine.mode = RefineMode::kOff;
+  layered.layers.count = 4;
+  size_t n = 0;
+  Scene painted;
+  HeldOutPsnr(c, layered, &n, &painted);
+  ASSERT_EQ(painted.view_layers.size(), n);
+  ASSERT_GE(n, 2u);
+  const std::string path = testing::MakeTempDir("view_layers") + "/painted.gltf";
+  ASSERT_TRUE(SaveGltfScene(painted, path).ok());
+  Scene loaded;
+  const Status status = LoadGltfScene(path, SceneLoadOptions(), &loaded);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+  ASSERT_EQ(loaded.view_layers.size(), n);
+  for (size_t k = 0; k < n; ++k) {
+    EXPECT_LT((loaded.view_layers[k].centre_world - painted.view_layers[k].centre_world).norm(),
+              1e-9);
+    EXPECT_EQ(loaded.view_layers[k].material_texture.size(), loaded.materials.size());
+  }
+  // A malformed extension (a texture list of the wrong length) loads the model without layers,
+  // with a warning naming the field.
+  {
+    std::ifstream in(path);
+    std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = "\"textures\": [";
+    const size_t at = json.find(key, json.find("\"FRESCO_view_layers\": {"));
+    ASSERT_NE(at, std::string::npos);
+    json.insert(at + key.size(), "-1, ");
+    std::ofstream(path) << json;
+    Scene broken;
+    ASSERT_TRUE(LoadGltfScene(path, SceneLoadOptions(), &broken).ok());
+    EXPECT_TRUE(broken.view_layers.empty());
+    ASSERT_EQ(broken.warnings.size(), 1u);
+    EXPECT_NE(broken.warnings[0].find("FRESCO_view_layers: layers[0]"), std::string::npos)
+        << broken.warnings[0];
+  }
+  const Renderer renderer(c.capture.camera, RenderOptions());
+  for (int i : {4, 31}) {
+    RenderOutput before, after, single;
+    RenderViewDependent(renderer, painted, c.capture.true_poses[i].cam_from_world, &before);
+    RenderViewDependent(renderer, loaded, c.capture.true_poses[i].cam_from_world, &after);
+    renderer.Render(loaded, c.capture.true_poses[i].cam_from_world, &single);
+    const cv::Mat both = cv::Mat(before.triangle_id >= 0) & cv::Mat(after.triangle_id >= 0);
+    EXPECT_GT(PsnrDb(before.rgba, after.rgba, both), 45.0);
+    // The base texture alone differs from the blend (frame 4 is on the bright side).
+    EXPECT_LT(PsnrDb(before.rgba, single.rgba, both), 30.0);
   }
 }
 
