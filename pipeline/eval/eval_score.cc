@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/image_metrics.h"
+#include "pipeline/render/view_dependent_render.h"
 
 namespace fresco {
 namespace {
@@ -46,7 +47,7 @@ bool SegmentNearPoint(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
 
 TruthViewScore ScoreTruthView(const TruthViewInputs& in) {
   RenderOutput painted, clean;
-  in.painted_renderer->Render(*in.painted, in.true_cam_from_world, &painted);
+  RenderViewDependent(*in.painted_renderer, *in.painted, in.true_cam_from_world, &painted);
   in.clean_renderer->Render(*in.truth, in.true_cam_from_world, &clean);
   const cv::Mat painted_bgr = Bgr(painted);
   cv::Mat clean_bgr = Bgr(clean);

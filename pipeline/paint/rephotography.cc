@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/image_metrics.h"
+#include "pipeline/render/view_dependent_render.h"
 
 namespace fresco {
 
@@ -35,7 +36,7 @@ RephotoScore Score(const RenderOutput& out, const cv::Mat& frame_bgr, cv::Mat* b
 RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr) {
   RenderOutput out;
-  renderer.Render(painted, cam_from_world, &out);
+  RenderViewDependent(renderer, painted, cam_from_world, &out);
   cv::Mat both, rendered_bgr;
   return Score(out, frame_bgr, &both, &rendered_bgr);
 }
@@ -44,7 +45,7 @@ RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr,
                           RephotoView* view) {
   RenderOutput out;
-  renderer.Render(painted, cam_from_world, &out);
+  RenderViewDependent(renderer, painted, cam_from_world, &out);
   return ScoreRendered(out, frame_bgr, view);
 }
 

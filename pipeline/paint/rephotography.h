@@ -18,7 +18,8 @@ struct RephotoScore {
   int pixels = 0;            // pixels compared
 };
 
-// `frame_bgr`: the photo at `cam_from_world`, the renderer's camera size.
+// `frame_bgr`: the photo at `cam_from_world`, the renderer's camera size. A model with
+// view-dependent layers is rendered with them (view_dependent_render.h).
 RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr);
 
