@@ -67,6 +67,7 @@ std::string RephotoToJson(const RephotoResult& result, const std::vector<std::st
                       {"image_coverage", f.image_coverage},
                       {"pixels", f.pixels},
                       {"frames_painted", f.frames_painted},
+                      {"view_layers", f.view_layers},
                       {"paint_seconds", f.paint_seconds}});
   }
   const json doc = {{"project", result.project},

@@ -89,6 +89,7 @@ Status ScoreOneOut(const Project& project, const PosedFrameId& id, const Rephoto
   result->counter = id.counter;
   result->stream = id.stream;
   result->frames_painted = run.stats().frames_painted;
+  result->view_layers = static_cast<int>(painted.view_layers.size());
   result->paint_seconds = run.stats().seconds;
   result->pixels = score.pixels;
   result->psnr_db = score.pixels > 0 ? score.psnr_db : std::numeric_limits<double>::quiet_NaN();

@@ -38,6 +38,7 @@ struct RephotoFrame {
   int counter = 0;            // position among the frames read (all streams), 0-based
   int stream = 0;             // index into Project::Streams()
   int frames_painted = 0;     // frames painted from (the others)
+  int view_layers = 0;        // view-dependent layers the render blended (pipeline.layers)
   double paint_seconds = 0;   // wall time of that paint run (reading and painting)
   double psnr_db = 0;         // over the compared pixels (NaN: none)
   double one_minus_ncc = 1;   // local 9 x 9, eroded mask (1 when nothing compared)
