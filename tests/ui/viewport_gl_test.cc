@@ -150,6 +150,39 @@ TEST(ViewportGl, GroupsInStableColoursSelectionTinted) {
       yellow += (b[0] + b[1]) / 2 - b[2] > (a[0] + a[1]) / 2 - a[2] + 20;
     }
     EXPECT_GT(yellow, 0);
+
+    // Painted mode with a view-dependent layer: where the layer has paint the view shows it
+    // (here solid green over grey buffers); with the layers switched off, the single texture.
+    state.selected_triangles.clear();
+    RunnerSnapshot layered = *snap;
+    auto grey = std::make_shared<std::vector<cv::Mat>>();
+    auto layers = std::make_shared<std::vector<RunnerSnapshot::LayerImages>>(1);
+    (*layers)[0].centre_local = Eigen::Vector3f(0, 5, 0);
+    for (const GroupSpec& g : geo.groups) {
+      (void)g;
+      grey->push_back(cv::Mat(8, 8, CV_8UC4, cv::Scalar(128, 128, 128, 255)));
+      (*layers)[0].bgra.push_back(cv::Mat(8, 8, CV_8UC4, cv::Scalar(0, 255, 0, 255)));
+    }
+    layered.painted = grey;
+    layered.layers = layers;
+    layered.painted_version = snap->painted_version + 1;
+    view.mode = ViewportView::Mode::kPainted;
+    const Rendered with_layers = Render(viewport, layered, state, &view);
+    view.view_layers = false;
+    const Rendered single = Render(viewport, layered, state, &view);
+    int green = 0, grey_pixels = 0, drawn = 0;
+    for (int i = 0; i < kW * kH; ++i) {
+      if (with_layers.triangle[i] < 0 || geo.buffer_of_triangle[with_layers.triangle[i]] < 0)
+        continue;
+      ++drawn;
+      const auto& a = with_layers.rgba[i];
+      green += a[1] > 200 && a[0] < 40 && a[2] < 40;
+      const auto& b = single.rgba[i];
+      grey_pixels += std::abs(b[0] - b[1]) < 3 && std::abs(b[1] - b[2]) < 3 && b[1] > 100;
+    }
+    ASSERT_GT(drawn, 100);
+    EXPECT_EQ(green, drawn);
+    EXPECT_EQ(grey_pixels, drawn);
   }
   glfwDestroyWindow(window);
   glfwTerminate();

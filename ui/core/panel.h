@@ -43,6 +43,7 @@ struct ViewportView {
   OrbitFrame orbit;                     // which way is up (from the capture's poses)
   uint64_t orbit_geometry_version = 0;  // the geometry `orbit` was taken from (0: none yet)
   bool show_path = true, show_frustum = true;
+  bool view_layers = true;  // painted mode: blend the view-dependent layers (when painted)
 };
 
 // Draws the model (painted textures, group colours or the current frame projected onto it),

@@ -156,8 +156,8 @@ void PipelineRunner::OpenSession(const Project& project) {
         l.problem = working_.status;
         return;
       }
-      sources.push_back(std::make_unique<LiveSessionSource>(s->lives[i].get(),
-                                                            options_.live_poll_ms, origin));
+      sources.push_back(
+          std::make_unique<LiveSessionSource>(s->lives[i].get(), options_.live_poll_ms, origin));
     }
     s->live = s->lives[first].get();
     s->live_stream = first;
@@ -330,6 +330,14 @@ void PipelineRunner::Publish(bool with_painted) {
     auto painted = std::make_shared<std::vector<cv::Mat>>();
     for (const PaintedBuffer& p : session_->paint->painted()) painted->push_back(p.bgra.clone());
     working_.painted = painted;
+    auto layers = std::make_shared<std::vector<RunnerSnapshot::LayerImages>>();
+    for (const ViewLayer& layer : session_->paint->view_layers()) {
+      RunnerSnapshot::LayerImages images;
+      images.centre_local = layer.Centre().cast<float>();
+      for (const PaintedBuffer& p : layer.painted) images.bgra.push_back(p.bgra.clone());
+      layers->push_back(std::move(images));
+    }
+    working_.layers = layers;
     ++working_.painted_version;
   }
   ++working_.version;

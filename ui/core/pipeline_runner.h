@@ -70,6 +70,13 @@ struct RunnerSnapshot {
   std::vector<cv::Mat> stream_frames;  // per stream, its latest input frame shown (or empty)
   FrameReport report;                  // stages with metrics and debug images
   std::shared_ptr<const std::vector<cv::Mat>> painted;  // per buffer BGRA (alpha 0 = never)
+  // View-dependent layers (pipeline.layers), published with `painted`: each layer's mean
+  // camera centre (the scene's local frame) and its buffers (BGRA); null or empty when off.
+  struct LayerImages {
+    Eigen::Vector3f centre_local = Eigen::Vector3f::Zero();
+    std::vector<cv::Mat> bgra;
+  };
+  std::shared_ptr<const std::vector<LayerImages>> layers;
   uint64_t painted_version = 0;
   double coverage = 0;
   // The painting job's counts so far (frames read, painted, without a pose), as `fresco run`

@@ -60,6 +60,14 @@ uniform sampler2D frame;     // the current frame
 uniform mat4 frame_from_local;  // pixel * z = K [R|t] x (pinhole part)
 uniform vec2 frame_size;
 uniform vec3 eye;
+// View-dependent layers (painted mode): the two nearest this draw's chart, their cameras'
+// centres and the cut-off angle (unstructured lumigraph weights, as view_dependent_render.h).
+uniform int layered;  // 0 none, 1 or 2 layers bound
+uniform sampler2D layer0;
+uniform sampler2D layer1;
+uniform vec3 layer_centre0;
+uniform vec3 layer_centre1;
+uniform float layer_cut;
 layout(location = 0) out vec4 colour;
 layout(location = 1) out int triangle;
 void main() {
@@ -71,6 +79,18 @@ void main() {
     base = v_group_rgb * shade;
   } else if (mode == 0) {
     vec4 t = texture(painted, v_uv);
+    if (layered > 0) {
+      vec3 to_eye = normalize(eye - v_position);
+      vec4 l0 = texture(layer0, v_uv);
+      vec4 l1 = texture(layer1, v_uv);
+      float a0 = acos(clamp(dot(normalize(layer_centre0 - v_position), to_eye), -1.0, 1.0));
+      float a1 = acos(clamp(dot(normalize(layer_centre1 - v_position), to_eye), -1.0, 1.0));
+      float w0 = l0.a > 0.5 ? max(0.0, 1.0 - a0 / layer_cut) / max(a0, 1e-4) : 0.0;
+      float w1 = (layered > 1 && l1.a > 0.5) ? max(0.0, 1.0 - a1 / layer_cut) / max(a1, 1e-4)
+                                               : 0.0;
+      if (w0 + w1 > 0.0) t = vec4((w0 * l0.rgb + w1 * l1.rgb) / (w0 + w1), 1.0);
+      else if (l0.a > 0.5) t = vec4(l0.rgb, 1.0);
+    }
     bool checker = (int(floor(gl_FragCoord.x / 8.0) + floor(gl_FragCoord.y / 8.0)) & 1) == 1;
     base = t.a > 0.5 ? t.rgb : vec3(checker ? 0.32 : 0.26) * shade;
   } else {
@@ -188,9 +208,14 @@ struct GlViewport::Impl {
   std::set<int> selection, selected_groups;
   // Draw ranges: buffer b's triangles are vertices [first[b], first[b] + count[b]).
   std::vector<int> first, count;
+  std::vector<Eigen::Vector3f> centre;  // per buffer, the mean of its vertices (local)
   int ungrouped_first = 0, ungrouped_count = 0;
   GlTextures textures;
   bool built = false;
+
+  // Binds the two view-dependent layers whose cameras are nearest the direction from buffer
+  // b's centre to the eye (texture units 2 and 3) and sets the shader's layer uniforms.
+  void BindNearestLayers(const RunnerSnapshot& snapshot, size_t b, const Eigen::Vector3f& eye);
 
   void Build() {
     mesh_program = Link(kMeshVertex, kMeshFragment);
@@ -266,6 +291,7 @@ struct GlViewport::Impl {
     vertices.reserve(3 * mesh.NumTriangles());
     first.assign(num_buffers, 0);
     count.assign(num_buffers, 0);
+    centre.assign(num_buffers, Eigen::Vector3f::Zero());
     for (int b = 0; b <= num_buffers; ++b) {
       const int start = static_cast<int>(vertices.size());
       const std::array<float, 3> rgb =
@@ -296,6 +322,11 @@ struct GlViewport::Impl {
       if (b < num_buffers) {
         first[b] = start;
         count[b] = static_cast<int>(vertices.size()) - start;
+        Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+        for (int i = start; i < static_cast<int>(vertices.size()); ++i)
+          sum += Eigen::Vector3f(vertices[i].position[0], vertices[i].position[1],
+                                 vertices[i].position[2]);
+        centre[b] = count[b] > 0 ? Eigen::Vector3f(sum / count[b]) : sum;
       } else {
         ungrouped_first = start;
         ungrouped_count = static_cast<int>(vertices.size()) - start;
@@ -306,6 +337,35 @@ struct GlViewport::Impl {
                  GL_STATIC_DRAW);
   }
 };
+
+void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t b,
+                                         const Eigen::Vector3f& eye) {
+  const std::vector<RunnerSnapshot::LayerImages>& layers = *snapshot.layers;
+  const Eigen::Vector3f c = centre[b], to_eye = (eye - c).normalized();
+  std::vector<std::pair<float, size_t>> near;
+  for (size_t k = 0; k < layers.size(); ++k) {
+    if (b >= layers[k].bgra.size()) continue;
+    const float dot = (layers[k].centre_local - c).normalized().dot(to_eye);
+    near.emplace_back(std::acos(std::clamp(dot, -1.0f, 1.0f)), k);
+  }
+  std::sort(near.begin(), near.end());
+  const int bound = static_cast<int>(std::min<size_t>(2, near.size()));
+  const float cut = near.size() > 2 ? near[2].first : 2.0f * near.back().first + 1e-3f;
+  for (int i = 0; i < bound; ++i) {
+    const RunnerSnapshot::LayerImages& layer = layers[near[i].second];
+    glActiveTexture(GL_TEXTURE2 + i);
+    glBindTexture(GL_TEXTURE_2D,
+                  static_cast<GLuint>(reinterpret_cast<intptr_t>(textures.Get(
+                      "layer/" + std::to_string(near[i].second) + "/" + std::to_string(b),
+                      layer.bgra[b], snapshot.painted_version))));
+    const Eigen::Vector3f& at = layer.centre_local;
+    glUniform3f(glGetUniformLocation(mesh_program, i == 0 ? "layer_centre0" : "layer_centre1"),
+                at.x(), at.y(), at.z());
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1f(glGetUniformLocation(mesh_program, "layer_cut"), cut);
+  glUniform1i(glGetUniformLocation(mesh_program, "layered"), bound);
+}
 
 GlViewport::GlViewport() : impl_(std::make_unique<Impl>()) {}
 
@@ -416,11 +476,18 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   glBindTexture(GL_TEXTURE_2D, frame_texture);
   glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(m.vao);
+  glUniform1i(glGetUniformLocation(m.mesh_program, "layer0"), 2);
+  glUniform1i(glGetUniformLocation(m.mesh_program, "layer1"), 3);
+  const bool layered = view->mode == ViewportView::Mode::kPainted && view->view_layers &&
+                       snapshot.layers && !snapshot.layers->empty();
+  const GLint layered_at = glGetUniformLocation(m.mesh_program, "layered");
+  glUniform1i(layered_at, 0);
   for (size_t b = 0; b < m.first.size(); ++b) {
     GLuint texture = 0;
     if (snapshot.painted && b < snapshot.painted->size())
       texture = static_cast<GLuint>(reinterpret_cast<intptr_t>(m.textures.Get(
           "buffer/" + std::to_string(b), (*snapshot.painted)[b], snapshot.painted_version)));
+    if (layered && b < m.centre.size()) m.BindNearestLayers(snapshot, b, eye);
     glBindTexture(GL_TEXTURE_2D, texture);
     if (m.count[b] > 0) glDrawArrays(GL_TRIANGLES, m.first[b], m.count[b]);
   }

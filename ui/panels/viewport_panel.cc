@@ -32,6 +32,15 @@ class ViewportPanel : public Panel {
     ImGui::SameLine();
     ImGui::Checkbox("frustum", &view_.show_frustum);
     ImGui::SameLine();
+    if (ui.snapshot->layers && !ui.snapshot->layers->empty()) {
+      ImGui::Checkbox("layers", &view_.view_layers);
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "painted mode: the view-dependent layers (pipeline.layers) whose frames were taken "
+            "nearest the viewer, blended (the two nearest each chart's centre); off: the single "
+            "texture");
+      ImGui::SameLine();
+    }
     if (ImGui::SmallButton("reset view")) {
       const ViewportView::Mode mode = view_.mode;
       view_ = ViewportView();
