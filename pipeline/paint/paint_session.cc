@@ -101,11 +101,9 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->warped_.resize(s->set_.buffers.size());
   for (size_t b = 0; b < s->set_.buffers.size(); ++b)
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
-  if (!mesh.vertices.empty()) {
-    Eigen::Vector3d lo = mesh.vertices[0], hi = mesh.vertices[0];
-    for (const Eigen::Vector3d& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
-    s->scene_centre_ = 0.5 * (lo + hi);
-  }
+  Eigen::Vector3d lo, hi;
+  inputs.scene->Bounds(&lo, &hi);
+  s->scene_centre_ = 0.5 * (lo + hi);
   s->StartAutoModes();
   *session = std::move(s);
   return Status::Ok();

@@ -46,12 +46,7 @@ RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           RephotoView* view) {
   RenderOutput out;
   RenderViewDependent(renderer, painted, cam_from_world, &out);
-  return ScoreRendered(out, frame_bgr, view);
-}
-
-RephotoScore ScoreRendered(const RenderOutput& rendered, const cv::Mat& frame_bgr,
-                           RephotoView* view) {
-  const RephotoScore score = Score(rendered, frame_bgr, &view->compared, &view->rendered_bgr);
+  const RephotoScore score = Score(out, frame_bgr, &view->compared, &view->rendered_bgr);
   view->rendered_bgr.setTo(cv::Scalar::all(0), view->compared == 0);
   view->local_one_minus_ncc =
       score.pixels > 0 ? LocalOneMinusNcc(frame_bgr, view->rendered_bgr, view->compared) : 0.0;

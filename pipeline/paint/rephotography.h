@@ -37,9 +37,4 @@ RephotoScore ScoreRephoto(const Renderer& renderer, const Scene& painted,
                           const Rigid3d& cam_from_world, const cv::Mat& frame_bgr,
                           RephotoView* view);
 
-// The same for a model already rendered at the frame's pose (e.g. with view-dependent layers,
-// view_dependent_render.h).
-RephotoScore ScoreRendered(const RenderOutput& rendered, const cv::Mat& frame_bgr,
-                           RephotoView* view);
-
 }  // namespace fresco

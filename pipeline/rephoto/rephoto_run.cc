@@ -11,7 +11,6 @@
 #include "pipeline/live/live_input.h"
 #include "pipeline/paint/rephotography.h"
 #include "pipeline/render/renderer.h"
-#include "pipeline/render/view_dependent_render.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
 
@@ -77,14 +76,12 @@ Status ScoreOneOut(const Project& project, const PosedFrameId& id, const Rephoto
     return Status::Error(project.file_path + ": frame '" + id.name +
                          "' was not read again (did the video change?)");
   }
-  // With view-dependent layers (pipeline.layers) the model is rendered as a viewer sees it:
-  // the layers blended by the direction to the left-out photo.
+  // With view-dependent layers (pipeline.layers) ScoreRephoto renders the model as a viewer
+  // sees it: the layers blended by the direction to the left-out photo.
   const Scene painted = job->session->PaintedScene();
   const Renderer renderer(*camera, RenderOptions());
-  RenderOutput rendered;
-  RenderViewDependent(renderer, painted, cam_from_world, &rendered);
   RephotoView view;
-  const RephotoScore score = ScoreRendered(rendered, photo, &view);
+  const RephotoScore score = ScoreRephoto(renderer, painted, cam_from_world, photo, &view);
   result->name = id.name;
   result->counter = id.counter;
   result->stream = id.stream;

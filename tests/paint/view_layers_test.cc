@@ -97,10 +97,10 @@ std::vector<double> HeldOutPsnr(const TwoLookCapture& c, const PipelineOptions& 
   const Renderer renderer(c.capture.camera, RenderOptions());
   std::vector<double> psnr;
   for (int i : c.held_out) {
-    RenderOutput out;
-    RenderViewDependent(renderer, painted, c.capture.true_poses[i].cam_from_world, &out);
     RephotoView view;
-    psnr.push_back(ScoreRendered(out, c.capture.frames_bgr[i], &view).psnr_db);
+    psnr.push_back(ScoreRephoto(renderer, painted, c.capture.true_poses[i].cam_from_world,
+                                c.capture.frames_bgr[i], &view)
+                       .psnr_db);
   }
   return psnr;
 }

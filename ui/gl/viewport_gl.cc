@@ -216,9 +216,16 @@ struct GlViewport::Impl {
   // Binds the two view-dependent layers whose cameras are nearest the direction from buffer
   // b's centre to the eye (texture units 2 and 3) and sets the shader's layer uniforms.
   void BindNearestLayers(const RunnerSnapshot& snapshot, size_t b, const Eigen::Vector3f& eye);
+  // The layer uniforms' locations (looked up once, after linking) and the sort's scratch.
+  GLint layered_at = -1, layer_cut_at = -1, layer_centre_at[2] = {-1, -1};
+  std::vector<std::pair<float, size_t>> nearest_layers;
 
   void Build() {
     mesh_program = Link(kMeshVertex, kMeshFragment);
+    layered_at = glGetUniformLocation(mesh_program, "layered");
+    layer_cut_at = glGetUniformLocation(mesh_program, "layer_cut");
+    layer_centre_at[0] = glGetUniformLocation(mesh_program, "layer_centre0");
+    layer_centre_at[1] = glGetUniformLocation(mesh_program, "layer_centre1");
     line_program = Link(kLineVertex, kLineFragment);
     glGenVertexArrays(1, &vao);
     glGenBuffers(1, &vbo);
@@ -342,7 +349,8 @@ void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t 
                                          const Eigen::Vector3f& eye) {
   const std::vector<RunnerSnapshot::LayerImages>& layers = *snapshot.layers;
   const Eigen::Vector3f c = centre[b], to_eye = (eye - c).normalized();
-  std::vector<std::pair<float, size_t>> near;
+  std::vector<std::pair<float, size_t>>& near = nearest_layers;
+  near.clear();
   for (size_t k = 0; k < layers.size(); ++k) {
     if (b >= layers[k].bgra.size()) continue;
     const float dot = (layers[k].centre_local - c).normalized().dot(to_eye);
@@ -350,6 +358,8 @@ void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t 
   }
   std::sort(near.begin(), near.end());
   const int bound = static_cast<int>(std::min<size_t>(2, near.size()));
+  glUniform1i(layered_at, bound);
+  if (bound == 0) return;
   const float cut = near.size() > 2 ? near[2].first : 2.0f * near.back().first + 1e-3f;
   for (int i = 0; i < bound; ++i) {
     const RunnerSnapshot::LayerImages& layer = layers[near[i].second];
@@ -359,12 +369,10 @@ void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t 
                       "layer/" + std::to_string(near[i].second) + "/" + std::to_string(b),
                       layer.bgra[b], snapshot.painted_version))));
     const Eigen::Vector3f& at = layer.centre_local;
-    glUniform3f(glGetUniformLocation(mesh_program, i == 0 ? "layer_centre0" : "layer_centre1"),
-                at.x(), at.y(), at.z());
+    glUniform3f(layer_centre_at[i], at.x(), at.y(), at.z());
   }
   glActiveTexture(GL_TEXTURE0);
-  glUniform1f(glGetUniformLocation(mesh_program, "layer_cut"), cut);
-  glUniform1i(glGetUniformLocation(mesh_program, "layered"), bound);
+  glUniform1f(layer_cut_at, cut);
 }
 
 GlViewport::GlViewport() : impl_(std::make_unique<Impl>()) {}
@@ -480,8 +488,7 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   glUniform1i(glGetUniformLocation(m.mesh_program, "layer1"), 3);
   const bool layered = view->mode == ViewportView::Mode::kPainted && view->view_layers &&
                        snapshot.layers && !snapshot.layers->empty();
-  const GLint layered_at = glGetUniformLocation(m.mesh_program, "layered");
-  glUniform1i(layered_at, 0);
+  glUniform1i(m.layered_at, 0);
   for (size_t b = 0; b < m.first.size(); ++b) {
     GLuint texture = 0;
     if (snapshot.painted && b < snapshot.painted->size())
