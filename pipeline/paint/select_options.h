@@ -21,9 +21,11 @@ namespace fresco {
 // the frame's depth map (silhouettes: where a mesh a few pixels off paints background); a
 // painted texel takes a new frame's sample only when it scores clearly better.
 struct SelectOptions {
-  bool enabled = false;  // off: the quality policy alone (`update`, `quality_slack`); on costs
-                         // 2-4 times the warp stage (real photos: docs/results.md)
-  bool exposure = true;  // divide out each frame's gain against the buffers
+  bool enabled = false;      // off: the quality policy alone (`update`, `quality_slack`); on costs
+                             // 2-4 times the warp stage (real photos: docs/results.md)
+  bool exposure = true;      // divide out each frame's gain against the buffers
+  bool level_seams = false;  // level each frame's colours locally against the buffers
+  int level_cell_texels = 16;   // ... in cells of this many texels a side, fading as far
   double switch_margin = 0.25;  // a painted texel switches frame when the score is this much better
   double region_weight = 0.5;   // 0: the texel's own score; 1: the frame's median over the buffer
   double edge_px = 6.0;         // texels seen within this many pixels of a depth discontinuity
@@ -49,6 +51,19 @@ void Fields(SelectOptions& o, V& v) {
           {.help = "per frame, a gain per colour channel against what the buffers already hold "
                    "(the median ratio over the texels both have) is divided out before painting: "
                    "one consistent exposure, set by the first frames"});
+  v.Field("level_seams", o.level_seams,
+          {.help = "where a frame's new samples meet texels that keep their stored sample, the new "
+                   "ones are levelled to continue the kept colours (per cell of "
+                   "`level_cell_texels`, the median ratio), fading to the frame's own colours "
+                   "over as many texels: fewer seams where the painting passes from one photo to "
+                   "the next, for light that changes across a photo (vignetting, haze, flare); "
+                   "on the Sceaux castle photos 1 - NCC 0.006 lower, PSNR within 0.14 dB"});
+  v.Field("level_cell_texels", o.level_cell_texels,
+          {.min = 4,
+           .max = 1024,
+           .help = "the levelling's cells, texels a side, and how far its correction fades: "
+                   "larger removes wider seams but carries one photo's light further into the "
+                   "next"});
   v.Field("switch_margin", o.switch_margin,
           {.min = 0,
            .max = 10,

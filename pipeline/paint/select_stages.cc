@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "pipeline/paint/exposure_gain.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/seam_levelling.h"
 #include "pipeline/paint/stage_clock.h"
 #include "pipeline/paint/view_select.h"
 
@@ -79,8 +81,16 @@ StageReport PaintSession::SelectViewsStage(const std::vector<size_t>& seen) {
   if (options_.occlusion.enabled && options_.select.edge_px > 0)
     inputs.edge_distance_px = DistanceToDepthEdges(depth_, options_.select.edge_depth_rel);
   std::vector<ViewSelectStats> stats(set_.buffers.size());
+  const bool level = options_.select.level_seams;
+  std::vector<SeamLevelStats> level_stats(level ? set_.buffers.size() : 0);
+  SeamLevelOptions level_options;
+  level_options.cell_texels = options_.select.level_cell_texels;
+  level_options.fade_texels = options_.select.level_cell_texels;
   ForEachBuffer(seen, false, [&](size_t b) {
-    stats[b] = SelectViews(set_.buffers[b], inputs, options_.select, painted_[b], &warped_[b]);
+    cv::Mat kept;  // the texels seen that keep their stored sample: the seams' other side
+    stats[b] = SelectViews(set_.buffers[b], inputs, options_.select, painted_[b], &warped_[b],
+                           level ? &kept : nullptr);
+    if (level) level_stats[b] = LevelSeams(painted_[b], kept, level_options, &warped_[b]);
   });
   long long candidates = 0, kept = 0, near_edge = 0;
   for (size_t b : seen) {
@@ -91,6 +101,20 @@ StageReport PaintSession::SelectViewsStage(const std::vector<size_t>& seen) {
   report.metrics["texels_candidate"] = static_cast<double>(candidates);
   report.metrics["texels_kept_better"] = static_cast<double>(kept);
   report.metrics["texels_near_edge"] = static_cast<double>(near_edge);
+  if (level) {
+    long long measured = 0, filled = 0;
+    double abs_log = 0;
+    for (size_t b : seen) {
+      measured += level_stats[b].cells_measured, filled += level_stats[b].cells_filled;
+      abs_log += level_stats[b].abs_log_sum;
+    }
+    report.metrics["level_cells_measured"] = static_cast<double>(measured);
+    report.metrics["level_cells_filled"] = static_cast<double>(filled);
+    // The mean correction over the measured cells, percent.
+    report.metrics["level_mean_percent"] =
+        measured > 0 ? 100.0 * (std::exp(abs_log / (3.0 * static_cast<double>(measured))) - 1.0)
+                     : 0.0;
+  }
   report.wall_ms = MsSince(start);
   return report;
 }

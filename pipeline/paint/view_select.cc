@@ -59,7 +59,7 @@ int ForEachValidTexel(const BaseBuffer& buffer, const WarpedBuffer& warped, cons
 
 ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& inputs,
                             const SelectOptions& options, const PaintedBuffer& painted,
-                            WarpedBuffer* warped) {
+                            WarpedBuffer* warped, cv::Mat* kept) {
   ViewSelectStats stats;
   const Camera& camera = *inputs.camera;
   const float focal_texel = static_cast<float>(0.5 * (camera.fx + camera.fy) * buffer.texel_size_m);
@@ -118,6 +118,11 @@ ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& in
   const float switch_factor = static_cast<float>(1.0 + options.switch_margin);
   const cv::Vec4b* stored = painted.bgra.ptr<cv::Vec4b>();
   const float* stored_quality = painted.quality.ptr<float>();
+  uint8_t* kept_at = nullptr;
+  if (kept) {
+    *kept = cv::Mat::zeros(warped->valid.size(), CV_8U);
+    kept_at = kept->data;
+  }
   stats.kept = ForEachValidTexel(buffer, *warped, [&](const BaseBuffer::Chunk&, int, int idx) {
     const float own = score[idx];
     const float a = std::max(std::abs(own), 1e-12f);
@@ -130,6 +135,7 @@ ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& in
     score[idx] = s;
     if (stored[idx][3] == 0 || s > stored_quality[idx] * switch_factor) return 0;
     valid[idx] = 0;  // the stored sample is better: keep it
+    if (kept_at) kept_at[idx] = 255;
     return 1;
   });
   return stats;

@@ -44,9 +44,10 @@ struct ViewSelectStats {
 };
 
 // Scores buffer `buffer`'s valid texels in `warped` (its quality replaced by the scores) and
-// clears those whose stored sample is better (stored quality in `painted`).
+// clears those whose stored sample is better (stored quality in `painted`); `kept`, if given,
+// becomes a CV_8U mask of the rectangle, 255 where a texel was cleared so.
 ViewSelectStats SelectViews(const BaseBuffer& buffer, const ViewSelectInputs& inputs,
                             const SelectOptions& options, const PaintedBuffer& painted,
-                            WarpedBuffer* warped);
+                            WarpedBuffer* warped, cv::Mat* kept = nullptr);
 
 }  // namespace fresco

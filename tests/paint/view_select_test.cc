@@ -22,15 +22,6 @@
 namespace fresco {
 namespace {
 
-// Paints every frame at its true pose.
-Scene PaintAll(const Scene& scene, const SynthCapture& capture, const PipelineOptions& options) {
-  std::unique_ptr<PaintSession> session = testing::SessionForCapture(scene, capture, options);
-  FrameReport report;
-  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
-    testing::PaintCaptureFrame(session.get(), capture, i, &report);
-  return session->PaintedScene();
-}
-
 // Mean PSNR of the painted model against the true scene with exposure `gain`, at the true
 // poses of frames `frames`, where both show a painted surface.
 double MeanPsnrAgainstTruth(const Scene& truth, const Scene& painted, const SynthCapture& capture,
@@ -40,18 +31,10 @@ double MeanPsnrAgainstTruth(const Scene& truth, const Scene& painted, const Synt
   const Renderer renderer(capture.camera, options);
   double sum = 0;
   for (int i : frames) {
-    RenderOutput t, p;
-    renderer.Render(truth, capture.true_poses[i].cam_from_world, &t);
-    renderer.Render(painted, capture.true_poses[i].cam_from_world, &p);
-    std::vector<cv::Mat> tc, pc;
-    cv::split(t.rgba, tc);
-    cv::split(p.rgba, pc);
-    const cv::Mat both = (tc[3] == 255) & (pc[3] == 255);
-    cv::Mat t_rgb, p_rgb;
-    cv::cvtColor(t.rgba, t_rgb, cv::COLOR_RGBA2RGB);
-    cv::cvtColor(p.rgba, p_rgb, cv::COLOR_RGBA2RGB);
-    t_rgb.convertTo(t_rgb, CV_8UC3, gain);
-    sum += PsnrDb(t_rgb, p_rgb, both);
+    testing::TruthAndPainted r = testing::RenderTruthAndPainted(
+        renderer, truth, painted, capture.true_poses[i].cam_from_world);
+    r.truth_bgr.convertTo(r.truth_bgr, CV_8UC3, gain);
+    sum += PsnrDb(r.truth_bgr, r.painted_bgr, r.both);
   }
   return sum / frames.size();
 }
@@ -99,11 +82,11 @@ TEST(ViewSelect, ExposureChangesPaintOneConsistentTexture) {
   PipelineOptions with = no_exposure;
   with.select.exposure = true;
   const double psnr_off =
-      MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, off), capture, g0, views);
-  const double psnr_no_exposure =
-      MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, no_exposure), capture, g0, views);
-  const double psnr_with =
-      MeanPsnrAgainstTruth(scene, PaintAll(scene, capture, with), capture, g0, views);
+      MeanPsnrAgainstTruth(scene, testing::PaintAllFrames(scene, capture, off), capture, g0, views);
+  const double psnr_no_exposure = MeanPsnrAgainstTruth(
+      scene, testing::PaintAllFrames(scene, capture, no_exposure), capture, g0, views);
+  const double psnr_with = MeanPsnrAgainstTruth(
+      scene, testing::PaintAllFrames(scene, capture, with), capture, g0, views);
   std::printf(
       "truth PSNR at the frames' mean exposure: select off %.2f, no exposure %.2f, "
       "with exposure %.2f dB\n",
@@ -131,7 +114,7 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   ASSERT_TRUE(SynthesizeCapture(truth, o, &capture).ok());
 
   const auto score = [&](const PipelineOptions& options, double* ncc) {
-    const Scene painted = PaintAll(mesh, capture, options);
+    const Scene painted = testing::PaintAllFrames(mesh, capture, options);
     const Renderer renderer(capture.camera, RenderOptions());
     double psnr = 0;
     *ncc = 0;

@@ -1,0 +1,147 @@
+#include "pipeline/paint/seam_levelling.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace fresco {
+namespace {
+
+// Values this far from black and saturation carry the colour (as the exposure fit's).
+constexpr int kMinValue = 4, kMaxValue = 251;
+
+const std::array<float, 256>& LogTable() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[i] = std::log(static_cast<float>(std::max(i, 1)));
+    return t;
+  }();
+  return table;
+}
+
+float MedianOf(std::vector<float>* v) {
+  auto mid = v->begin() + v->size() / 2;
+  std::nth_element(v->begin(), mid, v->end());
+  return *mid;
+}
+
+}  // namespace
+
+SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
+                          const SeamLevelOptions& options, WarpedBuffer* warped) {
+  SeamLevelStats stats;
+  const cv::Rect box = warped->valid_box;
+  if (box.empty() || kept.size() != warped->bgr.size() || kept.type() != CV_8U ||
+      painted.bgra.size() != warped->bgr.size())
+    return stats;
+  const int cell = std::max(1, options.cell_texels);
+  const int gx = (box.width + cell - 1) / cell, gy = (box.height + cell - 1) / cell;
+  const int cells = gx * gy;
+  const int width = warped->bgr.cols;
+  const uint8_t* valid = warped->valid.data;
+  cv::Vec3b* sample = warped->bgr.ptr<cv::Vec3b>();
+  const cv::Vec4b* stored = painted.bgra.ptr<cv::Vec4b>();
+  const float* stored_quality = painted.quality.ptr<float>();
+  const std::array<float, 256>& log_of = LogTable();
+  const float max_log = static_cast<float>(options.max_log_ratio);
+
+  // Per cell and channel, log(stored / sample) over the kept texels (trusted stored samples,
+  // values away from black and saturation, ratios within max_log_ratio of 1).
+  const uint8_t* keeps = kept.data;
+  std::vector<std::vector<float>> ratios(3 * static_cast<size_t>(cells));
+  for (int y = box.y; y < box.br().y; ++y) {
+    const int cy = (y - box.y) / cell;
+    for (int x = box.x; x < box.br().x; ++x) {
+      const int idx = y * width + x;
+      if (!keeps[idx] || stored[idx][3] == 0 || !(stored_quality[idx] > 0.0f)) continue;
+      float d[3];
+      bool usable = true;
+      for (int c = 0; c < 3 && usable; ++c) {
+        const int s = sample[idx][c], o = stored[idx][c];
+        usable = s >= kMinValue && s <= kMaxValue && o >= kMinValue && o <= kMaxValue;
+        d[c] = log_of[o] - log_of[s];
+        usable = usable && std::abs(d[c]) <= max_log;
+      }
+      if (!usable) continue;
+      const size_t at = 3 * static_cast<size_t>(cy * gx + (x - box.x) / cell);
+      for (int c = 0; c < 3; ++c) ratios[at + c].push_back(d[c]);
+    }
+  }
+
+  // The measured cells' medians; the others filled from their neighbours, fading.
+  std::vector<float> value(3 * static_cast<size_t>(cells), 0.0f);
+  std::vector<int> set(cells, 0);  // 0 unset, 1 measured, 2 + round filled
+  for (int i = 0; i < cells; ++i) {
+    std::vector<float>* r = &ratios[3 * static_cast<size_t>(i)];
+    if (static_cast<int>(r->size()) < options.min_samples) continue;
+    set[i] = 1;
+    ++stats.cells_measured;
+    stats.samples += static_cast<int>(r->size());
+    for (int c = 0; c < 3; ++c) {
+      value[3 * i + c] = MedianOf(&ratios[3 * static_cast<size_t>(i) + c]);
+      stats.abs_log_sum += std::abs(value[3 * i + c]);
+    }
+  }
+  if (stats.cells_measured == 0) return stats;
+  const float decay = static_cast<float>(options.fill_decay);
+  for (int round = 0; round < options.fill_cells; ++round) {
+    const std::vector<int> before = set;
+    for (int cy = 0; cy < gy; ++cy)
+      for (int cx = 0; cx < gx; ++cx) {
+        const int i = cy * gx + cx;
+        if (before[i] != 0) continue;
+        float sum[3] = {0, 0, 0};
+        int n = 0;
+        const int neighbours[4][2] = {{cx - 1, cy}, {cx + 1, cy}, {cx, cy - 1}, {cx, cy + 1}};
+        for (const auto& nb : neighbours) {
+          if (nb[0] < 0 || nb[1] < 0 || nb[0] >= gx || nb[1] >= gy) continue;
+          const int j = nb[1] * gx + nb[0];
+          if (before[j] == 0) continue;
+          for (int c = 0; c < 3; ++c) sum[c] += value[3 * j + c];
+          ++n;
+        }
+        if (n == 0) continue;
+        for (int c = 0; c < 3; ++c) value[3 * i + c] = decay * sum[c] / static_cast<float>(n);
+        set[i] = 2 + round;
+        ++stats.cells_filled;
+      }
+  }
+
+  // Each valid sample times the correction interpolated between the cells' centres, scaled
+  // down linearly with the texel's distance from the nearest kept texel (none at fade_texels).
+  cv::Mat not_kept = kept(box) == 0, distance;
+  cv::distanceTransform(not_kept, distance, cv::DIST_L2, cv::DIST_MASK_5);
+  const float inv_fade = 1.0f / static_cast<float>(std::max(1, options.fade_texels));
+  const float inv_cell = 1.0f / static_cast<float>(cell);
+  for (int y = box.y; y < box.br().y; ++y) {
+    const float fy = std::clamp((static_cast<float>(y - box.y) + 0.5f) * inv_cell - 0.5f, 0.0f,
+                                static_cast<float>(gy - 1));
+    const int y0 = std::min(static_cast<int>(fy), gy - 1), y1 = std::min(y0 + 1, gy - 1);
+    const float ay = fy - static_cast<float>(y0);
+    for (int x = box.x; x < box.br().x; ++x) {
+      const int idx = y * width + x;
+      if (!valid[idx]) continue;
+      const float fade = 1.0f - distance.at<float>(y - box.y, x - box.x) * inv_fade;
+      if (fade <= 0.0f) continue;
+      const float fx = std::clamp((static_cast<float>(x - box.x) + 0.5f) * inv_cell - 0.5f, 0.0f,
+                                  static_cast<float>(gx - 1));
+      const int x0 = std::min(static_cast<int>(fx), gx - 1), x1 = std::min(x0 + 1, gx - 1);
+      const float ax = fx - static_cast<float>(x0);
+      const float w00 = (1 - ax) * (1 - ay), w10 = ax * (1 - ay), w01 = (1 - ax) * ay,
+                  w11 = ax * ay;
+      const int c00 = 3 * (y0 * gx + x0), c10 = 3 * (y0 * gx + x1), c01 = 3 * (y1 * gx + x0),
+                c11 = 3 * (y1 * gx + x1);
+      for (int c = 0; c < 3; ++c) {
+        const float g = std::exp(fade * (w00 * value[c00 + c] + w10 * value[c10 + c] +
+                                         w01 * value[c01 + c] + w11 * value[c11 + c]));
+        sample[idx][c] = cv::saturate_cast<uint8_t>(static_cast<float>(sample[idx][c]) * g);
+      }
+    }
+  }
+  return stats;
+}
+
+}  // namespace fresco
