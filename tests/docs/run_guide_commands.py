@@ -13,6 +13,12 @@ Every ```bash / ```sh block is preceded by a marker that says what to do with it
     <!-- doc-test: mirror: T1, T2: WHY --> not run here (WHY: a window, two programs at once,
                                           minutes); the tests T1, T2 (GoogleTest Suite.Name or
                                           CTest names) do what it does, and must exist
+    <!-- doc-test: ci: WHY -->            CI's own commands (the quick start, the test and
+                                          sanitizer scripts: running them here would run CI
+                                          inside CI); checked instead: its first `bash .ci/X`
+                                          is one .ci/run reaches (CI runs it on every change),
+                                          every script and test program it names exists and
+                                          every `ctest -R NAME` names a test
     <!-- doc-test: skip: REASON -->       not run and not mirrored; REASON says why
 
 A block without a marker fails this test: a new command in the guide has to say whether it
@@ -37,7 +43,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 ORDER = ["painting.md", "automation.md", "calibration.md", "poses.md", "live.md"]
 MARKER = re.compile(r"<!--\s*doc-test:\s*(run given:\s*(.+?)|run|output\s+\"([^\"]*)\"|"
-                    r"mirror:\s*(.+?)|skip:\s*(.+?))\s*-->")
+                    r"mirror:\s*(.+?)|skip:\s*(.+?)|ci:\s*(.+?))\s*-->")
 SHARED = os.path.join(os.path.dirname(ROOT), "shared")
 TEST_NAME = re.compile(r"^\s*(?:TEST|TEST_F|TEST_P)\(\s*(\w+)\s*,\s*(\w+)\s*\)", re.M)
 CTEST_NAME = re.compile(r"add_test\(\s*NAME\s+(\w+)|fresco_add_test\(\s*(\w+)")
@@ -54,6 +60,43 @@ def known_tests():
             elif f == "CMakeLists.txt":
                 names.update(a or b for a, b in CTEST_NAME.findall(text))
     return names
+
+
+def ci_scripts():
+    """The .ci scripts CI runs: .ci/run and every `bash .ci/X` those scripts run, in turn."""
+    reached, todo = set(), [".ci/run"]
+    while todo:
+        script = todo.pop()
+        if script in reached or not os.path.exists(os.path.join(ROOT, script)):
+            continue
+        reached.add(script)
+        text = open(os.path.join(ROOT, script)).read()
+        todo += re.findall(r"^\s*(?:[\w$(){}\"=]+\s+)*bash\s+(\.ci/[\w-]+)", text, re.M)
+    return reached
+
+
+def check_ci_block(code, tests):
+    """What is wrong with a `ci:` block (a list of messages; empty when nothing is)."""
+    problems = []
+    commands = [l.split("#")[0].strip() for l in code.splitlines()]
+    commands = [c for c in commands if c]
+    first = next((re.search(r"bash\s+(\.ci/[\w-]+)", c) for c in commands
+                  if re.search(r"bash\s+\.ci/", c)), None)
+    if not first:
+        problems.append("names no `bash .ci/...` script")
+    elif first.group(1) not in ci_scripts():
+        problems.append(f"{first.group(1)} is not run by CI (.ci/run does not reach it)")
+    for c in commands:
+        for path in re.findall(r"(?<![\w/])((?:\.ci|tests)/[\w/.-]+)", c):
+            if not os.path.exists(os.path.join(ROOT, path)):
+                problems.append(f"{path} does not exist")
+        for name in re.findall(r"ctest\s+(?:-\S+\s+)*-R\s+(\w+)", c):
+            if name not in tests:
+                problems.append(f"no test named {name}")
+        for program in re.findall(r"(?<![\w/])build[\w-]*/tests/(?:\w+/)*(\w+)", c):
+            if not any(program + ".cc" in files for _, _, files in os.walk(os.path.join(ROOT, "tests"))):
+                problems.append(f"no test program {program} (tests/**/{program}.cc)")
+    return problems
 
 
 def blocks(path):
@@ -82,6 +125,8 @@ def blocks(path):
                 out.append((start + 1, "output", m.group(3), code))
             elif m.group(4) is not None:
                 out.append((start + 1, "mirror", m.group(4), code))
+            elif m.group(6) is not None:
+                out.append((start + 1, "ci", m.group(6), code))
             else:
                 out.append((start + 1, "skip", m.group(5), code))
             i = j + 1
@@ -109,7 +154,7 @@ def main():
     if has_shared:
         os.symlink(SHARED, os.path.join(outer, "shared"))
     tests = known_tests()
-    errors, ran, mirrored, skipped = [], 0, 0, 0
+    errors, ran, mirrored, cied, skipped = [], 0, 0, 0, 0
     started = time.time()
     try:
         shutil.copytree(os.path.join(ROOT, "projects"), os.path.join(scratch, "projects"),
@@ -131,6 +176,12 @@ def main():
                 if kind == "skip":
                     skipped += 1
                     print(f"skip {where}: {arg}")
+                    continue
+                if kind == "ci":
+                    for problem in check_ci_block(code, tests):
+                        errors.append(f"{where}: CI's commands: {problem}")
+                    cied += 1
+                    print(f"ci   {where}: {arg}")
                     continue
                 if kind == "mirror":
                     names = [n.strip() for n in arg.split(":")[0].split(",")]
@@ -165,8 +216,8 @@ def main():
         shutil.rmtree(outer, ignore_errors=True)
     for e in errors:
         print("FAIL " + e)
-    print(f"run_guide_commands: {ran} blocks run, {mirrored} mirrored by tests, {skipped} "
-          f"skipped (each with its reason), {len(errors)} problems, "
+    print(f"run_guide_commands: {ran} blocks run, {mirrored} mirrored by tests, {cied} CI's "
+          f"own (checked), {skipped} skipped (each with its reason), {len(errors)} problems, "
           f"{time.time() - started:.0f} s")
     return 1 if errors else 0
 
