@@ -60,14 +60,16 @@ uniform sampler2D frame;     // the current frame
 uniform mat4 frame_from_local;  // pixel * z = K [R|t] x (pinhole part)
 uniform vec2 frame_size;
 uniform vec3 eye;
-// View-dependent layers (painted mode): the two nearest this draw's chart, their cameras'
-// centres and the cut-off angle (unstructured lumigraph weights, as view_dependent_render.h).
-uniform int layered;  // 0 none, 1 or 2 layers bound
+// View-dependent layers (painted mode): the four whose cameras are nearest this draw's
+// chart, their cameras' centres; per pixel the two nearest the viewer's direction among those
+// painted there, the third as the cut-off (unstructured lumigraph weights, as
+// view_dependent_render.h).
+uniform int layered;  // 0 none, 1 to 4 layers bound
 uniform sampler2D layer0;
 uniform sampler2D layer1;
-uniform vec3 layer_centre0;
-uniform vec3 layer_centre1;
-uniform float layer_cut;
+uniform sampler2D layer2;
+uniform sampler2D layer3;
+uniform vec3 layer_centre[4];
 layout(location = 0) out vec4 colour;
 layout(location = 1) out int triangle;
 void main() {
@@ -81,15 +83,34 @@ void main() {
     vec4 t = texture(painted, v_uv);
     if (layered > 0) {
       vec3 to_eye = normalize(eye - v_position);
-      vec4 l0 = texture(layer0, v_uv);
-      vec4 l1 = texture(layer1, v_uv);
-      float a0 = acos(clamp(dot(normalize(layer_centre0 - v_position), to_eye), -1.0, 1.0));
-      float a1 = acos(clamp(dot(normalize(layer_centre1 - v_position), to_eye), -1.0, 1.0));
-      float w0 = l0.a > 0.5 ? max(0.0, 1.0 - a0 / layer_cut) / max(a0, 1e-4) : 0.0;
-      float w1 = (layered > 1 && l1.a > 0.5) ? max(0.0, 1.0 - a1 / layer_cut) / max(a1, 1e-4)
-                                               : 0.0;
-      if (w0 + w1 > 0.0) t = vec4((w0 * l0.rgb + w1 * l1.rgb) / (w0 + w1), 1.0);
-      else if (l0.a > 0.5) t = vec4(l0.rgb, 1.0);
+      vec4 l[4];
+      l[0] = texture(layer0, v_uv);
+      l[1] = texture(layer1, v_uv);
+      l[2] = texture(layer2, v_uv);
+      l[3] = texture(layer3, v_uv);
+      // The painted layers' angles, the three smallest in order (a: angle, i: layer).
+      float a[3] = float[3](1e9, 1e9, 1e9);
+      int i[3] = int[3](-1, -1, -1);
+      for (int k = 0; k < 4; ++k) {
+        if (k >= layered || l[k].a <= 0.5) continue;
+        float ak = acos(clamp(dot(normalize(layer_centre[k] - v_position), to_eye), -1.0, 1.0));
+        if (ak < a[0]) {
+          a[2] = a[1], i[2] = i[1], a[1] = a[0], i[1] = i[0], a[0] = ak, i[0] = k;
+        } else if (ak < a[1]) {
+          a[2] = a[1], i[2] = i[1], a[1] = ak, i[1] = k;
+        } else if (ak < a[2]) {
+          a[2] = ak, i[2] = k;
+        }
+      }
+      if (i[0] >= 0) {
+        int n = i[2] >= 0 ? 3 : (i[1] >= 0 ? 2 : 1);
+        float cut = n > 2 ? a[2] : 2.0 * a[n - 1] + 1e-3;
+        float w0 = max(0.0, 1.0 - a[0] / cut) / max(a[0], 1e-4);
+        float w1 = n > 1 ? max(0.0, 1.0 - a[1] / cut) / max(a[1], 1e-4) : 0.0;
+        vec3 c0 = l[i[0]].rgb;
+        vec3 c1 = n > 1 ? l[i[1]].rgb : c0;
+        t = w0 + w1 > 0.0 ? vec4((w0 * c0 + w1 * c1) / (w0 + w1), 1.0) : vec4(c0, 1.0);
+      }
     }
     bool checker = (int(floor(gl_FragCoord.x / 8.0) + floor(gl_FragCoord.y / 8.0)) & 1) == 1;
     base = t.a > 0.5 ? t.rgb : vec3(checker ? 0.32 : 0.26) * shade;
@@ -213,19 +234,21 @@ struct GlViewport::Impl {
   GlTextures textures;
   bool built = false;
 
-  // Binds the two view-dependent layers whose cameras are nearest the direction from buffer
-  // b's centre to the eye (texture units 2 and 3) and sets the shader's layer uniforms.
+  // Binds the (up to) four view-dependent layers whose cameras are nearest the direction from
+  // buffer b's centre to the eye (texture units 2 to 5) and sets the shader's layer uniforms;
+  // the shader chooses among them per pixel.
   void BindNearestLayers(const RunnerSnapshot& snapshot, size_t b, const Eigen::Vector3f& eye);
+  static constexpr int kLayersBound = 4;
   // The layer uniforms' locations (looked up once, after linking) and the sort's scratch.
-  GLint layered_at = -1, layer_cut_at = -1, layer_centre_at[2] = {-1, -1};
+  GLint layered_at = -1, layer_centre_at[kLayersBound] = {-1, -1, -1, -1};
   std::vector<std::pair<float, size_t>> nearest_layers;
 
   void Build() {
     mesh_program = Link(kMeshVertex, kMeshFragment);
     layered_at = glGetUniformLocation(mesh_program, "layered");
-    layer_cut_at = glGetUniformLocation(mesh_program, "layer_cut");
-    layer_centre_at[0] = glGetUniformLocation(mesh_program, "layer_centre0");
-    layer_centre_at[1] = glGetUniformLocation(mesh_program, "layer_centre1");
+    for (int i = 0; i < kLayersBound; ++i)
+      layer_centre_at[i] =
+          glGetUniformLocation(mesh_program, ("layer_centre[" + std::to_string(i) + "]").c_str());
     line_program = Link(kLineVertex, kLineFragment);
     glGenVertexArrays(1, &vao);
     glGenBuffers(1, &vbo);
@@ -357,10 +380,9 @@ void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t 
     near.emplace_back(std::acos(std::clamp(dot, -1.0f, 1.0f)), k);
   }
   std::sort(near.begin(), near.end());
-  const int bound = static_cast<int>(std::min<size_t>(2, near.size()));
+  const int bound = static_cast<int>(std::min<size_t>(kLayersBound, near.size()));
   glUniform1i(layered_at, bound);
   if (bound == 0) return;
-  const float cut = near.size() > 2 ? near[2].first : 2.0f * near.back().first + 1e-3f;
   for (int i = 0; i < bound; ++i) {
     const RunnerSnapshot::LayerImages& layer = layers[near[i].second];
     glActiveTexture(GL_TEXTURE2 + i);
@@ -372,7 +394,6 @@ void GlViewport::Impl::BindNearestLayers(const RunnerSnapshot& snapshot, size_t 
     glUniform3f(layer_centre_at[i], at.x(), at.y(), at.z());
   }
   glActiveTexture(GL_TEXTURE0);
-  glUniform1f(layer_cut_at, cut);
 }
 
 GlViewport::GlViewport() : impl_(std::make_unique<Impl>()) {}
@@ -484,8 +505,8 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   glBindTexture(GL_TEXTURE_2D, frame_texture);
   glActiveTexture(GL_TEXTURE0);
   glBindVertexArray(m.vao);
-  glUniform1i(glGetUniformLocation(m.mesh_program, "layer0"), 2);
-  glUniform1i(glGetUniformLocation(m.mesh_program, "layer1"), 3);
+  for (int i = 0; i < Impl::kLayersBound; ++i)
+    glUniform1i(glGetUniformLocation(m.mesh_program, ("layer" + std::to_string(i)).c_str()), 2 + i);
   const bool layered = view->mode == ViewportView::Mode::kPainted && view->view_layers &&
                        snapshot.layers && !snapshot.layers->empty();
   glUniform1i(m.layered_at, 0);

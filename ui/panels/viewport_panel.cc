@@ -37,8 +37,8 @@ class ViewportPanel : public Panel {
       if (ImGui::IsItemHovered())
         ImGui::SetTooltip(
             "painted mode: the view-dependent layers (pipeline.layers) whose frames were taken "
-            "nearest the viewer, blended (the two nearest each chart's centre); off: the single "
-            "texture");
+            "nearest the viewer, blended per pixel (among the four nearest each chart's centre); "
+            "off: the single texture");
       ImGui::SameLine();
     }
     if (ImGui::SmallButton("reset view")) {
