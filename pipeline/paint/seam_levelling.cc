@@ -110,11 +110,19 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
       }
   }
 
-  // Each valid sample times the correction interpolated between the cells' centres, scaled
-  // down linearly with the texel's distance from the nearest kept texel (none at fade_texels).
+  // Each valid sample times the gain interpolated between the cells' centres, drawn towards 1
+  // linearly with the texel's distance from the nearest kept texel (1 at fade_texels).
+  std::vector<float> gain(value.size());
+  for (size_t k = 0; k < value.size(); ++k) gain[k] = std::exp(value[k]);
+  // (City-block distances, in bytes where the fade is short: a fraction of the cost.)
+  const int fade_texels = std::max(1, options.fade_texels);
   cv::Mat not_kept = kept(box) == 0, distance;
-  cv::distanceTransform(not_kept, distance, cv::DIST_L2, cv::DIST_MASK_5);
-  const float inv_fade = 1.0f / static_cast<float>(std::max(1, options.fade_texels));
+  if (fade_texels < 255)
+    cv::distanceTransform(not_kept, distance, cv::DIST_L1, 3, CV_8U);
+  else
+    cv::distanceTransform(not_kept, distance, cv::DIST_L1, 3, CV_32F);
+  const bool bytes = distance.type() == CV_8U;
+  const float inv_fade = 1.0f / static_cast<float>(fade_texels);
   const float inv_cell = 1.0f / static_cast<float>(cell);
   for (int y = box.y; y < box.br().y; ++y) {
     const float fy = std::clamp((static_cast<float>(y - box.y) + 0.5f) * inv_cell - 0.5f, 0.0f,
@@ -124,7 +132,9 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
     for (int x = box.x; x < box.br().x; ++x) {
       const int idx = y * width + x;
       if (!valid[idx]) continue;
-      const float fade = 1.0f - distance.at<float>(y - box.y, x - box.x) * inv_fade;
+      const float d = bytes ? static_cast<float>(distance.at<uint8_t>(y - box.y, x - box.x))
+                            : distance.at<float>(y - box.y, x - box.x);
+      const float fade = 1.0f - d * inv_fade;
       if (fade <= 0.0f) continue;
       const float fx = std::clamp((static_cast<float>(x - box.x) + 0.5f) * inv_cell - 0.5f, 0.0f,
                                   static_cast<float>(gx - 1));
@@ -135,8 +145,8 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
       const int c00 = 3 * (y0 * gx + x0), c10 = 3 * (y0 * gx + x1), c01 = 3 * (y1 * gx + x0),
                 c11 = 3 * (y1 * gx + x1);
       for (int c = 0; c < 3; ++c) {
-        const float g = std::exp(fade * (w00 * value[c00 + c] + w10 * value[c10 + c] +
-                                         w01 * value[c01 + c] + w11 * value[c11 + c]));
+        const float g = 1.0f + fade * (w00 * gain[c00 + c] + w10 * gain[c10 + c] +
+                                       w01 * gain[c01 + c] + w11 * gain[c11 + c] - 1.0f);
         sample[idx][c] = cv::saturate_cast<uint8_t>(static_cast<float>(sample[idx][c]) * g);
       }
     }
