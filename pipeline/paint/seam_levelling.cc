@@ -71,7 +71,7 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
     }
   }
 
-  // The measured cells' medians; the others filled from their neighbours, fading.
+  // The measured cells' medians; the others filled from their neighbours.
   std::vector<float> value(3 * static_cast<size_t>(cells), 0.0f);
   std::vector<int> set(cells, 0);  // 0 unset, 1 measured, 2 + round filled
   for (int i = 0; i < cells; ++i) {
@@ -79,14 +79,12 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
     if (static_cast<int>(r->size()) < options.min_samples) continue;
     set[i] = 1;
     ++stats.cells_measured;
-    stats.samples += static_cast<int>(r->size());
     for (int c = 0; c < 3; ++c) {
       value[3 * i + c] = MedianOf(&ratios[3 * static_cast<size_t>(i) + c]);
       stats.abs_log_sum += std::abs(value[3 * i + c]);
     }
   }
   if (stats.cells_measured == 0) return stats;
-  const float decay = static_cast<float>(options.fill_decay);
   for (int round = 0; round < options.fill_cells; ++round) {
     const std::vector<int> before = set;
     for (int cy = 0; cy < gy; ++cy)
@@ -104,7 +102,7 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
           ++n;
         }
         if (n == 0) continue;
-        for (int c = 0; c < 3; ++c) value[3 * i + c] = decay * sum[c] / static_cast<float>(n);
+        for (int c = 0; c < 3; ++c) value[3 * i + c] = sum[c] / static_cast<float>(n);
         set[i] = 2 + round;
         ++stats.cells_filled;
       }

@@ -4,13 +4,13 @@
 // step in colour (light that changes across a photo: vignetting, haze, flare, which one gain
 // per frame leaves). The frame's samples of the kept texels are compared with the stored ones
 // cell by cell (cells of `cell_texels` texels of the buffer's rectangle; per channel the
-// median log ratio), the cells without kept texels take their neighbours' correction fading
-// out cell by cell, and every new sample is multiplied by the field interpolated between the
-// cells' centres, scaled down with the texel's distance from the nearest kept texel (to none at
-// `fade_texels`). Near a seam the new samples continue the colours that stay; away from it (a
-// region the frame paints whole, or paints first) they keep their own, so corrections chain
-// from frame to frame only as far as the fade reaches. Streaming, like the rest of the painting:
-// each frame against the buffers as they are, no global solve at the end.
+// median log ratio), the cells without kept texels take their neighbours' correction, and every new
+// sample is multiplied by the field interpolated between the cells' centres, scaled down with the
+// texel's distance from the nearest kept texel (to none at `fade_texels`). Near a seam the new
+// samples continue the colours that stay; away from it (a region the frame paints whole, or paints
+// first) they keep their own, so corrections chain from frame to frame only as far as the fade
+// reaches. Streaming, like the rest of the painting: each frame against the buffers as they are, no
+// global solve at the end.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -25,7 +25,6 @@ struct SeamLevelOptions {
   int min_samples = 32;        // kept texels that make a cell measured
   double max_log_ratio = 0.5;  // texels whose ratio is further from 1 (movers) are left out
   int fill_cells = 4;          // cells without kept texels take their neighbours' correction
-  double fill_decay = 1.0;     // ... times this per cell
   int fade_texels = 16;        // the correction fades out over this distance from kept texels
 };
 
@@ -33,7 +32,6 @@ struct SeamLevelStats {
   int cells_measured = 0;  // cells with enough kept texels
   int cells_filled = 0;    // cells corrected from their neighbours
   double abs_log_sum = 0;  // sum over measured cells and channels of |log correction|
-  int samples = 0;         // kept texels compared over all cells
 };
 
 // Levels the valid samples of `warped` (a buffer's, painted as `painted`) in place against

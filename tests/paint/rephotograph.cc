@@ -9,24 +9,30 @@
 
 namespace fresco::testing {
 
-Rephoto Rephotograph(const Renderer& renderer, const Scene& original, const Scene& painted,
-                     const Rigid3d& cam_from_world) {
+TruthAndPainted RenderTruthAndPainted(const Renderer& renderer, const Scene& original,
+                                      const Scene& painted, const Rigid3d& cam_from_world) {
   RenderOutput truth, paint;
   renderer.Render(original, cam_from_world, &truth);
   renderer.Render(painted, cam_from_world, &paint);
   std::vector<cv::Mat> t_ch, p_ch;
   cv::split(truth.rgba, t_ch);
   cv::split(paint.rgba, p_ch);
-  const cv::Mat surface = t_ch[3] == 255;
-  const cv::Mat both = surface & (p_ch[3] == 255);
-  cv::Mat t_rgb, p_rgb;
-  cv::cvtColor(truth.rgba, t_rgb, cv::COLOR_RGBA2RGB);
-  cv::cvtColor(paint.rgba, p_rgb, cv::COLOR_RGBA2RGB);
-  Rephoto r;
-  r.psnr_db = PsnrDb(t_rgb, p_rgb, both);
-  r.completeness =
-      static_cast<double>(cv::countNonZero(both)) / std::max(1, cv::countNonZero(surface));
-  return r;
+  TruthAndPainted out;
+  out.surface = t_ch[3] == 255;
+  out.both = out.surface & (p_ch[3] == 255);
+  cv::cvtColor(truth.rgba, out.truth_bgr, cv::COLOR_RGBA2BGR);
+  cv::cvtColor(paint.rgba, out.painted_bgr, cv::COLOR_RGBA2BGR);
+  return out;
+}
+
+Rephoto Rephotograph(const Renderer& renderer, const Scene& original, const Scene& painted,
+                     const Rigid3d& cam_from_world) {
+  const TruthAndPainted r = RenderTruthAndPainted(renderer, original, painted, cam_from_world);
+  Rephoto rephoto;
+  rephoto.psnr_db = PsnrDb(r.truth_bgr, r.painted_bgr, r.both);  // channel order: same MSE
+  rephoto.completeness =
+      static_cast<double>(cv::countNonZero(r.both)) / std::max(1, cv::countNonZero(r.surface));
+  return rephoto;
 }
 
 Renderer RephotoRenderer(const Camera& camera) {

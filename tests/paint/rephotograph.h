@@ -13,6 +13,14 @@ struct Rephoto {
   double completeness = 0;  // surface pixels of the original that the painted model covers
 };
 
+// `original` and `painted` rendered at `cam_from_world` as BGR, the original's surface pixels
+// and those where both show a surface (CV_8U, 255).
+struct TruthAndPainted {
+  cv::Mat truth_bgr, painted_bgr, surface, both;
+};
+TruthAndPainted RenderTruthAndPainted(const Renderer& renderer, const Scene& original,
+                                      const Scene& painted, const Rigid3d& cam_from_world);
+
 // `renderer`: anti-aliased (supersample 2) like the synthetic frames.
 Rephoto Rephotograph(const Renderer& renderer, const Scene& original, const Scene& painted,
                      const Rigid3d& cam_from_world);

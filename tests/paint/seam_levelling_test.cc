@@ -11,6 +11,7 @@
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/seam_levelling.h"
 #include "pipeline/render/renderer.h"
+#include "tests/paint/rephotograph.h"
 #include "tests/paint/room_capture.h"
 #include "tests/paint/synth_session.h"
 

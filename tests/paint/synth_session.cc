@@ -1,9 +1,6 @@
 #include "tests/paint/synth_session.h"
 
-#include <vector>
-
 #include <gtest/gtest.h>
-#include <opencv2/imgproc.hpp>
 
 namespace fresco::testing {
 
@@ -35,21 +32,6 @@ Scene PaintAllFrames(const Scene& scene, const SynthCapture& capture,
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
     PaintCaptureFrame(session.get(), capture, i, &report);
   return session->PaintedScene();
-}
-
-TruthAndPainted RenderTruthAndPainted(const Renderer& renderer, const Scene& truth,
-                                      const Scene& painted, const Rigid3d& cam_from_world) {
-  RenderOutput t, p;
-  renderer.Render(truth, cam_from_world, &t);
-  renderer.Render(painted, cam_from_world, &p);
-  std::vector<cv::Mat> tc, pc;
-  cv::split(t.rgba, tc);
-  cv::split(p.rgba, pc);
-  TruthAndPainted out;
-  out.both = (tc[3] == 255) & (pc[3] == 255);
-  cv::cvtColor(t.rgba, out.truth_bgr, cv::COLOR_RGBA2BGR);
-  cv::cvtColor(p.rgba, out.painted_bgr, cv::COLOR_RGBA2BGR);
-  return out;
 }
 
 SynthOptions BlocksHalfOrbit(const BlocksOptions& blocks, int frames, int seed) {

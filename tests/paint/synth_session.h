@@ -8,7 +8,6 @@
 
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/paint_session.h"
-#include "pipeline/render/renderer.h"
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
 
@@ -26,14 +25,6 @@ void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_
 // Paints every frame of the capture at its true pose; the painted scene.
 Scene PaintAllFrames(const Scene& scene, const SynthCapture& capture,
                      const PipelineOptions& options);
-
-// `truth` and `painted` rendered at `cam_from_world` as BGR, and the pixels where both show
-// a surface (CV_8U, 255).
-struct TruthAndPainted {
-  cv::Mat truth_bgr, painted_bgr, both;
-};
-TruthAndPainted RenderTruthAndPainted(const Renderer& renderer, const Scene& truth,
-                                      const Scene& painted, const Rigid3d& cam_from_world);
 
 // Half a turn (320x240) around the blocks scene `blocks`, looking at 0.3 of its tallest box's
 // height from 0.6 of its ground's size away and half of it up.

@@ -16,6 +16,7 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
+#include "tests/paint/rephotograph.h"
 #include "tests/paint/room_capture.h"
 #include "tests/paint/synth_session.h"
 
