@@ -10,7 +10,7 @@ namespace {
 
 constexpr double kSmoothTiles = 1.0;  // the field's smoothing (Gaussian sigma), tiles
 constexpr double kReach = 0.05;       // smoothed sample weight below which nothing moves
-constexpr double kNegligible = 0.0;  // texels: a tile whose mean is smaller does not move
+constexpr double kNegligible = 0.0;   // texels: a tile whose mean is smaller does not move
 
 cv::Point2d Apply(const cv::Matx33d& H, double x, double y) {
   const cv::Vec3d q = H * cv::Vec3d(x, y, 1);
@@ -50,11 +50,12 @@ struct MoveMap {
     cv::minMaxLoc(field.reshape(1), &low, &high);
     const double largest = std::max(high, -low);
     const int margin = static_cast<int>(std::ceil(largest)) + 3;  // + bicubic support
-    source = cv::Rect(roi.x - margin, roi.y - margin, roi.width + 2 * margin,
-                      roi.height + 2 * margin) &
-             cv::Rect(0, 0, image.width, image.height);
+    source =
+        cv::Rect(roi.x - margin, roi.y - margin, roi.width + 2 * margin, roi.height + 2 * margin) &
+        cv::Rect(0, 0, image.width, image.height);
     map.create(roi.size(), CV_32FC2);
-    const float dx = static_cast<float>(roi.x - source.x), dy = static_cast<float>(roi.y - source.y);
+    const float dx = static_cast<float>(roi.x - source.x),
+                dy = static_cast<float>(roi.y - source.y);
     for (int y = 0; y < roi.height; ++y) {
       const cv::Vec2f* f = field.ptr<cv::Vec2f>(y);
       cv::Vec2f* m = map.ptr<cv::Vec2f>(y);
@@ -68,6 +69,42 @@ struct MoveMap {
     return out;
   }
 };
+
+// Colours of the texels next to `alpha`'s (CV_8U) set ones carried into the unset ones, two
+// texels deep, in place: bicubic interpolation reaches two texels, so a texel moved next to
+// unpainted ones reads their extended colour instead of whatever they hold.
+void ExtendColours(cv::Mat* bgra, const cv::Mat& alpha) {
+  CV_Assert(bgra->type() == CV_8UC4 && alpha.type() == CV_8U && bgra->size() == alpha.size());
+  cv::Mat set = alpha > 0;
+  if (cv::countNonZero(set) == set.rows * set.cols) return;  // nothing unpainted
+  for (int pass = 0; pass < 2; ++pass) {
+    cv::Mat reached = set.clone();
+    for (int y = 0; y < set.rows; ++y) {
+      const uchar* s = set.ptr<uchar>(y);
+      for (int x = 0; x < set.cols; ++x) {
+        if (s[x]) continue;
+        int sum[3] = {0, 0, 0}, n = 0;
+        for (int dy = -1; dy <= 1; ++dy) {
+          const int yy = y + dy;
+          if (yy < 0 || yy >= set.rows) continue;
+          const uchar* sn = set.ptr<uchar>(yy);
+          const cv::Vec4b* cn = bgra->ptr<cv::Vec4b>(yy);
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx;
+            if (xx < 0 || xx >= set.cols || !sn[xx]) continue;
+            for (int c = 0; c < 3; ++c) sum[c] += cn[xx][c];
+            ++n;
+          }
+        }
+        if (n == 0) continue;
+        cv::Vec4b& out = bgra->at<cv::Vec4b>(y, x);
+        for (int c = 0; c < 3; ++c) out[c] = static_cast<uchar>((sum[c] + n / 2) / n);
+        reached.at<uchar>(y, x) = 255;
+      }
+    }
+    set = reached;
+  }
+}
 
 }  // namespace
 
@@ -92,16 +129,32 @@ double LargestDisplacement(const cv::Matx33d& H, const cv::Rect& region) {
   return largest;
 }
 
-bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const std::vector<cv::Point2f>& at,
-                     const RefineOptions& options, RefineAnchor* anchor, AnchorMove* move) {
-  ++anchor->samples;
-  // Tiles where the frame had matches: the correction is measured there, not extrapolated.
-  cv::Mat matched = cv::Mat::zeros(anchor->count.size(), CV_8U);
-  for (const cv::Point2f& p : at) {
+cv::Mat TilesAt(const RefineAnchor& anchor, const std::vector<cv::Point2f>& points) {
+  cv::Mat tiles = cv::Mat::zeros(anchor.count.size(), CV_8U);
+  for (const cv::Point2f& p : points) {
     const int tx = static_cast<int>(p.x) / kAnchorTileTexels;
     const int ty = static_cast<int>(p.y) / kAnchorTileTexels;
-    if (tx >= 0 && ty >= 0 && tx < matched.cols && ty < matched.rows) matched.at<uchar>(ty, tx) = 1;
+    if (tx >= 0 && ty >= 0 && tx < tiles.cols && ty < tiles.rows) tiles.at<uchar>(ty, tx) = 1;
   }
+  return tiles;
+}
+
+cv::Mat TilesSet(const RefineAnchor& anchor, const cv::Mat& valid, const cv::Rect& box) {
+  cv::Mat tiles = cv::Mat::zeros(anchor.count.size(), CV_8U);
+  const cv::Rect within = box & cv::Rect(0, 0, valid.cols, valid.rows);
+  for (int y = within.y; y < within.br().y; ++y) {
+    const uchar* v = valid.ptr<uchar>(y);
+    uchar* t = tiles.ptr<uchar>(y / kAnchorTileTexels);
+    for (int x = within.x; x < within.br().x; ++x)
+      if (v[x]) t[x / kAnchorTileTexels] = 1;
+  }
+  return tiles;
+}
+
+bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Mat& measured,
+                     const cv::Mat& in_view, const RefineOptions& options, RefineAnchor* anchor,
+                     AnchorMove* move) {
+  ++anchor->samples;
   // Older samples fade (time constant anchor_window_frames): the buffer drifts a little
   // as registered frames paint over it, and old samples would not see that.
   const double keep =
@@ -109,7 +162,7 @@ bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const std::vector<cv
   double largest_mean = 0;
   for (int ty = 0; ty < anchor->count.rows; ++ty) {
     for (int tx = 0; tx < anchor->count.cols; ++tx) {
-      if (!matched.at<uchar>(ty, tx)) continue;
+      if (!measured.at<uchar>(ty, tx)) continue;
       const cv::Point2d c = TileCentre(tx, ty);
       const cv::Point2d d = Apply(buffer_from_warped, c.x, c.y) - c;
       cv::Vec2d& s = anchor->sum.at<cv::Vec2d>(ty, tx);
@@ -133,7 +186,7 @@ bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const std::vector<cv
   for (int ty = 0; ty < tiles.rows; ++ty) {
     for (int tx = 0; tx < tiles.cols; ++tx) {
       const double n = count_smooth.at<double>(ty, tx);
-      if (n < kReach) continue;
+      if (n < kReach || !in_view.at<uchar>(ty, tx)) continue;
       const cv::Vec2d f = sum_smooth.at<cv::Vec2d>(ty, tx) / n;
       if (cv::norm(f) < kNegligible) continue;
       tiles.at<cv::Vec2d>(ty, tx) = f;
@@ -167,17 +220,19 @@ bool TakeBackgroundMove(RefineAnchor* anchor, AnchorMove* move) {
   return true;
 }
 
-void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor,
-                       PaintedBuffer* painted) {
+void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor, PaintedBuffer* painted) {
   const MoveMap m(move, move.roi, painted->bgra.size());
   cv::Mat alpha_before, alpha;
   cv::extractChannel(painted->bgra(m.roi), alpha_before, 3);
   const int surface_before = cv::countNonZero(alpha_before & anchor.surface(m.roi));
   cv::extractChannel(painted->bgra(m.source), alpha, 3);
+  // Unpainted texels take their painted neighbours' colours first, so that a texel moved
+  // next to them does not blend in what they hold; the paint's extent moves as it is.
+  cv::Mat source_bgra = painted->bgra(m.source).clone();
+  ExtendColours(&source_bgra, alpha);
   cv::remap(alpha, alpha, m.map, cv::noArray(), cv::INTER_NEAREST, cv::BORDER_CONSTANT);
-  const cv::Mat bgra = m.Moved(painted->bgra, cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  // A texel next to an unpainted one would have blended white into its colour: unpainted.
-  cv::erode(alpha, alpha, cv::Mat());
+  cv::Mat bgra;
+  cv::remap(source_bgra, bgra, m.map, cv::noArray(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::insertChannel(alpha, bgra, 3);
   bgra.copyTo(painted->bgra(m.roi));
   // What moved was painted in a worse gauge: any later frame may replace it.
@@ -186,8 +241,8 @@ void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor,
       cv::countNonZero(alpha & anchor.surface(m.roi)) - surface_before;
 }
 
-void MoveWarpedImages(const AnchorMove& move, const cv::Rect& within, cv::Mat* bgr,
-                      cv::Mat* valid, cv::Mat* quality) {
+void MoveWarpedImages(const AnchorMove& move, const cv::Rect& within, cv::Mat* bgr, cv::Mat* valid,
+                      cv::Mat* quality) {
   const cv::Rect roi = move.roi & within;
   if (roi.empty()) return;
   const MoveMap m(move, roi, bgr->size());

@@ -48,11 +48,22 @@ struct AnchorMove {
 
 void InitRefineAnchor(const BaseBuffer& buffer, RefineAnchor* anchor);
 
-// Adds a frame's correction `buffer_from_warped` (identity when none was needed), measured
-// at the tiles of the matched positions `at` (the inliers). Returns true, with the move,
-// when the buffer should move; the anchor is then re-expressed in the moved buffer.
-bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const std::vector<cv::Point2f>& at,
-                     const RefineOptions& options, RefineAnchor* anchor, AnchorMove* move);
+// The anchor's tiles (CV_8U, 1 or 0) holding any of `points` (texels).
+cv::Mat TilesAt(const RefineAnchor& anchor, const std::vector<cv::Point2f>& points);
+
+// The anchor's tiles holding any texel set in `valid` (CV_8U, buffer size) within `box`.
+cv::Mat TilesSet(const RefineAnchor& anchor, const cv::Mat& valid, const cv::Rect& box);
+
+// Adds a frame's correction `buffer_from_warped` (identity when none was needed) as a sample
+// at the tiles `measured` (TilesAt, TilesSet): where the correction holds. A homography fitted
+// to one buffer's matches holds where its inliers are (not extrapolated); a correction
+// derived from the frame's pose (refine_pose.h) holds wherever the frame sees the buffer.
+// Returns true, with the move, when the buffer should move; the anchor is then re-expressed
+// in the moved buffer. Only tiles in `in_view` move: the frame repaints those right after,
+// while content out of view would be resampled (and its edges eroded) on old evidence.
+bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Mat& measured,
+                     const cv::Mat& in_view, const RefineOptions& options, RefineAnchor* anchor,
+                     AnchorMove* move);
 
 // When the moves not yet applied to the background model reach half a texel somewhere:
 // their sum, to move the model by (BufferBackground::Move rounds it per texel); they are
@@ -68,7 +79,7 @@ void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor, Paint
 
 // The same move for a frame's warped images (bgr bicubic, valid and quality nearest), where
 // they may be valid (`within`, WarpedBuffer::valid_box).
-void MoveWarpedImages(const AnchorMove& move, const cv::Rect& within, cv::Mat* bgr,
-                      cv::Mat* valid, cv::Mat* quality);
+void MoveWarpedImages(const AnchorMove& move, const cv::Rect& within, cv::Mat* bgr, cv::Mat* valid,
+                      cv::Mat* quality);
 
 }  // namespace fresco

@@ -52,6 +52,7 @@ void PaintSession::KeepOutOfPainted(size_t b, const cv::Rect& roi) {
 // One buffer's refinement: register, warp again, anchor; what the stage reports about it.
 struct PaintSession::BufferRefinement {
   RefineEstimate estimate;
+  bool from_pose = false;  // the correction was derived from the frame's corrected pose
   bool moved = false, kept_out = false;
   double estimate_ms = 0, rewarp_ms = 0, anchor_ms = 0;
   std::map<std::string, cv::Mat> images;
@@ -80,11 +81,21 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   t0 = std::chrono::steady_clock::now();
   // A registered frame is a sample of the buffer's offset (refine_anchor.h).
   AnchorMove move;
-  std::vector<cv::Point2f> inliers_at;
-  for (size_t i = 0; i < e.to.size(); ++i)
-    if (e.inlier[i]) inliers_at.push_back(e.to[i]);
-  if (options_.refine.anchor && e.registered &&
-      AddAnchorSample(e.buffer_from_warped, inliers_at, options_.refine, &anchors_[b], &move)) {
+  bool sample = options_.refine.anchor && e.registered;
+  cv::Mat in_view, measured;
+  if (sample) {
+    in_view = TilesSet(anchors_[b], w.valid, w.valid_box);
+    if (r->from_pose) {  // the pose's correction holds wherever the frame sees the buffer
+      measured = in_view;
+    } else {  // a homography fitted to this buffer's matches holds where they are
+      std::vector<cv::Point2f> inliers_at;
+      for (size_t i = 0; i < e.to.size(); ++i)
+        if (e.inlier[i]) inliers_at.push_back(e.to[i]);
+      measured = TilesAt(anchors_[b], inliers_at);
+    }
+  }
+  if (sample && AddAnchorSample(e.buffer_from_warped, measured, in_view, options_.refine,
+                                &anchors_[b], &move)) {
     MovePaintedBuffer(move, anchors_[b], &painted);
     // The frame, registered to the buffer before the move, moves with it.
     const int margin = static_cast<int>(std::ceil(e.correction_px)) + 2;
@@ -152,6 +163,7 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
       continue;  // keeps its own estimate
     }
     e.buffer_from_warped = H;
+    (*results)[i].from_pose = true;
     e.model = MotionModel::kHomography;
     e.registered = true;
     e.correction_px = LargestDisplacement(H, box);

@@ -20,6 +20,7 @@ struct Baseline {
     if (!MakeRefineScenario(300, 0.5, &scenario).ok()) std::abort();
     PipelineOptions options;
     options.background.mode = BackgroundMode::kOff;
+    options.refine.mode = RefineMode::kOff;  // the default, `auto`, would refine the noisy one
     PaintedScenario perfect, noisy;
     if (!PaintScenario(scenario, scenario.capture.true_poses, options, &perfect).ok() ||
         !PaintScenario(scenario, scenario.capture.given_poses, options, &noisy).ok())

@@ -6,8 +6,8 @@
 // buffer is registered to the one painted at the true poses (misalignment, texels).
 // Registration alone makes the frames agree with the buffer but inherits (and random-walks)
 // the buffer's offset; anchoring removes most of it. The target is >= 80 % of the
-// PSNR the noise costs: per-buffer homographies reach 80 % (README), held here at >= 75 %;
-// correcting the frame's pose from all buffers' matches reaches 86 %, held at >= 80 %.
+// PSNR the noise costs: per-buffer homographies reach 76 % (docs/results.md), held here at
+// >= 72 %; correcting the frame's pose from all buffers' matches reaches 86 %, held at >= 80 %.
 #include <cstdio>
 
 #include <gtest/gtest.h>
@@ -36,8 +36,14 @@ class RefinePainting : public ::testing::Test {
 
   struct Row {
     double psnr = 0, recovered = 0, misalignment = 0;
+    long long painted_texels = 0;  // on-surface texels painted, all buffers
     PaintedScenario painted;
   };
+  static long long PaintedTexels(const PaintSession& session) {
+    long long n = 0;
+    for (const PaintedBuffer& p : session.painted()) n += p.painted_surface_texels;
+    return n;
+  }
   static Row Measure(const char* name, const std::vector<PosedImage>& poses,
                      const PipelineOptions& options, double noisy_psnr) {
     Row row;
@@ -46,10 +52,14 @@ class RefinePainting : public ::testing::Test {
     if (noisy_psnr == 0) noisy_psnr = row.psnr;  // this is the noisy run
     row.recovered = (row.psnr - noisy_psnr) / (perfect_psnr_ - noisy_psnr);
     row.misalignment = MisalignmentPx(*row.painted.session, *perfect_->session);
-    std::printf("%-28s PSNR %.2f dB (recovers %4.0f %%), misalignment %.2f texels, registration "
-                "residual %.2f -> %.2f texels, %d registrations applied, refine %.1f ms/frame\n",
-                name, row.psnr, 100 * row.recovered, row.misalignment, row.painted.refine_before_px,
-                row.painted.refine_after_px, row.painted.refined, row.painted.refine_ms);
+    row.painted_texels = PaintedTexels(*row.painted.session);
+    std::printf(
+        "%-28s PSNR %.2f dB (recovers %4.0f %%), misalignment %.2f texels, registration "
+        "residual %.2f -> %.2f texels, %d registrations applied, refine %.1f ms/frame, "
+        "%.1f %% of the texels painted at the true poses\n",
+        name, row.psnr, 100 * row.recovered, row.misalignment, row.painted.refine_before_px,
+        row.painted.refine_after_px, row.painted.refined, row.painted.refine_ms,
+        100.0 * row.painted_texels / PaintedTexels(*perfect_->session));
     return row;
   }
 
@@ -84,7 +94,9 @@ TEST_F(RefinePainting, AnchoredRobustRefinementRecoversMostOfThePsnrLostToPoseNo
   const Row pose = Measure("robust, anchored, pose (default)", noisy_poses, options, noisy_psnr);
 
   EXPECT_GT(perfect_psnr_ - noisy_psnr, 5.0);  // the noise costs something: the test can fail
-  EXPECT_GE(robust.recovered, 0.75);
+  // Per-buffer homographies: 79 % while anchoring also moved (and eroded) content out of the
+  // frame's view, 75 % since it moves only what the frame sees (which keeps coverage).
+  EXPECT_GE(robust.recovered, 0.72);
   EXPECT_GT(robust.psnr, robust_free.psnr + 3.0);  // anchoring is what recovers it
   EXPECT_GT(robust.psnr, paper.psnr + 2.0);
   EXPECT_LT(robust.misalignment, 0.6 * noisy.misalignment);
@@ -94,6 +106,11 @@ TEST_F(RefinePainting, AnchoredRobustRefinementRecoversMostOfThePsnrLostToPoseNo
   EXPECT_GE(pose.recovered, 0.80);
   EXPECT_GT(pose.psnr, robust.psnr + 0.3);
   EXPECT_LT(pose.misalignment, robust.misalignment);
+  // Anchoring moves only content the frame sees (and repaints): what the camera has turned
+  // away from keeps its paint. Moving it on old samples eroded its edges at every move.
+  const long long perfect_texels = PaintedTexels(*perfect_->session);
+  EXPECT_GE(pose.painted_texels, 0.97 * perfect_texels);
+  EXPECT_GE(robust.painted_texels, 0.97 * perfect_texels);
 }
 
 // Refinement must not damage a capture whose poses are right: registration noise applied
@@ -103,8 +120,8 @@ TEST_F(RefinePainting, CorrectPosesStayCorrectWithRefinementOn) {
   options.background.mode = BackgroundMode::kOff;
   options.refine.mode = RefineMode::kRobust;
   options.refine.pose = false;
-  const Row row = Measure("perfect poses, robust", scenario_->capture.true_poses, options,
-                          perfect_psnr_ - 1);
+  const Row row =
+      Measure("perfect poses, robust", scenario_->capture.true_poses, options, perfect_psnr_ - 1);
   EXPECT_GT(row.psnr, perfect_psnr_ - 0.3);
   EXPECT_LT(row.misalignment, 0.3);
   options.refine.pose = true;
