@@ -4,8 +4,10 @@
 //
 //   refinement  While deciding, each frame is registered to what the buffers hold but not
 //               corrected (painting is what `off` paints). After `kRefineAutoFrames` frames
-//               with a measurement, the median of their misalignment (the pose fit's RMS over
-//               its inliers, texels) is compared with `kRefineAutoThresholdPx`: above, `robust`
+//               with a measurement, the median of the misalignment a correction would remove
+//               (sqrt(before^2 - after^2) of the pose fit's RMS over its inliers, texels: the
+//               part that is pose error, not matching noise or movers) is compared with
+//               `kRefineAutoThresholdPx`: above, `robust`
 //               refines every later frame; below, refinement stops (no further cost). It
 //               stops too when none of the first frames could be registered at all.
 //   background  The robust model runs from the start (masking as `robust` does). Once its
@@ -23,9 +25,11 @@
 
 namespace fresco {
 
-// Perfect poses measure 0.15-0.45 texels of misalignment, 0.5 degree of pose noise about 2
-// (docs/results.md, "Evaluation suite").
-constexpr double kRefineAutoThresholdPx = 0.6;
+// The misalignment a pose correction removes (texels): perfect poses 0-0.02 on the
+// evaluation suites' first frames (with movers, exposure changes and distortion: the fit
+// chooses no correction, however large the residual), pose noise 0.49-3.4 (docs/results.md,
+// "Evaluation suite").
+constexpr double kRefineAutoThresholdPx = 0.25;
 constexpr int kRefineAutoFrames = 6;
 // Refinement decides by this frame whatever it measured (off without a measurement: frames
 // too small or too plain to register).

@@ -72,7 +72,8 @@ struct FrameWork {
   std::vector<bool> seen;
   bool paint_in_warp = false;
   std::vector<PaintUpdateStats> paint_stats;
-  // refine.mode auto, deciding: the misalignment refinement measured this frame (< 0: none).
+  // refine.mode auto, deciding: the misalignment a correction would remove this frame,
+  // measured by refinement (< 0: none).
   double measured_misalignment_px = -1;
 };
 
@@ -236,6 +237,10 @@ class PaintSession {
   // pose fit's RMS over its inliers, pixels; without pose correction the RMS over every
   // buffer's inliers, texels); -1 when it could not tell.
   double frame_misalignment_px_ = -1;
+  // The part of it a correction removes: sqrt(before^2 - after^2) of the same RMS with the
+  // chosen correction (0 when the fit chose none: matching noise, movers); -1 as above. The
+  // evidence refine.mode `auto` decides on.
+  double frame_explained_px_ = -1;
 };
 
 // Whether the exposure and select stages run: pipeline.select.enabled, with `update: quality`

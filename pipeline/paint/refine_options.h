@@ -14,8 +14,8 @@ namespace fresco {
 
 // Texture alignment refinement (paper §3.5, refine_alignment.h). kAuto: measures the
 // misalignment between the first frames and the buffers without correcting, then refines
-// (`robust`) for the rest of the capture only when it exceeds what perfect poses give
-// (auto_modes.h).
+// (`robust`) for the rest of the capture only when a pose correction would remove enough of
+// it (auto_modes.h).
 enum class RefineMode { kOff, kPaper, kRobust, kAuto };
 // The most general 2D motion model refinement may choose (model selection picks simpler
 // ones when the evidence does not need more).
@@ -76,8 +76,9 @@ void Fields(RefineOptions& o, V& v) {
          "`paper`: Harris corners, SSD search, affine fit (the paper's §3.5); `robust`: tracked "
          "corners, RANSAC and model selection; `auto` (the default): the first frames' "
          "misalignment to the buffers is measured without correcting, and `robust` refines the "
-         "rest of the capture only when its median exceeds what perfect poses give (0.6 "
-         "texels); the decision and its evidence are in the refine stage's report");
+         "rest of the capture only when the part of it a pose correction would remove exceeds "
+         "0.25 texels (median; perfect poses give 0-0.02, with movers and distortion too); the "
+         "decision and its evidence are in the refine stage's report");
   v.Enum("max_model", o.max_model, RefineModelNames(),
          "the most general 2D motion `robust` may choose (simpler ones win when the evidence does "
          "not need more)");

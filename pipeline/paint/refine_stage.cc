@@ -25,6 +25,11 @@ namespace {
 // 0.15-0.45 texels there, 0.5 degree of noise about 2.
 constexpr double kKeepOutMisalignmentPx = 1.0;
 
+// The part of an RMS residual `before` that a correction leaving `after` removes.
+double ExplainedPx(double before, double after) {
+  return std::sqrt(std::max(0.0, before * before - after * after));
+}
+
 }  // namespace
 
 void PaintSession::RefineStage(FrameWork* work) {
@@ -35,7 +40,7 @@ void PaintSession::RefineStage(FrameWork* work) {
   if (measure_only || work->number % options_.refine.every_n_frames == 0) {
     work->report->stages.push_back(
         RefineAlignment(work->seen, work->debug, measure_only, &work->report->refine));
-    if (measure_only) work->measured_misalignment_px = frame_misalignment_px_;
+    if (measure_only) work->measured_misalignment_px = frame_explained_px_;
   } else {  // not registered this frame: it only fills what the buffers lack
     for (size_t b = 0; b < set_.buffers.size(); ++b)
       if (work->seen[b]) KeepOutOfPainted(b, warped_[b].valid_box);
@@ -149,7 +154,10 @@ void PaintSession::CorrectThroughPose(const std::vector<size_t>& todo,
   report->metrics["pose_translation_m"] = pose.delta.translation.norm();
   report->metrics["pose_model_" + pose.model] = 1;
   report->notes["pose"] = pose.applied ? pose.model : "no pose correction: " + pose.fallback;
-  if (pose.inliers > 0) frame_misalignment_px_ = pose.residual_before_px;
+  if (pose.inliers > 0) {
+    frame_misalignment_px_ = pose.residual_before_px;
+    frame_explained_px_ = ExplainedPx(pose.residual_before_px, pose.residual_after_px);
+  }
   if (!pose.applied || measure_only) return;  // the buffers keep their own 2D estimates
   const Rigid3d corrected = pose.delta * frame_cam_from_local_;
   results->resize(todo.size() + fresh.size());
@@ -184,6 +192,7 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
   StageReport report;
   report.name = "refine";
   frame_misalignment_px_ = -1;
+  frame_explained_px_ = -1;
   std::vector<size_t> todo, fresh;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (seen[b] && painted_[b].painted_surface_texels > 0)
@@ -228,13 +237,18 @@ StageReport PaintSession::RefineAlignment(const std::vector<bool>& seen, bool de
     if (!measure_only) for_each_buffer(&PaintSession::FinishBuffer);
   } else {  // each buffer on its own; the frame's misalignment pooled over their inliers
     for_each_buffer(&PaintSession::EstimateBuffer);
-    double sum_sq = 0;
+    double before_sq = 0, after_sq = 0;
     int pooled = 0;
     for (const BufferRefinement& r : results) {
-      sum_sq += r.estimate.inliers * r.estimate.residual_before_px * r.estimate.residual_before_px;
-      pooled += r.estimate.inliers;
+      const RefineEstimate& e = r.estimate;
+      before_sq += e.inliers * e.residual_before_px * e.residual_before_px;
+      after_sq += e.inliers * e.residual_after_px * e.residual_after_px;
+      pooled += e.inliers;
     }
-    if (pooled > 0) frame_misalignment_px_ = std::sqrt(sum_sq / pooled);
+    if (pooled > 0) {
+      frame_misalignment_px_ = std::sqrt(before_sq / pooled);
+      frame_explained_px_ = ExplainedPx(frame_misalignment_px_, std::sqrt(after_sq / pooled));
+    }
     if (!measure_only) for_each_buffer(&PaintSession::FinishBuffer);
   }
 
