@@ -235,8 +235,9 @@ void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor, Paint
   cv::remap(source_bgra, bgra, m.map, cv::noArray(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
   cv::insertChannel(alpha, bgra, 3);
   bgra.copyTo(painted->bgra(m.roi));
-  // What moved was painted in a worse gauge: any later frame may replace it.
-  painted->quality(m.roi).setTo(0);
+  // Each texel keeps the sharpness of the sample it moved with: the same sample, now where it
+  // belongs, so the quality rule keeps it against blurrier frames as before the move.
+  m.Moved(painted->quality, cv::INTER_NEAREST, cv::BORDER_CONSTANT).copyTo(painted->quality(m.roi));
   painted->painted_surface_texels +=
       cv::countNonZero(alpha & anchor.surface(m.roi)) - surface_before;
 }

@@ -73,8 +73,8 @@ bool TakeBackgroundMove(RefineAnchor* anchor, AnchorMove* move);
 // Largest displacement of `region`'s corners under `H`, texels.
 double LargestDisplacement(const cv::Matx33d& H, const cv::Rect& region);
 
-// Moves the painted content: colour bicubic, alpha and quality nearest. Moved texels get
-// quality 0, so that later frames (registered to the moved buffer) replace them.
+// Moves the painted content: colour bicubic, alpha and quality nearest (a texel keeps its
+// sample's sharpness, so later frames replace it by the quality rule as before).
 void MovePaintedBuffer(const AnchorMove& move, const RefineAnchor& anchor, PaintedBuffer* painted);
 
 // The same move for a frame's warped images (bgr bicubic, valid and quality nearest), where
