@@ -10,7 +10,6 @@ namespace {
 
 constexpr double kSmoothTiles = 1.0;  // the field's smoothing (Gaussian sigma), tiles
 constexpr double kReach = 0.05;       // smoothed sample weight below which nothing moves
-constexpr double kNegligible = 0.0;   // texels: a tile whose mean is smaller does not move
 
 cv::Point2d Apply(const cv::Matx33d& H, double x, double y) {
   const cv::Vec3d q = H * cv::Vec3d(x, y, 1);
@@ -188,7 +187,6 @@ bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Mat& measu
       const double n = count_smooth.at<double>(ty, tx);
       if (n < kReach || !in_view.at<uchar>(ty, tx)) continue;
       const cv::Vec2d f = sum_smooth.at<cv::Vec2d>(ty, tx) / n;
-      if (cv::norm(f) < kNegligible) continue;
       tiles.at<cv::Vec2d>(ty, tx) = f;
       box |= cv::Rect(tx, ty, 1, 1);
       largest_mean = std::max(largest_mean, cv::norm(f));

@@ -11,7 +11,7 @@
 // is kept as a field: per tile of kAnchorTileTexels, the sums and count of the displacements
 // the frames' corrections ask for there. When the mean at some tile with enough samples
 // exceeds the step, the buffer's content is moved back by the (smoothed) mean field once
-// (bicubic; only tiles whose mean is not negligible) and the sums are re-expressed in the
+// (bicubic; only tiles the frame sees) and the sums are re-expressed in the
 // moved buffer, so the estimate keeps every sample and sharpens as 1/sqrt(frames).
 #pragma once
 
@@ -60,7 +60,7 @@ cv::Mat TilesSet(const RefineAnchor& anchor, const cv::Mat& valid, const cv::Rec
 // derived from the frame's pose (refine_pose.h) holds wherever the frame sees the buffer.
 // Returns true, with the move, when the buffer should move; the anchor is then re-expressed
 // in the moved buffer. Only tiles in `in_view` move: the frame repaints those right after,
-// while content out of view would be resampled (and its edges eroded) on old evidence.
+// while content out of view would be resampled on old evidence.
 bool AddAnchorSample(const cv::Matx33d& buffer_from_warped, const cv::Mat& measured,
                      const cv::Mat& in_view, const RefineOptions& options, RefineAnchor* anchor,
                      AnchorMove* move);

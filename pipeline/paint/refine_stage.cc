@@ -86,7 +86,7 @@ void PaintSession::FinishBuffer(size_t b, bool debug, BufferRefinement* r) {
   t0 = std::chrono::steady_clock::now();
   // A registered frame is a sample of the buffer's offset (refine_anchor.h).
   AnchorMove move;
-  bool sample = options_.refine.anchor && e.registered;
+  const bool sample = options_.refine.anchor && e.registered;
   cv::Mat in_view, measured;
   if (sample) {
     in_view = TilesSet(anchors_[b], w.valid, w.valid_box);
