@@ -12,10 +12,11 @@
 //               stops too when none of the first frames could be registered at all.
 //   background  The robust model runs from the start (masking as `robust` does). Once its
 //               texels have warmed up, the foreground it finds among the texels it trusts is
-//               counted frame by frame: once a fraction above `kBackgroundAutoThreshold`
-//               (movers, or misaligned samples it keeps out) is seen after
-//               `kBackgroundAutoFrames` frames, it stays; if none by a third of the capture,
-//               the model is dropped and painting continues as `off`.
+//               counted frame by frame (its cleaned mask, before any growth by colour:
+//               growth spreads whatever was flagged, and is no evidence of movers): once a fraction
+//               above `kBackgroundAutoThreshold` (movers, or misaligned samples it keeps out) is
+//               seen after `kBackgroundAutoFrames` frames, it stays; if none by a third of the
+//               capture, the model is dropped and painting continues as `off`.
 #pragma once
 
 #include <string>

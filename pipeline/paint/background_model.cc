@@ -293,6 +293,7 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
                                 cv::Point(total.x_max + pad + 1, total.y_max + pad + 1)) &
                        cv::Rect(0, 0, buffer.width, buffer.height);
   Clean(roi, frame);
+  frame->masked_ungrown = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
   const int reach = options_.grow_reach_texels;
   if (grow && options_.grow_levels > 0 && reach > 0) {
     // From the flagged texels that survived the cleaning (not its dilation ring), by colour;
@@ -310,7 +311,7 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
       return;
     }
   }
-  frame->masked = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
+  frame->masked = frame->masked_ungrown;
 }
 
 cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {

@@ -38,7 +38,8 @@ struct BackgroundFrame {
   cv::Mat difference;      // CV_8U (debug only): RMS colour distance to the background x 2
   int observed = 0;        // texels sampled this frame (valid in the warped buffer)
   int foreground_raw = 0;  // ... classified foreground before cleaning
-  int masked = 0;          // ... masked after cleaning (small blobs out, margin in)
+  int masked = 0;          // ... masked after cleaning (small blobs out, margin in) and growth
+  int masked_ungrown = 0;  // ... masked after cleaning, before growth (the model's own verdict)
   int warming_up = 0;      // ... whose model is still warming up (painted provisionally)
   int blobs_removed = 0;   // foreground blobs smaller than min_blob_texels
 };

@@ -163,7 +163,9 @@ void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
       if (!seen[b]) continue;
       observed += background_frame_[b].observed;
       warming += background_frame_[b].warming_up;
-      masked += background_frame_[b].masked;
+      // The model's own verdict: growth spreads whatever was flagged (thin edges of a
+      // high-frequency texture seen at another resolution too), so it is no evidence.
+      masked += background_frame_[b].masked_ungrown;
     }
     if (background_auto_.AddFrame(frame_number, observed, warming, masked) &&
         background_auto_.decision().state == AutoDecision::State::kOff) {

@@ -90,13 +90,14 @@ SynthOptions RoomWithMovers(bool movers) {
   return o;
 }
 
-AutoDecision BackgroundDecision(bool movers) {
+AutoDecision BackgroundDecision(bool movers, GrowMode grow = GrowMode::kAuto) {
   const Scene scene = RoomScene();
   SynthCapture capture;
   EXPECT_TRUE(SynthesizeCapture(scene, RoomWithMovers(movers), &capture).ok());
   PipelineOptions options;
   options.refine.mode = RefineMode::kOff;
   options.background.mode = BackgroundMode::kAuto;
+  options.background.grow = grow;
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
   FrameReport report;
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
@@ -126,6 +127,17 @@ TEST(AutoBackground, OnWithMoversOffWithout) {
   EXPECT_EQ(without.state, State::kOff);
   EXPECT_GT(without.frames_measured, kBackgroundAutoFrames);  // movers could still come
   EXPECT_LT(without.evidence, with_movers.evidence / 3);
+}
+
+// The evidence is the model's own verdict (its cleaned mask), not the mask grown by colour:
+// growth spreads whatever was flagged, e.g. over a uniform road from the few texels of a
+// high-frequency pavement that a closer view flags, and would decide a static scene on.
+TEST(AutoBackground, GrowthIsNoEvidence) {
+  const AutoDecision grown = BackgroundDecision(true, GrowMode::kOn);
+  const AutoDecision ungrown = BackgroundDecision(true, GrowMode::kOff);
+  EXPECT_EQ(grown.state, State::kOn);
+  EXPECT_EQ(grown.frames_measured, ungrown.frames_measured);
+  EXPECT_DOUBLE_EQ(grown.evidence, ungrown.evidence);
 }
 
 // The evidence is the misalignment a pose correction removes, not the residual: movers and
