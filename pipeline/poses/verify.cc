@@ -21,6 +21,44 @@ Status VerifyOptions::Check() const {
   return Status::Ok();
 }
 
+namespace {
+
+// The robust line (Theil-Sen: the median slope, then the median intercept) through (x, y),
+// at x = 0.
+double TheilSenAtZero(const std::vector<double>& x, const std::vector<double>& y) {
+  std::vector<double> slopes, at_zero;
+  for (size_t a = 0; a < x.size(); ++a)
+    for (size_t b = a + 1; b < x.size(); ++b)
+      if (x[b] != x[a]) slopes.push_back((y[b] - y[a]) / (x[b] - x[a]));
+  const double slope = slopes.empty() ? 0.0 : Median(slopes);
+  for (size_t a = 0; a < x.size(); ++a) at_zero.push_back(y[a] - slope * x[a]);
+  return Median(at_zero);
+}
+
+// Pair k's given rotation against its neighbours' (the pairs `around`), measured by COLMAP's
+// rotations between the same frames: no alignment, so a reconstruction that turns along the
+// walk moves it only by how much it turns between neighbours, which the line over the
+// neighbours' offsets takes out. Degrees.
+double RelativeRotationDeg(const std::vector<PosePair>& pairs, int k,
+                           const std::vector<int>& around) {
+  std::vector<double> offsets;
+  std::vector<double> components[3];
+  for (int j : around) {
+    const Eigen::Quaterniond given =
+        pairs[k].given_cam_from_world.rotation * pairs[j].given_cam_from_world.rotation.conjugate();
+    const Eigen::Quaterniond colmap = pairs[k].colmap_cam_from_colmap.rotation *
+                                      pairs[j].colmap_cam_from_colmap.rotation.conjugate();
+    const Eigen::Vector3d e = Rigid3d::AxisAngleFromQuaternion(colmap * given.conjugate());
+    offsets.push_back(j - k);
+    for (int c = 0; c < 3; ++c) components[c].push_back(e[c]);
+  }
+  Eigen::Vector3d at_k;
+  for (int c = 0; c < 3; ++c) at_k[c] = TheilSenAtZero(offsets, components[c]);
+  return at_k.norm() * 180.0 / M_PI;
+}
+
+}  // namespace
+
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
                    const VerifyOptions& options, VerifyResult* result) {
   FRESCO_RETURN_IF_ERROR(options.Check());
@@ -72,7 +110,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
 
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
-  std::map<int, PoseAlignment> fits;  // by window start
+  std::map<int, PoseAlignment> fits;                         // by window start
   std::vector<Eigen::Matrix<double, 6, 1>> disagreement(n);  // under each frame's own fit
   for (int k = 0; k < n; ++k) {
     int begin = 0, end = n;
@@ -132,7 +170,10 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         trend[c] = Median(at_k);
       }
       const Eigen::Matrix<double, 6, 1> residual = disagreement[k] - trend;
-      if (residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0) {
+      v.relative_rotation_deg = RelativeRotationDeg(pairs, k, around);
+      const bool rotation_follows =
+          residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
+      if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
         v.flagged = false;
         v.follows_drift = true;
         ++out.following_drift;

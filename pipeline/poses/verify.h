@@ -28,7 +28,10 @@ struct VerifyOptions {
   // over a long walk), each frame is judged against its neighbours' disagreement (a robust
   // line through the `drift_neighbours` frames on each side) instead of against none: a
   // frame that disagrees as its neighbours do follows the drift and is not flagged; one that
-  // stands out from them is. 0 = never.
+  // stands out from them is. Its rotation is also judged without any alignment: the
+  // rotations between it and each neighbour, given against COLMAP's, through a robust line
+  // over the neighbours' offsets (a drift that bends faster than the line through the
+  // disagreements follows still moves these little). 0 = never.
   int drift_neighbours = 5;
   unsigned seed = 1;
 
@@ -43,6 +46,10 @@ struct FrameVerdict {
   double position_error_m = 0.0;
   bool flagged = false;
   bool follows_drift = false;  // beyond the thresholds, but as its neighbours (not flagged)
+  // Where judged against the drift: how far the frame's given rotation turns from what its
+  // neighbours' given rotations and COLMAP's rotations between them imply (alignment-free;
+  // < 0: not measured).
+  double relative_rotation_deg = -1.0;
   bool inlier = false;  // supported the (global or its local) alignment
 };
 

@@ -72,6 +72,7 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
     }
     f["flagged"] = v.flagged;
     f["follows_drift"] = v.follows_drift;
+    if (v.relative_rotation_deg >= 0) f["relative_rotation_deg"] = v.relative_rotation_deg;
     frames.push_back(f);
   }
   const Sim3d& s = result.world_from_colmap;
