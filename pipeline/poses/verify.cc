@@ -35,13 +35,12 @@ double TheilSenAtZero(const std::vector<double>& x, const std::vector<double>& y
   return Median(at_zero);
 }
 
-// Pair k's given rotation against its neighbours' (the pairs `around`), measured by COLMAP's
-// rotations between the same frames: no alignment, so a reconstruction that turns along the
-// walk moves it only by how much it turns between neighbours, which the line over the
-// neighbours' offsets takes out. Degrees.
+// Pair k's given rotation against its neighbours' (the pairs `around`, at `offsets` from k),
+// measured by COLMAP's rotations between the same frames: no alignment, so a reconstruction
+// that turns along the walk moves it only by how much it turns between neighbours, which the
+// line over the offsets takes out. Degrees.
 double RelativeRotationDeg(const std::vector<PosePair>& pairs, int k,
-                           const std::vector<int>& around) {
-  std::vector<double> offsets;
+                           const std::vector<int>& around, const std::vector<double>& offsets) {
   std::vector<double> components[3];
   for (int j : around) {
     const Eigen::Quaterniond given =
@@ -49,7 +48,6 @@ double RelativeRotationDeg(const std::vector<PosePair>& pairs, int k,
     const Eigen::Quaterniond colmap = pairs[k].colmap_cam_from_colmap.rotation *
                                       pairs[j].colmap_cam_from_colmap.rotation.conjugate();
     const Eigen::Vector3d e = Rigid3d::AxisAngleFromQuaternion(colmap * given.conjugate());
-    offsets.push_back(j - k);
     for (int c = 0; c < 3; ++c) components[c].push_back(e[c]);
   }
   Eigen::Vector3d at_k;
@@ -158,19 +156,16 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       for (int j = std::max(0, k - h); j <= std::min(n - 1, k + h); ++j)
         if (j != k) around.push_back(j);
       if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
+      std::vector<double> offsets;
+      for (int j : around) offsets.push_back(j - k);
       Eigen::Matrix<double, 6, 1> trend;
       for (int c = 0; c < 6; ++c) {
-        std::vector<double> slopes, at_k;
-        for (size_t a = 0; a < around.size(); ++a)
-          for (size_t b = a + 1; b < around.size(); ++b)
-            slopes.push_back((disagreement[around[b]][c] - disagreement[around[a]][c]) /
-                             (around[b] - around[a]));
-        const double slope = Median(slopes);
-        for (int j : around) at_k.push_back(disagreement[j][c] + slope * (k - j));
-        trend[c] = Median(at_k);
+        std::vector<double> values;
+        for (int j : around) values.push_back(disagreement[j][c]);
+        trend[c] = TheilSenAtZero(offsets, values);
       }
       const Eigen::Matrix<double, 6, 1> residual = disagreement[k] - trend;
-      v.relative_rotation_deg = RelativeRotationDeg(pairs, k, around);
+      v.relative_rotation_deg = RelativeRotationDeg(pairs, k, around, offsets);
       const bool rotation_follows =
           residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
       if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
