@@ -167,6 +167,17 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
     for (const auto& [key, mean] : by_key) metrics["stage_metrics"][stage][key] = mean;
   // What the `auto` modes decided, with their evidence (null for a mode not auto).
   metrics["auto"] = nlohmann::json::parse(AutoDecisionsJson(session->auto_decisions()));
+  if (job.joint_poses) {  // pipeline.refine.joint: the poses adjusted before painting
+    const PoseAdjustResult& a = *job.joint_poses;
+    metrics["joint_poses"] = {{"applied", a.applied},
+                              {"matches", a.matches},
+                              {"inliers", a.inliers},
+                              {"rms_before_px", a.rms_before_px},
+                              {"rms_after_px", a.rms_after_px},
+                              {"median_rotation_deg", a.median_rotation_deg},
+                              {"median_translation_m", a.median_translation_m},
+                              {"seconds", a.seconds}};
+  }
   metrics["texels"] = session->NumSurfaceTexels();
   metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
   metrics["coverage"] = session->Coverage();
@@ -264,6 +275,7 @@ int RunVerbRun(const CommandArgs& argv) {
                                     std::to_string(specs.size()) + ")"));
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
+  job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   std::unique_ptr<PaintJob> job;
   if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
   const double setup_peak_rss_mb = PeakRssMb();
@@ -278,6 +290,18 @@ int RunVerbRun(const CommandArgs& argv) {
         scene.mesh.NumTriangles(), session->buffers().size(), session->NumSurfaceTexels(),
         session->default_texel_size_m(),
         specs.size() > 1 ? (", " + std::to_string(specs.size()) + " streams").c_str() : "");
+    if (job->joint_poses) {
+      const PoseAdjustResult& a = *job->joint_poses;
+      std::fprintf(stderr,
+                   "fresco run: poses adjusted together (%d tracks, %.1f s): %s, RMS %.3f -> "
+                   "%.3f px, median correction %.3f deg, %.1f mm\n",
+                   a.inliers, a.seconds,
+                   a.applied ? "applied"
+                             : "not applied (the given poses "
+                               "explain the tracks nearly as well)",
+                   a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
+                   1000 * a.median_translation_m);
+    }
   }
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)

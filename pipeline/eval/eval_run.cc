@@ -10,8 +10,10 @@
 #include "pipeline/core/project.h"
 #include "pipeline/eval/eval_score.h"
 #include "pipeline/eval/mover_provenance.h"
+#include "pipeline/paint/joint_pose_adjustment.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/rephotography.h"
+#include "pipeline/render/renderer.h"
 #include "pipeline/synth/synth_writer.h"
 
 namespace fresco {
@@ -100,6 +102,15 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
   Frame frame;
   Status read_status;
   FrameReport report;
+  // The frames to paint, read first (the joint adjustment needs them all).
+  struct PaintFrame {
+    Frame frame;
+    Rigid3d painted_pose;
+    const Camera* camera = nullptr;
+    int plan_k = 0;
+    Rigid3d true_pose;
+  };
+  std::vector<PaintFrame> to_paint;
   while (loaded.video->Next(&frame, &read_status)) {
     if (options.stop && options.stop()) return Status::Error(dir + ": interrupted");
     const int index = result->frames++;
@@ -119,6 +130,27 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
       result->noisy_poses = true;
     const Rigid3d& painted_pose = options.true_poses ? true_pose : pose->cam_from_world;
     const Camera& camera = *loaded.CameraFor(*pose);
+    to_paint.push_back({frame, painted_pose, &camera, k->second, true_pose});
+    to_paint.back().frame.bgr = frame.bgr.clone();  // the source may reuse its buffer
+  }
+  FRESCO_RETURN_IF_ERROR(read_status);
+  if (project.pipeline.refine.joint) {  // all poses adjusted together before painting
+    std::vector<PoseAdjustFrame> adjust;
+    for (const PaintFrame& pf : to_paint)
+      adjust.push_back({pf.frame.bgr, pf.camera, CamFromLocal(loaded.scene, pf.painted_pose)});
+    PoseAdjustResult adjusted;
+    FRESCO_RETURN_IF_ERROR(
+        AdjustPosesOnMesh(loaded.scene.mesh, adjust, PoseAdjustOptions(), &adjusted));
+    const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -loaded.scene.origin_in_world);
+    for (size_t k = 0; k < to_paint.size(); ++k)
+      to_paint[k].painted_pose = adjusted.cam_from_local[k] * local_from_world;
+  }
+  for (const PaintFrame& pf : to_paint) {
+    const Frame& frame = pf.frame;
+    const Rigid3d& painted_pose = pf.painted_pose;
+    const Camera& camera = *pf.camera;
+    const Rigid3d& true_pose = pf.true_pose;
+    const int plan_k = pf.plan_k;
     if (!plan.movers.empty() && !provenance)
       provenance =
           std::make_unique<MoverProvenance>(job.scene, plan.movers, loaded.scene, camera, *session);
@@ -127,12 +159,10 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     session->PaintFrame(frame, camera, painted_pose, &report);
     paint_seconds += SecondsSince(start);
     if (!report.painted) continue;
-    if (provenance)
-      provenance->AfterFrame(*session, k->second, true_pose, painted_pose);
+    if (provenance) provenance->AfterFrame(*session, plan_k, true_pose, painted_pose);
     ++result->painted_frames;
-    painted_frames.push_back({k->second, plan.true_poses[k->second].cam_from_world.Centre()});
+    painted_frames.push_back({plan_k, plan.true_poses[plan_k].cam_from_world.Centre()});
   }
-  FRESCO_RETURN_IF_ERROR(read_status);
   result->paint_fps = paint_seconds > 0 ? result->painted_frames / paint_seconds : 0.0;
   result->coverage = session->Coverage();
   result->decisions = session->auto_decisions();

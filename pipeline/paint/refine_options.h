@@ -43,6 +43,9 @@ struct RefineOptions {
   // Correct the frame's pose from the matches of every buffer together, and derive each
   // buffer's correction from it (refine_pose.h), instead of one homography per buffer.
   bool pose = true;
+  // Before painting, correct all the given poses together against the mesh (captures read
+  // from files only; joint_pose_adjustment.h).
+  bool joint = false;
   int anchor_min_frames = 3;
   int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
   double anchor_step_px = 0.1;
@@ -108,6 +111,14 @@ void Fields(RefineOptions& o, V& v) {
   v.Field("pose", o.pose,
           {.help = "correct the frame's camera pose from the matches of all its buffers together, "
                    "instead of one homography per buffer"});
+  v.Field("joint", o.joint,
+          {.help = "before painting, correct all the given poses together: image corners tracked "
+                   "from each frame to the next 1, 2, 4, 8 and 16 frames through the mesh, one "
+                   "adjustment of every pose (`fresco run`, `bench`, `rephoto` and `eval` on "
+                   "captures from files; live captures and the app's frame-by-frame painting "
+                   "ignore it); "
+                   "applied only where it explains the tracks over twice as well as the given "
+                   "poses"});
   v.Field("anchor_min_frames", o.anchor_min_frames,
           {.min = 2, .help = "frames that must agree before a buffer is moved"});
   v.Field("anchor_window_frames", o.anchor_window_frames,

@@ -2,12 +2,60 @@
 
 #include <future>
 
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/joint_pose_adjustment.h"
 #include "pipeline/paint/open_project.h"
+#include "pipeline/render/renderer.h"
 #include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/live_frame_source.h"
 #include "pipeline/run/merged_frame_source.h"
 
 namespace fresco {
+
+namespace {
+
+// refine.joint: every frame is read once (kept grey), all poses are adjusted together
+// (joint_pose_adjustment.h) and written into the captures; the videos open again for painting.
+Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+  std::vector<const Capture*> streams;
+  for (const Capture& capture : j->captures) streams.push_back(&capture);
+  std::vector<PoseAdjustFrame> frames;
+  std::vector<std::pair<int, int>> where;  // stream, pose index
+  {
+    FileFrameSource source(project, streams);
+    SourcedFrame f;
+    Status status;
+    int read = 0;
+    while ((project.pipeline.max_frames <= 0 || read++ < project.pipeline.max_frames) &&
+           source.Next(&f, &status) == FrameRead::kFrame) {
+      if (!f.posed.has_pose || !f.camera || f.pose_index < 0) continue;
+      if (f.posed.frame.bgr.size() != cv::Size(f.camera->width, f.camera->height)) continue;
+      PoseAdjustFrame frame;
+      cv::cvtColor(f.posed.frame.bgr, frame.bgr, cv::COLOR_BGR2GRAY);
+      frame.camera = f.camera;
+      frame.cam_from_local = CamFromLocal(j->scene(), f.posed.cam_from_world);
+      frames.push_back(frame);
+      where.emplace_back(f.stream, f.pose_index);
+    }
+    FRESCO_RETURN_IF_ERROR(status);
+  }
+  PoseAdjustOptions adjust_options;
+  adjust_options.progress = options.joint_progress;
+  PoseAdjustResult adjusted;
+  FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(j->scene().mesh, frames, adjust_options, &adjusted));
+  j->joint_poses = adjusted;
+  const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
+  for (size_t k = 0; k < where.size(); ++k)
+    j->captures[where[k].first].poses[where[k].second].cam_from_world =
+        adjusted.cam_from_local[k] * local_from_world;
+  const std::vector<StreamSpec> specs = project.Streams();
+  for (size_t s = 0; s < j->captures.size(); ++s)
+    FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
+  return Status::Ok();
+}
+
+}  // namespace
 
 bool IsLiveStream(const Project& project, int index) {
   return IsLiveProject(project.ForStream(index));
@@ -31,6 +79,8 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
   if (!j.live) {
+    if (project.pipeline.refine.joint)
+      FRESCO_RETURN_IF_ERROR(AdjustPosesJointly(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     j.source = std::make_unique<FileFrameSource>(project, streams);

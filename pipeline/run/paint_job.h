@@ -6,13 +6,16 @@
 // projects this way; the app opens the same captures and source for file projects.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
 #include "pipeline/live/live_input.h"
+#include "pipeline/paint/joint_pose_adjustment.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/run/posed_frame_source.h"
 
@@ -24,6 +27,8 @@ struct PaintJobOptions {
   std::string one_stream_for;
   // Live projects: keep every tracker pose (a recording writes them; LiveInputs).
   bool keep_tracker_poses = false;
+  // pipeline.refine.joint: progress of the poses' adjustment before painting (optional).
+  std::function<void(int done, int total, const std::string& line)> joint_progress;
 };
 
 struct PaintJob {
@@ -33,6 +38,8 @@ struct PaintJob {
   // One per stream; a file stream's is empty (no frames).
   std::vector<LiveInputs> live_inputs;
   std::unique_ptr<PosedFrameSource> source;
+  // pipeline.refine.joint: what the joint adjustment of the poses did before painting.
+  std::optional<PoseAdjustResult> joint_poses;
 
   const Scene& scene() const { return captures[0].scene; }
 };

@@ -1,0 +1,390 @@
+#include "pipeline/paint/joint_pose_adjustment.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <mutex>
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "pipeline/render/rasterizer.h"
+
+namespace fresco {
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// A corner of one frame on the mesh: its pixel, its ray (normalized, z = 1, camera frame) and
+// the plane of the triangle it shows (local coordinates: normal . X = offset).
+struct Corner {
+  cv::Point2f pixel;
+  Eigen::Vector3d ray;
+  Eigen::Vector3d normal;
+  double offset = 0;
+  Eigen::Vector3d point_local;  // where the given pose puts it
+};
+
+struct FrameData {
+  cv::Mat grey;      // exposure-normalised
+  cv::Mat depth;     // CV_32F camera z at the given pose
+  cv::Mat triangle;  // CV_32S triangle id there (-1: none)
+  std::vector<Corner> corners;
+};
+
+struct Match {
+  int i = 0, j = 0;
+  Eigen::Vector3d ray, normal;
+  double offset = 0;
+  Eigen::Vector2d pixel_j;
+};
+
+Rigid3d Corrected(const Vec6& x, const Rigid3d& given) {
+  return Rigid3d(Rigid3d::QuaternionFromAxisAngle(x.head<3>()), x.tail<3>()) * given;
+}
+
+// Frame j's pixel of the point frame i's ray meets the plane at, both poses corrected.
+bool Predict(const Match& m, const Camera& camera_j, const Rigid3d& pose_i, const Rigid3d& pose_j,
+             Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d centre = pose_i.Centre();
+  const Eigen::Vector3d direction = pose_i.rotation.conjugate() * m.ray;
+  const double denom = m.normal.dot(direction);
+  if (std::abs(denom) < 1e-9) return false;
+  const double s = (m.offset - m.normal.dot(centre)) / denom;
+  if (!(s > 0)) return false;
+  return camera_j.Project(pose_j * (centre + s * direction), pixel);
+}
+
+cv::Mat NormalisedGrey(const cv::Mat& image) {
+  cv::Mat grey;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else
+    grey = image;
+  const double mean = cv::mean(grey)[0];
+  cv::Mat out;
+  grey.convertTo(out, CV_8U, mean > 1 ? 110.0 / mean : 1.0);
+  return out;
+}
+
+Mat6& Block(std::map<std::pair<int, int>, Mat6>* blocks, int a, int b) {
+  return blocks->try_emplace({a, b}, Mat6::Zero()).first->second;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& frames,
+                         const PoseAdjustOptions& options, PoseAdjustResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  *result = PoseAdjustResult();
+  const int n = static_cast<int>(frames.size());
+  for (const PoseAdjustFrame& f : frames) result->cam_from_local.push_back(f.cam_from_local);
+  result->frame_matches.assign(n, 0);
+  if (n < 2) return Status::Ok();
+
+  // Per frame: depth and triangles at the given pose, corners on the surface away from
+  // depth edges (where the mesh's silhouette, and so the plane, is least certain).
+  std::map<const Camera*, std::unique_ptr<Rasterizer>> rasterizers;
+  std::vector<FrameData> data(n);
+  for (int f = 0; f < n; ++f) {
+    const PoseAdjustFrame& in = frames[f];
+    auto& rasterizer = rasterizers[in.camera];
+    if (!rasterizer) rasterizer = std::make_unique<Rasterizer>(*in.camera, RasterOptions());
+    RasterOutput raster;
+    rasterizer->Rasterize(mesh, in.cam_from_local, &raster);
+    FrameData& d = data[f];
+    // A frame of another size than its camera's takes no part (no corners, never tracked into).
+    if (in.bgr.size() != raster.depth.size()) continue;
+    d.grey = NormalisedGrey(in.bgr);
+    d.depth = raster.depth;
+    d.triangle = raster.triangle_id;
+    // Inverse depth is linear across a plane's image (up to the lens's distortion): where its
+    // second difference over 3 pixels is large, the surface folds or ends.
+    cv::Mat inverse_depth;
+    cv::divide(1.0, raster.depth, inverse_depth, CV_32F);  // 1 / inf = 0 off the surface
+    const cv::Mat second = (cv::Mat_<float>(1, 7) << 1, 0, 0, -2, 0, 0, 1);
+    cv::Mat across, down;
+    cv::filter2D(inverse_depth, across, CV_32F, second, cv::Point(-1, -1), 0, cv::BORDER_REPLICATE);
+    cv::filter2D(inverse_depth, down, CV_32F, second.t(), cv::Point(-1, -1), 0,
+                 cv::BORDER_REPLICATE);
+    const cv::Mat mask = (raster.triangle_id >= 0) & (cv::abs(across) < 0.01f * inverse_depth) &
+                         (cv::abs(down) < 0.01f * inverse_depth);
+    std::vector<cv::Point2f> points;
+    cv::goodFeaturesToTrack(d.grey, points, options.max_corners, 0.01,
+                            options.min_corner_distance_px, mask, 5);
+    const Rigid3d local_from_cam = in.cam_from_local.Inverse();
+    for (const cv::Point2f& p : points) {
+      const int c = std::clamp(static_cast<int>(std::lround(p.x)), 0, raster.depth.cols - 1);
+      const int r = std::clamp(static_cast<int>(std::lround(p.y)), 0, raster.depth.rows - 1);
+      const int tri = raster.triangle_id.at<int>(r, c);
+      if (tri < 0) continue;
+      Eigen::Vector2d normalized;
+      if (!in.camera->Unproject(Eigen::Vector2d(p.x, p.y), &normalized)) continue;
+      Corner k;
+      k.pixel = p;
+      k.ray = Eigen::Vector3d(normalized.x(), normalized.y(), 1.0);
+      k.normal = mesh.Normal(tri);
+      if (k.normal.squaredNorm() < 0.5) continue;
+      k.offset = k.normal.dot(mesh.Corner(tri, 0));
+      // The ray's hit on the plane at the given pose.
+      const Eigen::Vector3d centre = in.cam_from_local.Centre();
+      const Eigen::Vector3d direction = local_from_cam.rotation * k.ray;
+      const double denom = k.normal.dot(direction);
+      if (std::abs(denom) < 0.05 * direction.norm()) continue;  // grazing
+      k.point_local = centre + (k.offset - k.normal.dot(centre)) / denom * direction;
+      d.corners.push_back(k);
+    }
+    if (options.progress && ((f + 1) % std::max(1, n / 4) == 0 || f + 1 == n))
+      options.progress(f + 1, 2 * n + options.iterations, "frames prepared");
+  }
+
+  // Matches: frame j is reprojected into frame i's view through the mesh at the given poses
+  // (so that what both see looks alike there, but for the pose errors), frame i's corners are
+  // tracked into it, and a track's end is carried back to frame j's pixel through the mesh.
+  // Kept when the track comes back and the point is visible in frame j.
+  std::vector<Match> matches;
+  std::mutex matches_mutex;
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    std::vector<Match> local;
+    for (int i = range.start; i < range.end; ++i) {
+      const FrameData& a = data[i];
+      if (a.corners.empty()) continue;
+      const Camera& camera_i = *frames[i].camera;
+      const Rigid3d local_from_i = frames[i].cam_from_local.Inverse();
+      for (int offset : options.offsets) {
+        const int j = i + offset;
+        if (j >= n) break;
+        const FrameData& b = data[j];
+        if (b.grey.empty()) continue;
+        const Camera& camera_j = *frames[j].camera;
+        const Rigid3d j_from_i = frames[j].cam_from_local * local_from_i;
+        // Where each pixel of frame i falls in frame j, on a grid, then interpolated.
+        const int step = 4;
+        const int gw = a.depth.cols / step + 2, gh = a.depth.rows / step + 2;
+        cv::Mat grid(gh, gw, CV_32FC2, cv::Scalar(-1000, -1000));
+        for (int gy = 0; gy < gh; ++gy)
+          for (int gx = 0; gx < gw; ++gx) {
+            // cv::resize puts grid node g at pixel g * step + (step - 1) / 2.
+            const double px = gx * step + 0.5 * (step - 1), py = gy * step + 0.5 * (step - 1);
+            const int x = std::min(static_cast<int>(std::lround(px)), a.depth.cols - 1);
+            const int y = std::min(static_cast<int>(std::lround(py)), a.depth.rows - 1);
+            const int tri = a.triangle.at<int>(y, x);
+            if (tri < 0) continue;
+            Eigen::Vector2d normalized, pixel;
+            if (!camera_i.Unproject(Eigen::Vector2d(px, py), &normalized, 1e-3)) continue;
+            // The exact hit on the triangle's plane (the depth map's is the pixel centre's).
+            const Eigen::Vector3d ray(normalized.x(), normalized.y(), 1.0);
+            const Eigen::Vector3d normal_i = frames[i].cam_from_local.rotation * mesh.Normal(tri);
+            const Eigen::Vector3d corner_i = frames[i].cam_from_local * mesh.Corner(tri, 0);
+            const double denom = normal_i.dot(ray);
+            if (std::abs(denom) < 1e-6) continue;
+            const Eigen::Vector3d in_i = normal_i.dot(corner_i) / denom * ray;
+            if (!camera_j.Project(j_from_i * in_i, &pixel)) continue;
+            grid.at<cv::Vec2f>(gy, gx) = cv::Vec2f(pixel.x(), pixel.y());
+          }
+        cv::Mat map_full;
+        cv::resize(grid, map_full, cv::Size(gw * step, gh * step), 0, 0, cv::INTER_LINEAR);
+        map_full = map_full(cv::Rect(0, 0, a.depth.cols, a.depth.rows));
+        cv::Mat j_in_i;
+        cv::remap(b.grey, j_in_i, map_full, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+        std::vector<cv::Point2f> from, to;
+        std::vector<int> which;
+        for (size_t k = 0; k < a.corners.size(); ++k) {
+          const Eigen::Vector3d in_j = frames[j].cam_from_local * a.corners[k].point_local;
+          Eigen::Vector2d pixel;
+          if (!camera_j.Project(in_j, &pixel)) continue;
+          const int c = static_cast<int>(std::lround(pixel.x()));
+          const int r = static_cast<int>(std::lround(pixel.y()));
+          if (c < 12 || r < 12 || c >= b.depth.cols - 12 || r >= b.depth.rows - 12) continue;
+          const float z = b.depth.at<float>(r, c);
+          if (!(std::abs(z - in_j.z()) < 0.05 * in_j.z())) continue;  // hidden in frame j
+          from.push_back(a.corners[k].pixel);
+          which.push_back(static_cast<int>(k));
+        }
+        if (from.size() < 8) continue;
+        to = from;
+        std::vector<uchar> status, back_status;
+        std::vector<float> error;
+        const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.003);
+        const cv::Size window(options.window_px, options.window_px);
+        cv::calcOpticalFlowPyrLK(a.grey, j_in_i, from, to, status, error, window, 2, criteria,
+                                 cv::OPTFLOW_USE_INITIAL_FLOW);
+        std::vector<cv::Point2f> back = from;
+        cv::calcOpticalFlowPyrLK(j_in_i, a.grey, to, back, back_status, error, window, 2, criteria,
+                                 cv::OPTFLOW_USE_INITIAL_FLOW);
+        for (size_t k = 0; k < from.size(); ++k) {
+          if (!status[k] || !back_status[k]) continue;
+          if (cv::norm(back[k] - from[k]) > options.forward_backward_px) continue;
+          if (cv::norm(to[k] - from[k]) > options.search_px) continue;
+          const Corner& corner = a.corners[which[k]];
+          // The track's end, through frame i's ray and the corner's plane, into frame j.
+          Eigen::Vector2d normalized, pixel_j;
+          if (!camera_i.Unproject(Eigen::Vector2d(to[k].x, to[k].y), &normalized)) continue;
+          Match m;
+          m.i = i, m.j = j;
+          m.ray = Eigen::Vector3d(normalized.x(), normalized.y(), 1.0);
+          m.normal = corner.normal, m.offset = corner.offset;
+          if (!Predict(m, camera_j, frames[i].cam_from_local, frames[j].cam_from_local, &pixel_j))
+            continue;
+          m.ray = corner.ray;
+          m.pixel_j = pixel_j;
+          local.push_back(m);
+        }
+      }
+    }
+    std::lock_guard<std::mutex> lock(matches_mutex);
+    matches.insert(matches.end(), local.begin(), local.end());
+  });
+  // Deterministic order whatever the threads did.
+  std::sort(matches.begin(), matches.end(), [](const Match& x, const Match& y) {
+    if (x.i != y.i) return x.i < y.i;
+    if (x.j != y.j) return x.j < y.j;
+    if (x.ray.x() != y.ray.x()) return x.ray.x() < y.ray.x();
+    return x.ray.y() < y.ray.y();
+  });
+  result->matches = static_cast<int>(matches.size());
+  if (options.progress)
+    options.progress(2 * n, 2 * n + options.iterations, std::to_string(matches.size()) + " tracks");
+  if (matches.empty()) return Status::Ok();
+
+  // Gauss-Newton over all corrections (6 per frame), Huber-weighted, with the prior.
+  const int dof = options.translation ? 6 : 3;
+  std::vector<Vec6> x(n, Vec6::Zero());
+  const double rot_prior = 1.0 / std::pow(options.rotation_prior_deg * M_PI / 180.0, 2);
+  const double trans_prior = 1.0 / std::pow(options.translation_prior_m, 2);
+  const double match_weight = 1.0 / (options.match_sigma_px * options.match_sigma_px);
+  std::vector<double> residual(matches.size(), 0);
+  auto residuals = [&](const std::vector<Vec6>& at, std::vector<double>* out) {
+    std::vector<Rigid3d> poses(n);
+    for (int f = 0; f < n; ++f) poses[f] = Corrected(at[f], frames[f].cam_from_local);
+    cv::parallel_for_(cv::Range(0, static_cast<int>(matches.size())), [&](const cv::Range& r) {
+      for (int k = r.start; k < r.end; ++k) {
+        const Match& m = matches[k];
+        Eigen::Vector2d p;
+        (*out)[k] = Predict(m, *frames[m.j].camera, poses[m.i], poses[m.j], &p)
+                        ? (p - m.pixel_j).norm()
+                        : 1e9;
+      }
+    });
+  };
+  residuals(x, &residual);
+  // Matches far off at the start (wrong tracks, movers) stay out.
+  std::vector<char> use(matches.size(), 0);
+  {
+    std::vector<double> finite;
+    for (double r : residual)
+      if (r < 1e8) finite.push_back(r);
+    const double limit = std::max(3.0, 4.0 * Median(finite));
+    for (size_t k = 0; k < matches.size(); ++k) use[k] = residual[k] < limit;
+  }
+  auto rms = [&](const std::vector<double>& r) {
+    double sum = 0;
+    int count = 0;
+    for (size_t k = 0; k < r.size(); ++k)
+      if (use[k] && r[k] < 3 * options.huber_px) sum += r[k] * r[k], ++count;
+    return count > 0 ? std::sqrt(sum / count) : 0.0;
+  };
+  result->rms_before_px = rms(residual);
+
+  for (int iteration = 0; iteration < options.iterations; ++iteration) {
+    std::vector<Rigid3d> poses(n);
+    for (int f = 0; f < n; ++f) poses[f] = Corrected(x[f], frames[f].cam_from_local);
+    // Blocks of J^T W J per frame pair (i <= j) and J^T W r per frame.
+    std::map<std::pair<int, int>, Mat6> blocks;
+    std::vector<Vec6> gradient(n, Vec6::Zero());
+    const double step = 1e-7;
+    for (size_t k = 0; k < matches.size(); ++k) {
+      if (!use[k]) continue;
+      const Match& m = matches[k];
+      const Camera& camera_j = *frames[m.j].camera;
+      Eigen::Vector2d p0;
+      if (!Predict(m, camera_j, poses[m.i], poses[m.j], &p0)) continue;
+      const Eigen::Vector2d r = p0 - m.pixel_j;
+      const double norm = r.norm();
+      const double w = match_weight * (norm <= options.huber_px ? 1.0 : options.huber_px / norm);
+      Eigen::Matrix<double, 2, 12> J;
+      bool ok = true;
+      for (int q = 0; q < 12 && ok; ++q) {
+        Vec6 xi = x[m.i], xj = x[m.j];
+        (q < 6 ? xi : xj)[q % 6] += step;
+        Eigen::Vector2d p;
+        ok = Predict(m, camera_j, Corrected(xi, frames[m.i].cam_from_local),
+                     Corrected(xj, frames[m.j].cam_from_local), &p);
+        J.col(q) = (p - p0) / step;
+      }
+      if (!ok) continue;
+      const Eigen::Matrix<double, 2, 6> Ji = J.leftCols<6>(), Jj = J.rightCols<6>();
+      Block(&blocks, m.i, m.i) += w * Ji.transpose() * Ji;
+      Block(&blocks, m.j, m.j) += w * Jj.transpose() * Jj;
+      Block(&blocks, m.i, m.j) += w * Ji.transpose() * Jj;
+      gradient[m.i] += w * Ji.transpose() * r;
+      gradient[m.j] += w * Jj.transpose() * r;
+    }
+    std::vector<Eigen::Triplet<double>> triplets;
+    Eigen::VectorXd rhs(n * dof);
+    for (int f = 0; f < n; ++f) {
+      Mat6& d = Block(&blocks, f, f);
+      Vec6 g = gradient[f];
+      for (int c = 0; c < 3; ++c) d(c, c) += rot_prior, g[c] += rot_prior * x[f][c];
+      for (int c = 3; c < 6; ++c) d(c, c) += trans_prior, g[c] += trans_prior * x[f][c];
+      for (int c = 0; c < dof; ++c) rhs[f * dof + c] = -g[c];
+    }
+    for (const auto& [key, block] : blocks) {
+      const auto [a, b] = key;
+      for (int r = 0; r < dof; ++r)
+        for (int c = 0; c < dof; ++c) {
+          if (block(r, c) == 0) continue;
+          triplets.emplace_back(a * dof + r, b * dof + c, block(r, c));
+          if (a != b) triplets.emplace_back(b * dof + c, a * dof + r, block(r, c));
+        }
+    }
+    Eigen::SparseMatrix<double> H(n * dof, n * dof);
+    H.setFromTriplets(triplets.begin(), triplets.end());
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
+    if (solver.info() != Eigen::Success) break;
+    const Eigen::VectorXd delta = solver.solve(rhs);
+    if (solver.info() != Eigen::Success || !delta.allFinite()) break;
+    double largest = 0;
+    for (int f = 0; f < n; ++f) {
+      x[f].head(dof) += delta.segment(f * dof, dof);
+      largest = std::max(largest, delta.segment(f * dof, dof).cwiseAbs().maxCoeff());
+    }
+    if (largest < 1e-8) break;
+  }
+  residuals(x, &residual);
+  result->rms_after_px = rms(residual);
+  if (options.progress)
+    options.progress(2 * n + options.iterations, 2 * n + options.iterations, "adjusted");
+  for (size_t k = 0; k < matches.size(); ++k)
+    if (use[k] && residual[k] < 3 * options.huber_px) {
+      ++result->inliers;
+      ++result->frame_matches[matches[k].i];
+      ++result->frame_matches[matches[k].j];
+    }
+  result->applied = result->rms_after_px > 0 &&
+                    result->rms_before_px >= options.min_improvement * result->rms_after_px;
+  std::vector<double> rotations, translations;
+  for (int f = 0; f < n; ++f) {
+    if (result->applied) result->cam_from_local[f] = Corrected(x[f], frames[f].cam_from_local);
+    rotations.push_back(x[f].head<3>().norm() * 180.0 / M_PI);
+    translations.push_back(x[f].tail<3>().norm());
+  }
+  result->median_rotation_deg = Median(rotations);
+  result->median_translation_m = Median(translations);
+  result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+}  // namespace fresco

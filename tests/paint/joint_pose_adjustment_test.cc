@@ -1,0 +1,176 @@
+// Joint adjustment of all poses against the mesh (joint_pose_adjustment.h) on a synthetic
+// orbit: the adjusted poses put the scene's points on the image much closer to where the
+// true poses put them than the given ones do; at exact poses nothing moves.
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/project.h"
+#include "pipeline/paint/joint_pose_adjustment.h"
+#include "pipeline/render/renderer.h"
+#include "pipeline/run/paint_job.h"
+#include "pipeline/synth/blocks_scene.h"
+#include "pipeline/synth/synth_writer.h"
+#include "pipeline/synth/synthesize.h"
+#include "tests/paint/synth_session.h"
+#include "tests/test_support.h"
+
+namespace fresco {
+namespace {
+
+struct Orbit {
+  Scene scene;
+  SynthCapture capture;
+};
+
+SynthOptions OrbitOptions(const BlocksOptions& blocks, double noise_deg, double noise_m) {
+  SynthOptions options = testing::BlocksHalfOrbit(blocks, 40, 17);
+  options.pose_noise_deg = noise_deg;
+  options.pose_noise_m = noise_m;
+  return options;
+}
+
+Orbit MakeOrbit(double noise_deg, double noise_m) {
+  Orbit o;
+  BlocksOptions blocks;
+  blocks.seed = 5;
+  EXPECT_TRUE(MakeBlocksScene(blocks, &o.scene).ok());
+  EXPECT_TRUE(
+      SynthesizeCapture(o.scene, OrbitOptions(blocks, noise_deg, noise_m), &o.capture).ok());
+  return o;
+}
+
+std::vector<PoseAdjustFrame> Frames(const Orbit& o) {
+  std::vector<PoseAdjustFrame> frames;
+  for (size_t i = 0; i < o.capture.frames_bgr.size(); ++i)
+    frames.push_back({o.capture.frames_bgr[i], &o.capture.camera,
+                      CamFromLocal(o.scene, o.capture.given_poses[i].cam_from_world)});
+  return frames;
+}
+
+// Mean distance (pixels) between where `cam_from_local` and the true pose put the mesh's
+// vertices that the true pose sees in the image, over all frames.
+double MeanPixelError(const Orbit& o, const std::vector<Rigid3d>& cam_from_local) {
+  const Camera& camera = o.capture.camera;
+  double sum = 0;
+  long long count = 0;
+  for (size_t i = 0; i < cam_from_local.size(); ++i) {
+    const Rigid3d truth = CamFromLocal(o.scene, o.capture.true_poses[i].cam_from_world);
+    for (const Eigen::Vector3d& v : o.scene.mesh.vertices) {
+      Eigen::Vector2d at_truth, at_pose;
+      if (!camera.Project(truth * v, &at_truth) || !camera.Project(cam_from_local[i] * v, &at_pose))
+        continue;
+      if (at_truth.x() < 0 || at_truth.y() < 0 || at_truth.x() > camera.width - 1 ||
+          at_truth.y() > camera.height - 1)
+        continue;
+      sum += (at_pose - at_truth).norm();
+      ++count;
+    }
+  }
+  return count > 0 ? sum / count : 0.0;
+}
+
+TEST(JointPoseAdjustment, NoisyPosesComeMuchCloserToTheTruth) {
+  const Orbit o = MakeOrbit(0.5, 0.01);
+  const std::vector<PoseAdjustFrame> frames = Frames(o);
+  std::vector<Rigid3d> given;
+  for (const PoseAdjustFrame& f : frames) given.push_back(f.cam_from_local);
+  PoseAdjustResult result;
+  ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
+  const double before = MeanPixelError(o, given);
+  const double after = MeanPixelError(o, result.cam_from_local);
+  std::printf("matches %d (inliers %d), RMS %.3f -> %.3f px; mesh points %.3f -> %.3f px off\n",
+              result.matches, result.inliers, result.rms_before_px, result.rms_after_px, before,
+              after);
+  EXPECT_TRUE(result.applied);
+  EXPECT_GT(result.inliers, 500);
+  EXPECT_GT(before, 1.5);  // 0.5 degree at f = 229 px is 2 px
+  EXPECT_LT(after, 0.1 * before);
+  EXPECT_LT(result.rms_after_px, 0.4);
+}
+
+TEST(JointPoseAdjustment, ExactPosesStay) {
+  const Orbit o = MakeOrbit(0, 0);
+  const std::vector<PoseAdjustFrame> frames = Frames(o);
+  PoseAdjustResult result;
+  ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
+  std::printf("RMS %.3f -> %.3f px, median correction %.4f deg\n", result.rms_before_px,
+              result.rms_after_px, result.median_rotation_deg);
+  EXPECT_FALSE(result.applied);
+  EXPECT_LT(result.rms_before_px, 0.5);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    EXPECT_EQ(result.cam_from_local[i].translation, frames[i].cam_from_local.translation);
+    EXPECT_EQ(result.cam_from_local[i].rotation.coeffs(),
+              frames[i].cam_from_local.rotation.coeffs());
+  }
+}
+
+TEST(JointPoseAdjustment, FewerThanTwoFramesChangeNothing) {
+  const Orbit o = MakeOrbit(0.5, 0.01);
+  std::vector<PoseAdjustFrame> frames = Frames(o);
+  frames.resize(1);
+  PoseAdjustResult result;
+  ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
+  EXPECT_FALSE(result.applied);
+  ASSERT_EQ(result.cam_from_local.size(), 1u);
+  EXPECT_EQ(result.cam_from_local[0].translation, frames[0].cam_from_local.translation);
+}
+
+TEST(JointPoseAdjustment, AFrameOfAnotherSizeIsLeftOut) {
+  const Orbit o = MakeOrbit(0.5, 0.01);
+  std::vector<PoseAdjustFrame> frames = Frames(o);
+  cv::Mat half;
+  cv::resize(frames[5].bgr, half, cv::Size(), 0.5, 0.5);
+  frames[5].bgr = half;
+  PoseAdjustResult result;
+  ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
+  EXPECT_TRUE(result.applied);
+  EXPECT_EQ(result.frame_matches[5], 0);
+  EXPECT_EQ(result.cam_from_local[5].translation, frames[5].cam_from_local.translation);
+  EXPECT_GT(result.frame_matches[6], 0);
+}
+
+// `fresco run` (and bench, rephoto) read the capture once, adjust its poses and paint with
+// them: the job's captures hold the adjusted poses, closer to the truth than the files'.
+TEST(JointPoseAdjustment, APaintJobPaintsWithTheAdjustedPoses) {
+  const Orbit o = MakeOrbit(0.5, 0.01);
+  BlocksOptions blocks;
+  blocks.seed = 5;
+  const std::string dir = testing::MakeTempDir("joint_pose_job");
+  ASSERT_TRUE(
+      WriteSynthCapture(o.scene, OrbitOptions(blocks, 0.5, 0.01), dir, SynthWriteOptions()).ok());
+  for (const bool joint : {false, true}) {
+    Project project;
+    ASSERT_TRUE(LoadProject(dir + "/project.json",
+                            {std::string("pipeline.refine.joint=") + (joint ? "true" : "false")},
+                            &project)
+                    .ok());
+    std::unique_ptr<PaintJob> job;
+    ASSERT_TRUE(OpenPaintJob(project, PaintJobOptions(), &job).ok());
+    ASSERT_EQ(job->joint_poses.has_value(), joint);
+    std::vector<Rigid3d> poses;
+    for (const PosedImage& p : job->captures[0].poses)
+      poses.push_back(CamFromLocal(o.scene, p.cam_from_world));  // in the orbit's frame
+    ASSERT_EQ(poses.size(), o.capture.true_poses.size());
+    const double error = MeanPixelError(o, poses);
+    std::printf("joint %d: mesh points %.3f px off\n", joint, error);
+    if (joint) {
+      EXPECT_TRUE(job->joint_poses->applied);
+      EXPECT_LT(error, 0.2);
+    } else {
+      EXPECT_GT(error, 1.5);
+    }
+    // The video was opened again: painting reads every frame.
+    int frames = 0;
+    SourcedFrame frame;
+    Status status;
+    while (job->source->Next(&frame, &status) == FrameRead::kFrame) ++frames;
+    EXPECT_TRUE(status.ok());
+    EXPECT_EQ(frames, 40);
+  }
+}
+
+}  // namespace
+}  // namespace fresco
