@@ -124,6 +124,7 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   cv::setNumThreads(threads);
   PaintJobOptions job_options;
   job_options.one_stream_for = "fresco bench";
+  job_options.joint_holdout_every = holdout;
   std::unique_ptr<PaintJob> job;
   FRESCO_RETURN_IF_ERROR(OpenPaintJob(project, job_options, &job));
   const Capture& capture = job->captures[0];

@@ -52,7 +52,9 @@ Status ListPosedFrames(const Project& project, std::vector<PosedFrameId>* posed,
 Status ScoreOneOut(const Project& project, const PosedFrameId& id, const RephotoOptions& options,
                    const RephotoViewSink& sink, RephotoFrame* result) {
   std::unique_ptr<PaintJob> job;
-  FRESCO_RETURN_IF_ERROR(OpenPaintJob(project, PaintJobOptions(), &job));
+  PaintJobOptions job_options;
+  job_options.joint_holdout_counter = id.counter;  // the photo left out plays no part
+  FRESCO_RETURN_IF_ERROR(OpenPaintJob(project, job_options, &job));
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   run_options.holdout_counter = id.counter;

@@ -26,9 +26,12 @@ Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options
     FileFrameSource source(project, streams);
     SourcedFrame f;
     Status status;
-    int read = 0;
-    while ((project.pipeline.max_frames <= 0 || read++ < project.pipeline.max_frames) &&
-           source.Next(&f, &status) == FrameRead::kFrame) {
+    for (int read = 0; (project.pipeline.max_frames <= 0 || read < project.pipeline.max_frames) &&
+                       source.Next(&f, &status) == FrameRead::kFrame;
+         ++read) {
+      const int every = options.joint_holdout_every;
+      if (read == options.joint_holdout_counter || (every > 0 && read % every == every / 2))
+        continue;
       if (!f.posed.has_pose || !f.camera || f.pose_index < 0) continue;
       if (f.posed.frame.bgr.size() != cv::Size(f.camera->width, f.camera->height)) continue;
       PoseAdjustFrame frame;

@@ -29,6 +29,11 @@ struct PaintJobOptions {
   bool keep_tracker_poses = false;
   // pipeline.refine.joint: progress of the poses' adjustment before painting (optional).
   std::function<void(int done, int total, const std::string& line)> joint_progress;
+  // pipeline.refine.joint: frames held out of painting (as PaintRunOptions' holdout_every and
+  // holdout_counter, by position in reading order) take no part in the adjustment and keep
+  // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.
+  int joint_holdout_every = 0;
+  int joint_holdout_counter = -1;
 };
 
 struct PaintJob {

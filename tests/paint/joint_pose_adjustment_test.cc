@@ -170,6 +170,27 @@ TEST(JointPoseAdjustment, APaintJobPaintsWithTheAdjustedPoses) {
     EXPECT_TRUE(status.ok());
     EXPECT_EQ(frames, 40);
   }
+  // A frame held out of painting (as `fresco rephoto` and `fresco bench` score them) takes no
+  // part and keeps its pose from the file.
+  std::vector<Rigid3d> given, held_out;
+  for (const int holdout : {-2, 5}) {
+    Project project;
+    ASSERT_TRUE(
+        LoadProject(dir + "/project.json",
+                    {std::string("pipeline.refine.joint=") + (holdout >= 0 ? "true" : "false")},
+                    &project)
+            .ok());
+    PaintJobOptions options;
+    options.joint_holdout_counter = holdout;
+    std::unique_ptr<PaintJob> job;
+    ASSERT_TRUE(OpenPaintJob(project, options, &job).ok());
+    for (const PosedImage& p : job->captures[0].poses)
+      (holdout >= 0 ? held_out : given).push_back(p.cam_from_world);
+  }
+  ASSERT_EQ(held_out.size(), given.size());
+  EXPECT_EQ(held_out[5].translation, given[5].translation);
+  EXPECT_EQ(held_out[5].rotation.coeffs(), given[5].rotation.coeffs());
+  EXPECT_NE(held_out[6].translation, given[6].translation);
 }
 
 }  // namespace
