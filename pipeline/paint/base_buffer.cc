@@ -73,10 +73,12 @@ void SetAffineTile(const BaseBuffer& buffer, BaseBuffer::Chunk* chunk) {
   const Eigen::Vector3f origin =
       (mean - mean_col * by_col / col_var - mean_row * by_row / row_var).cast<float>();
   // Within one quantization step per axis (and a float's rounding) of every stored point.
-  const Eigen::Array3f bound = chunk->point_step.array() + 1e-6f * chunk->bounds_max.cwiseAbs().array();
+  const Eigen::Array3f bound =
+      chunk->point_step.array() + 1e-6f * chunk->bounds_max.cwiseAbs().array();
   for (int row = 0, k = chunk->begin; row < th; ++row)
     for (int col = 0; col < tw; ++col, ++k) {
-      const Eigen::Vector3f fit = origin + static_cast<float>(col) * du + static_cast<float>(row) * dv;
+      const Eigen::Vector3f fit =
+          origin + static_cast<float>(col) * du + static_cast<float>(row) * dv;
       if (((fit - buffer.PointIn(*chunk, k)).cwiseAbs().array() > bound).any()) return;
     }
   chunk->affine = true;
@@ -168,7 +170,8 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
     const double inner = 2.0 * gutter + 1;
     s *= std::max({std::sqrt(wd * hd / options.max_buffer_texels),
                    (wd - inner) / std::max(1.0, max_side - inner),
-                   (hd - inner) / std::max(1.0, max_side - inner), 1.0}) * 1.01;
+                   (hd - inner) / std::max(1.0, max_side - inner), 1.0}) *
+         1.01;
     dims(s);
   }
   const int w = static_cast<int>(wd), h = static_cast<int>(hd);
@@ -188,7 +191,7 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   std::vector<uint8_t> is_folded(num_local, 0);
   std::vector<Eigen::Vector3d> normal_of(num_local);
   for (int li = 0; li < num_local; ++li) normal_of[li] = mesh.Normal(triangles[li]);
-  auto plane_point = [&](int i, int j) {
+  auto plane_point = [&](int i, int j) -> Eigen::Vector3d {
     return buffer.origin + ((i + 0.5) * s) * buffer.axis_u + ((j + 0.5) * s) * buffer.axis_v;
   };
   for (int li = 0; li < num_local; ++li) {
@@ -246,8 +249,8 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
       const size_t idx = static_cast<size_t>(j) * w + i;
       if (owner[idx] < 0) {
         owner[idx] = li;
-        point[idx] = ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0)
-                         .cast<float>();
+        point[idx] =
+            ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0).cast<float>();
       }
     }
   }
@@ -279,8 +282,8 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
         if (best < 0) continue;
         next[idx] = best;
         const int t = triangles[best];
-        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(t, 0),
-                                            mesh.Corner(t, 1), mesh.Corner(t, 2))
+        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(t, 0), mesh.Corner(t, 1),
+                                            mesh.Corner(t, 2))
                          .cast<float>();
       }
     }

@@ -523,7 +523,8 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
 
   // Lines: the path (grey), the current camera's frustum (yellow).
   std::vector<LineVertex> lines;
-  auto centre_of = [&](const Rigid3d& cam_from_world) {
+  // The return type spelled out: deduced, it would be an Eigen expression over a temporary.
+  auto centre_of = [&](const Rigid3d& cam_from_world) -> Eigen::Vector3f {
     return CamFromLocal(scene, cam_from_world).Centre().cast<float>();
   };
   auto add = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, float g, float bl) {
