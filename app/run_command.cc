@@ -176,6 +176,8 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                               {"rms_after_px", a.rms_after_px},
                               {"median_rotation_deg", a.median_rotation_deg},
                               {"median_translation_m", a.median_translation_m},
+                              {"rotation_prior_deg", a.rotation_prior_deg},
+                              {"translation_prior_m", a.translation_prior_m},
                               {"seconds", a.seconds}};
   }
   metrics["texels"] = session->NumSurfaceTexels();

@@ -34,14 +34,15 @@ struct HeldOut {
 
 }  // namespace
 
-// The references for EvalOptions::recovery: the capture painted again with refinement off,
-// and at the true poses.
+// The references for EvalOptions::recovery: the capture painted again with refinement off
+// (no pose correction at all: neither frame by frame nor joint), and at the true poses.
 static Status PaintReferences(const EvalSuite& suite, const SuiteCapture& capture,
                               const EvalOptions& options, CaptureEval* result) {
   EvalOptions reference = options;
   reference.recovery = false;
   reference.progress = nullptr;
   reference.overrides.push_back("pipeline.refine.mode=off");
+  reference.overrides.push_back("pipeline.refine.joint=false");
   CaptureEval unrefined;
   FRESCO_RETURN_IF_ERROR(EvaluateCapture(suite, capture, reference, &unrefined));
   result->unrefined_truth_psnr_db = unrefined.truth_psnr_db;

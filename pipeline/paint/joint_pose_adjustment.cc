@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -13,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "pipeline/core/scaled_camera.h"
 #include "pipeline/render/rasterizer.h"
 
 namespace fresco {
@@ -85,18 +89,53 @@ double Median(std::vector<double> v) {
 
 }  // namespace
 
-Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& frames,
+Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& given,
                          const PoseAdjustOptions& options, PoseAdjustResult* result) {
   const auto start = std::chrono::steady_clock::now();
   *result = PoseAdjustResult();
-  const int n = static_cast<int>(frames.size());
-  for (const PoseAdjustFrame& f : frames) result->cam_from_local.push_back(f.cam_from_local);
+  const int n = static_cast<int>(given.size());
+  for (const PoseAdjustFrame& f : given) result->cam_from_local.push_back(f.cam_from_local);
   result->frame_matches.assign(n, 0);
   if (n < 2) return Status::Ok();
+
+  // Large frames are tracked halved (as often as needed) down to max_side_px, with their
+  // cameras scaled alike; a frame of another size than its camera's is kept as it is (it then
+  // takes no part).
+  std::map<const Camera*, std::unique_ptr<Camera>> scaled_cameras;
+  std::vector<PoseAdjustFrame> frames = given;
+  for (PoseAdjustFrame& f : frames) {
+    const Camera& camera = *f.camera;
+    if (f.bgr.size() != cv::Size(camera.width, camera.height)) continue;
+    int halvings = 0;
+    while (options.max_side_px > 0 &&
+           (std::max(camera.width, camera.height) >> halvings) > options.max_side_px)
+      ++halvings;
+    if (halvings == 0) continue;
+    for (int h = 0; h < halvings; ++h) cv::pyrDown(f.bgr, f.bgr);
+    auto& scaled = scaled_cameras[f.camera];
+    if (!scaled) scaled = std::make_unique<Camera>(ScaledCamera(camera, f.bgr.cols, f.bgr.rows));
+    f.camera = scaled.get();
+  }
 
   // Per frame: depth and triangles at the given pose, corners on the surface away from
   // depth edges (where the mesh's silhouette, and so the plane, is least certain).
   std::map<const Camera*, std::unique_ptr<Rasterizer>> rasterizers;
+  // Per camera: each pixel's normalised ray (x, y; NaN where the lens model has none).
+  std::map<const Camera*, cv::Mat> rays;
+  for (const PoseAdjustFrame& f : frames) {
+    cv::Mat& table = rays[f.camera];
+    if (!table.empty()) continue;
+    table.create(f.camera->height, f.camera->width, CV_32FC2);
+    cv::parallel_for_(cv::Range(0, table.rows), [&](const cv::Range& r) {
+      for (int y = r.start; y < r.end; ++y)
+        for (int x = 0; x < table.cols; ++x) {
+          Eigen::Vector2d normalized;
+          const bool ok = f.camera->Unproject(Eigen::Vector2d(x, y), &normalized, 1e-3);
+          table.at<cv::Vec2f>(y, x) =
+              ok ? cv::Vec2f(normalized.x(), normalized.y()) : cv::Vec2f(NAN, NAN);
+        }
+    });
+  }
   std::vector<FrameData> data(n);
   for (int f = 0; f < n; ++f) {
     const PoseAdjustFrame& in = frames[f];
@@ -163,6 +202,33 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
       if (a.corners.empty()) continue;
       const Camera& camera_i = *frames[i].camera;
       const Rigid3d local_from_i = frames[i].cam_from_local.Inverse();
+      // Each pixel's surface point in frame i's camera frame, exactly on the plane of the
+      // triangle it sees (NaN off the surface): then each pair's warp is a transform and a
+      // projection per pixel. (A map interpolated between grid points bends the warp where
+      // perspective is strong, a road ahead, and the tracks then pull the poses.)
+      cv::Mat surface(a.depth.size(), CV_32FC3, cv::Scalar::all(NAN));
+      {
+        const cv::Mat& ray_table = rays.at(frames[i].camera);
+        int cached_triangle = -1;
+        Eigen::Vector3d normal_i;
+        double offset_i = 0;
+        for (int y = 0; y < surface.rows; ++y)
+          for (int x = 0; x < surface.cols; ++x) {
+            const int tri = a.triangle.at<int>(y, x);
+            const cv::Vec2f ray_xy = ray_table.at<cv::Vec2f>(y, x);
+            if (tri < 0 || !std::isfinite(ray_xy[0])) continue;
+            if (tri != cached_triangle) {
+              normal_i = frames[i].cam_from_local.rotation * mesh.Normal(tri);
+              offset_i = normal_i.dot(frames[i].cam_from_local * mesh.Corner(tri, 0));
+              cached_triangle = tri;
+            }
+            const Eigen::Vector3d ray(ray_xy[0], ray_xy[1], 1.0);
+            const double denom = normal_i.dot(ray);
+            if (std::abs(denom) < 1e-6) continue;
+            const Eigen::Vector3d point = offset_i / denom * ray;
+            surface.at<cv::Vec3f>(y, x) = cv::Vec3f(point.x(), point.y(), point.z());
+          }
+      }
       for (int offset : options.offsets) {
         const int j = i + offset;
         if (j >= n) break;
@@ -170,33 +236,16 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
         if (b.grey.empty()) continue;
         const Camera& camera_j = *frames[j].camera;
         const Rigid3d j_from_i = frames[j].cam_from_local * local_from_i;
-        // Where each pixel of frame i falls in frame j, on a grid, then interpolated.
-        const int step = 4;
-        const int gw = a.depth.cols / step + 2, gh = a.depth.rows / step + 2;
-        cv::Mat grid(gh, gw, CV_32FC2, cv::Scalar(-1000, -1000));
-        for (int gy = 0; gy < gh; ++gy)
-          for (int gx = 0; gx < gw; ++gx) {
-            // cv::resize puts grid node g at pixel g * step + (step - 1) / 2.
-            const double px = gx * step + 0.5 * (step - 1), py = gy * step + 0.5 * (step - 1);
-            const int x = std::min(static_cast<int>(std::lround(px)), a.depth.cols - 1);
-            const int y = std::min(static_cast<int>(std::lround(py)), a.depth.rows - 1);
-            const int tri = a.triangle.at<int>(y, x);
-            if (tri < 0) continue;
-            Eigen::Vector2d normalized, pixel;
-            if (!camera_i.Unproject(Eigen::Vector2d(px, py), &normalized, 1e-3)) continue;
-            // The exact hit on the triangle's plane (the depth map's is the pixel centre's).
-            const Eigen::Vector3d ray(normalized.x(), normalized.y(), 1.0);
-            const Eigen::Vector3d normal_i = frames[i].cam_from_local.rotation * mesh.Normal(tri);
-            const Eigen::Vector3d corner_i = frames[i].cam_from_local * mesh.Corner(tri, 0);
-            const double denom = normal_i.dot(ray);
-            if (std::abs(denom) < 1e-6) continue;
-            const Eigen::Vector3d in_i = normal_i.dot(corner_i) / denom * ray;
-            if (!camera_j.Project(j_from_i * in_i, &pixel)) continue;
-            grid.at<cv::Vec2f>(gy, gx) = cv::Vec2f(pixel.x(), pixel.y());
+        // Where each pixel of frame i falls in frame j.
+        cv::Mat map_full(a.depth.size(), CV_32FC2, cv::Scalar(-1000, -1000));
+        for (int y = 0; y < map_full.rows; ++y)
+          for (int x = 0; x < map_full.cols; ++x) {
+            const cv::Vec3f point = surface.at<cv::Vec3f>(y, x);
+            if (!std::isfinite(point[0])) continue;
+            Eigen::Vector2d pixel;
+            if (camera_j.Project(j_from_i * Eigen::Vector3d(point[0], point[1], point[2]), &pixel))
+              map_full.at<cv::Vec2f>(y, x) = cv::Vec2f(pixel.x(), pixel.y());
           }
-        cv::Mat map_full;
-        cv::resize(grid, map_full, cv::Size(gw * step, gh * step), 0, 0, cv::INTER_LINEAR);
-        map_full = map_full(cv::Rect(0, 0, a.depth.cols, a.depth.rows));
         cv::Mat j_in_i;
         cv::remap(b.grey, j_in_i, map_full, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
         std::vector<cv::Point2f> from, to;
@@ -262,8 +311,8 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   // Gauss-Newton over all corrections (6 per frame), Huber-weighted, with the prior.
   const int dof = options.translation ? 6 : 3;
   std::vector<Vec6> x(n, Vec6::Zero());
-  const double rot_prior = 1.0 / std::pow(options.rotation_prior_deg * M_PI / 180.0, 2);
-  const double trans_prior = 1.0 / std::pow(options.translation_prior_m, 2);
+  double rotation_sigma = options.rotation_prior_deg * M_PI / 180.0;
+  double translation_sigma = options.translation_prior_m;
   const double match_weight = 1.0 / (options.match_sigma_px * options.match_sigma_px);
   std::vector<double> residual(matches.size(), 0);
   auto residuals = [&](const std::vector<Vec6>& at, std::vector<double>* out) {
@@ -298,70 +347,106 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   };
   result->rms_before_px = rms(residual);
 
-  for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    std::vector<Rigid3d> poses(n);
-    for (int f = 0; f < n; ++f) poses[f] = Corrected(x[f], frames[f].cam_from_local);
-    // Blocks of J^T W J per frame pair (i <= j) and J^T W r per frame.
-    std::map<std::pair<int, int>, Mat6> blocks;
-    std::vector<Vec6> gradient(n, Vec6::Zero());
-    const double step = 1e-7;
-    for (size_t k = 0; k < matches.size(); ++k) {
-      if (!use[k]) continue;
-      const Match& m = matches[k];
-      const Camera& camera_j = *frames[m.j].camera;
-      Eigen::Vector2d p0;
-      if (!Predict(m, camera_j, poses[m.i], poses[m.j], &p0)) continue;
-      const Eigen::Vector2d r = p0 - m.pixel_j;
-      const double norm = r.norm();
-      const double w = match_weight * (norm <= options.huber_px ? 1.0 : options.huber_px / norm);
-      Eigen::Matrix<double, 2, 12> J;
-      bool ok = true;
-      for (int q = 0; q < 12 && ok; ++q) {
-        Vec6 xi = x[m.i], xj = x[m.j];
-        (q < 6 ? xi : xj)[q % 6] += step;
-        Eigen::Vector2d p;
-        ok = Predict(m, camera_j, Corrected(xi, frames[m.i].cam_from_local),
-                     Corrected(xj, frames[m.j].cam_from_local), &p);
-        J.col(q) = (p - p0) / step;
+  // Tracks over longer gaps are noisier (the views differ more: 0.26 px RMS at one frame, 1 px
+  // at 16 on a street walk) and a little biased, while they are what fixes slow drifts of the
+  // poses: once the poses are mostly corrected, each gap's matches are weighted by the inverse
+  // of their spread (relative to the tightest gap's).
+  std::map<int, double> gap_weight;
+  // Rounds: the first with the given priors; each further one with priors from the
+  // corrections the previous found (per axis, their RMS times `prior_from_corrections`,
+  // never below the given priors): poses noisier than assumed are not held back.
+  for (int round = 0; round <= options.prior_rounds; ++round) {
+    if (round > 0) {
+      double rotation2 = 0, translation2 = 0;
+      for (int f = 0; f < n; ++f)
+        rotation2 += x[f].head<3>().squaredNorm(), translation2 += x[f].tail<3>().squaredNorm();
+      const double k = options.prior_from_corrections;
+      rotation_sigma =
+          std::max(options.rotation_prior_deg * M_PI / 180.0, k * std::sqrt(rotation2 / (3.0 * n)));
+      translation_sigma =
+          std::max(options.translation_prior_m, k * std::sqrt(translation2 / (3.0 * n)));
+    }
+    const double rot_prior = 1.0 / (rotation_sigma * rotation_sigma);
+    const double trans_prior = 1.0 / (translation_sigma * translation_sigma);
+    for (int iteration = 0; iteration < options.iterations; ++iteration) {
+      if (round == 0 && iteration == options.weigh_gaps_after && iteration > 0) {
+        residuals(x, &residual);
+        std::map<int, std::pair<double, int>> spread;  // gap: sum of squares, count
+        for (size_t k = 0; k < matches.size(); ++k)
+          if (use[k] && residual[k] < 3 * options.huber_px) {
+            auto& [sum, count] = spread[matches[k].j - matches[k].i];
+            sum += residual[k] * residual[k], ++count;
+          }
+        double tightest = std::numeric_limits<double>::infinity();
+        for (const auto& [gap, sc] : spread) tightest = std::min(tightest, sc.first / sc.second);
+        for (const auto& [gap, sc] : spread)
+          gap_weight[gap] = std::min(1.0, tightest / std::max(1e-12, sc.first / sc.second));
       }
-      if (!ok) continue;
-      const Eigen::Matrix<double, 2, 6> Ji = J.leftCols<6>(), Jj = J.rightCols<6>();
-      Block(&blocks, m.i, m.i) += w * Ji.transpose() * Ji;
-      Block(&blocks, m.j, m.j) += w * Jj.transpose() * Jj;
-      Block(&blocks, m.i, m.j) += w * Ji.transpose() * Jj;
-      gradient[m.i] += w * Ji.transpose() * r;
-      gradient[m.j] += w * Jj.transpose() * r;
-    }
-    std::vector<Eigen::Triplet<double>> triplets;
-    Eigen::VectorXd rhs(n * dof);
-    for (int f = 0; f < n; ++f) {
-      Mat6& d = Block(&blocks, f, f);
-      Vec6 g = gradient[f];
-      for (int c = 0; c < 3; ++c) d(c, c) += rot_prior, g[c] += rot_prior * x[f][c];
-      for (int c = 3; c < 6; ++c) d(c, c) += trans_prior, g[c] += trans_prior * x[f][c];
-      for (int c = 0; c < dof; ++c) rhs[f * dof + c] = -g[c];
-    }
-    for (const auto& [key, block] : blocks) {
-      const auto [a, b] = key;
-      for (int r = 0; r < dof; ++r)
-        for (int c = 0; c < dof; ++c) {
-          if (block(r, c) == 0) continue;
-          triplets.emplace_back(a * dof + r, b * dof + c, block(r, c));
-          if (a != b) triplets.emplace_back(b * dof + c, a * dof + r, block(r, c));
+      std::vector<Rigid3d> poses(n);
+      for (int f = 0; f < n; ++f) poses[f] = Corrected(x[f], frames[f].cam_from_local);
+      // Blocks of J^T W J per frame pair (i <= j) and J^T W r per frame.
+      std::map<std::pair<int, int>, Mat6> blocks;
+      std::vector<Vec6> gradient(n, Vec6::Zero());
+      const double step = 1e-7;
+      for (size_t k = 0; k < matches.size(); ++k) {
+        if (!use[k]) continue;
+        const Match& m = matches[k];
+        const Camera& camera_j = *frames[m.j].camera;
+        Eigen::Vector2d p0;
+        if (!Predict(m, camera_j, poses[m.i], poses[m.j], &p0)) continue;
+        const Eigen::Vector2d r = p0 - m.pixel_j;
+        const double norm = r.norm();
+        double w = match_weight * (norm <= options.huber_px ? 1.0 : options.huber_px / norm);
+        if (const auto it = gap_weight.find(m.j - m.i); it != gap_weight.end()) w *= it->second;
+        Eigen::Matrix<double, 2, 12> J;
+        bool ok = true;
+        for (int q = 0; q < 12 && ok; ++q) {
+          Vec6 xi = x[m.i], xj = x[m.j];
+          (q < 6 ? xi : xj)[q % 6] += step;
+          Eigen::Vector2d p;
+          ok = Predict(m, camera_j, Corrected(xi, frames[m.i].cam_from_local),
+                       Corrected(xj, frames[m.j].cam_from_local), &p);
+          J.col(q) = (p - p0) / step;
         }
+        if (!ok) continue;
+        const Eigen::Matrix<double, 2, 6> Ji = J.leftCols<6>(), Jj = J.rightCols<6>();
+        Block(&blocks, m.i, m.i) += w * Ji.transpose() * Ji;
+        Block(&blocks, m.j, m.j) += w * Jj.transpose() * Jj;
+        Block(&blocks, m.i, m.j) += w * Ji.transpose() * Jj;
+        gradient[m.i] += w * Ji.transpose() * r;
+        gradient[m.j] += w * Jj.transpose() * r;
+      }
+      std::vector<Eigen::Triplet<double>> triplets;
+      Eigen::VectorXd rhs(n * dof);
+      for (int f = 0; f < n; ++f) {
+        Mat6& d = Block(&blocks, f, f);
+        Vec6 g = gradient[f];
+        for (int c = 0; c < 3; ++c) d(c, c) += rot_prior, g[c] += rot_prior * x[f][c];
+        for (int c = 3; c < 6; ++c) d(c, c) += trans_prior, g[c] += trans_prior * x[f][c];
+        for (int c = 0; c < dof; ++c) rhs[f * dof + c] = -g[c];
+      }
+      for (const auto& [key, block] : blocks) {
+        const auto [a, b] = key;
+        for (int r = 0; r < dof; ++r)
+          for (int c = 0; c < dof; ++c) {
+            if (block(r, c) == 0) continue;
+            triplets.emplace_back(a * dof + r, b * dof + c, block(r, c));
+            if (a != b) triplets.emplace_back(b * dof + c, a * dof + r, block(r, c));
+          }
+      }
+      Eigen::SparseMatrix<double> H(n * dof, n * dof);
+      H.setFromTriplets(triplets.begin(), triplets.end());
+      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
+      if (solver.info() != Eigen::Success) break;
+      const Eigen::VectorXd delta = solver.solve(rhs);
+      if (solver.info() != Eigen::Success || !delta.allFinite()) break;
+      double largest = 0;
+      for (int f = 0; f < n; ++f) {
+        x[f].head(dof) += delta.segment(f * dof, dof);
+        largest = std::max(largest, delta.segment(f * dof, dof).cwiseAbs().maxCoeff());
+      }
+      if (largest < 1e-8) break;
     }
-    Eigen::SparseMatrix<double> H(n * dof, n * dof);
-    H.setFromTriplets(triplets.begin(), triplets.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(H);
-    if (solver.info() != Eigen::Success) break;
-    const Eigen::VectorXd delta = solver.solve(rhs);
-    if (solver.info() != Eigen::Success || !delta.allFinite()) break;
-    double largest = 0;
-    for (int f = 0; f < n; ++f) {
-      x[f].head(dof) += delta.segment(f * dof, dof);
-      largest = std::max(largest, delta.segment(f * dof, dof).cwiseAbs().maxCoeff());
-    }
-    if (largest < 1e-8) break;
   }
   residuals(x, &residual);
   result->rms_after_px = rms(residual);
@@ -381,6 +466,8 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
     rotations.push_back(x[f].head<3>().norm() * 180.0 / M_PI);
     translations.push_back(x[f].tail<3>().norm());
   }
+  result->rotation_prior_deg = rotation_sigma * 180.0 / M_PI;
+  result->translation_prior_m = translation_sigma;
   result->median_rotation_deg = Median(rotations);
   result->median_translation_m = Median(translations);
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -41,13 +41,24 @@ struct PoseAdjustOptions {
   double forward_backward_px = 0.5;  // a track must come back to within this
   double search_px = 20;             // a track this far from where the given poses put it: dropped
   int window_px = 15;                // tracking window (pixels, square)
+  // Frames whose longer side exceeds this are tracked at half (a quarter, ...) resolution;
+  // pixel figures below are then at that resolution. 0: always at full resolution.
+  int max_side_px = 720;
   // The given poses' assumed error: a prior on each correction. Weaker priors let the image
   // noise move what the matches hardly see (a camera's sideways step against its turn).
   double rotation_prior_deg = 0.5;
   double translation_prior_m = 0.01;
+  // Further rounds with priors from the corrections found (their RMS per axis times
+  // prior_from_corrections, never below the priors above): given poses noisier than the
+  // priors assume (3 cm against 1 cm) are then corrected in full. 0 rounds: the priors above.
+  int prior_rounds = 2;
+  double prior_from_corrections = 1.5;
   double match_sigma_px = 0.5;
   double huber_px = 1.0;
   int iterations = 6;
+  // From this iteration on, each frame gap's matches are weighted by the inverse of their
+  // spread at the time (0: all matches weigh the same).
+  int weigh_gaps_after = 2;
   bool translation = true;  // false: rotations only
   // The corrections are applied only when they explain the matches this many times better
   // than the given poses (RMS before / after): at exact poses the ratio is about 1 (0.6-1.4
@@ -65,6 +76,7 @@ struct PoseAdjustResult {
   int matches = 0, inliers = 0;
   double rms_before_px = 0, rms_after_px = 0;                // over the inliers
   double median_rotation_deg = 0, median_translation_m = 0;  // corrections found
+  double rotation_prior_deg = 0, translation_prior_m = 0;    // the priors of the last round
   double seconds = 0;
 };
 

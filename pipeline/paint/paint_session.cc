@@ -8,6 +8,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/core/scaled_camera.h"
 #include "pipeline/paint/charts.h"
 #include "pipeline/paint/stage_clock.h"
 #include "pipeline/render/renderer.h"
@@ -33,13 +34,8 @@ double AutomaticTexelSize(const Scene& scene, const Camera& camera,
   // 8 times, and take the median depth over all surface samples. A pixel covers z / f
   // metres there: one texel per pixel at the typical distance.
   const int scale = 8;
-  Camera small = camera;
-  small.width = std::max(1, camera.width / scale);
-  small.height = std::max(1, camera.height / scale);
-  const double sx = static_cast<double>(small.width) / camera.width;
-  const double sy = static_cast<double>(small.height) / camera.height;
-  small.fx *= sx, small.fy *= sy;
-  small.cx = (camera.cx + 0.5) * sx - 0.5, small.cy = (camera.cy + 0.5) * sy - 0.5;
+  const Camera small =
+      ScaledCamera(camera, std::max(1, camera.width / scale), std::max(1, camera.height / scale));
   std::vector<float> depths;
   try {
     const Rasterizer raster(small, RasterOptions());

@@ -218,8 +218,11 @@ Status FinishCaptureFolder(const Scene& scene, const fs::path& root, json settin
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic((root / "synth_stamp.txt").string(), fingerprint + "\n"));
   const std::string project_path = (root / "project.json").string();
   project.scene = "scene.gltf";
-  project.file_path = fs::absolute(project_path).lexically_normal().string();
-  return SaveProject(project, project_path);
+  // The pipeline's settings are the defaults: left out, so the capture paints with the
+  // defaults of the Fresco that reads it (written out, they would pin this version's).
+  json written = json::parse(ProjectToJsonText(project));
+  written.erase("pipeline");
+  return WriteFileAtomic(project_path, written.dump(2) + "\n");
 }
 
 // From here on the folder is rewritten: without project.json (and the stamp) it is
