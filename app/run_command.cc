@@ -170,6 +170,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   if (job.joint_poses) {  // pipeline.refine.joint: the poses adjusted before painting
     const PoseAdjustResult& a = *job.joint_poses;
     metrics["joint_poses"] = {{"applied", a.applied},
+                              {"not_run", a.not_run},
                               {"matches", a.matches},
                               {"inliers", a.inliers},
                               {"rms_before_px", a.rms_before_px},
@@ -292,7 +293,10 @@ int RunVerbRun(const CommandArgs& argv) {
         scene.mesh.NumTriangles(), session->buffers().size(), session->NumSurfaceTexels(),
         session->default_texel_size_m(),
         specs.size() > 1 ? (", " + std::to_string(specs.size()) + " streams").c_str() : "");
-    if (job->joint_poses) {
+    if (job->joint_poses && !job->joint_poses->not_run.empty()) {
+      std::fprintf(stderr, "fresco run: poses not adjusted together: %s\n",
+                   job->joint_poses->not_run.c_str());
+    } else if (job->joint_poses) {
       const PoseAdjustResult& a = *job->joint_poses;
       std::fprintf(stderr,
                    "fresco run: poses adjusted together (%d tracks, %.1f s): %s, RMS %.3f -> "

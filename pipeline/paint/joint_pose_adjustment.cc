@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -89,6 +90,12 @@ double Median(std::vector<double> v) {
 
 }  // namespace
 
+std::string TooManyFramesToAdjust(int frames, const PoseAdjustOptions& options) {
+  if (options.max_frames <= 0 || frames <= options.max_frames) return "";
+  return std::to_string(frames) + " frames, more than the " + std::to_string(options.max_frames) +
+         " it holds in memory";
+}
+
 Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& given,
                          const PoseAdjustOptions& options, PoseAdjustResult* result) {
   const auto start = std::chrono::steady_clock::now();
@@ -96,7 +103,12 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   const int n = static_cast<int>(given.size());
   for (const PoseAdjustFrame& f : given) result->cam_from_local.push_back(f.cam_from_local);
   result->frame_matches.assign(n, 0);
-  if (n < 2) return Status::Ok();
+  if (n < 2) {
+    result->not_run = "fewer than two frames";
+    return Status::Ok();
+  }
+  result->not_run = TooManyFramesToAdjust(n, options);
+  if (!result->not_run.empty()) return Status::Ok();
 
   // Large frames are tracked halved (as often as needed) down to max_side_px, with their
   // cameras scaled alike; a frame of another size than its camera's is kept as it is (it then

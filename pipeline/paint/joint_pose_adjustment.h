@@ -65,12 +65,16 @@ struct PoseAdjustOptions {
   // on the evaluation suites' clean captures, where the matches' own errors would otherwise
   // move the poses), with 0.5 degree of noise 2.5-11.
   double min_improvement = 2.2;
+  // Captures with more frames are not adjusted (not_run says so): every frame is held in
+  // memory, with its depth and triangle maps (a few MB a frame).
+  int max_frames = 500;
   // Progress (optional): frames prepared, then matched, then solver iterations.
   std::function<void(int done, int total, const std::string& line)> progress;
 };
 
 struct PoseAdjustResult {
   bool applied = false;                 // false: the given poses stand (min_improvement)
+  std::string not_run;                  // why nothing was tried ("" when it ran)
   std::vector<Rigid3d> cam_from_local;  // corrected (or given), one per frame
   std::vector<int> frame_matches;       // matches each frame takes part in
   int matches = 0, inliers = 0;
@@ -79,6 +83,9 @@ struct PoseAdjustResult {
   double rotation_prior_deg = 0, translation_prior_m = 0;    // the priors of the last round
   double seconds = 0;
 };
+
+// Why a capture of `frames` frames is not adjusted ("" when it is): more than max_frames.
+std::string TooManyFramesToAdjust(int frames, const PoseAdjustOptions& options);
 
 Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& frames,
                          const PoseAdjustOptions& options, PoseAdjustResult* result);

@@ -1,6 +1,8 @@
 #include "pipeline/run/paint_job.h"
 
+#include <algorithm>
 #include <future>
+#include <string>
 
 #include <opencv2/imgproc.hpp>
 
@@ -18,6 +20,19 @@ namespace {
 // refine.joint: every frame is read once (kept grey), all poses are adjusted together
 // (joint_pose_adjustment.h) and written into the captures; the videos open again for painting.
 Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+  PoseAdjustOptions adjust_options;
+  adjust_options.progress = options.joint_progress;
+  // A capture too long to hold is not read for it (the frames with poses count).
+  size_t posed = 0;
+  for (const Capture& capture : j->captures) posed += capture.poses.size();
+  const int limit = project.pipeline.max_frames > 0
+                        ? std::min<int>(static_cast<int>(posed), project.pipeline.max_frames)
+                        : static_cast<int>(posed);
+  if (std::string why = TooManyFramesToAdjust(limit, adjust_options); !why.empty()) {
+    j->joint_poses = PoseAdjustResult();
+    j->joint_poses->not_run = why;
+    return Status::Ok();
+  }
   std::vector<const Capture*> streams;
   for (const Capture& capture : j->captures) streams.push_back(&capture);
   std::vector<PoseAdjustFrame> frames;
@@ -43,8 +58,6 @@ Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options
     }
     FRESCO_RETURN_IF_ERROR(status);
   }
-  PoseAdjustOptions adjust_options;
-  adjust_options.progress = options.joint_progress;
   PoseAdjustResult adjusted;
   FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(j->scene().mesh, frames, adjust_options, &adjusted));
   j->joint_poses = adjusted;

@@ -200,6 +200,21 @@ TEST(JointPoseAdjustment, FewerThanTwoFramesChangeNothing) {
   EXPECT_EQ(result.cam_from_local[0].translation, frames[0].cam_from_local.translation);
 }
 
+// A capture longer than it holds in memory is left as given, saying why.
+TEST(JointPoseAdjustment, ACaptureTooLongToHoldIsNotAdjusted) {
+  const Orbit o = MakeOrbit(0.5, 0.01);
+  const std::vector<PoseAdjustFrame> frames = Frames(o);
+  PoseAdjustOptions options;
+  options.max_frames = 30;
+  PoseAdjustResult result;
+  ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, options, &result).ok());
+  EXPECT_FALSE(result.applied);
+  EXPECT_EQ(result.not_run, "40 frames, more than the 30 it holds in memory");
+  EXPECT_EQ(TooManyFramesToAdjust(30, options), "");
+  for (size_t i = 0; i < frames.size(); ++i)
+    EXPECT_EQ(result.cam_from_local[i].translation, frames[i].cam_from_local.translation);
+}
+
 TEST(JointPoseAdjustment, AFrameOfAnotherSizeIsLeftOut) {
   const Orbit o = MakeOrbit(0.5, 0.01);
   std::vector<PoseAdjustFrame> frames = Frames(o);
