@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/capture.h"
+#include "pipeline/core/scaled_camera.h"
 #include "pipeline/live/live_input.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
@@ -57,14 +58,7 @@ using Clock = std::chrono::steady_clock;
 
 // The camera at half size (pixel centres stay on the same rays).
 Camera HalfSize(const Camera& camera) {
-  Camera half = camera;
-  half.width = std::max(1, camera.width / 2);
-  half.height = std::max(1, camera.height / 2);
-  const double sx = static_cast<double>(half.width) / camera.width;
-  const double sy = static_cast<double>(half.height) / camera.height;
-  half.fx *= sx, half.fy *= sy;
-  half.cx = (camera.cx + 0.5) * sx - 0.5, half.cy = (camera.cy + 0.5) * sy - 0.5;
-  return half;
+  return ScaledCamera(camera, std::max(1, camera.width / 2), std::max(1, camera.height / 2));
 }
 
 }  // namespace
