@@ -181,6 +181,14 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                               {"translation_prior_m", a.translation_prior_m},
                               {"seconds", a.seconds}};
   }
+  if (job.mover_masks) {  // background.mode auto: movers found across views before painting
+    const MoverMaskResult& m = *job.mover_masks;
+    metrics["movers_across_views"] = {{"not_run", m.not_run},
+                                      {"pixels_judged", m.judged},
+                                      {"pixels_masked", m.flagged},
+                                      {"fraction", m.fraction()},
+                                      {"seconds", m.seconds}};
+  }
   metrics["texels"] = session->NumSurfaceTexels();
   metrics["texels_painted"] = session->NumPaintedSurfaceTexels();
   metrics["coverage"] = session->Coverage();
@@ -308,6 +316,13 @@ int RunVerbRun(const CommandArgs& argv) {
                    a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
                    1000 * a.median_translation_m);
     }
+    if (job->mover_masks && !job->mover_masks->not_run.empty())
+      std::fprintf(stderr, "fresco run: background decided frame by frame: %s\n",
+                   job->mover_masks->not_run.c_str());
+    else if (job->mover_masks)
+      std::fprintf(stderr, "fresco run: background %s (%.1f s)\n",
+                   session->auto_decisions().background.Describe().c_str(),
+                   job->mover_masks->seconds);
   }
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)

@@ -5,12 +5,14 @@
 #include <memory>
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
 #include "pipeline/eval/eval_score.h"
 #include "pipeline/eval/mover_provenance.h"
 #include "pipeline/paint/joint_pose_adjustment.h"
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/paint/rephotography.h"
 #include "pipeline/render/renderer.h"
@@ -145,6 +147,22 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -loaded.scene.origin_in_world);
     for (size_t k = 0; k < to_paint.size(); ++k)
       to_paint[k].painted_pose = adjusted.cam_from_local[k] * local_from_world;
+  }
+  if (project.pipeline.background.mode == BackgroundMode::kAuto) {  // decided up front
+    const MoverMaskOptions mover_options;
+    std::vector<MoverMaskFrame> frames;
+    for (const PaintFrame& pf : to_paint) {
+      MoverMaskFrame f;
+      cv::resize(pf.frame.bgr, f.bgr, MoverMaskSize(*pf.camera, mover_options), 0, 0,
+                 cv::INTER_AREA);
+      f.camera = pf.camera;
+      f.cam_from_local = CamFromLocal(loaded.scene, pf.painted_pose);
+      frames.push_back(f);
+    }
+    MoverMaskResult found;
+    FRESCO_RETURN_IF_ERROR(FindMoverMasks(loaded.scene.mesh, frames, mover_options, &found));
+    session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(frames.size()));
+    result->movers_across_views = found.fraction();
   }
   for (const PaintFrame& pf : to_paint) {
     const Frame& frame = pf.frame;

@@ -53,7 +53,10 @@ struct CaptureEval {
   // those of them seen with a mover at least as often as without, and the texels seen
   // mover-free at least once that are painted (fractions).
   double mover_texels = 0, mover_dominated_texels = 0, open_coverage = 0;
-  double coverage = 0;      // on-surface texels painted
+  double coverage = 0;  // on-surface texels painted
+  // background.mode auto: the share of the surface pixels judged that were masked (NaN
+  // when not run).
+  double movers_across_views = std::numeric_limits<double>::quiet_NaN();
   bool noisy_poses = false;  // the given poses differ from the true ones
   // With EvalOptions::recovery (NaN otherwise): truth PSNR with refinement off at the given
   // poses, with the setting at the true poses (noisy captures only), and the share of the

@@ -126,6 +126,7 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                        {"dominated_texels", c.mover_dominated_texels},
                        {"open_coverage", c.open_coverage}};
     row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
+    if (std::isfinite(c.movers_across_views)) row["movers_across_views"] = c.movers_across_views;
     row["noisy_poses"] = c.noisy_poses;
     if (std::isfinite(c.unrefined_truth_psnr_db)) {
       const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };

@@ -10,7 +10,7 @@ namespace fresco {
 
 std::string AutoDecision::Describe() const {
   if (!is_auto()) return "";
-  char line[160];
+  char line[200];
   if (!std::isfinite(evidence)) {
     std::snprintf(line, sizeof line, "%s: no evidence yet%s", StateName(),
                   state == State::kOff ? " (view selection runs without refinement)" : "");
@@ -21,6 +21,11 @@ std::string AutoDecision::Describe() const {
   if (state == State::kDeciding)
     std::snprintf(line, sizeof line, "deciding: %.3g %s %.3g over %d frames so far", evidence,
                   relation, threshold, frames_measured);
+  else if (basis == "across_views")
+    std::snprintf(line, sizeof line,
+                  "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
+                  "(decided before painting)",
+                  StateName(), evidence, relation, threshold, frames_measured);
   else
     std::snprintf(line, sizeof line, "%s: %.3g %s %.3g over %d frames (decided at frame %d)",
                   StateName(), evidence, relation, threshold, frames_measured, decided_at_frame);
@@ -32,6 +37,7 @@ namespace {
 nlohmann::json DecisionJson(const AutoDecision& d) {
   if (!d.is_auto()) return nullptr;
   return {{"decision", d.StateName()},
+          {"basis", d.basis.empty() ? nlohmann::json(nullptr) : nlohmann::json(d.basis)},
           {"evidence", std::isfinite(d.evidence) ? nlohmann::json(d.evidence) : nullptr},
           {"threshold", d.threshold},
           {"frames_measured", d.frames_measured},
@@ -94,6 +100,18 @@ void BackgroundAutoDecider::Start(bool enabled, int warmup_frames, int expected_
   if (!enabled) return;
   decision_.state = AutoDecision::State::kDeciding;
   decision_.threshold = kBackgroundAutoThreshold;
+  decision_.basis = "texels";
+}
+
+void BackgroundAutoDecider::DecideAcrossViews(double fraction, int frames) {
+  if (!deciding()) return;
+  decision_.basis = "across_views";
+  decision_.threshold = kBackgroundAcrossViewsThreshold;
+  decision_.evidence = fraction;
+  decision_.frames_measured = frames;
+  decision_.decided_at_frame = 0;
+  decision_.state =
+      fraction > decision_.threshold ? AutoDecision::State::kOn : AutoDecision::State::kOff;
 }
 
 bool BackgroundAutoDecider::AddFrame(int frame_number, long long observed, long long warming,

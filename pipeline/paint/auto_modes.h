@@ -17,6 +17,11 @@
 //               above `kBackgroundAutoThreshold` (movers, or misaligned samples it keeps out) is
 //               seen after `kBackgroundAutoFrames` frames, it stays; if none by a third of the
 //               capture, the model is dropped and painting continues as `off`.
+//               Captures from files decide before painting instead: every frame is compared
+//               with the frames near it through the mesh (mover_masks.h), and the share of the
+//               pixels that differ from most of them (movers) is compared with
+//               `kBackgroundAcrossViewsThreshold`: above, `robust` from the first frame; below,
+//               `off` (no model, no warm-up).
 #pragma once
 
 #include <string>
@@ -40,6 +45,9 @@ constexpr int kRefineAutoLastFrame = 20;
 // measures; 10 photos of a castle 8-30 degrees apart measured 0 or 1).
 constexpr int kRefineAutoNoEvidenceFrame = 4;
 constexpr double kBackgroundAutoThreshold = 0.01;
+// The share of the pixels masked across views above which a capture has movers: captures
+// without movers 0-0.31 %, with movers 1.56-7.63 % (evaluation suite, docs/results.md).
+constexpr double kBackgroundAcrossViewsThreshold = 0.008;
 // The background decides on as soon as the fraction exceeds the threshold after this many
 // frames, off when it has not after a third of the expected frames (at least this many, at
 // most kBackgroundAutoMaxFrames): movers may enter late.
@@ -78,6 +86,9 @@ class BackgroundAutoDecider {
   // One frame's counts over the buffers seen: texels observed, still warming up, masked.
   // Returns true when this frame decided.
   bool AddFrame(int frame_number, long long observed, long long warming, long long masked);
+  // Decides before the first frame from the movers found across views: `fraction` of the
+  // pixels judged over `frames` frames masked.
+  void DecideAcrossViews(double fraction, int frames);
   const AutoDecision& decision() const { return decision_; }
   bool deciding() const { return decision_.state == AutoDecision::State::kDeciding; }
 

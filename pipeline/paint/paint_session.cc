@@ -124,6 +124,12 @@ void PaintSession::StartAutoModes() {
   options_.background.mode = background_auto ? BackgroundMode::kRobust : requested_background_;
   refine_auto_.Start(refine_auto);
   background_auto_.Start(background_auto, options_.background.warmup_frames, expected_frames_);
+  if (background_auto && background_across_views_.second >= 0) {
+    background_auto_.DecideAcrossViews(background_across_views_.first,
+                                       background_across_views_.second);
+    if (background_auto_.decision().state == AutoDecision::State::kOff)
+      options_.background.mode = BackgroundMode::kOff;
+  }
   if (refine_auto && options_.select.enabled && options_.update == UpdatePolicy::kQuality) {
     refine_auto_.DecideOff(0);  // view selection runs without refinement (SelectActive)
     options_.refine.mode = RefineMode::kOff;
@@ -134,6 +140,16 @@ void PaintSession::StartAutoModes() {
     background_frame_.resize(set_.buffers.size());
     StreamBackground(0);  // every project has a stream 0: its set-up is not the first frame's
   }
+}
+
+void PaintSession::DecideBackgroundAcrossViews(double fraction, int frames) {
+  background_across_views_ = {fraction, frames};
+  if (!background_auto_.deciding()) return;
+  background_auto_.DecideAcrossViews(fraction, frames);
+  if (background_auto_.decision().state != AutoDecision::State::kOff) return;
+  options_.background.mode = BackgroundMode::kOff;
+  background_.clear();
+  background_frame_.clear();
 }
 
 std::vector<BufferBackground>& PaintSession::StreamBackground(int stream) {

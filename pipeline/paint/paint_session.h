@@ -22,6 +22,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pipeline/core/camera.h"
@@ -131,6 +132,10 @@ class PaintSession {
   // robust or off, background.mode robust or off; robust while deciding).
   const PipelineOptions& options() const { return options_; }
   // What the `auto` modes decided so far, and on what evidence (auto_modes.h).
+  // background.mode auto, before the first frame: decides from the movers found across views
+  // (`fraction` of the pixels judged over `frames` frames masked; mover_masks.h) instead of
+  // frame by frame. Kept through ResetPainting.
+  void DecideBackgroundAcrossViews(double fraction, int frames);
   AutoDecisions auto_decisions() const {
     return {refine_auto_.decision(), background_auto_.decision()};
   }
@@ -208,6 +213,8 @@ class PaintSession {
   PipelineOptions options_;
   RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)
   BackgroundMode requested_background_ = BackgroundMode::kOff;
+  // DecideBackgroundAcrossViews' evidence (fraction, frames); frames < 0: none.
+  std::pair<double, int> background_across_views_{0.0, -1};
   int expected_frames_ = 0;  // the poses the inputs promised (0: unknown)
   RefineAutoDecider refine_auto_;
   BackgroundAutoDecider background_auto_;

@@ -76,6 +76,10 @@ struct AutoDecision {
   double threshold = std::numeric_limits<double>::quiet_NaN();
   int frames_measured = 0;
   int decided_at_frame = -1;  // the session's frame number where it was decided; -1: not yet
+  // What the evidence is, when the mode has more than one kind: background "across_views"
+  // (decided before painting from the movers found across views) or "texels" (the model's own
+  // verdicts while painting); "" otherwise.
+  std::string basis;
 
   bool is_auto() const { return state != State::kNotAuto; }
   // "deciding" | "on" | "off" ("" when the mode is not auto).
@@ -107,8 +111,10 @@ struct AutoDecision {
 };
 
 struct AutoDecisions {
-  AutoDecision refine;      // evidence: median misalignment of the first frames, texels
-  AutoDecision background;  // evidence: foreground fraction of the warmed-up texels
+  AutoDecision refine;  // evidence: median misalignment of the first frames, texels
+  // evidence: the share of the pixels masked across views (basis "across_views"), or the
+  // foreground fraction of the warmed-up texels ("texels")
+  AutoDecision background;
 };
 
 struct FrameReport {

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/joint_pose_adjustment.h"
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/open_project.h"
 #include "pipeline/render/renderer.h"
 #include "pipeline/run/file_frame_source.h"
@@ -17,11 +18,18 @@ namespace fresco {
 
 namespace {
 
-// refine.joint: every frame is read once (kept grey), all poses are adjusted together
-// (joint_pose_adjustment.h) and written into the captures; the videos open again for painting.
-Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+// What needs the whole capture before painting: every frame is read once (kept grey for the
+// joint adjustment of the poses, refine.joint: joint_pose_adjustment.h; small and in colour
+// for the movers found across views that background.mode auto decides on: mover_masks.h),
+// the poses are adjusted and written into the captures, the background decided; the videos
+// open again for painting.
+Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& options,
+                               PaintJob* j) {
+  const bool joint = project.pipeline.refine.joint;
+  const bool movers = project.pipeline.background.mode == BackgroundMode::kAuto;
   PoseAdjustOptions adjust_options;
   adjust_options.progress = options.joint_progress;
+  const MoverMaskOptions mover_options;
   // A capture too long to hold is not read for it (the frames with poses count).
   size_t posed = 0;
   for (const Capture& capture : j->captures) posed += capture.poses.size();
@@ -29,13 +37,20 @@ Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options
                         ? std::min<int>(static_cast<int>(posed), project.pipeline.max_frames)
                         : static_cast<int>(posed);
   if (std::string why = TooManyFramesToAdjust(limit, adjust_options); !why.empty()) {
-    j->joint_poses = PoseAdjustResult();
-    j->joint_poses->not_run = why;
+    if (joint) {
+      j->joint_poses = PoseAdjustResult();
+      j->joint_poses->not_run = why;
+    }
+    if (movers) {
+      j->mover_masks = MoverMaskResult();
+      j->mover_masks->not_run = why;
+    }
     return Status::Ok();
   }
   std::vector<const Capture*> streams;
   for (const Capture& capture : j->captures) streams.push_back(&capture);
   std::vector<PoseAdjustFrame> frames;
+  std::vector<cv::Mat> small;              // colour, at the movers' size
   std::vector<std::pair<int, int>> where;  // stream, pose index
   {
     FileFrameSource source(project, streams);
@@ -48,23 +63,55 @@ Status AdjustPosesJointly(const Project& project, const PaintJobOptions& options
       if (read == options.joint_holdout_counter || (every > 0 && read % every == every / 2))
         continue;
       if (!f.posed.has_pose || !f.camera || f.pose_index < 0) continue;
-      if (f.posed.frame.bgr.size() != cv::Size(f.camera->width, f.camera->height)) continue;
+      const cv::Mat& bgr = f.posed.frame.bgr;
+      if (bgr.size() != cv::Size(f.camera->width, f.camera->height)) continue;
       PoseAdjustFrame frame;
-      cv::cvtColor(f.posed.frame.bgr, frame.bgr, cv::COLOR_BGR2GRAY);
+      if (joint) cv::cvtColor(bgr, frame.bgr, cv::COLOR_BGR2GRAY);
       frame.camera = f.camera;
       frame.cam_from_local = CamFromLocal(j->scene(), f.posed.cam_from_world);
       frames.push_back(frame);
+      if (movers) {
+        small.emplace_back();
+        cv::resize(bgr, small.back(), MoverMaskSize(*f.camera, mover_options), 0, 0,
+                   cv::INTER_AREA);
+      }
       where.emplace_back(f.stream, f.pose_index);
     }
     FRESCO_RETURN_IF_ERROR(status);
   }
-  PoseAdjustResult adjusted;
-  FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(j->scene().mesh, frames, adjust_options, &adjusted));
-  j->joint_poses = adjusted;
-  const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
-  for (size_t k = 0; k < where.size(); ++k)
-    j->captures[where[k].first].poses[where[k].second].cam_from_world =
-        adjusted.cam_from_local[k] * local_from_world;
+  std::vector<Rigid3d> cam_from_local;
+  for (const PoseAdjustFrame& frame : frames) cam_from_local.push_back(frame.cam_from_local);
+  if (joint) {
+    PoseAdjustResult adjusted;
+    FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(j->scene().mesh, frames, adjust_options, &adjusted));
+    j->joint_poses = adjusted;
+    cam_from_local = adjusted.cam_from_local;
+    const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
+    for (size_t k = 0; k < where.size(); ++k)
+      j->captures[where[k].first].poses[where[k].second].cam_from_world =
+          adjusted.cam_from_local[k] * local_from_world;
+  }
+  frames.clear();
+  if (movers) {
+    // Each stream's frames are compared with that stream's frames near them.
+    MoverMaskResult all;
+    for (size_t s = 0; s < j->captures.size(); ++s) {
+      std::vector<MoverMaskFrame> stream_frames;
+      for (size_t k = 0; k < where.size(); ++k) {
+        if (where[k].first != static_cast<int>(s)) continue;
+        MoverMaskFrame frame;
+        frame.bgr = small[k];
+        frame.camera = j->captures[s].CameraFor(j->captures[s].poses[where[k].second]);
+        frame.cam_from_local = cam_from_local[k];
+        stream_frames.push_back(frame);
+      }
+      MoverMaskResult found;
+      FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
+      all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
+    }
+    j->mover_masks = all;
+    j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
+  }
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
@@ -95,8 +142,8 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
   if (!j.live) {
-    if (project.pipeline.refine.joint)
-      FRESCO_RETURN_IF_ERROR(AdjustPosesJointly(project, options, &j));
+    if (project.pipeline.refine.joint || project.pipeline.background.mode == BackgroundMode::kAuto)
+      FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     j.source = std::make_unique<FileFrameSource>(project, streams);

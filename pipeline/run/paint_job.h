@@ -16,6 +16,7 @@
 #include "pipeline/core/project.h"
 #include "pipeline/live/live_input.h"
 #include "pipeline/paint/joint_pose_adjustment.h"
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/run/posed_frame_source.h"
 
@@ -45,6 +46,9 @@ struct PaintJob {
   std::unique_ptr<PosedFrameSource> source;
   // pipeline.refine.joint: what the joint adjustment of the poses did before painting.
   std::optional<PoseAdjustResult> joint_poses;
+  // background.mode auto: the movers found across views before painting, which decided it
+  // (`masks` is empty).
+  std::optional<MoverMaskResult> mover_masks;
 
   const Scene& scene() const { return captures[0].scene; }
 };

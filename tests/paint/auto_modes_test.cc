@@ -14,6 +14,8 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/paint/auto_modes.h"
+#include "pipeline/paint/mover_masks.h"
+#include "pipeline/render/renderer.h"
 #include "tests/paint/refine_scenario.h"
 #include "tests/paint/room_capture.h"
 #include "tests/paint/synth_session.h"
@@ -127,6 +129,57 @@ TEST(AutoBackground, OnWithMoversOffWithout) {
   EXPECT_EQ(without.state, State::kOff);
   EXPECT_GT(without.frames_measured, kBackgroundAutoFrames);  // movers could still come
   EXPECT_LT(without.evidence, with_movers.evidence / 3);
+}
+
+// Captures from files decide before painting, from the movers found across views
+// (mover_masks.h): on from the first frame with movers; off without, and then the session
+// paints exactly what `off` paints (no model, no warm-up); the decision holds through
+// ResetPainting.
+AutoDecision DecideAcrossViews(bool movers, bool* paints_as_off) {
+  const Scene scene = RoomScene();
+  SynthCapture capture;
+  EXPECT_TRUE(SynthesizeCapture(scene, RoomWithMovers(movers), &capture).ok());
+  std::vector<MoverMaskFrame> frames;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    frames.push_back({capture.frames_bgr[i], &capture.camera,
+                      CamFromLocal(scene, capture.true_poses[i].cam_from_world)});
+  MoverMaskResult found;
+  EXPECT_TRUE(FindMoverMasks(scene.mesh, frames, MoverMaskOptions(), &found).ok());
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kAuto;
+  std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
+  session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(frames.size()));
+  const AutoDecision decided = session->auto_decisions().background;
+  std::printf("%s: background auto %s\n", movers ? "movers" : "no movers",
+              decided.Describe().c_str());
+  session->ResetPainting();
+  EXPECT_EQ(session->auto_decisions().background.state, decided.state);
+  FrameReport report;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    PaintCaptureFrame(session.get(), capture, i, &report);
+  EXPECT_EQ(report.decisions.background.state, decided.state);
+  options.background.mode = BackgroundMode::kOff;
+  std::unique_ptr<PaintSession> off = SessionForCapture(scene, capture, options);
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    PaintCaptureFrame(off.get(), capture, i, &report);
+  *paints_as_off = SameBuffers(*session, *off);
+  return decided;
+}
+
+TEST(AutoBackground, CapturesFromFilesDecideBeforePaintingFromMoversAcrossViews) {
+  bool as_off = false;
+  const AutoDecision with_movers = DecideAcrossViews(true, &as_off);
+  EXPECT_EQ(with_movers.state, State::kOn);
+  EXPECT_EQ(with_movers.basis, "across_views");
+  EXPECT_EQ(with_movers.decided_at_frame, 0);
+  EXPECT_EQ(with_movers.frames_measured, 40);
+  EXPECT_GT(with_movers.evidence, 2 * kBackgroundAcrossViewsThreshold);
+  EXPECT_FALSE(as_off);  // movers masked
+  const AutoDecision without = DecideAcrossViews(false, &as_off);
+  EXPECT_EQ(without.state, State::kOff);
+  EXPECT_LT(without.evidence, kBackgroundAcrossViewsThreshold / 4);
+  EXPECT_TRUE(as_off);
 }
 
 // The evidence is the model's own verdict (its cleaned mask), not the mask grown by colour:

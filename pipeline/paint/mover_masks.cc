@@ -1,0 +1,222 @@
+#include "pipeline/paint/mover_masks.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/scaled_camera.h"
+#include "pipeline/render/rasterizer.h"
+
+namespace fresco {
+namespace {
+
+// One frame at the reduced size: its colours, their 3 x 3 range, its depth and its surface
+// points (local coordinates, NaN off the surface).
+struct SmallFrame {
+  cv::Mat bgr, low, high;  // CV_8UC3
+  cv::Mat depth;           // CV_32F camera z, +inf off the surface
+  cv::Mat points;          // CV_32FC3 local
+  const Camera* camera = nullptr;
+  Rigid3d cam_from_local;
+};
+
+// Where frame `self`'s surface points land in frame `other` (pixel index, -1 where `other`
+// does not see them), and the gain per channel from `other`'s colours to `self`'s over them.
+void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_tolerance,
+                std::vector<int>* where, std::array<float, 3>* gain) {
+  where->assign(self.points.total(), -1);
+  std::array<double, 3> sum_self{}, sum_other{};
+  for (int y = 0; y < self.points.rows; ++y)
+    for (int x = 0; x < self.points.cols; ++x) {
+      const cv::Vec3f p = self.points.at<cv::Vec3f>(y, x);
+      if (!std::isfinite(p[0])) continue;
+      const Eigen::Vector3d in_other = other.cam_from_local * Eigen::Vector3d(p[0], p[1], p[2]);
+      Eigen::Vector2d pixel;
+      if (!other.camera->Project(in_other, &pixel)) continue;
+      const int u = static_cast<int>(std::lround(pixel.x()));
+      const int v = static_cast<int>(std::lround(pixel.y()));
+      if (u < 0 || v < 0 || u >= other.depth.cols || v >= other.depth.rows) continue;
+      const float seen = other.depth.at<float>(v, u);
+      if (!(std::abs(seen - in_other.z()) <= depth_tolerance * in_other.z())) continue;
+      (*where)[y * self.points.cols + x] = v * other.depth.cols + u;
+      const cv::Vec3b a = self.bgr.at<cv::Vec3b>(y, x), b = other.bgr.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) sum_self[c] += a[c], sum_other[c] += b[c];
+    }
+  for (int c = 0; c < 3; ++c)
+    (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
+}
+
+// Frame `self`'s mask from its neighbours.
+cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
+                   const MoverMaskOptions& options, long long* judged, long long* flagged) {
+  const SmallFrame& self = frames[self_index];
+  const int n = static_cast<int>(frames.size());
+  cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
+      differing(self.bgr.size(), CV_8U, cv::Scalar(0));
+  std::vector<int> where;
+  for (int offset : options.offsets)
+    for (int sign : {-1, 1}) {
+      const int o = self_index + sign * offset;
+      if (o < 0 || o >= n || frames[o].points.empty()) continue;
+      const SmallFrame& other = frames[o];
+      std::array<float, 3> gain;
+      Correspond(self, other, options.depth_tolerance, &where, &gain);
+      const float limit = static_cast<float>(options.difference);
+      for (int y = 0; y < self.bgr.rows; ++y)
+        for (int x = 0; x < self.bgr.cols; ++x) {
+          const int k = where[y * self.bgr.cols + x];
+          if (k < 0) continue;
+          ++seeing.at<uchar>(y, x);
+          const cv::Vec3b a = self.bgr.at<cv::Vec3b>(y, x);
+          const cv::Vec3b lo = other.low.at<cv::Vec3b>(k / other.low.cols, k % other.low.cols);
+          const cv::Vec3b hi = other.high.at<cv::Vec3b>(k / other.high.cols, k % other.high.cols);
+          float worst = 0;
+          for (int c = 0; c < 3; ++c) {
+            const float value = a[c], below = gain[c] * lo[c] - value,
+                        above = value - gain[c] * hi[c];
+            worst = std::max(worst, std::max(below, above));
+          }
+          if (worst > limit) ++differing.at<uchar>(y, x);
+        }
+    }
+  cv::Mat mask(self.bgr.size(), CV_8U, cv::Scalar(0));
+  long long seen_pixels = 0;
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x) {
+      const int s = seeing.at<uchar>(y, x), d = differing.at<uchar>(y, x);
+      if (s < options.min_differing) continue;
+      ++seen_pixels;
+      if (d >= options.min_differing && d >= options.share * s) mask.at<uchar>(y, x) = 255;
+    }
+  // Cleaning: small blobs are noise. A mover's pixels that match the frames near it (its
+  // inside, where they show it too: it is large or slow) join it: within each blob's box,
+  // the pixels of its colour (within grow_levels of its median, every channel).
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  cv::Mat grown = mask.clone();
+  for (int label = 1; label < count; ++label) {
+    if (stats.at<int>(label, cv::CC_STAT_AREA) < options.min_blob_px) {
+      grown.setTo(0, labels == label);
+      continue;
+    }
+    if (options.grow_levels <= 0) continue;
+    const cv::Rect box(
+        stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
+        stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    std::array<std::vector<uchar>, 3> channels;
+    for (int y = box.y; y < box.br().y; ++y)
+      for (int x = box.x; x < box.br().x; ++x) {
+        if (labels.at<int>(y, x) != label) continue;
+        const cv::Vec3b c = self.bgr.at<cv::Vec3b>(y, x);
+        for (int k = 0; k < 3; ++k) channels[k].push_back(c[k]);
+      }
+    cv::Vec3b median;
+    for (int k = 0; k < 3; ++k) {
+      std::vector<uchar>& v = channels[k];
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      median[k] = v[v.size() / 2];
+    }
+    for (int y = box.y; y < box.br().y; ++y)
+      for (int x = box.x; x < box.br().x; ++x) {
+        const cv::Vec3b c = self.bgr.at<cv::Vec3b>(y, x);
+        bool near = true;
+        for (int k = 0; k < 3; ++k)
+          near = near && std::abs(c[k] - median[k]) <= options.grow_levels;
+        if (near && !std::isnan(self.points.at<cv::Vec3f>(y, x)[0])) grown.at<uchar>(y, x) = 255;
+      }
+  }
+  mask = grown;
+  if (options.dilate_px > 0)
+    cv::dilate(mask, mask,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
+                                                                     2 * options.dilate_px + 1)));
+  *judged = seen_pixels;
+  *flagged = cv::countNonZero(mask & (seeing >= options.min_differing));
+  return mask;
+}
+
+}  // namespace
+
+cv::Size MoverMaskSize(const Camera& camera, const MoverMaskOptions& options) {
+  const int side = std::max(camera.width, camera.height);
+  if (options.max_side_px <= 0 || side <= options.max_side_px)
+    return cv::Size(camera.width, camera.height);
+  const double scale = static_cast<double>(options.max_side_px) / side;
+  return cv::Size(std::max(1, static_cast<int>(std::lround(camera.width * scale))),
+                  std::max(1, static_cast<int>(std::lround(camera.height * scale))));
+}
+
+Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame>& given,
+                      const MoverMaskOptions& options, MoverMaskResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  *result = MoverMaskResult();
+  const int n = static_cast<int>(given.size());
+  result->masks.resize(n);
+  // Per camera: the camera at the reduced size, its rasterizer and each pixel's ray.
+  struct Small {
+    std::unique_ptr<Camera> camera;
+    std::unique_ptr<Rasterizer> rasterizer;
+    cv::Mat rays;  // CV_32FC2 normalized (x, y), NaN where the lens has none
+  };
+  std::map<const Camera*, Small> small;
+  std::vector<SmallFrame> frames(n);
+  for (int f = 0; f < n; ++f) {
+    const MoverMaskFrame& in = given[f];
+    if (!in.camera || in.bgr.empty() || in.bgr.type() != CV_8UC3) continue;
+    Small& s = small[in.camera];
+    if (!s.camera) {
+      const cv::Size size = MoverMaskSize(*in.camera, options);
+      s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
+      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
+      s.rays.create(size, CV_32FC2);
+      for (int y = 0; y < size.height; ++y)
+        for (int x = 0; x < size.width; ++x) {
+          Eigen::Vector2d normalized;
+          const bool ok = s.camera->Unproject(Eigen::Vector2d(x, y), &normalized, 1e-3);
+          s.rays.at<cv::Vec2f>(y, x) =
+              ok ? cv::Vec2f(normalized.x(), normalized.y()) : cv::Vec2f(NAN, NAN);
+        }
+    }
+    SmallFrame& d = frames[f];
+    d.camera = s.camera.get();
+    d.cam_from_local = in.cam_from_local;
+    if (in.bgr.size() == s.rays.size())
+      d.bgr = in.bgr;
+    else
+      cv::resize(in.bgr, d.bgr, s.rays.size(), 0, 0, cv::INTER_AREA);
+    const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+    cv::erode(d.bgr, d.low, box);
+    cv::dilate(d.bgr, d.high, box);
+    s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d.depth);
+    d.points.create(d.depth.size(), CV_32FC3);
+    const Rigid3d local_from_cam = in.cam_from_local.Inverse();
+    for (int y = 0; y < d.depth.rows; ++y)
+      for (int x = 0; x < d.depth.cols; ++x) {
+        const float z = d.depth.at<float>(y, x);
+        const cv::Vec2f ray = s.rays.at<cv::Vec2f>(y, x);
+        if (!std::isfinite(z) || !std::isfinite(ray[0])) {
+          d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
+          continue;
+        }
+        const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray[0] * z, ray[1] * z, z);
+        d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+      }
+  }
+  std::vector<long long> judged(n, 0), flagged(n, 0);
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    for (int f = range.start; f < range.end; ++f)
+      if (!frames[f].points.empty())
+        result->masks[f] = JudgeFrame(frames, f, options, &judged[f], &flagged[f]);
+  });
+  for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
+  result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return Status::Ok();
+}
+
+}  // namespace fresco

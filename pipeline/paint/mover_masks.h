@@ -1,0 +1,66 @@
+// Movers found across views: each frame of a capture compared, pixel by pixel, with the other
+// frames near it in the capture (1, 2, 4, ... frames before and after), each warped onto it
+// through the mesh (the surface point a pixel shows, projected into the other frame, where
+// that frame's depth map says it sees it too). A pixel that differs from most of the frames
+// that see its surface point shows something that is not the mesh: a mover, wherever it goes
+// and however few times each texel is seen (the background model learns per texel, over many
+// samples). The masks mark those pixels; the share of the pixels masked over a capture is the
+// evidence background.mode `auto` decides on before painting a capture from files
+// (auto_modes.h).
+//
+// Differences are judged against the other frame's 3 x 3 range around the point (a pixel's
+// misalignment costs nothing), after a gain per colour channel between the two frames (over
+// the pixels both see: exposure), on the largest channel. A large or slow mover matches the
+// frames near it where they show it too: its blob grows over the pixels of its colour within
+// its box. Frames are compared at a reduced size (max_side_px); masks have that size.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "pipeline/core/camera.h"
+#include "pipeline/core/rigid3.h"
+#include "pipeline/core/scene.h"
+#include "pipeline/core/status.h"
+
+namespace fresco {
+
+struct MoverMaskOptions {
+  std::vector<int> offsets = {1, 2, 4, 8, 16};  // frame i is compared with i -/+ each
+  int max_side_px = 320;                        // frames are compared resized to this
+  double difference = 30;  // grey levels beyond the other frame's 3 x 3 range (largest channel)
+  double share = 0.5;      // a pixel differing from this share of the frames that see it ...
+  int min_differing = 2;   // ... and from at least this many is a mover's
+  double depth_tolerance = 0.03;  // relative: the other frame sees the point when its depth agrees
+  int min_blob_px = 4;            // smaller flagged blobs are noise (at the reduced size)
+  // Within each flagged blob's box, pixels within this many grey levels (every channel) of the
+  // blob's median colour join it (0: none).
+  double grow_levels = 24;
+  int dilate_px = 1;  // the rest grows by this margin (blurred edges)
+};
+
+struct MoverMaskFrame {
+  cv::Mat bgr;  // CV_8UC3, any size (resized to the camera's aspect at max_side_px)
+  const Camera* camera = nullptr;
+  Rigid3d cam_from_local;
+};
+
+struct MoverMaskResult {
+  std::vector<cv::Mat> masks;  // CV_8U, 255 = a mover's pixel; one per frame (empty: not judged)
+  std::string not_run;         // why nothing was looked for ("" when it ran)
+  long long judged = 0;        // surface pixels seen by enough other frames to be judged
+  long long flagged = 0;       // ... of which masked (after cleaning)
+  double seconds = 0;
+
+  double fraction() const { return judged > 0 ? static_cast<double>(flagged) / judged : 0.0; }
+};
+
+Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame>& frames,
+                      const MoverMaskOptions& options, MoverMaskResult* result);
+
+// The size frames of `camera` are compared at (its aspect, the longer side at most max_side_px).
+cv::Size MoverMaskSize(const Camera& camera, const MoverMaskOptions& options);
+
+}  // namespace fresco

@@ -1,0 +1,95 @@
+// Movers found across views (mover_masks.h) on a synthetic orbit of the blocks scene with a
+// ball and a box moving through it: the masks hold most of the pixels where they are (the
+// truth: the scene with the movers rasterized at each true pose) and little of the rest;
+// without movers almost nothing is masked. The share masked is what background.mode `auto`
+// decides on (auto_modes.h): far above its threshold with movers, far below without.
+#include <cstdio>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/core/scaled_camera.h"
+#include "pipeline/paint/auto_modes.h"
+#include "pipeline/paint/mover_masks.h"
+#include "pipeline/render/rasterizer.h"
+#include "pipeline/render/renderer.h"
+#include "pipeline/synth/blocks_scene.h"
+#include "pipeline/synth/movers.h"
+#include "pipeline/synth/synthesize.h"
+#include "tests/paint/synth_session.h"
+
+namespace fresco {
+namespace {
+
+struct Orbit {
+  Scene scene;
+  SynthCapture capture;
+  MoverMaskResult found;
+};
+
+Orbit FindMovers(int random_movers) {
+  Orbit o;
+  BlocksOptions blocks;
+  blocks.seed = 3;
+  EXPECT_TRUE(MakeBlocksScene(blocks, &o.scene).ok());
+  SynthOptions options = testing::BlocksHalfOrbit(blocks, 40, 11);
+  options.random_movers = random_movers;
+  EXPECT_TRUE(SynthesizeCapture(o.scene, options, &o.capture).ok());
+  std::vector<MoverMaskFrame> frames;
+  for (size_t i = 0; i < o.capture.frames_bgr.size(); ++i)
+    frames.push_back({o.capture.frames_bgr[i], &o.capture.camera,
+                      CamFromLocal(o.scene, o.capture.true_poses[i].cam_from_world)});
+  EXPECT_TRUE(FindMoverMasks(o.scene.mesh, frames, MoverMaskOptions(), &o.found).ok());
+  EXPECT_EQ(o.found.masks.size(), frames.size());
+  return o;
+}
+
+TEST(MoverMasks, MostOfTheMoversPixelsAndLittleElseAreMasked) {
+  const Orbit o = FindMovers(2);
+  ASSERT_EQ(o.capture.movers.size(), 2u);
+  const cv::Size size = MoverMaskSize(o.capture.camera, MoverMaskOptions());
+  const Camera small = ScaledCamera(o.capture.camera, size.width, size.height);
+  const Rasterizer rasterizer(small, RasterOptions());
+  MoverScene with_movers(o.scene, o.capture.movers);
+  long long mover_pixels = 0, mover_masked = 0, other_pixels = 0, other_masked = 0;
+  for (size_t i = 0; i < o.found.masks.size(); ++i) {
+    with_movers.SetFrame(static_cast<int>(i));
+    RasterOutput raster;
+    rasterizer.Rasterize(with_movers.scene().mesh,
+                         CamFromLocal(with_movers.scene(), o.capture.true_poses[i].cam_from_world),
+                         &raster);
+    const cv::Mat& mask = o.found.masks[i];
+    ASSERT_EQ(mask.size(), size);
+    for (int y = 0; y < size.height; ++y)
+      for (int x = 0; x < size.width; ++x) {
+        const int tri = raster.triangle_id.at<int>(y, x);
+        if (tri < 0) continue;
+        const bool masked = mask.at<uchar>(y, x) != 0;
+        if (tri >= with_movers.FirstMoverTriangle())
+          ++mover_pixels, mover_masked += masked;
+        else
+          ++other_pixels, other_masked += masked;
+      }
+  }
+  const double recall = static_cast<double>(mover_masked) / mover_pixels;
+  const double false_share = static_cast<double>(other_masked) / other_pixels;
+  std::printf(
+      "mover pixels %lld, %.1f %% masked; other surface pixels %lld, %.2f %% masked; "
+      "%.2f s\n",
+      mover_pixels, 100 * recall, other_pixels, 100 * false_share, o.found.seconds);
+  ASSERT_GT(mover_pixels, 2000);
+  EXPECT_GT(recall, 0.55);
+  EXPECT_LT(false_share, 0.02);
+  EXPECT_GT(o.found.fraction(), 2 * kBackgroundAcrossViewsThreshold);
+}
+
+TEST(MoverMasks, AStaticSceneIsHardlyMasked) {
+  const Orbit o = FindMovers(0);
+  std::printf("%.3f %% of %lld pixels judged masked\n", 100 * o.found.fraction(), o.found.judged);
+  EXPECT_GT(o.found.judged, 100000);
+  EXPECT_LT(o.found.fraction(), kBackgroundAcrossViewsThreshold / 4);
+}
+
+}  // namespace
+}  // namespace fresco
