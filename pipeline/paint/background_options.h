@@ -18,9 +18,9 @@ namespace fresco {
 // samples, then image subtraction with a fixed `average_threshold`. kRobust: two colour
 // modes per texel with weights over a sliding window (background = the heavier mode, so
 // it converges to what the texel shows most of the time, whatever came first), an adaptive
-// per-texel noise threshold and a per-frame global gain (exposure) estimate. kAuto: the
-// robust model learns from the start, and what it finds over the first frames decides
-// whether it keeps masking or is dropped (auto_modes.h).
+// per-texel noise threshold and a per-frame global gain (exposure) estimate. kAuto: kRobust
+// where the capture shows movers, else kOff, decided before painting for captures from
+// files (the movers found across views), over the first frames otherwise (auto_modes.h).
 enum class BackgroundMode { kOff, kAverage, kRobust, kAuto };
 enum class GrowMode { kOff, kOn, kAuto };
 
@@ -91,10 +91,12 @@ template <class V>
 void Fields(BackgroundOptions& o, V& v) {
   v.Enum("mode", o.mode, BackgroundModeNames(),
          "`average` is the paper's (§3.4); `robust` follows changes and exposure; `auto` (the "
-         "default): `robust` learns from the start and keeps masking only when the texels it "
-         "trusts show enough foreground (moving objects or misaligned samples) once warmed up, "
-         "else it is dropped; the decision and its evidence are in the background stage's "
-         "report");
+         "default): `robust` where the capture shows moving objects, else `off`. Captures from "
+         "files decide before painting (every frame compared with the frames near it through "
+         "the mesh: more than 0.8 % of the pixels differing from most of them); the app and "
+         "live captures decide once warmed up (`robust` learns from the start and stays when "
+         "the texels it trusts show enough foreground). The decision and its evidence are in "
+         "the background stage's report and `metrics.json`");
   v.Field(
       "training_frames", o.training_frames,
       {.min = 1, .max = 250, .help = "`average`: samples averaged per texel before it segments"});
