@@ -229,7 +229,9 @@ TEST(SynthStreams, CommandWritesStreamsThatRunPaintsWithPerStreamCounts) {
   const auto synth = RunFresco({"synth", dir + "/spec.json", "--out", dir + "/cap"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
   EXPECT_NE(synth.out.find("2 streams"), std::string::npos) << synth.out;
-  const auto run = RunFresco({"run", dir + "/cap/project.json", "--out", dir + "/out", "--quiet"});
+  // The background model pinned on (`auto` finds no movers here and paints without one).
+  const auto run = RunFresco({"run", dir + "/cap/project.json", "--out", dir + "/out", "--quiet",
+                              "--set", "pipeline.background.mode=robust"});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const nlohmann::json m = nlohmann::json::parse(ReadText(dir + "/out/metrics.json"));
   EXPECT_EQ(m["frames"], 8);
@@ -241,7 +243,7 @@ TEST(SynthStreams, CommandWritesStreamsThatRunPaintsWithPerStreamCounts) {
   EXPECT_EQ(m["streams"][1]["video"], "hand/frames/");
   EXPECT_EQ(m["streams"][1]["frames"], 5);
   EXPECT_EQ(m["streams"][1]["frames_painted"], 5);
-  // The background model (auto: robust while it decides) ran on both streams' frames.
+  // The background model ran on both streams' frames.
   for (int k = 0; k < 2; ++k) {
     ASSERT_TRUE(m["streams"][k]["masked_fraction"].is_number()) << m["streams"][k];
     EXPECT_GE(m["streams"][k]["masked_fraction"].get<double>(), 0.0);
