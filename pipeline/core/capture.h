@@ -29,6 +29,9 @@ struct Capture {
   // whose extension differs from the listed name ("a.png" listed, "a.jpg" on disk) still match.
   std::map<std::string, int> pose_by_stem;
   bool poses_are_tum = false;  // TUM poses match frames in order
+  // Per pose (index into `poses`; empty or shorter: none): the frame's Frame::movers, found
+  // before painting (paint_job.h).
+  std::vector<cv::Mat> movers;
 
   // The pose for a frame (by name for COLMAP, by order for TUM); nullptr when none.
   const PosedImage* PoseForFrame(const Frame& frame) const;

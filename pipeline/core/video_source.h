@@ -15,8 +15,8 @@
 namespace fresco {
 
 struct Frame {
-  int index = -1;        // 0-based position in the stream
-  std::string name;      // file name for folders ("000012.png"); "%06d" index for videos
+  int index = -1;    // 0-based position in the stream
+  std::string name;  // file name for folders ("000012.png"); "%06d" index for videos
   // Capture time, seconds, the first frame at 0. Folders: index / 30; files: the stream's
   // presentation time; live sources: the stream's presentation time when it has one
   // (VideoSourceOptions::stream_clock), else the arrival time below.
@@ -24,7 +24,11 @@ struct Frame {
   // Live sources: when the frame was received, seconds on the steady clock after the first
   // frame arrived (0 for files).
   double arrival_s = 0.0;
-  cv::Mat bgr;           // CV_8UC3
+  cv::Mat bgr;  // CV_8UC3
+  // Optional: pixels found to show moving objects (mover_masks.h: compared with the frames
+  // near it through the mesh): CV_8U, 255 there, any size (scaled to the frame's). The
+  // background model takes those that touch the foreground it flags for foreground too.
+  cv::Mat movers;
 };
 
 class VideoSource {

@@ -148,7 +148,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     for (size_t k = 0; k < to_paint.size(); ++k)
       to_paint[k].painted_pose = adjusted.cam_from_local[k] * local_from_world;
   }
-  if (project.pipeline.background.mode == BackgroundMode::kAuto) {  // decided up front
+  if (NeedsMoversAcrossViews(project.pipeline.background)) {  // movers found first
     const MoverMaskOptions mover_options;
     std::vector<MoverMaskFrame> frames;
     for (const PaintFrame& pf : to_paint) {
@@ -162,6 +162,9 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     MoverMaskResult found;
     FRESCO_RETURN_IF_ERROR(FindMoverMasks(loaded.scene.mesh, frames, mover_options, &found));
     session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(frames.size()));
+    if (project.pipeline.background.across_views &&
+        session->options().background.mode != BackgroundMode::kOff)
+      for (size_t k = 0; k < to_paint.size(); ++k) to_paint[k].frame.movers = found.masks[k];
     result->movers_across_views = found.fraction();
   }
   for (const PaintFrame& pf : to_paint) {

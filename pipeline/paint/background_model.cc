@@ -5,6 +5,9 @@
 #include <cmath>
 #include <cstring>
 #include <utility>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/foreground_blobs.h"
 #include "pipeline/paint/foreground_grow.h"
@@ -240,8 +243,41 @@ void PrefetchTileRows(const BaseBuffer& buffer, const WarpedBuffer& warped, cons
 
 }  // namespace
 
+namespace {
+
+// The texels of `movers` (valid ones) connected to `foreground` join it; returns how many.
+int JoinConnectedMovers(const cv::Mat& movers, const cv::Mat& valid, cv::Mat* foreground) {
+  cv::Mat candidates = movers & valid;
+  const cv::Rect box = cv::boundingRect(candidates);
+  if (box.empty()) return 0;
+  const cv::Rect roi = cv::Rect(box.x - 1, box.y - 1, box.width + 2, box.height + 2) &
+                       cv::Rect(0, 0, movers.cols, movers.rows);
+  cv::Mat seeds = (*foreground)(roi) != 0;
+  if (cv::countNonZero(seeds) == 0) return 0;
+  cv::Mat either = seeds | candidates(roi), labels;
+  const int count = cv::connectedComponents(either, labels, 8, CV_32S);
+  std::vector<uint8_t> touched(count, 0);
+  for (int y = 0; y < roi.height; ++y) {
+    const uint8_t* s = seeds.ptr<uint8_t>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (s[x]) touched[l[x]] = 1;
+  }
+  int joined = 0;
+  for (int y = 0; y < roi.height; ++y) {
+    uint8_t* f = (*foreground)(roi).ptr<uint8_t>(y);
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < roi.width; ++x)
+      if (l[x] > 0 && touched[l[x]] && !f[x]) f[x] = 255, ++joined;
+  }
+  return joined;
+}
+
+}  // namespace
+
 void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
-                              bool debug, bool grow, BackgroundFrame* frame) {
+                              bool debug, bool grow, BackgroundFrame* frame,
+                              const cv::Mat* movers) {
   // The images are reused from frame to frame (no allocation, no page faults per frame),
   // except when debugging: then the stage's report holds them and each frame gets its own.
   const auto clear = [&](cv::Mat* image) {
@@ -295,6 +331,7 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
   Clean(roi, frame);
   frame->masked_ungrown = cv::countNonZero(frame->foreground(roi) & warped.valid(roi));
   const int reach = options_.grow_reach_texels;
+  frame->masked = frame->masked_ungrown;
   if (grow && options_.grow_levels > 0 && reach > 0) {
     // From the flagged texels that survived the cleaning (not its dilation ring), by colour;
     // then cleaned again. raw_ stays this frame's classification.
@@ -308,10 +345,11 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
       out.setTo(0);
       CleanForeground(grown, options_.min_blob_texels, options_.dilate_texels, &out);
       frame->masked = cv::countNonZero(out & warped.valid(wide));
-      return;
     }
   }
-  frame->masked = frame->masked_ungrown;
+  if (movers && !movers->empty() &&
+      JoinConnectedMovers(*movers, warped.valid, &frame->foreground) > 0)
+    frame->masked = cv::countNonZero(frame->foreground & warped.valid);
 }
 
 cv::Mat BufferBackground::Image(const BaseBuffer& buffer) const {

@@ -71,8 +71,10 @@ class BufferBackground {
   // Classifies the warped samples, updates the model with them, cleans the mask.
   // `gain`: the frame's exposure relative to the model (robust mode; 1 = none). `grow`: the
   // foreground then grows by colour (BackgroundOptions::grow, resolved by the caller).
+  // `movers` (optional, CV_8U, buffer size): texels the frame's movers found across views
+  // cover (mover_masks.h); those connected to the foreground the model flags join it.
   void Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
-              bool grow, BackgroundFrame* frame);
+              bool grow, BackgroundFrame* frame, const cv::Mat* movers = nullptr);
   // The background estimate (CV_8UC3, buffer size, black where never seen).
   cv::Mat Image(const BaseBuffer& buffer) const;
   // Moves the model with its buffer (refine_anchor.h): the texel at q (in `roi`) takes the

@@ -64,9 +64,19 @@ struct BackgroundOptions {
   GrowMode grow = GrowMode::kAuto;
   double grow_levels = 32.0;
   int grow_reach_texels = 256;
+  // Captures from files, with a model: the movers found across views before painting
+  // (mover_masks.h) that touch the foreground the model flags in a buffer join it there.
+  // Measured over both evaluation suites (docs/results.md).
+  bool across_views = true;
 
   bool operator==(const BackgroundOptions&) const = default;
 };
+
+// Whether a capture from files is compared across views before painting (mover_masks.h): for
+// `auto`'s decision, or for `across_views` with a model.
+inline bool NeedsMoversAcrossViews(const BackgroundOptions& o) {
+  return o.mode == BackgroundMode::kAuto || (o.across_views && o.mode != BackgroundMode::kOff);
+}
 
 inline const EnumNames<BackgroundMode>& BackgroundModeNames() {
   static const EnumNames<BackgroundMode> names = {
@@ -148,6 +158,11 @@ void Fields(BackgroundOptions& o, V& v) {
                    "levels of the flagged texel it grows from"});
   v.Field("grow_reach_texels", o.grow_reach_texels,
           {.min = 0, .max = 4096, .help = "`grow`: how far, in texels, the foreground may grow"});
+  v.Field("across_views", o.across_views,
+          {.help = "captures from files, with a background model: the pixels found before "
+                   "painting to differ from most of the frames near them (compared through the "
+                   "mesh: moving objects) join the model's foreground where they touch it in a "
+                   "buffer (on: less of the movers painted; off: the model alone)"});
 }
 
 }  // namespace fresco

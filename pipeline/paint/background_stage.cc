@@ -6,6 +6,7 @@
 #include <string>
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/stage_clock.h"
@@ -14,11 +15,13 @@ namespace fresco {
 
 void PaintSession::BackgroundStage(FrameWork* work) {
   if (options_.background.mode == BackgroundMode::kOff) return;
-  work->report->stages.push_back(
-      SegmentForeground(work->seen, work->stream, work->debug, &work->report->background));
+  work->report->stages.push_back(SegmentForeground(work->seen, work->stream, work->debug,
+                                                   work->frame->movers, &work->view,
+                                                   &work->report->background));
 }
 
 StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
+                                            const cv::Mat& movers, const FrameView* view,
                                             BackgroundFigures* figures) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
@@ -57,8 +60,11 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   const bool grow = grow_mode == GrowMode::kOn ||
                     (grow_mode == GrowMode::kAuto && aligned.state == AutoDecision::State::kOff &&
                      aligned.frames_measured > 0 && std::isfinite(aligned.evidence));
+  const bool with_movers = !movers.empty() && view && view->camera;
+  if (with_movers) WarpMovers(seen_list, movers, *view);
   ForEachBuffer(seen_list, false, [&](size_t b) {
-    models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &background_frame_[b]);
+    models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &background_frame_[b],
+                     with_movers ? &mover_texels_[b] : nullptr);
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];
@@ -82,6 +88,32 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   report.metrics["grown"] = grow ? 1.0 : 0.0;
   report.wall_ms = MsSince(start);
   return report;
+}
+
+}  // namespace fresco
+
+namespace fresco {
+
+void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Mat& movers,
+                              const FrameView& view) {
+  const cv::Size size(view.camera->width, view.camera->height);
+  cv::Mat full = movers, bgr;
+  if (full.size() != size) cv::resize(movers, full, size, 0, 0, cv::INTER_NEAREST);
+  cv::cvtColor(full, bgr, cv::COLOR_GRAY2BGR);
+  FrameView movers_view = view;
+  movers_view.frame_bgr = &bgr;
+  movers_view.pyramid.clear();
+  WarpOptions nearest;
+  nearest.sampling = SamplingMode::kNearest;
+  nearest.occlusion = options_.occlusion;
+  movers_warped_.resize(set_.buffers.size());
+  mover_texels_.resize(set_.buffers.size());
+  ForEachBuffer(seen_list, false, [&](size_t b) {
+    WarpedBuffer& warped = movers_warped_[b];
+    WarpFrameToBuffer(set_.buffers[b], movers_view, nearest, &warped);
+    cv::extractChannel(warped.bgr, mover_texels_[b], 0);
+    mover_texels_[b] = (mover_texels_[b] > 127) & warped.valid;
+  });
 }
 
 }  // namespace fresco

@@ -197,8 +197,15 @@ class PaintSession {
                           StageReport* report);
   // The background stage over the buffers seen this frame, against stream `stream`'s models
   // (fills background_frame_ and `figures`).
+  // `movers`: the frame's Frame::movers (or empty), warped through `view` (the frame's); where
+  // they touch the foreground the model flags in a buffer, they join it.
   StageReport SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
+                                const cv::Mat& movers, const FrameView* view,
                                 BackgroundFigures* figures);
+  // The frame's movers found across views (`movers`, mover_masks.h) warped into the buffers
+  // seen as the frame was: mover_texels_ (255 where they cover a texel seen).
+  void WarpMovers(const std::vector<size_t>& seen_list, const cv::Mat& movers,
+                  const FrameView& view);
   // Stream `stream`'s background models, one per buffer, initialized on first use.
   std::vector<BufferBackground>& StreamBackground(int stream);
   // The exposure and select stages (select_stages.cc) over the buffers seen this frame.
@@ -223,6 +230,9 @@ class PaintSession {
   TextureAtlas atlas_;  // where each buffer goes in PaintedScene()
   std::vector<PaintedBuffer> painted_;
   std::vector<WarpedBuffer> warped_;
+  // The frame's movers found across views (Frame::movers) warped into each buffer (WarpMovers).
+  std::vector<WarpedBuffer> movers_warped_;
+  std::vector<cv::Mat> mover_texels_;
   std::vector<RefineAnchor> anchors_;                       // per buffer (refinement on)
   std::vector<ViewLayer> layers_;                           // pipeline.layers (layers_stage.cc)
   Eigen::Vector3d scene_centre_ = Eigen::Vector3d::Zero();  // the mesh's box centre (local)

@@ -64,12 +64,15 @@ void FileFrameSource::MatchPose(int s, SourcedFrame* frame) const {
   frame->camera_id = -1;
   frame->pose_name.clear();
   frame->pose_index = -1;
+  frame->posed.frame.movers.release();
   if (!pose) return;
   frame->posed.cam_from_world = pose->cam_from_world;
   frame->camera = capture.CameraFor(*pose);
   frame->camera_id = pose->camera_id;
   frame->pose_name = pose->name;
   frame->pose_index = static_cast<int>(pose - capture.poses.data());
+  if (frame->pose_index < static_cast<int>(capture.movers.size()))
+    frame->posed.frame.movers = capture.movers[frame->pose_index];
 }
 
 }  // namespace fresco

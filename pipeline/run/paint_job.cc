@@ -20,13 +20,14 @@ namespace {
 
 // What needs the whole capture before painting: every frame is read once (kept grey for the
 // joint adjustment of the poses, refine.joint: joint_pose_adjustment.h; small and in colour
-// for the movers found across views that background.mode auto decides on: mover_masks.h),
-// the poses are adjusted and written into the captures, the background decided; the videos
-// open again for painting.
+// for the movers found across views that background.mode auto decides on and, with
+// background.across_views, the model's foreground joins: mover_masks.h), the poses are
+// adjusted and written into the captures, the background decided, each frame's movers kept
+// with its capture; the videos open again for painting.
 Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& options,
                                PaintJob* j) {
   const bool joint = project.pipeline.refine.joint;
-  const bool movers = project.pipeline.background.mode == BackgroundMode::kAuto;
+  const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
   PoseAdjustOptions adjust_options;
   adjust_options.progress = options.joint_progress;
   const MoverMaskOptions mover_options;
@@ -97,6 +98,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     MoverMaskResult all;
     for (size_t s = 0; s < j->captures.size(); ++s) {
       std::vector<MoverMaskFrame> stream_frames;
+      std::vector<int> pose_index;
       for (size_t k = 0; k < where.size(); ++k) {
         if (where[k].first != static_cast<int>(s)) continue;
         MoverMaskFrame frame;
@@ -104,13 +106,23 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
         frame.camera = j->captures[s].CameraFor(j->captures[s].poses[where[k].second]);
         frame.cam_from_local = cam_from_local[k];
         stream_frames.push_back(frame);
+        pose_index.push_back(where[k].second);
       }
       MoverMaskResult found;
       FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
       all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
+      if (project.pipeline.background.across_views) {
+        Capture& capture = j->captures[s];
+        capture.movers.resize(capture.poses.size());
+        for (size_t k = 0; k < pose_index.size(); ++k)
+          capture.movers[pose_index[k]] = found.masks[k];
+      }
     }
     j->mover_masks = all;
     j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
+    // No background model, nothing for the masks to join: not kept.
+    if (j->session->options().background.mode == BackgroundMode::kOff)
+      for (Capture& capture : j->captures) capture.movers.clear();
   }
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < j->captures.size(); ++s)
@@ -142,7 +154,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
   if (!j.live) {
-    if (project.pipeline.refine.joint || project.pipeline.background.mode == BackgroundMode::kAuto)
+    if (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background))
       FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);

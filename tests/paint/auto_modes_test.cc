@@ -15,7 +15,6 @@
 
 #include "pipeline/paint/auto_modes.h"
 #include "pipeline/paint/mover_masks.h"
-#include "pipeline/render/renderer.h"
 #include "tests/paint/refine_scenario.h"
 #include "tests/paint/room_capture.h"
 #include "tests/paint/synth_session.h"
@@ -139,17 +138,12 @@ AutoDecision DecideAcrossViews(bool movers, bool* paints_as_off) {
   const Scene scene = RoomScene();
   SynthCapture capture;
   EXPECT_TRUE(SynthesizeCapture(scene, RoomWithMovers(movers), &capture).ok());
-  std::vector<MoverMaskFrame> frames;
-  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
-    frames.push_back({capture.frames_bgr[i], &capture.camera,
-                      CamFromLocal(scene, capture.true_poses[i].cam_from_world)});
-  MoverMaskResult found;
-  EXPECT_TRUE(FindMoverMasks(scene.mesh, frames, MoverMaskOptions(), &found).ok());
+  const MoverMaskResult found = FindCaptureMovers(scene, capture);
   PipelineOptions options;
   options.refine.mode = RefineMode::kOff;
   options.background.mode = BackgroundMode::kAuto;
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
-  session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(frames.size()));
+  session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(found.masks.size()));
   const AutoDecision decided = session->auto_decisions().background;
   std::printf("%s: background auto %s\n", movers ? "movers" : "no movers",
               decided.Describe().c_str());

@@ -36,12 +36,7 @@ Orbit FindMovers(int random_movers) {
   SynthOptions options = testing::BlocksHalfOrbit(blocks, 40, 11);
   options.random_movers = random_movers;
   EXPECT_TRUE(SynthesizeCapture(o.scene, options, &o.capture).ok());
-  std::vector<MoverMaskFrame> frames;
-  for (size_t i = 0; i < o.capture.frames_bgr.size(); ++i)
-    frames.push_back({o.capture.frames_bgr[i], &o.capture.camera,
-                      CamFromLocal(o.scene, o.capture.true_poses[i].cam_from_world)});
-  EXPECT_TRUE(FindMoverMasks(o.scene.mesh, frames, MoverMaskOptions(), &o.found).ok());
-  EXPECT_EQ(o.found.masks.size(), frames.size());
+  o.found = testing::FindCaptureMovers(o.scene, o.capture);
   return o;
 }
 

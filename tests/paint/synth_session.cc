@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "pipeline/render/renderer.h"
+
 namespace fresco::testing {
 
 std::unique_ptr<PaintSession> SessionForCapture(const Scene& scene, const SynthCapture& capture,
@@ -23,6 +25,18 @@ void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_
   frame.index = static_cast<int>(i);
   frame.bgr = capture.frames_bgr[i];
   session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, report);
+}
+
+MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture) {
+  std::vector<MoverMaskFrame> frames;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    frames.push_back({capture.frames_bgr[i], &capture.camera,
+                      CamFromLocal(scene, capture.true_poses[i].cam_from_world)});
+  MoverMaskResult found;
+  const Status status = FindMoverMasks(scene.mesh, frames, MoverMaskOptions(), &found);
+  EXPECT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(found.masks.size(), frames.size());
+  return found;
 }
 
 Scene PaintAllFrames(const Scene& scene, const SynthCapture& capture,

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "pipeline/core/scene.h"
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/synthesize.h"
@@ -21,6 +22,10 @@ std::unique_ptr<PaintSession> SessionForCapture(const Scene& scene, const SynthC
 // Paints the capture's frame `i` at its true pose.
 void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_t i,
                        FrameReport* report);
+
+// The capture's movers found across views (mover_masks.h), at its true poses; a failure fails
+// the calling test.
+MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture);
 
 // Paints every frame of the capture at its true pose; the painted scene.
 Scene PaintAllFrames(const Scene& scene, const SynthCapture& capture,

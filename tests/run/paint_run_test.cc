@@ -169,14 +169,15 @@ TEST(PaintRun, MaxFramesEndsTheRunWithoutAnError) {
 }
 
 // Painting frame by frame, the run ends at the broken frame; with the joint pose adjustment
-// or the background's `auto` (the defaults for captures from files) the capture is read
-// before painting, and the same error comes before any frame is painted.
+// or the background's `auto` and `across_views` (the defaults for captures from files) the
+// capture is read before painting, and the same error comes before any frame is painted.
 TEST(PaintRun, CorruptImageEndsTheRunNamingTheFile) {
   const std::string project = MakeBadCapture(BadCapture::kCorruptImage);
   const std::string file = fs::path(project).parent_path().string() + "/frames/000005.png";
   const Ran frame_by_frame =
       RunJob(project, PaintRunOptions(),
-             {"pipeline.refine.joint=false", "pipeline.background.mode=robust"});
+             {"pipeline.refine.joint=false", "pipeline.background.mode=robust",
+              "pipeline.background.across_views=false"});
   ASSERT_FALSE(frame_by_frame.status.ok());
   EXPECT_EQ(frame_by_frame.status.message().rfind(file + ": ", 0), 0u)
       << frame_by_frame.status.message();
