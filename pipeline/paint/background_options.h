@@ -65,8 +65,8 @@ struct BackgroundOptions {
   double grow_levels = 32.0;
   int grow_reach_texels = 256;
   // Captures from files, with a model: the movers found across views before painting
-  // (mover_masks.h) that touch the foreground the model flags in a buffer join it there.
-  // Measured over both evaluation suites (docs/results.md).
+  // (mover_masks.h) that touch the foreground the model flags in a buffer join it there,
+  // where it grows (`grow`). Measured over both evaluation suites (docs/results.md).
   bool across_views = true;
 
   bool operator==(const BackgroundOptions&) const = default;
@@ -162,7 +162,8 @@ void Fields(BackgroundOptions& o, V& v) {
           {.help = "captures from files, with a background model: the pixels found before "
                    "painting to differ from most of the frames near them (compared through the "
                    "mesh: moving objects) join the model's foreground where they touch it in a "
-                   "buffer (on: less of the movers painted; off: the model alone)"});
+                   "buffer, when it grows (`grow`) (on: less of the movers painted; off: the "
+                   "model alone)"});
 }
 
 }  // namespace fresco

@@ -103,7 +103,8 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
 }
 
 // The movers found across views (mover_masks.h) that touch what the robust model flags join
-// its foreground: less of the movers is painted, and nothing seen without one is lost.
+// its foreground (where it grows): less of the movers is painted, and nothing seen without
+// one is lost.
 TEST(MoversAcrossViews, JoinTheForegroundTheyTouch) {
   const Scene scene = Room();
   SynthCapture capture;
@@ -112,6 +113,7 @@ TEST(MoversAcrossViews, JoinTheForegroundTheyTouch) {
   PipelineOptions options;
   options.refine.mode = RefineMode::kOff;
   options.background.mode = BackgroundMode::kRobust;
+  options.background.grow = GrowMode::kOn;  // the join comes with growth (refinement is off)
   const MoverFigures alone = PaintWithMovers(scene, capture, options);
   const MoverFigures joined = PaintWithMovers(scene, capture, options, &found.masks);
   Print("alone", alone);
