@@ -93,10 +93,6 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   return report;
 }
 
-}  // namespace fresco
-
-namespace fresco {
-
 void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Mat& movers,
                               const FrameView& view) {
   const cv::Size size(view.camera->width, view.camera->height);

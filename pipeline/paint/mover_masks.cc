@@ -158,11 +158,11 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   *result = MoverMaskResult();
   const int n = static_cast<int>(given.size());
   result->masks.resize(n);
-  // Per camera: the camera at the reduced size, its rasterizer and each pixel's ray.
+  // Per camera: the camera at the reduced size and its rasterizer (which holds each pixel's
+  // ray).
   struct Small {
     std::unique_ptr<Camera> camera;
     std::unique_ptr<Rasterizer> rasterizer;
-    cv::Mat rays;  // CV_32FC2 normalized (x, y), NaN where the lens has none
   };
   std::map<const Camera*, Small> small;
   std::vector<SmallFrame> frames(n);
@@ -174,22 +174,15 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       const cv::Size size = MoverMaskSize(*in.camera, options);
       s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
       s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
-      s.rays.create(size, CV_32FC2);
-      for (int y = 0; y < size.height; ++y)
-        for (int x = 0; x < size.width; ++x) {
-          Eigen::Vector2d normalized;
-          const bool ok = s.camera->Unproject(Eigen::Vector2d(x, y), &normalized, 1e-3);
-          s.rays.at<cv::Vec2f>(y, x) =
-              ok ? cv::Vec2f(normalized.x(), normalized.y()) : cv::Vec2f(NAN, NAN);
-        }
     }
     SmallFrame& d = frames[f];
     d.camera = s.camera.get();
     d.cam_from_local = in.cam_from_local;
-    if (in.bgr.size() == s.rays.size())
+    const cv::Size size(s.camera->width, s.camera->height);
+    if (in.bgr.size() == size)
       d.bgr = in.bgr;
     else
-      cv::resize(in.bgr, d.bgr, s.rays.size(), 0, 0, cv::INTER_AREA);
+      cv::resize(in.bgr, d.bgr, size, 0, 0, cv::INTER_AREA);
     const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
     cv::erode(d.bgr, d.low, box);
     cv::dilate(d.bgr, d.high, box);
@@ -199,12 +192,12 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
     for (int y = 0; y < d.depth.rows; ++y)
       for (int x = 0; x < d.depth.cols; ++x) {
         const float z = d.depth.at<float>(y, x);
-        const cv::Vec2f ray = s.rays.at<cv::Vec2f>(y, x);
-        if (!std::isfinite(z) || !std::isfinite(ray[0])) {
+        const Eigen::Vector2f ray = s.rasterizer->Ray(x, y);
+        if (!std::isfinite(z) || !ray.allFinite()) {
           d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
           continue;
         }
-        const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray[0] * z, ray[1] * z, z);
+        const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray.x() * z, ray.y() * z, z);
         d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
       }
   }

@@ -92,7 +92,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
       j->captures[where[k].first].poses[where[k].second].cam_from_world =
           adjusted.cam_from_local[k] * local_from_world;
   }
-  frames.clear();
+  for (PoseAdjustFrame& frame : frames) frame.bgr.release();  // only their cameras are left
   if (movers) {
     // Each stream's frames are compared with that stream's frames near them.
     MoverMaskResult all;
@@ -103,7 +103,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
         if (where[k].first != static_cast<int>(s)) continue;
         MoverMaskFrame frame;
         frame.bgr = small[k];
-        frame.camera = j->captures[s].CameraFor(j->captures[s].poses[where[k].second]);
+        frame.camera = frames[k].camera;
         frame.cam_from_local = cam_from_local[k];
         stream_frames.push_back(frame);
         pose_index.push_back(where[k].second);
