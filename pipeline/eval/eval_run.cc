@@ -149,7 +149,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
       to_paint[k].painted_pose = adjusted.cam_from_local[k] * local_from_world;
   }
   if (NeedsMoversAcrossViews(project.pipeline.background)) {  // movers found first
-    const MoverMaskOptions mover_options;
+    const MoverMaskOptions mover_options = MoverMaskOptionsFor(project.pipeline.background);
     std::vector<MoverMaskFrame> frames;
     for (const PaintFrame& pf : to_paint) {
       MoverMaskFrame f;

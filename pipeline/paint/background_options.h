@@ -66,7 +66,9 @@ struct BackgroundOptions {
   int grow_reach_texels = 256;
   // Captures from files, with a model: the movers found across views before painting
   // (mover_masks.h) that touch the foreground the model flags in a buffer join it there,
-  // where it grows (`grow`). Measured over both evaluation suites (docs/results.md).
+  // where it grows (`grow`), and the pixels they cover are not painted there (with `grow`
+  // `auto`, also while refinement's `auto` is deciding, once it has measured a frame).
+  // Measured over both evaluation suites (docs/results.md).
   bool across_views = true;
 
   bool operator==(const BackgroundOptions&) const = default;
@@ -161,9 +163,10 @@ void Fields(BackgroundOptions& o, V& v) {
   v.Field("across_views", o.across_views,
           {.help = "captures from files, with a background model: the pixels found before "
                    "painting to differ from most of the frames near them (compared through the "
-                   "mesh: moving objects) join the model's foreground where they touch it in a "
-                   "buffer, when it grows (`grow`) (on: less of the movers painted; off: the "
-                   "model alone)"});
+                   "mesh: moving objects) are not painted, and join the model's foreground "
+                   "where they touch it in a buffer, when it grows (`grow`; `auto`: also while "
+                   "refinement is still deciding, once it has measured a frame) (on: less of "
+                   "the movers painted; off: the model alone)"});
 }
 
 }  // namespace fresco

@@ -60,14 +60,29 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   const bool grow = grow_mode == GrowMode::kOn ||
                     (grow_mode == GrowMode::kAuto && aligned.state == AutoDecision::State::kOff &&
                      aligned.frames_measured > 0 && std::isfinite(aligned.evidence));
-  // The movers found across views join the foreground as growth does, once the frames are
-  // found aligned: between photos far apart (a castle's 10, where refinement cannot measure)
-  // the masks are mostly the mesh's error, and joining them lost up to 1.2 dB on a photo.
-  const bool with_movers = grow && !movers.empty() && view && view->camera;
-  if (with_movers) WarpMovers(seen_list, movers, *view);
+  // The movers found across views (Frame::movers) join the foreground as growth does, once
+  // the frames are found aligned: between photos far apart (a castle's 10, where refinement
+  // cannot measure) the masks are mostly the mesh's error, and joining them lost up to 1.2 dB
+  // on a photo. Where they join, whatever else they cover is kept out of painting too (a pixel
+  // that differs from most frames that see its surface point shows a mover, or the background
+  // beside one, which a later frame paints), and already while refinement's `auto` is still
+  // deciding once it has measured a frame: the first frames' movers are the ones that stay.
+  // Without growth, keeping them out painted more of the movers in background_test's room.
+  const bool have_movers = !movers.empty() && view && view->camera;
+  const bool with_movers = grow && have_movers;
+  const bool deciding_measured = aligned.state == AutoDecision::State::kDeciding &&
+                                 aligned.frames_measured > 0 && std::isfinite(aligned.evidence);
+  const bool keep_out =
+      with_movers || (have_movers && deciding_measured && grow_mode == GrowMode::kAuto);
+  if (with_movers || keep_out) WarpMovers(seen_list, movers, *view);
   ForEachBuffer(seen_list, false, [&](size_t b) {
-    models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &background_frame_[b],
+    BackgroundFrame& frame = background_frame_[b];
+    models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &frame,
                      with_movers ? &mover_texels_[b] : nullptr);
+    if (keep_out && cv::countNonZero(mover_texels_[b]) > 0) {
+      cv::bitwise_or(frame.foreground, mover_texels_[b], frame.foreground);
+      frame.masked = cv::countNonZero(frame.foreground & warped_[b].valid);
+    }
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];

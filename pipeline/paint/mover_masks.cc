@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/scaled_camera.h"
+#include "pipeline/paint/auto_modes.h"
 #include "pipeline/render/rasterizer.h"
 
 namespace fresco {
@@ -52,9 +53,11 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
     (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
 }
 
-// Frame `self`'s mask from its neighbours.
+// Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
+// whose masked pixels do not judge.
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
-                   const MoverMaskOptions& options, long long* judged, long long* flagged) {
+                   const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
+                   long long* judged, long long* flagged) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
@@ -67,11 +70,13 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
       const SmallFrame& other = frames[o];
       std::array<float, 3> gain;
       Correspond(self, other, options.depth_tolerance, &where, &gain);
+      const uchar* other_masked =
+          previous && !(*previous)[o].empty() ? (*previous)[o].data : nullptr;
       const float limit = static_cast<float>(options.difference);
       for (int y = 0; y < self.bgr.rows; ++y)
         for (int x = 0; x < self.bgr.cols; ++x) {
           const int k = where[y * self.bgr.cols + x];
-          if (k < 0) continue;
+          if (k < 0 || (other_masked && other_masked[k])) continue;
           ++seeing.at<uchar>(y, x);
           const cv::Vec3b a = self.bgr.at<cv::Vec3b>(y, x);
           const cv::Vec3b lo = other.low.at<cv::Vec3b>(k / other.low.cols, k % other.low.cols);
@@ -143,6 +148,14 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
 
 }  // namespace
 
+MoverMaskOptions MoverMaskOptionsFor(const BackgroundOptions& background) {
+  MoverMaskOptions options;
+  if (!background.across_views || background.mode == BackgroundMode::kOff) options.passes = 1;
+  if (background.mode == BackgroundMode::kAuto)
+    options.later_passes_min_fraction = kBackgroundAcrossViewsThreshold;
+  return options;
+}
+
 cv::Size MoverMaskSize(const Camera& camera, const MoverMaskOptions& options) {
   const int side = std::max(camera.width, camera.height);
   if (options.max_side_px <= 0 || side <= options.max_side_px)
@@ -205,9 +218,33 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
       if (!frames[f].points.empty())
-        result->masks[f] = JudgeFrame(frames, f, options, &judged[f], &flagged[f]);
+        result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f]);
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
+  // A later pass judges a frame again only where a frame it is compared with had its mask
+  // changed by the pass before (the first pass: any masked pixel); none once nothing changes.
+  const bool later_passes = result->fraction() > options.later_passes_min_fraction;
+  std::vector<uint8_t> changed(n, 0);
+  for (int f = 0; f < n; ++f)
+    changed[f] = !result->masks[f].empty() && cv::countNonZero(result->masks[f]) > 0;
+  for (int pass = 1; later_passes && pass < options.passes; ++pass) {
+    const std::vector<cv::Mat> previous = result->masks;
+    std::vector<uint8_t> now_changed(n, 0);
+    cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+      for (int f = range.start; f < range.end; ++f) {
+        if (frames[f].points.empty()) continue;
+        bool any = false;
+        for (int offset : options.offsets)
+          for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
+        if (!any) continue;
+        long long unused = 0;
+        result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused);
+        now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
+      }
+    });
+    changed = now_changed;
+    if (std::find(changed.begin(), changed.end(), 1) == changed.end()) break;
+  }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();
 }

@@ -12,7 +12,8 @@
 // misalignment costs nothing), after a gain per colour channel between the two frames (over
 // the pixels both see: exposure), on the largest channel. A large or slow mover matches the
 // frames near it where they show it too: its blob grows over the pixels of its colour within
-// its box. Frames are compared at a reduced size (max_side_px); masks have that size.
+// its box, and later passes judge again without the pixels the pass before masked in the other
+// frames. Frames are compared at a reduced size (max_side_px); masks have that size.
 #pragma once
 
 #include <string>
@@ -24,6 +25,7 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/core/status.h"
+#include "pipeline/paint/background_options.h"
 
 namespace fresco {
 
@@ -39,6 +41,15 @@ struct MoverMaskOptions {
   // blob's median colour join it (0: none).
   double grow_levels = 24;
   int dilate_px = 1;  // the rest grows by this margin (blurred edges)
+  // Passes after the first judge each pixel again without the other frames' pixels the pass
+  // before masked (they show a mover, not the background): a large or slow mover's inside, which
+  // the frames near it show too, is found from its edges inwards, and the background beside a
+  // mover is no longer masked for what a neighbour showed. The share masked (the evidence
+  // background `auto` decides on) is the first pass's.
+  int passes = 5;
+  // ... only when the first pass masked more than this share of the pixels judged (a caller
+  // that drops the masks below a threshold: background `auto`).
+  double later_passes_min_fraction = 0;
 };
 
 struct MoverMaskFrame {
@@ -59,6 +70,11 @@ struct MoverMaskResult {
 
 Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame>& frames,
                       const MoverMaskOptions& options, MoverMaskResult* result);
+
+// The options a capture painted with `background` looks for its movers with: the later passes
+// only where the masks are kept (across_views) and, with `auto`, only when the first pass
+// decides the model on (auto_modes.h).
+MoverMaskOptions MoverMaskOptionsFor(const BackgroundOptions& background);
 
 // The size frames of `camera` are compared at (its aspect, the longer side at most max_side_px).
 cv::Size MoverMaskSize(const Camera& camera, const MoverMaskOptions& options);
