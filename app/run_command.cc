@@ -287,6 +287,7 @@ int RunVerbRun(const CommandArgs& argv) {
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
+  job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
   if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
   const double setup_peak_rss_mb = PeakRssMb();

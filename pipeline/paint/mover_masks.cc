@@ -4,6 +4,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <memory>
 
@@ -224,10 +225,23 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   // A later pass judges a frame again only where a frame it is compared with had its mask
   // changed by the pass before (the first pass: any masked pixel); none once nothing changes.
   const bool later_passes = result->fraction() > options.later_passes_min_fraction;
+  const int passes = later_passes ? std::max(1, options.passes) : 1;
+  const auto report = [&](int done, const std::vector<uint8_t>& changed) {
+    if (!options.progress) return;
+    long long masked = 0;
+    for (const cv::Mat& m : result->masks)
+      if (!m.empty()) masked += cv::countNonZero(m);
+    const long long frames_changed = std::count(changed.begin(), changed.end(), 1);
+    char line[160];
+    std::snprintf(line, sizeof line, "%d frames, %lld pixels masked, %lld frames changed", n,
+                  masked, frames_changed);
+    options.progress(done, passes, line);
+  };
   std::vector<uint8_t> changed(n, 0);
   for (int f = 0; f < n; ++f)
     changed[f] = !result->masks[f].empty() && cv::countNonZero(result->masks[f]) > 0;
-  for (int pass = 1; later_passes && pass < options.passes; ++pass) {
+  report(1, changed);
+  for (int pass = 1; pass < passes; ++pass) {
     const std::vector<cv::Mat> previous = result->masks;
     std::vector<uint8_t> now_changed(n, 0);
     cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
@@ -243,6 +257,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       }
     });
     changed = now_changed;
+    report(pass + 1, changed);
     if (std::find(changed.begin(), changed.end(), 1) == changed.end()) break;
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

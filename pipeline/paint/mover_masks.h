@@ -16,6 +16,7 @@
 // frames. Frames are compared at a reduced size (max_side_px); masks have that size.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,8 @@ struct MoverMaskOptions {
   // ... only when the first pass masked more than this share of the pixels judged (a caller
   // that drops the masks below a threshold: background `auto`).
   double later_passes_min_fraction = 0;
+  // Called after each pass (optional): passes done, passes at most, a line for people.
+  std::function<void(int done, int total, const std::string& line)> progress;
 };
 
 struct MoverMaskFrame {

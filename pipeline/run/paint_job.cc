@@ -30,7 +30,8 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
   PoseAdjustOptions adjust_options;
   adjust_options.progress = options.joint_progress;
-  const MoverMaskOptions mover_options = MoverMaskOptionsFor(project.pipeline.background);
+  MoverMaskOptions mover_options = MoverMaskOptionsFor(project.pipeline.background);
+  mover_options.progress = options.movers_progress;
   // A capture too long to hold is not read for it (the frames with poses count).
   size_t posed = 0;
   for (const Capture& capture : j->captures) posed += capture.poses.size();

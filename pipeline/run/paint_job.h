@@ -30,6 +30,9 @@ struct PaintJobOptions {
   bool keep_tracker_poses = false;
   // pipeline.refine.joint: progress of the poses' adjustment before painting (optional).
   std::function<void(int done, int total, const std::string& line)> joint_progress;
+  // Captures from files with background `auto` or a model: progress of the search for movers
+  // across views before painting, pass by pass (optional).
+  std::function<void(int done, int total, const std::string& line)> movers_progress;
   // pipeline.refine.joint: frames held out of painting (as PaintRunOptions' holdout_every and
   // holdout_counter, by position in reading order) take no part in the adjustment and keep
   // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.

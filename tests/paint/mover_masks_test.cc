@@ -4,6 +4,8 @@
 // without movers almost nothing is masked. The share masked is what background.mode `auto`
 // decides on (auto_modes.h): far above its threshold with movers, far below without.
 #include <cstdio>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -28,7 +30,7 @@ struct Orbit {
   MoverMaskResult found;
 };
 
-Orbit FindMovers(int random_movers) {
+Orbit FindMovers(int random_movers, const MoverMaskOptions& mask_options = MoverMaskOptions()) {
   Orbit o;
   BlocksOptions blocks;
   blocks.seed = 3;
@@ -36,7 +38,7 @@ Orbit FindMovers(int random_movers) {
   SynthOptions options = testing::BlocksHalfOrbit(blocks, 40, 11);
   options.random_movers = random_movers;
   EXPECT_TRUE(SynthesizeCapture(o.scene, options, &o.capture).ok());
-  o.found = testing::FindCaptureMovers(o.scene, o.capture);
+  o.found = testing::FindCaptureMovers(o.scene, o.capture, mask_options);
   return o;
 }
 
@@ -100,6 +102,32 @@ TEST(MoverMasks, LaterPassesOnlyWhereTheMasksAreUsed) {
   EXPECT_EQ(options.later_passes_min_fraction, 0.0);
   background.across_views = false;
   EXPECT_EQ(MoverMaskOptionsFor(background).passes, 1);
+}
+
+// Each pass is reported; with the first pass below later_passes_min_fraction (a capture
+// `auto` paints without a model) there is no other, and the masks are the first pass's.
+TEST(MoverMasks, PassesAreReportedAndSkippedWhereTheModelIsOff) {
+  std::vector<std::pair<int, int>> reported;
+  MoverMaskOptions options;
+  options.progress = [&](int done, int total, const std::string&) {
+    reported.emplace_back(done, total);
+  };
+  const Orbit all = FindMovers(2, options);
+  ASSERT_GE(reported.size(), 2u);
+  for (size_t i = 0; i < reported.size(); ++i) {
+    EXPECT_EQ(reported[i].first, static_cast<int>(i) + 1);
+    EXPECT_EQ(reported[i].second, options.passes);
+  }
+  reported.clear();
+  options.later_passes_min_fraction = 1.0;
+  const Orbit first = FindMovers(2, options);
+  ASSERT_EQ(reported.size(), 1u);
+  EXPECT_EQ(reported[0], std::make_pair(1, 1));
+  EXPECT_EQ(first.found.flagged, all.found.flagged);  // the share decided on: the first pass's
+  long long changed = 0;
+  for (size_t f = 0; f < all.found.masks.size(); ++f)
+    changed += cv::countNonZero(all.found.masks[f] != first.found.masks[f]);
+  EXPECT_GT(changed, 0);
 }
 
 }  // namespace

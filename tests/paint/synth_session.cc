@@ -27,13 +27,14 @@ void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_
   session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, report);
 }
 
-MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture) {
+MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture,
+                                  const MoverMaskOptions& options) {
   std::vector<MoverMaskFrame> frames;
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
     frames.push_back({capture.frames_bgr[i], &capture.camera,
                       CamFromLocal(scene, capture.true_poses[i].cam_from_world)});
   MoverMaskResult found;
-  const Status status = FindMoverMasks(scene.mesh, frames, MoverMaskOptions(), &found);
+  const Status status = FindMoverMasks(scene.mesh, frames, options, &found);
   EXPECT_TRUE(status.ok()) << status.message();
   EXPECT_EQ(found.masks.size(), frames.size());
   return found;

@@ -25,7 +25,8 @@ void PaintCaptureFrame(PaintSession* session, const SynthCapture& capture, size_
 
 // The capture's movers found across views (mover_masks.h), at its true poses; a failure fails
 // the calling test.
-MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture);
+MoverMaskResult FindCaptureMovers(const Scene& scene, const SynthCapture& capture,
+                                  const MoverMaskOptions& options = MoverMaskOptions());
 
 // Paints every frame of the capture at its true pose; the painted scene.
 Scene PaintAllFrames(const Scene& scene, const SynthCapture& capture,
