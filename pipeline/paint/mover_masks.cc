@@ -13,6 +13,7 @@
 
 #include "pipeline/core/scaled_camera.h"
 #include "pipeline/paint/auto_modes.h"
+#include "pipeline/paint/mover_follow.h"
 #include "pipeline/render/rasterizer.h"
 
 namespace fresco {
@@ -55,10 +56,11 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
 }
 
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
-// whose masked pixels do not judge.
+// whose masked pixels do not judge. `joinable`: the surface pixels that may join a mover by
+// their colour (those that differ from a frame that sees them, or are seen by too few).
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
-                   long long* judged, long long* flagged) {
+                   long long* judged, long long* flagged, cv::Mat* joinable) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
@@ -102,40 +104,31 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
     }
   // Cleaning: small blobs are noise. A mover's pixels that match the frames near it (its
   // inside, where they show it too: it is large or slow) join it: within each blob's box,
-  // the pixels of its colour (within grow_levels of its median, every channel).
+  // the pixels of its colours. Not pixels that agree with every frame that sees them: the
+  // background beside a blob of its own colour (a façade beside a misjudged patch of it).
+  *joinable = (differing >= 1) | (seeing < options.min_differing);
+  for (int y = 0; y < mask.rows; ++y)
+    for (int x = 0; x < mask.cols; ++x)
+      if (std::isnan(self.points.at<cv::Vec3f>(y, x)[0])) joinable->at<uchar>(y, x) = 0;
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   cv::Mat grown = mask.clone();
   for (int label = 1; label < count; ++label) {
-    if (stats.at<int>(label, cv::CC_STAT_AREA) < options.min_blob_px) {
+    const int area = stats.at<int>(label, cv::CC_STAT_AREA);
+    if (area < options.min_blob_px) {
       grown.setTo(0, labels == label);
       continue;
     }
-    if (options.grow_levels <= 0) continue;
+    if (!options.grow) continue;
     const cv::Rect box(
         stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
         stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    std::array<std::vector<uchar>, 3> channels;
+    const ColourSet colours =
+        ColourSet::Of(self.bgr, labels == label, box, std::max(2, area / 100));
     for (int y = box.y; y < box.br().y; ++y)
-      for (int x = box.x; x < box.br().x; ++x) {
-        if (labels.at<int>(y, x) != label) continue;
-        const cv::Vec3b c = self.bgr.at<cv::Vec3b>(y, x);
-        for (int k = 0; k < 3; ++k) channels[k].push_back(c[k]);
-      }
-    cv::Vec3b median;
-    for (int k = 0; k < 3; ++k) {
-      std::vector<uchar>& v = channels[k];
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      median[k] = v[v.size() / 2];
-    }
-    for (int y = box.y; y < box.br().y; ++y)
-      for (int x = box.x; x < box.br().x; ++x) {
-        const cv::Vec3b c = self.bgr.at<cv::Vec3b>(y, x);
-        bool near = true;
-        for (int k = 0; k < 3; ++k)
-          near = near && std::abs(c[k] - median[k]) <= options.grow_levels;
-        if (near && !std::isnan(self.points.at<cv::Vec3f>(y, x)[0])) grown.at<uchar>(y, x) = 255;
-      }
+      for (int x = box.x; x < box.br().x; ++x)
+        if (joinable->at<uchar>(y, x) && colours.Contains(self.bgr.at<cv::Vec3b>(y, x)))
+          grown.at<uchar>(y, x) = 255;
   }
   mask = grown;
   if (options.dilate_px > 0)
@@ -216,10 +209,12 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       }
   }
   std::vector<long long> judged(n, 0), flagged(n, 0);
+  std::vector<cv::Mat> joinable(n);
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
       if (!frames[f].points.empty())
-        result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f]);
+        result->masks[f] =
+            JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f], &joinable[f]);
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask
@@ -252,13 +247,20 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
           for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
         if (!any) continue;
         long long unused = 0;
-        result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused);
+        result->masks[f] =
+            JudgeFrame(frames, f, options, &previous, &unused, &unused, &joinable[f]);
         now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
       }
     });
     changed = now_changed;
     report(pass + 1, changed);
     if (std::find(changed.begin(), changed.end(), 1) == changed.end()) break;
+  }
+  if (passes > 1 && options.follow_frames > 0) {
+    std::vector<FollowFrame> follow(n);
+    for (int f = 0; f < n; ++f)
+      if (!joinable[f].empty()) follow[f] = FollowFrame{frames[f].bgr, joinable[f]};
+    FollowMovers(follow, options.follow_frames, &result->masks);
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();

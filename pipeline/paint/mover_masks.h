@@ -11,9 +11,10 @@
 // Differences are judged against the other frame's 3 x 3 range around the point (a pixel's
 // misalignment costs nothing), after a gain per colour channel between the two frames (over
 // the pixels both see: exposure), on the largest channel. A large or slow mover matches the
-// frames near it where they show it too: its blob grows over the pixels of its colour within
-// its box, and later passes judge again without the pixels the pass before masked in the other
-// frames. Frames are compared at a reduced size (max_side_px); masks have that size.
+// frames near it where they show it too: its blob grows over the pixels of its colours within
+// its box, later passes judge again without the pixels the pass before masked in the other
+// frames, and what they found is followed by its colours into the frames next to it
+// (mover_follow.h). Frames are compared at a reduced size (max_side_px); masks have that size.
 #pragma once
 
 #include <functional>
@@ -38,9 +39,9 @@ struct MoverMaskOptions {
   int min_differing = 2;   // ... and from at least this many is a mover's
   double depth_tolerance = 0.03;  // relative: the other frame sees the point when its depth agrees
   int min_blob_px = 4;            // smaller flagged blobs are noise (at the reduced size)
-  // Within each flagged blob's box, pixels within this many grey levels (every channel) of the
-  // blob's median colour join it (0: none).
-  double grow_levels = 24;
+  // Within each flagged blob's box, pixels of its colours join it (ColourSet, mover_follow.h),
+  // except those that agree with every frame that sees them.
+  bool grow = true;
   int dilate_px = 1;  // the rest grows by this margin (blurred edges)
   // Passes after the first judge each pixel again without the other frames' pixels the pass
   // before masked (they show a mover, not the background): a large or slow mover's inside, which
@@ -51,6 +52,9 @@ struct MoverMaskOptions {
   // ... only when the first pass masked more than this share of the pixels judged (a caller
   // that drops the masks below a threshold: background `auto`).
   double later_passes_min_fraction = 0;
+  // After the passes (where they run), the movers found are followed by their colours into the
+  // frames up to this many frames away (FollowMovers, mover_follow.h; 0: not followed).
+  int follow_frames = 6;
   // Called after each pass (optional): passes done, passes at most, a line for people.
   std::function<void(int done, int total, const std::string& line)> progress;
 };

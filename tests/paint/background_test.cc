@@ -107,11 +107,12 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
 struct AloneAndWithMasks {
   MoverFigures alone, with_masks;
 };
-AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow) {
+AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow,
+                                         const MoverMaskOptions& mask_options = {}) {
   const Scene scene = Room();
   SynthCapture capture;
   EXPECT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(frames, 0.0), &capture).ok());
-  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture);
+  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, mask_options);
   EXPECT_GT(found.fraction(), 0.0);
   PipelineOptions options;
   options.refine.mode = RefineMode::kOff;
@@ -129,8 +130,12 @@ AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow) {
 // its foreground (where it grows): less of the movers is painted, and nothing seen without
 // one is lost.
 TEST(MoversAcrossViews, JoinTheForegroundTheyTouch) {
-  // The join comes with growth (refinement is off: on by hand).
-  const AloneAndWithMasks f = PaintAloneAndWithMasks(150, GrowMode::kOn);
+  // The join comes with growth (refinement is off: on by hand). The masks as the comparison
+  // across views finds them: following them by their colours (mover_follow.h) lowers the leak
+  // on the evaluation suites, but here paints 91 of these texels instead of 73 (of 704,600).
+  MoverMaskOptions mask_options;
+  mask_options.follow_frames = 0;
+  const AloneAndWithMasks f = PaintAloneAndWithMasks(150, GrowMode::kOn, mask_options);
   EXPECT_LT(f.with_masks.mover_fraction(), 0.8 * f.alone.mover_fraction());
   EXPECT_GE(f.with_masks.open_coverage(), 0.99 * f.alone.open_coverage());
 }
