@@ -198,9 +198,10 @@ class PaintSession {
   // The background stage over the buffers seen this frame, against stream `stream`'s models
   // (fills background_frame_ and `figures`).
   // `movers`: the frame's Frame::movers (or empty), warped through `view` (the frame's); where
-  // they touch the foreground the model flags in a buffer, they join it.
+  // they touch the foreground the model flags in a buffer, they join it. `first_frames`: one
+  // of the session's first frames (background_stage.cc).
   StageReport SegmentForeground(const std::vector<bool>& seen, int stream, bool debug,
-                                const cv::Mat& movers, const FrameView* view,
+                                const cv::Mat& movers, const FrameView* view, bool first_frames,
                                 BackgroundFigures* figures);
   // The frame's movers found across views (`movers`, mover_masks.h) warped into the buffers
   // seen as the frame was: mover_texels_ (255 where they cover a texel seen).
