@@ -35,9 +35,9 @@ std::vector<Blob> BlobsOf(const cv::Mat& bgr, const cv::Mat& mask) {
     b.box =
         cv::Rect(stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
                  stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
-    const cv::Mat pixels = (labels == label) & inside;
+    const cv::Mat pixels = (labels(b.box) == label) & inside(b.box);
     b.colours =
-        std::make_shared<ColourSet>(ColourSet::Of(bgr, pixels, b.box, std::max(2, b.area / 200)));
+        std::make_shared<ColourSet>(ColourSet::Of(bgr(b.box), pixels, std::max(2, b.area / 200)));
     const int margin = std::max(2, std::max(b.box.width, b.box.height) / 3);
     const cv::Rect around = cv::Rect(b.box.x - margin, b.box.y - margin, b.box.width + 2 * margin,
                                      b.box.height + 2 * margin) &
@@ -99,11 +99,10 @@ std::vector<Blob> Follow(const FollowFrame& frame, const std::vector<Blob>& from
 
 }  // namespace
 
-ColourSet ColourSet::Of(const cv::Mat& bgr, const cv::Mat& pixels, const cv::Rect& box,
-                        int min_count) {
+ColourSet ColourSet::Of(const cv::Mat& bgr, const cv::Mat& pixels, int min_count) {
   std::vector<int> counts(kBins, 0);
-  for (int y = box.y; y < box.br().y; ++y)
-    for (int x = box.x; x < box.br().x; ++x)
+  for (int y = 0; y < bgr.rows; ++y)
+    for (int x = 0; x < bgr.cols; ++x)
       if (pixels.at<uchar>(y, x)) ++counts[Bin(bgr.at<cv::Vec3b>(y, x))];
   ColourSet set;
   set.bins_.assign(kBins, 0);

@@ -15,9 +15,8 @@ namespace fresco {
 class ColourSet {
  public:
   ColourSet() = default;
-  // The colours of `bgr` (CV_8UC3) where `pixels` (CV_8U, same size) is set, within `box`.
-  static ColourSet Of(const cv::Mat& bgr, const cv::Mat& pixels, const cv::Rect& box,
-                      int min_count);
+  // The colours of `bgr` (CV_8UC3) where `pixels` (CV_8U, same size) is set.
+  static ColourSet Of(const cv::Mat& bgr, const cv::Mat& pixels, int min_count);
   bool Contains(const cv::Vec3b& bgr) const { return !bins_.empty() && bins_[Bin(bgr)]; }
 
  private:

@@ -115,16 +115,16 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   cv::Mat grown = mask.clone();
   for (int label = 1; label < count; ++label) {
     const int area = stats.at<int>(label, cv::CC_STAT_AREA);
-    if (area < options.min_blob_px) {
-      grown.setTo(0, labels == label);
-      continue;
-    }
-    if (!options.grow) continue;
     const cv::Rect box(
         stats.at<int>(label, cv::CC_STAT_LEFT), stats.at<int>(label, cv::CC_STAT_TOP),
         stats.at<int>(label, cv::CC_STAT_WIDTH), stats.at<int>(label, cv::CC_STAT_HEIGHT));
+    if (area < options.min_blob_px) {
+      grown(box).setTo(0, labels(box) == label);
+      continue;
+    }
+    if (!options.grow) continue;
     const ColourSet colours =
-        ColourSet::Of(self.bgr, labels == label, box, std::max(2, area / 100));
+        ColourSet::Of(self.bgr(box), labels(box) == label, std::max(2, area / 100));
     for (int y = box.y; y < box.br().y; ++y)
       for (int x = box.x; x < box.br().x; ++x)
         if (joinable->at<uchar>(y, x) && colours.Contains(self.bgr.at<cv::Vec3b>(y, x)))
