@@ -67,7 +67,8 @@ struct BackgroundOptions {
   // Captures from files, with a model: the movers found across views before painting
   // (mover_masks.h) that touch the foreground the model flags in a buffer join it there,
   // where it grows (`grow`), and the pixels they cover are not painted there (with `grow`
-  // `auto`, also while refinement's `auto` is deciding, once it has measured a frame).
+  // `auto`, also while refinement's `auto` is deciding: in the first two frames and once it
+  // has measured a frame).
   // Measured over both evaluation suites (docs/results.md).
   bool across_views = true;
 
@@ -165,8 +166,8 @@ void Fields(BackgroundOptions& o, V& v) {
                    "painting to differ from most of the frames near them (compared through the "
                    "mesh: moving objects) are not painted, and join the model's foreground "
                    "where they touch it in a buffer, when it grows (`grow`; `auto`: also while "
-                   "refinement is still deciding, once it has measured a frame) (on: less of "
-                   "the movers painted; off: the model alone)"});
+                   "refinement is still deciding, in the first two frames and once it has "
+                   "measured a frame) (on: less of the movers painted; off: the model alone)"});
 }
 
 }  // namespace fresco

@@ -86,7 +86,7 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   const bool deciding_first = aligned.state == AutoDecision::State::kDeciding && first_frames;
   const bool keep_out = with_movers || (have_movers && (deciding_measured || deciding_first) &&
                                         grow_mode == GrowMode::kAuto);
-  if (with_movers || keep_out) WarpMovers(seen_list, movers, *view);
+  if (keep_out) WarpMovers(seen_list, movers, *view);  // keep_out includes with_movers
   ForEachBuffer(seen_list, false, [&](size_t b) {
     BackgroundFrame& frame = background_frame_[b];
     models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &frame,

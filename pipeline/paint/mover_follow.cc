@@ -14,6 +14,14 @@ constexpr int kMinBlobPx = 8;
 // third) have its colours: else its colours do not tell it from the background.
 constexpr double kMostAlikeAround = 0.3;
 
+// A blob's box grown by a third of its size on every side (at least 2 pixels), within `image`:
+// where it is compared with what is around it, and looked for in the next frame.
+cv::Rect GrownBox(const cv::Rect& box, const cv::Rect& image) {
+  const int margin = std::max(2, std::max(box.width, box.height) / 3);
+  return cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+         image;
+}
+
 struct Blob {
   cv::Rect box;
   std::shared_ptr<const ColourSet> colours;
@@ -38,10 +46,7 @@ std::vector<Blob> BlobsOf(const cv::Mat& bgr, const cv::Mat& mask) {
     const cv::Mat pixels = (labels(b.box) == label) & inside(b.box);
     b.colours =
         std::make_shared<ColourSet>(ColourSet::Of(bgr(b.box), pixels, std::max(2, b.area / 200)));
-    const int margin = std::max(2, std::max(b.box.width, b.box.height) / 3);
-    const cv::Rect around = cv::Rect(b.box.x - margin, b.box.y - margin, b.box.width + 2 * margin,
-                                     b.box.height + 2 * margin) &
-                            cv::Rect(0, 0, bgr.cols, bgr.rows);
+    const cv::Rect around = GrownBox(b.box, cv::Rect(0, 0, bgr.cols, bgr.rows));
     int ring = 0, alike = 0;  // pixels around the blob, and of them those of its colours
     for (int y = around.y; y < around.br().y; ++y)
       for (int x = around.x; x < around.br().x; ++x) {
@@ -63,10 +68,7 @@ std::vector<Blob> Follow(const FollowFrame& frame, const std::vector<Blob>& from
   const cv::Rect image(0, 0, frame.bgr.cols, frame.bgr.rows);
   for (const Blob& b : from) {
     if (b.age >= frames_away) continue;
-    const int margin = std::max(2, std::max(b.box.width, b.box.height) / 3);
-    const cv::Rect box = cv::Rect(b.box.x - margin, b.box.y - margin, b.box.width + 2 * margin,
-                                  b.box.height + 2 * margin) &
-                         image;
+    const cv::Rect box = GrownBox(b.box, image);
     if (box.empty()) continue;
     cv::Mat gathered(box.size(), CV_8U, cv::Scalar(0));
     int count = 0;
