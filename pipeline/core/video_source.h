@@ -28,6 +28,8 @@ struct Frame {
   // Optional: pixels found to show moving objects (mover_masks.h: compared with the frames
   // near it through the mesh): CV_8U, 255 there, any size (scaled to the frame's). The
   // background model takes those that touch the foreground it flags for foreground too.
+  // 128: pixels the frames near it agree with (the background model's growth does not start
+  // from them).
   cv::Mat movers;
 };
 

@@ -164,7 +164,7 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(frames.size()));
     if (project.pipeline.background.across_views &&
         session->options().background.mode != BackgroundMode::kOff)
-      for (size_t k = 0; k < to_paint.size(); ++k) to_paint[k].frame.movers = found.masks[k];
+      for (size_t k = 0; k < to_paint.size(); ++k) to_paint[k].frame.movers = found.Packed(k);
     result->movers_across_views = found.fraction();
   }
   for (const PaintFrame& pf : to_paint) {

@@ -276,8 +276,8 @@ int JoinConnectedMovers(const cv::Mat& movers, const cv::Mat& valid, cv::Mat* fo
 }  // namespace
 
 void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
-                              bool debug, bool grow, BackgroundFrame* frame,
-                              const cv::Mat* movers) {
+                              bool debug, bool grow, BackgroundFrame* frame, const cv::Mat* movers,
+                              const cv::Mat* agreed) {
   // The images are reused from frame to frame (no allocation, no page faults per frame),
   // except when debugging: then the stage's report holds them and each frame gets its own.
   const auto clear = [&](cv::Mat* image) {
@@ -334,11 +334,15 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
   frame->masked = frame->masked_ungrown;
   if (grow && options_.grow_levels > 0 && reach > 0) {
     // From the flagged texels that survived the cleaning (not its dilation ring), by colour;
-    // then cleaned again. raw_ stays this frame's classification.
+    // then cleaned again. raw_ stays this frame's classification. Not from the texels the
+    // frames near this one agree with: where a mover the model learned as background has gone,
+    // the model flags the background, and growth from there covered whole walls of its colour
+    // (on a street capture 12 % of what was seen without a mover was never painted).
     const cv::Rect wide =
         cv::Rect(roi.x - reach, roi.y - reach, roi.width + 2 * reach, roi.height + 2 * reach) &
         cv::Rect(0, 0, buffer.width, buffer.height);
     cv::Mat grown = raw_(wide) & frame->foreground(wide);
+    if (agreed && !agreed->empty()) grown.setTo(0, (*agreed)(wide));
     if (GrowForegroundByColour(warped.bgr(wide), warped.valid(wide),
                                static_cast<int>(options_.grow_levels), reach, &grown) > 0) {
       cv::Mat out = frame->foreground(wide);

@@ -73,8 +73,11 @@ class BufferBackground {
   // foreground then grows by colour (BackgroundOptions::grow, resolved by the caller).
   // `movers` (optional, CV_8U, buffer size): texels the frame's movers found across views
   // cover (mover_masks.h); those connected to the foreground the model flags join it.
+  // `agreed` (optional, the same): texels whose pixels the frames near it agree with; growth
+  // does not start from them (a ghost: the background where a mover the model learned was).
   void Update(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain, bool debug,
-              bool grow, BackgroundFrame* frame, const cv::Mat* movers = nullptr);
+              bool grow, BackgroundFrame* frame, const cv::Mat* movers = nullptr,
+              const cv::Mat* agreed = nullptr);
   // The background estimate (CV_8UC3, buffer size, black where never seen).
   cv::Mat Image(const BaseBuffer& buffer) const;
   // Moves the model with its buffer (refine_anchor.h): the texel at q (in `roi`) takes the

@@ -8,6 +8,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/paint/stage_clock.h"
 
@@ -90,7 +91,8 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   ForEachBuffer(seen_list, false, [&](size_t b) {
     BackgroundFrame& frame = background_frame_[b];
     models[b].Update(set_.buffers[b], warped_[b], gain, debug, grow, &frame,
-                     with_movers ? &mover_texels_[b] : nullptr);
+                     with_movers ? &mover_texels_[b] : nullptr,
+                     with_movers ? &agreed_texels_[b] : nullptr);
     if (keep_out && cv::countNonZero(mover_texels_[b]) > 0) {
       cv::bitwise_or(frame.foreground, mover_texels_[b], frame.foreground);
       frame.masked = cv::countNonZero(frame.foreground & warped_[b].valid);
@@ -134,11 +136,14 @@ void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Ma
   nearest.occlusion = options_.occlusion;
   movers_warped_.resize(set_.buffers.size());
   mover_texels_.resize(set_.buffers.size());
+  agreed_texels_.resize(set_.buffers.size());
   ForEachBuffer(seen_list, false, [&](size_t b) {
     WarpedBuffer& warped = movers_warped_[b];
     WarpFrameToBuffer(set_.buffers[b], movers_view, nearest, &warped);
-    cv::extractChannel(warped.bgr, mover_texels_[b], 0);
-    mover_texels_[b] = (mover_texels_[b] > 127) & warped.valid;
+    cv::Mat values;  // kMoverPixel, kAgreedPixel or 0 (nearest: no value in between)
+    cv::extractChannel(warped.bgr, values, 0);
+    mover_texels_[b] = (values == kMoverPixel) & warped.valid;
+    agreed_texels_[b] = (values == kAgreedPixel) & warped.valid;
   });
 }
 

@@ -57,10 +57,11 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
 
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
 // whose masked pixels do not judge. `joinable`: the surface pixels that may join a mover by
-// their colour (those that differ from a frame that sees them, or are seen by too few).
+// their colour (those that differ from a frame that sees them, or are seen by too few);
+// `agreed`: the surface pixels seen by a frame and differing from none.
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
-                   long long* judged, long long* flagged, cv::Mat* joinable) {
+                   long long* judged, long long* flagged, cv::Mat* joinable, cv::Mat* agreed) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
@@ -107,9 +108,11 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   // the pixels of its colours. Not pixels that agree with every frame that sees them: the
   // background beside a blob of its own colour (a façade beside a misjudged patch of it).
   *joinable = (differing >= 1) | (seeing < options.min_differing);
+  *agreed = (differing == 0) & (seeing >= 1);
   for (int y = 0; y < mask.rows; ++y)
     for (int x = 0; x < mask.cols; ++x)
-      if (std::isnan(self.points.at<cv::Vec3f>(y, x)[0])) joinable->at<uchar>(y, x) = 0;
+      if (std::isnan(self.points.at<cv::Vec3f>(y, x)[0]))
+        joinable->at<uchar>(y, x) = agreed->at<uchar>(y, x) = 0;
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   cv::Mat grown = mask.clone();
@@ -141,6 +144,14 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
 }
 
 }  // namespace
+
+cv::Mat MoverMaskResult::Packed(size_t k) const {
+  if (k >= masks.size() || masks[k].empty()) return cv::Mat();
+  cv::Mat packed = cv::Mat::zeros(masks[k].size(), CV_8U);
+  if (k < agreed.size() && !agreed[k].empty()) packed.setTo(kAgreedPixel, agreed[k]);
+  packed.setTo(kMoverPixel, masks[k]);
+  return packed;
+}
 
 MoverMaskOptions MoverMaskOptionsFor(const BackgroundOptions& background) {
   MoverMaskOptions options;
@@ -210,11 +221,12 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   }
   std::vector<long long> judged(n, 0), flagged(n, 0);
   std::vector<cv::Mat> joinable(n);
+  result->agreed.resize(n);
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
       if (!frames[f].points.empty())
-        result->masks[f] =
-            JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f], &joinable[f]);
+        result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f],
+                                      &joinable[f], &result->agreed[f]);
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask
@@ -247,8 +259,8 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
           for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
         if (!any) continue;
         long long unused = 0;
-        result->masks[f] =
-            JudgeFrame(frames, f, options, &previous, &unused, &unused, &joinable[f]);
+        result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused, &joinable[f],
+                                      &result->agreed[f]);
         now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
       }
     });
@@ -262,6 +274,8 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       if (!joinable[f].empty()) follow[f] = FollowFrame{frames[f].bgr, joinable[f]};
     FollowMovers(follow, options.follow_frames, &result->masks);
   }
+  for (int f = 0; f < n; ++f)
+    if (!result->agreed[f].empty()) result->agreed[f].setTo(0, result->masks[f]);
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();
 }

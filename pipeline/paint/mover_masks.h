@@ -17,6 +17,7 @@
 // (mover_follow.h). Frames are compared at a reduced size (max_side_px); masks have that size.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -65,14 +66,25 @@ struct MoverMaskFrame {
   Rigid3d cam_from_local;
 };
 
+// The values of a frame's mask as painting takes it (MoverMaskResult::Packed, Frame::movers):
+// a mover's pixel, or a surface pixel that every frame near it that sees its surface point
+// agrees with (at least one does, none differs: it shows what the mesh there looks like).
+inline constexpr uint8_t kMoverPixel = 255;
+inline constexpr uint8_t kAgreedPixel = 128;
+
 struct MoverMaskResult {
   std::vector<cv::Mat> masks;  // CV_8U, 255 = a mover's pixel; one per frame (empty: not judged)
-  std::string not_run;         // why nothing was looked for ("" when it ran)
-  long long judged = 0;        // surface pixels seen by enough other frames to be judged
-  long long flagged = 0;       // ... of which masked (after cleaning)
+  // CV_8U, 255 = a surface pixel not masked that the frames compared with it agree with (seen
+  // by at least one of them, differing from none); one per frame, as `masks`.
+  std::vector<cv::Mat> agreed;
+  std::string not_run;    // why nothing was looked for ("" when it ran)
+  long long judged = 0;   // surface pixels seen by enough other frames to be judged
+  long long flagged = 0;  // ... of which masked (after cleaning)
   double seconds = 0;
 
   double fraction() const { return judged > 0 ? static_cast<double>(flagged) / judged : 0.0; }
+  // Frame k's mask and agreed pixels in one image: kMoverPixel, kAgreedPixel, 0 elsewhere.
+  cv::Mat Packed(size_t k) const;
 };
 
 Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame>& frames,

@@ -116,7 +116,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
         Capture& capture = j->captures[s];
         capture.movers.resize(capture.poses.size());
         for (size_t k = 0; k < pose_index.size(); ++k)
-          capture.movers[pose_index[k]] = found.masks[k];
+          capture.movers[pose_index[k]] = found.Packed(k);
       }
     }
     j->mover_masks = all;
