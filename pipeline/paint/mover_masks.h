@@ -67,15 +67,17 @@ struct MoverMaskFrame {
 };
 
 // The values of a frame's mask as painting takes it (MoverMaskResult::Packed, Frame::movers):
-// a mover's pixel, or a surface pixel that every frame near it that sees its surface point
-// agrees with (at least one does, none differs: it shows what the mesh there looks like).
+// a mover's pixel, or a surface pixel that the frames near it that see its surface point agree
+// with (at least one sees it and none differs, or at most one of four or more: it shows what
+// the mesh there looks like).
 inline constexpr uint8_t kMoverPixel = 255;
 inline constexpr uint8_t kAgreedPixel = 128;
 
 struct MoverMaskResult {
   std::vector<cv::Mat> masks;  // CV_8U, 255 = a mover's pixel; one per frame (empty: not judged)
   // CV_8U, 255 = a surface pixel not masked that the frames compared with it agree with (seen
-  // by at least one of them, differing from none); one per frame, as `masks`.
+  // by at least one of them and differing from none, or from at most one of four or more); one
+  // per frame, as `masks`.
   std::vector<cv::Mat> agreed;
   std::string not_run;    // why nothing was looked for ("" when it ran)
   long long judged = 0;   // surface pixels seen by enough other frames to be judged
