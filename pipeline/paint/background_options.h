@@ -167,7 +167,9 @@ void Fields(BackgroundOptions& o, V& v) {
                    "mesh: moving objects) are not painted, and join the model's foreground "
                    "where they touch it in a buffer, when it grows (`grow`; `auto`: also while "
                    "refinement is still deciding, in the first two frames and once it has "
-                   "measured a frame) (on: less of the movers painted; off: the model alone)"});
+                   "measured a frame); growth does not start from the pixels the frames near "
+                   "them agree with (where a mover the model learned has gone) (on: less of the "
+                   "movers painted and more of the rest; off: the model alone)"});
 }
 
 }  // namespace fresco
