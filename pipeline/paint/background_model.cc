@@ -337,7 +337,7 @@ void BufferBackground::Update(const BaseBuffer& buffer, const WarpedBuffer& warp
     // then cleaned again. raw_ stays this frame's classification. Not from the texels the
     // frames near this one agree with: where a mover the model learned as background has gone,
     // the model flags the background, and growth from there covered whole walls of its colour
-    // (on a street capture 12 % of what was seen without a mover was never painted).
+    // (on a street capture 14 % of what was seen without a mover was never painted).
     const cv::Rect wide =
         cv::Rect(roi.x - reach, roi.y - reach, roi.width + 2 * reach, roi.height + 2 * reach) &
         cv::Rect(0, 0, buffer.width, buffer.height);

@@ -58,7 +58,7 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
 // whose masked pixels do not judge. `joinable`: the surface pixels that may join a mover by
 // their colour (those that differ from a frame that sees them, or are seen by too few);
-// `agreed`: the surface pixels seen by a frame and differing from none.
+// `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed).
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
                    long long* judged, long long* flagged, cv::Mat* joinable, cv::Mat* agreed) {

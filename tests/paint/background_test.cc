@@ -144,8 +144,8 @@ TEST(MoversAcrossViews, JoinTheForegroundTheyTouch) {
 // itself (a ghost), and growth from there covers the surface around it of that colour. The
 // frames near each frame agree with what its pixels show there (MoverMaskResult::agreed):
 // growth does not start from those texels, and more of what was seen without a mover is
-// painted, no more of the movers (on the evaluation suites' streets 85.9 -> 90.9 % and
-// 90.5 -> 91.8 % of it).
+// painted, no more of the movers (on the evaluation suite's streets 85.9 -> 91.7 % and
+// 90.5 -> 91.9 % of it).
 TEST(MoversAcrossViews, GrowthDoesNotStartWhereTheFramesAgree) {
   const Scene scene = Room();
   SynthCapture capture;

@@ -86,7 +86,7 @@ TEST(MoverMasks, MostOfTheMoversPixelsAndLittleElseAreMasked) {
   EXPECT_LT(false_share, 0.009);  // 0.71 % (five passes alone: 0.70 %)
   EXPECT_GT(o.found.fraction(), 2 * kBackgroundAcrossViewsThreshold);
   // What the frames near each frame agree with is the static scene: 97.8 % of its pixels,
-  // 4.5 % of the movers..
+  // 4.5 % of the movers'.
   EXPECT_GT(static_cast<double>(other_agreed) / other_pixels, 0.9);
   EXPECT_LT(static_cast<double>(mover_agreed) / mover_pixels, 0.08);
 }
