@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <vector>
+
+#include <Eigen/Dense>
 
 #include <apriltag/apriltag.h>
 #include <opencv2/calib3d.hpp>
@@ -78,6 +81,87 @@ void RefineTagCorners(const cv::Mat& gray, const TagQuad& quad, std::vector<cv::
   cv::cornerSubPix(gray, *corners, cv::Size(half, half), cv::Size(-1, -1),
                    cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 40, 1e-3));
   for (int k = 0; k < 4; ++k) refined[k] = (*corners)[k] != start[k];
+}
+
+// Whether corner i lies where the corners near it on the board (those with `usable` set)
+// place it: x and y each a quadratic in the board coordinates (in tag pitches) about it
+// (perspective and lens distortion over a few tags), fitted by least squares to the corners
+// within 1.05 pitches (up to twice that where fewer than 12 are), then again without the
+// neighbours it explains worst (a wrong neighbour); within 1.5 px or 4 % of the local pitch.
+// `undecided` when too few neighbours are there to tell.
+bool WhereItsNeighboursPlaceIt(const std::vector<CornerObservation>& corners,
+                               const std::vector<Eigen::Vector2d>& board,
+                               const std::vector<uint8_t>& usable, size_t i, bool undecided) {
+  constexpr size_t kMinNeighbours = 12;
+  constexpr double kReachPitches = 1.05, kLimitPx = 1.5, kLimitOfPitch = 0.04;
+  std::vector<Eigen::Vector2d> from, to;
+  for (double reach : {kReachPitches, 1.5 * kReachPitches, 2 * kReachPitches}) {
+    from.clear(), to.clear();
+    for (size_t j = 0; j < corners.size(); ++j) {
+      if (j == i || !usable[j] || (board[j] - board[i]).norm() > reach) continue;
+      from.push_back(board[j] - board[i]);
+      to.push_back(corners[j].pixel);
+    }
+    if (from.size() >= kMinNeighbours) break;
+  }
+  if (from.size() < kMinNeighbours) return undecided;
+  const auto terms = [](const Eigen::Vector2d& b) {
+    return (Eigen::Matrix<double, 6, 1>() << 1, b.x(), b.y(), b.x() * b.x(), b.x() * b.y(),
+            b.y() * b.y())
+        .finished();
+  };
+  Eigen::Matrix<double, 6, 2> coefficients;
+  const auto fit = [&](const std::vector<uint8_t>& use) {
+    const int n = static_cast<int>(std::count(use.begin(), use.end(), 1));
+    if (n < 9) return false;
+    Eigen::MatrixXd a(n, 6), b(n, 2);
+    for (size_t j = 0, row = 0; j < from.size(); ++j)
+      if (use[j]) a.row(row) = terms(from[j]).transpose(), b.row(row++) = to[j].transpose();
+    coefficients = a.colPivHouseholderQr().solve(b);
+    return true;
+  };
+  std::vector<uint8_t> use(from.size(), 1);
+  if (!fit(use)) return undecided;
+  std::vector<double> errors(from.size());
+  for (size_t j = 0; j < from.size(); ++j)
+    errors[j] = (coefficients.transpose() * terms(from[j]) - to[j]).norm();
+  std::vector<double> sorted = errors;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double cut = std::max(0.5, 4 * sorted[sorted.size() / 2]);
+  for (size_t j = 0; j < from.size(); ++j) use[j] = errors[j] <= cut;
+  if (!fit(use)) return undecided;
+  // At the corner itself (board offset 0) the quadratic is its constant term; the local pitch
+  // in pixels is the square root of the linear terms' determinant.
+  const Eigen::Vector2d predicted = coefficients.row(0).transpose();
+  const double pitch_px = std::sqrt(
+      std::abs(coefficients(1, 0) * coefficients(2, 1) - coefficients(2, 0) * coefficients(1, 1)));
+  return (predicted - corners[i].pixel).norm() <= std::max(kLimitPx, kLimitOfPitch * pitch_px);
+}
+
+// Drops the corners the board's other corners near them place elsewhere: cornerSubPix can
+// settle on a point of a tag's edge instead of its corner (a foreshortened tag under strong
+// distortion), several pixels off. A corner found out of place is judged again from the
+// corners found in place only (a wrong neighbour can put a right corner out of place).
+// Returns how many were dropped.
+int DropCornersTheirNeighboursPlaceElsewhere(const BoardSpec& spec,
+                                             std::vector<CornerObservation>* corners) {
+  const double pitch = spec.TagPitch_m();
+  std::vector<Eigen::Vector2d> board(corners->size());
+  for (size_t i = 0; i < corners->size(); ++i)
+    board[i] = CornerPosition(spec, (*corners)[i].id).head<2>() / pitch;
+  const std::vector<uint8_t> all(corners->size(), 1);
+  std::vector<uint8_t> in_place(corners->size(), 1);
+  for (size_t i = 0; i < corners->size(); ++i)
+    in_place[i] = WhereItsNeighboursPlaceIt(*corners, board, all, i, true);
+  std::vector<uint8_t> keep = in_place;
+  for (size_t i = 0; i < corners->size(); ++i)
+    if (!in_place[i]) keep[i] = WhereItsNeighboursPlaceIt(*corners, board, in_place, i, false);
+  size_t kept = 0;
+  for (size_t i = 0; i < corners->size(); ++i)
+    if (keep[i]) (*corners)[kept++] = (*corners)[i];
+  const int dropped = static_cast<int>(corners->size() - kept);
+  corners->resize(kept);
+  return dropped;
 }
 
 }  // namespace
@@ -166,6 +250,8 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   }
   std::sort(out.corners.begin(), out.corners.end(),
             [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+  if (options.refine_tag_corners && options.drop_inconsistent_corners)
+    out.corners_inconsistent = DropCornersTheirNeighboursPlaceElsewhere(spec, &out.corners);
   if (out.tags == 0) {
     out.corners.clear();
     out.reason = "no tag36h11 tag of the board (ids 0.." + std::to_string(num_ids - 1) + ") found";

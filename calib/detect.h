@@ -30,11 +30,17 @@ struct BoardDetection {
   std::vector<CornerObservation> corners;
   int tags = 0;              // AprilGrid: tags kept
   int tags_second_look = 0;  // AprilGrid: of those, found by the second look
+  // AprilGrid: corners dropped because the corners near them on the board place them more
+  // than 1.5 px (or 4 % of a tag pitch) elsewhere (settled on a tag's edge, not its corner).
+  int corners_inconsistent = 0;
 };
 
 struct DetectOptions {
   // AprilGrid: refine each tag corner with cv::cornerSubPix (window scaled to the tag size).
   bool refine_tag_corners = true;
+  // AprilGrid: drop refined corners that the corners near them on the board place elsewhere
+  // (BoardDetection::corners_inconsistent).
+  bool drop_inconsistent_corners = true;
   double quad_decimate = 1.0;  // apriltag: 1 keeps full resolution (small tags need it)
   int max_hamming = 1;         // apriltag: bit errors accepted per tag
   int min_corners = 8;         // fewer than this: not found

@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
   options.refine_tag_corners = !no_refine;
   int in_view = 0, ours = 0, aruco = 0, views_ok = 0, views_aruco_ok = 0;
   double sq_error = 0, max_error = 0, aruco_sq_error = 0;
-  int corners = 0, aruco_corners = 0;
+  int corners = 0, aruco_corners = 0, over_2px = 0, inconsistent = 0;
   const auto poses = WholeBoardPoses(spec, lens, views, seed);
   for (size_t v = 0; v < poses.size(); ++v) {
     image_options.seed = seed * 1000 + static_cast<unsigned>(v);
@@ -73,6 +73,7 @@ int main(int argc, char** argv) {
       const double e = (c.pixel - image.truth[c.id]).norm();
       sq_error += e * e;
       max_error = std::max(max_error, e);
+      over_2px += e > 2;
       if (verbose && e > 1.5)
         std::printf(
             "  view %zu corner %d (tag %d): error %.2f px (found %.1f %.1f, true %.1f %.1f)\n", v,
@@ -89,6 +90,7 @@ int main(int argc, char** argv) {
       }
     in_view += tags;
     ours += d.tags;
+    inconsistent += d.corners_inconsistent;
     aruco += static_cast<int>(quads.size());
     views_ok += d.found;
     views_aruco_ok += quads.size() >= 2;
@@ -100,9 +102,9 @@ int main(int argc, char** argv) {
               image_options.blur_sigma_px, image_options.noise_px, in_view);
   std::printf(
       "%-10s recall %.3f (%d tags, %d corners), views with a board %d, corner error rms %.3f "
-      "px, max %.3f px\n",
+      "px, max %.3f px, %d over 2 px (%d dropped: their neighbours place them elsewhere)\n",
       single ? "apriltag" : "fresco", ours / double(in_view), ours, corners, views_ok,
-      std::sqrt(sq_error / std::max(1, corners)), max_error);
+      std::sqrt(sq_error / std::max(1, corners)), max_error, over_2px, inconsistent);
   std::printf(
       "%-10s recall %.3f (%d tags), views with >= 2 tags %d, corner error rms %.3f px "
       "(unrefined)\n",
