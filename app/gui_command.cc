@@ -30,7 +30,7 @@ int RunGuiCommand(const CommandArgs& argv) {
       "  --screenshot FILE  paint N frames, draw every panel, write the window to FILE (PNG)\n"
       "                     and FILE.json (the panels and their places), then exit\n"
       "  --frames N         frames to paint before the screenshot (default 30)\n"
-      "  --size WxH         window size (default 1600x1000)\n"
+      "  --size WxH         window size (default 1600x1000, times a dense monitor's scale)\n"
       "  --calib-images DIR open the Calibration panel on DIR and detect the board in its\n"
       "                     images (with --screenshot: detect and solve before the shot)\n"
       "  --board BOARD      the board for --calib-images (as `fresco calib solve --board`)\n"
@@ -62,6 +62,7 @@ int RunGuiCommand(const CommandArgs& argv) {
        options.width < 320 || options.height < 240))
     return UsageError("gui", spec,
                       "--size: expected WxH of at least 320x240, got " + args.Get("--size"));
+  options.size_given = args.Has("--size");
   options.calib_images = args.Get("--calib-images");
   options.calib_board = args.Get("--board");
   options.calib_model = args.Get("--model", "auto");

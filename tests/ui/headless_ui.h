@@ -89,6 +89,7 @@ struct ImGuiHeadless {
   void Frame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels,
              const InputState* input = nullptr) {
     if (input) CopyToImGui(*input, &ImGui::GetIO());
+    ApplyUiScale(ui.scale.Total(), &ui.scale_applied);  // as the GL app does between frames
     ImGui::NewFrame();
     DrawAppFrame(ui, panels);
     ImGui::Render();

@@ -18,6 +18,7 @@
 #include "ui/core/layout.h"
 #include "ui/core/layout_file.h"
 #include "ui/core/natural_sort.h"
+#include "ui/core/ui_scale.h"
 #include "ui/core/zoom_pan.h"
 #include "ui/panels/panels.h"
 
@@ -237,6 +238,30 @@ TEST(GroupingSplitBack, SaysWhichStoredGroupWasSplitAndWhy) {
   EXPECT_NE(message.find("group 0"), std::string::npos) << message;
   EXPECT_NE(message.find("became 2 buffers"), std::string::npos) << message;
   EXPECT_NE(message.find("fold over"), std::string::npos) << message;
+}
+
+// The scale of a dense monitor times the user's: the font built at the next whole multiple
+// of 13 pixels and shown at the scale, the style's sizes scaled; rebuilt only on a change.
+TEST(UiScaleTest, FontsAreBuiltAtTheScaleAndRebuiltOnlyWhenItChanges) {
+  EXPECT_EQ(FontAtlasMultiple(0.75f), 1);
+  EXPECT_EQ(FontAtlasMultiple(1.0f), 1);
+  EXPECT_EQ(FontAtlasMultiple(1.5f), 2);
+  EXPECT_EQ(FontAtlasMultiple(2.0f), 2);
+  EXPECT_EQ((UiScale{2.0f, 1.5f}.Total()), 3.0f);
+  EXPECT_EQ((UiScale{4.0f, 2.0f}.Total()), kMaxUiScale);
+  ImGui::CreateContext();
+  const float padding = ImGui::GetStyle().FramePadding.y;
+  float applied = 0;
+  EXPECT_TRUE(ApplyUiScale(1.5f, &applied));
+  EXPECT_EQ(applied, 1.5f);
+  EXPECT_EQ(ImGui::GetIO().Fonts->Fonts[0]->FontSize, 26.0f);
+  EXPECT_EQ(ImGui::GetIO().FontGlobalScale, 0.75f);
+  EXPECT_EQ(ImGui::GetStyle().FramePadding.y, std::floor(1.5f * padding));
+  EXPECT_FALSE(ApplyUiScale(1.5f, &applied));  // unchanged: nothing rebuilt
+  EXPECT_TRUE(ApplyUiScale(1.0f, &applied));
+  EXPECT_EQ(ImGui::GetIO().Fonts->Fonts[0]->FontSize, 13.0f);
+  EXPECT_EQ(ImGui::GetStyle().FramePadding.y, padding);  // from the dark style, not compounded
+  ImGui::DestroyContext();
 }
 
 TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {

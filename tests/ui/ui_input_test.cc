@@ -115,7 +115,7 @@ TEST(UiInput, TitleBarsStayBelowTheMenuBar) {
   EXPECT_EQ(window->Pos.x, floating.x);
   EXPECT_EQ(window->Pos.y, floating.y);
   app.Drag(ImVec2(window->Pos.x + 60, window->Pos.y + 5), ImVec2(5000, 5000), 10);
-  EXPECT_LE(window->Pos.y, 1000 - kStatusBarHeight - ImGui::GetFrameHeight());
+  EXPECT_LE(window->Pos.y, 1000 - StatusBarHeight() - ImGui::GetFrameHeight());
   EXPECT_LE(window->Pos.x, 1600 - 48);
   // Tiled panels do not move at all: dragging a title bar leaves the tile where it was.
   ImGuiWindow* view = App::Window("3D view");

@@ -1,7 +1,8 @@
 // The app's tiled layout driven headless: the 3D view is the largest panel by default, at
 // 1600 x 1000 and at 1280 x 800 every tile is wide enough; a splitter drag resizes both
 // neighbours; a double-click on a title bar maximises a panel and another restores the
-// layout; closing a panel gives its space to its neighbour; the font scale applies.
+// layout; closing a panel gives its space to its neighbour; the font scale applies; on a 4K
+// monitor at twice the density the layout and text are twice the size.
 #include <gtest/gtest.h>
 #include <imgui.h>
 #include <imgui_internal.h>
@@ -43,18 +44,21 @@ TEST(UiLayout, EveryTiledPanelExistsAndTheLayoutCoversTheBand) {
   EXPECT_NEAR(area, 1600.0 * 956, 1600.0 * 956 * 0.005) << "tiles and bars fill the band";
 }
 
-void ExpectUsable(ImVec2 display) {
+void ExpectUsable(ImVec2 display, float content_scale = 1) {
   LayoutApp app(display);
+  app.ui.scale.content = content_scale;  // the monitor's, as GLFW reports it
+  app.Frames(4);
+  const float s = content_scale;
   float view_area = 0, largest_other = 0;
   for (const auto& p : app.panels) {
     if (!p->open) continue;
     ImGuiWindow* w = LayoutApp::Window(p->Title());
     ASSERT_NE(w, nullptr) << p->Title();
-    EXPECT_GE(w->Size.x, 150) << p->Title() << " at " << display.x << "x" << display.y;
-    EXPECT_GE(w->Size.y, 120) << p->Title() << " at " << display.x << "x" << display.y;
+    EXPECT_GE(w->Size.x, 150 * s) << p->Title() << " at " << display.x << "x" << display.y;
+    EXPECT_GE(w->Size.y, 120 * s) << p->Title() << " at " << display.x << "x" << display.y;
     EXPECT_GE(w->Pos.y, ImGui::GetFrameHeight()) << p->Title();
     EXPECT_LE(w->Pos.x + w->Size.x, display.x + 0.5f) << p->Title();
-    EXPECT_LE(w->Pos.y + w->Size.y, display.y - kStatusBarHeight + 0.5f) << p->Title();
+    EXPECT_LE(w->Pos.y + w->Size.y, display.y - StatusBarHeight() + 0.5f) << p->Title();
     const float area = w->Size.x * w->Size.y;
     if (std::string(p->Title()) == "3D view")
       view_area = area;
@@ -73,6 +77,21 @@ void ExpectUsable(ImVec2 display) {
 
 TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1600x1000) { ExpectUsable({1600, 1000}); }
 TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1280x800) { ExpectUsable({1280, 800}); }
+// A 4K monitor at 192 dpi (content scale 2): the same layout at twice the size, the text
+// drawn from a font built at 26 pixels (crisp, not a 13-pixel font magnified), the status bar
+// as tall as its text needs.
+TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt3840x2160OnADenseMonitor) {
+  ExpectUsable({3840, 2160}, 2);
+  LayoutApp app({3840, 2160});
+  const float frame_height = ImGui::GetFrameHeight();
+  app.ui.scale.content = 2;
+  app.Frames(2);
+  EXPECT_EQ(ImGui::GetIO().FontGlobalScale, 1.0f);
+  EXPECT_EQ(ImGui::GetIO().Fonts->Fonts[0]->FontSize, 26.0f);
+  EXPECT_NEAR(ImGui::GetFrameHeight(), 2 * frame_height, 1.0f);
+  EXPECT_GE(StatusBarHeight(), ImGui::GetFrameHeight() + 4);
+  EXPECT_GE(LayoutApp::Window("Project")->Pos.y, ImGui::GetFrameHeight());
+}
 
 TEST(UiLayout, DraggingASplitterResizesBothNeighbours) {
   LayoutApp app({1600, 1000});
@@ -142,11 +161,11 @@ TEST(UiLayout, AClosedPanelGivesItsSpaceToItsNeighbour) {
 
 TEST(UiLayout, FontScaleScalesTheText) {
   LayoutApp app({1280, 800});
-  const float height = ImGui::GetFrameHeight();
-  ImGui::GetIO().FontGlobalScale = 1.5f;
+  const float height = ImGui::GetFrameHeight(), font = ImGui::GetFontSize();
+  app.ui.scale.user = 1.5f;  // View > font scale
   app.Frames(2);
-  EXPECT_NEAR(ImGui::GetFrameHeight() - 2 * ImGui::GetStyle().FramePadding.y,
-              1.5f * (height - 2 * ImGui::GetStyle().FramePadding.y), 0.5f);
+  EXPECT_NEAR(ImGui::GetFontSize(), 1.5f * font, 0.5f);
+  EXPECT_NEAR(ImGui::GetFrameHeight(), 1.5f * height, 1.0f);  // paddings scaled too
   EXPECT_GE(LayoutApp::Window("Project")->Pos.y, ImGui::GetFrameHeight())
       << "tiles start below the taller menu bar";
 }

@@ -126,8 +126,8 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
       layout.ToggleMaximised(layout.maximised());
     if (ImGui::MenuItem("Default layout")) layout = DefaultTileLayout();
     ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8);
-    ImGui::SliderFloat("font scale", &ImGui::GetIO().FontGlobalScale, kMinFontScale, kMaxFontScale,
-                       "%.2f");
+    // Applied from the next frame on (ApplyUiScale), times the monitor's content scale.
+    ImGui::SliderFloat("font scale", &ui.scale.user, kMinFontScale, kMaxFontScale, "%.2f");
     ImGui::EndMenu();
   }
   const auto& snap = *ui.snapshot;
@@ -168,8 +168,8 @@ void HandleShortcuts(UiContext& ui) {
 
 void DrawStatusBar(UiContext& ui) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
-  ImGui::SetNextWindowPos(ImVec2(0, display.y - kStatusBarHeight));
-  ImGui::SetNextWindowSize(ImVec2(display.x, kStatusBarHeight));
+  ImGui::SetNextWindowPos(ImVec2(0, display.y - StatusBarHeight()));
+  ImGui::SetNextWindowSize(ImVec2(display.x, StatusBarHeight()));
   ImGui::Begin("##status", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
@@ -200,7 +200,7 @@ std::vector<TileLayout::Splitter> PlaceTiles(const TileLayout& layout,
                                              std::vector<std::unique_ptr<Panel>>& panels) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   const float top = std::ceil(ImGui::GetFrameHeight());  // the menu bar's height
-  const LayoutRect band{0, top, display.x, std::max(0.0f, display.y - top - kStatusBarHeight)};
+  const LayoutRect band{0, top, display.x, std::max(0.0f, display.y - top - StatusBarHeight())};
   auto is_open = [&](const std::string& title) {
     for (const auto& p : panels)
       if (title == p->Title()) return p->open;

@@ -12,7 +12,7 @@ namespace fresco {
 
 struct SavedLayout {
   TileLayout layout = DefaultTileLayout();
-  float font_scale = 1;  // ImGuiIO::FontGlobalScale
+  float font_scale = 1;  // View > font scale (UiScale::user)
 };
 
 // Writes {"fractions": [...], "font_scale": s} atomically.

@@ -6,6 +6,7 @@
 // in ui/panels/panel_registry.cc.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -21,6 +22,7 @@
 #include "ui/core/pipeline_runner.h"
 #include "ui/core/poses_runner.h"
 #include "ui/core/tile_layout.h"
+#include "ui/core/ui_scale.h"
 
 namespace fresco {
 
@@ -74,6 +76,8 @@ struct UiContext {
   TileLayout layout = DefaultTileLayout();
   bool new_project_requested = false;  // File > New project...: the app frame opens the form
   std::vector<std::string> dropped_paths = {};  // dropped on the window (DropPaths), not yet placed
+  UiScale scale = {};                           // the monitor's and the user's (View > font scale)
+  float scale_applied = 0;  // what the fonts and style were last built for (ApplyUiScale)
 };
 
 class Panel {
@@ -105,8 +109,9 @@ class Panel {
 // Every panel, in menu order (panel_registry.cc).
 std::vector<std::unique_ptr<Panel>> MakePanels();
 
-// The status bar at the bottom of the window (app_frame.cc), pixels.
-inline constexpr float kStatusBarHeight = 24;
+// The status bar at the bottom of the window (app_frame.cc), pixels: a line of text and its
+// padding (24 at scale 1).
+inline float StatusBarHeight() { return std::round(ImGui::GetFrameHeight() + 5); }
 
 // Helpers for panels.
 // Starts the panel's window: in its tile when tiled (a double-click on the title bar asks to

@@ -36,7 +36,7 @@ bool BeginPanel(Panel& panel) {
   ImGui::PushTextWrapPos(0.0f);
   // However it was dragged, the title bar stays below the menu bar and on screen.
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
-  const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), kStatusBarHeight};
+  const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), StatusBarHeight()};
   const LayoutRect kept =
       KeepTitleBarReachable({pos.x, pos.y, size.x, size.y}, band, ImGui::GetFrameHeight());
   if (kept.x != pos.x || kept.y != pos.y) ImGui::SetWindowPos(ImVec2(kept.x, kept.y));

@@ -1,5 +1,6 @@
 #include "ui/gl/app_window.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -22,6 +23,7 @@
 #include "ui/core/dropped_file.h"
 #include "ui/core/input_queue.h"
 #include "ui/core/layout_file.h"
+#include "ui/core/ui_scale.h"
 #include "ui/gl/gl.h"
 #include "ui/gl/gl_textures.h"
 #include "ui/gl/viewport_gl.h"
@@ -206,7 +208,22 @@ int RunGuiApp(const GuiOptions& options) {
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  GLFWwindow* window = glfwCreateWindow(options.width, options.height, "Fresco", nullptr, nullptr);
+  // On a high-density monitor the default size grows with its content scale (1600 x 1000 is
+  // 3200 x 2000 on a 4K screen at 192 dpi), within its work area.
+  int width = options.width, height = options.height;
+  if (!options.size_given) {
+    if (GLFWmonitor* monitor = glfwGetPrimaryMonitor()) {
+      float scale_x = 1, scale_y = 1;
+      glfwGetMonitorContentScale(monitor, &scale_x, &scale_y);
+      int area_x = 0, area_y = 0, area_w = 0, area_h = 0;
+      glfwGetMonitorWorkarea(monitor, &area_x, &area_y, &area_w, &area_h);
+      const float scale = std::clamp(std::max(scale_x, scale_y), 1.0f, kMaxUiScale);
+      width = static_cast<int>(width * scale), height = static_cast<int>(height * scale);
+      if (area_w > 0 && area_h > 0)
+        width = std::min(width, area_w), height = std::min(height, area_h);
+    }
+  }
+  GLFWwindow* window = glfwCreateWindow(width, height, "Fresco", nullptr, nullptr);
   if (!window) {
     std::fprintf(stderr, "fresco gui: cannot create an OpenGL 3.3 window\n");
     glfwTerminate();
@@ -256,7 +273,7 @@ int RunGuiApp(const GuiOptions& options) {
       if (Status s = LoadLayoutFile(layout_file, &saved); !s.ok())
         std::fprintf(stderr, "fresco gui: %s (the default layout instead)\n", s.message().c_str());
       ui.layout = saved.layout;
-      io.FontGlobalScale = saved.font_scale;
+      ui.scale.user = saved.font_scale;
     }
     if (state.has_project) {
       runner.Restart(state.project);
@@ -278,6 +295,16 @@ int RunGuiApp(const GuiOptions& options) {
       ui.snapshot = runner.Snapshot();
       DropPaths(ui, events.dropped);
       events.dropped.clear();
+      // The monitor's scale (it changes when the window moves to another monitor) and the
+      // user's: fonts and style rebuilt between frames when they change; the first frame's
+      // font texture is uploaded by the backend's first NewFrame.
+      float scale_x = 1, scale_y = 1;
+      glfwGetWindowContentScale(window, &scale_x, &scale_y);
+      ui.scale.content = std::max(scale_x, scale_y);
+      if (ApplyUiScale(ui.scale.Total(), &ui.scale_applied) && frames_drawn > 0) {
+        ImGui_ImplOpenGL3_DestroyFontsTexture();
+        ImGui_ImplOpenGL3_CreateFontsTexture();
+      }
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
       events.input.NextFrame(&input);  // this frame's share of the queued input
@@ -313,7 +340,7 @@ int RunGuiApp(const GuiOptions& options) {
     }
     if (!layout_file.empty()) {
       saved.layout = ui.layout;
-      saved.font_scale = io.FontGlobalScale;
+      saved.font_scale = ui.scale.user;
       if (Status s = SaveLayoutFile(layout_file, saved); !s.ok())
         std::fprintf(stderr, "fresco gui: %s\n", s.message().c_str());
     }

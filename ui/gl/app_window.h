@@ -12,6 +12,7 @@ struct GuiOptions {
   std::string screenshot;  // "" = interactive
   int frames = 30;         // --screenshot: frames to paint first
   int width = 1600, height = 1000;
+  bool size_given = false;  // --size: the size as given (otherwise scaled on dense monitors)
   // Calibration panel: a folder to detect at start (--screenshot also solves before the shot).
   std::string calib_images, calib_board, calib_model = "auto";
   // Poses panel: "" (closed), "verify" (run COLMAP and verify at start; --screenshot waits
