@@ -34,6 +34,7 @@ const char* kColmapOptionsHelp =
     "  --keyframe-step F    in a sequence, send a frame to COLMAP when its given pose moved\n"
     "                       F x scene size since the last one sent (default 0.005)...\n"
     "  --keyframe-rotation-deg X  ...or turned X degrees (default 2); 0 and 0: every frame\n"
+    "                       (the other frames are registered to the keyframes afterwards)\n"
     "  --scene-size-m M     scene size for the position threshold (default: the diagonal of\n"
     "                       the scene's bounding box)\n"
     "  --colmap PROGRAM     the colmap program (default: `colmap` on PATH)\n"
@@ -192,9 +193,16 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
                     seconds);
       steps += detail;
     }
-    std::cout << "colmap: " << result->frames.size() << " of " << result->run.frames_offered
-              << " frames sent (keyframes), " << result->run.matcher << " matching; " << steps
-              << "\n";
+    std::cout << "colmap: " << result->run.keyframes << " of " << result->run.frames_offered
+              << " frames reconstructed as keyframes";
+    const int others = static_cast<int>(result->frames.size()) - result->run.keyframes;
+    if (others > 0) {
+      std::cout << ", " << result->run.registered_later << " of the other " << others
+                << " registered to them";
+      if (!result->run.register_error.empty())
+        std::cout << " (" << result->run.register_error << ")";
+    }
+    std::cout << "; " << result->run.matcher << " matching; " << steps << "\n";
   }
   return -1;
 }

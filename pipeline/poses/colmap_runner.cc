@@ -124,7 +124,8 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
                     "--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point",
                     "0", "--Mapper.ba_refine_extra_params", "0", "--Mapper.num_threads", threads}});
 
-  const int total_steps = static_cast<int>(steps.size()) + 1;
+  const int total_steps =
+      static_cast<int>(steps.size()) + 1 + (options.register_names.empty() ? 0 : 4);
   auto run_step = [&](const Step& step, int index) -> Status {
     if (options.progress) options.progress(step.name, index, total_steps);
     std::vector<std::string> argv = {program};
@@ -186,6 +187,63 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
     FRESCO_RETURN_IF_ERROR(ReadColmapModel(txt.string(), &model));
     if (best < 0 || model.images.size() > result->model.images.size()) {
       best = static_cast<int>(i);
+      result->model = std::move(model);
+    }
+  }
+  if (!options.register_names.empty()) {
+    // The frames between keyframes, registered to the keyframes' reconstruction.
+    const fs::path registered = ws / "sparse_registered";
+    const fs::path registered_txt = sparse_txt / "registered";
+    fs::remove_all(registered, ec);
+    FRESCO_RETURN_IF_ERROR(MakeDirectories(registered.string()));
+    FRESCO_RETURN_IF_ERROR(MakeDirectories(registered_txt.string()));
+    std::string list, pairs;
+    for (const std::string& name : options.register_names) list += name + "\n";
+    for (const auto& [a, b] : options.register_pairs) pairs += a + " " + b + "\n";
+    const fs::path list_path = ws / "register_list.txt", pairs_path = ws / "register_pairs.txt";
+    FRESCO_RETURN_IF_ERROR(WriteFileAtomic(list_path.string(), list));
+    FRESCO_RETURN_IF_ERROR(WriteFileAtomic(pairs_path.string(), pairs));
+    Step extract{"feature_extractor_others",
+                 {"feature_extractor", "--database_path", database.string(), "--image_path",
+                  options.image_path, "--image_list_path", list_path.string(),
+                  "--ImageReader.existing_camera_id", "1", "--SiftExtraction.use_gpu", "0",
+                  "--SiftExtraction.num_threads", threads}};
+    if (options.max_image_size > 0) {
+      extract.args.insert(extract.args.end(), {"--SiftExtraction.max_image_size",
+                                               std::to_string(options.max_image_size)});
+    }
+    if (options.max_num_features > 0) {
+      extract.args.insert(extract.args.end(), {"--SiftExtraction.max_num_features",
+                                               std::to_string(options.max_num_features)});
+    }
+    const std::vector<Step> later = {
+        extract,
+        {"matches_importer",
+         {"matches_importer", "--database_path", database.string(), "--match_list_path",
+          pairs_path.string(), "--match_type", "pairs", "--SiftMatching.use_gpu", "0",
+          "--SiftMatching.num_threads", threads}},
+        {"image_registrator",
+         {"image_registrator", "--database_path", database.string(), "--input_path",
+          (sparse / model_folders[best]).string(), "--output_path", registered.string(),
+          "--Mapper.ba_refine_focal_length", "0", "--Mapper.ba_refine_principal_point", "0",
+          "--Mapper.ba_refine_extra_params", "0", "--Mapper.num_threads", threads}},
+        {"model_converter",
+         {"model_converter", "--input_path", registered.string(), "--output_path",
+          registered_txt.string(), "--output_type", "TXT"}}};
+    // A failure here keeps the keyframes' reconstruction (said in register_error); a cancel
+    // ends the run.
+    const int first = static_cast<int>(steps.size()) + 1;
+    Status status = Status::Ok();
+    for (size_t i = 0; i < later.size() && status.ok(); ++i)
+      status = run_step(later[i], first + static_cast<int>(i));
+    ColmapModel model;
+    if (status.ok()) status = ReadColmapModel(registered_txt.string(), &model);
+    if (options.cancel && *options.cancel) return Status::Error("colmap: cancelled");
+    if (!status.ok()) {
+      result->register_error = status.message();
+    } else if (model.images.size() >= result->model.images.size()) {
+      result->registered_later =
+          static_cast<int>(model.images.size()) - static_cast<int>(result->model.images.size());
       result->model = std::move(model);
     }
   }

@@ -6,7 +6,12 @@
 //   exhaustive_matcher or sequential_matcher (loop detection off: Debian has no vocab tree)
 //   mapper (ba_refine_focal_length/principal_point/extra_params 0)
 //   model_converter (each model to TXT under WORKSPACE/sparse_txt/N), then the one with the
-//   most registered images is read (ColmapModel, Fresco's (0,0) pixel convention).
+//   most registered images is read (ColmapModel, Fresco's (0,0) pixel convention)
+// and, with `register_names` (the frames between keyframes), those registered to it:
+//   feature_extractor (the same camera), matches_importer (each with the keyframes beside
+//   it, `register_pairs`), image_registrator (into WORKSPACE/sparse_registered, no bundle
+//   adjustment: the keyframes' reconstruction stays as it was), model_converter
+//   (WORKSPACE/sparse_txt/registered), read instead.
 #pragma once
 
 #include <atomic>
@@ -43,6 +48,10 @@ struct ColmapRunOptions {
   int max_num_features = 0;  // SiftExtraction.max_num_features; 0 = COLMAP's default (8192)
   int threads = 0;           // num_threads of every step; 0 = all cores
   int min_registered = 3;    // fewer registered images is an error
+  // Images (relative to image_path) registered to the reconstruction once it is made, each
+  // matched only with the images `register_pairs` pairs it with (its keyframes).
+  std::vector<std::string> register_names;
+  std::vector<std::pair<std::string, std::string>> register_pairs;
   // Called before each step: (step name, index from 0, number of steps).
   std::function<void(const std::string& step, int index, int total)> progress;
   // When set and it becomes true, the running step is stopped and RunColmap fails with
@@ -59,6 +68,8 @@ struct ColmapRunResult {
   // Frames of the project offered (after every_n_frames/max_frames) and the keyframes among
   // them that COLMAP was given (RunColmapOnProject fills these; 0 = not selected).
   int frames_offered = 0, keyframes = 0;
+  int registered_later = 0;    // of `register_names`, those image_registrator registered
+  std::string register_error;  // why they were not (the keyframes' reconstruction is kept)
   double seconds = 0.0;
   std::vector<std::pair<std::string, double>> step_seconds;  // wall time of each step
 };

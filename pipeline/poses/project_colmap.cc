@@ -144,9 +144,25 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
                                options.keyframe_rotation_deg);
   }
   std::vector<std::string> names;
-  for (int i : selected) {
-    result->frames.push_back(offered[i]);
-    names.push_back(offered[i].name);
+  for (int i : selected) names.push_back(offered[i].name);
+  // The frames between keyframes, registered afterwards, each matched with the two keyframes
+  // on either side of it.
+  std::vector<std::string> others;
+  std::vector<std::pair<std::string, std::string>> pairs;
+  const bool register_others = options.register_other_frames && options.existing_model.empty() &&
+                               selected.size() < offered.size();
+  for (size_t i = 0, k = 0; i < offered.size(); ++i) {
+    while (k < selected.size() && selected[k] < static_cast<int>(i)) ++k;
+    const bool keyframe = k < selected.size() && selected[k] == static_cast<int>(i);
+    if (keyframe || register_others) {
+      result->frames.push_back(offered[i]);
+      result->frames.back().keyframe = keyframe;
+    }
+    if (keyframe || !register_others) continue;
+    others.push_back(offered[i].name);
+    for (int side : {-2, -1, 0, 1})  // selected[k] is the first keyframe after frame i
+      if (const int j = static_cast<int>(k) + side; j >= 0 && j < static_cast<int>(selected.size()))
+        pairs.emplace_back(offered[i].name, offered[selected[j]].name);
   }
   if (names.size() < 3) {
     return Status::Error(project.video + ": COLMAP needs at least 3 frames, the project has " +
@@ -166,6 +182,8 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     run.image_names = names;
     run.camera = result->camera;
     run.ordered = ordered;
+    run.register_names = others;
+    run.register_pairs = pairs;
     FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
   }
   result->run.frames_offered = static_cast<int>(offered.size());
@@ -184,7 +202,7 @@ std::vector<VerifyFrameInput> VerifyInputs(const ProjectColmap& colmap) {
   std::vector<VerifyFrameInput> inputs;
   for (const ProjectColmapFrame& f : colmap.frames) {
     inputs.push_back({f.name, f.given ? &f.given->cam_from_world : nullptr,
-                      f.colmap ? &f.colmap->cam_from_world : nullptr});
+                      f.colmap ? &f.colmap->cam_from_world : nullptr, f.keyframe});
   }
   return inputs;
 }

@@ -30,6 +30,9 @@ struct ProjectColmapOptions {
   // do). 0 and 0 = every frame. Ordered sequences are matched sequentially (kAuto).
   double keyframe_step_rel = 0.005;
   double keyframe_rotation_deg = 2.0;
+  // The frames between keyframes are then registered to the keyframes' reconstruction (each
+  // matched with the two keyframes on either side of it), so that they are compared too.
+  bool register_other_frames = true;
   ColmapRunOptions colmap;  // workspace, image_path, image_names, camera are filled in
   // A COLMAP text model folder from an earlier run (e.g. OUT/colmap/sparse_txt/0 of
   // `fresco poses verify`) to use instead of running COLMAP; "" = run COLMAP. Its images are
@@ -42,13 +45,14 @@ struct ProjectColmapFrame {
   int index = 0;                       // the frame's index in the project's video
   const PosedImage* given = nullptr;   // into ProjectColmap::capture.poses
   const PosedImage* colmap = nullptr;  // into ProjectColmap::run.model.images
+  bool keyframe = true;  // reconstructed by the mapper (else registered to it afterwards)
 };
 
 struct ProjectColmap {
   Capture capture;
   Camera camera;
   double scene_size_m = 0.0;
-  std::vector<ProjectColmapFrame> frames;  // in sequence order
+  std::vector<ProjectColmapFrame> frames;  // in sequence order (keyframes and others)
   ColmapRunResult run;
 };
 

@@ -39,14 +39,14 @@ double TheilSenAtZero(const std::vector<double>& x, const std::vector<double>& y
 // measured by COLMAP's rotations between the same frames: no alignment, so a reconstruction
 // that turns along the walk moves it only by how much it turns between neighbours, which the
 // line over the offsets takes out. Degrees.
-double RelativeRotationDeg(const std::vector<PosePair>& pairs, int k,
+double RelativeRotationDeg(const PosePair& self, const std::vector<PosePair>& pairs,
                            const std::vector<int>& around, const std::vector<double>& offsets) {
   std::vector<double> components[3];
   for (int j : around) {
     const Eigen::Quaterniond given =
-        pairs[k].given_cam_from_world.rotation * pairs[j].given_cam_from_world.rotation.conjugate();
-    const Eigen::Quaterniond colmap = pairs[k].colmap_cam_from_colmap.rotation *
-                                      pairs[j].colmap_cam_from_colmap.rotation.conjugate();
+        self.given_cam_from_world.rotation * pairs[j].given_cam_from_world.rotation.conjugate();
+    const Eigen::Quaterniond colmap =
+        self.colmap_cam_from_colmap.rotation * pairs[j].colmap_cam_from_colmap.rotation.conjugate();
     const Eigen::Vector3d e = Rigid3d::AxisAngleFromQuaternion(colmap * given.conjugate());
     for (int c = 0; c < 3; ++c) components[c].push_back(e[c]);
   }
@@ -66,8 +66,8 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   out.rotation_threshold_deg = options.rotation_threshold_deg;
   out.position_threshold_m = options.position_threshold_rel * scene_size_m;
 
-  std::vector<PosePair> pairs;
-  std::vector<int> frame_of_pair;
+  std::vector<PosePair> pairs, others;  // keyframes' and the other frames' pose pairs
+  std::vector<int> frame_of_pair, frame_of_other, keyframes_before_other;
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameVerdict v;
     v.name = frames[i].name;
@@ -75,12 +75,20 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     v.registered = frames[i].colmap_cam_from_colmap != nullptr;
     if (v.registered) ++out.registered;
     if (v.has_given && v.registered) {
-      pairs.push_back({v.name, *frames[i].given_cam_from_world, *frames[i].colmap_cam_from_colmap});
-      frame_of_pair.push_back(static_cast<int>(i));
+      const PosePair pair{v.name, *frames[i].given_cam_from_world,
+                          *frames[i].colmap_cam_from_colmap};
+      if (frames[i].reference) {
+        pairs.push_back(pair);
+        frame_of_pair.push_back(static_cast<int>(i));
+      } else {
+        others.push_back(pair);
+        frame_of_other.push_back(static_cast<int>(i));
+        keyframes_before_other.push_back(static_cast<int>(pairs.size()));
+      }
     }
     out.frames.push_back(v);
   }
-  out.compared = static_cast<int>(pairs.size());
+  out.compared = static_cast<int>(pairs.size() + others.size());
 
   PoseAlignmentOptions align;
   align.inlier_position_m = options.inlier_fraction * out.position_threshold_m;
@@ -109,6 +117,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
   std::map<int, PoseAlignment> fits;                         // by window start
+  std::vector<int> window_of(n, 0);                          // each frame's window start
   std::vector<Eigen::Matrix<double, 6, 1>> disagreement(n);  // under each frame's own fit
   for (int k = 0; k < n; ++k) {
     int begin = 0, end = n;
@@ -130,6 +139,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         fits[begin] = fit;
       }
     }
+    window_of[k] = begin;
     const PoseAlignment& fit = fits[begin];
     const PoseError e = ComparePose(pairs[k], fit.world_from_colmap);
     FrameVerdict& v = out.frames[frame_of_pair[k]];
@@ -165,7 +175,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         trend[c] = TheilSenAtZero(offsets, values);
       }
       const Eigen::Matrix<double, 6, 1> residual = disagreement[k] - trend;
-      v.relative_rotation_deg = RelativeRotationDeg(pairs, k, around, offsets);
+      v.relative_rotation_deg = RelativeRotationDeg(pairs[k], pairs, around, offsets);
       const bool rotation_follows =
           residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
       if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
@@ -173,6 +183,43 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         v.follows_drift = true;
         ++out.following_drift;
       }
+    }
+  }
+  // The other frames (between keyframes), each by the fit of the keyframe after it (or the
+  // last) and, where the disagreement drifts, against the keyframes on either side of it.
+  for (size_t o = 0; o < others.size() && n > 0; ++o) {
+    const int after = keyframes_before_other[o];  // it sits between keyframes after-1 and after
+    const PoseAlignment& fit = fits[window_of[std::min(after, n - 1)]];
+    const PoseError e = ComparePose(others[o], fit.world_from_colmap);
+    FrameVerdict& v = out.frames[frame_of_other[o]];
+    v.rotation_error_deg = e.rotation_deg;
+    v.position_error_m = e.position_m;
+    v.flagged =
+        e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
+    if (!v.flagged || !out.drift_followed) continue;
+    const int h = options.drift_neighbours;
+    std::vector<int> around;
+    for (int j = std::max(0, after - h); j < std::min(n, after + h); ++j) around.push_back(j);
+    if (static_cast<int>(around.size()) < std::min(h, n)) continue;
+    std::vector<double> offsets;
+    for (int j : around) offsets.push_back(j - (after - 0.5));
+    Eigen::Matrix<double, 6, 1> trend;
+    for (int c = 0; c < 6; ++c) {
+      std::vector<double> values;
+      for (int j : around) values.push_back(disagreement[j][c]);
+      trend[c] = TheilSenAtZero(offsets, values);
+    }
+    const Eigen::Matrix<double, 6, 1> residual =
+        DisagreementOf(others[o], fit.world_from_colmap, out.rotation_threshold_deg,
+                       out.position_threshold_m) -
+        trend;
+    v.relative_rotation_deg = RelativeRotationDeg(others[o], pairs, around, offsets);
+    const bool rotation_follows =
+        residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
+    if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
+      v.flagged = false;
+      v.follows_drift = true;
+      ++out.following_drift;
     }
   }
   std::vector<double> rotations, positions;

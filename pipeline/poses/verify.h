@@ -102,6 +102,10 @@ struct VerifyFrameInput {
   std::string name;
   const Rigid3d* given_cam_from_world = nullptr;    // nullptr: no given pose
   const Rigid3d* colmap_cam_from_colmap = nullptr;  // nullptr: not registered
+  // A keyframe: the alignment, its windows and the drift are measured on these; a frame
+  // that is not one (registered to the keyframes' reconstruction afterwards) is judged by
+  // the fit and the neighbours of the keyframes beside it.
+  bool reference = true;
 };
 
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,

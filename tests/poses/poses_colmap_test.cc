@@ -157,6 +157,32 @@ TEST_F(PosesColmapTest, VerifyFlagsEveryInjectedErrorAndNoCleanFrame) {
   EXPECT_TRUE(fs::is_regular_file(out + "/colmap/logs/03_mapper.log"));
 }
 
+// Frames between keyframes are registered to the keyframes' reconstruction and judged too:
+// with keyframes every 20 degrees only the even frames (and the last) are reconstructed, and
+// frame 11 (1 degree and 2 % of the scene off), between two of them, is still flagged; every
+// frame is compared, no clean one flagged. (Before, the frames between keyframes were not
+// compared at all: frame 11 went unseen.)
+TEST_F(PosesColmapTest, FramesBetweenKeyframesAreRegisteredAndJudgedToo) {
+  const std::string out = *dir_ + "/verify-keyframes";
+  const auto r = RunFresco({"poses", "verify", Project(), "--out", out, "--threads", "2",
+                            "--keyframe-rotation-deg", "20", "--keyframe-step", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("9 of 16 frames reconstructed as keyframes, 7 of the other 7 registered"),
+            std::string::npos)
+      << r.out;
+  const nlohmann::json v = nlohmann::json::parse(ReadText(out + "/verify.json"));
+  EXPECT_EQ(v["registered"], kFrames);
+  ASSERT_EQ(v["frames"].size(), static_cast<size_t>(kFrames));
+  for (int i = 0; i < kFrames; ++i) {
+    const nlohmann::json& f = v["frames"][i];
+    EXPECT_TRUE(f["registered"].get<bool>()) << i;
+    const bool injected = kRotated.count(i) || kMoved.count(i);
+    EXPECT_EQ(f["flagged"].get<bool>(), injected) << "frame " << i << ": " << f.dump();
+  }
+  EXPECT_NEAR(v["frames"][11]["rotation_error_deg"].get<double>(), 1.0, 0.2);
+  EXPECT_TRUE(fs::is_regular_file(out + "/colmap/logs/07_image_registrator.log"));
+}
+
 // COLMAP logs through glog, which writes files of its own into the temporary folder (a dozen
 // a run, never removed) unless told to log to stderr: its log goes into the workspace's step
 // logs instead.

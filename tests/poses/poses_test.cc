@@ -434,6 +434,30 @@ TEST(Verify, AReconstructionThatDriftsIsToldFromWrongPoses) {
     ASSERT_TRUE(VerifyPoses(with_wrong, 45.0, judged, &r).ok());
     EXPECT_GT(r.flagged, 8) << "window " << window;
   }
+  // The odd frames registered between keyframes (not references): judged by the keyframes'
+  // fits and drift beside them, with the same flags (29 and 35 are odd), and the keyframes'
+  // own verdicts as with the keyframes alone.
+  std::vector<VerifyFrameInput> keyframes_only;
+  for (VerifyFrameInput& input : with_wrong) {
+    input.reference = std::stoi(input.name) % 2 == 0;
+    if (input.reference) keyframes_only.push_back(input);
+  }
+  for (int window : {0, 16}) {
+    VerifyOptions judged;
+    judged.window_frames = window;
+    VerifyResult r, alone;
+    ASSERT_TRUE(VerifyPoses(with_wrong, 45.0, judged, &r).ok());
+    ASSERT_TRUE(VerifyPoses(keyframes_only, 45.0, judged, &alone).ok());
+    std::vector<int> flagged;
+    for (int i = 0; i < n; ++i)
+      if (r.frames[i].flagged) flagged.push_back(i);
+    EXPECT_EQ(flagged, wrong) << "window " << window;
+    EXPECT_EQ(r.compared, n);
+    for (int i = 0; i < n; i += 2) {
+      EXPECT_EQ(r.frames[i].flagged, alone.frames[i / 2].flagged) << i;
+      EXPECT_DOUBLE_EQ(r.frames[i].rotation_error_deg, alone.frames[i / 2].rotation_error_deg) << i;
+    }
+  }
   const SyntheticColmap s(truth, drifting);
   BootstrapResult bootstrap;
   ASSERT_TRUE(BootstrapFromColmap(Project(), s.colmap, BootstrapOptions(), &bootstrap).ok());

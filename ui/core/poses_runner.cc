@@ -142,6 +142,7 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   working_.step_seconds = colmap->run.step_seconds;
   working_.matcher = colmap->run.matcher;
   working_.frames_offered = colmap->run.frames_offered;
+  working_.keyframes = colmap->run.keyframes;
   for (const ProjectColmapFrame& f : colmap->frames) working_.frame_index.push_back(f.index);
 
   // `fresco poses verify`: the table, verify.json and verify.png.

@@ -54,7 +54,8 @@ struct PosesSnapshot {
   double colmap_seconds = 0.0;
   std::vector<std::pair<std::string, double>> step_seconds;
   std::string matcher;     // "exhaustive" or "sequential" ("" for an earlier model)
-  int frames_offered = 0;  // frames before keyframe selection (`frames` were sent)
+  int frames_offered = 0;  // frames before keyframe selection
+  int keyframes = 0;       // of them, sent to COLMAP's mapper (the others registered later)
   // The verification (`fresco poses verify`): per frame in verify.frames, and the frame's
   // index in the project's video (where the pipeline goes to show it).
   bool verified = false;

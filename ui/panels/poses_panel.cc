@@ -231,8 +231,10 @@ class PosesPanel : public Panel {
     if (snap.reconstructed) {
       ImGui::Separator();
       if (!snap.matcher.empty())
-        ImGui::TextWrapped("%d of %d frames sent (keyframes), %s matching", snap.frames,
-                           snap.frames_offered, snap.matcher.c_str());
+        ImGui::TextWrapped(
+            "%d of %d frames reconstructed as keyframes, the others registered "
+            "to them; %s matching",
+            snap.keyframes, snap.frames_offered, snap.matcher.c_str());
       for (const auto& [step, seconds] : snap.step_seconds)
         ImGui::Text("  %-20s %6.1f s", step.c_str(), seconds);
     }
