@@ -55,6 +55,28 @@ double RelativeRotationDeg(const PosePair& self, const std::vector<PosePair>& pa
   return at_k.norm() * 180.0 / M_PI;
 }
 
+// Whether a flagged frame (`self`, its disagreement `own`) disagrees as the frames `around`
+// it (at `offsets` from it) do: within the thresholds of the robust line through their
+// disagreements (Theil-Sen per component), its rotation also by the rotations between it and
+// them (alignment-free; set in `v`).
+bool FollowsDrift(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
+                  const std::vector<PosePair>& pairs,
+                  const std::vector<Eigen::Matrix<double, 6, 1>>& disagreement,
+                  const std::vector<int>& around, const std::vector<double>& offsets,
+                  double rotation_threshold_deg, FrameVerdict* v) {
+  Eigen::Matrix<double, 6, 1> trend;
+  for (int c = 0; c < 6; ++c) {
+    std::vector<double> values;
+    for (int j : around) values.push_back(disagreement[j][c]);
+    trend[c] = TheilSenAtZero(offsets, values);
+  }
+  const Eigen::Matrix<double, 6, 1> residual = own - trend;
+  v->relative_rotation_deg = RelativeRotationDeg(self, pairs, around, offsets);
+  const bool rotation_follows =
+      residual.head<3>().norm() <= 1.0 || v->relative_rotation_deg <= rotation_threshold_deg;
+  return rotation_follows && residual.tail<3>().norm() <= 1.0;
+}
+
 }  // namespace
 
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
@@ -168,17 +190,8 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
       std::vector<double> offsets;
       for (int j : around) offsets.push_back(j - k);
-      Eigen::Matrix<double, 6, 1> trend;
-      for (int c = 0; c < 6; ++c) {
-        std::vector<double> values;
-        for (int j : around) values.push_back(disagreement[j][c]);
-        trend[c] = TheilSenAtZero(offsets, values);
-      }
-      const Eigen::Matrix<double, 6, 1> residual = disagreement[k] - trend;
-      v.relative_rotation_deg = RelativeRotationDeg(pairs[k], pairs, around, offsets);
-      const bool rotation_follows =
-          residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
-      if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
+      if (FollowsDrift(pairs[k], disagreement[k], pairs, disagreement, around, offsets,
+                       out.rotation_threshold_deg, &v)) {
         v.flagged = false;
         v.follows_drift = true;
         ++out.following_drift;
@@ -203,20 +216,10 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     if (static_cast<int>(around.size()) < std::min(h, n)) continue;
     std::vector<double> offsets;
     for (int j : around) offsets.push_back(j - (after - 0.5));
-    Eigen::Matrix<double, 6, 1> trend;
-    for (int c = 0; c < 6; ++c) {
-      std::vector<double> values;
-      for (int j : around) values.push_back(disagreement[j][c]);
-      trend[c] = TheilSenAtZero(offsets, values);
-    }
-    const Eigen::Matrix<double, 6, 1> residual =
-        DisagreementOf(others[o], fit.world_from_colmap, out.rotation_threshold_deg,
-                       out.position_threshold_m) -
-        trend;
-    v.relative_rotation_deg = RelativeRotationDeg(others[o], pairs, around, offsets);
-    const bool rotation_follows =
-        residual.head<3>().norm() <= 1.0 || v.relative_rotation_deg <= out.rotation_threshold_deg;
-    if (rotation_follows && residual.tail<3>().norm() <= 1.0) {
+    const Eigen::Matrix<double, 6, 1> own = DisagreementOf(
+        others[o], fit.world_from_colmap, out.rotation_threshold_deg, out.position_threshold_m);
+    if (FollowsDrift(others[o], own, pairs, disagreement, around, offsets,
+                     out.rotation_threshold_deg, &v)) {
       v.flagged = false;
       v.follows_drift = true;
       ++out.following_drift;
