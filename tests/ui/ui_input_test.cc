@@ -619,3 +619,51 @@ TEST(UiInput, DroppedFilesFillTheNewProjectFormOrThePathEditorOrOpenAProject) {
 
 }  // namespace
 }  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// The File menu's Open... and Save As...: a path typed into the submenu, then its item.
+// Returns the submenu's window after hovering `entry` (the File menu open).
+ImGuiWindow* OpenFileSubmenu(App& app, int entry) {
+  const float line = ImGui::GetFrameHeight();
+  app.Click(ImVec2(15, line / 2));  // "File" in the menu bar
+  ImGuiWindow* file = ImGui::FindWindowByName("##Menu_00");
+  EXPECT_NE(file, nullptr);
+  if (!file) return nullptr;
+  const float item = ImGui::GetTextLineHeight() + ImGui::GetStyle().ItemSpacing.y;
+  const ImVec2 at(file->Pos.x + 30, file->DC.CursorStartPos.y + (entry + 0.5f) * item);
+  app.MouseTo(at.x, at.y);
+  app.Frames(3);
+  ImGuiWindow* sub = ImGui::FindWindowByName("##Menu_01");
+  EXPECT_NE(sub, nullptr);
+  return sub;
+}
+
+TEST(UiInput, TheFileMenuSavesAsAndOpensATypedPath) {
+  App app(0);
+  const std::string copy = app.dir + "/capture/saved-from-menu.json";
+  ImGuiWindow* save_as = OpenFileSubmenu(app, 3);  // New project, Open, Save, Save As
+  ASSERT_NE(save_as, nullptr);
+  testing::TypeInto(app, save_as->Name, "##menu_save_as", copy);
+  EXPECT_EQ(app.ui.menu_path, copy);
+  ImGui::ActivateItem(save_as->GetID("Save As"));
+  app.Frames(2);
+  ASSERT_TRUE(fs::is_regular_file(copy)) << app.state.message;
+  EXPECT_EQ(app.state.project.file_path, copy);
+  // Back to the first through Open... (the field cleared, as a user selects and retypes).
+  const std::string first = app.dir + "/capture/project.json";
+  app.ui.menu_path.clear();
+  ImGuiWindow* open = OpenFileSubmenu(app, 1);
+  ASSERT_NE(open, nullptr);
+  testing::TypeInto(app, open->Name, "##menu_open", first);
+  ImGui::ActivateItem(open->GetID("Open"));
+  app.Frames(2);
+  app.runner.WaitIdle();
+  app.Frames(2);
+  EXPECT_EQ(app.state.project.file_path, first) << app.state.message;
+  EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+}
+
+}  // namespace
+}  // namespace fresco

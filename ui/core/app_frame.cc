@@ -5,6 +5,7 @@
 #include <string>
 
 #include "ui/panels/panels.h"
+#include "ui/panels/path_field.h"
 
 namespace fresco {
 namespace {
@@ -93,8 +94,21 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   if (!ImGui::BeginMainMenuBar()) return;
   if (ImGui::BeginMenu("File")) {
     if (ImGui::MenuItem("New project...")) ui.new_project_requested = true;
+    // Open and Save As take a path (typed, or picked with "..." from the folder typed so far).
+    if (ImGui::BeginMenu("Open...")) {
+      PathField("project", "##menu_open", "project.json to open", &ui.menu_path, {".json"});
+      if (ImGui::MenuItem("Open", nullptr, false, !ui.menu_path.empty()))
+        RequestOpen(ui, ui.menu_path);
+      ImGui::EndMenu();
+    }
     if (ImGui::MenuItem("Save", "Ctrl+S", false, state.has_project))
       if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
+    if (ImGui::BeginMenu("Save As...", state.has_project)) {
+      PathField("as", "##menu_save_as", "path for Save As", &ui.menu_path, {".json"});
+      if (ImGui::MenuItem("Save As", nullptr, false, !ui.menu_path.empty()))
+        if (Status s = state.Save(ui.menu_path); !s.ok()) state.message = "error: " + s.message();
+      ImGui::EndMenu();
+    }
     if (ImGui::BeginMenu("Open recent", !state.recent.empty())) {
       for (const std::string& path : state.recent)
         if (ImGui::MenuItem(path.c_str())) RequestOpen(ui, path);

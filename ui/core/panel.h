@@ -77,7 +77,8 @@ struct UiContext {
   bool new_project_requested = false;  // File > New project...: the app frame opens the form
   std::vector<std::string> dropped_paths = {};  // dropped on the window (DropPaths), not yet placed
   UiScale scale = {};                           // the monitor's and the user's (View > font scale)
-  float scale_applied = 0;  // what the fonts and style were last built for (ApplyUiScale)
+  float scale_applied = 0;     // what the fonts and style were last built for (ApplyUiScale)
+  std::string menu_path = {};  // File > Open... / Save As...: the path typed there
 };
 
 class Panel {
