@@ -85,9 +85,10 @@ PoseError ComparePose(const PosePair& pair, const Sim3d& world_from_colmap);
 // How the frames beyond the thresholds disagree, in sequence order (`pairs` in order): a
 // frame's disagreement is its rotation (world side, in units of `rotation_deg`) and centre
 // offset (in units of `position_m`) from the given pose to the aligned COLMAP pose. It is
-// smooth where a neighbour also disagrees and differs from it by under half its size: one
-// of the two (COLMAP's reconstruction or the given poses) drifts along the sequence, which
-// a wrong given pose here and there does not do.
+// smooth where a neighbour also disagrees and differs from it by under half its size, or
+// where the median of the 3 frames on each side does: one of the two (COLMAP's
+// reconstruction or the given poses) drifts along the sequence, which a wrong given pose
+// here and there does not do.
 struct Disagreement {
   int disagreeing = 0;        // frames beyond either threshold
   int smooth = 0;             // of those, the smooth ones
