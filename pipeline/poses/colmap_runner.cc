@@ -36,6 +36,16 @@ struct Step {
   std::vector<std::string> args;  // after the program
 };
 
+// The feature extraction's limits the options set (image size, features per image).
+void AddSiftLimits(const ColmapRunOptions& options, std::vector<std::string>* args) {
+  if (options.max_image_size > 0)
+    args->insert(args->end(),
+                 {"--SiftExtraction.max_image_size", std::to_string(options.max_image_size)});
+  if (options.max_num_features > 0)
+    args->insert(args->end(),
+                 {"--SiftExtraction.max_num_features", std::to_string(options.max_num_features)});
+}
+
 }  // namespace
 
 std::string FindColmap(const std::string& program) {
@@ -87,14 +97,7 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
       FRESCO_RETURN_IF_ERROR(WriteFileAtomic(list_path.string(), list));
       s.args.insert(s.args.end(), {"--image_list_path", list_path.string()});
     }
-    if (options.max_image_size > 0) {
-      s.args.insert(s.args.end(),
-                    {"--SiftExtraction.max_image_size", std::to_string(options.max_image_size)});
-    }
-    if (options.max_num_features > 0) {
-      s.args.insert(s.args.end(), {"--SiftExtraction.max_num_features",
-                                   std::to_string(options.max_num_features)});
-    }
+    AddSiftLimits(options, &s.args);
     steps.push_back(s);
   }
   int image_count = static_cast<int>(options.image_names.size());
@@ -208,14 +211,7 @@ Status RunColmap(const ColmapRunOptions& options, ColmapRunResult* result) {
                   options.image_path, "--image_list_path", list_path.string(),
                   "--ImageReader.existing_camera_id", "1", "--SiftExtraction.use_gpu", "0",
                   "--SiftExtraction.num_threads", threads}};
-    if (options.max_image_size > 0) {
-      extract.args.insert(extract.args.end(), {"--SiftExtraction.max_image_size",
-                                               std::to_string(options.max_image_size)});
-    }
-    if (options.max_num_features > 0) {
-      extract.args.insert(extract.args.end(), {"--SiftExtraction.max_num_features",
-                                               std::to_string(options.max_num_features)});
-    }
+    AddSiftLimits(options, &extract.args);
     const std::vector<Step> later = {
         extract,
         {"matches_importer",
