@@ -139,7 +139,9 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
   const bool ordered = folder_names.empty() || CentresLookOrdered(given_centres);
   std::vector<int> selected(offered.size());
   for (size_t i = 0; i < offered.size(); ++i) selected[i] = static_cast<int>(i);
-  if (ordered && options.existing_model.empty()) {  // an earlier model has its own frames
+  // With an earlier model, the keyframes are chosen as its run chose them: the frames of the
+  // model between them are judged as that run judged them.
+  if (ordered) {
     selected = SelectKeyframes(given_poses, options.keyframe_step_rel * result->scene_size_m,
                                options.keyframe_rotation_deg);
   }
@@ -154,7 +156,7 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
   for (size_t i = 0, k = 0; i < offered.size(); ++i) {
     while (k < selected.size() && selected[k] < static_cast<int>(i)) ++k;
     const bool keyframe = k < selected.size() && selected[k] == static_cast<int>(i);
-    if (keyframe || register_others) {
+    if (keyframe || register_others || !options.existing_model.empty()) {
       result->frames.push_back(offered[i]);
       result->frames.back().keyframe = keyframe;
     }

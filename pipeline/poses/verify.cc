@@ -23,16 +23,24 @@ Status VerifyOptions::Check() const {
 
 namespace {
 
-// The robust line (Theil-Sen: the median slope, then the median intercept) through (x, y),
-// at x = 0.
-double TheilSenAtZero(const std::vector<double>& x, const std::vector<double>& y) {
+// The robust line (Theil-Sen: the median slope, then the median intercept) through (x, y).
+struct RobustLine {
+  double slope = 0.0, at_zero = 0.0;
+  double At(double x) const { return at_zero + slope * x; }
+};
+RobustLine TheilSen(const std::vector<double>& x, const std::vector<double>& y) {
   std::vector<double> slopes, at_zero;
   for (size_t a = 0; a < x.size(); ++a)
     for (size_t b = a + 1; b < x.size(); ++b)
       if (x[b] != x[a]) slopes.push_back((y[b] - y[a]) / (x[b] - x[a]));
-  const double slope = slopes.empty() ? 0.0 : Median(slopes);
-  for (size_t a = 0; a < x.size(); ++a) at_zero.push_back(y[a] - slope * x[a]);
-  return Median(at_zero);
+  RobustLine line;
+  line.slope = slopes.empty() ? 0.0 : Median(slopes);
+  for (size_t a = 0; a < x.size(); ++a) at_zero.push_back(y[a] - line.slope * x[a]);
+  line.at_zero = Median(at_zero);
+  return line;
+}
+double TheilSenAtZero(const std::vector<double>& x, const std::vector<double>& y) {
+  return TheilSen(x, y).at_zero;
 }
 
 // Pair k's given rotation against its neighbours' (the pairs `around`, at `offsets` from k),
@@ -58,23 +66,51 @@ double RelativeRotationDeg(const PosePair& self, const std::vector<PosePair>& pa
 // Whether a flagged frame (`self`, its disagreement `own`) disagrees as the frames `around`
 // it (at `offsets` from it) do: within the thresholds of the robust line through their
 // disagreements (Theil-Sen per component), its rotation also by the rotations between it and
-// them (alignment-free; set in `v`).
+// them (alignment-free; set in `v`). Where the neighbours themselves scatter about that line
+// by more than the thresholds, in rotation or position (a reconstruction that bends faster
+// and faster, degrees a frame), the tolerance (in units of the thresholds, set in `v`) widens
+// by kDriftScatter times the excess of their median distance from it: a frame stands out only
+// from what its neighbours do. Neighbours within the thresholds (given poses with noise below
+// them) leave it at 1.
+constexpr double kDriftScatter = 3.0;
+double DriftTolerance(const std::vector<double>& scatter) {
+  return 1.0 + kDriftScatter * std::max(0.0, Median(scatter) - 1.0);
+}
 bool FollowsDrift(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
                   const std::vector<PosePair>& pairs,
                   const std::vector<Eigen::Matrix<double, 6, 1>>& disagreement,
                   const std::vector<int>& around, const std::vector<double>& offsets,
                   double rotation_threshold_deg, FrameVerdict* v) {
-  Eigen::Matrix<double, 6, 1> trend;
+  RobustLine lines[6];
   for (int c = 0; c < 6; ++c) {
     std::vector<double> values;
     for (int j : around) values.push_back(disagreement[j][c]);
-    trend[c] = TheilSenAtZero(offsets, values);
+    lines[c] = TheilSen(offsets, values);
   }
-  const Eigen::Matrix<double, 6, 1> residual = own - trend;
+  std::vector<double> scatter_rotation, scatter_position;
+  for (size_t a = 0; a < around.size(); ++a) {
+    Eigen::Matrix<double, 6, 1> off;
+    for (int c = 0; c < 6; ++c) off[c] = disagreement[around[a]][c] - lines[c].At(offsets[a]);
+    scatter_rotation.push_back(off.head<3>().norm());
+    scatter_position.push_back(off.tail<3>().norm());
+  }
+  const double tolerance =
+      std::max(DriftTolerance(scatter_rotation), DriftTolerance(scatter_position));
+  v->drift_tolerance = tolerance;
+  Eigen::Matrix<double, 6, 1> residual;
+  for (int c = 0; c < 6; ++c) residual[c] = own[c] - lines[c].at_zero;
   v->relative_rotation_deg = RelativeRotationDeg(self, pairs, around, offsets);
   const bool rotation_follows =
-      residual.head<3>().norm() <= 1.0 || v->relative_rotation_deg <= rotation_threshold_deg;
-  return rotation_follows && residual.tail<3>().norm() <= 1.0;
+      residual.head<3>().norm() <= tolerance || v->relative_rotation_deg <= rotation_threshold_deg;
+  return rotation_follows && residual.tail<3>().norm() <= tolerance;
+}
+
+// Counts a frame let through as following the drift with a widened tolerance.
+void NoteWidened(const FrameVerdict& v, VerifyResult* out) {
+  if (v.drift_tolerance <= 1.0) return;
+  ++out->widened;
+  out->widest_tolerance_deg =
+      std::max(out->widest_tolerance_deg, v.drift_tolerance * out->rotation_threshold_deg);
 }
 
 }  // namespace
@@ -195,11 +231,14 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         v.flagged = false;
         v.follows_drift = true;
         ++out.following_drift;
+        NoteWidened(v, &out);
       }
     }
   }
   // The other frames (between keyframes), each by the fit of the keyframe after it (or the
-  // last) and, where the disagreement drifts, against the keyframes on either side of it.
+  // last) and, where the disagreement drifts, against the keyframes around it: the line
+  // through theirs, or between the two on either side of it (in proportion to where it sits
+  // between them) where neither of those is flagged.
   for (size_t o = 0; o < others.size() && n > 0; ++o) {
     const int after = keyframes_before_other[o];  // it sits between keyframes after-1 and after
     const PoseAlignment& fit = fits[window_of[std::min(after, n - 1)]];
@@ -214,15 +253,35 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     std::vector<int> around;
     for (int j = std::max(0, after - h); j < std::min(n, after + h); ++j) around.push_back(j);
     if (static_cast<int>(around.size()) < std::min(h, n)) continue;
+    // Where it sits between keyframes after-1 and after (0.5 before the first or after the last).
+    double between = 0.5;
+    const bool inside = after > 0 && after < n;
+    if (inside) {
+      between = static_cast<double>(frame_of_other[o] - frame_of_pair[after - 1]) /
+                (frame_of_pair[after] - frame_of_pair[after - 1]);
+    }
     std::vector<double> offsets;
-    for (int j : around) offsets.push_back(j - (after - 0.5));
+    for (int j : around) offsets.push_back(j - (after - 1 + between));
     const Eigen::Matrix<double, 6, 1> own = DisagreementOf(
         others[o], fit.world_from_colmap, out.rotation_threshold_deg, out.position_threshold_m);
-    if (FollowsDrift(others[o], own, pairs, disagreement, around, offsets,
-                     out.rotation_threshold_deg, &v)) {
+    bool follows = FollowsDrift(others[o], own, pairs, disagreement, around, offsets,
+                                out.rotation_threshold_deg, &v);
+    if (!follows && inside && !out.frames[frame_of_pair[after - 1]].flagged &&
+        !out.frames[frame_of_pair[after]].flagged) {
+      const Eigen::Matrix<double, 6, 1> expected =
+          (1 - between) * DisagreementOf(pairs[after - 1], fit.world_from_colmap,
+                                         out.rotation_threshold_deg, out.position_threshold_m) +
+          between * DisagreementOf(pairs[after], fit.world_from_colmap, out.rotation_threshold_deg,
+                                   out.position_threshold_m);
+      const Eigen::Matrix<double, 6, 1> residual = own - expected;
+      follows = residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0;
+      if (follows) v.drift_tolerance = 1.0;
+    }
+    if (follows) {
       v.flagged = false;
       v.follows_drift = true;
       ++out.following_drift;
+      NoteWidened(v, &out);
     }
   }
   std::vector<double> rotations, positions;
@@ -280,6 +339,14 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
                     "(following the drift, not flagged), %d stand out (flagged).",
                     result.following_drift, result.flagged);
       note += text;
+      if (result.widened > 0) {
+        std::snprintf(text, sizeof(text),
+                      " Where the neighbours themselves scatter beyond the thresholds (a "
+                      "reconstruction bending unevenly), %d of them were judged only to within "
+                      "%.2g deg.",
+                      result.widened, result.widest_tolerance_deg);
+        note += text;
+      }
     } else {
       note += ", and flags in that stretch may be the reconstruction's.";
     }

@@ -50,6 +50,9 @@ struct FrameVerdict {
   // neighbours' given rotations and COLMAP's rotations between them imply (alignment-free;
   // < 0: not measured).
   double relative_rotation_deg = -1.0;
+  // Where judged against the drift: how far it may stand out from its neighbours' line, in
+  // units of the thresholds (1, or more where the neighbours scatter more; 0: not judged).
+  double drift_tolerance = 0.0;
   bool inlier = false;  // supported the (global or its local) alignment
 };
 
@@ -84,6 +87,12 @@ struct VerifyResult {
   // frames beyond the thresholds were let through as following it.
   bool drift_followed = false;
   int following_drift = 0;
+  // Of the frames following the drift, those judged with a wider tolerance (their neighbours
+  // scatter beyond the thresholds: a reconstruction bending unevenly), and the widest, as a
+  // rotation (the tolerance times rotation_threshold_deg): a given pose wrong by less than
+  // that goes unnoticed there.
+  int widened = 0;
+  double widest_tolerance_deg = 0.0;
   // Statistics of the unflagged frames that agree within the thresholds (those following a
   // drift left out): how well COLMAP and the poses agree; zero when `unflagged` is 0.
   int unflagged = 0;

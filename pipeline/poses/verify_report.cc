@@ -73,6 +73,9 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
     f["flagged"] = v.flagged;
     f["follows_drift"] = v.follows_drift;
     if (v.relative_rotation_deg >= 0) f["relative_rotation_deg"] = v.relative_rotation_deg;
+    if (v.drift_tolerance > 0) {
+      f["drift_tolerance_deg"] = v.drift_tolerance * result.rotation_threshold_deg;
+    }
     frames.push_back(f);
   }
   const Sim3d& s = result.world_from_colmap;
@@ -109,7 +112,9 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
         {"first", result.drift_first},
         {"last", result.drift_last},
         {"followed", result.drift_followed},
-        {"following_frames", result.following_drift}}},
+        {"following_frames", result.following_drift},
+        {"widened_frames", result.widened},
+        {"widest_tolerance_deg", result.widest_tolerance_deg}}},
       {"notes", VerifyNotes(result)},
       {"agreement_unflagged",
        {{"frames", result.unflagged},
