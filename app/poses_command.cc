@@ -172,8 +172,9 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
     return kExitFailure;
   }
   const bool quiet = args.Switch("--quiet");
-  Progress progress("colmap", 5, quiet);
+  Progress progress("colmap", 5, quiet);  // the runner gives the steps' count as it starts
   options.colmap.progress = [&](const std::string& step, int index, int total) {
+    progress.SetTotal(total);
     if (!quiet && index < total) progress.Update(index, step);
   };
   bool bad_input = false;

@@ -18,6 +18,8 @@ class Progress {
   // `total` < 0: unknown (a live stream), shown as "?".
   Progress(std::string label, int total, bool quiet = false);
   void Update(int done, const std::string& detail = "");
+  // The total once it is known better than at the start (e.g. steps added on the way).
+  void SetTotal(int total) { total_ = total; }
   void Finish(const std::string& detail = "");
   // Erases the bar (terminal only) so that a message can take its line.
   void Clear();

@@ -181,6 +181,9 @@ TEST_F(PosesColmapTest, FramesBetweenKeyframesAreRegisteredAndJudgedToo) {
   }
   EXPECT_NEAR(v["frames"][11]["rotation_error_deg"].get<double>(), 1.0, 0.2);
   EXPECT_TRUE(fs::is_regular_file(out + "/colmap/logs/07_image_registrator.log"));
+  // The progress counts the registration's steps too (it said 5 steps, then went past them).
+  EXPECT_TRUE(std::regex_search(r.err, std::regex(R"(colmap: 6/8 \([0-9.]+s\) image_registrator)")))
+      << r.err;
 }
 
 // COLMAP logs through glog, which writes files of its own into the temporary folder (a dozen
