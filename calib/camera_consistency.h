@@ -28,4 +28,10 @@ std::vector<std::string> ImageSizeDoubts(const CalibrationRun& run);
 // and splits over kSplitSigmaRatio) and adds them to run->warnings.
 void CheckOneCamera(const CalibrateRequest& request, CalibrationRun* run);
 
+// The same before any solve, right after detection (the app's "enough data yet?" light):
+// the views seeded, both splits and the joint fit solved with kBeforeSolvingModel. Sets
+// run->split_tests and run->camera_doubts (not the warnings); a few seconds for 30 views.
+constexpr const char* kBeforeSolvingModel = "opencv4";
+void CheckOneCameraBeforeSolving(const CalibrateRequest& request, CalibrationRun* run);
+
 }  // namespace fresco::calib

@@ -35,12 +35,17 @@ std::string LinkImages(const std::string& tag, const std::vector<std::string>& p
   return dir.string();
 }
 
-CalibrationRun Calibrate(const std::string& dir, const std::vector<std::string>& exclude) {
+CalibrateRequest Request(const std::string& dir) {
   CalibrateRequest request;
   request.images_dir = dir;
   request.board = Spec("chessboard:9x6:0.025");
   request.model = "opencv4";
   request.cross_validate = false;
+  return request;
+}
+
+CalibrationRun Calibrate(const std::string& dir, const std::vector<std::string>& exclude) {
+  CalibrateRequest request = Request(dir);
   request.exclude = exclude;
   CalibrationRun run;
   Status s = DetectViews(request, &run);
@@ -81,6 +86,57 @@ TEST(OneCameraTest, TwoImageSizesAreADoubtAndKeepTheLightOffGreen) {
   EXPECT_EQ(mixed.reasons.back(), doubts[0]);
 }
 
+// Two cameras of one image size (a stereo pair: focal lengths 600 and 660 px, principal
+// points 30 px apart), 14 views each, in one folder: the split test before any solve finds
+// them, and the "enough data" light stays off green from detection on; one camera's 28 views
+// raise no doubt.
+TEST(OneCameraTest, TwoCamerasOfOneSizeAreFoundBeforeSolving) {
+  const BoardSpec spec = Spec("chessboard:9x6:0.025");
+  const auto views_of = [&](const std::string& stem, std::vector<double> intrinsics,
+                            unsigned seed) {
+    SyntheticCapture capture;
+    capture.views = 14;
+    capture.intrinsics = std::move(intrinsics);
+    capture.seed = seed;
+    std::vector<BoardView> views = SyntheticViews(spec, capture);
+    for (size_t i = 0; i < views.size(); ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "%s%02zu.png", stem.c_str(), i + 1);
+      views[i].name = name;
+    }
+    return views;
+  };
+  CalibrateRequest request;
+  request.board = spec;
+  CalibrationRun mixed;
+  mixed.width = 640;
+  mixed.height = 480;
+  mixed.image_sizes = {{"640x480", 28}};
+  mixed.views = views_of("left", {600, 605, 322, 238}, 7);
+  for (BoardView& v : views_of("right", {660, 665, 292, 250}, 8)) mixed.views.push_back(v);
+  CheckOneCameraBeforeSolving(request, &mixed);
+  ASSERT_FALSE(mixed.split_tests.empty());
+  for (const SplitTest& t : mixed.split_tests)
+    std::printf("two cameras: %s: ratio %.2f\n", t.how.c_str(), t.ratio);
+  EXPECT_EQ(mixed.split_tests[0].how, "file names left* / right*");
+  ASSERT_FALSE(mixed.camera_doubts.empty());
+  EXPECT_NE(mixed.camera_doubts[0].find("look like two cameras"), std::string::npos);
+  CalibrationSeed seed;
+  ASSERT_TRUE(SeedCalibration(mixed.views, spec, 640, 480, &seed).ok());
+  EXPECT_NE(AssessReadiness(mixed.views, 640, 480, &seed, mixed.camera_doubts).level,
+            DataReadiness::Level::kGreen);
+
+  CalibrationRun one = mixed;
+  one.views = views_of("left", {600, 605, 322, 238}, 7);
+  for (BoardView& v : views_of("right", {600, 605, 322, 238}, 8)) one.views.push_back(v);
+  CheckOneCameraBeforeSolving(request, &one);
+  for (const SplitTest& t : one.split_tests) {
+    std::printf("one camera: %s: ratio %.2f\n", t.how.c_str(), t.ratio);
+    EXPECT_LT(t.ratio, kSplitSigmaRatio) << t.how;
+  }
+  EXPECT_TRUE(one.camera_doubts.empty());
+}
+
 TEST(OneCameraRealDataTest, MixedLeftAndRightImagesAreFlaggedAndExclusionFixesIt) {
   if (StereoDir().empty())
     GTEST_SKIP() << "../shared/data/opencv-chessboard-stereo is absent: real-data check skipped";
@@ -97,6 +153,13 @@ TEST(OneCameraRealDataTest, MixedLeftAndRightImagesAreFlaggedAndExclusionFixesIt
       AssessReadiness(mixed.views, mixed.width, mixed.height, &mixed.seed, mixed.camera_doubts)
           .level,
       DataReadiness::Level::kGreen);
+  // Found before solving too (right after detection, as the app's light shows it).
+  CalibrationRun detected = mixed;
+  detected.choice = {};
+  CheckOneCameraBeforeSolving(Request(""), &detected);
+  ASSERT_FALSE(detected.split_tests.empty());
+  std::printf("mixed, before solving: ratio %.3f\n", detected.split_tests[0].ratio);
+  EXPECT_FALSE(detected.camera_doubts.empty());
 
   // The same folder with the right camera's images excluded: one camera, no doubt.
   const CalibrationRun left = Calibrate(LinkImages("mixed", {"left", "right"}), {"right*"});

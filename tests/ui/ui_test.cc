@@ -343,18 +343,24 @@ std::string ChessboardLeftImages() {
   return dir;
 }
 
+// Detects the 9x6 chessboard of opencv-chessboard-stereo in `dir` (model opencv4) and waits.
+std::shared_ptr<const CalibrationSnapshot> DetectChessboard(const std::string& dir,
+                                                            CalibrationRunner* runner) {
+  calib::CalibrateRequest request;
+  request.images_dir = dir;
+  EXPECT_TRUE(calib::ParseBoardSpec("chessboard:9x6:0.025", "board", &request.board).ok());
+  request.model = "opencv4";
+  runner->Detect(request);
+  runner->WaitIdle();
+  return runner->Snapshot();
+}
+
 // The calibration worker: detections arrive image by image, the light turns from red once
 // kMinViews boards are seen, the solve picks the requested model, Save writes what the CLI does.
 TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   FRESCO_REQUIRE_SHARED_DATA();
-  calib::CalibrateRequest request;
-  request.images_dir = ChessboardLeftImages();
-  ASSERT_TRUE(calib::ParseBoardSpec("chessboard:9x6:0.025", "board", &request.board).ok());
-  request.model = "opencv4";
   CalibrationRunner runner;
-  runner.Detect(request);
-  runner.WaitIdle();
-  auto snap = runner.Snapshot();
+  auto snap = DetectChessboard(ChessboardLeftImages(), &runner);
   EXPECT_EQ(snap->images.size(), 13u);
   EXPECT_EQ(snap->images_done, 13);
   EXPECT_EQ(snap->run.views.size(), 13u);
@@ -408,6 +414,36 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   runner.WaitIdle();
   EXPECT_EQ(runner.Snapshot()->run.views.size(), 13u);
   EXPECT_TRUE(runner.Snapshot()->run.excluded.empty());
+}
+
+// A folder with both cameras of opencv-chessboard-stereo (left and right images, one size):
+// after Detect, before any solve, the light is off green and the panel's reason says two
+// cameras; once the right images are ticked off (13 in a row, checked once after the last),
+// the doubt is gone.
+TEST(CalibrationRunner, AFolderOfTwoCamerasIsToldRightAfterDetection) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string data = fresco::testing::SharedDataDir() + "/opencv-chessboard-stereo";
+  const std::string dir = MakeTempDir("ui-calib-mixed") + "/both";
+  fs::create_directories(dir);
+  for (const auto& e : fs::directory_iterator(data))
+    if (e.path().extension() == ".jpg")
+      fs::copy(e.path(), dir + "/" + e.path().filename().string());
+  CalibrationRunner runner;
+  auto snap = DetectChessboard(dir, &runner);
+  EXPECT_EQ(snap->run.views.size(), 26u);
+  EXPECT_FALSE(snap->solved);
+  ASSERT_FALSE(snap->run.camera_doubts.empty());
+  EXPECT_NE(snap->run.camera_doubts[0].find("look like two cameras"), std::string::npos);
+  EXPECT_NE(snap->readiness.level, calib::DataReadiness::Level::kGreen);
+  EXPECT_NE(std::find(snap->readiness.reasons.begin(), snap->readiness.reasons.end(),
+                      snap->run.camera_doubts[0]),
+            snap->readiness.reasons.end());
+  for (const CalibrationImage& image : snap->images)
+    if (image.name.rfind("right", 0) == 0) runner.Exclude(image.name, true);
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_EQ(snap->run.views.size(), 13u);
+  EXPECT_TRUE(snap->run.camera_doubts.empty()) << snap->run.camera_doubts[0];
 }
 
 // Every third image of aprilgrid-yac-mocap's cam0 (10 of 30): a real Kalibr AprilGrid.

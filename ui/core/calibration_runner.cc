@@ -138,10 +138,19 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
     RebuildViews();
     UpdateReadiness();
   }
+  CheckOneCamera();
   working_.status = "detected: board in " + std::to_string(working_.run.views.size()) + " of " +
                     std::to_string(working_.images.size()) + " images";
   if (!working_.run.excluded.empty())
     working_.status += " (" + std::to_string(working_.run.excluded.size()) + " excluded)";
+}
+
+void CalibrationRunner::CheckOneCamera() {
+  working_.status =
+      "checking that the " + std::to_string(working_.run.views.size()) + " images are one camera's";
+  Publish();
+  calib::CheckOneCameraBeforeSolving(working_.request, &working_.run);
+  UpdateReadiness();
 }
 
 void CalibrationRunner::RebuildViews() {
@@ -170,11 +179,16 @@ void CalibrationRunner::RunExclude(const std::string& name, bool excluded) {
     working_.solved = false;
     working_.run.choice = {};
     working_.run.warnings.clear();
-    working_.run.split_tests.clear();
-    working_.run.camera_doubts = calib::ImageSizeDoubts(working_.run);
     working_.residuals_picture = cv::Mat();
     working_.uncertainty_picture = cv::Mat();
   }
+  bool more_queued = false;  // several images ticked in a row: check once, after the last
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (const Command& later : queue_)
+      more_queued |= later.kind == Command::kExclude || later.kind == Command::kInclude;
+  }
+  if (!more_queued) CheckOneCamera();
   UpdateReadiness();
   working_.status = (excluded ? "excluded " : "included ") + name + ": " +
                     std::to_string(working_.run.views.size()) + " images used; solve again";

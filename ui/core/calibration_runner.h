@@ -75,6 +75,9 @@ class CalibrationRunner {
   void RunExclude(const std::string& name, bool excluded);
   void RebuildViews();  // run.views from the images used and not excluded
   void UpdateReadiness();
+  // The split test before any solve (calib::CheckOneCameraBeforeSolving): a folder mixing two
+  // cameras keeps the light off green from detection on.
+  void CheckOneCamera();
   void Publish();
 
   mutable std::mutex mutex_;
