@@ -143,12 +143,13 @@ struct HeadlessApp {
     input.mouse_down[0] = false;
     Frame();
   }
-  void Click(ImVec2 at) {
+  // Presses and releases mouse `button` (0 left, 1 right) at `at`.
+  void Click(ImVec2 at, int button = 0) {
     MouseTo(at.x, at.y);
     Frame();
-    input.mouse_down[0] = true;
+    input.mouse_down[button] = true;
     Frame();
-    input.mouse_down[0] = false;
+    input.mouse_down[button] = false;
     Frame();
   }
   Panel& Find(const std::string& title) {

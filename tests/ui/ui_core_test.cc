@@ -264,7 +264,7 @@ TEST(UiScaleTest, FontsAreBuiltAtTheScaleAndRebuiltOnlyWhenItChanges) {
   ImGui::DestroyContext();
 }
 
-TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {
+TEST(LayoutFile, SplittersPlacesAndFontScaleSurviveARestart) {
   const std::string dir = testing::MakeTempDir("ui-layout");
   SavedLayout saved;
   std::vector<float> fractions = saved.layout.Fractions();
@@ -272,12 +272,21 @@ TEST(LayoutFile, SplittersAndFontScaleSurviveARestart) {
   fractions[0] = 0.31f;
   fractions.back() = 0.66f;
   saved.layout.SetFractions(fractions);
+  ASSERT_TRUE(saved.layout.Swap("3D view", "Grouping"));  // places swapped too
   saved.font_scale = 1.5f;
   ASSERT_TRUE(SaveLayoutFile(dir + "/cfg/layout.json", saved).ok());
   SavedLayout loaded;
   ASSERT_TRUE(LoadLayoutFile(dir + "/cfg/layout.json", &loaded).ok());
   EXPECT_EQ(loaded.layout.Fractions(), fractions);
+  EXPECT_EQ(loaded.layout.Panels(), saved.layout.Panels());
+  EXPECT_NE(loaded.layout.Panels(), DefaultTileLayout().Panels());
   EXPECT_EQ(loaded.font_scale, 1.5f);
+  // Panels that are not a reordering of the app's (another version's) are ignored.
+  std::ofstream(dir + "/renamed.json")
+      << R"({"fractions": [], "panels": ["3D view", "Gone"], "font_scale": 1})";
+  SavedLayout renamed;
+  ASSERT_TRUE(LoadLayoutFile(dir + "/renamed.json", &renamed).ok());
+  EXPECT_EQ(renamed.layout.Panels(), DefaultTileLayout().Panels());
   // No file: the defaults, no error.
   SavedLayout fresh;
   EXPECT_TRUE(LoadLayoutFile(dir + "/none.json", &fresh).ok());

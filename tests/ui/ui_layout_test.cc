@@ -148,6 +148,36 @@ TEST(UiLayout, DoubleClickOnATitleBarMaximisesAndRestores) {
   EXPECT_TRUE(LayoutApp::Shown("3D view"));
 }
 
+// A right-click on a title bar offers the other tiled panels; choosing one swaps the two
+// panels' tiles (here the 3D view goes where the timing was, and back).
+TEST(UiLayout, ARightClickOnATitleBarSwapsPlacesWithAnotherPanel) {
+  LayoutApp app({1600, 1000});
+  ImGuiWindow* view = LayoutApp::Window("3D view");
+  ImGuiWindow* timing = LayoutApp::Window("Timing");
+  const ImVec2 view_pos = view->Pos, view_size = view->Size, timing_pos = timing->Pos;
+  app.Click(ImVec2(view_pos.x + 30, view_pos.y + 4), 1);
+  const ImGuiID item = [&] {
+    ImGuiWindow* popup = nullptr;
+    for (ImGuiWindow* w : ImGui::GetCurrentContext()->Windows)
+      if ((w->Flags & ImGuiWindowFlags_Popup) && w->Active) popup = w;
+    EXPECT_TRUE(popup) << "no menu after a right-click on the title";
+    return popup ? popup->GetID("Timing") : 0;
+  }();
+  ASSERT_NE(item, 0u);
+  ImGui::ActivateItem(item);
+  app.Frames(3);
+  EXPECT_EQ(view->Pos.x, timing_pos.x);
+  EXPECT_EQ(view->Pos.y, timing_pos.y);
+  EXPECT_EQ(timing->Pos.x, view_pos.x);
+  EXPECT_EQ(timing->Size.x, view_size.x);
+  EXPECT_EQ(app.state.message, "3D view and Timing swapped places");
+  ASSERT_TRUE(app.ui.layout.Swap("3D view", "Timing"));
+  app.Frames(2);
+  EXPECT_EQ(view->Pos.x, view_pos.x);
+  EXPECT_EQ(view->Size.y, view_size.y);
+  EXPECT_FALSE(app.ui.layout.Swap("3D view", "no such panel"));
+}
+
 TEST(UiLayout, AClosedPanelGivesItsSpaceToItsNeighbour) {
   LayoutApp app({1600, 1000});
   ImGuiWindow* view = LayoutApp::Window("3D view");

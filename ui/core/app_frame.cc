@@ -15,7 +15,8 @@ const ImVec4 kErrorColour(1.0f, 0.4f, 0.4f, 1.0f);
 // ImGui 1.86 indexes io.KeysDown by the backend's key codes: GLFW_KEY_F5 (letters are
 // their ASCII capitals there, as 'S' below).
 constexpr int kKeyF5 = 294;
-constexpr float kSplitterPx = 5;   // the bars between tiled panels
+constexpr float kSplitterPx = 5;  // the bars between tiled panels
+constexpr const char* kSwapPopup = "##swap places";
 constexpr float kMinTilePx = 120;  // a splitter stops before a side gets narrower
 constexpr float kMinFontScale = 0.75f, kMaxFontScale = 2.0f;
 
@@ -297,6 +298,23 @@ void ApplyProject(UiContext& ui) {
   if (frame >= 0) ui.runner->Seek(frame);
 }
 
+// The menu a right-click on a tiled panel's title opens: the other tiled panels, to swap
+// places with (the layout file keeps the places).
+void DrawSwapMenu(UiContext& ui, const std::vector<std::unique_ptr<Panel>>& panels) {
+  if (!ImGui::BeginPopup(kSwapPopup)) return;
+  ImGui::TextDisabled("Swap places of %s with", ui.swapping.c_str());
+  ImGui::Separator();
+  for (const auto& panel : panels) {
+    const std::string title = panel->Title();
+    if (title == ui.swapping || !ui.layout.Contains(title)) continue;
+    if (ImGui::MenuItem(title.c_str(), nullptr, false, panel->open)) {
+      ui.layout.Swap(ui.swapping, title);
+      ui.state->message = ui.swapping + " and " + title + " swapped places";
+    }
+  }
+  ImGui::EndPopup();
+}
+
 void ConfigureImGui(ImGuiIO* io) { io->ConfigWindowsMoveFromTitleBarOnly = true; }
 
 void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
@@ -316,7 +334,13 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
       panel->Draw(ui);
     if (panel->maximise_requested) ui.layout.ToggleMaximised(panel->Title());
     panel->maximise_requested = false;
+    if (panel->swap_menu_requested) {
+      ui.swapping = panel->Title();
+      ImGui::OpenPopup(kSwapPopup);
+    }
+    panel->swap_menu_requested = false;
   }
+  DrawSwapMenu(ui, panels);
   DrawSplitters(&ui.layout, splitters);
   DrawUnsavedPrompt(ui);
   DrawStatusBar(ui);

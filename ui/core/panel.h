@@ -79,6 +79,7 @@ struct UiContext {
   UiScale scale = {};                           // the monitor's and the user's (View > font scale)
   float scale_applied = 0;     // what the fonts and style were last built for (ApplyUiScale)
   std::string menu_path = {};  // File > Open... / Save As...: the path typed there
+  std::string swapping = {};   // the panel whose "swap places" menu is open
 };
 
 class Panel {
@@ -105,6 +106,8 @@ class Panel {
   ImVec2 tile_pos, tile_size;
   // A double-click on a tiled panel's title bar: the app frame maximises or restores it.
   bool maximise_requested = false;
+  // A right-click on it: the app frame offers the other tiled panels to swap places with.
+  bool swap_menu_requested = false;
 };
 
 // Every panel, in menu order (panel_registry.cc).

@@ -23,8 +23,10 @@ bool BeginPanel(Panel& panel) {
     const bool on_title = ImGui::IsWindowHovered() && ImGui::GetIO().MousePos.y < title_bottom;
     if (on_title && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left))
       panel.maximise_requested = true;
+    if (on_title && ImGui::IsMouseClicked(ImGuiMouseButton_Right)) panel.swap_menu_requested = true;
     if (on_title)  // the whole title where a narrow tile cuts it short
-      ImGui::SetTooltip("%s (double-click: maximise / restore)", panel.Title());
+      ImGui::SetTooltip("%s (double-click: maximise / restore; right-click: swap places)",
+                        panel.Title());
     return visible;
   }
   const float sx = display.x / 1600.0f, sy = display.y / 1000.0f;

@@ -90,6 +90,37 @@ void TileLayout::ToggleMaximised(const std::string& title) {
   maximised_ = maximised_ == title ? "" : title;
 }
 
+bool TileLayout::Swap(const std::string& a, const std::string& b) {
+  Node* na = nullptr;
+  Node* nb = nullptr;
+  for (Node& n : nodes_) {
+    if (n.a >= 0) continue;
+    if (n.panel == a) na = &n;
+    if (n.panel == b) nb = &n;
+  }
+  if (!na || !nb) return false;
+  std::swap(na->panel, nb->panel);
+  return true;
+}
+
+std::vector<std::string> TileLayout::Panels() const {
+  std::vector<std::string> panels;
+  for (const Node& n : nodes_)
+    if (n.a < 0) panels.push_back(n.panel);
+  return panels;
+}
+
+bool TileLayout::SetPanels(const std::vector<std::string>& panels) {
+  std::vector<std::string> have = Panels(), want = panels;
+  std::sort(have.begin(), have.end());
+  std::sort(want.begin(), want.end());
+  if (have != want) return false;
+  size_t k = 0;
+  for (Node& n : nodes_)
+    if (n.a < 0) n.panel = panels[k++];
+  return true;
+}
+
 std::vector<float> TileLayout::Fractions() const {
   std::vector<float> f;
   for (const Node& n : nodes_)

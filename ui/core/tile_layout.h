@@ -1,6 +1,7 @@
 // The app's tiled layout, pure logic (no ImGui): a tree of splits whose leaves are panels.
 // Every split has a draggable splitter between its two sides; a closed panel gives its
-// space to its neighbour; one panel can be maximised over the whole band and restored.
+// space to its neighbour; one panel can be maximised over the whole band and restored; two
+// panels can swap places.
 #pragma once
 
 #include <functional>
@@ -43,9 +44,16 @@ class TileLayout {
   const std::string& maximised() const { return maximised_; }
   void ToggleMaximised(const std::string& title);
 
+  // Panels `a` and `b` (both tiled) swap their tiles; false when either is not tiled.
+  bool Swap(const std::string& a, const std::string& b);
+
   // Every split's fraction, in node order (to save and restore a layout of the same tree).
   std::vector<float> Fractions() const;
   void SetFractions(const std::vector<float>& fractions);
+  // The panel of every leaf, in node order (to save and restore swapped places); SetPanels
+  // takes only a reordering of the same panels, else changes nothing and returns false.
+  std::vector<std::string> Panels() const;
+  bool SetPanels(const std::vector<std::string>& panels);
 
  private:
   struct Node {
