@@ -25,6 +25,7 @@
 #include "ui/core/group_colour.h"
 #include "ui/core/image_view.h"
 #include "ui/core/input_queue.h"
+#include "ui/core/project_paths.h"
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -663,6 +664,54 @@ TEST(UiInput, TheFileMenuSavesAsAndOpensATypedPath) {
   app.Frames(2);
   EXPECT_EQ(app.state.project.file_path, first) << app.state.message;
   EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+}
+
+// The "..." beside a path field browses: a folder opens in place (the list stays open), the
+// entry above goes up, only the fitting files are listed, and picking a file fills the field
+// and closes the list.
+TEST(UiInput, ThePathFieldBrowsesFoldersUpAndDownAndPicksAFile) {
+  App app(0);
+  const std::string browse = app.dir + "/browse/";
+  fs::create_directories(browse + "sub");
+  std::ofstream(browse + "mesh.ply") << "ply\n";
+  std::ofstream(browse + "notes.md") << "not a mesh\n";
+  std::ofstream(browse + "sub/inner.obj") << "v 0 0 0\n";
+  Activate(app, "Project", "New");
+  app.Frame();
+  ASSERT_TRUE(app.Find(kNewProjectTitle).open);
+  TypeInto(app, kNewProjectTitle, "##scene", browse);
+  ImGuiWindow* form = App::Window(kNewProjectTitle);
+  ImGui::ActivateItem(ImHashStr("...", 0, form->GetID("##scene")));
+  app.Frames(2);
+  const auto list = [] {
+    for (ImGuiWindow* w : GImGui->Windows)
+      if ((w->Flags & ImGuiWindowFlags_Popup) && w->Active) return w;
+    return static_cast<ImGuiWindow*>(nullptr);
+  };
+  const auto pick = [&](const char* label) {
+    ImGuiWindow* popup = list();
+    ASSERT_NE(popup, nullptr) << "the list is not open to pick " << label;
+    ImGui::ActivateItem(popup->GetID(label));
+    app.Frames(2);
+  };
+  const auto scene = [&] { return app.ReportOf(kNewProjectTitle, "scene"); };
+  pick("sub/");
+  EXPECT_EQ(scene(), browse + "sub/");
+  ASSERT_NE(list(), nullptr) << "a folder opens in place";
+  pick("../ (the folder above)");
+  EXPECT_EQ(scene(), browse);
+  EXPECT_EQ(ParentFolder(browse + "mesh"), app.dir + "/");
+  EXPECT_EQ(BrowseEntries(browse, {".ply"}),
+            (std::vector<std::string>{browse + "mesh.ply", browse + "sub/"}));
+  pick("mesh.ply");
+  EXPECT_EQ(scene(), browse + "mesh.ply");
+  EXPECT_EQ(list(), nullptr) << "a file picked closes the list";
+  EXPECT_EQ(ParentFolder("/"), "");
+  EXPECT_EQ(ParentFolder("/usr/"), "/");
+  EXPECT_EQ(ParentFolder("mesh.ply"), "../");
+  EXPECT_EQ(ParentFolder("../x"), "../../");
+  EXPECT_EQ(ParentFolder("a/b/x"), "a/");
+  EXPECT_EQ(ParentFolder("a/x"), "./");
 }
 
 }  // namespace

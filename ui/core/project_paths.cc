@@ -139,4 +139,24 @@ std::vector<std::string> BrowseEntries(const std::string& typed,
   return entries;
 }
 
+std::string ParentFolder(const std::string& typed) {
+  const std::string::size_type slash = typed.rfind('/');
+  fs::path folder =
+      slash == std::string::npos ? fs::path(".") : fs::path(typed.substr(0, slash + 1));
+  folder = folder.lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();  // "a/b/" -> "a/b"
+  if (folder.empty()) folder = ".";
+  if (folder.is_absolute() && folder == folder.root_path()) return "";
+  fs::path parent;
+  if (folder == "." || folder.filename() == "..") {
+    parent = folder == "." ? fs::path("..") : folder / "..";
+  } else {
+    parent = folder.parent_path();
+    if (parent.empty()) parent = ".";
+  }
+  std::string text = parent.string();
+  if (text.back() != '/') text += '/';
+  return text;
+}
+
 }  // namespace fresco

@@ -59,5 +59,8 @@ std::string* FieldFor(DroppedKind kind, ProjectPaths* paths);
 // sorted; folders end in '/'.
 std::vector<std::string> BrowseEntries(const std::string& typed,
                                        const std::vector<std::string>& extensions);
+// The folder above the one a typed path lists ("a/" for "a/b/x", "../" for "x", "/" for
+// "/usr/"), "" at the file system's root.
+std::string ParentFolder(const std::string& typed);
 
 }  // namespace fresco
