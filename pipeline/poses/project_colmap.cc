@@ -203,8 +203,13 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
 std::vector<VerifyFrameInput> VerifyInputs(const ProjectColmap& colmap) {
   std::vector<VerifyFrameInput> inputs;
   for (const ProjectColmapFrame& f : colmap.frames) {
+    int observations = -1;
+    if (f.colmap && !f.colmap->point3d_ids.empty())
+      observations =
+          static_cast<int>(std::count_if(f.colmap->point3d_ids.begin(), f.colmap->point3d_ids.end(),
+                                         [](long long id) { return id >= 0; }));
     inputs.push_back({f.name, f.given ? &f.given->cam_from_world : nullptr,
-                      f.colmap ? &f.colmap->cam_from_world : nullptr, f.keyframe});
+                      f.colmap ? &f.colmap->cam_from_world : nullptr, f.keyframe, observations});
   }
   return inputs;
 }

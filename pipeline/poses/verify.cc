@@ -15,6 +15,9 @@ Status VerifyOptions::Check() const {
   if (window_frames > 0 && window_frames < 5) {
     return Status::Error("window_frames: must be 0 or >= 5");
   }
+  if (!(weak_support_fraction >= 0 && weak_support_fraction < 1)) {
+    return Status::Error("weak_support_fraction: must be in [0, 1)");
+  }
   if (!(inlier_fraction > 0 && inlier_fraction <= 1)) {
     return Status::Error("inlier_fraction: must be in (0, 1]");
   }
@@ -284,6 +287,23 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       NoteWidened(v, &out);
     }
   }
+  // Flags where COLMAP's own pose rests on few points are not given.
+  std::vector<double> observations;
+  for (size_t i = 0; i < frames.size(); ++i) {
+    out.frames[i].observations = frames[i].colmap_observations;
+    if (out.frames[i].registered && frames[i].colmap_observations >= 0)
+      observations.push_back(frames[i].colmap_observations);
+  }
+  out.median_observations = Median(observations);
+  out.weak_support_fraction = options.weak_support_fraction;
+  for (FrameVerdict& v : out.frames) {
+    if (!v.flagged || v.observations < 0 ||
+        v.observations >= options.weak_support_fraction * out.median_observations)
+      continue;
+    v.flagged = false;
+    v.weak_support = true;
+    ++out.weak_support;
+  }
   std::vector<double> rotations, positions;
   for (const FrameVerdict& v : out.frames) {
     if (!v.has_given || !v.registered) continue;
@@ -291,7 +311,8 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
       ++out.flagged;
       continue;
     }
-    if (v.follows_drift) continue;  // beyond the thresholds: not agreeing, not flagged
+    // Beyond the thresholds: not agreeing, not flagged.
+    if (v.follows_drift || v.weak_support) continue;
     ++out.unflagged;
     rotations.push_back(v.rotation_error_deg);
     positions.push_back(v.position_error_m);
@@ -351,6 +372,16 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
       note += ", and flags in that stretch may be the reconstruction's.";
     }
     notes.push_back(note);
+  }
+  if (result.weak_support > 0) {
+    std::snprintf(text, sizeof(text),
+                  "%d frames beyond the thresholds were not judged: COLMAP's pose of each rests "
+                  "on under %.0f%% of the median frame's %.0f observed points (often a "
+                  "reconstruction's last frames, where it turns away), too weak to say the given "
+                  "pose is wrong (`weak_support` in verify.json).",
+                  result.weak_support, 100 * result.weak_support_fraction,
+                  result.median_observations);
+    notes.push_back(text);
   }
   return notes;
 }

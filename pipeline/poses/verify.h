@@ -33,6 +33,11 @@ struct VerifyOptions {
   // over the neighbours' offsets (a drift that bends faster than the line through the
   // disagreements follows still moves these little). 0 = never.
   int drift_neighbours = 5;
+  // A frame beyond the thresholds whose COLMAP pose rests on fewer than this fraction of the
+  // median frame's observations (2D points with a 3D point; a reconstruction's last frames,
+  // where it often turns away) is not judged: its pose from COLMAP is too weak to say that
+  // the given one is wrong. 0 = always judged.
+  double weak_support_fraction = 0.3;
   unsigned seed = 1;
 
   Status Check() const;
@@ -53,7 +58,9 @@ struct FrameVerdict {
   // Where judged against the drift: how far it may stand out from its neighbours' line, in
   // units of the thresholds (1, or more where the neighbours scatter more; 0: not judged).
   double drift_tolerance = 0.0;
-  bool inlier = false;  // supported the (global or its local) alignment
+  int observations = -1;      // COLMAP's 2D points with a 3D point (-1: unknown)
+  bool weak_support = false;  // beyond the thresholds, not judged: see weak_support_fraction
+  bool inlier = false;        // supported the (global or its local) alignment
 };
 
 struct VerifyResult {
@@ -93,6 +100,11 @@ struct VerifyResult {
   // that goes unnoticed there.
   int widened = 0;
   double widest_tolerance_deg = 0.0;
+  // Frames beyond the thresholds not judged for their COLMAP pose's weak support, and the
+  // median observations they were measured against (VerifyOptions::weak_support_fraction).
+  int weak_support = 0;
+  double median_observations = 0.0;
+  double weak_support_fraction = 0.0;
   // Statistics of the unflagged frames that agree within the thresholds (those following a
   // drift left out): how well COLMAP and the poses agree; zero when `unflagged` is 0.
   int unflagged = 0;
@@ -115,6 +127,7 @@ struct VerifyFrameInput {
   // that is not one (registered to the keyframes' reconstruction afterwards) is judged by
   // the fit and the neighbours of the keyframes beside it.
   bool reference = true;
+  int colmap_observations = -1;  // COLMAP's 2D points with a 3D point (-1: unknown)
 };
 
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,

@@ -73,6 +73,8 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
     f["flagged"] = v.flagged;
     f["follows_drift"] = v.follows_drift;
     if (v.relative_rotation_deg >= 0) f["relative_rotation_deg"] = v.relative_rotation_deg;
+    if (v.observations >= 0) f["observations"] = v.observations;
+    f["weak_support"] = v.weak_support;
     if (v.drift_tolerance > 0) {
       f["drift_tolerance_deg"] = v.drift_tolerance * result.rotation_threshold_deg;
     }
@@ -115,6 +117,10 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
         {"following_frames", result.following_drift},
         {"widened_frames", result.widened},
         {"widest_tolerance_deg", result.widest_tolerance_deg}}},
+      {"weak_support",
+       {{"frames", result.weak_support},
+        {"median_observations", result.median_observations},
+        {"fraction", result.weak_support_fraction}}},
       {"notes", VerifyNotes(result)},
       {"agreement_unflagged",
        {{"frames", result.unflagged},

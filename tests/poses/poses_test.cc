@@ -167,6 +167,44 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
   }
 }
 
+// COLMAP's last two frames turned 5 degrees away (as a reconstruction's end often does): with
+// their poses resting on a tenth of the median frame's observed points they are not judged
+// (weak support, said in a note); with as many points as the others, they are flagged; the
+// given pose 1 degree off with ordinary support is flagged either way.
+TEST(Verify, AFrameCOLMAPBarelySupportsIsNotJudged) {
+  const int n = 40;
+  const auto truth = ArcPoses(n);
+  const Sim3d world_from_colmap = SomeSimilarity();
+  std::vector<Rigid3d> given = truth, colmap;
+  for (int i = 0; i < n; ++i) {
+    const Rigid3d off =
+        i >= n - 2 ? Perturbed(truth[i], 5.0, 0.0, Eigen::Vector3d(1, 0, 0)) : truth[i];
+    colmap.push_back(InColmapFrame(off, world_from_colmap));
+  }
+  given[10] = Perturbed(truth[10], 1.0, 0.0, Eigen::Vector3d(0, 1, 0));
+  for (const int last_observations : {50, 500}) {
+    std::vector<VerifyFrameInput> inputs;
+    for (int i = 0; i < n; ++i)
+      inputs.push_back(
+          {std::to_string(i), &given[i], &colmap[i], true, i >= n - 2 ? last_observations : 500});
+    VerifyResult r;
+    ASSERT_TRUE(VerifyPoses(inputs, 6.0, VerifyOptions(), &r).ok());
+    const bool weak = last_observations == 50;
+    EXPECT_TRUE(r.frames[10].flagged);
+    for (int i : {n - 2, n - 1}) {
+      EXPECT_EQ(r.frames[i].flagged, !weak) << i;
+      EXPECT_EQ(r.frames[i].weak_support, weak) << i;
+      EXPECT_EQ(r.frames[i].observations, last_observations);
+    }
+    EXPECT_EQ(r.weak_support, weak ? 2 : 0);
+    EXPECT_EQ(r.median_observations, 500);
+    EXPECT_EQ(r.flagged, weak ? 1 : 3);
+    EXPECT_LT(r.max_unflagged_rotation_error_deg, 0.2);  // the weak ones are not "agreeing"
+    const std::vector<std::string> notes = VerifyNotes(r);
+    EXPECT_EQ(!notes.empty() && notes.back().find("not judged") != std::string::npos, weak);
+  }
+}
+
 // A straight walk (as the bundled street project): centres on one line from (-14, 1.6, -1.2)
 // to (14, 1.6, 1.2) (plus `wobble_m` sideways, 0 = exactly collinear), looking along it and
 // glancing +-35 deg left and right, 6 deg down.
