@@ -386,6 +386,28 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
   return notes;
 }
 
+std::string VerdictText(const FrameVerdict& f, const VerifyResult& result) {
+  if (!f.registered) return "not registered";
+  if (!f.has_given) return "no given pose";
+  char text[120];
+  if (f.flagged) {
+    std::snprintf(text, sizeof(text), "FLAGGED%s%s",
+                  f.rotation_error_deg > result.rotation_threshold_deg ? " rotation" : "",
+                  f.position_error_m > result.position_threshold_m ? " position" : "");
+    return text;
+  }
+  if (f.weak_support) {
+    std::snprintf(text, sizeof(text), "not judged: weak COLMAP pose (%d points)", f.observations);
+    return text;
+  }
+  if (f.follows_drift) {
+    std::snprintf(text, sizeof(text), "follows the drift (within %.2g deg)",
+                  std::max(1.0, f.drift_tolerance) * result.rotation_threshold_deg);
+    return text;
+  }
+  return f.inlier ? "ok" : "ok (not in fit)";
+}
+
 std::string VerifyAgreementText(const VerifyResult& result) {
   if (result.compared == 0) return "No frame has both a given and a COLMAP pose.";
   if (result.unflagged == 0) {

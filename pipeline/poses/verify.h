@@ -115,6 +115,10 @@ struct VerifyResult {
 // One line each for the CLI, the report and the panel: what the numbers mean and what to
 // be wary of (degenerate centres, weak alignment, no frame agreeing).
 std::vector<std::string> VerifyNotes(const VerifyResult& result);
+// A frame's verdict in a few words, for tables: "not registered", "no given pose", "FLAGGED
+// rotation position", "follows the drift (within 2.3 deg)", "not judged: weak COLMAP pose (52
+// points)", "ok" or "ok (not in fit)".
+std::string VerdictText(const FrameVerdict& frame, const VerifyResult& result);
 // "Unflagged frames agree within ..." or, with none unflagged, says so.
 std::string VerifyAgreementText(const VerifyResult& result);
 

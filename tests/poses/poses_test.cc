@@ -195,6 +195,8 @@ TEST(Verify, AFrameCOLMAPBarelySupportsIsNotJudged) {
       EXPECT_EQ(r.frames[i].flagged, !weak) << i;
       EXPECT_EQ(r.frames[i].weak_support, weak) << i;
       EXPECT_EQ(r.frames[i].observations, last_observations);
+      EXPECT_EQ(VerdictText(r.frames[i], r),
+                weak ? "not judged: weak COLMAP pose (50 points)" : "FLAGGED rotation");
     }
     EXPECT_EQ(r.weak_support, weak ? 2 : 0);
     EXPECT_EQ(r.median_observations, 500);
@@ -581,6 +583,8 @@ TEST(Verify, AReconstructionBendingFasterAndFasterIsADriftNotWrongFrames) {
   EXPECT_GT(r.widened, 5);
   EXPECT_GT(r.widest_tolerance_deg, 2.0);  // in the bend, a pose a degree off cannot be told
   EXPECT_NE(VerifyNotes(r).back().find("judged only to within"), std::string::npos);
+  EXPECT_EQ(VerdictText(r.frames[55], r).rfind("follows the drift (within ", 0), 0u)
+      << VerdictText(r.frames[55], r);
 
   // Frames 15 (the straight part) and 55 (000108.png, in the bend) turned off.
   std::vector<PosedImage> wrong = given;

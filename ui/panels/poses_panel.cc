@@ -104,8 +104,8 @@ int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool
   else if (!f.has_given)
     ImGui::SetTooltip("%s: no given pose", f.name.c_str());
   else
-    ImGui::SetTooltip("%s: %.3f deg, %.4f m%s (click to go there)", f.name.c_str(),
-                      f.rotation_error_deg, f.position_error_m, f.flagged ? ", FLAGGED" : "");
+    ImGui::SetTooltip("%s: %.3f deg, %.4f m, %s (click to go there)", f.name.c_str(),
+                      f.rotation_error_deg, f.position_error_m, VerdictText(f, v).c_str());
   return ImGui::IsItemClicked() ? i : -1;
 }
 
@@ -386,16 +386,15 @@ class PosesPanel : public Panel {
       ImGui::TableSetColumnIndex(4);
       if (both) ImGui::Text("%.2f", 100 * f.position_error_m / std::max(1e-12, v.scene_size_m));
       ImGui::TableSetColumnIndex(5);
-      if (!f.registered)
-        ImGui::TextDisabled("not registered");
-      else if (!f.has_given)
-        ImGui::TextDisabled("no given pose");
+      const std::string verdict = VerdictText(f, v);
+      if (!both || f.weak_support)
+        ImGui::TextDisabled("%s", verdict.c_str());
       else if (f.flagged)
-        ImGui::TextColored(ImVec4(1, 0.75f, 0.7f, 1), "FLAGGED%s%s",
-                           f.rotation_error_deg > v.rotation_threshold_deg ? " rotation" : "",
-                           f.position_error_m > v.position_threshold_m ? " position" : "");
+        ImGui::TextColored(ImVec4(1, 0.75f, 0.7f, 1), "%s", verdict.c_str());
+      else if (f.follows_drift)
+        ImGui::TextColored(ImVec4(1, 0.85f, 0.5f, 1), "%s", verdict.c_str());
       else
-        ImGui::TextUnformatted(f.inlier ? "ok" : "ok (not in fit)");
+        ImGui::TextUnformatted(verdict.c_str());
     }
     ImGui::EndTable();
     return clicked;
