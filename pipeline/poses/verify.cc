@@ -108,6 +108,11 @@ bool FollowsDrift(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
   return rotation_follows && residual.tail<3>().norm() <= tolerance;
 }
 
+void SetCentres(const PosePair& pair, const Sim3d& world_from_colmap, FrameVerdict* v) {
+  v->given_centre_m = pair.given_cam_from_world.Centre();
+  v->colmap_centre_m = world_from_colmap.TransformPose(pair.colmap_cam_from_colmap).Centre();
+}
+
 // Counts a frame let through as following the drift with a widened tolerance.
 void NoteWidened(const FrameVerdict& v, VerifyResult* out) {
   if (v.drift_tolerance <= 1.0) return;
@@ -206,6 +211,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     FrameVerdict& v = out.frames[frame_of_pair[k]];
     v.rotation_error_deg = e.rotation_deg;
     v.position_error_m = e.position_m;
+    SetCentres(pairs[k], fit.world_from_colmap, &v);
     v.inlier = fit.inliers[k - begin];
     v.flagged =
         e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
@@ -249,6 +255,7 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
     FrameVerdict& v = out.frames[frame_of_other[o]];
     v.rotation_error_deg = e.rotation_deg;
     v.position_error_m = e.position_m;
+    SetCentres(others[o], fit.world_from_colmap, &v);
     v.flagged =
         e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
     if (!v.flagged || !out.drift_followed) continue;

@@ -58,6 +58,10 @@ struct FrameVerdict {
   // Where judged against the drift: how far it may stand out from its neighbours' line, in
   // units of the thresholds (1, or more where the neighbours scatter more; 0: not judged).
   double drift_tolerance = 0.0;
+  // Where compared: the camera centres, given and COLMAP's under the alignment the frame was
+  // judged by (world, metres; their distance is position_error_m).
+  Eigen::Vector3d given_centre_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d colmap_centre_m = Eigen::Vector3d::Zero();
   int observations = -1;      // COLMAP's 2D points with a 3D point (-1: unknown)
   bool weak_support = false;  // beyond the thresholds, not judged: see weak_support_fraction
   bool inlier = false;        // supported the (global or its local) alignment

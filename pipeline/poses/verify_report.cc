@@ -66,6 +66,8 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
       f["rotation_error_deg"] = v.rotation_error_deg;
       f["position_error_m"] = v.position_error_m;
       f["inlier"] = v.inlier;
+      f["given_centre_m"] = {v.given_centre_m.x(), v.given_centre_m.y(), v.given_centre_m.z()};
+      f["colmap_centre_m"] = {v.colmap_centre_m.x(), v.colmap_centre_m.y(), v.colmap_centre_m.z()};
     } else {
       f["rotation_error_deg"] = nullptr;
       f["position_error_m"] = nullptr;

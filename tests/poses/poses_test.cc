@@ -159,6 +159,11 @@ TEST(Verify, FlagsExactlyTheFramesWithInjectedErrors) {
       EXPECT_EQ(result.frames[i].flagged, injected) << "frame " << i << " window " << window;
     }
     EXPECT_EQ(result.flagged, 4);
+    for (int i : {3, 12}) {  // the centres compared (the 3D view draws them)
+      const FrameVerdict& f = result.frames[i];
+      EXPECT_NEAR((f.colmap_centre_m - f.given_centre_m).norm(), f.position_error_m, 1e-9);
+      EXPECT_LT((f.given_centre_m - given[i].Centre()).norm(), 1e-12);
+    }
     EXPECT_NEAR(result.frames[5].rotation_error_deg, 1.0, 0.15);
     EXPECT_NEAR(result.frames[12].position_error_m, 0.12, 0.01);
     EXPECT_NEAR(result.world_from_colmap.scale, world_from_colmap.scale, 0.01);

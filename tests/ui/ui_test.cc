@@ -641,6 +641,15 @@ TEST(PosesRunner, FlagsTheInjectedFramesJumpsToThemAndAppliesTheBootstrap) {
   for (size_t i = 0; i < snap->verify.frames.size(); ++i)
     if (snap->verify.frames[i].flagged) flagged.insert(snap->frame_index[i]);
   EXPECT_EQ(flagged, (std::set<int>{3, 5, 7}));
+  {  // The 3D view takes COLMAP's path from the verification: a mark per compared frame.
+    std::unique_ptr<Panel> view;
+    for (auto& p : MakePanels())
+      if (std::string(p->Title()) == "3D view") view = std::move(p);
+    ASSERT_TRUE(view);
+    ui.snapshot = runner.Snapshot();
+    ImGuiHeadless::DrawPanel(ui, *view, ImVec2(800, 600));
+    EXPECT_EQ(view->Report().at("COLMAP path frames"), std::to_string(kFrames));
+  }
   for (int i : rotated) EXPECT_NEAR(snap->verify.frames[i].rotation_error_deg, 1.0, 0.2) << i;
   for (int i : moved)
     EXPECT_NEAR(snap->verify.frames[i].position_error_m, 0.02 * scene_size_m, 0.002 * scene_size_m)

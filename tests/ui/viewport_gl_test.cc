@@ -1,6 +1,8 @@
 // The 3D view's OpenGL renderer on a real context: in "groups" mode every group is drawn in
 // its stable colour (ui/core/group_colour.h), the triangles of selected groups are tinted
-// cyan and picked triangles yellow, and nothing else changes. Without a display the test
+// cyan and picked triangles yellow, and nothing else changes; a view-dependent layer shows
+// where it has paint; after a pose verification COLMAP's path and the flagged frames' offsets
+// are drawn over the model. Without a display the test
 // runs itself again under xvfb-run (and skips when there is none).
 #include <unistd.h>
 
@@ -183,6 +185,32 @@ TEST(ViewportGl, GroupsInStableColoursSelectionTinted) {
     ASSERT_GT(drawn, 100);
     EXPECT_EQ(green, drawn);
     EXPECT_EQ(grey_pixels, drawn);
+
+    // After a pose verification: COLMAP's path in orange, a flagged frame's offset in red,
+    // drawn over the model; none with the "COLMAP path" box off.
+    view.view_layers = true;
+    view.show_path = view.show_frustum = false;
+    ASSERT_GE(geo.path.size(), 10u);
+    for (size_t i = 0; i < geo.path.size(); ++i) {
+      const Eigen::Vector3d given = geo.path[i].Centre();
+      const bool flagged = i == geo.path.size() / 2;
+      view.pose_check.push_back(
+          {given, given + Eigen::Vector3d(0.05, 0, 0) * (flagged ? 20 : 1), flagged});
+    }
+    const auto count = [](const Rendered& r, bool red) {
+      int n = 0;
+      for (const auto& p : r.rgba)
+        n += red ? p[0] > 200 && p[1] < 80 && p[2] < 80
+                 : p[0] > 200 && p[1] > 100 && p[1] < 180 && p[2] < 60;
+      return n;
+    };
+    const Rendered with_check = Render(viewport, layered, state, &view);
+    EXPECT_GT(count(with_check, false), 20) << "COLMAP's path";
+    EXPECT_GT(count(with_check, true), 3) << "the flagged frame's offset";
+    view.show_pose_check = false;
+    const Rendered without = Render(viewport, layered, state, &view);
+    EXPECT_EQ(count(without, false), 0);
+    EXPECT_EQ(count(without, true), 0);
   }
   glfwDestroyWindow(window);
   glfwTerminate();

@@ -46,6 +46,15 @@ struct ViewportView {
   uint64_t orbit_geometry_version = 0;  // the geometry `orbit` was taken from (0: none yet)
   bool show_path = true, show_frustum = true;
   bool view_layers = true;  // painted mode: blend the view-dependent layers (when painted)
+  // After a pose verification (Poses panel): COLMAP's camera centres under the alignment each
+  // frame was judged by, as a path beside the given one, each flagged frame's offset from its
+  // given centre marked (world, metres).
+  struct PoseCheckMark {
+    Eigen::Vector3d given, colmap;
+    bool flagged = false;
+  };
+  std::vector<PoseCheckMark> pose_check;
+  bool show_pose_check = true;
 };
 
 // Draws the model (painted textures, group colours or the current frame projected onto it),

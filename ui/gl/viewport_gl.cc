@@ -521,7 +521,8 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
   }
   if (m.ungrouped_count > 0) glDrawArrays(GL_TRIANGLES, m.ungrouped_first, m.ungrouped_count);
 
-  // Lines: the path (grey), the current camera's frustum (yellow).
+  // Lines: the path (grey), COLMAP's path after a pose verification (orange, flagged frames'
+  // offsets red), the current camera's frustum (yellow).
   std::vector<LineVertex> lines;
   // The return type spelled out: deduced, it would be an Eigen expression over a temporary.
   auto centre_of = [&](const Rigid3d& cam_from_world) -> Eigen::Vector3f {
@@ -545,6 +546,17 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
       for (size_t i = 1; i < path->size(); ++i)
         add(centre_of((*path)[i - 1]), centre_of((*path)[i]), colour[0], colour[1], colour[2]);
     }
+  }
+  if (view->show_pose_check && !view->pose_check.empty()) {
+    // COLMAP's path (orange) and each flagged frame's offset from its given centre (red).
+    auto local_of = [&](const Eigen::Vector3d& world) -> Eigen::Vector3f {
+      return (world - scene.origin_in_world).cast<float>();
+    };
+    for (size_t i = 1; i < view->pose_check.size(); ++i)
+      add(local_of(view->pose_check[i - 1].colmap), local_of(view->pose_check[i].colmap), 1.0f,
+          0.55f, 0.1f);
+    for (const ViewportView::PoseCheckMark& mark : view->pose_check)
+      if (mark.flagged) add(local_of(mark.given), local_of(mark.colmap), 1.0f, 0.15f, 0.15f);
   }
   if (view->show_frustum && snapshot.has_pose) {
     const Rigid3d local_from_cam = cam_from_local.Inverse();

@@ -41,10 +41,21 @@ class ViewportPanel : public Panel {
             "off: the single texture");
       ImGui::SameLine();
     }
+    FillPoseCheck(ui);
+    if (!view_.pose_check.empty()) {
+      ImGui::Checkbox("COLMAP path", &view_.show_pose_check);
+      if (ImGui::IsItemHovered())
+        ImGui::SetTooltip(
+            "the last pose verification (Poses panel): COLMAP's camera centres aligned to the "
+            "given poses (orange), each flagged frame's offset from its given centre (red)");
+      ImGui::SameLine();
+    }
     if (ImGui::SmallButton("reset view")) {
       const ViewportView::Mode mode = view_.mode;
+      const bool show_pose_check = view_.show_pose_check;
       view_ = ViewportView();
       view_.mode = mode;
+      view_.show_pose_check = show_pose_check;
     }
 
     const ImVec2 avail = ImGui::GetContentRegionAvail();
@@ -74,10 +85,29 @@ class ViewportPanel : public Panel {
     char text[64];
     std::snprintf(text, sizeof(text), "%.2f %.2f %.4f", view_.yaw_deg, view_.pitch_deg,
                   view_.distance_m);
-    return {{"yaw pitch distance", text}};
+    return {{"yaw pitch distance", text},
+            {"COLMAP path frames", std::to_string(view_.pose_check.size())}};
   }
 
  private:
+  // The marks of the Poses panel's last verification (none before one, or for another
+  // project's run).
+  void FillPoseCheck(UiContext& ui) {
+    if (!ui.poses) return;
+    const std::shared_ptr<const PosesSnapshot> poses = ui.poses->Snapshot();
+    const std::string& project = ui.state->project.file_path;
+    if (poses->version == pose_check_version_ && project == pose_check_project_) return;
+    pose_check_version_ = poses->version;
+    pose_check_project_ = project;
+    view_.pose_check.clear();
+    if (!poses->verified || poses->request.project.file_path != project) return;
+    for (const FrameVerdict& f : poses->verify.frames)
+      if (f.registered && f.has_given)
+        view_.pose_check.push_back({f.given_centre_m, f.colmap_centre_m, f.flagged});
+  }
+  uint64_t pose_check_version_ = 0;
+  std::string pose_check_project_;
+
   void HandleMouse(UiContext& ui, ImVec2 origin, int w, int h) {
     const bool active = ImGui::IsItemActive();
     if (!ImGui::IsItemHovered() && !active) return;
