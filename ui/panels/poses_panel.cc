@@ -21,6 +21,7 @@ const float kLabelWidth = 120;  // right of the input fields
 const ImU32 kFlaggedColour = IM_COL32(235, 70, 60, 255);
 const ImU32 kOkColour = IM_COL32(120, 200, 120, 255);
 const ImU32 kMissingColour = IM_COL32(130, 130, 130, 255);
+const ImU32 kDriftColour = IM_COL32(240, 180, 60, 255);
 
 std::string Format(const char* format, double value) {
   char buffer[64];
@@ -28,8 +29,9 @@ std::string Format(const char* format, double value) {
   return buffer;
 }
 
-// One error along the sequence: a point per frame (red when flagged, grey ticks where COLMAP
-// registered nothing or there is no given pose), the threshold dashed, the selected frame
+// One error along the sequence: a point per frame (red when flagged, amber when following a
+// drift, grey when not judged; grey ticks where COLMAP registered nothing or there is no
+// given pose), the threshold dashed, the selected frame
 // and the pipeline's current frame as vertical lines. Returns the frame clicked, else -1.
 int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool rotation,
               double scale, const char* unit, int selected, int current_row) {
@@ -84,7 +86,11 @@ int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool
     const FrameVerdict& f = v.frames[i];
     if (!f.registered || !f.has_given) continue;
     const ImVec2 p(x_of(i), y_of((rotation ? f.rotation_error_deg : f.position_error_m) * scale));
-    draw->AddCircleFilled(p, f.flagged ? 4.5f : 3.0f, f.flagged ? kFlaggedColour : kOkColour);
+    const ImU32 colour = f.flagged         ? kFlaggedColour
+                         : f.weak_support  ? kMissingColour
+                         : f.follows_drift ? kDriftColour
+                                           : kOkColour;
+    draw->AddCircleFilled(p, f.flagged ? 4.5f : 3.0f, colour);
   }
   if (n > 0) {  // the sequence's ends
     const std::string first = std::string("frame ") + std::to_string(snap.frame_index.front()),
