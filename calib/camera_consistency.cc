@@ -77,12 +77,11 @@ std::string Figure(const char* format, double value) {
   return buffer;
 }
 
-// The split tests and the doubts they raise (run->split_tests, run->camera_doubts after the
-// image sizes'), with `seed` (a board pose per view) and `options`; `joint` as in RunSplit.
+// The split tests and the doubts they raise (appended to run->split_tests and
+// run->camera_doubts, which the callers start with the image sizes' doubts), with `seed` (a board
+// pose per view) and `options`; `joint` as in RunSplit.
 void RunSplitTests(const CalibrateRequest& request, const CalibrationSeed& seed,
                    const SolveOptions& options, const SolveResult* joint, CalibrationRun* run) {
-  run->camera_doubts = ImageSizeDoubts(*run);
-  run->split_tests.clear();
   const int n = static_cast<int>(run->views.size());
   if (n < 2 * kMinGroupViews || static_cast<int>(seed.rt_cam_from_board.size()) != n) return;
   // Split 1: by file-name stem (the two largest groups).

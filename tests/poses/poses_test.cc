@@ -521,6 +521,31 @@ void ReadKeptPoses(const std::string& dir, std::vector<PosedImage>* given,
               [](const PosedImage& a, const PosedImage& b) { return a.name < b.name; });
 }
 
+// The image of `images` named `name` (a test failure and the first image when there is none).
+const PosedImage& Named(const std::vector<PosedImage>& images, const std::string& name) {
+  const auto it = std::find_if(images.begin(), images.end(),
+                               [&](const PosedImage& p) { return p.name == name; });
+  if (it != images.end()) return *it;
+  ADD_FAILURE() << "no image " << name;
+  return images.front();
+}
+
+// One input per COLMAP image, in its order: the given pose of the same name against COLMAP's.
+std::vector<VerifyFrameInput> KeptInputs(const std::vector<PosedImage>& given,
+                                         const std::vector<PosedImage>& colmap) {
+  std::vector<VerifyFrameInput> inputs;
+  for (const PosedImage& c : colmap)
+    inputs.push_back({c.name, &Named(given, c.name).cam_from_world, &c.cam_from_world});
+  return inputs;
+}
+
+// How far `pose` turns from the true pose of its name, degrees.
+double DegreesOff(const PosedImage& pose, const std::vector<PosedImage>& truth) {
+  return pose.cam_from_world.rotation.angularDistance(
+             Named(truth, pose.name).cam_from_world.rotation) *
+         180.0 / M_PI;
+}
+
 // COLMAP's reconstruction of a held-out 60-frame street walk (tests/poses/data/street-bend-60)
 // that bends over its last third, unevenly from frame to frame, against given poses with 0.3
 // degrees of noise and three frames (12, 31, 47) 3 degrees off: the three are flagged and
@@ -532,23 +557,15 @@ TEST(Verify, AnUnevenBendOfARealReconstructionIsStillADrift) {
   ReadKeptPoses(dir, &given, &truth, &colmap);
   ASSERT_EQ(given.size(), 60u);
   ASSERT_EQ(colmap.size(), 60u);
-  std::vector<VerifyFrameInput> inputs;
-  for (size_t i = 0; i < colmap.size(); ++i) {
-    ASSERT_EQ(given[i].name, colmap[i].name);
-    inputs.push_back({colmap[i].name, &given[i].cam_from_world, &colmap[i].cam_from_world});
-  }
+  const std::vector<VerifyFrameInput> inputs = KeptInputs(given, colmap);
   VerifyResult r;
   ASSERT_TRUE(VerifyPoses(inputs, 70.34, VerifyOptions(), &r).ok());
   EXPECT_TRUE(r.disagreement.Drifts())
       << r.disagreement.smooth << " of " << r.disagreement.disagreeing;
   for (int i : {12, 31, 47}) EXPECT_TRUE(r.frames[i].flagged) << i;
   int false_flags = 0;
-  for (size_t i = 0; i < inputs.size(); ++i) {
-    const double off_deg =
-        given[i].cam_from_world.rotation.angularDistance(truth[i].cam_from_world.rotation) * 180.0 /
-        M_PI;
-    false_flags += off_deg < 0.42 && r.frames[i].flagged;
-  }
+  for (size_t i = 0; i < inputs.size(); ++i)
+    false_flags += DegreesOff(given[i], truth) < 0.42 && r.frames[i].flagged;
   EXPECT_LE(false_flags, 4);
 }
 
@@ -567,23 +584,14 @@ TEST(Verify, AReconstructionBendingFasterAndFasterIsADriftNotWrongFrames) {
   ASSERT_EQ(given.size(), 62u);
   ASSERT_EQ(colmap.size(), 62u);
   const auto verify = [&](const std::vector<PosedImage>& poses, VerifyResult* r) {
-    std::vector<VerifyFrameInput> inputs;
-    for (size_t i = 0; i < colmap.size(); ++i) {
-      EXPECT_EQ(poses[i].name, colmap[i].name);
-      inputs.push_back({colmap[i].name, &poses[i].cam_from_world, &colmap[i].cam_from_world});
-    }
-    ASSERT_TRUE(VerifyPoses(inputs, 70.34, VerifyOptions(), r).ok());
-  };
-  const auto off_deg = [&](const std::vector<PosedImage>& poses, size_t i) {
-    return poses[i].cam_from_world.rotation.angularDistance(truth[i].cam_from_world.rotation) *
-           180.0 / M_PI;
+    ASSERT_TRUE(VerifyPoses(KeptInputs(poses, colmap), 70.34, VerifyOptions(), r).ok());
   };
   VerifyResult r;
   verify(given, &r);
   EXPECT_TRUE(r.drift_followed);
   int false_flags = 0;
   for (size_t i = 0; i < given.size(); ++i)
-    false_flags += r.frames[i].flagged && off_deg(given, i) < 0.35;
+    false_flags += r.frames[i].flagged && DegreesOff(given[i], truth) < 0.35;
   EXPECT_LE(false_flags, 1);
   EXPECT_GT(r.widened, 5);
   EXPECT_GT(r.widest_tolerance_deg, 2.0);  // in the bend, a pose a degree off cannot be told
@@ -620,18 +628,9 @@ TEST(Verify, ARealReconstructionThatBendsIsToldFromPosesOffByAFractionOfADegree)
   ReadKeptPoses(dir, &given, &truth, &colmap);
   ASSERT_EQ(given.size(), 120u);
   ASSERT_EQ(colmap.size(), 66u);
-  std::vector<VerifyFrameInput> inputs;
+  const std::vector<VerifyFrameInput> inputs = KeptInputs(given, colmap);
   std::vector<double> off_deg;
-  for (const PosedImage& c : colmap) {
-    const auto g = std::find_if(given.begin(), given.end(),
-                                [&](const PosedImage& p) { return p.name == c.name; });
-    const auto t = std::find_if(truth.begin(), truth.end(),
-                                [&](const PosedImage& p) { return p.name == c.name; });
-    ASSERT_TRUE(g != given.end() && t != truth.end()) << c.name;
-    inputs.push_back({c.name, &g->cam_from_world, &c.cam_from_world});
-    off_deg.push_back(g->cam_from_world.rotation.angularDistance(t->cam_from_world.rotation) *
-                      180.0 / M_PI);
-  }
+  for (const PosedImage& c : colmap) off_deg.push_back(DegreesOff(Named(given, c.name), truth));
   VerifyResult r;
   ASSERT_TRUE(VerifyPoses(inputs, 70.34, VerifyOptions(), &r).ok());
   EXPECT_TRUE(r.drift_followed);

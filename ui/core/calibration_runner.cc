@@ -139,6 +139,7 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
     UpdateReadiness();
   }
   CheckOneCamera();
+  UpdateReadiness();
   working_.status = "detected: board in " + std::to_string(working_.run.views.size()) + " of " +
                     std::to_string(working_.images.size()) + " images";
   if (!working_.run.excluded.empty())
@@ -150,7 +151,6 @@ void CalibrationRunner::CheckOneCamera() {
       "checking that the " + std::to_string(working_.run.views.size()) + " images are one camera's";
   Publish();
   calib::CheckOneCameraBeforeSolving(working_.request, &working_.run);
-  UpdateReadiness();
 }
 
 void CalibrationRunner::RebuildViews() {

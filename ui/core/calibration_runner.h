@@ -76,7 +76,7 @@ class CalibrationRunner {
   void RebuildViews();  // run.views from the images used and not excluded
   void UpdateReadiness();
   // The split test before any solve (calib::CheckOneCameraBeforeSolving): a folder mixing two
-  // cameras keeps the light off green from detection on.
+  // cameras keeps the light off green from detection on (the caller updates the readiness).
   void CheckOneCamera();
   void Publish();
 
