@@ -21,7 +21,7 @@ namespace fresco {
 enum class SamplingMode { kNearest, kBilinear, kArea };
 // kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
 // when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
-enum class UpdatePolicy { kLatest, kQuality };
+enum class UpdatePolicy { kLatest, kQuality, kMean };
 
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;

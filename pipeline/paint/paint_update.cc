@@ -16,6 +16,7 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->quality.create(buffer.height, buffer.width, CV_32F);
   painted->quality.setTo(0);
   painted->painted_surface_texels = 0;
+  painted->mean_sum.release();
   painted->texel_kind = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   for (int k = 0; k < buffer.NumTexels(); ++k)
     painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
@@ -32,6 +33,7 @@ struct PaintArrays {
   const uint8_t* provisional;  // null: no sample is provisional
   uint8_t* dst;
   float* stored_quality;
+  float* mean_sum;  // `update: mean` (4 floats per texel), null otherwise
 
   PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
               PaintedBuffer* painted)
@@ -41,13 +43,21 @@ struct PaintArrays {
         skip(mask.empty() ? nullptr : mask.data),
         provisional(warming.empty() ? nullptr : warming.data),
         dst(painted->bgra.data),
-        stored_quality(painted->quality.ptr<float>()) {}
+        stored_quality(painted->quality.ptr<float>()),
+        mean_sum(painted->mean_sum.empty() ? nullptr : painted->mean_sum.ptr<float>()) {}
 };
 
 // One texel (rectangle index `idx`).
 [[gnu::always_inline]] inline void PaintTexel(const PaintArrays& a, int idx, bool on_surface,
                                               const TexelUpdateRule& rule,
                                               PaintUpdateStats* stats) {
+  if (a.mean_sum) {  // every sample counts, provisional or not: nothing to give way
+    if (a.valid[idx] && !(a.skip && a.skip[idx]))
+      MeanTexel(a.src + 3 * static_cast<size_t>(idx), a.quality[idx], on_surface,
+                a.dst + 4 * static_cast<size_t>(idx), a.stored_quality + idx,
+                a.mean_sum + 4 * static_cast<size_t>(idx), stats);
+    return;
+  }
   const bool provisional = a.provisional && a.provisional[idx];
   if (a.valid[idx] && !(a.skip && a.skip[idx])) {
     const float stored = a.stored_quality[idx];
@@ -108,6 +118,8 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
                              const cv::Mat& mask, const PipelineOptions& options,
                              PaintedBuffer* painted, const cv::Mat& warming) {
   const TexelUpdateRule rule = TexelUpdateRule::From(options);
+  if (rule.policy == UpdatePolicy::kMean && painted->mean_sum.empty())
+    painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
     stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);

@@ -22,6 +22,9 @@ struct PaintedBuffer {
   // the surface (BaseBuffer::texel_index and on_surface in the rectangle's layout), for
   // updates that walk the rectangle row by row (InitPaintedBuffer).
   cv::Mat texel_kind;
+  // `update: mean`: per texel the sum of the samples taken, each weighted by its quality
+  // (CV_32FC4: B, G, R and the weights' sum; made on the first frame painted, empty otherwise).
+  cv::Mat mean_sum;
 };
 
 struct PaintUpdateStats {
@@ -54,17 +57,23 @@ struct TexelUpdateRule {
   }
 };
 
+// The misalignment signal: a sample against what a painted texel holds (BT.601 luma, integer
+// weights), into `stats`.
+inline void CompareWithStored(const uint8_t* sample, const uint8_t* texel,
+                              PaintUpdateStats* stats) {
+  if (texel[3] == 0) return;
+  const int new_grey = (29 * sample[0] + 150 * sample[1] + 77 * sample[2]) >> 8;
+  const int old_grey = (29 * texel[0] + 150 * texel[1] + 77 * texel[2]) >> 8;
+  stats->abs_grey_difference_sum += std::abs(new_grey - old_grey);
+  ++stats->compared;
+}
+
 // `sample`: BGR; `quality`: its pixels per texel; `texel`: the stored BGRA; `stored_quality`:
 // the stored sample's quality. Counts into `stats`.
 inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, float quality,
                         bool on_surface, uint8_t* texel, float* stored_quality,
                         PaintUpdateStats* stats) {
-  if (texel[3] != 0) {  // compare with what the buffer holds (BT.601 luma, integer weights)
-    const int new_grey = (29 * sample[0] + 150 * sample[1] + 77 * sample[2]) >> 8;
-    const int old_grey = (29 * texel[0] + 150 * texel[1] + 77 * texel[2]) >> 8;
-    stats->abs_grey_difference_sum += std::abs(new_grey - old_grey);
-    ++stats->compared;
-  }
+  CompareWithStored(sample, texel, stats);
   if (rule.policy == UpdatePolicy::kQuality && quality < *stored_quality * rule.keep) {
     ++stats->rejected;
     return;
@@ -79,6 +88,21 @@ inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, floa
   }
   *stored_quality =
       rule.policy == UpdatePolicy::kQuality ? std::max(*stored_quality, quality) : quality;
+  ++stats->written;
+}
+
+// `update: mean`: adds the sample, weighted by its quality, to the texel's sums (`sum`: B, G,
+// R, weight) and stores their mean; the stored quality is the best seen. Counts into `stats`.
+inline void MeanTexel(const uint8_t* sample, float quality, bool on_surface, uint8_t* texel,
+                      float* stored_quality, float* sum, PaintUpdateStats* stats) {
+  CompareWithStored(sample, texel, stats);
+  if (texel[3] == 0 && on_surface) ++stats->newly_painted;
+  const float w = std::max(quality, 1e-3f);
+  for (int c = 0; c < 3; ++c) sum[c] += w * sample[c];
+  sum[3] += w;
+  for (int c = 0; c < 3; ++c) texel[c] = cv::saturate_cast<uint8_t>(sum[c] / sum[3]);
+  texel[3] = 255;
+  *stored_quality = std::max(*stored_quality, quality);
   ++stats->written;
 }
 

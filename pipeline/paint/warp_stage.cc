@@ -46,9 +46,10 @@ void PaintSession::WarpStage(FrameWork* work) {
                            warp_options.near_m))
       in_frustum.push_back(b);
   // When no stage looks at the warped samples before the paint stage (no background
-  // model, no refinement, no exposure or view selection, no debug images), the warp paints
-  // them directly: the same texels, without writing and reading back the warped images.
-  work->paint_in_warp = options_.background.mode == BackgroundMode::kOff &&
+  // model, no refinement, no exposure or view selection, no debug images, not `update: mean`), the
+  // warp paints them directly: the same texels, without writing and reading back the warped images.
+  work->paint_in_warp = options_.update != UpdatePolicy::kMean &&
+                        options_.background.mode == BackgroundMode::kOff &&
                         options_.refine.mode == RefineMode::kOff && !SelectActive(options_) &&
                         options_.layers.count == 0 && !work->debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);

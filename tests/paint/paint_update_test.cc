@@ -48,6 +48,35 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
   EXPECT_EQ(average.painted.painted_surface_texels, 2);
 }
 
+// `update: mean`: each texel the mean of every sample it took, weighted by the samples'
+// quality (pixels per texel); masked samples do not count, provisional ones do; the sums go
+// with InitPaintedBuffer.
+TEST(PaintUpdate, MeanWeighsEverySampleByItsQuality) {
+  PipelineOptions options;
+  options.update = UpdatePolicy::kMean;
+  TwoTexels t;
+  t.Paint(100, options);
+  EXPECT_EQ(t.Stored(), 100);
+  EXPECT_EQ(t.painted.painted_surface_texels, 2);
+  t.Paint(200, options);
+  EXPECT_EQ(t.Stored(), 150);
+  t.warped.quality.setTo(0.5f);  // half as sharp: half the weight
+  t.Paint(45, options);
+  EXPECT_EQ(t.Stored(), 129);                                // (100 + 200 + 0.5 * 45) / 2.5
+  EXPECT_FLOAT_EQ(t.painted.quality.at<float>(0, 1), 1.0f);  // the best seen
+  const cv::Mat masked(1, 2, CV_8U, cv::Scalar(255));
+  t.warped.bgr.setTo(cv::Scalar::all(0));
+  PaintBuffer(t.buffer, t.warped, masked, options, &t.painted, masked);
+  EXPECT_EQ(t.Stored(), 129);
+  t.warped.quality.setTo(1.0f);
+  PaintBuffer(t.buffer, t.warped, cv::Mat(), options, &t.painted, masked);  // provisional
+  EXPECT_EQ(t.Stored(), 92);                                                // (322.5 + 0) / 3.5
+  EXPECT_GT(t.painted.quality.at<float>(0, 1), 0.0f);  // nothing marked provisional
+  InitPaintedBuffer(t.buffer, &t.painted);
+  t.Paint(10, options);
+  EXPECT_EQ(t.Stored(), 10);
+}
+
 // While a texel's background model warms up its samples are provisional (PaintBuffer's `warming`):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
 // rule), a trusted one whatever its quality, even one showing nearly the same (per-texel
@@ -119,7 +148,12 @@ TEST(PaintUpdate, RowByRowEqualsTheTexelOrder) {
   ASSERT_EQ(cv::countNonZero(rows.texel_kind), buffer.NumTexels());
   texels.texel_kind.release();  // the texel order
   PipelineOptions options;
-  for (int frame = 0; frame < 12; ++frame) {
+  for (int frame = 0; frame < 18; ++frame) {
+    if (frame == 12) {  // then the mean, onto what the quality rule painted
+      options.update = UpdatePolicy::kMean;
+      rows.quality.setTo(0, rows.quality < 0);
+      texels.quality.setTo(0, texels.quality < 0);
+    }
     WarpedBuffer warped;
     warped.bgr.create(buffer.height, buffer.width, CV_8UC3);
     cv::randu(warped.bgr, cv::Scalar::all(0), cv::Scalar::all(256));

@@ -101,21 +101,29 @@ TEST(ViewSelect, ExposureChangesPaintOneConsistentTexture) {
 // painted is the same boxes moved 5 cm sideways (a few pixels at these distances), so near
 // every silhouette frames sample what lies behind. Scored as a user can (rephotography: the
 // painted mesh rendered at frame poses against the frames, mean PSNR and local 1 - NCC).
-TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
-  BlocksOptions blocks;
-  blocks.seed = 3;
-  Scene truth;
-  ASSERT_TRUE(MakeBlocksScene(blocks, &truth).ok());
-  Scene mesh = truth;
-  for (Eigen::Vector3d& v : mesh.mesh.vertices)
-    if (v.y() > 1e-6) v += Eigen::Vector3d(0.05, 0, 0.0);  // the boxes; the ground stays
-  SynthOptions o = testing::BlocksHalfOrbit(blocks, 30, 7);
-  o.exposure_jitter = 0.2;
+struct DisplacedBoxes {
+  Scene truth, mesh;
   SynthCapture capture;
-  ASSERT_TRUE(SynthesizeCapture(truth, o, &capture).ok());
+  SynthCapture painting;  // the same frames at the given (noisy) poses
 
-  const auto score = [&](const PipelineOptions& options, double* ncc) {
-    const Scene painted = testing::PaintAllFrames(mesh, capture, options);
+  explicit DisplacedBoxes(double pose_noise_deg = 0) {
+    BlocksOptions blocks;
+    blocks.seed = 3;
+    EXPECT_TRUE(MakeBlocksScene(blocks, &truth).ok());
+    mesh = truth;
+    for (Eigen::Vector3d& v : mesh.mesh.vertices)
+      if (v.y() > 1e-6) v += Eigen::Vector3d(0.05, 0, 0.0);  // the boxes; the ground stays
+    SynthOptions o = testing::BlocksHalfOrbit(blocks, 30, 7);
+    o.exposure_jitter = 0.2;
+    o.pose_noise_deg = pose_noise_deg;
+    EXPECT_TRUE(SynthesizeCapture(truth, o, &capture).ok());
+    painting = capture;
+    painting.true_poses = capture.given_poses;
+  }
+
+  // Mean PSNR (returned) and 1 - NCC at five of the frames.
+  double Score(const PipelineOptions& options, double* ncc) const {
+    const Scene painted = testing::PaintAllFrames(mesh, painting, options);
     const Renderer renderer(capture.camera, RenderOptions());
     double psnr = 0;
     *ncc = 0;
@@ -132,7 +140,11 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
       *ncc += LocalOneMinusNcc(capture.frames_bgr[i], bgr, painted_px) / views.size();
     }
     return psnr;
-  };
+  }
+};
+
+TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
+  const DisplacedBoxes boxes;
   PipelineOptions off;  // the robust background model, no refinement
   off.background.mode = BackgroundMode::kRobust;
   off.refine.mode = RefineMode::kOff;
@@ -140,8 +152,8 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   PipelineOptions on = off;
   on.select.enabled = true;
   double ncc_off = 0, ncc_on = 0;
-  const double psnr_off = score(off, &ncc_off);
-  const double psnr_on = score(on, &ncc_on);
+  const double psnr_off = boxes.Score(off, &ncc_off);
+  const double psnr_on = boxes.Score(on, &ncc_on);
   // The edge penalty alone: the robust background model also rejects most background
   // sampled past a silhouette (a minority of a texel's samples), so it shows without it.
   PipelineOptions no_model = on;
@@ -149,8 +161,8 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   PipelineOptions no_model_no_edges = no_model;
   no_model_no_edges.select.edge_px = 0;
   double ncc_edges = 0, ncc_no_edges = 0;
-  const double psnr_edges = score(no_model, &ncc_edges);
-  const double psnr_no_edges = score(no_model_no_edges, &ncc_no_edges);
+  const double psnr_edges = boxes.Score(no_model, &ncc_edges);
+  const double psnr_no_edges = boxes.Score(no_model_no_edges, &ncc_no_edges);
   std::printf(
       "displaced boxes, exposure changes: select off %.2f dB / 1-NCC %.3f, on "
       "%.2f / %.3f; background off: edge penalty off %.2f / %.3f, on %.2f / %.3f\n",
@@ -159,6 +171,38 @@ TEST(ViewSelect, DisplacedMeshAndExposureChanges) {
   EXPECT_LT(ncc_on, ncc_off - 0.03);
   EXPECT_GT(psnr_edges, psnr_no_edges + 0.3);
   EXPECT_LT(ncc_edges, ncc_no_edges - 0.005);
+}
+
+// `update: mean` on the same capture: every view averaged (weighted by pixels per texel) against
+// the best view kept per texel with its exposure matched; and with the given poses 0.3 deg
+// off (frames that disagree by a few pixels, as real photos do): blended, not interleaved.
+TEST(ViewSelect, TheMeanOfEveryViewOnADisplacedMeshAndNoisyPoses) {
+  PipelineOptions quality;  // the default update, no background model, no refinement
+  quality.background.mode = BackgroundMode::kOff;
+  quality.refine.mode = RefineMode::kOff;
+  PipelineOptions select = quality;
+  select.select.enabled = true;
+  PipelineOptions mean = quality;
+  mean.update = UpdatePolicy::kMean;
+  for (const double noise_deg : {0.0, 0.3}) {
+    const DisplacedBoxes boxes(noise_deg);
+    double ncc_quality = 0, ncc_select = 0, ncc_mean = 0;
+    const double psnr_quality = boxes.Score(quality, &ncc_quality);
+    const double psnr_select = boxes.Score(select, &ncc_select);
+    const double psnr_mean = boxes.Score(mean, &ncc_mean);
+    std::printf(
+        "displaced boxes, exposure changes, pose noise %.1f deg: quality %.2f dB / 1-NCC %.3f, "
+        "select %.2f / %.3f, mean %.2f / %.3f\n",
+        noise_deg, psnr_quality, ncc_quality, psnr_select, ncc_select, psnr_mean, ncc_mean);
+    if (noise_deg == 0) {
+      EXPECT_GT(psnr_mean, psnr_select - 0.3);
+      EXPECT_LT(ncc_mean, ncc_select + 0.005);
+    } else {
+      EXPECT_GT(psnr_mean, psnr_select + 2.0);
+      EXPECT_GT(psnr_mean, psnr_quality + 1.0);
+      EXPECT_LT(ncc_mean, ncc_select - 0.1);
+    }
+  }
 }
 
 }  // namespace
