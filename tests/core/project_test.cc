@@ -383,8 +383,8 @@ TEST(ProjectTest, EnumsAndRangesAreChecked) {
             "p.json: pipeline.sampling: 'cubic' is not one of \"nearest\", \"bilinear\" or "
             "\"area\"");
   EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"update": "newest"})")),
-              StartsWith("p.json: pipeline.update: 'newest' is not one of \"latest\" or "
-                         "\"quality\""));
+              StartsWith("p.json: pipeline.update: 'newest' is not one of \"latest\", "
+                         "\"quality\" or \"mean\""));
   EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"quality_slack": 1.5})")),
               StartsWith("p.json: pipeline.quality_slack: must be in [0, 1], got 1.5"));
   EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"update_every": 0})")),
