@@ -21,6 +21,7 @@ namespace fresco {
 enum class SamplingMode { kNearest, kBilinear, kArea };
 // kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
 // when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
+// kMean: each texel the mean of every sample it took, weighted by pixels per texel.
 enum class UpdatePolicy { kLatest, kQuality, kMean };
 
 struct PipelineOptions {

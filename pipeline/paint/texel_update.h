@@ -1,6 +1,7 @@
 // How one new sample updates one stored texel (the paper's §4 policy, or quality-aware, with
 // an optional running average), shared by the paint stage and by the warp when it paints
-// directly (frame_warp.h): one rule, one place.
+// directly (frame_warp.h): one rule, one place. `update: mean` (MeanTexel) keeps sums beside
+// the texels and runs in the paint stage only.
 #pragma once
 
 #include <algorithm>
