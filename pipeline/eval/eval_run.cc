@@ -197,8 +197,15 @@ Status EvaluateCapture(const EvalSuite& suite, const SuiteCapture& capture,
     mover_texels = session->PaintedScene(provenance->MaskImages(*session));
     const MoverProvenance::Figures f = provenance->Count(*session);
     result->mover_texels = f.mover_fraction();
-    result->mover_dominated_texels = f.painted > 0 ? double(f.mover_dominated) / f.painted : 0.0;
+    const auto share = [&](long long texels) {
+      return f.painted > 0 ? static_cast<double>(texels) / f.painted : 0.0;
+    };
+    result->mover_dominated_texels = share(f.mover_dominated);
     result->open_coverage = f.open_coverage();
+    result->mover_never_open = share(f.mover_never_open);
+    result->mover_open_masked = share(f.mover_open_masked);
+    result->mover_open_passed = share(f.mover_open_passed);
+    result->mover_open_replaced = share(f.mover_open_replaced);
   }
   const Renderer painted_renderer(plan.camera, RenderOptions());
   RenderOptions clean_options;

@@ -53,6 +53,11 @@ struct CaptureEval {
   // those of them seen with a mover at least as often as without, and the texels seen
   // mover-free at least once that are painted (fractions).
   double mover_texels = 0, mover_dominated_texels = 0, open_coverage = 0;
+  // The texels painted from a mover by why (fractions of the painted texels; they sum to
+  // mover_texels, MoverProvenance::Figures): never seen without a mover, every sample without
+  // one kept out of painting, one not kept out but not taken, one painted and then replaced.
+  double mover_never_open = 0, mover_open_masked = 0, mover_open_passed = 0,
+         mover_open_replaced = 0;
   double coverage = 0;  // on-surface texels painted
   // background.mode auto: the share of the surface pixels judged that were masked (NaN
   // when not run).

@@ -124,7 +124,12 @@ std::string EvalToJson(const std::vector<std::string>& settings,
       row["movers"] = {{"region_error", c.mover_region_error},
                        {"texels", c.mover_texels},
                        {"dominated_texels", c.mover_dominated_texels},
-                       {"open_coverage", c.open_coverage}};
+                       {"open_coverage", c.open_coverage},
+                       {"texels_by_why",
+                        {{"never_seen_without", c.mover_never_open},
+                         {"without_kept_out", c.mover_open_masked},
+                         {"without_not_taken", c.mover_open_passed},
+                         {"without_replaced", c.mover_open_replaced}}}};
     row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
     if (std::isfinite(c.movers_across_views)) row["movers_across_views"] = c.movers_across_views;
     row["noisy_poses"] = c.noisy_poses;

@@ -20,6 +20,8 @@ MoverProvenance::MoverProvenance(const Scene& world_scene, const std::vector<Mov
     shows_mover_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
     n_mover_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
     n_open_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
+    open_written_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
+    open_passed_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
   }
   before_.resize(buffers.size());
 }
@@ -66,8 +68,12 @@ void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
     cv::transform(diff, written, cv::Matx14f(1, 1, 1, 1));
     written = written > 0;
     mover_texel.copyTo(shows_mover_[b], written);
+    const cv::Mat open = warped.valid & ~mover_texel;
     cv::add(n_mover_[b], 1, n_mover_[b], warped.valid & mover_texel);
-    cv::add(n_open_[b], 1, n_open_[b], warped.valid & ~mover_texel);
+    cv::add(n_open_[b], 1, n_open_[b], open);
+    open_written_[b].setTo(255, open & written);
+    const cv::Mat kept_out = session.KeptOutOfPainting(b);
+    open_passed_[b].setTo(255, kept_out.empty() ? open & ~written : open & ~written & ~kept_out);
   }
 }
 
@@ -87,6 +93,16 @@ MoverProvenance::Figures MoverProvenance::Count(const PaintSession& session) con
       f.painted += painted;
       f.painted_mover += mover;
       f.mover_dominated += mover && n_mover[idx] >= n_open[idx];
+      if (mover) {
+        if (n_open[idx] == 0)
+          ++f.mover_never_open;
+        else if (open_written_[b].data[idx])
+          ++f.mover_open_replaced;
+        else if (open_passed_[b].data[idx])
+          ++f.mover_open_passed;
+        else
+          ++f.mover_open_masked;
+      }
       f.open += n_open[idx] > 0;
       f.open_painted += painted && n_open[idx] > 0;
     }

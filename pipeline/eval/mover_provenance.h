@@ -44,6 +44,12 @@ class MoverProvenance {
     long long mover_dominated = 0;
     long long open = 0;          // on-surface texels seen at least once with no mover on them
     long long open_painted = 0;  // ... that are painted
+    // Why the texels painted from a mover were (painted_mover, split four ways):
+    long long mover_never_open = 0;     // never seen without a mover: nothing else to paint
+    long long mover_open_masked = 0;    // each sample without a mover was kept out of painting
+    long long mover_open_passed = 0;    // ... not kept out, not taken (the texel kept a sample
+                                        // it preferred, a mover's or one later replaced by it)
+    long long mover_open_replaced = 0;  // one was painted, then a mover's replaced it
     double mover_fraction() const { return painted > 0 ? double(painted_mover) / painted : 0.0; }
     double open_coverage() const { return open > 0 ? double(open_painted) / open : 0.0; }
   };
@@ -61,8 +67,9 @@ class MoverProvenance {
   NormalizedBounds bounds_;
   std::vector<cv::Mat> before_;  // painted BGRA before the frame
   // Per buffer: does the stored sample show a mover; how often the texel was seen with and
-  // without a mover on it.
-  std::vector<cv::Mat> shows_mover_, n_mover_, n_open_;
+  // without a mover on it; whether a sample without a mover was painted, and whether one was
+  // neither painted nor kept out of painting.
+  std::vector<cv::Mat> shows_mover_, n_mover_, n_open_, open_written_, open_passed_;
 };
 
 }  // namespace fresco

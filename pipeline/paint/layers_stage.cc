@@ -34,14 +34,11 @@ void PaintSession::LayersStage(FrameWork* work) {
   ViewLayer& layer = layers_[k];
   layer.centre_sum += camera_centre;
   ++layer.frames;
-  const bool background = options_.background.mode != BackgroundMode::kOff;
   const std::vector<size_t> seen = Indices(work->seen);
   std::vector<PaintUpdateStats> stats(set_.buffers.size());
   ForEachBuffer(seen, false, [&](size_t b) {
-    const cv::Mat mask = !background || background_frame_[b].masked == 0
-                             ? cv::Mat()
-                             : background_frame_[b].foreground;
-    stats[b] = PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &layer.painted[b]);
+    stats[b] =
+        PaintBuffer(set_.buffers[b], warped_[b], KeptOutOfPainting(b), options_, &layer.painted[b]);
   });
   long long written = 0;
   for (size_t b : seen) written += stats[b].written;

@@ -142,6 +142,10 @@ class PaintSession {
 
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
+  // The texels of buffer b that the last frame's background stage kept out of painting
+  // (CV_8U, 255, the buffer's size), for a buffer that frame saw; empty where it kept none
+  // out or the background model is off.
+  cv::Mat KeptOutOfPainting(size_t b) const;
   const std::vector<RefineAnchor>& anchors() const { return anchors_; }
   const Grouping& grouping() const { return set_.grouping; }
   int folds_split() const { return set_.folds_split; }

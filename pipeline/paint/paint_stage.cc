@@ -10,6 +10,13 @@
 
 namespace fresco {
 
+cv::Mat PaintSession::KeptOutOfPainting(size_t b) const {
+  if (options_.background.mode == BackgroundMode::kOff || b >= background_frame_.size() ||
+      background_frame_[b].masked == 0)
+    return cv::Mat();
+  return background_frame_[b].foreground;
+}
+
 void PaintSession::PaintStage(FrameWork* work) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
@@ -22,9 +29,7 @@ void PaintSession::PaintStage(FrameWork* work) {
     report.notes["painted"] = "during the warp (no stage between them)";
   } else {
     ForEachBuffer(seen, false, [&](size_t b) {
-      const cv::Mat mask = !background || background_frame_[b].masked == 0
-                               ? cv::Mat()
-                               : background_frame_[b].foreground;
+      const cv::Mat mask = KeptOutOfPainting(b);
       const cv::Mat warming = !background || background_frame_[b].warming_up == 0
                                   ? cv::Mat()
                                   : background_frame_[b].warming;

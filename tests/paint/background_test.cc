@@ -33,6 +33,21 @@ namespace {
 
 Scene Room() { return testing::RoomScene(); }
 
+// The room with movers over `frames` frames, steady exposure.
+SynthCapture SteadyRoomWithMovers(const Scene& scene, int frames) {
+  SynthCapture capture;
+  EXPECT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(frames, 0.0), &capture).ok());
+  return capture;
+}
+
+// The robust background model alone: refinement off (exact poses).
+PipelineOptions RobustWithoutRefinement() {
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kRobust;
+  return options;
+}
+
 struct MoverFigures : MoverProvenance::Figures {
   double masked_fraction = 0;  // mean of the background stage's masked_fraction
 };
@@ -68,6 +83,10 @@ void Print(const char* name, const MoverFigures& f) {
       "masked %5.2f %% per frame, dominated %lld\n",
       name, 100 * f.mover_fraction(), f.painted_mover, f.painted, 100 * f.open_coverage(),
       100 * f.masked_fraction, f.mover_dominated);
+  std::printf(
+      "         painted from a mover: %lld never seen without one, %lld every sample without "
+      "one kept out, %lld one not taken, %lld one painted and replaced\n",
+      f.mover_never_open, f.mover_open_masked, f.mover_open_passed, f.mover_open_replaced);
 }
 
 class MoversTest : public ::testing::TestWithParam<double> {};
@@ -100,6 +119,43 @@ TEST_P(MoversTest, RobustModelPaintsAlmostNoMoverAndKeepsTheStaticScene) {
   EXPECT_LT(robust.mover_fraction(), off.mover_fraction() / 10);
   // What was ever seen without a mover on it is painted (nearly) as without movers.
   EXPECT_GE(robust.open_coverage(), 0.99 * off.open_coverage());
+  // Why the movers are painted: without a model no sample is kept out of painting.
+  EXPECT_EQ(off.mover_open_masked, 0);
+  EXPECT_GT(off.mover_open_passed + off.mover_open_replaced, 0);
+}
+
+// What the session reports it kept out of painting (PaintSession::KeptOutOfPainting, which
+// `fresco eval` splits the painted movers by) is what the paint stage left alone: no texel it
+// names is written that frame, and the robust model does keep movers out.
+TEST(KeptOutOfPainting, IsWhatThePaintStageLeftAlone) {
+  const Scene scene = Room();
+  const SynthCapture capture = SteadyRoomWithMovers(scene, 40);
+  std::unique_ptr<PaintSession> session =
+      testing::SessionForCapture(scene, capture, RobustWithoutRefinement());
+  FrameReport report;
+  long long kept_out = 0, kept_out_written = 0, written = 0;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
+    std::vector<cv::Mat> before;
+    for (const PaintedBuffer& p : session->painted()) before.push_back(p.bgra.clone());
+    Frame frame;
+    frame.index = static_cast<int>(i);
+    frame.bgr = capture.frames_bgr[i];
+    session->PaintFrame(frame, capture.camera, capture.true_poses[i].cam_from_world, &report);
+    for (size_t b = 0; b < before.size(); ++b) {
+      cv::Mat diff, changed;
+      cv::absdiff(before[b], session->painted()[b].bgra, diff);
+      cv::transform(diff, changed, cv::Matx14f(1, 1, 1, 1));
+      changed = changed > 0;
+      written += cv::countNonZero(changed);
+      const cv::Mat out = session->KeptOutOfPainting(b);
+      if (out.empty()) continue;
+      kept_out += cv::countNonZero(out);
+      kept_out_written += cv::countNonZero(out & changed);
+    }
+  }
+  EXPECT_GT(written, 0);
+  EXPECT_GT(kept_out, 0);
+  EXPECT_EQ(kept_out_written, 0);
 }
 
 // The room with movers (`frames` of them, exact poses) painted by the robust model with
@@ -212,12 +268,9 @@ INSTANTIATE_TEST_SUITE_P(Exposure, MoversTest, ::testing::Values(0.0, 0.08), [](
 // half as bright, as a second stream) neither teaches nor is judged by another's model.
 TEST(StreamBackground, EachStreamLearnsOnlyFromItsOwnFrames) {
   const Scene scene = Room();
-  SynthCapture capture;
-  ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(12, 0.0), &capture).ok());
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
+  const SynthCapture capture = SteadyRoomWithMovers(scene, 12);
+  PipelineOptions options = RobustWithoutRefinement();
   options.select.enabled = false;  // the exposure stage would adapt frames to the buffers
-  options.background.mode = BackgroundMode::kRobust;
   std::unique_ptr<PaintSession> alone = testing::SessionForCapture(scene, capture, options);
   std::unique_ptr<PaintSession> both = testing::SessionForCapture(scene, capture, options);
   ASSERT_TRUE(alone && both);
