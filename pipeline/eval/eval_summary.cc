@@ -188,6 +188,24 @@ std::string EvalToText(const std::vector<CaptureEval>& results,
                   f.psnr_db.median, f.psnr_db.worst, leak, f.paint_fps.median, f.paint_fps.worst);
     out += line;
   }
+  bool movers = false;
+  for (const CaptureEval& c : results) movers |= c.has_movers;
+  if (movers) {
+    // Where the movers are, how much of the static scene is painted and why the movers that
+    // are painted were (MoverProvenance::Figures, % of the painted texels).
+    out +=
+        "\n| capture with movers | mover leak % | static texels painted % | mover texels % | "
+        "never seen without | every view without kept out | one not taken | one replaced "
+        "|\n|---|---|---|---|---|---|---|---|\n";
+    for (const CaptureEval& c : results) {
+      if (!c.has_movers) continue;
+      std::snprintf(line, sizeof line, "| %s | %.3f | %.1f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                    c.name.c_str(), 100 * c.mover_leak, 100 * c.open_coverage, 100 * c.mover_texels,
+                    100 * c.mover_never_open, 100 * c.mover_open_masked, 100 * c.mover_open_passed,
+                    100 * c.mover_open_replaced);
+      out += line;
+    }
+  }
   bool references = false;
   for (const CaptureEval& c : results) references |= std::isfinite(c.unrefined_truth_psnr_db);
   if (!references) return out;

@@ -34,7 +34,8 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                        const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families);
 
-// Per capture one line, then per family median and worst (Markdown tables); with
+// Per capture one line, then per family median and worst (Markdown tables); where captures
+// have movers, a line each on the static scene painted and why movers were; with
 // EvalOptions::recovery also what refinement recovers.
 std::string EvalToText(const std::vector<CaptureEval>& results,
                        const std::vector<FamilySummary>& families);

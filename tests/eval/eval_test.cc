@@ -113,6 +113,27 @@ TEST(EvalSummaryTest, MedianAndWorstPerFamily) {
   EXPECT_TRUE(j["families"][1]["mover_leak"].is_null());
 }
 
+// Captures with movers get a line each on why their movers were painted; the others none.
+TEST(EvalSummaryTest, WhyMoversWerePaintedPerCaptureWithMovers) {
+  std::vector<CaptureEval> r(2);
+  r[0].name = "with", r[0].family = "a", r[0].has_movers = true, r[0].mover_leak = 0.01;
+  r[0].open_coverage = 0.95, r[0].mover_texels = 0.02;
+  r[0].mover_never_open = 0.001, r[0].mover_open_masked = 0.012;
+  r[0].mover_open_passed = 0.002, r[0].mover_open_replaced = 0.005;
+  r[1].name = "without", r[1].family = "a";
+  const std::string text = EvalToText(r, SummarizeByFamily(r));
+  EXPECT_NE(text.find("| with | 1.000 | 95.0 | 2.00 | 0.10 | 1.20 | 0.20 | 0.50 |"),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("| without |", text.find("capture with movers")), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(EvalToJson({}, r, SummarizeByFamily(r)));
+  EXPECT_DOUBLE_EQ(j["captures"][0]["movers"]["texels_by_why"]["without_kept_out"], 0.012);
+  EXPECT_FALSE(j["captures"][1].contains("movers"));
+  // Without captures with movers, no such table.
+  r.erase(r.begin());
+  EXPECT_EQ(EvalToText(r, SummarizeByFamily(r)).find("capture with movers"), std::string::npos);
+}
+
 // --recovery: the references are painted, and what refinement recovers of the PSNR lost to
 // pose noise is a fraction between them; a capture with exact poses gets no true-pose
 // reference.
