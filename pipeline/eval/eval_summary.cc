@@ -51,6 +51,8 @@ FamilySummary Summarize(const std::string& family, const std::vector<const Captu
       group, [](const CaptureEval& c) { return c.one_minus_ncc; }, true);
   f.mover_leak = Spread(
       group, [](const CaptureEval& c) { return c.mover_leak; }, true, true);
+  f.static_texels_painted = Spread(
+      group, [](const CaptureEval& c) { return c.open_coverage; }, false, true);
   f.paint_fps = Spread(
       group, [](const CaptureEval& c) { return c.paint_fps; }, false);
   f.coverage = Spread(
@@ -150,6 +152,7 @@ std::string EvalToJson(const std::vector<std::string>& settings,
                                 {"psnr_db", SpreadJson(f.psnr_db)},
                                 {"one_minus_ncc", SpreadJson(f.one_minus_ncc)},
                                 {"mover_leak", SpreadJson(f.mover_leak)},
+                                {"static_texels_painted", SpreadJson(f.static_texels_painted)},
                                 {"paint_fps", SpreadJson(f.paint_fps)},
                                 {"coverage", SpreadJson(f.coverage)},
                                 {"recovered", SpreadJson(f.recovered)},
@@ -177,15 +180,20 @@ std::string EvalToText(const std::vector<CaptureEval>& results,
   }
   out +=
       "\n| family | captures | truth PSNR dB median / worst | rephoto PSNR dB median / worst | "
-      "mover leak % median / worst | paint fps median / worst |\n|---|---|---|---|---|---|\n";
+      "mover leak % median / worst | static texels painted % median / worst (with movers) | "
+      "paint fps median / worst |\n|---|---|---|---|---|---|---|\n";
   for (const FamilySummary& f : families) {
-    char leak[48] = "-";
+    char leak[48] = "-", painted[48] = "-";
     if (f.mover_leak.count > 0)
       std::snprintf(leak, sizeof leak, "%.3f / %.3f", 100 * f.mover_leak.median,
                     100 * f.mover_leak.worst);
-    std::snprintf(line, sizeof line, "| %s | %d | %.2f / %.2f | %.2f / %.2f | %s | %.0f / %.0f |\n",
-                  f.family.c_str(), f.captures, f.truth_psnr_db.median, f.truth_psnr_db.worst,
-                  f.psnr_db.median, f.psnr_db.worst, leak, f.paint_fps.median, f.paint_fps.worst);
+    if (f.static_texels_painted.count > 0)
+      std::snprintf(painted, sizeof painted, "%.1f / %.1f", 100 * f.static_texels_painted.median,
+                    100 * f.static_texels_painted.worst);
+    std::snprintf(
+        line, sizeof line, "| %s | %d | %.2f / %.2f | %.2f / %.2f | %s | %s | %.0f / %.0f |\n",
+        f.family.c_str(), f.captures, f.truth_psnr_db.median, f.truth_psnr_db.worst,
+        f.psnr_db.median, f.psnr_db.worst, leak, painted, f.paint_fps.median, f.paint_fps.worst);
     out += line;
   }
   bool movers = false;

@@ -20,6 +20,9 @@ struct FamilySummary {
   int captures = 0;
   FigureSpread truth_psnr_db, truth_one_minus_ncc, psnr_db, one_minus_ncc, mover_leak, paint_fps,
       coverage;
+  // Captures with movers: the static texels painted (CaptureEval::open_coverage; the worst is
+  // the lowest).
+  FigureSpread static_texels_painted;
   // With EvalOptions::recovery: the share of the PSNR lost to pose noise that is recovered
   // (noisy captures), and truth PSNR against refinement off on captures with exact poses (dB;
   // the worst is the lowest).

@@ -129,6 +129,11 @@ TEST(EvalSummaryTest, WhyMoversWerePaintedPerCaptureWithMovers) {
   const nlohmann::json j = nlohmann::json::parse(EvalToJson({}, r, SummarizeByFamily(r)));
   EXPECT_DOUBLE_EQ(j["captures"][0]["movers"]["texels_by_why"]["without_kept_out"], 0.012);
   EXPECT_FALSE(j["captures"][1].contains("movers"));
+  // Per family: the static texels painted over the captures with movers only.
+  const std::vector<FamilySummary> f = SummarizeByFamily(r);
+  EXPECT_EQ(f[0].static_texels_painted.count, 1);
+  EXPECT_DOUBLE_EQ(f[0].static_texels_painted.worst, 0.95);
+  EXPECT_NE(text.find("| 1.000 / 1.000 | 95.0 / 95.0 |"), std::string::npos) << text;
   // Without captures with movers, no such table.
   r.erase(r.begin());
   EXPECT_EQ(EvalToText(r, SummarizeByFamily(r)).find("capture with movers"), std::string::npos);
