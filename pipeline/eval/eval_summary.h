@@ -1,6 +1,7 @@
 // The distribution of a suite's figures: per family and over all captures, the median and
-// the worst of each figure (lowest PSNR, coverage and fps; highest 1-NCC and mover leak;
-// mover leak over the captures that have movers only). Written as JSON and as a text table.
+// the worst of each figure (lowest PSNR, coverage, static texels painted and fps; highest
+// 1-NCC and mover leak; mover leak and static texels painted over the captures that have
+// movers only). Written as JSON and as a text table.
 #pragma once
 
 #include <string>
