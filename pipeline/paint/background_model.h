@@ -33,8 +33,11 @@ namespace fresco {
 
 // One buffer's segmentation of one frame.
 struct BackgroundFrame {
-  cv::Mat foreground;      // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
-  cv::Mat warming;         // CV_8U, buffer size: 255 = sampled this frame, model still warming up
+  cv::Mat foreground;  // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
+  cv::Mat warming;     // CV_8U, buffer size: 255 = sampled this frame, model still warming up
+  // CV_8U, buffer size: `foreground` and the texels near a mover found across views
+  // (BackgroundOptions::mover_margin); empty when there are none near one.
+  cv::Mat kept_out;
   cv::Mat difference;      // CV_8U (debug only): RMS colour distance to the background x 2
   int observed = 0;        // texels sampled this frame (valid in the warped buffer)
   int foreground_raw = 0;  // ... classified foreground before cleaning

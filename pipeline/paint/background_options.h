@@ -71,6 +71,11 @@ struct BackgroundOptions {
   // has measured a frame).
   // Measured over both evaluation suites (docs/results.md).
   bool across_views = true;
+  // ... and the pixels around them, out to this share of the frame's longer side, are not
+  // painted either (they are not the model's foreground): where the frames near a mover
+  // disagree about which side of an edge is the mover, its edge pixels and the background it
+  // just uncovered are the ones painting took it from. 0: none.
+  double mover_margin = 0.0125;
 
   bool operator==(const BackgroundOptions&) const = default;
 };
@@ -170,6 +175,13 @@ void Fields(BackgroundOptions& o, V& v) {
                    "measured a frame); growth does not start from the pixels the frames near "
                    "them agree with (where a mover the model learned has gone) (on: less of the "
                    "movers painted and more of the rest; off: the model alone)"});
+  v.Field("mover_margin", o.mover_margin,
+          {.min = 0,
+           .max = 0.25,
+           .help = "`across_views`: the pixels around the movers found, out to this share of "
+                   "the frame's longer side, are not painted either (a mover's edge and the "
+                   "background it just uncovered, where the frames near it disagree about which "
+                   "is the mover); 0: none"});
 }
 
 }  // namespace fresco

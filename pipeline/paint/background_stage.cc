@@ -1,9 +1,11 @@
 // The background stage (paint_stages.h): each visible texel compared with its background
 // model, learned from this stream's earlier frames; movers masked out of painting (§3.4,
 // background_model.h). Off with pipeline.background.mode off.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
@@ -97,6 +99,9 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
       cv::bitwise_or(frame.foreground, mover_texels_[b], frame.foreground);
       frame.masked = cv::countNonZero(frame.foreground & warped_[b].valid);
     }
+    frame.kept_out.release();
+    if (keep_out && cv::countNonZero(near_mover_texels_[b]) > 0)
+      cv::bitwise_or(frame.foreground, near_mover_texels_[b], frame.kept_out);
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];
@@ -125,9 +130,25 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
 void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Mat& movers,
                               const FrameView& view) {
   const cv::Size size(view.camera->width, view.camera->height);
+  // The margin around the movers, at the masks' own size (they are made at a reduced size).
+  cv::Mat near = cv::Mat::zeros(movers.size(), CV_8U);
+  const int margin = static_cast<int>(
+      std::lround(options_.background.mover_margin * std::max(movers.cols, movers.rows)));
+  if (margin > 0) {
+    const cv::Mat mover = movers == kMoverPixel;
+    cv::dilate(
+        mover, near,
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
+    near &= ~mover;
+  }
   cv::Mat full = movers, bgr;
-  if (full.size() != size) cv::resize(movers, full, size, 0, 0, cv::INTER_NEAREST);
-  cv::cvtColor(full, bgr, cv::COLOR_GRAY2BGR);
+  if (full.size() != size) {
+    cv::resize(movers, full, size, 0, 0, cv::INTER_NEAREST);
+    cv::resize(near, near, size, 0, 0, cv::INTER_NEAREST);
+  }
+  // Nearest sampling carries the values unchanged: the packed mask in the first channel, the
+  // margin in the second.
+  cv::merge(std::vector<cv::Mat>{full, near, full}, bgr);
   FrameView movers_view = view;
   movers_view.frame_bgr = &bgr;
   movers_view.pyramid.clear();
@@ -137,6 +158,7 @@ void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Ma
   movers_warped_.resize(set_.buffers.size());
   mover_texels_.resize(set_.buffers.size());
   agreed_texels_.resize(set_.buffers.size());
+  near_mover_texels_.resize(set_.buffers.size());
   ForEachBuffer(seen_list, false, [&](size_t b) {
     WarpedBuffer& warped = movers_warped_[b];
     WarpFrameToBuffer(set_.buffers[b], movers_view, nearest, &warped);
@@ -144,6 +166,8 @@ void PaintSession::WarpMovers(const std::vector<size_t>& seen_list, const cv::Ma
     cv::extractChannel(warped.bgr, values, 0);
     mover_texels_[b] = (values == kMoverPixel) & warped.valid;
     agreed_texels_[b] = (values == kAgreedPixel) & warped.valid;
+    cv::extractChannel(warped.bgr, values, 1);
+    near_mover_texels_[b] = (values > 0) & warped.valid;
   });
 }
 

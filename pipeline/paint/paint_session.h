@@ -209,7 +209,8 @@ class PaintSession {
                                 BackgroundFigures* figures);
   // The frame's movers found across views (`movers`, mover_masks.h) warped into the buffers
   // seen as the frame was: mover_texels_ (255 where they cover a texel seen) and
-  // agreed_texels_ (255 where the pixels the frames near it agree with do).
+  // agreed_texels_ (255 where the pixels the frames near it agree with do), and
+  // near_mover_texels_ (255 within background.mover_margin of a mover, not a mover's).
   void WarpMovers(const std::vector<size_t>& seen_list, const cv::Mat& movers,
                   const FrameView& view);
   // Stream `stream`'s background models, one per buffer, initialized on first use.
@@ -238,7 +239,7 @@ class PaintSession {
   std::vector<WarpedBuffer> warped_;
   // The frame's movers found across views (Frame::movers) warped into each buffer (WarpMovers).
   std::vector<WarpedBuffer> movers_warped_;
-  std::vector<cv::Mat> mover_texels_, agreed_texels_;
+  std::vector<cv::Mat> mover_texels_, agreed_texels_, near_mover_texels_;
   std::vector<RefineAnchor> anchors_;                       // per buffer (refinement on)
   std::vector<ViewLayer> layers_;                           // pipeline.layers (layers_stage.cc)
   Eigen::Vector3d scene_centre_ = Eigen::Vector3d::Zero();  // the mesh's box centre (local)

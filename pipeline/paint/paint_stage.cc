@@ -11,10 +11,11 @@
 namespace fresco {
 
 cv::Mat PaintSession::KeptOutOfPainting(size_t b) const {
-  if (options_.background.mode == BackgroundMode::kOff || b >= background_frame_.size() ||
-      background_frame_[b].masked == 0)
+  if (options_.background.mode == BackgroundMode::kOff || b >= background_frame_.size())
     return cv::Mat();
-  return background_frame_[b].foreground;
+  const BackgroundFrame& frame = background_frame_[b];
+  if (!frame.kept_out.empty()) return frame.kept_out;
+  return frame.masked == 0 ? cv::Mat() : frame.foreground;
 }
 
 void PaintSession::PaintStage(FrameWork* work) {

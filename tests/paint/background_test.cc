@@ -234,6 +234,26 @@ TEST(MoversAcrossViews, ChangeNothingWithoutGrowth) {
   EXPECT_EQ(f.with_masks.painted_mover, f.alone.painted_mover);
 }
 
+// Masks over the middle third of each frame of `capture`.
+std::vector<cv::Mat> MiddleThirdMasks(const SynthCapture& capture) {
+  const cv::Size size(capture.camera.width, capture.camera.height);
+  std::vector<cv::Mat> masks(capture.true_poses.size());
+  for (cv::Mat& m : masks) {
+    m = cv::Mat::zeros(size, CV_8U);
+    m(cv::Rect(size.width / 3, 0, size.width / 3, size.height)).setTo(255);
+  }
+  return masks;
+}
+
+// The robust model with refinement and growth `auto` (growth waits for refinement).
+PipelineOptions RobustWithAutoRefinement() {
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kAuto;
+  options.background.mode = BackgroundMode::kRobust;
+  options.background.grow = GrowMode::kAuto;
+  return options;
+}
+
 // In the first two frames refinement's `auto` has nothing to measure yet, and growth waits
 // for it; the movers found across views are kept out of painting there all the same (the
 // first frames' movers are the ones that stay). Masks over the middle third of each frame.
@@ -241,22 +261,56 @@ TEST(MoversAcrossViews, KeptOutOfTheFirstFramesWhileRefinementDecides) {
   const Scene scene = Room();
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(2, 0.0), &capture).ok());
-  const cv::Size size(capture.camera.width, capture.camera.height);
-  std::vector<cv::Mat> masks(2, cv::Mat::zeros(size, CV_8U));
-  for (cv::Mat& m : masks) {
-    m = cv::Mat::zeros(size, CV_8U);
-    m(cv::Rect(size.width / 3, 0, size.width / 3, size.height)).setTo(255);
-  }
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kAuto;
-  options.background.mode = BackgroundMode::kRobust;
-  options.background.grow = GrowMode::kAuto;
+  const std::vector<cv::Mat> masks = MiddleThirdMasks(capture);
+  const PipelineOptions options = RobustWithAutoRefinement();
   const MoverFigures alone = PaintWithMovers(scene, capture, options);
   const MoverFigures with_masks = PaintWithMovers(scene, capture, options, &masks);
   Print("alone", alone);
   Print("masks", with_masks);
   EXPECT_GT(alone.painted, 0);
   EXPECT_LT(with_masks.painted, 0.8 * alone.painted);
+}
+
+// The pixels around the movers found (background.mover_margin, a share of the frame's longer
+// side) are kept out of painting too: with masks over the middle third of two frames, a
+// margin of 5 % of the width leaves out that much more of the frame on each side of them.
+TEST(MoversAcrossViews, TheMarginAroundThemIsNotPainted) {
+  const Scene scene = Room();
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(2, 0.0), &capture).ok());
+  const std::vector<cv::Mat> masks = MiddleThirdMasks(capture);
+  PipelineOptions options = RobustWithAutoRefinement();
+  options.background.mover_margin = 0;
+  const MoverFigures none = PaintWithMovers(scene, capture, options, &masks);
+  options.background.mover_margin = 0.05;
+  const MoverFigures margin = PaintWithMovers(scene, capture, options, &masks);
+  Print("no margin", none);
+  Print("margin", margin);
+  // Two thirds of the width painted without the margin, a little over half with it.
+  EXPECT_LT(margin.painted, 0.92 * none.painted);
+  EXPECT_GT(margin.painted, 0.7 * none.painted);
+}
+
+// On the room with movers, the margin paints less of the movers.
+TEST(MoversAcrossViews, TheMarginPaintsLessOfTheMovers) {
+  const Scene scene = Room();
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, 0.0), &capture).ok());
+  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, {});
+  std::vector<cv::Mat> packed;
+  for (size_t k = 0; k < found.masks.size(); ++k) packed.push_back(found.Packed(k));
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kRobust;
+  options.background.grow = GrowMode::kOn;
+  options.background.mover_margin = 0;
+  const MoverFigures none = PaintWithMovers(scene, capture, options, &packed);
+  options.background.mover_margin = BackgroundOptions().mover_margin;
+  const MoverFigures margin = PaintWithMovers(scene, capture, options, &packed);
+  Print("no margin", none);
+  Print("margin", margin);
+  EXPECT_LT(margin.painted_mover, none.painted_mover);
+  EXPECT_GE(margin.open_coverage(), 0.99 * none.open_coverage());
 }
 
 INSTANTIATE_TEST_SUITE_P(Exposure, MoversTest, ::testing::Values(0.0, 0.08), [](const auto& info) {
