@@ -45,6 +45,7 @@ struct BackgroundFrame {
   int masked_ungrown = 0;  // ... masked after cleaning, before growth (the model's own verdict)
   int warming_up = 0;      // ... whose model is still warming up (painted provisionally)
   int blobs_removed = 0;   // foreground blobs smaller than min_blob_texels
+  int near_movers = 0;     // ... kept out only for the margin around a mover (kept_out)
 };
 
 // Histogram of log2(sample / background) grey ratios over all buffers of a frame, for the

@@ -63,7 +63,7 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
     }
     gain = histogram.MedianGain();
   }
-  long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0;
+  long long observed = 0, raw = 0, masked = 0, warming = 0, blobs = 0, near_movers = 0;
   const std::vector<size_t> seen_list = Indices(seen);
   // Growing by colour spreads whatever was flagged: misaligned edges too. `auto` grows once
   // the refinement's `auto` has measured the frames and found them aligned (not when it
@@ -100,13 +100,16 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
       frame.masked = cv::countNonZero(frame.foreground & warped_[b].valid);
     }
     frame.kept_out.release();
-    if (keep_out && cv::countNonZero(near_mover_texels_[b]) > 0)
+    frame.near_movers = 0;
+    if (keep_out && cv::countNonZero(near_mover_texels_[b]) > 0) {
       cv::bitwise_or(frame.foreground, near_mover_texels_[b], frame.kept_out);
+      frame.near_movers = cv::countNonZero(near_mover_texels_[b] & ~frame.foreground);
+    }
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];
     observed += frame.observed, raw += frame.foreground_raw, masked += frame.masked;
-    warming += frame.warming_up, blobs += frame.blobs_removed;
+    warming += frame.warming_up, blobs += frame.blobs_removed, near_movers += frame.near_movers;
     if (debug) {
       const std::string suffix = "_b" + std::to_string(b);
       report.images["model" + suffix] = models[b].Image(set_.buffers[b]);
@@ -122,6 +125,7 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
   report.metrics["texels_warming_up"] = static_cast<double>(warming);
   report.metrics["warming_fraction"] = observed > 0 ? static_cast<double>(warming) / observed : 0.0;
   report.metrics["blobs_removed"] = static_cast<double>(blobs);
+  report.metrics["texels_near_movers"] = static_cast<double>(near_movers);
   report.metrics["grown"] = grow ? 1.0 : 0.0;
   report.wall_ms = MsSince(start);
   return report;

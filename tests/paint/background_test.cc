@@ -50,6 +50,7 @@ PipelineOptions RobustWithoutRefinement() {
 
 struct MoverFigures : MoverProvenance::Figures {
   double masked_fraction = 0;  // mean of the background stage's masked_fraction
+  long long near_movers = 0;   // sum of the background stage's texels_near_movers
 };
 
 // Paints the capture (true poses) and follows which painted texels took a mover's colour.
@@ -69,8 +70,10 @@ MoverFigures PaintWithMovers(const Scene& scene, const SynthCapture& capture,
     frame.bgr = capture.frames_bgr[i];
     if (movers) frame.movers = (*movers)[i];
     session->PaintFrame(frame, capture.camera, cam_from_world, &report);
-    if (const StageReport* stage = report.Stage("background"))
+    if (const StageReport* stage = report.Stage("background")) {
       figures.masked_fraction += stage->metrics.at("masked_fraction") / capture.frames_bgr.size();
+      figures.near_movers += static_cast<long long>(stage->metrics.at("texels_near_movers"));
+    }
     provenance.AfterFrame(*session, static_cast<int>(i), cam_from_world, cam_from_world);
   }
   static_cast<MoverProvenance::Figures&>(figures) = provenance.Count(*session);
@@ -286,9 +289,12 @@ TEST(MoversAcrossViews, TheMarginAroundThemIsNotPainted) {
   const MoverFigures margin = PaintWithMovers(scene, capture, options, &masks);
   Print("no margin", none);
   Print("margin", margin);
-  // Two thirds of the width painted without the margin, a little over half with it.
+  // Two thirds of the width painted without the margin, a little over half with it; the
+  // background stage reports the texels it kept out for the margin alone.
   EXPECT_LT(margin.painted, 0.92 * none.painted);
   EXPECT_GT(margin.painted, 0.7 * none.painted);
+  EXPECT_EQ(none.near_movers, 0);
+  EXPECT_GT(margin.near_movers, 0);
 }
 
 // On the room with movers, the margin paints less of the movers.
