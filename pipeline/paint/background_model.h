@@ -36,7 +36,7 @@ struct BackgroundFrame {
   cv::Mat foreground;  // CV_8U, buffer size: 255 = foreground after cleaning (not painted)
   cv::Mat warming;     // CV_8U, buffer size: 255 = sampled this frame, model still warming up
   // CV_8U, buffer size: `foreground` and the texels near a mover found across views
-  // (BackgroundOptions::mover_margin); empty when there are none near one.
+  // (BackgroundOptions::mover_margin); made only where near_movers > 0.
   cv::Mat kept_out;
   cv::Mat difference;      // CV_8U (debug only): RMS colour distance to the background x 2
   int observed = 0;        // texels sampled this frame (valid in the warped buffer)

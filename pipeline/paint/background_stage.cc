@@ -99,12 +99,10 @@ StageReport PaintSession::SegmentForeground(const std::vector<bool>& seen, int s
       cv::bitwise_or(frame.foreground, mover_texels_[b], frame.foreground);
       frame.masked = cv::countNonZero(frame.foreground & warped_[b].valid);
     }
-    frame.kept_out.release();
-    frame.near_movers = 0;
-    if (keep_out && cv::countNonZero(near_mover_texels_[b]) > 0) {
+    // The margin's texels outside the foreground (the model's Update reset the rest).
+    frame.near_movers = keep_out ? cv::countNonZero(near_mover_texels_[b] & ~frame.foreground) : 0;
+    if (frame.near_movers > 0)
       cv::bitwise_or(frame.foreground, near_mover_texels_[b], frame.kept_out);
-      frame.near_movers = cv::countNonZero(near_mover_texels_[b] & ~frame.foreground);
-    }
   });
   for (size_t b : seen_list) {
     const BackgroundFrame& frame = background_frame_[b];

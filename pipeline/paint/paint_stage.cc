@@ -14,7 +14,7 @@ cv::Mat PaintSession::KeptOutOfPainting(size_t b) const {
   if (options_.background.mode == BackgroundMode::kOff || b >= background_frame_.size())
     return cv::Mat();
   const BackgroundFrame& frame = background_frame_[b];
-  if (!frame.kept_out.empty()) return frame.kept_out;
+  if (frame.near_movers > 0) return frame.kept_out;
   return frame.masked == 0 ? cv::Mat() : frame.foreground;
 }
 
