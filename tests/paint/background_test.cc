@@ -166,6 +166,22 @@ TEST(KeptOutOfPainting, IsWhatThePaintStageLeftAlone) {
 struct AloneAndWithMasks {
   MoverFigures alone, with_masks;
 };
+// The robust model with refinement off (exact poses) and growth `grow`, with the masks found
+// across views alone: no margin around them (that is TheMarginPaintsLessOfTheMovers').
+PipelineOptions MasksAlone(GrowMode grow) {
+  PipelineOptions options = RobustWithoutRefinement();
+  options.background.grow = grow;
+  options.background.mover_margin = 0;
+  return options;
+}
+
+// Each frame's masks and agreed pixels in one image (MoverMaskResult::Packed).
+std::vector<cv::Mat> PackedMasks(const MoverMaskResult& found) {
+  std::vector<cv::Mat> packed;
+  for (size_t k = 0; k < found.masks.size(); ++k) packed.push_back(found.Packed(k));
+  return packed;
+}
+
 AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow,
                                          const MoverMaskOptions& mask_options = {}) {
   const Scene scene = Room();
@@ -173,10 +189,7 @@ AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow,
   EXPECT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(frames, 0.0), &capture).ok());
   const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, mask_options);
   EXPECT_GT(found.fraction(), 0.0);
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kRobust;
-  options.background.grow = grow;
+  const PipelineOptions options = MasksAlone(grow);
   AloneAndWithMasks out;
   out.alone = PaintWithMovers(scene, capture, options);
   out.with_masks = PaintWithMovers(scene, capture, options, &found.masks);
@@ -210,15 +223,10 @@ TEST(MoversAcrossViews, GrowthDoesNotStartWhereTheFramesAgree) {
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, 0.0), &capture).ok());
   const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, {});
-  std::vector<cv::Mat> packed;
-  for (size_t k = 0; k < found.masks.size(); ++k) {
-    packed.push_back(found.Packed(k));
+  const std::vector<cv::Mat> packed = PackedMasks(found);
+  for (size_t k = 0; k < found.masks.size(); ++k)
     ASSERT_EQ(cv::countNonZero(packed[k] == kMoverPixel), cv::countNonZero(found.masks[k]));
-  }
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kRobust;
-  options.background.grow = GrowMode::kOn;
+  const PipelineOptions options = MasksAlone(GrowMode::kOn);
   const MoverFigures masks = PaintWithMovers(scene, capture, options, &found.masks);
   const MoverFigures agreed = PaintWithMovers(scene, capture, options, &packed);
   Print("masks", masks);
@@ -302,14 +310,8 @@ TEST(MoversAcrossViews, TheMarginPaintsLessOfTheMovers) {
   const Scene scene = Room();
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, 0.0), &capture).ok());
-  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, {});
-  std::vector<cv::Mat> packed;
-  for (size_t k = 0; k < found.masks.size(); ++k) packed.push_back(found.Packed(k));
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kRobust;
-  options.background.grow = GrowMode::kOn;
-  options.background.mover_margin = 0;
+  const std::vector<cv::Mat> packed = PackedMasks(testing::FindCaptureMovers(scene, capture, {}));
+  PipelineOptions options = MasksAlone(GrowMode::kOn);
   const MoverFigures none = PaintWithMovers(scene, capture, options, &packed);
   options.background.mover_margin = BackgroundOptions().mover_margin;
   const MoverFigures margin = PaintWithMovers(scene, capture, options, &packed);
