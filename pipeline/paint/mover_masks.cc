@@ -137,12 +137,21 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
           grown.at<uchar>(y, x) = 255;
   }
   mask = grown;
+  cv::Mat ringed;
+  if (options.ringed.share > 0) {
+    cv::Mat surface(mask.size(), CV_8U);
+    for (int y = 0; y < mask.rows; ++y)
+      for (int x = 0; x < mask.cols; ++x)
+        surface.at<uchar>(y, x) = std::isnan(self.points.at<cv::Vec3f>(y, x)[0]) ? 0 : 255;
+    ringed = RingedRegions(self.bgr, mask, surface, options.ringed);
+  }
   if (options.dilate_px > 0)
     cv::dilate(mask, mask,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
                                                                      2 * options.dilate_px + 1)));
   *judged = seen_pixels;
   *flagged = cv::countNonZero(mask & (seeing >= options.min_differing));
+  if (!ringed.empty()) mask |= ringed;
   return mask;
 }
 

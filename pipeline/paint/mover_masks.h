@@ -12,9 +12,10 @@
 // misalignment costs nothing), after a gain per colour channel between the two frames (over
 // the pixels both see: exposure), on the largest channel. A large or slow mover matches the
 // frames near it where they show it too: its blob grows over the pixels of its colours within
-// its box, later passes judge again without the pixels the pass before masked in the other
-// frames, and what they found is followed by its colours into the frames next to it
-// (mover_follow.h). Frames are compared at a reduced size (max_side_px); masks have that size.
+// its box, the regions of one colour the mask rings join it (ringed_regions.h), later passes
+// judge again without the pixels the pass before masked in the other frames, and what they
+// found is followed by its colours into the frames next to it (mover_follow.h). Frames are
+// compared at a reduced size (max_side_px); masks have that size.
 #pragma once
 
 #include <cstdint>
@@ -29,6 +30,7 @@
 #include "pipeline/core/scene.h"
 #include "pipeline/core/status.h"
 #include "pipeline/paint/background_options.h"
+#include "pipeline/paint/ringed_regions.h"
 
 namespace fresco {
 
@@ -44,6 +46,11 @@ struct MoverMaskOptions {
   // except those that agree with every frame that sees them.
   bool grow = true;
   int dilate_px = 1;  // the rest grows by this margin (blurred edges)
+  // Then the regions of one colour the mask rings join it (ringed_regions.h): a plain mover the
+  // frames near it show over the same surface (large, slow, moving with the camera) differs from
+  // them only at its edges. Not counted in the share masked (the evidence `auto` decides on: it
+  // stays what the comparison found). `share` 0: none.
+  RingedRegionOptions ringed;
   // Passes after the first judge each pixel again without the other frames' pixels the pass
   // before masked (they show a mover, not the background): a large or slow mover's inside, which
   // the frames near it show too, is found from its edges inwards, and the background beside a
