@@ -55,13 +55,24 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
     (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
 }
 
+// The pixels of a frame that show the mesh (CV_8U, 255).
+cv::Mat SurfacePixels(const SmallFrame& frame) {
+  cv::Mat surface(frame.points.size(), CV_8U);
+  for (int y = 0; y < surface.rows; ++y)
+    for (int x = 0; x < surface.cols; ++x)
+      surface.at<uchar>(y, x) = std::isnan(frame.points.at<cv::Vec3f>(y, x)[0]) ? 0 : 255;
+  return surface;
+}
+
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
 // whose masked pixels do not judge. `joinable`: the surface pixels that may join a mover by
 // their colour (those that differ from a frame that sees them, or are seen by too few);
-// `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed).
+// `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed);
+// `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h).
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
-                   long long* judged, long long* flagged, cv::Mat* joinable, cv::Mat* agreed) {
+                   long long* judged, long long* flagged, cv::Mat* joinable, cv::Mat* agreed,
+                   cv::Mat* ringed_regions) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
@@ -138,13 +149,8 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   }
   mask = grown;
   cv::Mat ringed;
-  if (options.ringed.share > 0) {
-    cv::Mat surface(mask.size(), CV_8U);
-    for (int y = 0; y < mask.rows; ++y)
-      for (int x = 0; x < mask.cols; ++x)
-        surface.at<uchar>(y, x) = std::isnan(self.points.at<cv::Vec3f>(y, x)[0]) ? 0 : 255;
-    ringed = RingedRegions(self.bgr, mask, surface, options.ringed);
-  }
+  if (options.ringed.share > 0)
+    ringed = RingedRegions(self.bgr, mask, SurfacePixels(self), options.ringed);
   if (options.dilate_px > 0)
     cv::dilate(mask, mask,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
@@ -152,6 +158,7 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   *judged = seen_pixels;
   *flagged = cv::countNonZero(mask & (seeing >= options.min_differing));
   if (!ringed.empty()) mask |= ringed;
+  *ringed_regions = ringed;
   return mask;
 }
 
@@ -232,13 +239,13 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       }
   }
   std::vector<long long> judged(n, 0), flagged(n, 0);
-  std::vector<cv::Mat> joinable(n);
+  std::vector<cv::Mat> joinable(n), ringed(n);
   result->agreed.resize(n);
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
       if (!frames[f].points.empty())
         result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f],
-                                      &joinable[f], &result->agreed[f]);
+                                      &joinable[f], &result->agreed[f], &ringed[f]);
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask
@@ -272,7 +279,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
         if (!any) continue;
         long long unused = 0;
         result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused, &joinable[f],
-                                      &result->agreed[f]);
+                                      &result->agreed[f], &ringed[f]);
         now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
       }
     });
@@ -284,6 +291,20 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
     std::vector<FollowFrame> follow(n);
     for (int f = 0; f < n; ++f)
       if (!joinable[f].empty()) follow[f] = FollowFrame{frames[f].bgr, joinable[f]};
+    if (options.ringed_follow_frames > 0) {
+      // The regions the masks ring, followed over any pixel of the surface (their inside
+      // agrees with the frames near it), then what that found followed as the rest is.
+      std::vector<FollowFrame> any_surface(n);
+      std::vector<cv::Mat> found(n);
+      for (int f = 0; f < n; ++f) {
+        if (joinable[f].empty() || ringed[f].empty()) continue;
+        any_surface[f] = FollowFrame{frames[f].bgr, SurfacePixels(frames[f])};
+        found[f] = ringed[f].clone();
+      }
+      FollowMovers(any_surface, options.ringed_follow_frames, &found);
+      for (int f = 0; f < n; ++f)
+        if (!found[f].empty()) result->masks[f] |= found[f];
+    }
     FollowMovers(follow, options.follow_frames, &result->masks);
   }
   for (int f = 0; f < n; ++f)

@@ -61,8 +61,13 @@ struct MoverMaskOptions {
   // that drops the masks below a threshold: background `auto`).
   double later_passes_min_fraction = 0;
   // After the passes (where they run), the movers found are followed by their colours into the
-  // frames up to this many frames away (FollowMovers, mover_follow.h; 0: not followed).
+  // frames up to this many frames away (FollowMovers, mover_follow.h; 0: not followed) ...
   int follow_frames = 6;
+  // ... the regions the masks ring (`ringed`) first, into the frames up to this many away, over
+  // any pixel of the surface, not only those a frame near differs from: a plain mover's inside
+  // agrees with the frames near it, and where its ring is missed in a frame, so is its inside.
+  // 0: not followed that way.
+  int ringed_follow_frames = 2;
   // Called after each pass (optional): passes done, passes at most, a line for people.
   std::function<void(int done, int total, const std::string& line)> progress;
 };

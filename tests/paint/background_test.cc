@@ -204,7 +204,7 @@ AloneAndWithMasks PaintAloneAndWithMasks(int frames, GrowMode grow,
 TEST(MoversAcrossViews, JoinTheForegroundTheyTouch) {
   // The join comes with growth (refinement is off: on by hand). The masks as the comparison
   // across views finds them: following them by their colours (mover_follow.h) lowers the leak
-  // on the evaluation suites, but here paints 77 of these texels instead of 58 (of 704,800).
+  // on the evaluation suites, but here paints 95 of these texels instead of 58 (of 704,800).
   MoverMaskOptions mask_options;
   mask_options.follow_frames = 0;
   const AloneAndWithMasks f = PaintAloneAndWithMasks(150, GrowMode::kOn, mask_options);
@@ -222,7 +222,11 @@ TEST(MoversAcrossViews, GrowthDoesNotStartWhereTheFramesAgree) {
   const Scene scene = Room();
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(scene, testing::RoomCaptureWithMovers(150, 0.0), &capture).ok());
-  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, {});
+  // The masks as measured when this was built: here the regions the masks ring, followed into
+  // the frames next to them, leave fewer agreed pixels to make the difference (0.26 -> 0.24 %).
+  MoverMaskOptions mask_options;
+  mask_options.ringed_follow_frames = 0;
+  const MoverMaskResult found = testing::FindCaptureMovers(scene, capture, mask_options);
   const std::vector<cv::Mat> packed = PackedMasks(found);
   for (size_t k = 0; k < found.masks.size(); ++k)
     ASSERT_EQ(cv::countNonZero(packed[k] == kMoverPixel), cv::countNonZero(found.masks[k]));

@@ -82,11 +82,12 @@ TEST(MoverMasks, MostOfTheMoversPixelsAndLittleElseAreMasked) {
       mover_pixels, 100 * recall, other_pixels, 100 * false_share, o.found.seconds,
       100.0 * mover_agreed / mover_pixels, 100.0 * other_agreed / other_pixels);
   ASSERT_GT(mover_pixels, 2000);
-  // 97.8 % and 0.53 %; without the regions the masks ring (ringed.share 0) 73.8 % and 0.71 %.
+  // 97.8 % and 0.70 %; without the regions the masks ring (ringed.share 0) 73.8 % and 0.71 %,
+  // with them but not followed (ringed_follow_frames 0) 97.8 % and 0.53 %.
   EXPECT_GT(recall, 0.95);
-  EXPECT_LT(false_share, 0.007);
+  EXPECT_LT(false_share, 0.008);
   EXPECT_GT(o.found.fraction(), 2 * kBackgroundAcrossViewsThreshold);
-  // What the frames near each frame agree with is the static scene: 98.0 % of its pixels,
+  // What the frames near each frame agree with is the static scene: 97.8 % of its pixels,
   // 0.4 % of the movers' (without the ringed regions 97.8 % and 4.5 %).
   EXPECT_GT(static_cast<double>(other_agreed) / other_pixels, 0.9);
   EXPECT_LT(static_cast<double>(mover_agreed) / mover_pixels, 0.02);
