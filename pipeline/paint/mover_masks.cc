@@ -25,6 +25,7 @@ struct SmallFrame {
   cv::Mat bgr, low, high;  // CV_8UC3
   cv::Mat depth;           // CV_32F camera z, +inf off the surface
   cv::Mat points;          // CV_32FC3 local
+  cv::Mat surface;         // CV_8U, 255 where `points` has one (the pixel shows the mesh)
   const Camera* camera = nullptr;
   Rigid3d cam_from_local;
 };
@@ -53,15 +54,6 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
     }
   for (int c = 0; c < 3; ++c)
     (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
-}
-
-// The pixels of a frame that show the mesh (CV_8U, 255).
-cv::Mat SurfacePixels(const SmallFrame& frame) {
-  cv::Mat surface(frame.points.size(), CV_8U);
-  for (int y = 0; y < surface.rows; ++y)
-    for (int x = 0; x < surface.cols; ++x)
-      surface.at<uchar>(y, x) = std::isnan(frame.points.at<cv::Vec3f>(y, x)[0]) ? 0 : 255;
-  return surface;
 }
 
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
@@ -150,7 +142,7 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   mask = grown;
   cv::Mat ringed;
   if (options.ringed.share > 0)
-    ringed = RingedRegions(self.bgr, mask, SurfacePixels(self), options.ringed);
+    ringed = RingedRegions(self.bgr, mask, self.surface, options.ringed);
   if (options.dilate_px > 0)
     cv::dilate(mask, mask,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
@@ -225,6 +217,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
     cv::dilate(d.bgr, d.high, box);
     s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d.depth);
     d.points.create(d.depth.size(), CV_32FC3);
+    d.surface = cv::Mat::zeros(d.depth.size(), CV_8U);
     const Rigid3d local_from_cam = in.cam_from_local.Inverse();
     for (int y = 0; y < d.depth.rows; ++y)
       for (int x = 0; x < d.depth.cols; ++x) {
@@ -236,6 +229,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
         }
         const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray.x() * z, ray.y() * z, z);
         d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+        d.surface.at<uchar>(y, x) = 255;
       }
   }
   std::vector<long long> judged(n, 0), flagged(n, 0);
@@ -298,7 +292,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       std::vector<cv::Mat> found(n);
       for (int f = 0; f < n; ++f) {
         if (joinable[f].empty() || ringed[f].empty()) continue;
-        any_surface[f] = FollowFrame{frames[f].bgr, SurfacePixels(frames[f])};
+        any_surface[f] = FollowFrame{frames[f].bgr, frames[f].surface};
         found[f] = ringed[f].clone();
       }
       FollowMovers(any_surface, options.ringed_follow_frames, &found);
