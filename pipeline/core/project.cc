@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/core/atomic_file.h"
-#include "pipeline/core/setting_rule.h"
+#include "pipeline/settings/setting_rule.h"
 #include "pipeline/core/settings.h"
 
 namespace fresco {
@@ -32,71 +32,8 @@ constexpr int kProjectVersion = 2;  // the newest this Fresco reads
 // Version-1 keys that version 2 replaces by `streams`.
 constexpr const char* kStreamKeys[] = {"camera", "video", "poses", "time_offset_s"};
 
-const EnumNames<SamplingMode>& SamplingNames() {
-  static const EnumNames<SamplingMode> names = {
-      {SamplingMode::kNearest, "nearest"},
-      {SamplingMode::kBilinear, "bilinear"},
-      {SamplingMode::kArea, "area"},
-  };
-  return names;
-}
-
-const EnumNames<UpdatePolicy>& UpdatePolicyNames() {
-  static const EnumNames<UpdatePolicy> names = {
-      {UpdatePolicy::kLatest, "latest"},
-      {UpdatePolicy::kQuality, "quality"},
-      {UpdatePolicy::kMean, "mean"},
-  };
-  return names;
-}
-
 // ---- The fields, each listed once. ----------------------------------------------------------
 
-template <class V>
-void Fields(PipelineOptions& o, V& v) {
-  v.Enum("sampling", o.sampling, SamplingNames(),
-         "how a texel samples the frame: nearest pixel, bilinear (the paper's §3.2), or `area` "
-         "(bilinear on the pyramid level matching the texel's footprint: far or oblique views)");
-  v.Field("texel_size_m", o.texel_size_m,
-          {.min = 0,
-           .help = "texel edge in metres; 0 = automatic: median depth the cameras see over the "
-                   "focal length (one texel per pixel at the typical distance)"});
-  v.Field("max_buffer_texels", o.max_buffer_texels,
-          {.min = 1,
-           .help = "a bigger base buffer gets coarser texels (memory is bounded: buffers are "
-                   "fixed-size, frames are streamed)"});
-  v.Field("update_every", o.update_every,
-          {.min = 1, .help = "paint every N-th frame (the paper's §4)"});
-  v.Enum("update", o.update, UpdatePolicyNames(),
-         "`latest` (the paper: every visible sample overwrites), `quality` (a sample overwrites "
-         "only if at least `1 - quality_slack` as sharp, in pixels per texel) or `mean` (each "
-         "texel the mean of every sample it took, weighted by pixels per texel: for still photos "
-         "of a static scene, whose views disagree in light and by a few pixels; 16 more bytes "
-         "per texel)");
-  v.Field(
-      "quality_slack", o.quality_slack,
-      {.min = 0,
-       .max = 1,
-       .help = "with `update: quality`, accept samples this much blurrier than the stored one"});
-  v.Field(
-      "update_weight", o.update_weight,
-      {.min = 0.01,
-       .max = 1,
-       .help =
-           "weight of an accepted sample against what the texel holds: 1 replaces (the paper's); "
-           "below 1 keeps a running average, which averages out residual misalignment"});
-  v.Field("max_frames", o.max_frames, {.min = 0, .help = "stop after this many frames (0 = all)"});
-  v.Field("threads", o.threads, {.min = 0, .help = "threads for the stages (0 = all cores)"});
-  v.Field("debug_images", o.debug_images,
-          {.help = "make per-stage debug images (`fresco run --debug-images` writes them under "
-                   "`stages/`; costs time)"});
-  v.Object("occlusion", o.occlusion);
-  v.Object("refine", o.refine);
-  v.Object("background", o.background);
-  v.Object("atlas", o.atlas);
-  v.Object("select", o.select);
-  v.Object("layers", o.layers);
-}
 
 template <class V>
 void Fields(GroupingEdit& e, V& v) {

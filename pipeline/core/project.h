@@ -9,43 +9,9 @@
 #include <vector>
 
 #include "pipeline/core/status.h"
-#include "pipeline/paint/atlas_options.h"
-#include "pipeline/paint/background_options.h"
-#include "pipeline/paint/layers_options.h"
-#include "pipeline/paint/occlusion_options.h"
-#include "pipeline/paint/refine_options.h"
-#include "pipeline/paint/select_options.h"
+#include "pipeline/settings/pipeline_options.h"
 
 namespace fresco {
-
-enum class SamplingMode { kNearest, kBilinear, kArea };
-// kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
-// when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
-// kMean: each texel the mean of every sample it took, weighted by pixels per texel.
-enum class UpdatePolicy { kLatest, kQuality, kMean };
-
-struct PipelineOptions {
-  SamplingMode sampling = SamplingMode::kBilinear;
-  double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
-  int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
-  int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
-  UpdatePolicy update = UpdatePolicy::kQuality;
-  double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
-  // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
-  // below 1 = running average, which averages out the frames' residual misalignment).
-  double update_weight = 1.0;
-  int max_frames = 0;         // 0 = all frames
-  int threads = 0;            // 0 = all cores
-  bool debug_images = false;  // write per-stage debug images (costs time)
-  OcclusionOptions occlusion;
-  RefineOptions refine;
-  BackgroundOptions background;
-  AtlasOptions atlas;
-  SelectOptions select;
-  ViewLayerOptions layers;
-
-  bool operator==(const PipelineOptions&) const = default;
-};
 
 // Automatic base-buffer grouping (paper §3.6): neighbouring triangles whose normals are
 // within `angle_deg` of the group's seed normal share a buffer.

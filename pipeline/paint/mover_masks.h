@@ -29,7 +29,7 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/core/status.h"
-#include "pipeline/paint/background_options.h"
+#include "pipeline/settings/background_options.h"
 #include "pipeline/paint/ringed_regions.h"
 
 namespace fresco {

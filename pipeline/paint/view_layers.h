@@ -16,7 +16,7 @@
 
 #include <Eigen/Core>
 
-#include "pipeline/paint/layers_options.h"
+#include "pipeline/settings/layers_options.h"
 #include "pipeline/paint/texel_update.h"
 
 namespace fresco {

@@ -3,7 +3,7 @@
 // table see them (each with its range and help, listed once in Fields).
 #pragma once
 
-#include "pipeline/core/setting_rule.h"
+#include "pipeline/settings/setting_rule.h"
 
 namespace fresco {
 

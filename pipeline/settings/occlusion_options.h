@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline/core/setting_rule.h"
+#include "pipeline/settings/setting_rule.h"
 
 namespace fresco {
 
