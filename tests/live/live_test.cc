@@ -31,6 +31,7 @@
 #include "pipeline/live/pose_track.h"
 #include "pipeline/live/session_recorder.h"
 #include "pipeline/live/time_offset_estimation.h"
+#include "pipeline/run/offset_estimator.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/live/loopback.h"
