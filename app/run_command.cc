@@ -268,8 +268,7 @@ int RunVerbRun(const CommandArgs& argv) {
   const bool quiet = args.Switch("--quiet");
 
   Project project;
-  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok())
-    return InputError(s);
+  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok()) return Fail(s);
   if (args.Switch("--debug-images")) project.pipeline.debug_images = true;
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
@@ -277,25 +276,25 @@ int RunVerbRun(const CommandArgs& argv) {
   const std::vector<StreamSpec> specs = project.Streams();
   const std::string record_dir = args.Get("--record");
   if (!record_dir.empty() && !live)
-    return InputError(Status::Error(std::string("--record: only for live sources (") +
-                                    project_path + " replays files already)"));
+    return Fail(Status::Error(std::string("--record: only for live sources (") + project_path +
+                              " replays files already)"));
   if (!record_dir.empty() && specs.size() > 1)
-    return InputError(Status::Error(project_path +
-                                    ": streams: --record records a project with one stream "
-                                    "(this one has " +
-                                    std::to_string(specs.size()) + ")"));
+    return Fail(Status::Error(project_path +
+                              ": streams: --record records a project with one stream "
+                              "(this one has " +
+                              std::to_string(specs.size()) + ")"));
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
-  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
+  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return Fail(s);
   const double setup_peak_rss_mb = PeakRssMb();
   PaintSession* session = job->session.get();
   const Scene& scene = job->scene();
   SessionRecorder recorder;
   if (!record_dir.empty())
-    if (Status s = recorder.Start(record_dir, project.ForStream(0)); !s.ok()) return InputError(s);
+    if (Status s = recorder.Start(record_dir, project.ForStream(0)); !s.ok()) return Fail(s);
   if (!quiet) {
     std::fprintf(
         stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)%s\n",
@@ -327,11 +326,11 @@ int RunVerbRun(const CommandArgs& argv) {
   }
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
   // Debug images go to a staging folder that replaces DIR/stages/ only at the end.
   StagedFolder stages;
   if (project.pipeline.debug_images)
-    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
+    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return Fail(s);
   const std::string& stages_dir = stages.path();
 
   int total = job->source->FrameCount();  // frames of every stream; -1: unknown
@@ -354,7 +353,7 @@ int RunVerbRun(const CommandArgs& argv) {
     progress.Update(run.stats().frames, detail);
     return Status::Ok();
   };
-  if (Status s = RunToEnd(&run, hooks); !s.ok()) return InputError(s);
+  if (Status s = RunToEnd(&run, hooks); !s.ok()) return Fail(s);
   const PaintRunStats& stats = run.stats();
   const int frames = stats.frames;
   if (Interrupted()) {
@@ -371,7 +370,7 @@ int RunVerbRun(const CommandArgs& argv) {
         live_inputs.feed ? live_inputs.feed->AllPoses()
                          : std::vector<TimedPose>(live_inputs.track->samples().begin(),
                                                   live_inputs.track->samples().end());
-    if (Status s = recorder.Finish(tracker); !s.ok()) return InputError(s);
+    if (Status s = recorder.Finish(tracker); !s.ok()) return Fail(s);
   }
   const double seconds = stats.seconds;
   progress.Finish();
@@ -381,13 +380,11 @@ int RunVerbRun(const CommandArgs& argv) {
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
   if (Status s = WriteRunOutputs(out_dir, *job, metrics); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   if (project.pipeline.debug_images) {
     if (Status s = stages.Commit(); !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
+      return Fail(s);
     }
   }
   if (Interrupted()) {  // while the outputs were written: they were finished first
