@@ -1,7 +1,7 @@
-// Issue 22: `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner,
-// headless) are thin clients of one painting job, so on the same bad capture they come to
-// the same outcome: the same one-line error (exit 2 for the CLI, "error: ..." as the app's
-// status), or the same counts of frames read, painted and without a pose.
+// `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner, headless) are thin
+// clients of one painting job, so on the same bad capture they come to the same outcome: the same
+// one-line error (exit 2 for the CLI, "error: ..." as the app's status), or the same counts of
+// frames read, painted and without a pose.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
