@@ -219,19 +219,19 @@ int RunVerbBench(const CommandArgs& argv) {
   int holdout = 10;
   std::string error;
   if (args.Has("--holdout") && !ParseInt(args.Get("--holdout"), "--holdout", &holdout, &error))
-    return InputError(Status::Error(error));
-  if (holdout < 2) return InputError(Status::Error("--holdout: must be >= 2"));
+    return Fail(Status::Error(error));
+  if (holdout < 2) return Fail(Status::Error("--holdout: must be >= 2"));
   std::vector<Settings> runs;
-  if (Status s = ParseSweeps(args.All("--sweep"), &runs); !s.ok()) return InputError(s);
+  if (Status s = ParseSweeps(args.All("--sweep"), &runs); !s.ok()) return Fail(s);
   // Every run's settings must load before any runs (a typo fails at once, not after an hour).
   for (const Settings& run : runs) {
     std::vector<std::string> overrides;
     for (const auto& [key, value] : run) overrides.push_back(key + "=" + value);
     Project project;
-    if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return InputError(s);
-    if (Status s = CheckOneStream(project, "fresco bench"); !s.ok()) return InputError(s);
+    if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return Fail(s);
+    if (Status s = CheckOneStream(project, "fresco bench"); !s.ok()) return Fail(s);
   }
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
 
   InterruptCatcher interrupt;
   Progress progress("bench", static_cast<int>(runs.size()) + !args.Switch("--no-baseline"),
@@ -255,7 +255,7 @@ int RunVerbBench(const CommandArgs& argv) {
                    InterruptSignalName().c_str(), i + 1, total, out_dir.c_str());
       return InterruptExitCode();
     }
-    if (!s.ok()) return InputError(s);
+    if (!s.ok()) return Fail(s);
     rows.push_back(result.row);
     points.push_back(result.point);
     char detail[160];
@@ -266,13 +266,11 @@ int RunVerbBench(const CommandArgs& argv) {
   progress.Finish();
   for (size_t k : ParetoFront(points)) rows[k]["pareto"] = true;
   if (Status s = WriteFileAtomic(out_dir + "/bench.json", rows.dump(2) + "\n"); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   const cv::Mat plot = DrawPareto(points, "fresco bench " + project_path);
   if (Status s = WriteImageAtomic(out_dir + "/pareto.png", plot); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", total,
                out_dir.c_str(), out_dir.c_str());

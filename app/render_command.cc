@@ -92,7 +92,7 @@ bool OutputName(const std::string& name, const std::string& suffix, std::string*
 Status WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes))
-    return Status::Error(path + ": could not encode the PNG");
+    return Status::Internal(path + ": could not encode the PNG");
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
   return WriteFileAtomic(path, std::string(bytes.begin(), bytes.end()));
@@ -192,18 +192,18 @@ int RunVerbRender(const CommandArgs& args) {
   std::map<int, Camera> cameras;
   {
     const Status read = ReadCameras(camera_path, &cameras);
-    if (!read.ok()) return InputError(read);
+    if (!read.ok()) return Fail(read);
   }
-  if (cameras.empty()) return InputError(Status::Error(camera_path + ": no camera"));
+  if (cameras.empty()) return Fail(Status::Error(camera_path + ": no camera"));
   for (const auto& [id, camera] : cameras) {
     const Status valid = camera.Validate(camera_path + ": camera " + std::to_string(id));
-    if (!valid.ok()) return InputError(valid);
+    if (!valid.ok()) return Fail(valid);
     if (static_cast<double>(camera.width) * camera.height * n * n > kMaxSamplesPerImage) {
-      return InputError(
-          Status::Error(camera_path + ": camera " + std::to_string(id) + ": image size " +
-                        std::to_string(camera.width) + "x" + std::to_string(camera.height) + " x " +
-                        std::to_string(n * n) + " samples per pixel is too large (at most " +
-                        std::to_string(1 << 26) + " samples)"));
+      return Fail(Status::Error(camera_path + ": camera " + std::to_string(id) + ": image size " +
+                                std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                                " x " + std::to_string(n * n) +
+                                " samples per pixel is too large (at most " +
+                                std::to_string(1 << 26) + " samples)"));
     }
   }
 
@@ -212,9 +212,9 @@ int RunVerbRender(const CommandArgs& args) {
   bool is_tum = false;
   {
     const Status read = ReadPoses(poses_path, &poses, &is_tum);
-    if (!read.ok()) return InputError(read);
+    if (!read.ok()) return Fail(read);
   }
-  if (poses.empty()) return InputError(Status::Error(poses_path + ": no poses"));
+  if (poses.empty()) return Fail(Status::Error(poses_path + ": no poses"));
   std::vector<Job> jobs;
   std::set<std::string> outputs;
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -222,8 +222,7 @@ int RunVerbRender(const CommandArgs& args) {
     const std::string what =
         poses_path + ": " +
         (is_tum ? "pose " + std::to_string(i + 1) : "image '" + pose.name + "'");
-    if (!pose.cam_from_world.AllFinite())
-      return InputError(Status::Error(what + ": pose is not finite"));
+    if (!pose.cam_from_world.AllFinite()) return Fail(Status::Error(what + ": pose is not finite"));
     Job job;
     job.pose = &pose;
     if (cameras.count(pose.camera_id)) {
@@ -231,8 +230,8 @@ int RunVerbRender(const CommandArgs& args) {
     } else if (cameras.size() == 1) {
       job.camera_id = cameras.begin()->first;
     } else {
-      return InputError(Status::Error(what + ": CAMERA_ID " + std::to_string(pose.camera_id) +
-                                      " is not in " + camera_path));
+      return Fail(Status::Error(what + ": CAMERA_ID " + std::to_string(pose.camera_id) +
+                                " is not in " + camera_path));
     }
     if (is_tum) {
       char name[32];
@@ -241,11 +240,11 @@ int RunVerbRender(const CommandArgs& args) {
     } else {
       std::string why;
       if (!OutputName(pose.name, "", &job.relative, &why))
-        return InputError(Status::Error(what + ": " + why));
+        return Fail(Status::Error(what + ": " + why));
     }
     if (!outputs.insert(job.relative).second) {
-      return InputError(Status::Error(what + ": output " + job.relative +
-                                      ".png would overwrite another image's"));
+      return Fail(Status::Error(what + ": output " + job.relative +
+                                ".png would overwrite another image's"));
     }
     jobs.push_back(job);
   }
@@ -253,8 +252,8 @@ int RunVerbRender(const CommandArgs& args) {
     for (const Job& job : jobs) {
       for (const char* suffix : {".depth", ".ids"}) {
         if (outputs.count(job.relative + suffix)) {
-          return InputError(Status::Error(poses_path + ": output " + job.relative + suffix +
-                                          ".png clashes with an image's output"));
+          return Fail(Status::Error(poses_path + ": output " + job.relative + suffix +
+                                    ".png clashes with an image's output"));
         }
       }
     }
@@ -264,12 +263,12 @@ int RunVerbRender(const CommandArgs& args) {
   Scene scene;
   {
     const Status loaded = LoadScene(model_path, SceneLoadOptions(), &scene);
-    if (!loaded.ok()) return InputError(loaded);
+    if (!loaded.ok()) return Fail(loaded);
   }
 
   {
     const Status made = MakeDirectories(out_dir);
-    if (!made.ok()) return InputError(made);
+    if (!made.ok()) return Fail(made);
   }
 
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by camera id (ray tables)
@@ -291,8 +290,7 @@ int RunVerbRender(const CommandArgs& args) {
       written = WritePng(base + ".depth.png", DepthMillimetres(out.depth));
     if (written.ok() && write_ids) written = WritePng(base + ".ids.png", IdsRgba(out.triangle_id));
     if (!written.ok()) {
-      std::cerr << "error: " << written.message() << "\n";
-      return kExitFailure;
+      return Fail(written);
     }
     progress.Update(static_cast<int>(i + 1), job.relative + ".png");
   }

@@ -338,34 +338,33 @@ int RunVerbRun(const CommandArgs& argv) {
   const bool quiet = args.Switch("--quiet");
 
   Project project;
-  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok())
-    return InputError(s);
+  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok()) return Fail(s);
   if (args.Switch("--debug-images")) project.pipeline.debug_images = true;
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
   const std::vector<StreamSpec> specs = project.Streams();
   const std::string record_dir = args.Get("--record");
-  if (Status s = CheckRecording(project, project_path, record_dir); !s.ok()) return InputError(s);
+  if (Status s = CheckRecording(project, project_path, record_dir); !s.ok()) return Fail(s);
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
-  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
+  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return Fail(s);
   const double setup_peak_rss_mb = PeakRssMb();
   PaintSession* session = job->session.get();
   LiveRecording recording;
   if (!record_dir.empty())
     if (Status s = recording.Start(record_dir, project.ForStream(0), true); !s.ok())
-      return InputError(s);
+      return Fail(s);
   if (!quiet) PrintJobSummary(*job, specs.size());
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
   // Debug images go to a staging folder that replaces DIR/stages/ only at the end.
   StagedFolder stages;
   if (project.pipeline.debug_images)
-    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
+    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return Fail(s);
   const std::string& stages_dir = stages.path();
 
   Progress progress("painting", FramesToRead(*job, project), quiet);
@@ -385,7 +384,7 @@ int RunVerbRun(const CommandArgs& argv) {
     progress.Update(run.stats().frames, detail);
     return Status::Ok();
   };
-  if (Status s = RunToEnd(&run, hooks); !s.ok()) return InputError(s);
+  if (Status s = RunToEnd(&run, hooks); !s.ok()) return Fail(s);
   const PaintRunStats& stats = run.stats();
   const int frames = stats.frames;
   if (Interrupted()) {
@@ -398,7 +397,7 @@ int RunVerbRun(const CommandArgs& argv) {
   }
   if (recording.active()) {
     std::string recorded;
-    if (Status s = recording.Finish(job->live_inputs[0], &recorded); !s.ok()) return InputError(s);
+    if (Status s = recording.Finish(job->live_inputs[0], &recorded); !s.ok()) return Fail(s);
   }
   progress.Finish();
 
@@ -407,13 +406,11 @@ int RunVerbRun(const CommandArgs& argv) {
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
   if (Status s = WriteRunOutputs(out_dir, *job, metrics); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   if (project.pipeline.debug_images) {
     if (Status s = stages.Commit(); !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
+      return Fail(s);
     }
   }
   if (Interrupted()) {  // while the outputs were written: they were finished first

@@ -155,7 +155,7 @@ int RunVerbSynth(const CommandArgs& argv) {
     input.overrides = overrides;
     status = BuildSynthJob(input, &job);
   }
-  if (!status.ok()) return InputError(status);
+  if (!status.ok()) return Fail(status);
   const std::string out = args.Has("--out") ? Absolute(args.Get("--out")) : job.out_dir;
   if (out.empty()) return UsageError(kVerb, spec, "missing --out (or \"out\" in the spec)");
 
@@ -163,8 +163,7 @@ int RunVerbSynth(const CommandArgs& argv) {
     const std::string gltf = (fs::path(out) / "scene.gltf").string();
     status = ExportSynthScene(job.scene, job.texture_files, gltf);
     if (!status.ok()) {
-      std::cerr << "fresco synth: " << status.message() << "\n";
-      return kExitFailure;
+      return Fail(status);
     }
     std::cout << "wrote " << gltf << " (" << job.scene.mesh.NumTriangles() << " triangles, "
               << job.scene.textures.size() << " textures) from " << job.scene_source << "\n";
@@ -197,8 +196,7 @@ int RunVerbSynth(const CommandArgs& argv) {
     return InterruptExitCode();
   }
   if (!status.ok()) {
-    std::cerr << "fresco synth: " << status.message() << "\n";
-    return kExitFailure;
+    return Fail(status);
   }
   if (result.skipped) {
     std::cout << "synth: " << out << " is current (" << result.frames << " frames, fingerprint "

@@ -1044,7 +1044,9 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   const TriangleMesh& mesh = scene.mesh;
   const int num_triangles = mesh.NumTriangles();
   const int num_vertices = static_cast<int>(mesh.vertices.size());
-  auto fail = [&](const std::string& what) { return Status::Error(path + ": " + what); };
+  // A scene that cannot be saved is a broken invariant: the loaders and the painter make
+  // only saveable ones.
+  auto fail = [&](const std::string& what) { return Status::Internal(path + ": " + what); };
 
   // Validate the scene before writing anything.
   if (num_triangles == 0) return fail("cannot save a scene with no triangles");
@@ -1297,7 +1299,7 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
         file.write(reinterpret_cast<const char*>(png.data()),
                    static_cast<std::streamsize>(png.size()));
         file.close();
-        return file.good() ? Status::Ok() : Status::Error(temp + ": cannot write");
+        return file.good() ? Status::Ok() : Status::OutputError(temp + ": cannot write");
       }));
       Json image = {{"uri", png_name}};
       if (!texture.name.empty()) image["name"] = texture.name;

@@ -54,8 +54,7 @@ std::vector<int> SelectKeyframes(const std::vector<const Rigid3d*>& poses, doubl
 }
 
 Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
-                          ProjectColmap* result, bool* bad_input) {
-  *bad_input = true;
+                          ProjectColmap* result) {
   if (options.every_n_frames < 1) return Status::Error("every_n_frames: must be >= 1");
   if (options.max_frames < 0) return Status::Error("max_frames: must be >= 0");
   if (options.scene_size_m < 0) return Status::Error("scene_size_m: must be >= 0");
@@ -177,7 +176,6 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     result->run.models = 1;
     result->run.program = "(earlier run: " + options.existing_model + ")";
   } else {
-    *bad_input = false;
     ColmapRunOptions run = options.colmap;
     run.workspace = options.out_dir;
     run.image_path = image_path;
@@ -186,11 +184,10 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     run.ordered = ordered;
     run.register_names = others;
     run.register_pairs = pairs;
-    FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
+    FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run).Reclassified(StatusKind::kFailed));
   }
   result->run.frames_offered = static_cast<int>(offered.size());
   result->run.keyframes = static_cast<int>(names.size());
-  *bad_input = false;
   std::map<std::string, const PosedImage*> by_name;
   for (const PosedImage& image : result->run.model.images) by_name[image.name] = &image;
   for (ProjectColmapFrame& f : result->frames) {

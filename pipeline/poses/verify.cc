@@ -125,8 +125,10 @@ void NoteWidened(const FrameVerdict& v, VerifyResult* out) {
 
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
                    const VerifyOptions& options, VerifyResult* result) {
-  FRESCO_RETURN_IF_ERROR(options.Check());
-  if (!(scene_size_m > 0)) return Status::Error("scene size: must be > 0");
+  // Options are checked by the callers first (bad input there): here they are a broken
+  // invariant; an alignment that fails is failed work.
+  FRESCO_RETURN_IF_ERROR(options.Check().Reclassified(StatusKind::kInternal));
+  if (!(scene_size_m > 0)) return Status::Internal("scene size: must be > 0");
   VerifyResult out;
   out.scene_size_m = scene_size_m;
   out.rotation_threshold_deg = options.rotation_threshold_deg;
@@ -161,7 +163,8 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
   align.inlier_rotation_deg = options.inlier_fraction * options.rotation_threshold_deg;
   align.seed = options.seed;
   PoseAlignment global;
-  FRESCO_RETURN_IF_ERROR(AlignColmapToPoses(pairs, align, &global));
+  FRESCO_RETURN_IF_ERROR(
+      AlignColmapToPoses(pairs, align, &global).Reclassified(StatusKind::kFailed));
   out.world_from_colmap = global.world_from_colmap;
   out.global_inliers = global.num_inliers;
   out.centres = global.centres;

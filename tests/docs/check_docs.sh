@@ -2,7 +2,7 @@
 # Keeps the documentation from rotting. Checks, over README.md, CHANGELOG.md and docs/**/*.md:
 #   - README.md is at most 200 lines (the front door stays short);
 #   - every package the README's `apt install` line names is one .ci/setup installs;
-#   - no issue numbers in user-facing text ("issue 6", "(issue 12)");
+#   - no issue numbers in user-facing text (the word issue followed by a number);
 #   - every relative link and picture resolves, and every #anchor names a heading;
 #   - every `fresco VERB [SUBVERB]` in code exists, and every --option written after it is
 #     one that verb's --help lists;

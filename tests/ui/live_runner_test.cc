@@ -1,4 +1,4 @@
-// The app paints live (issue 12), headless on loopback: a synthetic capture streamed as
+// The app paints live sources, headless on loopback: a synthetic capture streamed as
 // H.264 over UDP by the `ffmpeg` program and its true poses over TCP (tracker clock 0.2 s
 // ahead); the app's PipelineRunner paints it through the live core, its snapshot and the
 // Pipeline panel show the sources' state (frames received, stalled, ended, the estimated
