@@ -2,8 +2,9 @@
 // (scene, cameras, poses, video), the PaintSession over the scene, and the source of its
 // posed frames: files read ahead (file_frame_source.h), or the live inputs
 // (live_frame_source.h) for a live stream; several streams of which one is live are merged as
-// their frames arrive (merged_frame_source.h). `fresco run` and `fresco bench` open their
-// projects this way; the app opens the same captures and source for file projects.
+// their frames arrive (merged_frame_source.h). `fresco run`, `fresco bench`, `fresco rephoto`
+// and `fresco eval` open their projects this way; the app opens the same captures and source
+// for file projects.
 #pragma once
 
 #include <functional>
@@ -38,6 +39,14 @@ struct PaintJobOptions {
   // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.
   int joint_holdout_every = 0;
   int joint_holdout_counter = -1;
+  // Checked between the frames the whole-capture pre-pass reads (pipeline.refine.joint,
+  // movers across views); true: OpenPaintJob stops with the error "PROJECT: interrupted"
+  // (optional; a run's stop is PaintRunHooks::stop).
+  std::function<bool()> stop;
+  // Paint at the project's true poses (truth.poses, as a synthetic capture has them) instead
+  // of its given ones: what exact poses would give (`fresco eval --recovery`). A pose without
+  // a true one of its name keeps the given pose.
+  bool paint_at_truth_poses = false;
 };
 
 struct PaintJob {
