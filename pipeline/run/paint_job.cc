@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <future>
+#include <map>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -103,6 +104,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     for (int read = 0; (project.pipeline.max_frames <= 0 || read < project.pipeline.max_frames) &&
                        source.Next(&f, &status) == FrameRead::kFrame;
          ++read) {
+      if (options.stop && options.stop()) return Status::Error(project.file_path + ": interrupted");
       const int every = options.joint_holdout_every;
       if (read == options.joint_holdout_counter || (every > 0 && read % every == every / 2))
         continue;
@@ -145,6 +147,15 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   return Status::Ok();
 }
 
+// PaintJobOptions::paint_at_truth_poses: each pose with a true one of its name takes it.
+void TakeTruthPoses(Capture* capture) {
+  std::map<std::string, const PosedImage*> truth;
+  for (const PosedImage& pose : capture->truth_poses) truth[pose.name] = &pose;
+  for (PosedImage& pose : capture->poses)
+    if (const auto t = truth.find(pose.name); t != truth.end())
+      pose.cam_from_world = t->second->cam_from_world;
+}
+
 }  // namespace
 
 bool IsLiveStream(const Project& project, int index) {
@@ -163,6 +174,8 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   CaptureLoadOptions load_options;
   load_options.open_live_video = false;  // a live video opens after its pose feed connects
   FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
+  if (options.paint_at_truth_poses)
+    for (Capture& capture : j.captures) TakeTruthPoses(&capture);
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).

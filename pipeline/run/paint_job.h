@@ -42,6 +42,14 @@ struct PaintJobOptions {
   // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.
   int joint_holdout_every = 0;
   int joint_holdout_counter = -1;
+  // Checked between the frames the whole-capture pre-pass reads (pipeline.refine.joint,
+  // movers across views); true: OpenPaintJob stops with the error "PROJECT: interrupted"
+  // (optional; a run's stop is PaintRunHooks::stop).
+  std::function<bool()> stop;
+  // Paint at the project's true poses (truth.poses, as a synthetic capture has them) instead
+  // of its given ones: what exact poses would give (`fresco eval --recovery`). A pose without
+  // a true one of its name keeps the given pose.
+  bool paint_at_truth_poses = false;
 };
 
 struct PaintJob {
