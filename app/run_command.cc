@@ -247,15 +247,45 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   return metrics;
 }
 
+using Clock = std::chrono::steady_clock;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// The run's wall time as a user waits for it, from the verb's start to the outputs written
+// (metrics.json is written last, just after): opening (loading, the pre-pass step by step),
+// painting (decoding included), writing; and the frames read per second of it ("fps" counts
+// the painting loop only).
+nlohmann::json WallJson(const PaintJob& job, const PaintRunStats& stats, double total_s,
+                        double write_s) {
+  const PaintJob::OpenSeconds& o = job.open_seconds;
+  return {{"seconds", total_s},
+          {"frames_per_second", total_s > 0 ? stats.frames / total_s : 0.0},
+          {"open_seconds",
+           {{"total", o.total},
+            {"load", o.load},
+            {"cameras", o.cameras},
+            {"prepass_read", o.read},
+            {"prepass_joint", o.joint},
+            {"prepass_movers", o.movers},
+            {"connect", o.connect}}},
+          {"paint_seconds", stats.seconds},
+          {"write_seconds", write_s},
+          {"other_seconds", std::max(0.0, total_s - o.total - stats.seconds - write_s)}};
+}
+
 // Writes DIR/painted.gltf (+ .bin, PNGs) and DIR/metrics.json: into a staging folder inside
 // DIR first, then moved into DIR with metrics.json last; a failure before that leaves DIR
 // as it was (all or nothing). Errors are not bad input (exit 1).
-Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job,
-                       const nlohmann::json& metrics) {
+Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job, const PaintRunStats& stats,
+                       Clock::time_point start, nlohmann::json metrics) {
+  const auto writing = Clock::now();
   StagedFolder outputs;
   FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
   FRESCO_RETURN_IF_ERROR(
       SaveGltfScene(job.session->PaintedScene(), outputs.path() + "/painted.gltf"));
+  metrics["wall"] = WallJson(job, stats, SecondsSince(start), SecondsSince(writing));
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
   return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
 }
@@ -270,13 +300,13 @@ int FramesToRead(const PaintJob& job, const Project& project) {
 
 // The last line of a run (unless --quiet).
 void PrintRunSummary(const PaintRunStats& stats, const PaintSession& session,
-                     const std::string& out_dir) {
+                     const std::string& out_dir, double wall_s) {
   std::fprintf(stderr,
-               "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; coverage %.1f%% of %lld "
-               "texels in %zu buffers -> %s\n",
-               stats.frames, stats.frames_painted, stats.seconds, stats.Fps(),
-               100.0 * session.Coverage(), session.NumSurfaceTexels(), session.buffers().size(),
-               out_dir.c_str());
+               "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; %.2fs end to end = %.1f "
+               "fps; coverage %.1f%% of %lld texels in %zu buffers -> %s\n",
+               stats.frames, stats.frames_painted, stats.seconds, stats.Fps(), wall_s,
+               wall_s > 0 ? stats.frames / wall_s : 0.0, 100.0 * session.Coverage(),
+               session.NumSurfaceTexels(), session.buffers().size(), out_dir.c_str());
 }
 
 // --record DIR: only for a live project with one stream.
@@ -284,7 +314,7 @@ Status CheckRecording(const Project& project, const std::string& project_path,
                       const std::string& record_dir) {
   if (record_dir.empty()) return Status::Ok();
   if (!IsLiveProject(project))
-    return Status::Error(std::string("--record: only for live sources (") + project.file_path +
+    return Status::Error(std::string("--record: only for live sources (") + project_path +
                          " replays files already)");
   const size_t streams = project.Streams().size();
   if (streams > 1)
@@ -333,6 +363,7 @@ int RunVerbRun(const CommandArgs& argv) {
   const ArgSpec spec = RunSpec();
   Args args;
   if (int code = ParseVerbArgs("run", argv, spec, &args); code >= 0) return code;
+  const auto start = Clock::now();  // the wall time a user waits for starts here
   const std::string project_path = args.positional[0];
   const std::string out_dir = args.Get("--out");
   const bool quiet = args.Switch("--quiet");
@@ -405,7 +436,7 @@ int RunVerbRun(const CommandArgs& argv) {
   // Where the memory goes: the process's peak after set-up (mesh, charts, buffers) and after
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
-  if (Status s = WriteRunOutputs(out_dir, *job, metrics); !s.ok()) {
+  if (Status s = WriteRunOutputs(out_dir, *job, stats, start, std::move(metrics)); !s.ok()) {
     return Fail(s);
   }
   if (project.pipeline.debug_images) {
@@ -418,7 +449,7 @@ int RunVerbRun(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), out_dir.c_str());
     return InterruptExitCode();
   }
-  if (!quiet) PrintRunSummary(stats, *session, out_dir);
+  if (!quiet) PrintRunSummary(stats, *session, out_dir, SecondsSince(start));
   return kExitOk;
 }
 

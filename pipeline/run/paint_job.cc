@@ -1,6 +1,7 @@
 #include "pipeline/run/paint_job.h"
 
 #include <algorithm>
+#include <chrono>
 #include <future>
 #include <map>
 #include <string>
@@ -19,6 +20,10 @@
 namespace fresco {
 
 namespace {
+
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 // The movers found across views (each stream's frames compared with that stream's frames
 // near them), which decide the background; the masks kept with the captures when the model
@@ -97,6 +102,8 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   std::vector<PoseAdjustFrame> frames;
   std::vector<cv::Mat> small;              // colour, at the movers' size
   std::vector<std::pair<int, int>> where;  // stream, pose index
+  PaintJob::OpenSeconds& seconds = j->open_seconds;
+  auto step = std::chrono::steady_clock::now();
   {
     FileFrameSource source(project, streams);
     SourcedFrame f;
@@ -125,6 +132,8 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     }
     FRESCO_RETURN_IF_ERROR(status);
   }
+  seconds.read = SecondsSince(step);
+  step = std::chrono::steady_clock::now();
   std::vector<Rigid3d> cam_from_local;
   for (const PoseAdjustFrame& frame : frames) cam_from_local.push_back(frame.cam_from_local);
   if (joint) {
@@ -137,10 +146,13 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
       j->captures[where[k].first].poses[where[k].second].cam_from_world =
           adjusted.cam_from_local[k] * local_from_world;
   }
+  seconds.joint = SecondsSince(step);
+  step = std::chrono::steady_clock::now();
   for (PoseAdjustFrame& frame : frames) frame.bgr.release();  // only their cameras are left
   if (movers)
     FRESCO_RETURN_IF_ERROR(
         FindMoversAcrossViews(project, mover_options, small, frames, cam_from_local, where, j));
+  seconds.movers = SecondsSince(step);
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
@@ -173,20 +185,25 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   const int num_streams = static_cast<int>(specs.size());
   CaptureLoadOptions load_options;
   load_options.open_live_video = false;  // a live video opens after its pose feed connects
+  const auto start = std::chrono::steady_clock::now();
+  PaintJob::OpenSeconds& seconds = j.open_seconds;
   FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
   if (options.paint_at_truth_poses)
     for (Capture& capture : j.captures) TakeTruthPoses(&capture);
+  seconds.load = SecondsSince(start);
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
+  seconds.cameras = SecondsSince(start) - seconds.load;
   if (!j.live) {
     if (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background))
       FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     j.source = std::make_unique<FileFrameSource>(project, streams);
+    seconds.total = SecondsSince(start);
     *job = std::move(result);
     return Status::Ok();
   }
@@ -216,6 +233,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                                                      std::to_string(s) + "]: " + status.message());
   }
   if (!first_error.ok()) return first_error;
+  seconds.connect = SecondsSince(start) - seconds.load - seconds.cameras;
   std::vector<std::unique_ptr<PosedFrameSource>> sources;
   for (int s = 0; s < num_streams; ++s) {
     const Project one = project.ForStream(s);
@@ -227,6 +245,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
           std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&j.captures[s]}));
   }
   j.source = JoinStreamSources(std::move(sources), options.poll_ms);
+  seconds.total = SecondsSince(start);
   *job = std::move(result);
   return Status::Ok();
 }

@@ -64,6 +64,17 @@ struct PaintJob {
   // background.mode auto: the movers found across views before painting, which decided it
   // (`masks` is empty).
   std::optional<MoverMaskResult> mover_masks;
+  // Where opening the job spent its wall time, seconds (what a user waits for before the
+  // first frame paints; `fresco run` reports them in metrics.json's "wall").
+  struct OpenSeconds {
+    double load = 0;      // scene, cameras, poses read; charts and base buffers built
+    double cameras = 0;   // each camera's ray table and the mesh's culling clusters
+    double read = 0;      // the whole-capture pre-pass: every frame read and decoded once
+    double joint = 0;     // ... the poses adjusted together (refine.joint)
+    double movers = 0;    // ... the movers found across views (background auto / across_views)
+    double connect = 0;   // live sources connected
+    double total = 0;
+  } open_seconds;
 
   const Scene& scene() const { return captures[0].scene; }
 };
