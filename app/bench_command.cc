@@ -21,7 +21,7 @@
 #include "pipeline/core/capture.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/paint/auto_modes.h"
-#include "pipeline/paint/rephotography.h"
+#include "pipeline/rephoto/holdout_scorer.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
 
@@ -130,12 +130,7 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   const Capture& capture = job->captures[0];
   PaintSession* session = job->session.get();
 
-  struct HeldOut {
-    Frame frame;
-    const PosedImage* pose;
-    const PosedImage* truth;
-  };
-  std::vector<HeldOut> held_out;
+  std::vector<HeldOutFrame> held_out;  // with their true poses where the project has them
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   run_options.holdout_every = holdout;
@@ -144,10 +139,7 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   PaintRunHooks hooks;
   hooks.stop = [] { return Interrupted(); };
   hooks.after_frame = [&](const RunFrame& f, const FrameReport*) {
-    if (f.fate != FrameFate::kHeldOut) return Status::Ok();
-    const size_t k = f.pose_index;
-    const PosedImage* truth = k < capture.truth_poses.size() ? &capture.truth_poses[k] : nullptr;
-    held_out.push_back({f.posed.frame, &capture.poses[k], truth});
+    if (f.fate == FrameFate::kHeldOut) held_out.push_back(HeldOutFrameOf(f, &capture));
     return Status::Ok();
   };
   FRESCO_RETURN_IF_ERROR(RunToEnd(&run, hooks));
@@ -156,28 +148,9 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   const PaintRunStats& stats = run.stats();
 
   // Accuracy on the held-out frames (at the given poses; at the true poses when known).
-  const Scene scene = session->PaintedScene();
-  double psnr = 0, ncc = 0, completeness = 0, truth_psnr = 0, truth_ncc = 0;
-  int scored = 0, truth_scored = 0;
-  std::map<const Camera*, std::unique_ptr<Renderer>> renderers;  // ray tables built once
-  for (const HeldOut& h : held_out) {
-    if (Interrupted()) return interrupted;
-    const Camera* camera = capture.CameraFor(*h.pose);
-    std::unique_ptr<Renderer>& cached = renderers[camera];
-    if (!cached) cached = std::make_unique<Renderer>(*camera, RenderOptions());
-    const Renderer& renderer = *cached;
-    const RephotoScore s = ScoreRephoto(renderer, scene, h.pose->cam_from_world, h.frame.bgr);
-    if (s.pixels > 0) psnr += s.psnr_db, ncc += s.one_minus_ncc, ++scored;
-    completeness += s.completeness;
-    if (h.truth) {
-      const bool same =
-          h.truth->cam_from_world.rotation.coeffs() == h.pose->cam_from_world.rotation.coeffs() &&
-          h.truth->cam_from_world.translation == h.pose->cam_from_world.translation;
-      const RephotoScore t =
-          same ? s : ScoreRephoto(renderer, scene, h.truth->cam_from_world, h.frame.bgr);
-      if (t.pixels > 0) truth_psnr += t.psnr_db, truth_ncc += t.one_minus_ncc, ++truth_scored;
-    }
-  }
+  HoldoutScorer scorer(session->PaintedScene(), HoldoutScorerOptions());
+  if (!scorer.AddAll(held_out, [] { return Interrupted(); })) return interrupted;
+  const HoldoutFigures& figures = scorer.figures();
   nlohmann::json& row = result->row;
   row["settings"] = nlohmann::json::object();
   for (const auto& [key, value] : settings) row["settings"][key] = value;
@@ -193,15 +166,16 @@ Status BenchOne(const std::string& project_path, const Settings& settings, int h
   row["stage_ms"] = nlohmann::json::object();
   for (const auto& [name, ms] : stats.MeanStageMs()) row["stage_ms"][name] = ms;
   row["holdout_frames"] = stats.frames_held_out;
-  row["psnr_db"] = scored > 0 ? psnr / scored : 0.0;
-  row["one_minus_ncc"] = scored > 0 ? ncc / scored : 1.0;
-  row["completeness"] = held_out.empty() ? 0.0 : completeness / held_out.size();
+  // Nothing compared: 0 dB, uncorrelated, nothing complete.
+  row["psnr_db"] = figures.scored > 0 ? figures.psnr_db : 0.0;
+  row["one_minus_ncc"] = figures.scored > 0 ? figures.one_minus_ncc : 1.0;
+  row["completeness"] = figures.frames > 0 ? figures.completeness : 0.0;
   row["coverage"] = session->Coverage();
   // What the `auto` modes decided, with their evidence (null for a mode not auto).
   if (!naive) row["auto"] = nlohmann::json::parse(AutoDecisionsJson(session->auto_decisions()));
-  if (truth_scored > 0) {
-    row["truth"] = {{"psnr_db", truth_psnr / truth_scored},
-                    {"one_minus_ncc", truth_ncc / truth_scored}};
+  if (figures.truth_scored > 0) {
+    row["truth"] = {{"psnr_db", figures.truth_psnr_db},
+                    {"one_minus_ncc", figures.truth_one_minus_ncc}};
   }
   result->point = {row["fps"].get<double>(), row["psnr_db"].get<double>(),
                    label.empty() ? "project settings" : label};
@@ -219,19 +193,19 @@ int RunVerbBench(const CommandArgs& argv) {
   int holdout = 10;
   std::string error;
   if (args.Has("--holdout") && !ParseInt(args.Get("--holdout"), "--holdout", &holdout, &error))
-    return InputError(Status::Error(error));
-  if (holdout < 2) return InputError(Status::Error("--holdout: must be >= 2"));
+    return Fail(Status::Error(error));
+  if (holdout < 2) return Fail(Status::Error("--holdout: must be >= 2"));
   std::vector<Settings> runs;
-  if (Status s = ParseSweeps(args.All("--sweep"), &runs); !s.ok()) return InputError(s);
+  if (Status s = ParseSweeps(args.All("--sweep"), &runs); !s.ok()) return Fail(s);
   // Every run's settings must load before any runs (a typo fails at once, not after an hour).
   for (const Settings& run : runs) {
     std::vector<std::string> overrides;
     for (const auto& [key, value] : run) overrides.push_back(key + "=" + value);
     Project project;
-    if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return InputError(s);
-    if (Status s = CheckOneStream(project, "fresco bench"); !s.ok()) return InputError(s);
+    if (Status s = LoadProject(project_path, overrides, &project); !s.ok()) return Fail(s);
+    if (Status s = CheckOneStream(project, "fresco bench"); !s.ok()) return Fail(s);
   }
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
 
   InterruptCatcher interrupt;
   Progress progress("bench", static_cast<int>(runs.size()) + !args.Switch("--no-baseline"),
@@ -255,7 +229,7 @@ int RunVerbBench(const CommandArgs& argv) {
                    InterruptSignalName().c_str(), i + 1, total, out_dir.c_str());
       return InterruptExitCode();
     }
-    if (!s.ok()) return InputError(s);
+    if (!s.ok()) return Fail(s);
     rows.push_back(result.row);
     points.push_back(result.point);
     char detail[160];
@@ -266,13 +240,11 @@ int RunVerbBench(const CommandArgs& argv) {
   progress.Finish();
   for (size_t k : ParetoFront(points)) rows[k]["pareto"] = true;
   if (Status s = WriteFileAtomic(out_dir + "/bench.json", rows.dump(2) + "\n"); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   const cv::Mat plot = DrawPareto(points, "fresco bench " + project_path);
   if (Status s = WriteImageAtomic(out_dir + "/pareto.png", plot); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   std::fprintf(stderr, "fresco bench: %zu runs -> %s/bench.json, %s/pareto.png\n", total,
                out_dir.c_str(), out_dir.c_str());

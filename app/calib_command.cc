@@ -122,7 +122,7 @@ int RunSolve(const CommandArgs& argv) {
   request.images_dir = args.positional[0];
   request.exclude = ExcludedNames(args);
   if (Status s = calib::ParseBoardSpec(args.Get("--board"), "--board", &request.board); !s.ok())
-    return InputError(s);
+    return Fail(s);
   request.model = args.Get("--model", "auto");
   bool known = request.model == "auto";
   for (const std::string& name : calib::LensModelShortNames()) known |= name == request.model;
@@ -152,11 +152,10 @@ int RunSolve(const CommandArgs& argv) {
   if (Status s = calib::DetectViews(request, &run); !s.ok()) {
     for (const calib::RejectedImage& r : run.rejected)
       std::cerr << "  rejected " << r.name << ": " << r.reason << "\n";
-    return InputError(s);
+    return Fail(s);
   }
   if (Status s = calib::SolveViews(request, &run); !s.ok()) {
-    std::cerr << "fresco calib solve: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   if (solve_progress) solve_progress->Finish();
   calib::CalibrationOutputs outputs;
@@ -166,7 +165,7 @@ int RunSolve(const CommandArgs& argv) {
   if (Status s =
           calib::WriteCalibrationOutputs(out, request, run, outputs, &optimization_inputs_missing);
       !s.ok())
-    return InputError(s);
+    return Fail(s);
   if (!optimization_inputs_missing.empty())
     std::cerr << "warning: " << out << " has no optimization_inputs (mrcal's uncertainty and "
               << "residual tools need them): " << optimization_inputs_missing << "\n";
@@ -188,15 +187,15 @@ int RunBoard(const CommandArgs& argv) {
   if (int code = ParseVerbArgs("calib board", argv, spec, &args); code >= 0) return code;
   BoardSpec board;
   if (Status s = calib::ParseBoardSpec(args.positional[0], "BOARD", &board); !s.ok())
-    return InputError(s);
+    return Fail(s);
   double dpi = 300;
   std::string error;
   if (args.Has("--dpi") && !ParseDouble(args.Get("--dpi"), "--dpi", &dpi, &error))
     return UsageError("calib board", spec, error);
   calib::BoardImage image;
-  if (Status s = calib::RenderBoardImage(board, dpi, &image); !s.ok()) return InputError(s);
+  if (Status s = calib::RenderBoardImage(board, dpi, &image); !s.ok()) return Fail(s);
   const std::string out = args.Get("--out");
-  if (Status s = WriteImageAtomic(out, image.gray); !s.ok()) return InputError(s);
+  if (Status s = WriteImageAtomic(out, image.gray); !s.ok()) return Fail(s);
   char json[1024];
   std::snprintf(json, sizeof(json),
                 "{\n  \"board\": \"%s\",\n  \"dpi\": %g,\n  \"image_px\": [%d, %d],\n"
@@ -208,7 +207,7 @@ int RunBoard(const CommandArgs& argv) {
                 image.drawn_square_m, image.drawn_spacing,
                 board.kind == calib::BoardKind::kAprilGrid ? "tag36h11" : "chessboard");
   const std::string sidecar = calib::SiblingPath(out, ".json");
-  if (Status s = WriteFileAtomic(sidecar, json); !s.ok()) return InputError(s);
+  if (Status s = WriteFileAtomic(sidecar, json); !s.ok()) return Fail(s);
   std::cout << image.label << "\nwrote " << out << " (" << image.gray.cols << "x" << image.gray.rows
             << " px) and " << sidecar << "\n";
   return kExitOk;
@@ -235,7 +234,7 @@ int RunSample(const CommandArgs& argv) {
   if (int code = ParseVerbArgs("calib sample", argv, spec, &args); code >= 0) return code;
   BoardSpec board;
   if (Status s = calib::ParseBoardSpec(args.positional[0], "BOARD", &board); !s.ok())
-    return InputError(s);
+    return Fail(s);
   if (board.kind != calib::BoardKind::kAprilGrid)
     return UsageError("calib sample", spec, "BOARD: sample views are made of AprilGrid boards");
   int views = 20, seed = 1;
@@ -253,7 +252,7 @@ int RunSample(const CommandArgs& argv) {
       options.noise_px < 0 || options.noise_px > 100)
     return UsageError("calib sample", spec, "--views 1 to 1000, --blur 0 to 20, --noise 0 to 100");
   const std::string out = args.Get("--out");
-  if (Status s = MakeDirectories(out); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out); !s.ok()) return Fail(s);
   const calib::SyntheticLens lens;
   const calib::SyntheticImageRenderer renderer(board, lens, /*kalibr_squares=*/false);
   const auto poses = calib::WholeBoardPoses(board, lens, views, static_cast<unsigned>(seed));
@@ -262,14 +261,14 @@ int RunSample(const CommandArgs& argv) {
     const calib::SyntheticImage image = renderer.Render(poses[v], options);
     char name[32];
     std::snprintf(name, sizeof(name), "/view_%03zu.png", v);
-    if (Status s = WriteImageAtomic(out + name, image.gray); !s.ok()) return InputError(s);
+    if (Status s = WriteImageAtomic(out + name, image.gray); !s.ok()) return Fail(s);
   }
   LensModel model = LensModel::kPinhole;
   LensModelFromName(lens.lensmodel, &model);
   CameraModelFile truth;
   truth.camera = Camera::FromParams(model, lens.width, lens.height, lens.intrinsics);
   const std::string truth_path = out + "/truth.cameramodel";
-  if (Status s = WriteCameraModel(truth_path, truth); !s.ok()) return InputError(s);
+  if (Status s = WriteCameraModel(truth_path, truth); !s.ok()) return Fail(s);
   std::cout << "wrote " << poses.size() << " views (" << lens.width << "x" << lens.height << ") to "
             << out << " and the lens they were made with to " << truth_path << "\n";
   return kExitOk;

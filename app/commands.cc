@@ -83,9 +83,23 @@ int UsageError(const std::string& verb, const ArgSpec& spec, const std::string& 
   return kExitBadInput;
 }
 
-int InputError(const Status& status) {
+int ExitCodeFor(const Status& status) {
+  switch (status.kind()) {
+    case StatusKind::kOk:
+      return kExitOk;
+    case StatusKind::kBadInput:
+      return kExitBadInput;
+    case StatusKind::kOutput:
+    case StatusKind::kFailed:
+    case StatusKind::kInternal:
+      return kExitFailure;
+  }
+  return kExitFailure;
+}
+
+int Fail(const Status& status) {
   std::cerr << "error: " << status.message() << "\n";
-  return kExitBadInput;
+  return ExitCodeFor(status);
 }
 
 }  // namespace fresco

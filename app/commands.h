@@ -1,6 +1,7 @@
 // The `fresco` verbs. Each verb is a function in its own file taking the arguments after the
 // verb; the dispatcher maps verb -> function. Exit codes (docs/contract.md): 0 success, 2 bad
-// usage or bad input (one line on stderr naming file and field), 1 anything else.
+// usage or bad input (one line on stderr naming file and field), 1 anything else. A verb
+// never picks 1 or 2 by hand after a Status: it returns Fail(status), whose kind decides.
 #pragma once
 
 #include <string>
@@ -34,8 +35,11 @@ int ParseVerbArgs(const std::string& verb, const CommandArgs& argv, const ArgSpe
                   Args* args);
 // Prints "fresco VERB: message" and the usage line; returns 2.
 int UsageError(const std::string& verb, const ArgSpec& spec, const std::string& message);
-// Prints a failed Status as one line on stderr; returns 2.
-int InputError(const Status& status);
+// The exit code for a Status, by its kind: 0 ok, 2 bad input, 1 anything else (output,
+// failed, internal). Every verb's exit code after a Status comes from here.
+int ExitCodeFor(const Status& status);
+// Prints a failed Status as one line "error: MESSAGE" on stderr; returns ExitCodeFor(status).
+int Fail(const Status& status);
 
 int RunVerbRun(const CommandArgs& args);
 int RunVerbRender(const CommandArgs& args);

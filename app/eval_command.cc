@@ -77,11 +77,11 @@ int RunVerbEval(const CommandArgs& argv) {
   if (options.holdout < 2) return UsageError("eval", spec, "--holdout: must be >= 2");
 
   EvalSuite suite;
-  if (Status s = LoadEvalSuite(args.positional[0], &suite); !s.ok()) return InputError(s);
+  if (Status s = LoadEvalSuite(args.positional[0], &suite); !s.ok()) return Fail(s);
   if (Status s = SelectSuiteCaptures(SplitCommas(args.Get("--only")), &suite); !s.ok())
-    return InputError(s);
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
-  if (Status s = MakeDirectories(options.cache_dir); !s.ok()) return InputError(s);
+    return Fail(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
+  if (Status s = MakeDirectories(options.cache_dir); !s.ok()) return Fail(s);
 
   const bool quiet = args.Switch("--quiet");
   options.progress = ProgressLines("eval", quiet);
@@ -94,15 +94,14 @@ int RunVerbEval(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), out_dir.c_str());
     return InterruptExitCode();
   }
-  if (!status.ok()) return InputError(status);
+  if (!status.ok()) return Fail(status);
   const std::vector<FamilySummary> families = SummarizeByFamily(results);
   const std::string text = EvalToText(results, families);
   for (const auto& [path, contents] :
        {std::pair{out_dir + "/eval.json", EvalToJson(options.overrides, results, families)},
         std::pair{out_dir + "/eval.md", text}}) {
     if (Status s = WriteFileAtomic(path, contents); !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
+      return Fail(s);
     }
   }
   std::cout << text;

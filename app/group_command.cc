@@ -43,11 +43,11 @@ int RunVerbGroup(const CommandArgs& argv) {
   if (int code = ParseVerbArgs("group", argv, spec, &args); code >= 0) return code;
   Project project;
   if (Status s = LoadProject(args.positional[0], args.All("--set"), &project); !s.ok())
-    return InputError(s);
+    return Fail(s);
   std::vector<Capture> streams;  // every stream's poses choose the automatic texel size
   std::unique_ptr<PaintSession> session;
   if (Status s = OpenPaintSession(project, CaptureLoadOptions(), &streams, &session); !s.ok())
-    return InputError(s);
+    return Fail(s);
 
   const TriangleMesh& mesh = streams[0].scene.mesh;
   nlohmann::json table = nlohmann::json::array();
@@ -83,15 +83,14 @@ int RunVerbGroup(const CommandArgs& argv) {
                                 {"ungrouped_triangles", ungrouped},
                                 {"texels", texels},
                                 {"groups", table}};
-    if (Status s = WriteFileAtomic(args.Get("--json"), out.dump(2) + "\n"); !s.ok())
-      return InputError(s);
+    if (Status s = WriteFileAtomic(args.Get("--json"), out.dump(2) + "\n"); !s.ok()) return Fail(s);
   }
   if (args.Switch("--save")) {
     Project saved;  // the file as written, without --set overrides, plus the grouping
-    if (Status s = LoadProject(args.positional[0], {}, &saved); !s.ok()) return InputError(s);
+    if (Status s = LoadProject(args.positional[0], {}, &saved); !s.ok()) return Fail(s);
     saved.grouping.groups = session->grouping().groups;
     saved.grouping.edits.clear();
-    if (Status s = SaveProject(saved, saved.file_path); !s.ok()) return InputError(s);
+    if (Status s = SaveProject(saved, saved.file_path); !s.ok()) return Fail(s);
     std::printf("saved %zu groups to %s\n", saved.grouping.groups.size(), saved.file_path.c_str());
   }
   return kExitOk;

@@ -72,7 +72,7 @@ int RunGuiCommand(const CommandArgs& argv) {
     calib::BoardSpec board;
     if (!args.Has("--board")) return UsageError("gui", spec, "--calib-images needs --board");
     if (Status s = calib::ParseBoardSpec(options.calib_board, "--board", &board); !s.ok())
-      return InputError(s);
+      return Fail(s);
     const auto& names = calib::LensModelShortNames();
     if (options.calib_model != "auto" &&
         std::find(names.begin(), names.end(), options.calib_model) == names.end())
@@ -91,15 +91,13 @@ int RunGuiCommand(const CommandArgs& argv) {
     return UsageError("gui", spec, "--poses-out and --poses-model go with --poses");
   if (!options.poses.empty() && options.project.empty())
     return UsageError("gui", spec, "--poses needs a PROJECT.json");
-  if (!options.poses_model.empty() && !std::filesystem::is_directory(options.poses_model)) {
-    std::cerr << "error: " << options.poses_model << ": --poses-model: no such folder\n";
-    return kExitBadInput;
-  }
+  if (!options.poses_model.empty() && !std::filesystem::is_directory(options.poses_model))
+    return Fail(Status::Error(options.poses_model + ": --poses-model: no such folder"));
   if (!options.screenshot.empty() && options.project.empty() && options.calib_images.empty())
     return UsageError("gui", spec, "--screenshot needs a PROJECT.json or --calib-images");
   if (!options.project.empty()) {  // bad input is exit 2 before any window opens
     Project project;
-    if (Status s = LoadProject(options.project, {}, &project); !s.ok()) return InputError(s);
+    if (Status s = LoadProject(options.project, {}, &project); !s.ok()) return Fail(s);
   }
   return RunGuiApp(options);
 }

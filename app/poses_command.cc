@@ -161,15 +161,12 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
   }
   options.colmap.program = args.Get("--colmap");
   options.existing_model = args.Get("--colmap-model");
-  if (!options.existing_model.empty() && !fs::is_directory(options.existing_model)) {
-    std::cerr << "error: " << options.existing_model << ": --colmap-model: no such folder\n";
-    return kExitBadInput;
-  }
+  if (!options.existing_model.empty() && !fs::is_directory(options.existing_model))
+    return Fail(Status::Error(options.existing_model + ": --colmap-model: no such folder"));
   if (options.existing_model.empty() && FindColmap(options.colmap.program).empty()) {
-    std::cerr << "error: " << (options.colmap.program.empty() ? "colmap" : options.colmap.program)
-              << ": program not found on PATH (install Debian's `colmap` package, or pass "
-                 "--colmap PATH)\n";
-    return kExitFailure;
+    return Fail(Status::Failed(
+        (options.colmap.program.empty() ? "colmap" : options.colmap.program) +
+        ": program not found on PATH (install Debian's `colmap` package, or pass --colmap PATH)"));
   }
   const bool quiet = args.Switch("--quiet");
   Progress progress("colmap", 5, quiet);  // the runner gives the steps' count as it starts
@@ -177,13 +174,7 @@ int RunColmapStage(const Args& args, const ArgSpec& spec, const Project& project
     progress.SetTotal(total);
     if (!quiet && index < total) progress.Update(index, step);
   };
-  bool bad_input = false;
-  const Status status = RunColmapOnProject(project, options, result, &bad_input);
-  if (!status.ok()) {
-    if (bad_input) return InputError(status);
-    std::cerr << "error: " << status.message() << "\n";
-    return kExitFailure;
-  }
+  if (Status s = RunColmapOnProject(project, options, result); !s.ok()) return Fail(s);
   char detail[200];
   std::snprintf(detail, sizeof(detail), "%d of %d frames registered, %.1f s",
                 result->run.registered, static_cast<int>(result->frames.size()),
@@ -230,16 +221,12 @@ int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
   VerifyResult result;
   if (Status s = VerifyPoses(VerifyInputs(colmap), colmap.scene_size_m, options, &result);
       !s.ok()) {
-    std::cerr << "error: " << project.poses << ": " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s.WithMessage(project.poses + ": " + s.message()));
   }
   const Status written =
       WriteVerifyReport(result, colmap.run, (fs::path(out_dir) / "verify.json").string(),
                         (fs::path(out_dir) / "verify.png").string());
-  if (!written.ok()) {
-    std::cerr << "error: " << written.message() << "\n";
-    return kExitFailure;
-  }
+  if (!written.ok()) return Fail(written);
   std::cout << "verify: " << result.compared << " frames compared (" << result.registered
             << " registered by COLMAP), " << result.flagged << " flagged\n"
             << VerifyAgreementText(result) << "\n";
@@ -268,7 +255,7 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
   const std::string control_file = args.Get("--control-points");
   if (!control_file.empty()) {
     if (Status s = ReadControlPoints(control_file, &control_points); !s.ok()) {
-      return InputError(s);
+      return Fail(s);
     }
   }
 
@@ -284,10 +271,7 @@ int RunBootstrap(const Args& args, const ArgSpec& spec, const Project& project,
   BootstrapResult result;
   Status s = BootstrapFromColmap(project, colmap, options, &result);
   if (s.ok()) s = WriteBootstrap(project, colmap, result, out_dir);
-  if (!s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
-  }
+  if (!s.ok()) return Fail(s);
   std::cout << "bootstrap: " << colmap.run.registered << " of " << colmap.frames.size()
             << " frames posed (" << result.aligned_with << ")\n"
             << result.comparison.summary << "\n"
@@ -313,12 +297,12 @@ int RunVerbPoses(const CommandArgs& argv) {
   Args args;
   if (int code = ParseVerbArgs(kVerb, argv, spec, &args); code >= 0) return code;
   Project project;
-  if (Status s = LoadProject(args.positional[1], {}, &project); !s.ok()) return InputError(s);
+  if (Status s = LoadProject(args.positional[1], {}, &project); !s.ok()) return Fail(s);
   // One stream, seen as a version-1 project (a bootstrapped project is written as one).
-  if (Status s = CheckOneStream(project, "fresco poses"); !s.ok()) return InputError(s);
+  if (Status s = CheckOneStream(project, "fresco poses"); !s.ok()) return Fail(s);
   project = project.ForStream(0);
   const std::string out_dir = args.Get("--out");
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
   return sub == "verify" ? RunVerify(args, spec, project, out_dir)
                          : RunBootstrap(args, spec, project, out_dir);
 }

@@ -92,7 +92,7 @@ bool OutputName(const std::string& name, const std::string& suffix, std::string*
 Status WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
   if (!cv::imencode(".png", image, bytes))
-    return Status::Error(path + ": could not encode the PNG");
+    return Status::Internal(path + ": could not encode the PNG");
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
   return WriteFileAtomic(path, std::string(bytes.begin(), bytes.end()));
@@ -302,16 +302,16 @@ int RunVerbRender(const CommandArgs& args) {
 
   std::map<int, Camera> cameras;
   if (Status s = ReadRenderCameras(camera_path, options.raster.supersample, &cameras); !s.ok())
-    return InputError(s);
+    return Fail(s);
   std::vector<PosedImage> poses;
   PoseSource source{poses_path, camera_path, cameras};
-  if (Status s = ReadPoses(poses_path, &poses, &source.is_tum); !s.ok()) return InputError(s);
-  if (poses.empty()) return InputError(Status::Error(poses_path + ": no poses"));
+  if (Status s = ReadPoses(poses_path, &poses, &source.is_tum); !s.ok()) return Fail(s);
+  if (poses.empty()) return Fail(Status::Error(poses_path + ": no poses"));
   std::vector<Job> jobs;
-  if (Status s = PlanJobs(source, poses, outputs, &jobs); !s.ok()) return InputError(s);
+  if (Status s = PlanJobs(source, poses, outputs, &jobs); !s.ok()) return Fail(s);
   Scene scene;
-  if (Status s = LoadScene(model_path, SceneLoadOptions(), &scene); !s.ok()) return InputError(s);
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = LoadScene(model_path, SceneLoadOptions(), &scene); !s.ok()) return Fail(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
 
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by camera id (ray tables)
   Progress progress("render", static_cast<int>(jobs.size()), parsed.Switch("--quiet"));
@@ -319,10 +319,8 @@ int RunVerbRender(const CommandArgs& args) {
     const Job& job = jobs[i];
     std::unique_ptr<Renderer>& renderer = renderers[job.camera_id];
     if (!renderer) renderer = std::make_unique<Renderer>(cameras.at(job.camera_id), options);
-    if (Status written = RenderJob(*renderer, scene, job, outputs, out_dir); !written.ok()) {
-      std::cerr << "error: " << written.message() << "\n";
-      return kExitFailure;
-    }
+    if (Status written = RenderJob(*renderer, scene, job, outputs, out_dir); !written.ok())
+      return Fail(written);
     progress.Update(static_cast<int>(i + 1), job.relative + ".png");
   }
   progress.Finish(std::to_string(jobs.size()) + " images in " + out_dir);

@@ -67,7 +67,7 @@ int RunVerbRephoto(const CommandArgs& argv) {
   if (args.Has("--every") && !ParseInt(args.Get("--every"), "--every", &options.every, &error))
     return UsageError("rephoto", spec, error);
   if (Status s = options.Check(); !s.ok()) return UsageError("rephoto", spec, s.message());
-  if (Status s = MakeDirectories(out_dir + "/views"); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir + "/views"); !s.ok()) return Fail(s);
 
   const bool quiet = args.Switch("--quiet");
   options.progress = ProgressLines("rephoto", quiet);
@@ -88,10 +88,9 @@ int RunVerbRephoto(const CommandArgs& argv) {
     return InterruptExitCode();
   }
   if (!write_error.ok()) {
-    std::cerr << "error: " << write_error.message() << "\n";
-    return kExitFailure;
+    return Fail(write_error);
   }
-  if (!status.ok()) return InputError(status);
+  if (!status.ok()) return Fail(status);
   const RephotoSummary summary = SummarizeRephoto(result);
   const std::string text = RephotoToMarkdown(result, summary);
   for (const auto& [path, contents] :
@@ -99,8 +98,7 @@ int RunVerbRephoto(const CommandArgs& argv) {
                   RephotoToJson(result, options.overrides, options.every, summary)},
         std::pair{out_dir + "/rephoto.md", text}}) {
     if (Status s = WriteFileAtomic(path, contents); !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
+      return Fail(s);
     }
   }
   std::cout << text;

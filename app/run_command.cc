@@ -18,7 +18,7 @@
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
 #include "pipeline/live/live_input.h"
-#include "pipeline/live/session_recorder.h"
+#include "pipeline/run/live_status.h"
 #include "pipeline/paint/charts.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/run/paint_job.h"
@@ -83,8 +83,8 @@ double PeakRssMb() {
   return usage.ru_maxrss / 1024.0;  // KB on Linux
 }
 
-nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
-  const LiveFramesStats s = live.frames->stats();
+nlohmann::json LiveMetrics(const LiveStatus& live) {
+  const LiveFramesStats& s = live.frames;
   nlohmann::json j;
   j["frames_received"] = s.frames_received;
   j["frames_dropped"] = s.frames_dropped;
@@ -98,8 +98,8 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
   j["end_reason"] = s.end_reason;
   j["time_offset_s"] = s.time_offset_s;
   j["offset_estimated"] = s.offset_estimated;
-  if (live.feed) {
-    const PoseFeedStats f = live.feed->stats();
+  if (live.pose_feed) {
+    const PoseFeedStats& f = live.feed;
     nlohmann::json gaps = nlohmann::json::array();
     for (const PoseFeedGap& g : f.gaps)  // NaN (no pose on that side) is written as null
       gaps.push_back({{"last_pose_before_s", g.last_pose_before_s},
@@ -108,7 +108,7 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
                       {"disconnected_s", g.disconnected_s},
                       {"attempts", g.attempts},
                       {"reconnected", g.reconnected}});
-    j["pose_feed"] = {{"address", live.feed->address()},
+    j["pose_feed"] = {{"address", live.pose_feed_address},
                       {"poses", f.poses},
                       {"reconnects", f.reconnects},
                       {"disconnects", f.disconnects},
@@ -141,14 +141,14 @@ nlohmann::json LiveMetrics(const LiveInputs& live, int recorded) {
                        {"seconds", p.seconds}});
     j["offset_track"] = track;
   }
-  j["recorded_frames"] = recorded;
+  j["recorded_frames"] = live.recorded_frames;
   return j;
 }
 
 // What metrics.json holds (CONTRACT.md): the run's statistics, the session's buffers and
 // atlas, and for live projects the sources' state.
 nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const PaintRunStats& stats,
-                          int recorded_frames) {
+                          const Status& end, const LiveRecording& recording) {
   const PaintSession* session = job.session.get();
   const Scene& scene = job.scene();
   const std::vector<StreamSpec> specs = project.Streams();
@@ -237,7 +237,10 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   // project with one stream has always had).
   for (size_t i = 0; i < job.live_inputs.size(); ++i) {
     if (!job.live_inputs[i].frames) continue;
-    const nlohmann::json live = LiveMetrics(job.live_inputs[i], recorded_frames);
+    LiveStatus status = LiveWatch().Read(project.ForStream(static_cast<int>(i)),
+                                         job.live_inputs[i], true, end, -1);
+    recording.Describe(&status);
+    const nlohmann::json live = LiveMetrics(status);
     metrics["streams"][i]["live"] = live;
     if (!metrics.contains("live")) metrics["live"] = live;
   }
@@ -257,6 +260,73 @@ Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job,
   return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
 }
 
+// The frames the run will read (for its progress): every stream's, at most max_frames; -1
+// when unknown (live).
+int FramesToRead(const PaintJob& job, const Project& project) {
+  const int total = job.source->FrameCount();
+  const int max_frames = project.pipeline.max_frames;
+  return max_frames > 0 && (total < 0 || total > max_frames) ? max_frames : total;
+}
+
+// The last line of a run (unless --quiet).
+void PrintRunSummary(const PaintRunStats& stats, const PaintSession& session,
+                     const std::string& out_dir) {
+  std::fprintf(stderr,
+               "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; coverage %.1f%% of %lld "
+               "texels in %zu buffers -> %s\n",
+               stats.frames, stats.frames_painted, stats.seconds, stats.Fps(),
+               100.0 * session.Coverage(), session.NumSurfaceTexels(), session.buffers().size(),
+               out_dir.c_str());
+}
+
+// --record DIR: only for a live project with one stream.
+Status CheckRecording(const Project& project, const std::string& project_path,
+                      const std::string& record_dir) {
+  if (record_dir.empty()) return Status::Ok();
+  if (!IsLiveProject(project))
+    return Status::Error(std::string("--record: only for live sources (") + project.file_path +
+                         " replays files already)");
+  const size_t streams = project.Streams().size();
+  if (streams > 1)
+    return Status::Error(project_path +
+                         ": streams: --record records a project with one stream (this one has " +
+                         std::to_string(streams) + ")");
+  return Status::Ok();
+}
+
+// What the job set up and what its pre-pass did, on stderr (before painting).
+void PrintJobSummary(const PaintJob& job, size_t streams) {
+  const PaintSession* session = job.session.get();
+  const Scene& scene = job.scene();
+  std::fprintf(
+      stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)%s\n",
+      scene.mesh.NumTriangles(), session->buffers().size(), session->NumSurfaceTexels(),
+      session->default_texel_size_m(),
+      streams > 1 ? (", " + std::to_string(streams) + " streams").c_str() : "");
+  if (job.joint_poses && !job.joint_poses->not_run.empty()) {
+    std::fprintf(stderr, "fresco run: poses not adjusted together: %s\n",
+                 job.joint_poses->not_run.c_str());
+  } else if (job.joint_poses) {
+    const PoseAdjustResult& a = *job.joint_poses;
+    std::fprintf(stderr,
+                 "fresco run: poses adjusted together (%d tracks, %.1f s): %s, RMS %.3f -> "
+                 "%.3f px, median correction %.3f deg, %.1f mm\n",
+                 a.inliers, a.seconds,
+                 a.applied ? "applied"
+                           : "not applied (the given poses "
+                             "explain the tracks nearly as well)",
+                 a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
+                 1000 * a.median_translation_m);
+  }
+  if (job.mover_masks && !job.mover_masks->not_run.empty())
+    std::fprintf(stderr, "fresco run: background decided frame by frame: %s\n",
+                 job.mover_masks->not_run.c_str());
+  else if (job.mover_masks)
+    std::fprintf(stderr, "fresco run: background %s (%.1f s)\n",
+                 session->auto_decisions().background.Describe().c_str(),
+                 job.mover_masks->seconds);
+}
+
 }  // namespace
 
 int RunVerbRun(const CommandArgs& argv) {
@@ -268,83 +338,43 @@ int RunVerbRun(const CommandArgs& argv) {
   const bool quiet = args.Switch("--quiet");
 
   Project project;
-  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok())
-    return InputError(s);
+  if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok()) return Fail(s);
   if (args.Switch("--debug-images")) project.pipeline.debug_images = true;
   if (project.pipeline.threads > 0) cv::setNumThreads(project.pipeline.threads);
 
-  const bool live = IsLiveProject(project);
   const std::vector<StreamSpec> specs = project.Streams();
   const std::string record_dir = args.Get("--record");
-  if (!record_dir.empty() && !live)
-    return InputError(Status::Error(std::string("--record: only for live sources (") +
-                                    project_path + " replays files already)"));
-  if (!record_dir.empty() && specs.size() > 1)
-    return InputError(Status::Error(project_path +
-                                    ": streams: --record records a project with one stream "
-                                    "(this one has " +
-                                    std::to_string(specs.size()) + ")"));
+  if (Status s = CheckRecording(project, project_path, record_dir); !s.ok()) return Fail(s);
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
-  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return InputError(s);
+  if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return Fail(s);
   const double setup_peak_rss_mb = PeakRssMb();
   PaintSession* session = job->session.get();
-  const Scene& scene = job->scene();
-  SessionRecorder recorder;
+  LiveRecording recording;
   if (!record_dir.empty())
-    if (Status s = recorder.Start(record_dir, project.ForStream(0)); !s.ok()) return InputError(s);
-  if (!quiet) {
-    std::fprintf(
-        stderr, "fresco run: %d triangles, %zu base buffers, %lld texels (%.4f m/texel)%s\n",
-        scene.mesh.NumTriangles(), session->buffers().size(), session->NumSurfaceTexels(),
-        session->default_texel_size_m(),
-        specs.size() > 1 ? (", " + std::to_string(specs.size()) + " streams").c_str() : "");
-    if (job->joint_poses && !job->joint_poses->not_run.empty()) {
-      std::fprintf(stderr, "fresco run: poses not adjusted together: %s\n",
-                   job->joint_poses->not_run.c_str());
-    } else if (job->joint_poses) {
-      const PoseAdjustResult& a = *job->joint_poses;
-      std::fprintf(stderr,
-                   "fresco run: poses adjusted together (%d tracks, %.1f s): %s, RMS %.3f -> "
-                   "%.3f px, median correction %.3f deg, %.1f mm\n",
-                   a.inliers, a.seconds,
-                   a.applied ? "applied"
-                             : "not applied (the given poses "
-                               "explain the tracks nearly as well)",
-                   a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
-                   1000 * a.median_translation_m);
-    }
-    if (job->mover_masks && !job->mover_masks->not_run.empty())
-      std::fprintf(stderr, "fresco run: background decided frame by frame: %s\n",
-                   job->mover_masks->not_run.c_str());
-    else if (job->mover_masks)
-      std::fprintf(stderr, "fresco run: background %s (%.1f s)\n",
-                   session->auto_decisions().background.Describe().c_str(),
-                   job->mover_masks->seconds);
-  }
+    if (Status s = recording.Start(record_dir, project.ForStream(0), true); !s.ok())
+      return Fail(s);
+  if (!quiet) PrintJobSummary(*job, specs.size());
 
   InterruptCatcher interrupt;  // from here on, Ctrl-C stops at the next frame (interrupt.h)
-  if (Status s = MakeDirectories(out_dir); !s.ok()) return InputError(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
   // Debug images go to a staging folder that replaces DIR/stages/ only at the end.
   StagedFolder stages;
   if (project.pipeline.debug_images)
-    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return InputError(s);
+    if (Status s = stages.Open(out_dir + "/stages"); !s.ok()) return Fail(s);
   const std::string& stages_dir = stages.path();
 
-  int total = job->source->FrameCount();  // frames of every stream; -1: unknown
-  if (project.pipeline.max_frames > 0 && (total < 0 || total > project.pipeline.max_frames))
-    total = project.pipeline.max_frames;
-  Progress progress("painting", total, quiet);
+  Progress progress("painting", FramesToRead(*job, project), quiet);
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   PaintRun run(session, job->source.get(), run_options);
   PaintRunHooks hooks;
   hooks.stop = [] { return Interrupted(); };
   hooks.before_paint = [&](const RunFrame& f) {
-    return record_dir.empty() ? Status::Ok() : recorder.Add(f.posed.frame, f.posed.cam_from_world);
+    return recording.Add(f.posed);
   };
   hooks.after_frame = [&](const RunFrame&, const FrameReport* report) {
     if (report && project.pipeline.debug_images)
@@ -354,7 +384,7 @@ int RunVerbRun(const CommandArgs& argv) {
     progress.Update(run.stats().frames, detail);
     return Status::Ok();
   };
-  if (Status s = RunToEnd(&run, hooks); !s.ok()) return InputError(s);
+  if (Status s = RunToEnd(&run, hooks); !s.ok()) return Fail(s);
   const PaintRunStats& stats = run.stats();
   const int frames = stats.frames;
   if (Interrupted()) {
@@ -365,29 +395,22 @@ int RunVerbRun(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), frames, frames == 1 ? "" : "s", out_dir.c_str());
     return InterruptExitCode();
   }
-  if (!record_dir.empty()) {
-    const LiveInputs& live_inputs = job->live_inputs[0];
-    const std::vector<TimedPose> tracker =
-        live_inputs.feed ? live_inputs.feed->AllPoses()
-                         : std::vector<TimedPose>(live_inputs.track->samples().begin(),
-                                                  live_inputs.track->samples().end());
-    if (Status s = recorder.Finish(tracker); !s.ok()) return InputError(s);
+  if (recording.active()) {
+    std::string recorded;
+    if (Status s = recording.Finish(job->live_inputs[0], &recorded); !s.ok()) return Fail(s);
   }
-  const double seconds = stats.seconds;
   progress.Finish();
 
-  nlohmann::json metrics = RunMetrics(project, *job, stats, recorder.frames());
+  nlohmann::json metrics = RunMetrics(project, *job, stats, run.status(), recording);
   // Where the memory goes: the process's peak after set-up (mesh, charts, buffers) and after
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
   if (Status s = WriteRunOutputs(out_dir, *job, metrics); !s.ok()) {
-    std::cerr << "error: " << s.message() << "\n";
-    return kExitFailure;
+    return Fail(s);
   }
   if (project.pipeline.debug_images) {
     if (Status s = stages.Commit(); !s.ok()) {
-      std::cerr << "error: " << s.message() << "\n";
-      return kExitFailure;
+      return Fail(s);
     }
   }
   if (Interrupted()) {  // while the outputs were written: they were finished first
@@ -395,13 +418,7 @@ int RunVerbRun(const CommandArgs& argv) {
                  InterruptSignalName().c_str(), out_dir.c_str());
     return InterruptExitCode();
   }
-  if (!quiet) {
-    std::fprintf(stderr,
-                 "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; coverage %.1f%% of %lld "
-                 "texels in %zu buffers -> %s\n",
-                 frames, stats.frames_painted, seconds, stats.Fps(), 100.0 * session->Coverage(),
-                 session->NumSurfaceTexels(), session->buffers().size(), out_dir.c_str());
-  }
+  if (!quiet) PrintRunSummary(stats, *session, out_dir);
   return kExitOk;
 }
 

@@ -140,10 +140,7 @@ std::string ParseOverrides(const Args& args, std::vector<SynthSpecOverride>* ove
 int ExportSceneOnly(const SynthJob& job, const std::string& out) {
   const std::string gltf = (fs::path(out) / "scene.gltf").string();
   const Status status = ExportSynthScene(job.scene, job.texture_files, gltf);
-  if (!status.ok()) {
-    std::cerr << "fresco synth: " << status.message() << "\n";
-    return kExitFailure;
-  }
+  if (!status.ok()) return Fail(status);
   std::cout << "wrote " << gltf << " (" << job.scene.mesh.NumTriangles() << " triangles, "
             << job.scene.textures.size() << " textures) from " << job.scene_source << "\n";
   return kExitOk;
@@ -193,10 +190,7 @@ int WriteCapture(const SynthJob& job, const std::string& out, bool if_changed) {
                  InterruptSignalName().c_str(), frames_written, total_frames, out.c_str());
     return InterruptExitCode();
   }
-  if (!status.ok()) {
-    std::cerr << "fresco synth: " << status.message() << "\n";
-    return kExitFailure;
-  }
+  if (!status.ok()) return Fail(status);
   if (result.skipped) {
     std::cout << "synth: " << out << " is current (" << result.frames << " frames, fingerprint "
               << result.fingerprint << "): nothing to do\n";
@@ -234,7 +228,7 @@ int RunVerbSynth(const CommandArgs& argv) {
     input.overrides = overrides;
     status = BuildSynthJob(input, &job);
   }
-  if (!status.ok()) return InputError(status);
+  if (!status.ok()) return Fail(status);
   const std::string out = args.Has("--out") ? Absolute(args.Get("--out")) : job.out_dir;
   if (out.empty()) return UsageError(kVerb, spec, "missing --out (or \"out\" in the spec)");
   if (args.Switch("--scene-only")) return ExportSceneOnly(job, out);

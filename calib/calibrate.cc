@@ -250,13 +250,15 @@ Status DetectViews(const CalibrateRequest& request, CalibrationRun* run) {
 
 Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   if (static_cast<int>(run->views.size()) < kMinViews)
-    return Status::Error("a calibration needs at least " + std::to_string(kMinViews) +
-                         " images with a board (got " + std::to_string(run->views.size()) + ")");
+    return Status::Failed("a calibration needs at least " + std::to_string(kMinViews) +
+                          " images with a board (got " + std::to_string(run->views.size()) + ")");
   if (static_cast<int>(run->views.size()) < kFewViews)
     run->warnings.push_back("only " + std::to_string(run->views.size()) +
                             " images with a board: use 20 or more for a trustworthy model");
+  // The images were read: a seed or a fit that fails is failed work, not bad input.
   FRESCO_RETURN_IF_ERROR(
-      SeedCalibration(run->views, request.board, run->width, run->height, &run->seed));
+      SeedCalibration(run->views, request.board, run->width, run->height, &run->seed)
+          .Reclassified(StatusKind::kFailed));
   CheckCoverage(run);
   SelectOptions select;
   if (request.model != "auto") select.candidates = {request.model};
@@ -267,7 +269,8 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
       request.progress("solve", done, total, what);
     };
   FRESCO_RETURN_IF_ERROR(FitLensModels(run->views, request.board, run->width, run->height,
-                                       run->seed, select, &run->choice));
+                                       run->seed, select, &run->choice)
+                             .Reclassified(StatusKind::kFailed));
   for (const std::string& w : run->choice.warnings) run->warnings.push_back(w);
   CheckOneCamera(request, run);
   CheckRequestedModel(request, run);

@@ -87,7 +87,8 @@ Status DetectViews(const CalibrateRequest& request, CalibrationRun* run);
 bool DetectImage(const std::string& path, const CalibrateRequest& request, CalibrationRun* run,
                  BoardDetection* detection = nullptr);
 
-// Everything after detection.
+// Everything after detection. Its errors are failed work (StatusKind::kFailed): the images
+// were read and detected before.
 Status SolveViews(const CalibrateRequest& request, CalibrationRun* run);
 
 constexpr int kMinViews = 3;

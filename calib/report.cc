@@ -208,8 +208,8 @@ Status WriteCalibration(const std::string& cameramodel_path, const CalibrateRequ
     mrcal_cameramodel_t* check =
         mrcal_read_cameramodel_string(text.c_str(), static_cast<int>(text.size()));
     if (!check)
-      return Status::Error(cameramodel_path +
-                           ": internal error: mrcal cannot read the model to write");
+      return Status::Internal(cameramodel_path +
+                              ": internal error: mrcal cannot read the model to write");
     mrcal_free_cameramodel(&check);
     return with_inputs.ok() ? Status::Ok() : WriteFileAtomic(temp, text);
   }));

@@ -33,15 +33,15 @@ std::string ParentFolder(const std::string& path) {
 // format by extension, e.g. cv::imwrite, still work).
 Status MakeTempFile(const std::string& path, std::string* temp_path) {
   const fs::path target(path);
-  if (target.filename().empty()) return Status::Error(path + ": not a file name");
+  if (target.filename().empty()) return Status::OutputError(path + ": not a file name");
   const std::string extension = target.extension().string();
   const std::string stem = target.filename().string();
   std::string pattern = (target.parent_path() / ("." + stem + ".tmp-XXXXXX" + extension)).string();
   const int fd = mkstemps(pattern.data(), static_cast<int>(extension.size()));
   if (fd < 0) {
     const int error = errno;
-    return Status::Error(path + ": cannot create a temp file in " + ParentFolder(path) + ": " +
-                         ErrnoText(error));
+    return Status::OutputError(path + ": cannot create a temp file in " + ParentFolder(path) +
+                               ": " + ErrnoText(error));
   }
   // mkstemps makes the file 0600; give it the mode the target has, or 0644 for a new file.
   struct stat target_stat;
@@ -57,13 +57,14 @@ Status SyncFile(const std::string& file, const std::string& path_for_messages) {
   const int fd = open(file.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     const int error = errno;
-    return Status::Error(path_for_messages +
-                         ": cannot reopen the written temp file: " + ErrnoText(error));
+    return Status::OutputError(path_for_messages +
+                               ": cannot reopen the written temp file: " + ErrnoText(error));
   }
   const int rc = fsync(fd);
   const int error = errno;
   close(fd);
-  if (rc != 0) return Status::Error(path_for_messages + ": fsync failed: " + ErrnoText(error));
+  if (rc != 0)
+    return Status::OutputError(path_for_messages + ": fsync failed: " + ErrnoText(error));
   return Status::Ok();
 }
 
@@ -80,7 +81,8 @@ Status WriteAll(const std::string& file, const std::string& contents,
   const int fd = open(file.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
   if (fd < 0) {
     const int error = errno;
-    return Status::Error(path_for_messages + ": cannot open for writing: " + ErrnoText(error));
+    return Status::OutputError(path_for_messages +
+                               ": cannot open for writing: " + ErrnoText(error));
   }
   size_t written = 0;
   while (written < contents.size()) {
@@ -89,13 +91,13 @@ Status WriteAll(const std::string& file, const std::string& contents,
       if (errno == EINTR) continue;
       const int error = errno;
       close(fd);
-      return Status::Error(path_for_messages + ": write failed: " + ErrnoText(error));
+      return Status::OutputError(path_for_messages + ": write failed: " + ErrnoText(error));
     }
     written += static_cast<size_t>(n);
   }
   if (close(fd) != 0) {
     const int error = errno;
-    return Status::Error(path_for_messages + ": write failed: " + ErrnoText(error));
+    return Status::OutputError(path_for_messages + ": write failed: " + ErrnoText(error));
   }
   return Status::Ok();
 }
@@ -105,7 +107,7 @@ Status WriteAll(const std::string& file, const std::string& contents,
 Status WriteFileAtomicWith(const std::string& path,
                            const std::function<Status(const std::string& temp_path)>& write) {
   std::error_code ec;
-  if (fs::is_directory(path, ec)) return Status::Error(path + ": is a folder, not a file");
+  if (fs::is_directory(path, ec)) return Status::OutputError(path + ": is a folder, not a file");
   std::string temp_path;
   FRESCO_RETURN_IF_ERROR(MakeTempFile(path, &temp_path));
   auto fail = [&](const Status& status) {
@@ -114,19 +116,20 @@ Status WriteFileAtomicWith(const std::string& path,
   };
   Status written;
   try {
-    written = write(temp_path);
+    written = write(temp_path).Reclassified(StatusKind::kOutput);  // failing here: output
   } catch (const std::exception& e) {
-    written = Status::Error(path + ": writing failed: " + e.what());
+    written = Status::OutputError(path + ": writing failed: " + e.what());
   }
   if (!written.ok()) return fail(written);
   if (!fs::is_regular_file(temp_path, ec)) {
-    return fail(Status::Error(path + ": the writer produced no file"));
+    return fail(Status::OutputError(path + ": the writer produced no file"));
   }
   Status synced = SyncFile(temp_path, path);
   if (!synced.ok()) return fail(synced);
   if (std::rename(temp_path.c_str(), path.c_str()) != 0) {
     const int error = errno;
-    return fail(Status::Error(path + ": cannot rename the temp file over it: " + ErrnoText(error)));
+    return fail(
+        Status::OutputError(path + ": cannot rename the temp file over it: " + ErrnoText(error)));
   }
   SyncFolder(ParentFolder(path));
   return Status::Ok();
@@ -173,12 +176,12 @@ Status StagedFolder::Open(const std::string& target) {
   const fs::path path = fs::path(target).lexically_normal();
   const std::string name = path.filename().string();
   if (name.empty() || name == "." || name == "..")
-    return Status::Error(target + ": not a folder name");
+    return Status::OutputError(target + ": not a folder name");
   const fs::path parent = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));
   std::error_code ec;
   if (fs::exists(path, ec) && !fs::is_directory(path, ec))
-    return Status::Error(target + ": exists and is not a folder");
+    return Status::OutputError(target + ": exists and is not a folder");
   // Leftovers of a process killed before it could clean up (SIGKILL, power loss).
   const std::string prefix = "." + name + ".partial-";
   for (const auto& entry : fs::directory_iterator(parent, ec)) {
@@ -189,8 +192,8 @@ Status StagedFolder::Open(const std::string& target) {
   std::string pattern = (parent / (prefix + "XXXXXX")).string();
   if (!mkdtemp(pattern.data())) {
     const int error = errno;
-    return Status::Error(target + ": cannot create a staging folder in " + parent.string() + ": " +
-                         ErrnoText(error));
+    return Status::OutputError(target + ": cannot create a staging folder in " + parent.string() +
+                               ": " + ErrnoText(error));
   }
   chmod(pattern.c_str(), 0755);  // mkdtemp makes it 0700
   target_ = path.string();
@@ -200,13 +203,14 @@ Status StagedFolder::Open(const std::string& target) {
 }
 
 Status StagedFolder::Commit() {
-  if (staging_.empty() || committed_) return Status::Error(target_ + ": nothing staged to commit");
+  if (staging_.empty() || committed_)
+    return Status::Internal(target_ + ": nothing staged to commit");
   std::error_code ec;
   if (!fs::exists(target_, ec)) {
     if (std::rename(staging_.c_str(), target_.c_str()) != 0) {
       const int error = errno;
-      return Status::Error(target_ +
-                           ": cannot rename the staging folder to it: " + ErrnoText(error));
+      return Status::OutputError(target_ +
+                                 ": cannot rename the staging folder to it: " + ErrnoText(error));
     }
   } else if (renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, target_.c_str(), RENAME_EXCHANGE) !=
              0) {
@@ -215,8 +219,8 @@ Status StagedFolder::Commit() {
     if (std::rename(target_.c_str(), aside.c_str()) != 0 ||
         std::rename(staging_.c_str(), target_.c_str()) != 0) {
       const int error = errno;
-      return Status::Error(target_ +
-                           ": cannot replace it with the staging folder: " + ErrnoText(error));
+      return Status::OutputError(
+          target_ + ": cannot replace it with the staging folder: " + ErrnoText(error));
     }
     fs::remove_all(aside, ec);
   }
@@ -236,7 +240,7 @@ Status MoveFilesInto(const std::string& from_dir, const std::string& to_dir,
     if (entry.is_regular_file(ec) && std::find(last.begin(), last.end(), name) == last.end())
       names.push_back(name);
   }
-  if (ec) return Status::Error(from_dir + ": cannot list it: " + ec.message());
+  if (ec) return Status::OutputError(from_dir + ": cannot list it: " + ec.message());
   for (const std::string& name : last)
     if (fs::exists(fs::path(from_dir) / name, ec)) names.push_back(name);
   for (const std::string& name : names) {
@@ -244,7 +248,8 @@ Status MoveFilesInto(const std::string& from_dir, const std::string& to_dir,
     const std::string to = (fs::path(to_dir) / name).string();
     if (std::rename(from.c_str(), to.c_str()) != 0) {
       const int error = errno;
-      return Status::Error(to + ": cannot move the written file into place: " + ErrnoText(error));
+      return Status::OutputError(to +
+                                 ": cannot move the written file into place: " + ErrnoText(error));
     }
   }
   SyncFolder(to_dir);

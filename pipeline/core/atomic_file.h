@@ -1,5 +1,7 @@
 // Writes files so that a reader never sees a half-written one: write to a temp file beside
 // the target, flush, then rename over it. On failure the previous file (if any) is intact.
+// Failures to write (and to make folders) are output errors (StatusKind::kOutput); failures
+// to read are bad input.
 #pragma once
 
 #include <functional>
@@ -11,11 +13,13 @@
 namespace fresco {
 
 Status WriteFileAtomic(const std::string& path, const std::string& contents);
-// Calls `write(temp_path)` to produce the file, then renames temp_path to `path`.
+// Calls `write(temp_path)` to produce the file, then renames temp_path to `path`. A
+// bad-input Status from `write` is returned as an output error (internal ones stay so).
 Status WriteFileAtomicWith(const std::string& path,
                            const std::function<Status(const std::string& temp_path)>& write);
 Status ReadFileToString(const std::string& path, std::string* contents);
-// Creates the folder and its parents; error names the folder.
+// Creates the folder and its parents; an error names the folder and is bad input (the
+// folder asked for cannot be made: exit 2, as a bad --out).
 Status MakeDirectories(const std::string& path);
 
 // A folder filled under a hidden name beside `target` (".NAME.partial-XXXXXX") and swapped

@@ -327,9 +327,10 @@ Status ReadCameraModel(const std::string& path, CameraModelFile* model) {
 }
 
 Status WriteCameraModel(const std::string& path, const CameraModelFile& model) {
-  FRESCO_RETURN_IF_ERROR(model.camera.Validate(path + " (camera to write)"));
+  FRESCO_RETURN_IF_ERROR(
+      model.camera.Validate(path + " (camera to write)").Reclassified(StatusKind::kInternal));
   if (!model.cam_from_ref.AllFinite())
-    return Status::Error(path + " (camera to write): extrinsics: not finite");
+    return Status::Internal(path + " (camera to write): extrinsics: not finite");
   Camera camera = model.camera;
   camera.model = MrcalEquivalent(camera.model);
   double rt[6];
@@ -349,8 +350,8 @@ Status WriteCameraModel(const std::string& path, const CameraModelFile& model) {
   CameraModelFile check;
   const Status readable = ParseCameraModel(text, path, &check);
   if (!readable.ok())
-    return Status::Error(path + ": internal error: the text to write does not read back (" +
-                         readable.message() + ")");
+    return Status::Internal(path + ": internal error: the text to write does not read back (" +
+                            readable.message() + ")");
   return WriteFileAtomic(path, text);
 }
 

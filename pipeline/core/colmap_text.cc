@@ -301,8 +301,10 @@ Status WriteColmapCameras(const std::string& path, const std::map<int, Camera>& 
   for (const auto& [camera_id, source] : cameras) {
     std::string model_name;
     std::vector<double> params;
-    FRESCO_RETURN_IF_ERROR(ColmapCameraParams(
-        source, path + ": camera " + std::to_string(camera_id), &model_name, &params));
+    FRESCO_RETURN_IF_ERROR(  // a camera COLMAP cannot hold: this file cannot be written
+        ColmapCameraParams(source, path + ": camera " + std::to_string(camera_id), &model_name,
+                           &params)
+            .Reclassified(StatusKind::kOutput));
     out += std::to_string(camera_id) + " " + model_name + " " + std::to_string(source.width) +
            " " + std::to_string(source.height);
     for (double p : params) text::AppendField(&out, FormatDouble(p));
@@ -323,12 +325,12 @@ Status WriteColmapImages(const std::string& path, const std::vector<PosedImage>&
       FormatDouble(images.empty() ? 0.0 : double(observations) / images.size()) + "\n";
   for (const PosedImage& image : images) {
     if (image.name.empty() || image.name.find('\n') != std::string::npos) {
-      return Status::Error(path + ": image " + std::to_string(image.image_id) +
-                           ": NAME must be one non-empty line");
+      return Status::OutputError(path + ": image " + std::to_string(image.image_id) +
+                                 ": NAME must be one non-empty line");
     }
     if (image.points2d.size() != image.point3d_ids.size()) {
-      return Status::Error(path + ": image '" + image.name +
-                           "': points2d and point3d_ids differ in length");
+      return Status::Internal(path + ": image '" + image.name +
+                              "': points2d and point3d_ids differ in length");
     }
     const Eigen::Quaterniond& q = image.cam_from_world.rotation;
     const Eigen::Vector3d& t = image.cam_from_world.translation;

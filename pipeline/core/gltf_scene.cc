@@ -1351,7 +1351,7 @@ Status WriteTextures(const Scene& scene, const std::string& path, const std::str
     cv::cvtColor(texture.rgba, bgra, cv::COLOR_RGBA2BGRA);
     std::vector<unsigned char> png;
     if (!cv::imencode(".png", bgra, png)) {
-      return Status::Error(path + ": texture " + std::to_string(t) + ": PNG encoding failed");
+      return Status::Internal(path + ": texture " + std::to_string(t) + ": PNG encoding failed");
     }
     bgra.release();
     FRESCO_RETURN_IF_ERROR(
@@ -1360,7 +1360,7 @@ Status WriteTextures(const Scene& scene, const std::string& path, const std::str
           file.write(reinterpret_cast<const char*>(png.data()),
                      static_cast<std::streamsize>(png.size()));
           file.close();
-          return file.good() ? Status::Ok() : Status::Error(temp + ": cannot write");
+          return file.good() ? Status::Ok() : Status::OutputError(temp + ": cannot write");
         }));
     Json image = {{"uri", png_name}};
     if (!texture.name.empty()) image["name"] = texture.name;
@@ -1391,10 +1391,11 @@ void AddViewLayers(const Scene& scene, Json* root) {
 }  // namespace
 
 Status SaveGltfScene(const Scene& scene, const std::string& path) {
-  // Validate the scene before writing anything.
+  // Validate the scene before writing anything. A scene that cannot be saved is a broken
+  // invariant: the loaders and the painter make only saveable ones.
   const std::vector<Material> materials = MaterialsToSave(scene);
   if (const std::string why = SavingProblem(scene, materials); !why.empty()) {
-    return Status::Error(path + ": " + why);
+    return Status::Internal(path + ": " + why);
   }
 
   const fs::path gltf_path(path);

@@ -18,14 +18,14 @@ namespace {
 
 // The image encoded in the format `path`'s extension names (PNG without one).
 Status EncodeImage(const std::string& path, const cv::Mat& image, std::string* encoded) {
-  if (image.empty()) return Status::Error(path + ": empty image");
+  if (image.empty()) return Status::Internal(path + ": empty image");
   const std::string ext = std::filesystem::path(path).extension().string();
   std::vector<uchar> bytes;
   try {
     if (!cv::imencode(ext.empty() ? ".png" : ext, image, bytes))
-      return Status::Error(path + ": could not encode image");
+      return Status::OutputError(path + ": could not encode image");
   } catch (const cv::Exception& e) {
-    return Status::Error(path + ": could not encode image (" + e.msg + ")");
+    return Status::OutputError(path + ": could not encode image (" + e.msg + ")");
   }
   encoded->assign(bytes.begin(), bytes.end());
   return Status::Ok();
@@ -43,10 +43,10 @@ Status WriteImage(const std::string& path, const cv::Mat& image) {
   std::string encoded;
   FRESCO_RETURN_IF_ERROR(EncodeImage(path, image, &encoded));
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) return Status::Error(path + ": cannot open for writing: " + std::strerror(errno));
+  if (!out) return Status::OutputError(path + ": cannot open for writing: " + std::strerror(errno));
   out.write(encoded.data(), static_cast<std::streamsize>(encoded.size()));
   out.close();
-  if (!out) return Status::Error(path + ": write failed: " + std::strerror(errno));
+  if (!out) return Status::OutputError(path + ": write failed: " + std::strerror(errno));
   return Status::Ok();
 }
 

@@ -40,20 +40,20 @@ bool EncodeRows(png_structp png_ptr, png_infop info_ptr, const cv::Mat& image,
 
 Status EncodeFastDecodingPng(const cv::Mat& image, std::vector<uint8_t>* png) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
-    return Status::Error("PNG encoding needs a non-empty 8-bit grey or BGR image, got type " +
-                         std::to_string(image.type()) + " of " + std::to_string(image.cols) + "x" +
-                         std::to_string(image.rows));
+    return Status::Internal("PNG encoding needs a non-empty 8-bit grey or BGR image, got type " +
+                            std::to_string(image.type()) + " of " + std::to_string(image.cols) +
+                            "x" + std::to_string(image.rows));
   png_structp png_ptr = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info_ptr = png_ptr ? png_create_info_struct(png_ptr) : nullptr;
   if (!info_ptr) {
     png_destroy_write_struct(&png_ptr, nullptr);
-    return Status::Error("PNG encoding: libpng could not start");
+    return Status::Internal("PNG encoding: libpng could not start");
   }
   png->clear();
   png->reserve(image.total() * image.elemSize() / 4);
   const bool ok = EncodeRows(png_ptr, info_ptr, image, png);
   png_destroy_write_struct(&png_ptr, &info_ptr);
-  if (!ok) return Status::Error("PNG encoding failed in libpng");
+  if (!ok) return Status::Internal("PNG encoding failed in libpng");
   return Status::Ok();
 }
 

@@ -59,7 +59,7 @@ struct TruthFiles {
   bool operator==(const TruthFiles&) const = default;
 };
 
-// Live sources (issue 12; pipeline/live/): a camera or stream as `video`, a pose feed
+// Live sources (pipeline/live/): a camera or stream as `video`, a pose feed
 // (tcp://, udp://, fifo://) as `poses`, matched by time. Ignored for files.
 struct LiveOptions {
   // Frames waiting between the source and the painter; when painting is slower the oldest

@@ -139,6 +139,8 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
 // in the file's `FRESCO_view_layers` extension (extensionsUsed, not required: other viewers
 // show the base-colour textures): {"layers": [{"centre": [x, y, z] (world), "textures": [per
 // material a texture index or -1]}]}; a malformed one is dropped with a warning on loading.
+// Errors: a scene that cannot be saved (not finite, indices out of range) is internal, a
+// failed write is output.
 Status SaveGltfScene(const Scene& scene, const std::string& path);
 
 }  // namespace fresco

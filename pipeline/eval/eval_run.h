@@ -1,7 +1,9 @@
 // Runs one setting over an evaluation suite (eval_suite.h): each capture is generated into
 // the cache (or found current there), painted with the project's settings plus the given
-// overrides while every `holdout`-th frame is held out, and scored on the held-out frames
-// (eval_score.h): rephotography at the given poses, truth at the true poses, mover leak.
+// overrides through the painting job (pipeline/run/: the whole-capture pre-pass, the paint
+// run) while every `holdout`-th frame is held out, and the held-out frames are scored by the
+// one held-out scorer (pipeline/rephoto/holdout_scorer.h): rephotography at the given poses,
+// truth at the true poses (truth_view.h), mover leak.
 #pragma once
 
 #include <functional>
@@ -22,7 +24,9 @@ struct EvalOptions {
   std::string cache_dir;               // captures are written to CACHE/NAME/
   int holdout = 10;                    // every N-th frame is held out of painting (>= 2)
   double leak_threshold = 40.0;        // levels; see TruthViewInputs::leak_threshold
-  bool true_poses = false;             // paint at the true poses instead of the given ones
+  // Paint at the true poses instead of the given ones (the held-out frames are rephotographed
+  // at theirs too): PaintJobOptions::paint_at_truth_poses.
+  bool true_poses = false;
   // Also paint each capture as references for what refinement recovers: at the given poses
   // with refinement off, and (where the given poses are noisy) at the true poses.
   bool recovery = false;

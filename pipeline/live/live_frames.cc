@@ -276,30 +276,4 @@ LiveFramesStats LiveFrames::stats() const {
   return s;
 }
 
-OffsetEstimator MakeTimeOffsetEstimator(const Scene* scene, const Camera& camera,
-                                        const PipelineOptions& pipeline,
-                                        const GroupingOptions& grouping, double texel_size_m,
-                                        const TimeOffsetOptions& options) {
-  return [=](const std::vector<Frame>& window, const PoseAtTime& pose_at, double centre_s,
-             double search_s) {
-    PaintSessionInputs inputs;
-    inputs.scene = scene;
-    inputs.pipeline = EstimationPipeline(pipeline);
-    inputs.pipeline.texel_size_m = texel_size_m;
-    inputs.grouping = grouping;
-    inputs.typical_camera = &camera;
-    std::unique_ptr<PaintSession> session;
-    TimeOffsetOptions around = options;
-    around.centre_s = centre_s;
-    around.search_s = search_s;
-    TimeOffsetEstimate failed;
-    failed.offset_s = centre_s;
-    if (Status s = PaintSession::Create(inputs, &session); !s.ok()) {
-      failed.note = s.message();
-      return failed;
-    }
-    return EstimateTimeOffset(window, camera, pose_at, around, session.get());
-  };
-}
-
 }  // namespace fresco

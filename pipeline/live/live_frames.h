@@ -48,7 +48,7 @@ struct PosedFrame {
 // The pose at tracker time `t`, waiting up to `timeout_s` for the tracker to get there.
 using WaitPoseAtTime = std::function<bool(double t, double timeout_s, Rigid3d* cam_from_world)>;
 // Estimates the offset on the window's frames, candidates within centre_s +- search_s (see
-// MakeTimeOffsetEstimator).
+// pipeline/run/offset_estimator.h).
 using OffsetEstimator = std::function<TimeOffsetEstimate(
     const std::vector<Frame>& window, const PoseAtTime& pose_at, double centre_s, double search_s)>;
 // Opens the video again after a stall (live streams).
@@ -141,12 +141,5 @@ class LiveFrames {
   OffsetTrackPoint tracking_point_;  // the running one's window and centre
   std::future<TimeOffsetEstimate> tracking_;  // last: finishes before the members it uses
 };
-
-// The estimator for LiveFrames: paints the window into its own session (EstimationPipeline)
-// over `scene` seen through `camera`, candidates around `centre_s`.
-OffsetEstimator MakeTimeOffsetEstimator(const Scene* scene, const Camera& camera,
-                                        const PipelineOptions& pipeline,
-                                        const GroupingOptions& grouping, double texel_size_m,
-                                        const TimeOffsetOptions& options);
 
 }  // namespace fresco

@@ -19,7 +19,7 @@ bool IsLiveProject(const Project& project) {
   return false;
 }
 
-Status OpenLiveInputs(const Project& project, const Capture& capture, const PaintSession& session,
+Status OpenLiveInputs(const Project& project, const Capture& capture, OffsetEstimator estimator,
                       bool keep_tracker_poses, LiveInputs* inputs) {
   if (capture.cameras.size() != 1) {
     return Status::Error(project.camera + ": a live capture needs exactly one camera, got " +
@@ -61,13 +61,7 @@ Status OpenLiveInputs(const Project& project, const Capture& capture, const Pain
   VideoOpener reopen = [video_path, video_options](std::unique_ptr<VideoSource>* again) {
     return OpenVideoSource(video_path, video_options, again);
   };
-  OffsetEstimator estimator;
-  if (project.live.estimate_offset || project.live.track_offset) {
-    TimeOffsetOptions offset_options;  // centre and range: given per estimation
-    estimator =
-        MakeTimeOffsetEstimator(&capture.scene, *inputs->camera, project.pipeline, project.grouping,
-                                session.default_texel_size_m(), offset_options);
-  }
+  if (!project.live.estimate_offset && !project.live.track_offset) estimator = nullptr;
   inputs->frames =
       std::make_unique<LiveFrames>(std::move(video), std::move(reopen), std::move(pose_at),
                                    project.live, project.time_offset_s, std::move(estimator));

@@ -12,7 +12,6 @@
 #include "pipeline/live/live_frames.h"
 #include "pipeline/live/pose_feed.h"
 #include "pipeline/live/pose_track.h"
-#include "pipeline/paint/paint_session.h"
 
 namespace fresco {
 
@@ -27,9 +26,10 @@ struct LiveInputs {
   const Camera* camera = nullptr;  // the project's only camera
 };
 
-// `capture` loaded with open_video false; `session` gives the texel size for the offset
-// estimation (which paints into its own session).
-Status OpenLiveInputs(const Project& project, const Capture& capture, const PaintSession& session,
+// `capture` loaded with open_video false; `estimator` scores the time offset when
+// live.estimate_offset or live.track_offset is on (pipeline/run/offset_estimator.h paints
+// for it; empty: the offset is not estimated).
+Status OpenLiveInputs(const Project& project, const Capture& capture, OffsetEstimator estimator,
                       bool keep_tracker_poses, LiveInputs* inputs);
 
 }  // namespace fresco

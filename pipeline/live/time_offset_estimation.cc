@@ -28,39 +28,8 @@ bool Better(const TimeOffsetCandidate& a, const TimeOffsetCandidate& b) {
 
 }  // namespace
 
-PipelineOptions EstimationPipeline(const PipelineOptions& pipeline) {
-  PipelineOptions p = pipeline;
-  p.background.mode = BackgroundMode::kOff;
-  p.refine.mode = RefineMode::kOff;
-  p.update = UpdatePolicy::kLatest;
-  p.update_every = 1;
-  p.debug_images = false;
-  return p;
-}
-
-TimeOffsetCandidate ScoreTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
-                                    const PoseAtTime& pose_at, double offset_s,
-                                    PaintSession* session) {
-  TimeOffsetCandidate c;
-  c.offset_s = offset_s;
-  session->ResetPainting();
-  double sum = 0;
-  FrameReport report;
-  for (const Frame& frame : frames) {
-    Rigid3d cam_from_world;
-    if (!pose_at(frame.timestamp_s + offset_s, &cam_from_world)) continue;
-    session->PaintFrame(frame, camera, cam_from_world, &report);
-    if (!report.painted || !std::isfinite(report.paint.difference_to_buffer)) continue;
-    sum += report.paint.difference_to_buffer;
-    ++c.frames_scored;
-  }
-  c.score = c.frames_scored > 0 ? sum / c.frames_scored : kNaN;
-  return c;
-}
-
-TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
-                                      const PoseAtTime& pose_at, const TimeOffsetOptions& options,
-                                      PaintSession* session) {
+TimeOffsetEstimate SearchTimeOffset(const std::vector<Frame>& frames,
+                                    const TimeOffsetOptions& options, const ScoreOffset& score_offset) {
   const auto start = std::chrono::steady_clock::now();
   TimeOffsetEstimate result;
   result.offset_s = options.centre_s;
@@ -68,7 +37,7 @@ TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Ca
   const double period = MedianInterval(frames);
   const double step = options.step_s > 0 ? options.step_s : period;
   auto score = [&](double offset) {
-    TimeOffsetCandidate c = ScoreTimeOffset(frames, camera, pose_at, offset, session);
+    TimeOffsetCandidate c = score_offset(offset);
     if (c.frames_scored < options.min_frames) c.score = kNaN;
     result.candidates.push_back(c);
     return c;

@@ -1,13 +1,8 @@
-// Estimates the time offset between a tracker's clock and a camera's from the data: the
-// offset with which the frames, warped into the base buffers with the poses interpolated at
-// `t_video + offset`, agree best with the buffers they paint.
+// The search for the time offset between a tracker's clock and a camera's: the offset with
+// which the frames, posed at `t_video + offset`, agree best with one another. How a
+// candidate is scored (painting the window: pipeline/run/offset_estimator.h) is given to the
+// search, so the live inputs stay below the painter.
 //
-// For each candidate offset the window's frames are painted from scratch, in order, into a
-// session with background learning and refinement off and `latest` updates; each frame's
-// score is the mean |grey difference| between its warp and what the earlier frames painted
-// (PaintSession's `difference_to_buffer`), and a candidate's score is the mean over frames.
-// A wrong offset moves each frame's warp by the camera's motion over the error; as the
-// motion changes from frame to frame (a hand-held camera) the warps stop agreeing.
 // Candidates: a coarse scan at one frame period over +-search_s, then a fine scan at a
 // quarter period around the best, then a parabola through the best fine score and its
 // neighbours.
@@ -20,7 +15,6 @@
 #include "pipeline/core/camera.h"
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/video_source.h"
-#include "pipeline/paint/paint_session.h"
 
 namespace fresco {
 
@@ -54,19 +48,12 @@ struct TimeOffsetEstimate {
 // cam_from_world at tracker time `t`; false when unknown.
 using PoseAtTime = std::function<bool(double t, Rigid3d* cam_from_world)>;
 
-// `frames`: the window, in capture order (timestamps on the video clock). `session` is
-// repainted for every candidate (ResetPainting); give one made for this (background off,
-// refinement off, update latest: see EstimationPipeline()).
-TimeOffsetEstimate EstimateTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
-                                      const PoseAtTime& pose_at, const TimeOffsetOptions& options,
-                                      PaintSession* session);
+// Scores one candidate offset (lower is better; NaN when it could not be scored).
+using ScoreOffset = std::function<TimeOffsetCandidate(double offset_s)>;
 
-// The pipeline settings the estimation paints with, from the project's.
-PipelineOptions EstimationPipeline(const PipelineOptions& pipeline);
-
-// Scores one candidate offset (exposed for tests).
-TimeOffsetCandidate ScoreTimeOffset(const std::vector<Frame>& frames, const Camera& camera,
-                                    const PoseAtTime& pose_at, double offset_s,
-                                    PaintSession* session);
+// The search over candidates around options.centre_s; `frames`: the window, in capture order
+// (timestamps on the video clock; their spacing sets the coarse step when step_s is 0).
+TimeOffsetEstimate SearchTimeOffset(const std::vector<Frame>& frames,
+                                    const TimeOffsetOptions& options, const ScoreOffset& score);
 
 }  // namespace fresco

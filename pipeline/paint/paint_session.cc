@@ -225,8 +225,28 @@ void PaintSession::ForEachBuffer(const std::vector<size_t>& todo, bool serial,
       static_cast<double>(small.size()));
 }
 
+namespace {
+
+// PaintFrame's precondition: the frame is 8-bit BGR of its camera's size, since its pixels
+// are read through the camera's rays. The frame policy (pipeline/run/frame_policy.h) keeps
+// other frames out with a message naming them; a caller that reaches here without it is a
+// defect: an internal error (exit 1), never a read out of bounds.
+void CheckFrameFitsCamera(const Frame& frame, const Camera& camera) {
+  if (frame.bgr.cols == camera.width && frame.bgr.rows == camera.height &&
+      frame.bgr.type() == CV_8UC3)
+    return;
+  throw std::logic_error("PaintFrame: frame '" + frame.name + "' is " +
+                         std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
+                         " with " + std::to_string(frame.bgr.channels()) +
+                         " channels, but its camera is " + std::to_string(camera.width) + "x" +
+                         std::to_string(camera.height) + " BGR (the frame policy was not applied)");
+}
+
+}  // namespace
+
 void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
                               const Rigid3d& cam_from_world, int stream, FrameReport* report) {
+  CheckFrameFitsCamera(frame, camera);
   const auto frame_start = std::chrono::steady_clock::now();
   report->frame = frame.index;
   report->name = frame.name;
@@ -389,6 +409,7 @@ Scene PaintSession::PaintedSceneByBuffer() const {
 // (Camera::Project), the depth compared, and the frame resampled with cv::remap.
 void PaintSession::PaintFrameNaive(const Frame& frame, const Camera& camera,
                                    const Rigid3d& cam_from_world, FrameReport* report) {
+  CheckFrameFitsCamera(frame, camera);
   const auto start = std::chrono::steady_clock::now();
   report->frame = frame.index;
   report->name = frame.name;

@@ -1,9 +1,8 @@
-// Refinement through the pose (issue 7: "refine against the pose"): the 2D matches that the
-// refinement stage finds between each warped buffer and what the buffer holds
-// (refine_alignment.h) all come from one frame, whose pose error is one rigid motion. So
-// instead of one homography per buffer, fitted to that buffer's matches alone (and
-// extrapolated over whatever part of it the buffer has not painted yet), one correction of
-// the camera pose is fitted to the matches of every buffer together, and each buffer's
+// Refinement through the pose: the 2D matches that the refinement stage finds between each warped
+// buffer and what the buffer holds (refine_alignment.h) all come from one frame, whose pose error
+// is one rigid motion. So instead of one homography per buffer, fitted to that buffer's matches
+// alone (and extrapolated over whatever part of it the buffer has not painted yet), one correction
+// of the camera pose is fitted to the matches of every buffer together, and each buffer's
 // correction is derived from it. Buffers the frame is the first to see get it too.
 //
 // A match says: the warped texel p (sampled from frame pixel u = project(pose * X(p))) shows

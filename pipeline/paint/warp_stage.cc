@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/paint_stages.h"
 #include "pipeline/paint/stage_clock.h"
 
 namespace fresco {
@@ -45,13 +46,10 @@ void PaintSession::WarpStage(FrameWork* work) {
     if (!BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view,
                            warp_options.near_m))
       in_frustum.push_back(b);
-  // When no stage looks at the warped samples before the paint stage (no background
-  // model, no refinement, no exposure or view selection, no debug images, not `update: mean`), the
-  // warp paints them directly: the same texels, without writing and reading back the warped images.
-  work->paint_in_warp = options_.update != UpdatePolicy::kMean &&
-                        options_.background.mode == BackgroundMode::kOff &&
-                        options_.refine.mode == RefineMode::kOff && !SelectActive(options_) &&
-                        options_.layers.count == 0 && !work->debug;
+  // When no stage looks at the warped samples before the paint stage (paint_stages.h) and no
+  // debug images are wanted, the warp paints them directly: the same texels, without writing
+  // and reading back the warped images.
+  work->paint_in_warp = !StagesReadWarpedSamples(options_) && !work->debug;
   const TexelUpdateRule rule = TexelUpdateRule::From(options_);
   if (work->paint_in_warp && view.depth && !in_frustum.empty() &&
       options_.sampling == SamplingMode::kBilinear) {

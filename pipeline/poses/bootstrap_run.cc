@@ -136,19 +136,20 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
   if (!options.control_points.empty()) {
     ControlPointFit fit;
     FRESCO_RETURN_IF_ERROR(AlignWithControlPoints(options.control_points, options.control_file,
-                                                  colmap.run.model, colmap.camera, &fit));
+                                                  colmap.run.model, colmap.camera, &fit)
+                               .Reclassified(StatusKind::kFailed));
     result->world_from_colmap = fit.world_from_colmap;
     result->aligned_with = "control_points";
     result->control_point_residual_m = fit.residual_m;
   } else {
     if (pairs.size() < 3) {
-      return Status::Error(project.poses + ": only " + std::to_string(pairs.size()) +
-                           " registered frames have a given pose: give --control-points to "
-                           "place COLMAP's reconstruction in the scene");
+      return Status::Failed(project.poses + ": only " + std::to_string(pairs.size()) +
+                            " registered frames have a given pose: give --control-points to "
+                            "place COLMAP's reconstruction in the scene");
     }
     PoseAlignment alignment;
     if (Status s = AlignColmapToPoses(pairs, align, &alignment); !s.ok()) {
-      return Status::Error(project.poses + ": " + s.message());
+      return Status::Failed(project.poses + ": " + s.message());
     }
     result->world_from_colmap = alignment.world_from_colmap;
     result->aligned_with = "given_poses";
@@ -163,7 +164,7 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
     if (Status s = AlignPointsToMesh(points, colmap.capture.scene, result->world_from_colmap, icp,
                                      &result->icp);
         !s.ok()) {
-      return Status::Error(project.scene + ": " + s.message());
+      return Status::Failed(project.scene + ": " + s.message());
     }
     result->world_from_colmap = result->icp.world_from_colmap;
     result->refined = true;
@@ -191,7 +192,8 @@ Status WriteBootstrap(const Project& project, const ProjectColmap& colmap,
                       const BootstrapResult& result, const std::string& out_dir) {
   const fs::path new_project_path = fs::absolute(fs::path(out_dir) / "project.json");
   if (fs::absolute(project.file_path).lexically_normal() == new_project_path.lexically_normal()) {
-    return Status::Error(out_dir + ": would overwrite the input project " + project.file_path);
+    return Status::OutputError(out_dir + ": would overwrite the input project " +
+                               project.file_path);
   }
   const fs::path sparse = fs::path(out_dir) / "sparse";
   Project out = project;

@@ -66,7 +66,8 @@ struct BootstrapResult {
 };
 
 // Aligns `colmap` (RunColmapOnProject's result) to the scene. Errors name the project's
-// poses or scene, or the control-point file.
+// poses or scene, or the control-point file; they are failed work (StatusKind::kFailed):
+// the inputs were read before.
 Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
                            const BootstrapOptions& options, BootstrapResult* result);
 

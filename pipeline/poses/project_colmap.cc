@@ -221,8 +221,7 @@ void LinkModelImages(ProjectColmap* result) {
 }  // namespace
 
 Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
-                          ProjectColmap* result, bool* bad_input) {
-  *bad_input = true;
+                          ProjectColmap* result) {
   FRESCO_RETURN_IF_ERROR(CheckOptions(options));
   FRESCO_RETURN_IF_ERROR(LoadProjectCapture(project, options, result));
   Capture& capture = result->capture;
@@ -250,7 +249,6 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
   if (!options.existing_model.empty()) {
     FRESCO_RETURN_IF_ERROR(ReadEarlierModel(options.existing_model, &result->run));
   } else {
-    *bad_input = false;
     ColmapRunOptions run = options.colmap;
     run.workspace = options.out_dir;
     run.image_path = image_path;
@@ -259,11 +257,10 @@ Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& op
     run.ordered = ordered;
     run.register_names = names.others;
     run.register_pairs = names.pairs;
-    FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run));
+    FRESCO_RETURN_IF_ERROR(RunColmap(run, &result->run).Reclassified(StatusKind::kFailed));
   }
   result->run.frames_offered = static_cast<int>(offered.size());
   result->run.keyframes = static_cast<int>(names.keyframes.size());
-  *bad_input = false;
   LinkModelImages(result);
   return Status::Ok();
 }

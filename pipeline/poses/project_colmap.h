@@ -66,9 +66,10 @@ std::vector<int> SelectKeyframes(const std::vector<const Rigid3d*>& poses, doubl
                                  double rotation_deg);
 
 // Loads the project's capture, writes the frames when needed and runs COLMAP. Input errors
-// (project, camera, video) come back as is; COLMAP errors are prefixed with "colmap".
+// (project, camera, video, an earlier model) are bad input; COLMAP's own errors, prefixed
+// with "colmap", are failed work (StatusKind::kFailed).
 Status RunColmapOnProject(const Project& project, const ProjectColmapOptions& options,
-                          ProjectColmap* result, bool* bad_input);
+                          ProjectColmap* result);
 
 // The frames as VerifyPoses takes them (pointing into `colmap`).
 std::vector<VerifyFrameInput> VerifyInputs(const ProjectColmap& colmap);

@@ -178,7 +178,8 @@ FramePairs CollectPairs(const std::vector<VerifyFrameInput>& frames, VerifyResul
 // The global alignment of all keyframes, how many agree under it and how they disagree.
 Status AlignGlobally(const std::vector<PosePair>& pairs, const PoseAlignmentOptions& align,
                      PoseAlignment* global, VerifyResult* out) {
-  FRESCO_RETURN_IF_ERROR(AlignColmapToPoses(pairs, align, global));
+  FRESCO_RETURN_IF_ERROR(
+      AlignColmapToPoses(pairs, align, global).Reclassified(StatusKind::kFailed));
   out->world_from_colmap = global->world_from_colmap;
   out->global_inliers = global->num_inliers;
   out->centres = global->centres;
@@ -380,8 +381,10 @@ void CountVerdicts(VerifyResult* out) {
 
 Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
                    const VerifyOptions& options, VerifyResult* result) {
-  FRESCO_RETURN_IF_ERROR(options.Check());
-  if (!(scene_size_m > 0)) return Status::Error("scene size: must be > 0");
+  // Options are checked by the callers first (bad input there): here they are a broken
+  // invariant; an alignment that fails is failed work.
+  FRESCO_RETURN_IF_ERROR(options.Check().Reclassified(StatusKind::kInternal));
+  if (!(scene_size_m > 0)) return Status::Internal("scene size: must be > 0");
   VerifyResult out;
   out.scene_size_m = scene_size_m;
   out.rotation_threshold_deg = options.rotation_threshold_deg;

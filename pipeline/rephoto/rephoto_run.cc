@@ -4,13 +4,13 @@
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <opencv2/core/utility.hpp>
 
 #include "pipeline/core/project.h"
 #include "pipeline/live/live_input.h"
-#include "pipeline/paint/rephotography.h"
-#include "pipeline/render/renderer.h"
+#include "pipeline/rephoto/holdout_scorer.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
 
@@ -59,43 +59,40 @@ Status ScoreOneOut(const Project& project, const PosedFrameId& id, const Rephoto
   run_options.max_frames = project.pipeline.max_frames;
   run_options.holdout_counter = id.counter;
   PaintRun run(job->session.get(), job->source.get(), run_options);
-  cv::Mat photo;
-  Rigid3d cam_from_world;
-  const Camera* camera = nullptr;
+  std::optional<HeldOutFrame> left_out;
   PaintRunHooks hooks;
   hooks.stop = [&] { return Stopped(options); };
   hooks.after_frame = [&](const RunFrame& f, const FrameReport*) {
-    if (f.fate == FrameFate::kHeldOut && f.counter == id.counter) {
-      photo = f.posed.frame.bgr.clone();
-      cam_from_world = f.posed.cam_from_world;
-      camera = f.camera;
-    }
+    if (f.fate == FrameFate::kHeldOut && f.counter == id.counter) left_out = HeldOutFrameOf(f);
     return Status::Ok();
   };
   FRESCO_RETURN_IF_ERROR(RunToEnd(&run, hooks));
   if (Stopped(options)) return Status::Error(project.file_path + ": interrupted");
-  if (!camera) {  // the first pass saw it: the frames changed on disk in between
+  if (!left_out) {  // the first pass saw it: the frames changed on disk in between
     return Status::Error(project.file_path + ": frame '" + id.name +
                          "' was not read again (did the video change?)");
   }
-  // With view-dependent layers (pipeline.layers) ScoreRephoto renders the model as a viewer
+  // With view-dependent layers (pipeline.layers) the scorer renders the model as a viewer
   // sees it: the layers blended by the direction to the left-out photo.
-  const Scene painted = job->session->PaintedScene();
-  const Renderer renderer(*camera, RenderOptions());
-  RephotoView view;
-  const RephotoScore score = ScoreRephoto(renderer, painted, cam_from_world, photo, &view);
+  HoldoutScorerOptions scorer_options;
+  scorer_options.keep_views = true;
+  HoldoutScorer scorer(job->session->PaintedScene(), scorer_options);
+  const HeldOutScore& score = scorer.Add(*left_out);
+  const RephotoView& view = score.view;
   result->name = id.name;
   result->counter = id.counter;
   result->stream = id.stream;
   result->frames_painted = run.stats().frames_painted;
-  result->view_layers = static_cast<int>(painted.view_layers.size());
+  result->view_layers = static_cast<int>(scorer.painted().view_layers.size());
   result->paint_seconds = run.stats().seconds;
-  result->pixels = score.pixels;
-  result->psnr_db = score.pixels > 0 ? score.psnr_db : std::numeric_limits<double>::quiet_NaN();
-  result->one_minus_ncc = score.pixels > 0 ? view.local_one_minus_ncc : 1.0;
-  result->completeness = score.completeness;
+  result->pixels = score.rephoto.pixels;
+  // Nothing compared: no PSNR, uncorrelated.
+  result->psnr_db =
+      score.rephoto.pixels > 0 ? score.rephoto.psnr_db : std::numeric_limits<double>::quiet_NaN();
+  result->one_minus_ncc = score.rephoto.pixels > 0 ? view.local_one_minus_ncc : 1.0;
+  result->completeness = score.rephoto.completeness;
   result->image_coverage = view.image_coverage;
-  return sink ? sink(*result, view.rendered_bgr, photo) : Status::Ok();
+  return sink ? sink(*result, view.rendered_bgr, left_out->photo_bgr) : Status::Ok();
 }
 
 }  // namespace

@@ -91,6 +91,7 @@ int MergedFrameSource::FrameCount() const {
 }
 
 std::string MergedFrameSource::EndReason() const {
+  if (streams_.size() == 1) return streams_[0]->EndReason();
   std::string reason;
   for (size_t s = 0; s < streams_.size(); ++s) {
     if (!reason.empty()) reason += "; ";
@@ -110,7 +111,7 @@ void MergedFrameSource::Stop() {
 
 std::unique_ptr<PosedFrameSource> JoinStreamSources(
     std::vector<std::unique_ptr<PosedFrameSource>> sources, int poll_ms) {
-  if (sources.size() == 1) return std::move(sources[0]);
+  if (sources.size() == 1 && poll_ms < 0) return std::move(sources[0]);
   return std::make_unique<MergedFrameSource>(std::move(sources), poll_ms);
 }
 

@@ -38,7 +38,8 @@ class MergedFrameSource : public PosedFrameSource {
   int NumStreams() const override { return static_cast<int>(streams_.size()); }
   const FrameOrigin& Origin(int stream) const override { return streams_[stream]->Origin(0); }
   int FrameCount() const override;
-  // Each stream's end ("stream 1: live video ended: ..."), "; "-separated.
+  // Each stream's end ("stream 1: live video ended: ..."), "; "-separated; one stream's as
+  // it says it.
   std::string EndReason() const override;
   void Stop() override;
 
@@ -62,7 +63,8 @@ class MergedFrameSource : public PosedFrameSource {
 };
 
 // The source of a run over several streams: `sources[i]` is stream i's own source. One
-// source is returned as it is; several are merged (MergedFrameSource, with `poll_ms`).
+// source is returned as it is unless it is to be polled (`poll_ms` >= 0: read on its own
+// thread, as several are); several are merged (MergedFrameSource, with `poll_ms`).
 std::unique_ptr<PosedFrameSource> JoinStreamSources(
     std::vector<std::unique_ptr<PosedFrameSource>> sources, int poll_ms = -1);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <future>
+#include <map>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -13,10 +14,52 @@
 #include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/live_frame_source.h"
 #include "pipeline/run/merged_frame_source.h"
+#include "pipeline/run/offset_estimator.h"
 
 namespace fresco {
 
 namespace {
+
+// The movers found across views (each stream's frames compared with that stream's frames
+// near them), which decide the background; the masks kept with the captures when the model
+// joins them. `small[k]`, `frames[k]`, `cam_from_local[k]`: frame k of the pre-pass, at
+// stream and pose index `where[k]`.
+Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mover_options,
+                             const std::vector<cv::Mat>& small,
+                             const std::vector<PoseAdjustFrame>& frames,
+                             const std::vector<Rigid3d>& cam_from_local,
+                             const std::vector<std::pair<int, int>>& where, PaintJob* j) {
+  // Each stream's frames are compared with that stream's frames near them.
+  MoverMaskResult all;
+  for (size_t s = 0; s < j->captures.size(); ++s) {
+    std::vector<MoverMaskFrame> stream_frames;
+    std::vector<int> pose_index;
+    for (size_t k = 0; k < where.size(); ++k) {
+      if (where[k].first != static_cast<int>(s)) continue;
+      MoverMaskFrame frame;
+      frame.bgr = small[k];
+      frame.camera = frames[k].camera;
+      frame.cam_from_local = cam_from_local[k];
+      stream_frames.push_back(frame);
+      pose_index.push_back(where[k].second);
+    }
+    MoverMaskResult found;
+    FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
+    all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
+    if (project.pipeline.background.across_views) {
+      Capture& capture = j->captures[s];
+      capture.movers.resize(capture.poses.size());
+      for (size_t k = 0; k < pose_index.size(); ++k)
+        capture.movers[pose_index[k]] = found.Packed(k);
+    }
+  }
+  j->mover_masks = all;
+  j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
+  // No background model, nothing for the masks to join: not kept.
+  if (j->session->options().background.mode == BackgroundMode::kOff)
+    for (Capture& capture : j->captures) capture.movers.clear();
+  return Status::Ok();
+}
 
 // What needs the whole capture before painting: every frame is read once (kept grey for the
 // joint adjustment of the poses, refine.joint: joint_pose_adjustment.h; small and in colour
@@ -61,6 +104,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     for (int read = 0; (project.pipeline.max_frames <= 0 || read < project.pipeline.max_frames) &&
                        source.Next(&f, &status) == FrameRead::kFrame;
          ++read) {
+      if (options.stop && options.stop()) return Status::Error(project.file_path + ": interrupted");
       const int every = options.joint_holdout_every;
       if (read == options.joint_holdout_counter || (every > 0 && read % every == every / 2))
         continue;
@@ -94,41 +138,22 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
           adjusted.cam_from_local[k] * local_from_world;
   }
   for (PoseAdjustFrame& frame : frames) frame.bgr.release();  // only their cameras are left
-  if (movers) {
-    // Each stream's frames are compared with that stream's frames near them.
-    MoverMaskResult all;
-    for (size_t s = 0; s < j->captures.size(); ++s) {
-      std::vector<MoverMaskFrame> stream_frames;
-      std::vector<int> pose_index;
-      for (size_t k = 0; k < where.size(); ++k) {
-        if (where[k].first != static_cast<int>(s)) continue;
-        MoverMaskFrame frame;
-        frame.bgr = small[k];
-        frame.camera = frames[k].camera;
-        frame.cam_from_local = cam_from_local[k];
-        stream_frames.push_back(frame);
-        pose_index.push_back(where[k].second);
-      }
-      MoverMaskResult found;
-      FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
-      all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
-      if (project.pipeline.background.across_views) {
-        Capture& capture = j->captures[s];
-        capture.movers.resize(capture.poses.size());
-        for (size_t k = 0; k < pose_index.size(); ++k)
-          capture.movers[pose_index[k]] = found.Packed(k);
-      }
-    }
-    j->mover_masks = all;
-    j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
-    // No background model, nothing for the masks to join: not kept.
-    if (j->session->options().background.mode == BackgroundMode::kOff)
-      for (Capture& capture : j->captures) capture.movers.clear();
-  }
+  if (movers)
+    FRESCO_RETURN_IF_ERROR(
+        FindMoversAcrossViews(project, mover_options, small, frames, cam_from_local, where, j));
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
   return Status::Ok();
+}
+
+// PaintJobOptions::paint_at_truth_poses: each pose with a true one of its name takes it.
+void TakeTruthPoses(Capture* capture) {
+  std::map<std::string, const PosedImage*> truth;
+  for (const PosedImage& pose : capture->truth_poses) truth[pose.name] = &pose;
+  for (PosedImage& pose : capture->poses)
+    if (const auto t = truth.find(pose.name); t != truth.end())
+      pose.cam_from_world = t->second->cam_from_world;
 }
 
 }  // namespace
@@ -149,6 +174,8 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   CaptureLoadOptions load_options;
   load_options.open_live_video = false;  // a live video opens after its pose feed connects
   FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
+  if (options.paint_at_truth_poses)
+    for (Capture& capture : j.captures) TakeTruthPoses(&capture);
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).
@@ -168,8 +195,14 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   std::vector<std::future<Status>> opened(num_streams);
   for (int s = 0; s < num_streams; ++s) {
     if (!IsLiveStream(project, s)) continue;
-    opened[s] = std::async(std::launch::async, [&, s] {
-      return OpenLiveInputs(project.ForStream(s), j.captures[s], *j.session,
+    const Capture& capture = j.captures[s];
+    OffsetEstimator estimator;
+    if (capture.cameras.size() == 1)  // else OpenLiveInputs says a live stream needs one
+      estimator = MakeTimeOffsetEstimator(
+          &j.scene(), capture.cameras.begin()->second, project.pipeline, project.grouping,
+          j.session->default_texel_size_m(), TimeOffsetOptions(), project.Resolve(specs[s].video));
+    opened[s] = std::async(std::launch::async, [&, s, estimator] {
+      return OpenLiveInputs(project.ForStream(s), j.captures[s], estimator,
                             options.keep_tracker_poses, &j.live_inputs[s]);
     });
   }
@@ -193,7 +226,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
       sources.push_back(
           std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&j.captures[s]}));
   }
-  j.source = JoinStreamSources(std::move(sources));
+  j.source = JoinStreamSources(std::move(sources), options.poll_ms);
   *job = std::move(result);
   return Status::Ok();
 }

@@ -2,8 +2,8 @@
 // (scene, cameras, poses, video), the PaintSession over the scene, and the source of its
 // posed frames: files read ahead (file_frame_source.h), or the live inputs
 // (live_frame_source.h) for a live stream; several streams of which one is live are merged as
-// their frames arrive (merged_frame_source.h). `fresco run` and `fresco bench` open their
-// projects this way; the app opens the same captures and source for file projects.
+// their frames arrive (merged_frame_source.h). The one way to open a project for painting:
+// `fresco run`, bench, rephoto, eval and the app's worker all open their projects here.
 #pragma once
 
 #include <functional>
@@ -28,6 +28,10 @@ struct PaintJobOptions {
   std::string one_stream_for;
   // Live projects: keep every tracker pose (a recording writes them; LiveInputs).
   bool keep_tracker_poses = false;
+  // Live projects: >= 0: the source's Next waits at most this long for a frame, then says
+  // kWaiting (the app's worker, which has commands to answer meanwhile); < 0: Next waits for
+  // a frame or the end (`fresco run`).
+  int poll_ms = -1;
   // pipeline.refine.joint: progress of the poses' adjustment before painting (optional).
   std::function<void(int done, int total, const std::string& line)> joint_progress;
   // Captures from files with background `auto` or a model: progress of the search for movers
@@ -38,6 +42,14 @@ struct PaintJobOptions {
   // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.
   int joint_holdout_every = 0;
   int joint_holdout_counter = -1;
+  // Checked between the frames the whole-capture pre-pass reads (pipeline.refine.joint,
+  // movers across views); true: OpenPaintJob stops with the error "PROJECT: interrupted"
+  // (optional; a run's stop is PaintRunHooks::stop).
+  std::function<bool()> stop;
+  // Paint at the project's true poses (truth.poses, as a synthetic capture has them) instead
+  // of its given ones: what exact poses would give (`fresco eval --recovery`). A pose without
+  // a true one of its name keeps the given pose.
+  bool paint_at_truth_poses = false;
 };
 
 struct PaintJob {

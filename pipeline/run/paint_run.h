@@ -1,7 +1,8 @@
 // A painting job: frames from a source (posed_frame_source.h), judged by the frame policy
 // (frame_policy.h), painted into a PaintSession, with the run's statistics (frames read,
 // painted, without a pose, held out; per stream; per-stage milliseconds and metrics). The
-// one frame loop under `fresco run`, `fresco bench` and the app's worker:
+// one frame loop under `fresco run`, `fresco bench`, `fresco rephoto`, `fresco eval` and the
+// app's worker (the frames held out are scored by pipeline/rephoto/holdout_scorer.h):
 //
 //   PaintRun run(session, source, options);
 //   RunFrame frame;

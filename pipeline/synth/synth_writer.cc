@@ -159,14 +159,14 @@ Status RenderFramesStaged(const Scene& scene, const SynthOptions& options, const
   FRESCO_RETURN_IF_ERROR(frames_dir->Open((root / "frames").string()));
   return RenderSynthFrames(scene, options, plan, [&](int index, const cv::Mat& bgr) -> Status {
     if (write_options.stop && write_options.stop()) {
-      return Status::Error(dir + ": stopped after " + std::to_string(*done) + " of " +
-                           std::to_string(total) + " frames");
+      return Status::Failed(dir + ": stopped after " + std::to_string(*done) + " of " +
+                            std::to_string(total) + " frames");
     }
     std::vector<uint8_t> png;
     const std::string name = plan.true_poses[index].name;
     const std::string path = (fs::path(frames_dir->path()) / name).string();
     if (Status s = EncodeFastDecodingPng(bgr, &png); !s.ok())
-      return Status::Error((root / "frames" / name).string() + ": " + s.message());
+      return s.WithMessage((root / "frames" / name).string() + ": " + s.message());
     FRESCO_RETURN_IF_ERROR(WriteFileAtomic(path, std::string(png.begin(), png.end())));
     ++*done;
     if (write_options.progress) write_options.progress(*done, total);
@@ -247,7 +247,8 @@ Status WriteSynthCapture(const Scene& scene, const SynthOptions& options, const 
   if (!result) result = &local;
   *result = SynthWriteResult();
   SynthCapture plan;
-  FRESCO_RETURN_IF_ERROR(PlanSynthCapture(scene, options, &plan));
+  // The options were checked when the job was built: a plan that fails now is failed work.
+  FRESCO_RETURN_IF_ERROR(PlanSynthCapture(scene, options, &plan).Reclassified(StatusKind::kFailed));
   const int frames = static_cast<int>(plan.true_poses.size());
   result->frames = frames;
   result->fingerprint = PlanFingerprint(scene, options, plan);
@@ -297,7 +298,7 @@ Status PlanSynthStreams(const Scene& scene, const std::vector<SynthStream>& stre
       }
     }
     if (Status s = PlanSynthCapture(scene, o, &(*plans)[k]); !s.ok())
-      return Status::Error("streams[" + std::to_string(k) + "]." + s.message());
+      return s.WithMessage("streams[" + std::to_string(k) + "]." + s.message());
   }
   return Status::Ok();
 }
@@ -308,10 +309,11 @@ Status WriteSynthStreams(const Scene& scene, const std::vector<SynthStream>& str
   SynthWriteResult local;
   if (!result) result = &local;
   *result = SynthWriteResult();
-  if (streams.empty()) return Status::Error(dir + ": no streams to write");
+  if (streams.empty()) return Status::Internal(dir + ": no streams to write");
   std::vector<SynthStream> resolved;
   std::vector<SynthCapture> plans;
-  FRESCO_RETURN_IF_ERROR(PlanSynthStreams(scene, streams, &resolved, &plans));
+  FRESCO_RETURN_IF_ERROR(  // as in WriteSynthCapture: failed work, not bad input
+      PlanSynthStreams(scene, streams, &resolved, &plans).Reclassified(StatusKind::kFailed));
   Fnv64 h;
   h.AddString("streams");
   for (size_t k = 0; k < resolved.size(); ++k) {
@@ -370,16 +372,16 @@ Status ExportSynthScene(const Scene& scene, const std::vector<std::string>& text
   if (!any) return Status::Ok();
 
   std::string text;
-  FRESCO_RETURN_IF_ERROR(ReadFileToString(gltf_path, &text));
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(gltf_path, &text).Reclassified(StatusKind::kOutput));
   json gltf = json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (gltf.is_discarded() || !gltf.contains("textures") || !gltf.contains("images")) {
-    return Status::Error(gltf_path + ": written glTF has no textures/images to point at files");
+    return Status::Internal(gltf_path + ": written glTF has no textures/images to point at files");
   }
   json& textures = gltf["textures"];
   json& images = gltf["images"];
   if (textures.size() != scene.textures.size()) {
-    return Status::Error(gltf_path + ": written glTF has " + std::to_string(textures.size()) +
-                         " textures for the scene's " + std::to_string(scene.textures.size()));
+    return Status::Internal(gltf_path + ": written glTF has " + std::to_string(textures.size()) +
+                            " textures for the scene's " + std::to_string(scene.textures.size()));
   }
   std::set<std::string> replaced;
   for (size_t i = 0; i < texture_files.size() && i < textures.size(); ++i) {

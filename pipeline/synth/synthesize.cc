@@ -199,8 +199,8 @@ Status RenderSynthFrames(const Scene& scene, const SynthOptions& options, const 
   const int frames = static_cast<int>(plan.true_poses.size());
   if (frames == 0) return Status::Ok();
   if (static_cast<int>(plan.exposure_gains.size()) != frames) {
-    return Status::Error("synth: plan has " + std::to_string(plan.exposure_gains.size()) +
-                         " gains for " + std::to_string(frames) + " frames");
+    return Status::Internal("synth: plan has " + std::to_string(plan.exposure_gains.size()) +
+                            " gains for " + std::to_string(frames) + " frames");
   }
   int threads =
       options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());

@@ -1,7 +1,7 @@
-// Corrupt inputs end to end (issue 11): `fresco run` on a project whose files are broken
-// one way at a time exits 2 with one line on stderr that names the broken file and says what
-// is wrong, and leaves the output folder of an earlier good run exactly as it was. Each case
-// has its own test (the README's reliability table names them).
+// Corrupt inputs end to end (README "Reliability"): `fresco run` on a project whose files are
+// broken one way at a time exits 2 with one line on stderr that names the broken file and says what
+// is wrong, and leaves the output folder of an earlier good run exactly as it was. Each case has
+// its own test (the README's reliability table names them).
 #include <cstring>
 #include <filesystem>
 #include <fstream>

@@ -1,4 +1,4 @@
-// The `fresco` CLI links no GL, GLFW or ImGui (issue 22): headless machines run it without
+// The `fresco` CLI links no GL, GLFW or ImGui: headless machines run it without
 // them. Its direct shared-library needs hold none of them, while the app's own executable
 // next to it, fresco-gui, needs them; `fresco gui` starts fresco-gui with the same
 // arguments and passes its exit code on.

@@ -1,9 +1,9 @@
-// Interrupt safety (issue 11): Ctrl-C (SIGINT) or SIGTERM in the middle of `fresco run`,
-// `fresco synth` and `fresco bench` leaves the output folder exactly as an earlier complete
-// run left it (or empty when there was none), no temp or staging files, a one-line message
-// saying so, and exit code 128 + the signal. Each test starts `fresco` as a child process,
-// waits until it is under way (its first progress line), sends the signal, and compares
-// every file of the output folder, byte for byte, with what was there before.
+// Interrupt safety (README "Reliability"): Ctrl-C (SIGINT) or SIGTERM in the middle of `fresco
+// run`, `fresco synth` and `fresco bench` leaves the output folder exactly as an earlier complete
+// run left it (or empty when there was none), no temp or staging files, a one-line message saying
+// so, and exit code 128 + the signal. Each test starts `fresco` as a child process, waits until it
+// is under way (its first progress line), sends the signal, and compares every file of the output
+// folder, byte for byte, with what was there before.
 #include <signal.h>
 #include <sys/wait.h>
 

@@ -1,4 +1,4 @@
-// Numerical stability at the extremes (issue 10): the cases the other tests do not already
+// Numerical stability at the extremes: the cases the other tests do not already
 // cover. Each asserts a concrete outcome (a bound, or a clean refusal). The README table
 // "Numerical stability at the extremes" lists every case and the test that covers it.
 #include <cmath>

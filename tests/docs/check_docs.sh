@@ -2,13 +2,13 @@
 # Keeps the documentation from rotting. Checks, over README.md, CHANGELOG.md and docs/**/*.md:
 #   - README.md is at most 200 lines (the front door stays short);
 #   - every package the README's `apt install` line names is one .ci/setup installs;
-#   - no issue numbers in user-facing text ("issue 6", "(issue 12)");
+#   - no issue numbers in user-facing text (the word issue followed by a number);
 #   - every relative link and picture resolves, and every #anchor names a heading;
 #   - every `fresco VERB [SUBVERB]` in code exists, and every --option written after it is
 #     one that verb's --help lists;
 #   - docs/reference/cli.md is exactly what tests/docs/make_cli_reference.sh writes now;
 #   - every key the project-file reader accepts (Fields() in pipeline/core/project.cc and the
-#     stages' pipeline/paint/*_options.h) is in
+#     painting settings in pipeline/settings/*.h) is in
 #     docs/reference/project-file.md, and every key that page's tables name is accepted;
 #   - every settings row there is the one `fresco settings --markdown` makes (default, range
 #     and meaning from the declarations);
@@ -91,7 +91,13 @@ if not verbs:
     err(f"{fresco} --help lists no verbs")
 helps = {}
 
+# The contract (docs/contract.md, ../shared/CONTRACT.md verbatim) may name verbs and options
+# an open issue is still building: those are listed as not implemented yet, not errors. Every
+# other page may name only what `fresco` does.
+pending = []
+
 def check_command(path, line_no, cmd):
+    err = (lambda msg: pending.append(msg)) if path == "docs/contract.md" else globals()["err"]
     m = re.search(r"(?:^|[\s/`(])fresco (\w+)(?: (\w+))?(.*)", cmd)
     if not m:
         return
@@ -168,10 +174,10 @@ for path in files:
             for code in re.findall(r"`([^`]*fresco [^`]*)`", line):
                 check_command(path, i, code)
 
-# Project-file keys: the reader's Fields() (project.cc, and the stages' settings headers)
+# Project-file keys: the reader's Fields() (project.cc, and the settings headers)
 # against docs/reference/project-file.md.
 import glob
-stage_headers = "".join(open(f).read() for f in sorted(glob.glob("pipeline/paint/*_options.h")))
+stage_headers = "".join(open(f).read() for f in sorted(glob.glob("pipeline/settings/*.h")))
 header = open("pipeline/core/project.h").read() + stage_headers
 source = open("pipeline/core/project.cc").read() + stage_headers
 member_type = {}
@@ -217,6 +223,8 @@ for row in rows.splitlines():
 
 for e in errors:
     print(e)
+for p in pending:
+    print("contract, not implemented yet: " + p)
 print(f"check_docs: {len(files)} files, {len(keys)} project keys, {len(errors)} problems")
 sys.exit(1 if errors else 0)
 PY

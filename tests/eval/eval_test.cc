@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/eval/eval_run.h"
-#include "pipeline/eval/eval_score.h"
 #include "pipeline/eval/eval_suite.h"
 #include "pipeline/eval/eval_summary.h"
+#include "pipeline/rephoto/truth_view.h"
 #include "tests/test_support.h"
 
 namespace fresco::testing {

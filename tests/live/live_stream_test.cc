@@ -1,4 +1,4 @@
-// End to end on loopback (issue 12): a synthetic capture streamed as H.264 over UDP by the
+// Live end to end on loopback: a synthetic capture streamed as H.264 over UDP by the
 // `ffmpeg` program and its true poses sent as TUM lines over TCP with the tracker's clock
 // 0.2 s ahead; `fresco run` paints it live, estimates the offset, records the session; the
 // painted buffers are compared with replaying the capture from its files. Also: clear

@@ -1,4 +1,4 @@
-// Live sources (issue 12), on loopback only: pose interpolation against exact motion, the
+// Live sources, on loopback only: pose interpolation against exact motion, the
 // bounded newest-wins queue, back-pressure under a source faster than the painter, pose
 // feeds over TCP/UDP/named pipes (errors, reconnects), the time-offset estimation on a
 // synthetic capture with a known offset, and the session recorder's staged frames.
@@ -31,6 +31,7 @@
 #include "pipeline/live/pose_track.h"
 #include "pipeline/live/session_recorder.h"
 #include "pipeline/live/time_offset_estimation.h"
+#include "pipeline/run/offset_estimator.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synthesize.h"
 #include "tests/live/loopback.h"

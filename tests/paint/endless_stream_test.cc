@@ -1,4 +1,4 @@
-// Endless streams (issue 11): Fresco runs for hours on live video, so painting must not
+// Endless streams: Fresco runs for hours on live video, so painting must not
 // grow without bound. A synthetic stream of 10,000 small frames (160x120, rendered on the
 // fly by the synthetic renderer, never written to disk) goes through the real PaintSession
 // with every stage on (robust background with a mover, refinement with consensus anchoring

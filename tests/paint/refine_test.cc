@@ -217,7 +217,7 @@ TEST(Refine, DebugImagesHaveTheBufferSize) {
   EXPECT_EQ(heat.size(), e.region.size());
 }
 
-// Repetitive buffers (issue 10): a texture that repeats with a period shorter than the search
+// Repetitive buffers (an extreme): a texture that repeats with a period shorter than the search
 // window matches equally well one period away, so the nearest match may be the wrong one. A
 // shift of 0.6 period puts the wrong copy nearest (0.4 period the other way). Whatever the
 // shift, the estimate must be the true one or none, with the reason: never a whole period off.

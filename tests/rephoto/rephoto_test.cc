@@ -1,21 +1,27 @@
-// `fresco rephoto` (pipeline/rephoto/): leave-one-out virtual rephotography on synthetic
-// captures whose truth is known. Perfect poses rephotograph well; a frame given a wrong pose
-// scores far below the others; the local 1 - NCC is 0 for images equal up to gain and
-// offset; bad input is one line naming the file and field, exit 2.
+// pipeline/rephoto/: the one held-out scorer, and `fresco rephoto`'s leave-one-out virtual
+// rephotography, on synthetic captures whose truth is known. Perfect poses rephotograph
+// well; a frame given a wrong pose scores far below the others; the local 1 - NCC is 0 for images
+// equal up to gain and offset; bad input is one line naming the file and field, exit 2.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/image_metrics.h"
+#include "pipeline/core/project.h"
+#include "pipeline/rephoto/holdout_scorer.h"
 #include "pipeline/rephoto/rephoto_report.h"
 #include "pipeline/rephoto/rephoto_run.h"
+#include "pipeline/run/paint_job.h"
+#include "pipeline/run/paint_run.h"
 #include "pipeline/synth/procedural_scenes.h"
 #include "pipeline/synth/synth_writer.h"
 #include "tests/test_support.h"
@@ -78,6 +84,66 @@ TEST(LocalOneMinusNcc, ZeroUpToGainAndOffsetOneForNoise) {
   cv::Mat small(a.size(), CV_8U, cv::Scalar(0));
   small(cv::Rect(10, 10, 8, 8)).setTo(255);
   EXPECT_TRUE(std::isnan(LocalOneMinusNcc(a, c, small)));
+}
+
+// The one held-out scorer, on frames a paint run held out: the figures are means over the
+// frames; a frame at its true pose scores the same there; a wrong given pose scores low at
+// it and high at the true pose; nothing scored leaves the means NaN; a stop stops.
+TEST(HoldoutScorer, ScoresHeldOutFramesAtTheirGivenAndTruePoses) {
+  Project project;
+  ASSERT_TRUE(LoadProject(MakeCapture("holdout-scorer"), {}, &project).ok());
+  PaintJobOptions job_options;
+  job_options.joint_holdout_every = 3;
+  std::unique_ptr<PaintJob> job;
+  ASSERT_TRUE(OpenPaintJob(project, job_options, &job).ok());
+  PaintRunOptions run_options;
+  run_options.holdout_every = 3;  // frames 1, 4, 7
+  PaintRun run(job->session.get(), job->source.get(), run_options);
+  std::vector<HeldOutFrame> held_out;
+  PaintRunHooks hooks;
+  hooks.after_frame = [&](const RunFrame& f, const FrameReport*) {
+    if (f.fate == FrameFate::kHeldOut) held_out.push_back(HeldOutFrameOf(f, &job->captures[0]));
+    return Status::Ok();
+  };
+  ASSERT_TRUE(RunToEnd(&run, hooks).ok());
+  ASSERT_EQ(held_out.size(), 3u);
+  for (const HeldOutFrame& h : held_out) ASSERT_TRUE(h.true_cam_from_world.has_value());
+
+  HoldoutScorerOptions options;
+  options.keep_views = true;
+  HoldoutScorer empty(job->session->PaintedScene(), options);
+  EXPECT_TRUE(std::isnan(empty.figures().psnr_db));
+  EXPECT_TRUE(std::isnan(empty.figures().completeness));
+  EXPECT_FALSE(empty.AddAll(held_out, [] { return true; }));
+  EXPECT_EQ(empty.figures().frames, 0);
+
+  HoldoutScorer scorer(job->session->PaintedScene(), options);
+  double psnr_sum = 0;
+  for (const HeldOutFrame& h : held_out) {
+    const HeldOutScore& s = scorer.Add(h);
+    ASSERT_TRUE(s.truth.has_value());
+    EXPECT_EQ(s.truth->psnr_db, s.rephoto.psnr_db);  // the true pose is the given one
+    EXPECT_EQ(s.view.rendered_bgr.size(), h.photo_bgr.size());
+    psnr_sum += s.rephoto.psnr_db;
+  }
+  const HoldoutFigures& f = scorer.figures();
+  EXPECT_EQ(f.frames, 3);
+  EXPECT_EQ(f.scored, 3);
+  EXPECT_EQ(f.truth_scored, 3);
+  EXPECT_DOUBLE_EQ(f.psnr_db, psnr_sum / 3);
+  EXPECT_GT(f.psnr_db, 30.0);
+  EXPECT_GT(f.completeness, 0.95);
+  EXPECT_LT(f.local_one_minus_ncc, 0.15);
+  EXPECT_EQ(f.MoverLeak(), 0.0);  // no SceneTruth: no mover figures
+
+  // A given pose 15 cm off: low at it, as high as before at the true pose.
+  HeldOutFrame wrong = held_out[1];
+  wrong.cam_from_world.translation.x() += 0.15;
+  const HeldOutScore& w = scorer.Add(wrong);
+  std::printf("held out at a wrong pose: %.2f dB there, %.2f dB at the true pose\n",
+              w.rephoto.psnr_db, w.truth->psnr_db);
+  EXPECT_LT(w.rephoto.psnr_db, w.truth->psnr_db - 12.0);
+  EXPECT_GT(w.truth->psnr_db, 30.0);
 }
 
 TEST(Rephoto, PerfectPosesScoreHighAndAWrongPoseScoresLow) {

@@ -1,16 +1,22 @@
-// Issue 22: `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner,
-// headless) are thin clients of one painting job, so on the same bad capture they come to
-// the same outcome: the same one-line error (exit 2 for the CLI, "error: ..." as the app's
-// status), or the same counts of frames read, painted and without a pose.
+// `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner, headless) are
+// thin clients of one painting job, so on the same bad capture they come to the same outcome:
+// the same one-line error (exit 2 for the CLI, "error: ..." as the app's status), or the same
+// counts of frames read, painted and without a pose; live, with the time offset estimated
+// before painting, too.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <thread>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
+#include "tests/live/stream_support.h"
 #include "tests/run/bad_captures.h"
+#include "tests/run/play_in_app.h"
 #include "tests/test_support.h"
 #include "ui/core/pipeline_runner.h"
 
@@ -82,17 +88,7 @@ Outcome BenchCommand(const std::string& project) {
 
 // The app's worker, played to the end.
 Outcome AppWorker(const std::string& project_json) {
-  Project project;
-  const Status loaded = LoadProject(project_json, {}, &project);
-  EXPECT_TRUE(loaded.ok()) << loaded.message();
-  RunnerOptions options;
-  options.misalignment = false;
-  options.debug_images = false;
-  PipelineRunner runner(options);
-  runner.Restart(project);
-  runner.Play();
-  runner.WaitIdle();
-  const auto snap = runner.Snapshot();
+  const auto snap = testing::PlayInApp(project_json);
   Outcome o;
   if (snap->status.rfind("error: ", 0) == 0) {
     o.error = snap->status.substr(7);
@@ -150,6 +146,41 @@ INSTANTIATE_TEST_SUITE_P(BadCaptures, SameOutcomeTest,
                            return name;
                          });
 
+// A live project (frames from a folder matched by time to poses from a TCP feed) whose frames
+// are smaller than its camera, with the time offset estimated: the estimate paints nothing
+// of them, and `fresco run` and the app stop at the first frame with the frame policy's
+// message (exit 2 from the CLI).
+TEST(SameOutcome, LiveFramesSmallerThanTheCameraStopAtTheFirstFrameWhileTheOffsetIsEstimated) {
+  const std::string project_json = testing::MakeBadCapture(
+      testing::BadCapture::kFramesSmallerThanCamera);
+  const std::string dir = project_json.substr(0, project_json.rfind('/'));
+  std::vector<PosedImage> truth;
+  bool is_tum = false;
+  ASSERT_TRUE(ReadPoses(dir + "/sparse/images.txt", &truth, &is_tum).ok());
+  testing::PoseServer server;
+  nlohmann::json live = nlohmann::json::parse(ReadText(project_json));
+  live["poses"] = "tcp://127.0.0.1:" + std::to_string(server.port());
+  live["live"] = {{"estimate_offset", true}, {"offset_window_frames", 8},
+                  {"offset_search_s", 0.1},  {"connect_timeout_s", 10},
+                  {"read_timeout_s", 2},     {"queue_frames", 50}};
+  const std::string live_json = dir + "/live.json";
+  testing::WriteText(live_json, live.dump(2));
+  const std::string expected =
+      dir + "/frames/: frame '000000.png' is 80x60 but the camera is 160x120";
+
+  std::thread tracker([&] { testing::ServeTrack(&server, truth, 30.0, 0.0); });
+  const CommandResult run =
+      RunFresco({"run", live_json, "--out", MakeTempDir("one-door-live") + "/out", "--quiet"});
+  tracker.join();
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_EQ(run.err, "error: " + expected + "\n");
+
+  std::thread tracker_again([&] { testing::ServeTrack(&server, truth, 30.0, 0.0); });
+  const Outcome app = AppWorker(live_json);
+  tracker_again.join();
+  EXPECT_EQ(app.error, expected);
+}
+
 // Out of memory (0.5 mm texels on the room: several GB, in a 700 MB address space): the CLI
 // exits 1 with "fresco run: MESSAGE", the app's worker shows "error: MESSAGE" as its status
 // and stays up; the same message.
@@ -174,16 +205,7 @@ TEST(SameOutcome, OutOfMemoryIsOneMessageFromTheCliAndTheApp) {
   if (pid == 0) {
     const rlimit limit{static_cast<rlim_t>(kLimit), static_cast<rlim_t>(kLimit)};
     setrlimit(RLIMIT_AS, &limit);
-    Project p;
-    if (!LoadProject(project, overrides, &p).ok()) _exit(3);
-    RunnerOptions options;
-    options.misalignment = false;
-    options.debug_images = false;
-    PipelineRunner runner(options);
-    runner.Restart(p);
-    runner.Play();
-    runner.WaitIdle();
-    testing::WriteText(status_file, runner.Snapshot()->status);
+    testing::WriteText(status_file, testing::PlayInApp(project, overrides)->status);
     _exit(0);
   }
   int wstatus = 0;

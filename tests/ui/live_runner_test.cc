@@ -1,4 +1,4 @@
-// The app paints live (issue 12), headless on loopback: a synthetic capture streamed as
+// The app paints live sources, headless on loopback: a synthetic capture streamed as
 // H.264 over UDP by the `ffmpeg` program and its true poses over TCP (tracker clock 0.2 s
 // ahead); the app's PipelineRunner paints it through the live core, its snapshot and the
 // Pipeline panel show the sources' state (frames received, stalled, ended, the estimated
@@ -107,8 +107,8 @@ TEST(UiLive, PaintsAStreamShowsItsStateAndRecordsASessionThatReplays) {
       "app live: %lld received, %lld delivered, %lld dropped, %lld without pose; offset %.4f s "
       "(estimated %d, score %.2f); pose lag %.3f s; recorded %d frames; coverage %.4f; "
       "status '%s'\n",
-      l.frames_received, l.frames_delivered, l.frames_dropped, l.frames_without_pose,
-      l.time_offset_s, l.offset_estimated, l.offset_score, l.pose_lag_s, l.recorded_frames,
+      l.frames.frames_received, l.frames.frames_delivered, l.frames.frames_dropped, l.frames.frames_without_pose,
+      l.frames.time_offset_s, l.frames.offset_estimated, l.frames.estimate.score, l.pose_lag_s, l.recorded_frames,
       live->coverage, live->status.c_str());
   ASSERT_TRUE(l.active);
   EXPECT_TRUE(saw_stalled) << "never reported the stalled stream";
@@ -116,17 +116,17 @@ TEST(UiLive, PaintsAStreamShowsItsStateAndRecordsASessionThatReplays) {
   EXPECT_EQ(l.state, "ended");
   // UDP carries no end of stream: the sender finishing reads as a stall.
   EXPECT_THAT(live->status, StartsWith("live video ended: stalled: no frame within 3.0 s after " +
-                                       std::to_string(l.frames_received) + " frames"));
+                                       std::to_string(l.frames.frames_received) + " frames"));
   EXPECT_THAT(live->status, HasSubstr("does not signal the end of a stream"));
   EXPECT_THAT(l.problem, HasSubstr("live video ended"));
-  EXPECT_GE(l.frames_received, frames - 5);  // loopback UDP loses little
-  EXPECT_EQ(l.frames_dropped, 0);            // the queue is longer than the capture
-  EXPECT_EQ(l.frames_delivered, l.frames_received);
-  EXPECT_TRUE(l.offset_estimated) << l.offset_note;
-  EXPECT_NEAR(l.time_offset_s, kOffsetS, 1.0 / kFps);
+  EXPECT_GE(l.frames.frames_received, frames - 5);  // loopback UDP loses little
+  EXPECT_EQ(l.frames.frames_dropped, 0);            // the queue is longer than the capture
+  EXPECT_EQ(l.frames.frames_delivered, l.frames.frames_received);
+  EXPECT_TRUE(l.frames.offset_estimated) << l.frames.estimate.note;
+  EXPECT_NEAR(l.frames.time_offset_s, kOffsetS, 1.0 / kFps);
   EXPECT_TRUE(l.pose_lag_known);
-  EXPECT_EQ(l.poses_received, frames);
-  const int painted = static_cast<int>(l.frames_delivered - l.frames_without_pose);
+  EXPECT_EQ(l.feed.poses, frames);
+  const int painted = static_cast<int>(l.frames.frames_delivered - l.frames.frames_without_pose);
   EXPECT_GT(painted, frames / 2);
   EXPECT_EQ(static_cast<int>(live->frames_painted.size()), painted);
   EXPECT_EQ(l.frames_painted, painted);
@@ -149,7 +149,7 @@ TEST(UiLive, PaintsAStreamShowsItsStateAndRecordsASessionThatReplays) {
   // The Pipeline panel shows it.
   const auto report = DrawPanels(&state, &runner);
   EXPECT_EQ(report.at("live.state"), "ended");
-  EXPECT_EQ(report.at("live.frames_received"), std::to_string(l.frames_received));
+  EXPECT_EQ(report.at("live.frames_received"), std::to_string(l.frames.frames_received));
   EXPECT_EQ(report.at("live.frames_dropped"), "0");
   EXPECT_EQ(report.at("live.frames_painted"), std::to_string(painted));
   EXPECT_THAT(report.at("live.time_offset"), HasSubstr("(estimated"));

@@ -169,7 +169,8 @@ TEST(UiHeadless, ATwoStreamProjectPaintsBothStreamsAsTheRunDoes) {
   }
 }
 
-// Endless live streams (issue 11): the per-frame histories keep only the latest frames.
+// Endless live streams (the app runs for hours): the per-frame histories keep only the latest
+// frames.
 TEST(UiHeadless, PerFrameHistoriesAreBounded) {
   AppState state;
   ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());

@@ -11,38 +11,38 @@
 
 #include "pipeline/core/capture.h"
 #include "pipeline/core/scaled_camera.h"
-#include "pipeline/live/live_input.h"
-#include "pipeline/paint/open_project.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/render/renderer.h"
-#include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/frame_policy.h"
-#include "pipeline/run/merged_frame_source.h"
 #include "pipeline/run/paint_job.h"
-#include "ui/core/live_session_source.h"
 
 namespace fresco {
 
 struct PipelineRunner::Session {
   Project project;
-  // One capture per stream (Project::Streams(); the scene in [0]).
-  std::vector<Capture> captures;
-  std::unique_ptr<PaintSession> paint;
-  // Per stream, its live sources (null for a file stream; they read capture and paint:
-  // after them); `live` is the first live stream's, whose state the Pipeline panel shows.
-  std::vector<std::unique_ptr<LiveSession>> lives;
-  LiveSession* live = nullptr;
-  int live_stream = 0;  // the stream `live` belongs to
-  // The painting job (pipeline/run): the capture's frames read ahead, or the live session's
-  // (reads the above: after them), judged and counted as `fresco run` does.
-  std::unique_ptr<PosedFrameSource> source;
+  // The project opened for painting as `fresco run` opens it (pipeline/run/paint_job.h): one
+  // capture per stream (the scene in [0]), the PaintSession after the whole-capture pre-pass,
+  // the live inputs, and the source of posed frames.
+  std::unique_ptr<PaintJob> job;
+  // The painting job's frame loop (reads `job`: after it), judged and counted as `fresco run`
+  // does.
   std::unique_ptr<PaintRun> run;
+  // The first live stream, whose state the Pipeline panel shows (-1: none); its state as
+  // read, its recording, and the pose time of its last frame taken (-1: none yet).
+  int live_stream = -1;
+  LiveWatch live_watch;
+  LiveRecording recording;
+  double live_pose_time_s = -1;
   // Per stream: a half-size renderer through the stream's first camera, for the
   // misalignment review (null when it could not be made).
   std::vector<std::unique_ptr<Renderer>> review;
   int next_frame = 0;  // index of the next frame to read (live: frames taken so far)
   bool ended = false;
   std::string end_message;  // the status once ended ("end of video", "error: ...")
+
+  PaintSession* paint() const { return job->session.get(); }
+  const std::vector<Capture>& captures() const { return job->captures; }
+  bool live() const { return live_stream >= 0; }
 };
 
 namespace {
@@ -59,6 +59,29 @@ using Clock = std::chrono::steady_clock;
 // The camera at half size (pixel centres stay on the same rays).
 Camera HalfSize(const Camera& camera) {
   return ScaledCamera(camera, std::max(1, camera.width / 2), std::max(1, camera.height / 2));
+}
+
+// What does not change while the job paints (SessionGeometry).
+std::shared_ptr<const SessionGeometry> MakeGeometry(const PaintJob& job) {
+  const PaintSession& paint = *job.session;
+  auto geometry = std::make_shared<SessionGeometry>();
+  geometry->painted_layout = paint.PaintedSceneByBuffer();
+  geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
+  geometry->groups = paint.grouping().groups;
+  geometry->buffer_of_triangle = paint.grouping().group_of_triangle;
+  for (const BaseBuffer& b : paint.buffers()) geometry->buffer_texels.push_back(b.num_surface_texels);
+  for (const Capture& c : job.captures) {
+    std::vector<Rigid3d>& path = geometry->stream_paths.emplace_back();
+    for (const PosedImage& p : c.poses) path.push_back(p.cam_from_world);
+    geometry->stream_cameras.push_back(c.cameras.begin()->second);
+  }
+  geometry->path = geometry->stream_paths[0];
+  geometry->camera = geometry->stream_cameras[0];
+  // A live video is not open yet, and has no end.
+  geometry->num_frames = job.live ? -1 : job.source->FrameCount();
+  geometry->texel_size_m = paint.default_texel_size_m();
+  geometry->folds_split = paint.folds_split();
+  return geometry;
 }
 
 }  // namespace
@@ -111,83 +134,44 @@ void PipelineRunner::OpenSession(const Project& project) {
   working_.geometry_version = geometry_version;
   auto s = std::make_unique<Session>();
   s->project = project;
-  const bool live = IsLiveProject(project);
-  CaptureLoadOptions load_options;
-  load_options.open_live_video = false;  // a live video opens after its pose feed connects
-  // Every stream paints, as `fresco run` paints them.
-  if (const Status opened = OpenPaintSession(project, load_options, &s->captures, &s->paint);
-      !opened.ok()) {
-    working_.status = "error: " + opened.message();
-    return;
-  }
   const std::vector<StreamSpec> specs = project.Streams();
-  const int num_streams = static_cast<int>(specs.size());
-  if (live) {
-    int first = 0;
-    while (!IsLiveStream(project, first)) ++first;
+  for (int i = 0; i < static_cast<int>(specs.size()) && s->live_stream < 0; ++i)
+    if (IsLiveStream(project, i)) s->live_stream = i;
+  if (s->live()) {
     LiveStatus& l = working_.live;
     l.active = true;
     l.state = "connecting";
-    l.video = project.Resolve(specs[first].video);
-    l.poses = project.Resolve(specs[first].poses);
+    l.video = project.Resolve(specs[s->live_stream].video);
+    l.poses = project.Resolve(specs[s->live_stream].poses);
     working_.status = "connecting to " + l.video + " and " + l.poses;
     Publish(false);  // opening waits for the sources (up to their timeouts)
-    std::vector<std::unique_ptr<PosedFrameSource>> sources;
-    s->lives.resize(num_streams);
-    for (int i = 0; i < num_streams; ++i) {
-      const Project one = project.ForStream(i);
-      const FrameOrigin origin{project.Resolve(specs[i].video), project.Resolve(specs[i].poses)};
-      if (!IsLiveStream(project, i)) {
-        sources.push_back(
-            std::make_unique<FileFrameSource>(one, std::vector<const Capture*>{&s->captures[i]}));
-        continue;
-      }
-      if (Status st = LiveSession::Open(one, s->captures[i], *s->paint, &s->lives[i]); !st.ok()) {
-        working_.status =
-            "error: " + (num_streams > 1 ? "streams[" + std::to_string(i) + "]: " : "") +
-            st.message();
-        l.state = "error";
-        l.problem = working_.status;
-        return;
-      }
-      sources.push_back(
-          std::make_unique<LiveSessionSource>(s->lives[i].get(), options_.live_poll_ms, origin));
+  }
+  // Opened as `fresco run` opens it: the same pre-pass, the same sources; a live source is
+  // polled so that the worker stays responsive while it stalls.
+  PaintJobOptions job_options;
+  job_options.poll_ms = options_.live_poll_ms;
+  const auto progress = [this](const char* what) {
+    return [this, what](int done, int total, const std::string&) {
+      working_.status = std::string(what) + " " + std::to_string(done) + "/" + std::to_string(total);
+      Publish(false);
+    };
+  };
+  job_options.joint_progress = progress("adjusting poses");
+  job_options.movers_progress = progress("finding movers, pass");
+  if (const Status opened = OpenPaintJob(project, job_options, &s->job); !opened.ok()) {
+    working_.status = "error: " + opened.message();
+    if (s->live()) {
+      working_.live.state = "error";
+      working_.live.problem = working_.status;
     }
-    s->live = s->lives[first].get();
-    s->live_stream = first;
-    s->source = JoinStreamSources(std::move(sources), options_.live_poll_ms);
-  } else {
-    std::vector<const Capture*> streams;
-    for (const Capture& c : s->captures) streams.push_back(&c);
-    s->source = std::make_unique<FileFrameSource>(project, streams);
+    return;
   }
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
-  s->run = std::make_unique<PaintRun>(s->paint.get(), s->source.get(), run_options);
-  auto geometry = std::make_shared<SessionGeometry>();
-  geometry->painted_layout = s->paint->PaintedSceneByBuffer();
-  geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
-  geometry->groups = s->paint->grouping().groups;
-  geometry->buffer_of_triangle = s->paint->grouping().group_of_triangle;
-  for (const BaseBuffer& b : s->paint->buffers())
-    geometry->buffer_texels.push_back(b.num_surface_texels);
-  for (const Capture& c : s->captures) {
-    std::vector<Rigid3d>& path = geometry->stream_paths.emplace_back();
-    for (const PosedImage& p : c.poses) path.push_back(p.cam_from_world);
-    geometry->stream_cameras.push_back(c.cameras.begin()->second);
-  }
-  geometry->path = geometry->stream_paths[0];
-  geometry->camera = geometry->stream_cameras[0];
-  geometry->num_frames = live ? -1 : 0;  // a live video is not open yet, and has no end
-  for (size_t i = 0; !live && i < s->captures.size() && geometry->num_frames >= 0; ++i) {
-    const int frames = s->captures[i].video->FrameCount();
-    geometry->num_frames = frames < 0 ? -1 : geometry->num_frames + frames;
-  }
-  geometry->texel_size_m = s->paint->default_texel_size_m();
-  geometry->folds_split = s->paint->folds_split();
-  working_.geometry = geometry;
-  working_.stream_frames.assign(s->captures.size(), cv::Mat());
-  for (const Camera& camera : geometry->stream_cameras) {
+  s->run = std::make_unique<PaintRun>(s->paint(), s->job->source.get(), run_options);
+  working_.geometry = MakeGeometry(*s->job);
+  working_.stream_frames.assign(s->captures().size(), cv::Mat());
+  for (const Camera& camera : working_.geometry->stream_cameras) {
     std::unique_ptr<Renderer>& review = s->review.emplace_back();
     if (!options_.misalignment) continue;
     try {
@@ -212,15 +196,17 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     const Status& status = s.run->status();
     s.end_message = status.ok() ? s.run->EndReason() : "error: " + status.message();
     std::string recorded;
-    if (s.live && s.live->recording()) s.live->StopRecording(&recorded);  // errors: in its status
+    if (s.recording.active())  // errors: in its status
+      s.recording.Finish(s.job->live_inputs[s.live_stream], &recorded);
     return Painted::kEnded;
   }
   const PosedFrame& posed = f.posed;
   const Frame& frame = posed.frame;
   // Several streams: frames are counted over all of them, as seeking counts them.
-  working_.frame = s.captures.size() > 1 ? f.counter : frame.index;
+  const bool several = s.captures().size() > 1;
+  working_.frame = several ? f.counter : frame.index;
   working_.frame_name =
-      s.captures.size() > 1 ? "stream " + std::to_string(f.stream) + " " + frame.name : frame.name;
+      several ? "stream " + std::to_string(f.stream) + " " + frame.name : frame.name;
   working_.has_pose = posed.has_pose;
   working_.stream = f.stream;
   if (show) {
@@ -234,8 +220,9 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     working_.report.skipped_reason = "no pose";
     return Painted::kFrame;
   }
-  if (s.live) {
-    if (s.captures.size() == 1) s.live->Record(posed);
+  if (s.live() && f.stream == s.live_stream) s.live_pose_time_s = posed.pose_time_s;
+  if (s.live()) {
+    if (!several) s.recording.Add(posed);  // an error stops it: in its status
     if (working_.live_paths.size() <= static_cast<size_t>(f.stream))
       working_.live_paths.resize(f.stream + 1);
     std::vector<Rigid3d>& path = working_.live_paths[f.stream];
@@ -246,9 +233,9 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   // Review: the painted model, as it stands before this frame, seen from this frame.
   Renderer* review =
       static_cast<size_t>(f.stream) < s.review.size() ? s.review[f.stream].get() : nullptr;
-  if (show && review && s.paint->NumPaintedSurfaceTexels() > 0) {
+  if (show && review && s.paint()->NumPaintedSurfaceTexels() > 0) {
     RenderOutput out;
-    review->Render(s.paint->PaintedSceneByBuffer(), posed.cam_from_world, &out);
+    review->Render(s.paint()->PaintedSceneByBuffer(), posed.cam_from_world, &out);
     cv::Mat small, rephoto, grey_frame, grey_rephoto, diff;
     cv::resize(frame.bgr, small, out.rgba.size(), 0, 0, cv::INTER_AREA);
     cv::cvtColor(out.rgba, rephoto, cv::COLOR_RGBA2BGR);
@@ -269,7 +256,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     working_.rephoto_bgr.release();
     working_.difference_heat.release();
   }
-  s.paint->set_debug_images(show && options_.debug_images);
+  s.paint()->set_debug_images(show && options_.debug_images);
   s.run->Paint(f, &working_.report);
   if (working_.report.painted) {
     working_.frames_painted.push_back(frame.index);
@@ -289,19 +276,19 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
     TrimHistory(keep, &working_.refine_after_px);
     for (auto& [stage, ms] : working_.stage_ms) TrimHistory(keep, &ms);
   }
-  working_.coverage = s.paint->Coverage();
+  working_.coverage = s.paint()->Coverage();
   return Painted::kFrame;
 }
 
 void PipelineRunner::SetRecording(const std::string& dir) {
   // The panel offers Record for live sources of a project with one stream only.
-  if (!session_ || !session_->live || session_->captures.size() > 1) return;
-  LiveSession& live = *session_->live;
-  std::string recorded;
+  if (!session_ || !session_->live() || session_->captures().size() > 1) return;
+  Session& s = *session_;
+  std::string recorded;  // errors: in the recording's status
   if (dir.empty()) {
-    if (live.recording()) live.StopRecording(&recorded);  // errors: in its status
-  } else if (!session_->ended) {
-    live.StartRecording(dir);
+    if (s.recording.active()) s.recording.Finish(s.job->live_inputs[s.live_stream], &recorded);
+  } else if (!s.ended) {
+    s.recording.Start(dir, s.project.ForStream(s.live_stream));
   }
 }
 
@@ -312,20 +299,23 @@ void PipelineRunner::Publish(bool with_painted) {
     working_.run = session_->run->stats();
     working_.status = session_->ended ? session_->end_message : playing_ ? "playing" : "paused";
     if (seek_target_ >= 0 && !session_->ended) working_.status = "seeking";
-    if (session_->live) {
-      working_.live = session_->live->CurrentStatus();
+    if (Session& s = *session_; s.live()) {
+      const int l = s.live_stream;
+      working_.live = s.live_watch.Read(s.project.ForStream(l), s.job->live_inputs[l], s.ended,
+                                        s.run->status(), s.live_pose_time_s);
+      s.recording.Describe(&working_.live);
       // The figures are the first live stream's: so is the count of frames painted.
-      working_.live.frames_painted = session_->run->stats().streams[session_->live_stream].painted;
-      working_.live.streams = static_cast<int>(session_->captures.size());
+      working_.live.frames_painted = s.run->stats().streams[l].painted;
+      working_.live.streams = static_cast<int>(s.captures().size());
       if (!session_->ended) working_.status += " (live: " + working_.live.state + ")";
     }
   }
   if (with_painted && session_) {
     auto painted = std::make_shared<std::vector<cv::Mat>>();
-    for (const PaintedBuffer& p : session_->paint->painted()) painted->push_back(p.bgra.clone());
+    for (const PaintedBuffer& p : session_->paint()->painted()) painted->push_back(p.bgra.clone());
     working_.painted = painted;
     auto layers = std::make_shared<std::vector<RunnerSnapshot::LayerImages>>();
-    for (const ViewLayer& layer : session_->paint->view_layers()) {
+    for (const ViewLayer& layer : session_->paint()->view_layers()) {
       RunnerSnapshot::LayerImages images;
       images.centre_local = layer.Centre().cast<float>();
       for (const PaintedBuffer& p : layer.painted) images.bgra.push_back(p.bgra.clone());
@@ -360,6 +350,60 @@ void PipelineRunner::Loop() {
   }
 }
 
+bool PipelineRunner::Handle(Command command, Clock::time_point* last_publish) {
+  switch (command.kind) {
+    case Command::kQuit:
+      return false;
+    case Command::kRestart:
+      playing_ = false;
+      seek_target_ = -1;
+      OpenSession(command.project);
+      Publish(true);
+      break;
+    case Command::kPlay:
+      playing_ = session_ != nullptr && !session_->ended;
+      Publish(false);
+      break;
+    case Command::kPause:
+      playing_ = false;
+      Publish(true);
+      break;
+    case Command::kStep:
+      playing_ = false;
+      if (session_ && session_->live()) {  // waits for the next frame (as a seek)
+        seek_target_ = session_->ended ? -1 : session_->next_frame;
+        if (seek_target_ < 0) Publish(false);
+        break;
+      }
+      PaintNext(true);
+      Publish(true);
+      break;
+    case Command::kRecord:
+      SetRecording(command.path);
+      Publish(false);
+      break;
+    case Command::kSeek:
+      playing_ = false;
+      // A live source cannot go back: only forward seeks (paint N more frames) apply.
+      if (session_ && !session_->live() && command.frame < session_->next_frame) {
+        // Back: reopen and repaint from frame 0. Say so at once (reopening can take
+        // seconds on large buffers); progress follows as frames are painted.
+        seek_target_ = command.frame;
+        working_.frame = -1;
+        Publish(false);
+        const Project project = session_->project;
+        OpenSession(project);
+      }
+      seek_target_ = session_ ? command.frame : -1;
+      if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
+      // Either the result, or that a seek is under way (the UI shows its progress).
+      Publish(seek_target_ < 0);
+      *last_publish = Clock::now();
+      break;
+  }
+  return true;
+}
+
 void PipelineRunner::Serve() {
   auto last_publish = Clock::now();
   for (;;) {
@@ -371,7 +415,7 @@ void PipelineRunner::Serve() {
       if (queue_.empty() && !busy_) idle_.notify_all();
       const auto ready = [this] { return !queue_.empty() || playing_ || seek_target_ >= 0; };
       // Paused on a live source: wake up now and then to publish the sources' state.
-      if (session_ && session_->live && !session_->ended)
+      if (session_ && session_->live() && !session_->ended)
         wake_.wait_for(lock, std::chrono::milliseconds(options_.publish_interval_ms), ready);
       else
         wake_.wait(lock, ready);
@@ -383,56 +427,7 @@ void PipelineRunner::Serve() {
       busy_ = true;
     }
     if (have_command) {
-      switch (command.kind) {
-        case Command::kQuit:
-          return;
-        case Command::kRestart:
-          playing_ = false;
-          seek_target_ = -1;
-          OpenSession(command.project);
-          Publish(true);
-          break;
-        case Command::kPlay:
-          playing_ = session_ != nullptr && !session_->ended;
-          Publish(false);
-          break;
-        case Command::kPause:
-          playing_ = false;
-          Publish(true);
-          break;
-        case Command::kStep:
-          playing_ = false;
-          if (session_ && session_->live) {  // waits for the next frame (as a seek)
-            seek_target_ = session_->ended ? -1 : session_->next_frame;
-            if (seek_target_ < 0) Publish(false);
-            break;
-          }
-          PaintNext(true);
-          Publish(true);
-          break;
-        case Command::kRecord:
-          SetRecording(command.path);
-          Publish(false);
-          break;
-        case Command::kSeek:
-          playing_ = false;
-          // A live source cannot go back: only forward seeks (paint N more frames) apply.
-          if (session_ && !session_->live && command.frame < session_->next_frame) {
-            // Back: reopen and repaint from frame 0. Say so at once (reopening can take
-            // seconds on large buffers); progress follows as frames are painted.
-            seek_target_ = command.frame;
-            working_.frame = -1;
-            Publish(false);
-            const Project project = session_->project;
-            OpenSession(project);
-          }
-          seek_target_ = session_ ? command.frame : -1;
-          if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
-          // Either the result, or that a seek is under way (the UI shows its progress).
-          Publish(seek_target_ < 0);
-          last_publish = Clock::now();
-          break;
-      }
+      if (!Handle(std::move(command), &last_publish)) return;
       continue;
     }
     const bool due =
@@ -458,7 +453,7 @@ void PipelineRunner::Serve() {
         Publish(painted == Painted::kFrame);
         last_publish = Clock::now();
       }
-    } else if (due && session_ && session_->live) {  // paused: the sources' state
+    } else if (due && session_ && session_->live()) {  // paused: the sources' state
       Publish(false);
       last_publish = Clock::now();
     }

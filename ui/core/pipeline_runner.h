@@ -4,11 +4,13 @@
 // commands (play, pause, step, seek, restart with new settings) are queued and the worker
 // picks them up between frames. Settings are copied in on Restart, never shared.
 //
-// A project whose video or poses are live (device:N, udp://..., a TUM pose feed) paints
-// through the same live core as `fresco run` (LiveSession over OpenLiveInputs): the worker
-// waits for frames a little at a time, so it stays responsive and keeps publishing the
-// sources' state (RunnerSnapshot::live) when a source stalls or dies; Record() writes the
-// session as a project to replay.
+// The worker opens and paints the project as `fresco run` does (pipeline/run: OpenPaintJob
+// with its whole-capture pre-pass, PaintRun with its frame policy), so the analyst reviews
+// what the replay produces. A project whose video or poses are live (device:N, udp://..., a
+// TUM pose feed) has its live source polled: the worker waits for frames a little at a time,
+// so it stays responsive and keeps publishing the sources' state (RunnerSnapshot::live,
+// read by LiveWatch) when a source stalls or dies; Record() writes the session as a project
+// to replay (LiveRecording).
 #pragma once
 
 #include <atomic>
@@ -30,7 +32,7 @@
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/run/paint_run.h"
-#include "ui/core/live_session.h"
+#include "pipeline/run/live_status.h"
 
 namespace fresco {
 
@@ -155,6 +157,8 @@ class PipelineRunner {
   void Post(Command command);
   void Loop();   // Serve(), and after an exception the error as the status
   void Serve();  // commands and painting until kQuit
+  // One command (Serve, between frames); false for kQuit.
+  bool Handle(Command command, std::chrono::steady_clock::time_point* last_publish);
   // kWaiting: a live source has no frame yet; kEnded: the end of the video, or an error.
   Painted PaintNext(bool show);
   void OpenSession(const Project& project);

@@ -130,8 +130,7 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   };
   // Held by pointer: its frames point into its own capture and model.
   auto colmap = std::make_unique<ProjectColmap>();
-  bool bad_input = false;
-  if (Status s = RunColmapOnProject(request.project, options, colmap.get(), &bad_input); !s.ok()) {
+  if (Status s = RunColmapOnProject(request.project, options, colmap.get()); !s.ok()) {
     working_.status = cancel_ ? "cancelled" : std::string("error: ") + s.message();
     return;
   }

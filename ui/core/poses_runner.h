@@ -1,4 +1,4 @@
-// The app's COLMAP worker (issue 9): on its own thread, runs COLMAP on the project's frames
+// The app's COLMAP worker: on its own thread, runs COLMAP on the project's frames
 // with the CLI's code (RunColmapOnProject, then VerifyPoses and WriteVerifyReport as
 // `fresco poses verify`, and BootstrapFromColmap and WriteBootstrap as `fresco poses
 // bootstrap`, from the same reconstruction), publishing a snapshot at every COLMAP step.

@@ -1,4 +1,4 @@
-// Calibration (issue 8) for the operator: the folder, board and lens model; Detect, Solve and
+// Calibration for the operator: the folder, board and lens model; Detect, Solve and
 // Save (beside the project by default) and Attach to project; the "enough data yet?" light
 // that follows the detections image by image (never green for a folder that mixes cameras);
 // the images (used, rejected with the reason, or excluded by their checkbox); the selected

@@ -61,26 +61,27 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
   ImGui::SameLine(60);
   std::string pose_state = "file";
   if (live.pose_feed) {
-    pose_state = live.poses_connected ? "connected" : "disconnected";
-    ImGui::TextColored(live.poses_connected ? kGood : kWarn, "%s", pose_state.c_str());
+    pose_state = live.feed.connected ? "connected" : "disconnected";
+    ImGui::TextColored(live.feed.connected ? kGood : kWarn, "%s", pose_state.c_str());
   } else {
     ImGui::TextDisabled("file");
   }
   ImGui::SameLine();
   ImGui::TextWrapped("%s", live.poses.c_str());
-  ImGui::Text("frames: %lld received, %lld painted", live.frames_received,
-              live.frames_painted);
-  ImGui::Text("        %lld dropped, %lld without pose", live.frames_dropped,
-              live.frames_without_pose);
-  ImGui::Text("queue: high water %d of %d; clock %s", live.queue_high_water, live.queue_capacity,
-              live.video_clock.c_str());
+  const LiveFramesStats& f = live.frames;
+  ImGui::Text("frames: %lld received, %lld painted", f.frames_received, live.frames_painted);
+  ImGui::Text("        %lld dropped, %lld without pose", f.frames_dropped + f.frames_held_dropped,
+              f.frames_without_pose);
+  ImGui::Text("queue: high water %d of %d; clock %s", f.queue_high_water, f.queue_capacity,
+              f.video_clock.c_str());
   if (live.pose_feed)
-    ImGui::Text("tracker: %lld poses, %lld reconnects", live.poses_received, live.pose_reconnects);
-  if (live.pose_feed && live.pose_gap_known) {
-    const std::string span = std::isfinite(live.pose_gap_tracker_s)
-                                 ? Format("%.3f s of tracker time", live.pose_gap_tracker_s)
+    ImGui::Text("tracker: %lld poses, %lld reconnects", live.feed.poses, live.feed.reconnects);
+  if (const PoseFeedGap* gap = live.last_gap(); live.pose_feed && gap) {
+    const double tracker_s = gap->tracker_gap_s();
+    const std::string span = std::isfinite(tracker_s)
+                                 ? Format("%.3f s of tracker time", tracker_s)
                                  : std::string("tracker time not known yet");
-    ImGui::Text("last gap: %.2f s disconnected, %s", live.pose_gap_disconnected_s, span.c_str());
+    ImGui::Text("last gap: %.2f s disconnected, %s", gap->disconnected_s, span.c_str());
   }
   const std::string lag = live.pose_lag_known ? Format("%+.3f s", live.pose_lag_s) : "-";
   ImGui::Text("pose-match lag: %s", lag.c_str());
@@ -88,19 +89,19 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
     ImGui::SetTooltip(
         "the tracker's newest pose time minus the last frame's pose time\n"
         "(> 0: the tracker is ahead of the video)");
-  std::string offset = Format("%.4f s", live.time_offset_s);
+  std::string offset = Format("%.4f s", f.time_offset_s);
   if (live.offset_estimating)
     offset += " (estimating...)";
-  else if (live.offset_estimated)
-    offset += Format(" (estimated, score %.2f)", live.offset_score);
-  else if (!live.offset_note.empty())
-    offset += " (not estimated: " + live.offset_note + ")";
+  else if (f.offset_estimated)
+    offset += Format(" (estimated, score %.2f)", f.estimate.score);
+  else if (!f.estimate.note.empty())
+    offset += " (not estimated: " + f.estimate.note + ")";
   else
     offset += " (as set)";
   ImGui::TextWrapped("time offset: %s", offset.c_str());
-  if (live.offset_track_points > 0)
-    ImGui::Text("tracked: %d re-estimates, last %.4f s (%s)", live.offset_track_points,
-                live.offset_track_last_s, live.offset_track_last_applied ? "applied" : "kept");
+  if (!f.offset_track.empty())
+    ImGui::Text("tracked: %zu re-estimates, last %.4f s (%s)", f.offset_track.size(),
+                f.offset_track.back().offset_s, f.offset_track.back().applied ? "applied" : "kept");
   if (!live.problem.empty()) WrappedColored(kBad, live.problem);
 
   if (live.streams > 1) {
@@ -114,8 +115,8 @@ void LiveStatusSection::Draw(UiContext& ui, const LiveStatus& live) {
 
   report_["live.state"] = live.state;
   report_["live.poses_state"] = pose_state;
-  report_["live.frames_received"] = std::to_string(live.frames_received);
-  report_["live.frames_dropped"] = std::to_string(live.frames_dropped);
+  report_["live.frames_received"] = std::to_string(f.frames_received);
+  report_["live.frames_dropped"] = std::to_string(f.frames_dropped + f.frames_held_dropped);
   report_["live.frames_painted"] = std::to_string(live.frames_painted);
   report_["live.pose_lag"] = lag;
   report_["live.time_offset"] = offset;

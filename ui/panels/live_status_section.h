@@ -1,4 +1,4 @@
-// The Pipeline panel's section for live sources (issue 12): each source's state (receiving,
+// The Pipeline panel's section for live sources (cameras, streams): each source's state (receiving,
 // stalled, ended, disconnected), frames received / painted / dropped, the queue, the
 // pose-match lag, the time offset (estimated or set), and the Record toggle that records
 // the session as a project to replay (opened from here).

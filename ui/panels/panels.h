@@ -22,11 +22,11 @@ std::unique_ptr<Panel> MakeInputFramePanel();
 std::unique_ptr<Panel> MakePaintedBuffersPanel();
 std::unique_ptr<Panel> MakeTimingPanel();
 std::unique_ptr<Panel> MakeMisalignmentPanel();
-// Calibration (issue 8): a window over columns 2-5, closed until opened from the View menu
+// Calibration: a window over columns 2-5, closed until opened from the View menu
 // or by `fresco gui --calib-images`.
 std::unique_ptr<Panel> MakeCalibrationPanel();
 inline constexpr const char* kCalibrationPanelTitle = "Calibration";
-// Poses with COLMAP (issue 9): a window over columns 2-5, closed until opened from the View
+// Poses with COLMAP: a window over columns 2-5, closed until opened from the View
 // menu or by `fresco gui --poses`.
 std::unique_ptr<Panel> MakePosesPanel();
 inline constexpr const char* kPosesPanelTitle = "Poses";

@@ -1,4 +1,4 @@
-// Poses with COLMAP (issue 9) for the operator: run COLMAP on the project's frames in the
+// Poses with COLMAP for the operator: run COLMAP on the project's frames in the
 // background (steps and elapsed time; cancel), the verification of the project's poses
 // against it (per-frame rotation and position disagreement along the sequence and as a
 // table, flagged frames red; a click on a row or a point moves the pipeline to that frame),

@@ -1,14 +1,13 @@
-// Scores of a painted model on one held-out frame of a synthetic capture, where the truth
-// is known: the frame's true pose, its exposure gain, and where the moving objects were.
+// The truth view of a held-out frame of a synthetic capture, where the truth is known: the
+// painted model rendered at the frame's TRUE pose against the static scene rendered there
+// with the frame's exposure gain (no movers): how close the painted texture is to the true
+// one where it is seen. HoldoutScorer (holdout_scorer.h) scores every held-out frame of a
+// capture with a SceneTruth this way, beside the rephotography at the given pose.
 //
-//   rephotography  the painted model rendered at the frame's GIVEN pose against the frame
-//                  itself (movers, exposure and all): what a user without truth can measure
-//                  (rephotography.h);
-//   truth          the painted model rendered at the TRUE pose against the static scene
-//                  rendered there with the frame's exposure gain (no movers): how close the
-//                  painted texture is to the true one where it is seen;
-//   mover leak     of the painted pixels in that truth view, those whose colour came from a
-//                  mover (the texels MoverProvenance followed, rendered as a texture);
+//   truth          PSNR and 1 - NCC over the pixels where both show the surface and the
+//                  model is painted;
+//   mover leak     of those painted pixels, the ones whose colour came from a mover (the
+//                  texels MoverProvenance followed, rendered as a texture);
 //   mover region error  of the painted pixels, those off the clean render by more than
 //                  `leak_threshold` levels (any channel) at a surface point that a mover hid
 //                  from the camera in at least one painted frame (movers, and any other error
@@ -22,7 +21,6 @@
 
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
-#include "pipeline/paint/rephotography.h"
 #include "pipeline/render/renderer.h"
 #include "pipeline/synth/movers.h"
 
@@ -35,18 +33,24 @@ struct PaintedFrameCentre {
   Eigen::Vector3d centre_world = Eigen::Vector3d::Zero();
 };
 
-struct TruthViewInputs {
-  const Renderer* painted_renderer = nullptr;  // the capture's camera, 1 sample per pixel
-  const Renderer* clean_renderer = nullptr;    // the same camera, the capture's supersampling
-  const Scene* painted = nullptr;              // PaintSession::PaintedScene()
-  const Scene* truth = nullptr;                // the static scene the frames were made of
-  Rigid3d true_cam_from_world;
-  double exposure_gain = 1.0;
+// What a synthetic capture knows besides its frames, for all of its held-out frames.
+struct SceneTruth {
+  const Scene* scene = nullptr;        // the static scene the frames were made of (world)
+  const Renderer* renderer = nullptr;  // the capture's camera, the capture's supersampling
+  // Where the movers were (optional: without them no mover figures).
   const std::vector<MoverOptions>* movers = nullptr;
   const std::vector<PaintedFrameCentre>* painted_frames = nullptr;
   double leak_threshold = 40.0;  // levels (0..255), largest channel difference
   // The painted scene with MoverProvenance::MaskImages as its texture, or null.
   const Scene* mover_texels = nullptr;
+};
+
+struct TruthViewInputs {
+  const Renderer* painted_renderer = nullptr;  // the capture's camera, 1 sample per pixel
+  const Scene* painted = nullptr;              // PaintSession::PaintedScene()
+  const SceneTruth* truth = nullptr;
+  Rigid3d true_cam_from_world;
+  double exposure_gain = 1.0;  // the frame's
 };
 
 struct TruthViewScore {

@@ -1,4 +1,4 @@
-#include "pipeline/eval/eval_score.h"
+#include "pipeline/rephoto/truth_view.h"
 
 #include <algorithm>
 #include <cmath>
@@ -19,9 +19,9 @@ double HidingRadius(const MoverOptions& mover) {
   return 1.05 * r;
 }
 
-bool HiddenByAMover(const Eigen::Vector3d& point_world, const TruthViewInputs& in) {
-  for (const PaintedFrameCentre& f : *in.painted_frames) {
-    for (const MoverOptions& m : *in.movers) {
+bool HiddenByAMover(const Eigen::Vector3d& point_world, const SceneTruth& truth) {
+  for (const PaintedFrameCentre& f : *truth.painted_frames) {
+    for (const MoverOptions& m : *truth.movers) {
       if (SegmentNearPoint(f.centre_world, point_world, MoverCentreAt(m, f.frame), HidingRadius(m)))
         return true;
     }
@@ -47,8 +47,9 @@ bool SegmentNearPoint(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
 
 TruthViewScore ScoreTruthView(const TruthViewInputs& in) {
   RenderOutput painted, clean;
+  const SceneTruth& truth = *in.truth;
   RenderViewDependent(*in.painted_renderer, *in.painted, in.true_cam_from_world, &painted);
-  in.clean_renderer->Render(*in.truth, in.true_cam_from_world, &clean);
+  truth.renderer->Render(*truth.scene, in.true_cam_from_world, &clean);
   const cv::Mat painted_bgr = Bgr(painted);
   cv::Mat clean_bgr = Bgr(clean);
   if (in.exposure_gain != 1.0) clean_bgr.convertTo(clean_bgr, CV_8U, in.exposure_gain);
@@ -61,7 +62,7 @@ TruthViewScore ScoreTruthView(const TruthViewInputs& in) {
   if (score.painted_pixels == 0) return score;
   score.psnr_db = PsnrDb(painted_bgr, clean_bgr, mask);
   score.one_minus_ncc = OneMinusNcc(painted_bgr, clean_bgr, mask);
-  if (!in.movers || in.movers->empty() || !in.painted_frames) return score;
+  if (!truth.movers || truth.movers->empty() || !truth.painted_frames) return score;
 
   cv::Mat diff;
   cv::absdiff(painted_bgr, clean_bgr, diff);
@@ -71,17 +72,17 @@ TruthViewScore ScoreTruthView(const TruthViewInputs& in) {
     for (int x = 0; x < mask.cols; ++x) {
       if (!mask.at<uint8_t>(y, x)) continue;
       const cv::Vec3b d = diff.at<cv::Vec3b>(y, x);
-      if (std::max({d[0], d[1], d[2]}) <= in.leak_threshold) continue;
+      if (std::max({d[0], d[1], d[2]}) <= truth.leak_threshold) continue;
       const Eigen::Vector2d normalized = rays.Ray(x, y).cast<double>();
       if (!normalized.allFinite()) continue;
       const double z = painted.depth.at<float>(y, x);
       const Eigen::Vector3d point = world_from_cam * (z * normalized.homogeneous());
-      score.region_error_pixels += HiddenByAMover(point, in);
+      score.region_error_pixels += HiddenByAMover(point, truth);
     }
   }
-  if (in.mover_texels) {
+  if (truth.mover_texels) {
     RenderOutput movers;
-    in.painted_renderer->Render(*in.mover_texels, in.true_cam_from_world, &movers);
+    in.painted_renderer->Render(*truth.mover_texels, in.true_cam_from_world, &movers);
     cv::Mat shows;
     cv::extractChannel(movers.rgba, shows, 0);
     score.leak_pixels = cv::countNonZero((shows >= 128) & mask);
