@@ -58,6 +58,52 @@ const char kBoardHelp[] =
 or a chessboard, at --dpi (default 300), and writes BOARD.png and BOARD.json (the physical
 size of what is drawn). Print at 100 % scale and check the size with a ruler.)";
 
+// The names --exclude lists (comma-separated, each option may repeat).
+std::vector<std::string> ExcludedNames(const Args& args) {
+  std::vector<std::string> names;
+  for (const std::string& list : args.All("--exclude"))
+    for (size_t start = 0; start <= list.size();) {
+      const size_t comma = std::min(list.find(',', start), list.size());
+      if (comma > start) names.push_back(list.substr(start, comma - start));
+      start = comma + 1;
+    }
+  return names;
+}
+
+// The summary on stdout: what was left out, every model tried, the one chosen and its
+// projection uncertainty.
+void PrintSolveSummary(const calib::CalibrationRun& run, const std::string& out) {
+  for (const std::string& name : run.excluded) std::cout << "excluded " << name << "\n";
+  for (const calib::RejectedImage& r : run.rejected)
+    std::cout << "rejected " << r.name << ": " << r.reason << "\n";
+  for (const calib::ModelTrial& t : run.choice.trials) {
+    char line[256];
+    if (!t.status.ok()) {
+      std::cout << "model " << t.short_name << ": failed: " << t.status.message() << "\n";
+      continue;
+    }
+    std::snprintf(line, sizeof(line), "model %-8s rms %.4f px  sigma %.4f px  ",
+                  t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px);
+    std::cout << line << calib::CrossValidationText(t) << "  " << calib::VerdictText(t) << "\n";
+  }
+  const calib::SolveResult& fit = run.Chosen().fit;
+  std::cout << "chosen " << run.Chosen().short_name << " (" << run.Chosen().lensmodel << "): fx "
+            << fit.intrinsics[0] << " fy " << fit.intrinsics[1] << " cx " << fit.intrinsics[2]
+            << " cy " << fit.intrinsics[3] << ", rms " << fit.rms_px << " px, " << run.views.size()
+            << " images used, " << run.rejected.size() << " rejected, " << run.excluded.size()
+            << " excluded\n";
+  for (const std::string& doubt : run.camera_doubts)
+    std::cout << "NOT ONE CAMERA: " << doubt << "\n";
+  const calib::UncertaintyMap& u = run.uncertainty;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "projection uncertainty at %.2f m: centre %.3f px, median where observed "
+                "%.3f px, max %.3f px\n",
+                u.range_m, u.centre_px, u.median_observed_px, u.max_px);
+  std::cout << line;
+  std::cout << "wrote " << out << " and " << calib::SiblingPath(out, ".report.json") << "\n";
+}
+
 int RunSolve(const CommandArgs& argv) {
   ArgSpec spec;
   spec.usage =
@@ -74,12 +120,7 @@ int RunSolve(const CommandArgs& argv) {
   if (int code = ParseVerbArgs("calib solve", argv, spec, &args); code >= 0) return code;
   calib::CalibrateRequest request;
   request.images_dir = args.positional[0];
-  for (const std::string& list : args.All("--exclude"))
-    for (size_t start = 0; start <= list.size();) {
-      const size_t comma = std::min(list.find(',', start), list.size());
-      if (comma > start) request.exclude.push_back(list.substr(start, comma - start));
-      start = comma + 1;
-    }
+  request.exclude = ExcludedNames(args);
   if (Status s = calib::ParseBoardSpec(args.Get("--board"), "--board", &request.board); !s.ok())
     return Fail(s);
   request.model = args.Get("--model", "auto");
@@ -130,37 +171,7 @@ int RunSolve(const CommandArgs& argv) {
               << "residual tools need them): " << optimization_inputs_missing << "\n";
 
   for (const std::string& w : run.warnings) std::cerr << "warning: " << w << "\n";
-  if (!quiet) {
-    for (const std::string& name : run.excluded) std::cout << "excluded " << name << "\n";
-    for (const calib::RejectedImage& r : run.rejected)
-      std::cout << "rejected " << r.name << ": " << r.reason << "\n";
-    for (const calib::ModelTrial& t : run.choice.trials) {
-      char line[256];
-      if (!t.status.ok()) {
-        std::cout << "model " << t.short_name << ": failed: " << t.status.message() << "\n";
-        continue;
-      }
-      std::snprintf(line, sizeof(line), "model %-8s rms %.4f px  sigma %.4f px  ",
-                    t.short_name.c_str(), t.fit.rms_px, t.fit.noise_sigma_px);
-      std::cout << line << calib::CrossValidationText(t) << "  " << calib::VerdictText(t) << "\n";
-    }
-    const calib::SolveResult& fit = run.Chosen().fit;
-    std::cout << "chosen " << run.Chosen().short_name << " (" << run.Chosen().lensmodel << "): fx "
-              << fit.intrinsics[0] << " fy " << fit.intrinsics[1] << " cx " << fit.intrinsics[2]
-              << " cy " << fit.intrinsics[3] << ", rms " << fit.rms_px << " px, "
-              << run.views.size() << " images used, " << run.rejected.size() << " rejected, "
-              << run.excluded.size() << " excluded\n";
-    for (const std::string& doubt : run.camera_doubts)
-      std::cout << "NOT ONE CAMERA: " << doubt << "\n";
-    const calib::UncertaintyMap& u = run.uncertainty;
-    char line[256];
-    std::snprintf(line, sizeof(line),
-                  "projection uncertainty at %.2f m: centre %.3f px, median where observed "
-                  "%.3f px, max %.3f px\n",
-                  u.range_m, u.centre_px, u.median_observed_px, u.max_px);
-    std::cout << line;
-    std::cout << "wrote " << out << " and " << calib::SiblingPath(out, ".report.json") << "\n";
-  }
+  if (!quiet) PrintSolveSummary(run, out);
   return kExitOk;
 }
 

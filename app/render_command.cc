@@ -137,6 +137,140 @@ struct Job {
   std::string relative;  // output path relative to DIR, without ".png"
 };
 
+// The images written besides the colour one, and how layers are shown.
+struct RenderOutputs {
+  bool depth = false;       // DIR/NAME.depth.png
+  bool ids = false;         // DIR/NAME.ids.png
+  bool view_layers = true;  // false: the base-colour texture only
+};
+
+// The renderer's options from the command line; "" or what is wrong with them.
+std::string ParseRenderOptions(const Args& parsed, RenderOptions* options) {
+  std::string error;
+  if (parsed.Has("--supersample")) {
+    if (!ParseInt(parsed.Get("--supersample"), "--supersample", &options->raster.supersample,
+                  &error))
+      return error;
+    if (options->raster.supersample < 1 || options->raster.supersample > 4)
+      return "--supersample: must be 1..4";
+  }
+  if (parsed.Has("--filter")) {
+    const std::string filter = parsed.Get("--filter");
+    if (filter == "bilinear") {
+      options->filter = TextureFilter::kBilinear;
+    } else if (filter == "nearest") {
+      options->filter = TextureFilter::kNearest;
+    } else {
+      return "--filter: '" + filter + "' is not nearest|bilinear";
+    }
+  }
+  if (parsed.Has("--near")) {
+    if (!ParseDouble(parsed.Get("--near"), "--near", &options->raster.near_m, &error)) return error;
+    if (!(options->raster.near_m > 0)) return "--near: must be > 0";
+  }
+  options->raster.cull_back_faces = parsed.Switch("--cull-back-faces");
+  return "";
+}
+
+// The cameras, each valid and small enough to render with n x n samples per pixel.
+Status ReadRenderCameras(const std::string& camera_path, int n, std::map<int, Camera>* cameras) {
+  FRESCO_RETURN_IF_ERROR(ReadCameras(camera_path, cameras));
+  if (cameras->empty()) return Status::Error(camera_path + ": no camera");
+  for (const auto& [id, camera] : *cameras) {
+    FRESCO_RETURN_IF_ERROR(camera.Validate(camera_path + ": camera " + std::to_string(id)));
+    if (static_cast<double>(camera.width) * camera.height * n * n > kMaxSamplesPerImage) {
+      return Status::Error(camera_path + ": camera " + std::to_string(id) + ": image size " +
+                           std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                           " x " + std::to_string(n * n) +
+                           " samples per pixel is too large (at most " + std::to_string(1 << 26) +
+                           " samples)");
+    }
+  }
+  return Status::Ok();
+}
+
+// Where the poses come from, and the cameras they may use.
+struct PoseSource {
+  const std::string& poses_path;
+  const std::string& camera_path;
+  const std::map<int, Camera>& cameras;
+  bool is_tum = false;
+};
+
+// Pose i as messages name it.
+std::string PoseWhat(const PoseSource& source, const std::vector<PosedImage>& poses, size_t i) {
+  return source.poses_path + ": " +
+         (source.is_tum ? "pose " + std::to_string(i + 1) : "image '" + poses[i].name + "'");
+}
+
+// Pose i's job: its camera (its own, or the only one) and its output name.
+Status JobFor(const PoseSource& source, const std::vector<PosedImage>& poses, size_t i, Job* job) {
+  const PosedImage& pose = poses[i];
+  const std::string what = PoseWhat(source, poses, i);
+  if (!pose.cam_from_world.AllFinite()) return Status::Error(what + ": pose is not finite");
+  job->pose = &pose;
+  if (source.cameras.count(pose.camera_id)) {
+    job->camera_id = pose.camera_id;
+  } else if (source.cameras.size() == 1) {
+    job->camera_id = source.cameras.begin()->first;
+  } else {
+    return Status::Error(what + ": CAMERA_ID " + std::to_string(pose.camera_id) + " is not in " +
+                         source.camera_path);
+  }
+  if (source.is_tum) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06zu", i);
+    job->relative = name;
+  } else {
+    std::string why;
+    if (!OutputName(pose.name, "", &job->relative, &why)) return Status::Error(what + ": " + why);
+  }
+  return Status::Ok();
+}
+
+// Poses, each matched to its camera and output name; no two outputs the same file.
+Status PlanJobs(const PoseSource& source, const std::vector<PosedImage>& poses,
+                const RenderOutputs& outputs_asked, std::vector<Job>* jobs) {
+  std::set<std::string> outputs;
+  for (size_t i = 0; i < poses.size(); ++i) {
+    Job job;
+    FRESCO_RETURN_IF_ERROR(JobFor(source, poses, i, &job));
+    if (!outputs.insert(job.relative).second) {
+      return Status::Error(PoseWhat(source, poses, i) + ": output " + job.relative +
+                           ".png would overwrite another image's");
+    }
+    jobs->push_back(job);
+  }
+  if (!outputs_asked.depth && !outputs_asked.ids) return Status::Ok();
+  for (const Job& job : *jobs) {
+    for (const char* suffix : {".depth", ".ids"}) {
+      if (outputs.count(job.relative + suffix)) {
+        return Status::Error(source.poses_path + ": output " + job.relative + suffix +
+                             ".png clashes with an image's output");
+      }
+    }
+  }
+  return Status::Ok();
+}
+
+// Renders one job and writes its images under `out_dir`.
+Status RenderJob(const Renderer& renderer, const Scene& scene, const Job& job,
+                 const RenderOutputs& outputs, const std::string& out_dir) {
+  RenderOutput out;
+  if (outputs.view_layers)
+    RenderViewDependent(renderer, scene, job.pose->cam_from_world, &out);
+  else
+    renderer.Render(scene, job.pose->cam_from_world, &out);
+  const std::string base = (fs::path(out_dir) / job.relative).string();
+  cv::Mat bgra;
+  cv::cvtColor(out.rgba, bgra, cv::COLOR_RGBA2BGRA);
+  Status written = WritePng(base + ".png", bgra);
+  if (written.ok() && outputs.depth)
+    written = WritePng(base + ".depth.png", DepthMillimetres(out.depth));
+  if (written.ok() && outputs.ids) written = WritePng(base + ".ids.png", IdsRgba(out.triangle_id));
+  return written;
+}
+
 }  // namespace
 
 int RunVerbRender(const CommandArgs& args) {
@@ -159,117 +293,25 @@ int RunVerbRender(const CommandArgs& args) {
   if (out_dir.empty()) return UsageError("render", spec, "--out: empty folder name");
 
   RenderOptions options;
-  std::string error;
-  if (parsed.Has("--supersample")) {
-    if (!ParseInt(parsed.Get("--supersample"), "--supersample", &options.raster.supersample,
-                  &error))
-      return UsageError("render", spec, error);
-    if (options.raster.supersample < 1 || options.raster.supersample > 4)
-      return UsageError("render", spec, "--supersample: must be 1..4");
-  }
-  if (parsed.Has("--filter")) {
-    const std::string filter = parsed.Get("--filter");
-    if (filter == "bilinear") {
-      options.filter = TextureFilter::kBilinear;
-    } else if (filter == "nearest") {
-      options.filter = TextureFilter::kNearest;
-    } else {
-      return UsageError("render", spec, "--filter: '" + filter + "' is not nearest|bilinear");
-    }
-  }
-  if (parsed.Has("--near")) {
-    if (!ParseDouble(parsed.Get("--near"), "--near", &options.raster.near_m, &error))
-      return UsageError("render", spec, error);
-    if (!(options.raster.near_m > 0)) return UsageError("render", spec, "--near: must be > 0");
-  }
-  options.raster.cull_back_faces = parsed.Switch("--cull-back-faces");
-  const bool write_depth = parsed.Switch("--depth");
-  const bool write_ids = parsed.Switch("--ids");
-  const bool view_layers = !parsed.Switch("--single-texture");
-  const int n = options.raster.supersample;
+  if (const std::string error = ParseRenderOptions(parsed, &options); !error.empty())
+    return UsageError("render", spec, error);
+  RenderOutputs outputs;
+  outputs.depth = parsed.Switch("--depth");
+  outputs.ids = parsed.Switch("--ids");
+  outputs.view_layers = !parsed.Switch("--single-texture");
 
-  // Cameras.
   std::map<int, Camera> cameras;
-  {
-    const Status read = ReadCameras(camera_path, &cameras);
-    if (!read.ok()) return Fail(read);
-  }
-  if (cameras.empty()) return Fail(Status::Error(camera_path + ": no camera"));
-  for (const auto& [id, camera] : cameras) {
-    const Status valid = camera.Validate(camera_path + ": camera " + std::to_string(id));
-    if (!valid.ok()) return Fail(valid);
-    if (static_cast<double>(camera.width) * camera.height * n * n > kMaxSamplesPerImage) {
-      return Fail(Status::Error(camera_path + ": camera " + std::to_string(id) + ": image size " +
-                                std::to_string(camera.width) + "x" + std::to_string(camera.height) +
-                                " x " + std::to_string(n * n) +
-                                " samples per pixel is too large (at most " +
-                                std::to_string(1 << 26) + " samples)"));
-    }
-  }
-
-  // Poses, each matched to its camera and output name.
+  if (Status s = ReadRenderCameras(camera_path, options.raster.supersample, &cameras); !s.ok())
+    return Fail(s);
   std::vector<PosedImage> poses;
-  bool is_tum = false;
-  {
-    const Status read = ReadPoses(poses_path, &poses, &is_tum);
-    if (!read.ok()) return Fail(read);
-  }
+  PoseSource source{poses_path, camera_path, cameras};
+  if (Status s = ReadPoses(poses_path, &poses, &source.is_tum); !s.ok()) return Fail(s);
   if (poses.empty()) return Fail(Status::Error(poses_path + ": no poses"));
   std::vector<Job> jobs;
-  std::set<std::string> outputs;
-  for (size_t i = 0; i < poses.size(); ++i) {
-    const PosedImage& pose = poses[i];
-    const std::string what =
-        poses_path + ": " +
-        (is_tum ? "pose " + std::to_string(i + 1) : "image '" + pose.name + "'");
-    if (!pose.cam_from_world.AllFinite()) return Fail(Status::Error(what + ": pose is not finite"));
-    Job job;
-    job.pose = &pose;
-    if (cameras.count(pose.camera_id)) {
-      job.camera_id = pose.camera_id;
-    } else if (cameras.size() == 1) {
-      job.camera_id = cameras.begin()->first;
-    } else {
-      return Fail(Status::Error(what + ": CAMERA_ID " + std::to_string(pose.camera_id) +
-                                " is not in " + camera_path));
-    }
-    if (is_tum) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "%06zu", i);
-      job.relative = name;
-    } else {
-      std::string why;
-      if (!OutputName(pose.name, "", &job.relative, &why))
-        return Fail(Status::Error(what + ": " + why));
-    }
-    if (!outputs.insert(job.relative).second) {
-      return Fail(Status::Error(what + ": output " + job.relative +
-                                ".png would overwrite another image's"));
-    }
-    jobs.push_back(job);
-  }
-  if (write_depth || write_ids) {
-    for (const Job& job : jobs) {
-      for (const char* suffix : {".depth", ".ids"}) {
-        if (outputs.count(job.relative + suffix)) {
-          return Fail(Status::Error(poses_path + ": output " + job.relative + suffix +
-                                    ".png clashes with an image's output"));
-        }
-      }
-    }
-  }
-
-  // Scene.
+  if (Status s = PlanJobs(source, poses, outputs, &jobs); !s.ok()) return Fail(s);
   Scene scene;
-  {
-    const Status loaded = LoadScene(model_path, SceneLoadOptions(), &scene);
-    if (!loaded.ok()) return Fail(loaded);
-  }
-
-  {
-    const Status made = MakeDirectories(out_dir);
-    if (!made.ok()) return Fail(made);
-  }
+  if (Status s = LoadScene(model_path, SceneLoadOptions(), &scene); !s.ok()) return Fail(s);
+  if (Status s = MakeDirectories(out_dir); !s.ok()) return Fail(s);
 
   std::map<int, std::unique_ptr<Renderer>> renderers;  // by camera id (ray tables)
   Progress progress("render", static_cast<int>(jobs.size()), parsed.Switch("--quiet"));
@@ -277,21 +319,8 @@ int RunVerbRender(const CommandArgs& args) {
     const Job& job = jobs[i];
     std::unique_ptr<Renderer>& renderer = renderers[job.camera_id];
     if (!renderer) renderer = std::make_unique<Renderer>(cameras.at(job.camera_id), options);
-    RenderOutput out;
-    if (view_layers)
-      RenderViewDependent(*renderer, scene, job.pose->cam_from_world, &out);
-    else
-      renderer->Render(scene, job.pose->cam_from_world, &out);
-    const std::string base = (fs::path(out_dir) / job.relative).string();
-    cv::Mat bgra;
-    cv::cvtColor(out.rgba, bgra, cv::COLOR_RGBA2BGRA);
-    Status written = WritePng(base + ".png", bgra);
-    if (written.ok() && write_depth)
-      written = WritePng(base + ".depth.png", DepthMillimetres(out.depth));
-    if (written.ok() && write_ids) written = WritePng(base + ".ids.png", IdsRgba(out.triangle_id));
-    if (!written.ok()) {
+    if (Status written = RenderJob(*renderer, scene, job, outputs, out_dir); !written.ok())
       return Fail(written);
-    }
     progress.Update(static_cast<int>(i + 1), job.relative + ".png");
   }
   progress.Finish(std::to_string(jobs.size()) + " images in " + out_dir);

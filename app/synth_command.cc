@@ -90,16 +90,9 @@ std::string Absolute(const std::string& path) {
   return fs::absolute(fs::path(path)).lexically_normal().string();
 }
 
-}  // namespace
-
-int RunVerbSynth(const CommandArgs& argv) {
-  const ArgSpec spec = SynthArgSpec();
-  Args args;
-  if (int code = ParseVerbArgs(kVerb, argv, spec, &args); code >= 0) return code;
-
-  // Command-line settings become overrides of the spec, checked here first so that errors
-  // name the option.
-  std::vector<SynthSpecOverride> overrides;
+// Command-line settings become overrides of the spec, checked here first so that errors
+// name the option. Returns "" or what is wrong.
+std::string ParseOverrides(const Args& args, std::vector<SynthSpecOverride>* overrides) {
   std::string error;
   struct NumberOption {
     const char* option;
@@ -120,28 +113,108 @@ int RunVerbSynth(const CommandArgs& argv) {
     const std::string text = args.Get(n.option);
     if (n.integer) {
       int value = 0;
-      if (!ParseInt(text, n.option, &value, &error)) return UsageError(kVerb, spec, error);
+      if (!ParseInt(text, n.option, &value, &error)) return error;
     } else {
       double value = 0;
-      if (!ParseDouble(text, n.option, &value, &error)) return UsageError(kVerb, spec, error);
+      if (!ParseDouble(text, n.option, &value, &error)) return error;
     }
-    overrides.push_back({n.key, text, false});
+    overrides->push_back({n.key, text, false});
   }
-  if (args.Has("--size")) overrides.push_back({"size", args.Get("--size"), true});
-  if (args.Has("--lens")) overrides.push_back({"lens", args.Get("--lens"), true});
-  if (args.Has("--path")) overrides.push_back({"path.kind", args.Get("--path"), true});
+  if (args.Has("--size")) overrides->push_back({"size", args.Get("--size"), true});
+  if (args.Has("--lens")) overrides->push_back({"lens", args.Get("--lens"), true});
+  if (args.Has("--path")) overrides->push_back({"path.kind", args.Get("--path"), true});
   if (args.Has("--scene")) {
     std::string scene = args.Get("--scene");
     if (scene.rfind("builtin:", 0) != 0) scene = Absolute(scene);
-    overrides.push_back({"scene", scene, true});
+    overrides->push_back({"scene", scene, true});
   }
   for (const std::string& set : args.All("--set")) {
     const size_t eq = set.find('=');
-    if (eq == std::string::npos || eq == 0) {
-      return UsageError(kVerb, spec, "--set: '" + set + "' is not KEY=VALUE");
-    }
-    overrides.push_back({set.substr(0, eq), set.substr(eq + 1), false});
+    if (eq == std::string::npos || eq == 0) return "--set: '" + set + "' is not KEY=VALUE";
+    overrides->push_back({set.substr(0, eq), set.substr(eq + 1), false});
   }
+  return "";
+}
+
+// --scene-only: the scene alone, as DIR/scene.gltf.
+int ExportSceneOnly(const SynthJob& job, const std::string& out) {
+  const std::string gltf = (fs::path(out) / "scene.gltf").string();
+  const Status status = ExportSynthScene(job.scene, job.texture_files, gltf);
+  if (!status.ok()) return Fail(status);
+  std::cout << "wrote " << gltf << " (" << job.scene.mesh.NumTriangles() << " triangles, "
+            << job.scene.textures.size() << " textures) from " << job.scene_source << "\n";
+  return kExitOk;
+}
+
+// What was written, stream by stream, and how to run it.
+void PrintWritten(const SynthJob& job, const std::string& out, const SynthWriteResult& result) {
+  if (job.streams.empty()) {
+    std::cout << "wrote " << out << ": " << result.frames << " frames " << job.options.width << "x"
+              << job.options.height << " of " << job.scene_source << "\n";
+  } else {
+    std::cout << "wrote " << out << ": " << job.streams.size() << " streams of " << job.scene_source
+              << "\n";
+    for (const SynthStream& stream : job.streams) {
+      const SynthOptions& o = stream.options;
+      std::cout << "  " << stream.name << "/: " << o.frames << " frames " << o.width << "x"
+                << o.height << ", " << CameraPathKindName(o.path) << " path\n";
+    }
+  }
+  std::cout << "run it: fresco run " << (fs::path(out) / "project.json").string() << " --out OUT\n";
+}
+
+// Renders and writes the capture (every stream) to `out`; returns the exit code.
+int WriteCapture(const SynthJob& job, const std::string& out, bool if_changed) {
+  SynthWriteOptions write_options;
+  write_options.skip_if_current = if_changed;
+  write_options.scene_source = job.scene_source;
+  int total_frames = job.streams.empty() ? job.options.frames : 0;
+  for (const SynthStream& stream : job.streams) total_frames += stream.options.frames;
+  Progress progress("synth", total_frames);
+  int frames_written = 0;
+  write_options.progress = [&](int done, int total) {
+    frames_written = done;
+    progress.Update(done);
+  };
+  write_options.stop = [] { return Interrupted(); };
+  SynthWriteResult result;
+  InterruptCatcher interrupt;
+  const Status status =
+      job.streams.empty() ? WriteSynthCapture(job.scene, job.options, out, write_options, &result)
+                          : WriteSynthStreams(job.scene, job.streams, out, write_options, &result);
+  if (Interrupted() && !status.ok()) {
+    progress.Clear();
+    std::fprintf(stderr,
+                 "fresco synth: interrupted by %s after %d of %d frames; %s keeps its earlier "
+                 "capture, if any (nothing of this one was kept)\n",
+                 InterruptSignalName().c_str(), frames_written, total_frames, out.c_str());
+    return InterruptExitCode();
+  }
+  if (!status.ok()) return Fail(status);
+  if (result.skipped) {
+    std::cout << "synth: " << out << " is current (" << result.frames << " frames, fingerprint "
+              << result.fingerprint << "): nothing to do\n";
+    return kExitOk;
+  }
+  progress.Finish();
+  PrintWritten(job, out, result);
+  if (Interrupted()) {  // after the frames: the capture was finished first
+    std::fprintf(stderr, "fresco synth: interrupted by %s while writing; finished %s first\n",
+                 InterruptSignalName().c_str(), out.c_str());
+    return InterruptExitCode();
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int RunVerbSynth(const CommandArgs& argv) {
+  const ArgSpec spec = SynthArgSpec();
+  Args args;
+  if (int code = ParseVerbArgs(kVerb, argv, spec, &args); code >= 0) return code;
+  std::vector<SynthSpecOverride> overrides;
+  if (const std::string error = ParseOverrides(args, &overrides); !error.empty())
+    return UsageError(kVerb, spec, error);
 
   SynthJob job;
   Status status;
@@ -158,71 +231,8 @@ int RunVerbSynth(const CommandArgs& argv) {
   if (!status.ok()) return Fail(status);
   const std::string out = args.Has("--out") ? Absolute(args.Get("--out")) : job.out_dir;
   if (out.empty()) return UsageError(kVerb, spec, "missing --out (or \"out\" in the spec)");
-
-  if (args.Switch("--scene-only")) {
-    const std::string gltf = (fs::path(out) / "scene.gltf").string();
-    status = ExportSynthScene(job.scene, job.texture_files, gltf);
-    if (!status.ok()) {
-      return Fail(status);
-    }
-    std::cout << "wrote " << gltf << " (" << job.scene.mesh.NumTriangles() << " triangles, "
-              << job.scene.textures.size() << " textures) from " << job.scene_source << "\n";
-    return kExitOk;
-  }
-
-  SynthWriteOptions write_options;
-  write_options.skip_if_current = args.Switch("--if-changed");
-  write_options.scene_source = job.scene_source;
-  int total_frames = job.streams.empty() ? job.options.frames : 0;
-  for (const SynthStream& stream : job.streams) total_frames += stream.options.frames;
-  Progress progress("synth", total_frames);
-  int frames_written = 0;
-  write_options.progress = [&](int done, int total) {
-    frames_written = done;
-    progress.Update(done);
-  };
-  write_options.stop = [] { return Interrupted(); };
-  SynthWriteResult result;
-  InterruptCatcher interrupt;
-  status = job.streams.empty()
-               ? WriteSynthCapture(job.scene, job.options, out, write_options, &result)
-               : WriteSynthStreams(job.scene, job.streams, out, write_options, &result);
-  if (Interrupted() && !status.ok()) {
-    progress.Clear();
-    std::fprintf(stderr,
-                 "fresco synth: interrupted by %s after %d of %d frames; %s keeps its earlier "
-                 "capture, if any (nothing of this one was kept)\n",
-                 InterruptSignalName().c_str(), frames_written, total_frames, out.c_str());
-    return InterruptExitCode();
-  }
-  if (!status.ok()) {
-    return Fail(status);
-  }
-  if (result.skipped) {
-    std::cout << "synth: " << out << " is current (" << result.frames << " frames, fingerprint "
-              << result.fingerprint << "): nothing to do\n";
-    return kExitOk;
-  }
-  progress.Finish();
-  if (job.streams.empty()) {
-    std::cout << "wrote " << out << ": " << result.frames << " frames " << job.options.width << "x"
-              << job.options.height << " of " << job.scene_source << "\n";
-  } else {
-    std::cout << "wrote " << out << ": " << job.streams.size() << " streams of " << job.scene_source
-              << "\n";
-    for (const SynthStream& stream : job.streams) {
-      const SynthOptions& o = stream.options;
-      std::cout << "  " << stream.name << "/: " << o.frames << " frames " << o.width << "x"
-                << o.height << ", " << CameraPathKindName(o.path) << " path\n";
-    }
-  }
-  std::cout << "run it: fresco run " << (fs::path(out) / "project.json").string() << " --out OUT\n";
-  if (Interrupted()) {  // after the frames: the capture was finished first
-    std::fprintf(stderr, "fresco synth: interrupted by %s while writing; finished %s first\n",
-                 InterruptSignalName().c_str(), out.c_str());
-    return InterruptExitCode();
-  }
-  return kExitOk;
+  if (args.Switch("--scene-only")) return ExportSceneOnly(job, out);
+  return WriteCapture(job, out, args.Switch("--if-changed"));
 }
 
 }  // namespace fresco

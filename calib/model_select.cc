@@ -55,8 +55,8 @@ void CrossValidate(const std::vector<BoardView>& views, const BoardSpec& spec, i
   std::vector<int> compared;
   std::vector<Eigen::Vector2d> diffs;
   if (!ProjectionDifferences_px(half_fit[0].lensmodel, half_fit[0].intrinsics,
-                                half_fit[1].lensmodel, half_fit[1].intrinsics, observed,
-                                &compared, &diffs))
+                                half_fit[1].lensmodel, half_fit[1].intrinsics, observed, &compared,
+                                &diffs))
     return;
   double diff_sum = 0;
   std::vector<Eigen::Vector2d> pixels;
@@ -110,7 +110,8 @@ std::string MrcalLensModelName(const std::string& short_name, const CalibrationS
                       {Eigen::Vector2d(-0.5, seed.cy), Eigen::Vector2d(width - 0.5, seed.cy)},
                       &rays) &&
       rays[0].allFinite() && rays[1].allFinite()) {
-    const double angle = std::acos(std::clamp(rays[0].normalized().dot(rays[1].normalized()), -1.0, 1.0));
+    const double angle =
+        std::acos(std::clamp(rays[0].normalized().dot(rays[1].normalized()), -1.0, 1.0));
     if (angle > 0.1) fov_deg = angle * 180 / M_PI;
   }
   const int fov = std::clamp(static_cast<int>(std::ceil(fov_deg * kFovMargin)), 10, 170);
@@ -143,7 +144,8 @@ std::string VerdictText(const ModelTrial& trial) {
 std::vector<Eigen::Vector2d> ObservedPixels(const std::vector<BoardView>& views, int width,
                                             int height) {
   const double cell = width / 16.0;
-  const int nx = static_cast<int>(std::ceil(width / cell)), ny = static_cast<int>(std::ceil(height / cell));
+  const int nx = static_cast<int>(std::ceil(width / cell)),
+            ny = static_cast<int>(std::ceil(height / cell));
   std::vector<bool> seen(nx * ny, false);
   for (const BoardView& v : views)
     for (const CornerObservation& c : v.corners) {
@@ -160,154 +162,214 @@ std::vector<Eigen::Vector2d> ObservedPixels(const std::vector<BoardView>& views,
   return pixels;
 }
 
-Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
-                     int height, const CalibrationSeed& seed, const SelectOptions& options,
-                     ModelChoice* choice) {
-  ModelChoice out;
-  std::vector<int> halves[2];
-  for (size_t i = 0; i < views.size(); ++i) halves[i % 2].push_back(static_cast<int>(i));
-  const bool can_cross_validate = options.cross_validate &&
-                                  static_cast<int>(halves[1].size()) >= kMinViewsPerHalf;
-  if (options.cross_validate && !can_cross_validate)
-    out.warnings.push_back("only " + std::to_string(views.size()) +
-                           " usable images: too few to cross-validate (need " +
-                           std::to_string(2 * kMinViewsPerHalf) + ")");
-  const std::vector<Eigen::Vector2d> observed = ObservedPixels(views, width, height);
-  const int total_solves =
-      static_cast<int>(options.candidates.size()) * (can_cross_validate ? 3 : 1);
-  int solves_started = 0;
-  auto starting = [&](const std::string& what) {
-    if (options.progress) options.progress(solves_started, total_solves, what);
-    ++solves_started;
-  };
-  for (const std::string& short_name : options.candidates) {
-    ModelTrial trial;
-    trial.short_name = short_name;
-    trial.lensmodel = MrcalLensModelName(short_name, seed, width, height);
-    if (trial.lensmodel.empty())
-      return Status::Error("--model: unknown lens model '" + short_name + "'");
-    SolveOptions solve = options.solve;
-    solve.lensmodel = trial.lensmodel;
-    starting(short_name + ": all " + std::to_string(views.size()) + " images");
-    trial.status = SolveIntrinsics(views, spec, width, height, seed, solve, &trial.fit);
-    if (trial.status.ok() && spec.kind == BoardKind::kAprilGrid) {
-      trial.corner_correlation = TagCornerCorrelation(views, trial.fit);
-      trial.noise_inflation = TagNoiseInflation(trial.corner_correlation);
-    }
-    out.trials.push_back(std::move(trial));
+namespace {
+
+// The calibration's data the models are fitted to.
+struct FitInputs {
+  const std::vector<BoardView>& views;
+  const BoardSpec& spec;
+  int width = 0, height = 0;
+  const CalibrationSeed& seed;
+};
+
+// Chooses among the candidate lens models (FitLensModels): the state its steps share.
+class ModelSelector {
+ public:
+  ModelSelector(const FitInputs& in, const SelectOptions& options)
+      : in_(in), options_(options), observed_(ObservedPixels(in.views, in.width, in.height)) {
+    for (size_t i = 0; i < in.views.size(); ++i) halves_[i % 2].push_back(static_cast<int>(i));
+    can_cross_validate_ =
+        options.cross_validate && static_cast<int>(halves_[1].size()) >= kMinViewsPerHalf;
+    if (options.cross_validate && !can_cross_validate_)
+      out_.warnings.push_back("only " + std::to_string(in.views.size()) +
+                              " usable images: too few to cross-validate (need " +
+                              std::to_string(2 * kMinViewsPerHalf) + ")");
+    total_solves_ = static_cast<int>(options.candidates.size()) * (can_cross_validate_ ? 3 : 1);
   }
-  if (std::none_of(out.trials.begin(), out.trials.end(),
-                   [](const ModelTrial& t) { return t.status.ok(); }))
-    return Status::Error("no lens model could be solved: " + out.trials[0].status.message());
+
+  // Every candidate solved on all images; an error when none could be.
+  Status SolveCandidates() {
+    for (const std::string& short_name : options_.candidates) {
+      ModelTrial trial;
+      trial.short_name = short_name;
+      trial.lensmodel = MrcalLensModelName(short_name, in_.seed, in_.width, in_.height);
+      if (trial.lensmodel.empty())
+        return Status::Error("--model: unknown lens model '" + short_name + "'");
+      SolveOptions solve = options_.solve;
+      solve.lensmodel = trial.lensmodel;
+      Starting(short_name + ": all " + std::to_string(in_.views.size()) + " images");
+      trial.status =
+          SolveIntrinsics(in_.views, in_.spec, in_.width, in_.height, in_.seed, solve, &trial.fit);
+      if (trial.status.ok() && in_.spec.kind == BoardKind::kAprilGrid) {
+        trial.corner_correlation = TagCornerCorrelation(in_.views, trial.fit);
+        trial.noise_inflation = TagNoiseInflation(trial.corner_correlation);
+      }
+      out_.trials.push_back(std::move(trial));
+    }
+    if (std::none_of(out_.trials.begin(), out_.trials.end(),
+                     [](const ModelTrial& t) { return t.status.ok(); }))
+      return Status::Error("no lens model could be solved: " + out_.trials[0].status.message());
+    return Status::Ok();
+  }
 
   // The halves are solved only where the choice depends on them (splined's halves are most
-  // of `auto`'s time on an AprilGrid): agree[i] is -1 until model i's halves are compared.
-  const int n = static_cast<int>(out.trials.size());
-  std::vector<int> agree(n, can_cross_validate ? -1 : 1);
-  for (int i = 0; i < n; ++i)
-    if (!out.trials[i].status.ok()) agree[i] = 0;
-  auto compare_halves = [&](int i) {
-    ModelTrial& t = out.trials[i];
-    SolveOptions solve = options.solve;
-    solve.lensmodel = t.lensmodel;
-    CrossValidate(views, spec, width, height, seed, halves, solve, observed, starting, &t);
-    agree[i] = t.cross_validation_px >= 0 && t.cross_validation_px <= AgreementLimit_px(t);
-  };
-  if (options.all_halves)
-    for (int i = 0; i < n; ++i)
-      if (agree[i] < 0) compare_halves(i);
-  std::vector<int> by_sigma;
-  for (int i = 0; i < n; ++i)
-    if (out.trials[i].status.ok()) by_sigma.push_back(i);
-  std::stable_sort(by_sigma.begin(), by_sigma.end(), [&](int a, int b) {
-    return out.trials[a].fit.noise_sigma_px < out.trials[b].fit.noise_sigma_px;
-  });
-  // The yardstick is the supported model with the lowest sigma: any model not yet compared
-  // below the lowest known-supported one may still be it.
-  auto possible_yardsticks = [&] {
-    std::vector<int> possible;
-    for (int i : by_sigma) {
-      if (agree[i] == 0) continue;
-      possible.push_back(i);
-      if (agree[i] == 1) break;
-    }
-    return possible;
-  };
-  std::map<int, double> uncertainty_of;             // yardstick -> RMS projection uncertainty
-  std::map<std::pair<int, int>, double> diff_of;    // (model, yardstick) -> projection diff
-  auto uncertainty = [&](int y) {
-    auto it = uncertainty_of.find(y);
-    if (it == uncertainty_of.end())
-      it = uncertainty_of.emplace(y, RmsProjectionUncertainty_px(out.trials[y], observed)).first;
-    return it->second;
-  };
-  auto projection_diff = [&](int i, int y) {
-    auto it = diff_of.find({i, y});
-    if (it == diff_of.end()) {
-      double d = ProjectionDifference_px(out.trials[i].fit.lensmodel, out.trials[i].fit.intrinsics,
-                                         out.trials[y].fit.lensmodel, out.trials[y].fit.intrinsics,
-                                         observed);
-      it = diff_of.emplace(std::make_pair(i, y), std::isfinite(d) ? d : -1).first;
-    }
-    return it->second;
-  };
-  // FITS against yardstick y: sigma within kFitTolerance of y's, or a projection within y's
-  // own uncertainty of y's (the richer model's gain is then below its own noise).
-  auto fits = [&](int i, int y) {
-    if (out.trials[i].fit.noise_sigma_px <= out.trials[y].fit.noise_sigma_px * (1 + kFitTolerance))
-      return true;
-    const double d = projection_diff(i, y);
-    return d >= 0 && d <= uncertainty(y);
-  };
+  // of `auto`'s time on an AprilGrid): agree_[i] is -1 until model i's halves are compared.
   // Simple to rich: the first model that is supported and fits whichever the yardstick turns
   // out to be. Where that is open, the simplest (cheapest) model whose halves would settle it
   // is compared, and the search starts again.
-  while (out.chosen < 0) {
-    const std::vector<int> possible = possible_yardsticks();
-    if (possible.empty()) break;  // no model's halves agree
-    int settle = -1;
-    for (int i = 0; i < n && out.chosen < 0 && settle < 0; ++i) {
-      if (agree[i] == 0) continue;
-      int fitting = 0;
-      for (int y : possible) fitting += fits(i, y);
-      if (fitting == 0) continue;  // too simple whichever model is the yardstick
-      if (fitting == static_cast<int>(possible.size()) && agree[i] == 1) {
-        out.chosen = i;
-        break;
-      }
-      settle = agree[i] < 0 ? i : n;
-      for (int y : possible)
-        if (agree[y] < 0) settle = std::min(settle, y);
+  void Choose() {
+    const int n = static_cast<int>(out_.trials.size());
+    agree_.assign(n, can_cross_validate_ ? -1 : 1);
+    for (int i = 0; i < n; ++i)
+      if (!out_.trials[i].status.ok()) agree_[i] = 0;
+    if (options_.all_halves)
+      for (int i = 0; i < n; ++i)
+        if (agree_[i] < 0) CompareHalves(i);
+    for (int i = 0; i < n; ++i)
+      if (out_.trials[i].status.ok()) by_sigma_.push_back(i);
+    std::stable_sort(by_sigma_.begin(), by_sigma_.end(), [&](int a, int b) {
+      return out_.trials[a].fit.noise_sigma_px < out_.trials[b].fit.noise_sigma_px;
+    });
+    while (out_.chosen < 0) {
+      const std::vector<int> possible = PossibleYardsticks();
+      if (possible.empty()) break;  // no model's halves agree
+      const int settle = ChooseOrSettle(possible);
+      if (out_.chosen >= 0 || settle < 0 || settle >= n) break;
+      CompareHalves(settle);
     }
-    if (out.chosen >= 0 || settle < 0 || settle >= n) break;
-    compare_halves(settle);
   }
+
   // Report every model against the yardstick: the lowest-sigma supported model (or, when no
   // model's halves agree, the lowest-sigma one).
-  int best = -1;
-  for (int i : by_sigma)
-    if (agree[i] == 1) {
-      best = i;
-      break;
+  ModelChoice Report() {
+    int best = -1;
+    for (int i : by_sigma_)
+      if (agree_[i] == 1) {
+        best = i;
+        break;
+      }
+    if (best < 0) best = by_sigma_.front();
+    for (int i = 0; i < static_cast<int>(out_.trials.size()); ++i) {
+      ModelTrial& t = out_.trials[i];
+      if (!t.status.ok()) continue;
+      t.supported = agree_[i] == 1;
+      t.halves_skipped = agree_[i] < 0;
+      t.fits = Fits(i, best);
+      t.projection_vs_best_px = ProjectionDiff(i, best);
+      t.best_uncertainty_px = Uncertainty(best);
     }
-  if (best < 0) best = by_sigma.front();
-  for (int i = 0; i < n; ++i) {
-    ModelTrial& t = out.trials[i];
-    if (!t.status.ok()) continue;
-    t.supported = agree[i] == 1;
-    t.halves_skipped = agree[i] < 0;
-    t.fits = fits(i, best);
-    t.projection_vs_best_px = projection_diff(i, best);
-    t.best_uncertainty_px = uncertainty(best);
+    if (out_.chosen < 0) {
+      out_.chosen = best;
+      out_.warnings.push_back("no model both fits and has halves that agree; kept the best fit, " +
+                              out_.trials[best].short_name + " (cross-validation " +
+                              Fixed(out_.trials[best].cross_validation_px, 3) +
+                              " px): add images that cover the whole imager");
+    }
+    return std::move(out_);
   }
-  if (out.chosen < 0) {
-    out.chosen = best;
-    out.warnings.push_back("no model both fits and has halves that agree; kept the best fit, " +
-                           out.trials[best].short_name + " (cross-validation " +
-                           Fixed(out.trials[best].cross_validation_px, 3) +
-                           " px): add images that cover the whole imager");
+
+ private:
+  void Starting(const std::string& what) {
+    if (options_.progress) options_.progress(solves_started_, total_solves_, what);
+    ++solves_started_;
   }
-  *choice = std::move(out);
+
+  void CompareHalves(int i) {
+    ModelTrial& t = out_.trials[i];
+    SolveOptions solve = options_.solve;
+    solve.lensmodel = t.lensmodel;
+    CrossValidate(
+        in_.views, in_.spec, in_.width, in_.height, in_.seed, halves_, solve, observed_,
+        [this](const std::string& what) { Starting(what); }, &t);
+    agree_[i] = t.cross_validation_px >= 0 && t.cross_validation_px <= AgreementLimit_px(t);
+  }
+
+  // The yardstick is the supported model with the lowest sigma: any model not yet compared
+  // below the lowest known-supported one may still be it.
+  std::vector<int> PossibleYardsticks() const {
+    std::vector<int> possible;
+    for (int i : by_sigma_) {
+      if (agree_[i] == 0) continue;
+      possible.push_back(i);
+      if (agree_[i] == 1) break;
+    }
+    return possible;
+  }
+
+  // Sets the choice when a supported model fits every possible yardstick; else returns the
+  // simplest model whose halves would settle it (n: none to compare, -1: none fits).
+  int ChooseOrSettle(const std::vector<int>& possible) {
+    const int n = static_cast<int>(out_.trials.size());
+    int settle = -1;
+    for (int i = 0; i < n && out_.chosen < 0 && settle < 0; ++i) {
+      if (agree_[i] == 0) continue;
+      int fitting = 0;
+      for (int y : possible) fitting += Fits(i, y);
+      if (fitting == 0) continue;  // too simple whichever model is the yardstick
+      if (fitting == static_cast<int>(possible.size()) && agree_[i] == 1) {
+        out_.chosen = i;
+        break;
+      }
+      settle = agree_[i] < 0 ? i : n;
+      for (int y : possible)
+        if (agree_[y] < 0) settle = std::min(settle, y);
+    }
+    return settle;
+  }
+
+  // Yardstick y's RMS projection uncertainty (computed once).
+  double Uncertainty(int y) {
+    auto it = uncertainty_of_.find(y);
+    if (it == uncertainty_of_.end())
+      it = uncertainty_of_.emplace(y, RmsProjectionUncertainty_px(out_.trials[y], observed_)).first;
+    return it->second;
+  }
+
+  // Model i's projection difference from yardstick y (computed once; -1 where not finite).
+  double ProjectionDiff(int i, int y) {
+    auto it = diff_of_.find({i, y});
+    if (it == diff_of_.end()) {
+      const ModelTrial& a = out_.trials[i];
+      const ModelTrial& b = out_.trials[y];
+      double d = ProjectionDifference_px(a.fit.lensmodel, a.fit.intrinsics, b.fit.lensmodel,
+                                         b.fit.intrinsics, observed_);
+      it = diff_of_.emplace(std::make_pair(i, y), std::isfinite(d) ? d : -1).first;
+    }
+    return it->second;
+  }
+
+  // FITS against yardstick y: sigma within kFitTolerance of y's, or a projection within y's
+  // own uncertainty of y's (the richer model's gain is then below its own noise).
+  bool Fits(int i, int y) {
+    if (out_.trials[i].fit.noise_sigma_px <=
+        out_.trials[y].fit.noise_sigma_px * (1 + kFitTolerance))
+      return true;
+    const double d = ProjectionDiff(i, y);
+    return d >= 0 && d <= Uncertainty(y);
+  }
+
+  const FitInputs in_;
+  const SelectOptions& options_;
+  const std::vector<Eigen::Vector2d> observed_;
+  std::vector<int> halves_[2];
+  bool can_cross_validate_ = false;
+  int total_solves_ = 0, solves_started_ = 0;
+  ModelChoice out_;
+  std::vector<int> agree_;
+  std::vector<int> by_sigma_;
+  std::map<int, double> uncertainty_of_;           // yardstick -> RMS projection uncertainty
+  std::map<std::pair<int, int>, double> diff_of_;  // (model, yardstick) -> projection diff
+};
+
+}  // namespace
+
+Status FitLensModels(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
+                     int height, const CalibrationSeed& seed, const SelectOptions& options,
+                     ModelChoice* choice) {
+  ModelSelector selector(FitInputs{views, spec, width, height, seed}, options);
+  FRESCO_RETURN_IF_ERROR(selector.SolveCandidates());
+  selector.Choose();
+  *choice = selector.Report();
   return Status::Ok();
 }
 

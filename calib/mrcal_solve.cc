@@ -202,6 +202,125 @@ Eigen::MatrixXd StateCovariance(const Problem& p, const std::vector<int>& rows,
   return JtJ_inverse * JtJ_obs * JtJ_inverse;
 }
 
+// The board poses from the seed and every view's corners in the pool (the others absent);
+// returns the corners observed.
+int AddViews(const std::vector<BoardView>& views, const CalibrationSeed& seed, Problem* p) {
+  const int points_per_view = p->grid.width_n * p->grid.height_n;
+  p->pool.assign(views.size() * points_per_view, mrcal_point3_t{{0.0, 0.0, -1.0}});
+  int observed = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    p->observations.push_back(mrcal_observation_board_t{{0, -1}, static_cast<int>(v)});
+    mrcal_pose_t pose;
+    for (int k = 0; k < 3; ++k) {
+      pose.r.xyz[k] = seed.rt_cam_from_board[v][k];
+      pose.t.xyz[k] = seed.rt_cam_from_board[v][3 + k];
+    }
+    p->frames.push_back(pose);
+    for (const CornerObservation& c : views[v].corners) {
+      mrcal_point3_t& q = p->pool[v * points_per_view + p->grid.grid_index_of_corner[c.id]];
+      q.x = c.pixel.x();
+      q.y = c.pixel.y();
+      q.z = 1.0;
+      ++observed;
+    }
+  }
+  return observed;
+}
+
+// Stage 1's model (a stereographic core for splined) and its intrinsics from the seed.
+void SeedCore(const mrcal_lensmodel_t& target, bool splined, const CalibrationSeed& seed,
+              Problem* p) {
+  if (splined) {
+    LensModelFromName("LENSMODEL_STEREOGRAPHIC", &p->lensmodel);
+  } else {
+    p->lensmodel = target;
+  }
+  p->intrinsics.assign(mrcal_lensmodel_num_params(&p->lensmodel), 0.0);
+  p->intrinsics[0] = seed.fx;
+  p->intrinsics[1] = seed.fy;
+  p->intrinsics[2] = seed.cx;
+  p->intrinsics[3] = seed.cy;
+  if (p->intrinsics.size() >= 6) {  // OpenCV models: k1, k2 first
+    p->intrinsics[4] = seed.k1;
+    p->intrinsics[5] = seed.k2;
+  }
+}
+
+// Each view's fit (board pose, residuals, outliers) into `out` from the measurements `x`;
+// the inliers' measurement rows are appended to `rows`. Returns the inliers' sum of squares.
+double AddViewFits(const std::vector<BoardView>& views, const Problem& p,
+                   const std::vector<double>& x, SolveResult* out, std::vector<int>* rows) {
+  const int points_per_view = p.grid.width_n * p.grid.height_n;
+  double ssr = 0;
+  for (size_t v = 0; v < views.size(); ++v) {
+    ViewFit fit;
+    for (int k = 0; k < 3; ++k) {
+      fit.rt_cam_from_board[k] = p.frames[v].r.xyz[k];
+      fit.rt_cam_from_board[3 + k] = p.frames[v].t.xyz[k];
+    }
+    double view_ssr = 0;
+    int view_inliers = 0;
+    for (const CornerObservation& c : views[v].corners) {
+      const int g = p.grid.grid_index_of_corner[c.id];
+      const int m = p.MeasurementIndex(static_cast<int>(v), g);
+      const bool outlier = p.pool[v * points_per_view + g].z < 0;
+      // x is weight * (projected - observed); weights are 1, outliers give 0: re-project.
+      Eigen::Vector2d r(x[m], x[m + 1]);
+      fit.outlier.push_back(outlier);
+      if (outlier) {
+        ++fit.outliers;
+      } else {
+        view_ssr += r.squaredNorm();
+        ++view_inliers;
+        rows->push_back(m);
+        rows->push_back(m + 1);
+      }
+      fit.residual_px.push_back(r);
+    }
+    fit.rms_px = view_inliers ? std::sqrt(view_ssr / view_inliers) : 0;
+    ssr += view_ssr;
+    out->corners_used += view_inliers;
+    out->outliers += fit.outliers;
+    out->views.push_back(fit);
+  }
+  return ssr;
+}
+
+// Outliers have x = 0 from mrcal: fill their residuals by re-evaluating with them as inliers.
+void FillOutlierResiduals(const std::vector<BoardView>& views, const Problem& p, SolveResult* out) {
+  const int points_per_view = p.grid.width_n * p.grid.height_n;
+  Problem all = p;
+  for (size_t v = 0; v < views.size(); ++v)
+    for (const CornerObservation& c : views[v].corners)
+      all.pool[v * points_per_view + p.grid.grid_index_of_corner[c.id]].z = 1.0;
+  std::vector<double> x_all;
+  if (!Evaluate(all, &x_all)) return;
+  for (size_t v = 0; v < views.size(); ++v)
+    for (size_t k = 0; k < views[v].corners.size(); ++k)
+      if (out->views[v].outlier[k]) {
+        const int m = p.MeasurementIndex(static_cast<int>(v),
+                                         p.grid.grid_index_of_corner[views[v].corners[k].id]);
+        out->views[v].residual_px[k] = Eigen::Vector2d(x_all[m], x_all[m + 1]);
+      }
+}
+
+// The state's covariance and the intrinsics' standard deviations; `rows`: the inliers'
+// measurement rows (the regularization's are appended).
+void AddUncertainty(const Problem& p, const SolveOptions& options, std::vector<int>* rows,
+                    SolveResult* out) {
+  const int observation_rows = static_cast<int>(rows->size());
+  const int regularization =
+      mrcal_measurement_index_regularization(p.Nframes(), 0, p.grid.width_n, p.grid.height_n);
+  for (int m = regularization; m < p.NumMeasurements(); ++m) rows->push_back(m);
+  out->state_covariance_per_px2 = StateCovariance(p, *rows, observation_rows);
+  const double sigma = out->noise_sigma_px * options.noise_inflation;
+  for (int i = 0;
+       i < static_cast<int>(out->intrinsics.size()) && i < out->state_covariance_per_px2.rows();
+       ++i)
+    out->intrinsics_stdev.push_back(sigma *
+                                    std::sqrt(std::max(0.0, out->state_covariance_per_px2(i, i))));
+}
+
 }  // namespace
 
 Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
@@ -219,41 +338,10 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   p.grid = MakeBoardGrid(spec);
   p.imagersize[0] = width;
   p.imagersize[1] = height;
-  const int points_per_view = p.grid.width_n * p.grid.height_n;
-  p.pool.assign(views.size() * points_per_view, mrcal_point3_t{{0.0, 0.0, -1.0}});
-  int observed = 0;
-  for (size_t v = 0; v < views.size(); ++v) {
-    p.observations.push_back(mrcal_observation_board_t{{0, -1}, static_cast<int>(v)});
-    mrcal_pose_t pose;
-    for (int k = 0; k < 3; ++k) {
-      pose.r.xyz[k] = seed.rt_cam_from_board[v][k];
-      pose.t.xyz[k] = seed.rt_cam_from_board[v][3 + k];
-    }
-    p.frames.push_back(pose);
-    for (const CornerObservation& c : views[v].corners) {
-      mrcal_point3_t& q = p.pool[v * points_per_view + p.grid.grid_index_of_corner[c.id]];
-      q.x = c.pixel.x();
-      q.y = c.pixel.y();
-      q.z = 1.0;
-      ++observed;
-    }
-  }
+  const int observed = AddViews(views, seed, &p);
 
   // Stage 1: core and board poses, distortion held (a stereographic core for splined).
-  if (splined) {
-    LensModelFromName("LENSMODEL_STEREOGRAPHIC", &p.lensmodel);
-  } else {
-    p.lensmodel = target;
-  }
-  p.intrinsics.assign(mrcal_lensmodel_num_params(&p.lensmodel), 0.0);
-  p.intrinsics[0] = seed.fx;
-  p.intrinsics[1] = seed.fy;
-  p.intrinsics[2] = seed.cx;
-  p.intrinsics[3] = seed.cy;
-  if (p.intrinsics.size() >= 6) {  // OpenCV models: k1, k2 first
-    p.intrinsics[4] = seed.k1;
-    p.intrinsics[5] = seed.k2;
-  }
+  SeedCore(target, splined, seed, &p);
   p.selections = Selections(true, false, false, false, false);
   FRESCO_RETURN_IF_ERROR(Optimize(&p, nullptr));
 
@@ -280,72 +368,14 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   out.outlier_rejection = options.reject_outliers;
   out.num_states = p.NumStates();
   out.corners_observed = observed;
-  double ssr = 0;
   std::vector<int> rows;
-  for (size_t v = 0; v < views.size(); ++v) {
-    ViewFit fit;
-    for (int k = 0; k < 3; ++k) {
-      fit.rt_cam_from_board[k] = p.frames[v].r.xyz[k];
-      fit.rt_cam_from_board[3 + k] = p.frames[v].t.xyz[k];
-    }
-    double view_ssr = 0;
-    int view_inliers = 0;
-    for (const CornerObservation& c : views[v].corners) {
-      const int g = p.grid.grid_index_of_corner[c.id];
-      const int m = p.MeasurementIndex(static_cast<int>(v), g);
-      const bool outlier = p.pool[v * points_per_view + g].z < 0;
-      // x is weight * (projected - observed); weights are 1, outliers give 0: re-project.
-      Eigen::Vector2d r(x[m], x[m + 1]);
-      fit.outlier.push_back(outlier);
-      if (outlier) {
-        ++fit.outliers;
-      } else {
-        view_ssr += r.squaredNorm();
-        ++view_inliers;
-        rows.push_back(m);
-        rows.push_back(m + 1);
-      }
-      fit.residual_px.push_back(r);
-    }
-    fit.rms_px = view_inliers ? std::sqrt(view_ssr / view_inliers) : 0;
-    ssr += view_ssr;
-    out.corners_used += view_inliers;
-    out.outliers += fit.outliers;
-    out.views.push_back(fit);
-  }
-  // Outliers have x = 0 from mrcal: fill their residuals by re-evaluating with them as inliers.
-  if (out.outliers > 0) {
-    Problem all = p;
-    for (size_t v = 0; v < views.size(); ++v)
-      for (const CornerObservation& c : views[v].corners)
-        all.pool[v * points_per_view + p.grid.grid_index_of_corner[c.id]].z = 1.0;
-    std::vector<double> x_all;
-    if (Evaluate(all, &x_all))
-      for (size_t v = 0; v < views.size(); ++v)
-        for (size_t k = 0; k < views[v].corners.size(); ++k)
-          if (out.views[v].outlier[k]) {
-            const int m = p.MeasurementIndex(static_cast<int>(v),
-                                             p.grid.grid_index_of_corner[views[v].corners[k].id]);
-            out.views[v].residual_px[k] = Eigen::Vector2d(x_all[m], x_all[m + 1]);
-          }
-  }
+  const double ssr = AddViewFits(views, p, x, &out, &rows);
+  if (out.outliers > 0) FillOutlierResiduals(views, p, &out);
   if (out.corners_used == 0) return Status::Error("mrcal rejected every corner as an outlier");
   out.rms_px = std::sqrt(ssr / out.corners_used);
   const int dof = 2 * out.corners_used - out.num_states;
   out.noise_sigma_px = dof > 0 ? std::sqrt(ssr / dof) : out.rms_px;
-  if (options.compute_uncertainty) {
-    const int observation_rows = static_cast<int>(rows.size());
-    const int regularization =
-        mrcal_measurement_index_regularization(p.Nframes(), 0, p.grid.width_n, p.grid.height_n);
-    for (int m = regularization; m < p.NumMeasurements(); ++m) rows.push_back(m);
-    out.state_covariance_per_px2 = StateCovariance(p, rows, observation_rows);
-    const double sigma = out.noise_sigma_px * options.noise_inflation;
-    for (int i = 0;
-         i < static_cast<int>(out.intrinsics.size()) && i < out.state_covariance_per_px2.rows();
-         ++i)
-      out.intrinsics_stdev.push_back(sigma *
-                                     std::sqrt(std::max(0.0, out.state_covariance_per_px2(i, i))));
-  }
+  if (options.compute_uncertainty) AddUncertainty(p, options, &rows, &out);
   for (double v : out.intrinsics)
     if (!std::isfinite(v)) return Status::Error("mrcal's solve diverged (non-finite intrinsics)");
   *result = std::move(out);

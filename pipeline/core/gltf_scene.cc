@@ -1038,94 +1038,112 @@ class BinaryWriter {
   std::string data_;
 };
 
-}  // namespace
+bool TriangleHasUv(const TriangleMesh& mesh, int t) {
+  return !mesh.uvs.empty() && (mesh.has_uv.empty() || mesh.has_uv[t]);
+}
 
-Status SaveGltfScene(const Scene& scene, const std::string& path) {
-  const TriangleMesh& mesh = scene.mesh;
-  const int num_triangles = mesh.NumTriangles();
-  const int num_vertices = static_cast<int>(mesh.vertices.size());
-  // A scene that cannot be saved is a broken invariant: the loaders and the painter make
-  // only saveable ones.
-  auto fail = [&](const std::string& what) { return Status::Internal(path + ": " + what); };
+int TriangleMaterial(const TriangleMesh& mesh, int t) {
+  return mesh.material.empty() ? 0 : mesh.material[t];
+}
 
-  // Validate the scene before writing anything.
-  if (num_triangles == 0) return fail("cannot save a scene with no triangles");
-  const bool any_uvs = !mesh.uvs.empty();
-  if (any_uvs && static_cast<int>(mesh.uvs.size()) != num_triangles) {
-    return fail("mesh has " + std::to_string(mesh.uvs.size()) + " uv triples for " +
-                std::to_string(num_triangles) + " triangles");
-  }
-  if (!mesh.has_uv.empty() && static_cast<int>(mesh.has_uv.size()) != num_triangles) {
-    return fail("mesh has_uv has the wrong size");
-  }
-  if (!mesh.material.empty() && static_cast<int>(mesh.material.size()) != num_triangles) {
-    return fail("mesh material has the wrong size");
-  }
+// The scene's materials, or one default material when it has none.
+std::vector<Material> MaterialsToSave(const Scene& scene) {
   std::vector<Material> materials = scene.materials;
   if (materials.empty()) {
     materials.emplace_back();
     materials.back().name = "default";
   }
-  for (int v = 0; v < num_vertices; ++v) {
-    if (!mesh.vertices[v].allFinite())
-      return fail("vertex " + std::to_string(v) + " is not finite");
+  return materials;
+}
+
+// Why the mesh's per-triangle arrays or its vertices cannot be saved ("" when they can).
+std::string MeshArraysProblem(const TriangleMesh& mesh) {
+  const int num_triangles = mesh.NumTriangles();
+  if (num_triangles == 0) return "cannot save a scene with no triangles";
+  if (!mesh.uvs.empty() && static_cast<int>(mesh.uvs.size()) != num_triangles) {
+    return "mesh has " + std::to_string(mesh.uvs.size()) + " uv triples for " +
+           std::to_string(num_triangles) + " triangles";
   }
-  if (!scene.origin_in_world.allFinite()) return fail("origin_in_world is not finite");
-  auto triangle_has_uv = [&](int t) { return any_uvs && (mesh.has_uv.empty() || mesh.has_uv[t]); };
-  auto triangle_material = [&](int t) { return mesh.material.empty() ? 0 : mesh.material[t]; };
-  for (int t = 0; t < num_triangles; ++t) {
+  if (!mesh.has_uv.empty() && static_cast<int>(mesh.has_uv.size()) != num_triangles) {
+    return "mesh has_uv has the wrong size";
+  }
+  if (!mesh.material.empty() && static_cast<int>(mesh.material.size()) != num_triangles) {
+    return "mesh material has the wrong size";
+  }
+  for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+    if (!mesh.vertices[v].allFinite()) return "vertex " + std::to_string(v) + " is not finite";
+  }
+  return "";
+}
+
+// Why a triangle cannot be saved ("" when all can): its vertices, UVs and material.
+std::string TrianglesProblem(const TriangleMesh& mesh, size_t num_materials) {
+  const int num_vertices = static_cast<int>(mesh.vertices.size());
+  for (int t = 0; t < mesh.NumTriangles(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const int v = mesh.triangles[t][k];
       if (v < 0 || v >= num_vertices) {
-        return fail("triangle " + std::to_string(t) + ": vertex " + std::to_string(v) +
-                    " out of range (" + std::to_string(num_vertices) + " vertices)");
+        return "triangle " + std::to_string(t) + ": vertex " + std::to_string(v) +
+               " out of range (" + std::to_string(num_vertices) + " vertices)";
       }
-      if (triangle_has_uv(t) && !mesh.uvs[t][k].allFinite()) {
-        return fail("triangle " + std::to_string(t) + ": uv is not finite");
+      if (TriangleHasUv(mesh, t) && !mesh.uvs[t][k].allFinite()) {
+        return "triangle " + std::to_string(t) + ": uv is not finite";
       }
     }
-    const int m = triangle_material(t);
-    if (m < 0 || m >= static_cast<int>(materials.size())) {
-      return fail("triangle " + std::to_string(t) + ": material " + std::to_string(m) +
-                  " out of range (" + std::to_string(materials.size()) + " materials)");
+    const int m = TriangleMaterial(mesh, t);
+    if (m < 0 || m >= static_cast<int>(num_materials)) {
+      return "triangle " + std::to_string(t) + ": material " + std::to_string(m) +
+             " out of range (" + std::to_string(num_materials) + " materials)";
     }
   }
+  return "";
+}
+
+// Why the materials, view layers or textures cannot be saved ("" when they can).
+std::string TexturingProblem(const Scene& scene, const std::vector<Material>& materials) {
   for (size_t m = 0; m < materials.size(); ++m) {
     const int t = materials[m].base_color_texture;
     if (t < -1 || t >= static_cast<int>(scene.textures.size())) {
-      return fail("material " + std::to_string(m) + ": texture " + std::to_string(t) +
-                  " out of range (" + std::to_string(scene.textures.size()) + " textures)");
+      return "material " + std::to_string(m) + ": texture " + std::to_string(t) +
+             " out of range (" + std::to_string(scene.textures.size()) + " textures)";
     }
     if (!materials[m].base_color_factor.allFinite()) {
-      return fail("material " + std::to_string(m) + ": base_color_factor is not finite");
+      return "material " + std::to_string(m) + ": base_color_factor is not finite";
     }
   }
   for (size_t k = 0; k < scene.view_layers.size(); ++k) {
     const ViewLayerTextures& layer = scene.view_layers[k];
     if (layer.material_texture.size() != scene.materials.size() ||
         !layer.centre_world.allFinite()) {
-      return fail("view layer " + std::to_string(k) +
-                  ": needs a finite centre and a texture entry per material");
+      return "view layer " + std::to_string(k) +
+             ": needs a finite centre and a texture entry per material";
     }
     for (int t : layer.material_texture)
       if (t < -1 || t >= static_cast<int>(scene.textures.size()))
-        return fail("view layer " + std::to_string(k) + ": texture " + std::to_string(t) +
-                    " out of range (" + std::to_string(scene.textures.size()) + " textures)");
+        return "view layer " + std::to_string(k) + ": texture " + std::to_string(t) +
+               " out of range (" + std::to_string(scene.textures.size()) + " textures)";
   }
   for (size_t t = 0; t < scene.textures.size(); ++t) {
     const cv::Mat& rgba = scene.textures[t].rgba;
     if (rgba.empty() || rgba.type() != CV_8UC4) {
-      return fail("texture " + std::to_string(t) + " '" + scene.textures[t].name +
-                  "': expected a non-empty CV_8UC4 RGBA image");
+      return "texture " + std::to_string(t) + " '" + scene.textures[t].name +
+             "': expected a non-empty CV_8UC4 RGBA image";
     }
   }
+  return "";
+}
 
-  const fs::path gltf_path(path);
-  const fs::path dir = gltf_path.parent_path();
-  const std::string stem = SafeStem(gltf_path.stem().string());
-  auto beside = [&](const std::string& name) { return (dir / name).string(); };
-  if (!dir.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(dir.string()));
+// Why the scene cannot be saved with `materials` ("" when it can), checked before anything
+// is written.
+std::string SavingProblem(const Scene& scene, const std::vector<Material>& materials) {
+  if (std::string why = MeshArraysProblem(scene.mesh); !why.empty()) return why;
+  if (!scene.origin_in_world.allFinite()) return "origin_in_world is not finite";
+  if (std::string why = TrianglesProblem(scene.mesh, materials.size()); !why.empty()) return why;
+  return TexturingProblem(scene, materials);
+}
 
+// The root's asset, scene and its one node (carrying the origin).
+Json RootWithNode(const Scene& scene) {
   Json root;
   root["asset"] = {{"version", "2.0"}, {"generator", "Fresco"}};
   root["scene"] = 0;
@@ -1138,16 +1156,16 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
                            scene.origin_in_world.z()};
   }
   root["nodes"] = Json::array({node});
+  return root;
+}
 
-  // Geometry: one primitive per material and UV presence (in the order they first appear),
-  // each with its own vertices (split where a vertex has different UVs on different
-  // corners). Within a primitive, triangles and vertices keep their order. (Charts on an
-  // atlas of several pages interleave materials in the mesh's order: a primitive per run
-  // would make 10^5 primitives, which viewers load badly.)
+// The triangles of each primitive: one per material and UV presence, in the order they
+// first appear, each keeping the mesh's order of triangles.
+std::vector<std::vector<int>> PrimitiveTriangles(const TriangleMesh& mesh) {
   std::map<std::pair<int, bool>, int> primitive_of_key;
   std::vector<std::vector<int>> primitive_triangles;
-  for (int t = 0; t < num_triangles; ++t) {
-    const auto key = std::make_pair(triangle_material(t), triangle_has_uv(t));
+  for (int t = 0; t < mesh.NumTriangles(); ++t) {
+    const auto key = std::make_pair(TriangleMaterial(mesh, t), TriangleHasUv(mesh, t));
     auto it = primitive_of_key.find(key);
     if (it == primitive_of_key.end()) {
       it = primitive_of_key.emplace(key, static_cast<int>(primitive_triangles.size())).first;
@@ -1155,113 +1173,151 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
     }
     primitive_triangles[it->second].push_back(t);
   }
-  Json views = Json::array(), accessors = Json::array(), primitives = Json::array();
-  BinaryWriter bin;
-  // At most a vertex per corner (position, uv) and an index, plus each view's alignment.
-  bin.Reserve(static_cast<size_t>(num_triangles) * 3 *
-                  (sizeof(Eigen::Vector3f) + sizeof(Eigen::Vector2f) + sizeof(uint32_t)) +
-              12 * primitive_triangles.size());
-  std::vector<int> slot(num_vertices, -1);
-  for (const std::vector<int>& run : primitive_triangles) {
-    const int material = triangle_material(run[0]);
-    const bool has_uv = triangle_has_uv(run[0]);
-    std::vector<int> used;
-    for (int t : run) {
-      for (int k = 0; k < 3; ++k) {
-        const int v = mesh.triangles[t][k];
-        if (slot[v] == -1) {
-          slot[v] = -2;
-          used.push_back(v);
-        }
-      }
-    }
-    std::sort(used.begin(), used.end());
-    for (size_t i = 0; i < used.size(); ++i) slot[used[i]] = static_cast<int>(i);
-    // Split vertices are appended: room for a vertex per corner (untouched where unused).
-    const size_t max_vertices = has_uv ? 3 * run.size() : used.size();
-    std::vector<Eigen::Vector3f> positions(used.size());
-    positions.reserve(max_vertices);
-    for (size_t i = 0; i < used.size(); ++i) positions[i] = mesh.vertices[used[i]].cast<float>();
-    std::vector<Eigen::Vector2f> uvs(used.size(), Eigen::Vector2f::Zero());
-    uvs.reserve(max_vertices);
-    std::vector<char> uv_set(used.size(), 0);
-    std::map<std::tuple<int, float, float>, int> splits;
-    std::vector<uint32_t> indices;
-    indices.reserve(3 * run.size());
-    for (int t : run) {
-      for (int k = 0; k < 3; ++k) {
-        const int v = mesh.triangles[t][k];
-        int out = slot[v];
-        if (has_uv) {
-          const Eigen::Vector2f& uv = mesh.uvs[t][k];
-          if (!uv_set[out]) {
-            uvs[out] = uv;
-            uv_set[out] = 1;
-          } else if (uvs[out] != uv) {
-            const auto key = std::make_tuple(v, uv.x(), uv.y());
-            auto it = splits.find(key);
-            if (it == splits.end()) {
-              it = splits.emplace(key, static_cast<int>(positions.size())).first;
-              positions.push_back(positions[out]);
-              uvs.push_back(uv);
-              uv_set.push_back(1);
-            }
-            out = it->second;
-          }
-        }
-        indices.push_back(static_cast<uint32_t>(out));
-      }
-    }
-    for (int v : used) slot[v] = -1;
+  return primitive_triangles;
+}
 
-    Eigen::Vector3f lo = positions[0], hi = positions[0];
-    for (const auto& p : positions) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
+// One primitive's vertex arrays and indices.
+struct PrimitiveArrays {
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<Eigen::Vector2f> uvs;
+  std::vector<uint32_t> indices;
+};
+
+// The vertices and indices of the triangles `run`: the vertices they use in the mesh's
+// order, split where a vertex has different UVs on different corners. `slot` (one per mesh
+// vertex, all -1) is scratch, left all -1.
+PrimitiveArrays BuildPrimitive(const TriangleMesh& mesh, const std::vector<int>& run, bool has_uv,
+                               std::vector<int>* slot_of_vertex) {
+  std::vector<int>& slot = *slot_of_vertex;
+  std::vector<int> used;
+  for (int t : run) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.triangles[t][k];
+      if (slot[v] == -1) {
+        slot[v] = -2;
+        used.push_back(v);
+      }
     }
-    Json attributes;
-    const int count = static_cast<int>(positions.size());
-    const int position_view =
-        bin.AddView(positions.data(), positions.size() * sizeof(Eigen::Vector3f), 34962, &views);
-    accessors.push_back({{"bufferView", position_view},
-                         {"componentType", TINYGLTF_COMPONENT_TYPE_FLOAT},
-                         {"count", count},
-                         {"type", "VEC3"},
-                         {"min", {lo.x(), lo.y(), lo.z()}},
-                         {"max", {hi.x(), hi.y(), hi.z()}}});
-    attributes["POSITION"] = accessors.size() - 1;
-    if (has_uv) {
-      const int uv_view =
-          bin.AddView(uvs.data(), uvs.size() * sizeof(Eigen::Vector2f), 34962, &views);
-      accessors.push_back({{"bufferView", uv_view},
-                           {"componentType", TINYGLTF_COMPONENT_TYPE_FLOAT},
-                           {"count", count},
-                           {"type", "VEC2"}});
-      attributes["TEXCOORD_0"] = accessors.size() - 1;
+  }
+  std::sort(used.begin(), used.end());
+  for (size_t i = 0; i < used.size(); ++i) slot[used[i]] = static_cast<int>(i);
+  // Split vertices are appended: room for a vertex per corner (untouched where unused).
+  const size_t max_vertices = has_uv ? 3 * run.size() : used.size();
+  PrimitiveArrays out;
+  std::vector<Eigen::Vector3f>& positions = out.positions;
+  positions.resize(used.size());
+  positions.reserve(max_vertices);
+  for (size_t i = 0; i < used.size(); ++i) positions[i] = mesh.vertices[used[i]].cast<float>();
+  std::vector<Eigen::Vector2f>& uvs = out.uvs;
+  uvs.assign(used.size(), Eigen::Vector2f::Zero());
+  uvs.reserve(max_vertices);
+  std::vector<char> uv_set(used.size(), 0);
+  std::map<std::tuple<int, float, float>, int> splits;
+  out.indices.reserve(3 * run.size());
+  for (int t : run) {
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh.triangles[t][k];
+      int index = slot[v];
+      if (has_uv) {
+        const Eigen::Vector2f& uv = mesh.uvs[t][k];
+        if (!uv_set[index]) {
+          uvs[index] = uv;
+          uv_set[index] = 1;
+        } else if (uvs[index] != uv) {
+          const auto key = std::make_tuple(v, uv.x(), uv.y());
+          auto it = splits.find(key);
+          if (it == splits.end()) {
+            it = splits.emplace(key, static_cast<int>(positions.size())).first;
+            positions.push_back(positions[index]);
+            uvs.push_back(uv);
+            uv_set.push_back(1);
+          }
+          index = it->second;
+        }
+      }
+      out.indices.push_back(static_cast<uint32_t>(index));
     }
-    const int index_view =
-        bin.AddView(indices.data(), indices.size() * sizeof(uint32_t), 34963, &views);
-    accessors.push_back({{"bufferView", index_view},
-                         {"componentType", TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                         {"count", indices.size()},
-                         {"type", "SCALAR"}});
-    primitives.push_back({{"attributes", attributes},
-                          {"indices", accessors.size() - 1},
-                          {"material", material},
-                          {"mode", TINYGLTF_MODE_TRIANGLES}});
+  }
+  for (int v : used) slot[v] = -1;
+  return out;
+}
+
+// The buffer views and accessors of one primitive's arrays; returns the primitive.
+Json WritePrimitive(const PrimitiveArrays& arrays, int material, bool has_uv, BinaryWriter* bin,
+                    Json* views, Json* accessors) {
+  const std::vector<Eigen::Vector3f>& positions = arrays.positions;
+  Eigen::Vector3f lo = positions[0], hi = positions[0];
+  for (const auto& p : positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  Json attributes;
+  const int count = static_cast<int>(positions.size());
+  const int position_view =
+      bin->AddView(positions.data(), positions.size() * sizeof(Eigen::Vector3f), 34962, views);
+  accessors->push_back({{"bufferView", position_view},
+                        {"componentType", TINYGLTF_COMPONENT_TYPE_FLOAT},
+                        {"count", count},
+                        {"type", "VEC3"},
+                        {"min", {lo.x(), lo.y(), lo.z()}},
+                        {"max", {hi.x(), hi.y(), hi.z()}}});
+  attributes["POSITION"] = accessors->size() - 1;
+  if (has_uv) {
+    const int uv_view =
+        bin->AddView(arrays.uvs.data(), arrays.uvs.size() * sizeof(Eigen::Vector2f), 34962, views);
+    accessors->push_back({{"bufferView", uv_view},
+                          {"componentType", TINYGLTF_COMPONENT_TYPE_FLOAT},
+                          {"count", count},
+                          {"type", "VEC2"}});
+    attributes["TEXCOORD_0"] = accessors->size() - 1;
+  }
+  const int index_view =
+      bin->AddView(arrays.indices.data(), arrays.indices.size() * sizeof(uint32_t), 34963, views);
+  accessors->push_back({{"bufferView", index_view},
+                        {"componentType", TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+                        {"count", arrays.indices.size()},
+                        {"type", "SCALAR"}});
+  return {{"attributes", attributes},
+          {"indices", accessors->size() - 1},
+          {"material", material},
+          {"mode", TINYGLTF_MODE_TRIANGLES}};
+}
+
+// Geometry: one primitive per material and UV presence (in the order they first appear),
+// each with its own vertices (split where a vertex has different UVs on different
+// corners). Within a primitive, triangles and vertices keep their order. (Charts on an
+// atlas of several pages interleave materials in the mesh's order: a primitive per run
+// would make 10^5 primitives, which viewers load badly.) Adds the mesh, accessors, views
+// and the buffer `bin_name` to `root`; the buffer's bytes go to `bin`.
+void AddGeometry(const TriangleMesh& mesh, const std::string& bin_name, Json* root,
+                 BinaryWriter* bin) {
+  const int num_triangles = mesh.NumTriangles();
+  const std::vector<std::vector<int>> primitive_triangles = PrimitiveTriangles(mesh);
+  Json views = Json::array(), accessors = Json::array(), primitives = Json::array();
+  // At most a vertex per corner (position, uv) and an index, plus each view's alignment.
+  bin->Reserve(static_cast<size_t>(num_triangles) * 3 *
+                   (sizeof(Eigen::Vector3f) + sizeof(Eigen::Vector2f) + sizeof(uint32_t)) +
+               12 * primitive_triangles.size());
+  std::vector<int> slot(mesh.vertices.size(), -1);
+  for (const std::vector<int>& run : primitive_triangles) {
+    const int material = TriangleMaterial(mesh, run[0]);
+    const bool has_uv = TriangleHasUv(mesh, run[0]);
+    const PrimitiveArrays arrays = BuildPrimitive(mesh, run, has_uv, &slot);
+    primitives.push_back(WritePrimitive(arrays, material, has_uv, bin, &views, &accessors));
   }
   Json json_mesh = Json::object();
   json_mesh["name"] = "fresco_mesh";
   json_mesh["primitives"] = primitives;
-  root["meshes"] = Json::array({json_mesh});
-  root["accessors"] = accessors;
-  root["bufferViews"] = views;
-  const std::string bin_name = stem + ".bin";
+  (*root)["meshes"] = Json::array({json_mesh});
+  (*root)["accessors"] = accessors;
+  (*root)["bufferViews"] = views;
   Json buffer = Json::object();
   buffer["uri"] = bin_name;
-  buffer["byteLength"] = bin.data().size();
-  root["buffers"] = Json::array({buffer});
+  buffer["byteLength"] = bin->data().size();
+  (*root)["buffers"] = Json::array({buffer});
+}
 
+Json MaterialsJson(const std::vector<Material>& materials) {
   Json json_materials = Json::array();
   for (const Material& material : materials) {
     Json pbr = {{"baseColorFactor",
@@ -1278,55 +1334,85 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
     out["doubleSided"] = material.double_sided;
     json_materials.push_back(out);
   }
-  root["materials"] = json_materials;
+  return json_materials;
+}
 
-  // Textures: PNG files beside the .gltf (RGBA, so alpha round-trips exactly), each written
-  // as soon as it is encoded (one encoded page in memory at a time), before the .gltf.
-  if (!scene.textures.empty()) {
-    Json images = Json::array(), samplers = Json::array(), textures = Json::array();
-    for (size_t t = 0; t < scene.textures.size(); ++t) {
-      const Texture& texture = scene.textures[t];
-      const std::string png_name = stem + "_texture" + std::to_string(t) + ".png";
-      cv::Mat bgra;
-      cv::cvtColor(texture.rgba, bgra, cv::COLOR_RGBA2BGRA);
-      std::vector<unsigned char> png;
-      if (!cv::imencode(".png", bgra, png)) {
-        return fail("texture " + std::to_string(t) + ": PNG encoding failed");
-      }
-      bgra.release();
-      FRESCO_RETURN_IF_ERROR(WriteFileAtomicWith(beside(png_name), [&](const std::string& temp) {
-        std::ofstream file(temp, std::ios::binary);
-        file.write(reinterpret_cast<const char*>(png.data()),
-                   static_cast<std::streamsize>(png.size()));
-        file.close();
-        return file.good() ? Status::Ok() : Status::OutputError(temp + ": cannot write");
-      }));
-      Json image = {{"uri", png_name}};
-      if (!texture.name.empty()) image["name"] = texture.name;
-      images.push_back(image);
-      samplers.push_back(
-          {{"wrapS", WrapToGltf(texture.wrap_s)}, {"wrapT", WrapToGltf(texture.wrap_t)}});
-      Json json_texture = {{"sampler", t}, {"source", t}};
-      if (!texture.name.empty()) json_texture["name"] = texture.name;
-      textures.push_back(json_texture);
+// Textures: PNG files beside the .gltf (RGBA, so alpha round-trips exactly), each written
+// as soon as it is encoded (one encoded page in memory at a time), before the .gltf. Adds
+// the images, samplers and textures to `root`; `path` is the .gltf's.
+Status WriteTextures(const Scene& scene, const std::string& path, const std::string& stem,
+                     Json* root) {
+  const fs::path dir = fs::path(path).parent_path();
+  Json images = Json::array(), samplers = Json::array(), textures = Json::array();
+  for (size_t t = 0; t < scene.textures.size(); ++t) {
+    const Texture& texture = scene.textures[t];
+    const std::string png_name = stem + "_texture" + std::to_string(t) + ".png";
+    cv::Mat bgra;
+    cv::cvtColor(texture.rgba, bgra, cv::COLOR_RGBA2BGRA);
+    std::vector<unsigned char> png;
+    if (!cv::imencode(".png", bgra, png)) {
+      return Status::Internal(path + ": texture " + std::to_string(t) + ": PNG encoding failed");
     }
-    root["images"] = images;
-    root["samplers"] = samplers;
-    root["textures"] = textures;
+    bgra.release();
+    FRESCO_RETURN_IF_ERROR(
+        WriteFileAtomicWith((dir / png_name).string(), [&](const std::string& temp) {
+          std::ofstream file(temp, std::ios::binary);
+          file.write(reinterpret_cast<const char*>(png.data()),
+                     static_cast<std::streamsize>(png.size()));
+          file.close();
+          return file.good() ? Status::Ok() : Status::OutputError(temp + ": cannot write");
+        }));
+    Json image = {{"uri", png_name}};
+    if (!texture.name.empty()) image["name"] = texture.name;
+    images.push_back(image);
+    samplers.push_back(
+        {{"wrapS", WrapToGltf(texture.wrap_s)}, {"wrapT", WrapToGltf(texture.wrap_t)}});
+    Json json_texture = {{"sampler", t}, {"source", t}};
+    if (!texture.name.empty()) json_texture["name"] = texture.name;
+    textures.push_back(json_texture);
+  }
+  (*root)["images"] = images;
+  (*root)["samplers"] = samplers;
+  (*root)["textures"] = textures;
+  return Status::Ok();
+}
+
+// The view layers as Fresco's extension.
+void AddViewLayers(const Scene& scene, Json* root) {
+  Json layers = Json::array();
+  for (const ViewLayerTextures& layer : scene.view_layers) {
+    const Eigen::Vector3d& c = layer.centre_world;
+    layers.push_back({{"centre", {c.x(), c.y(), c.z()}}, {"textures", layer.material_texture}});
+  }
+  (*root)["extensionsUsed"] = Json::array({kViewLayersExtension});
+  (*root)["extensions"][kViewLayersExtension] = {{"layers", layers}};
+}
+
+}  // namespace
+
+Status SaveGltfScene(const Scene& scene, const std::string& path) {
+  // Validate the scene before writing anything. A scene that cannot be saved is a broken
+  // invariant: the loaders and the painter make only saveable ones.
+  const std::vector<Material> materials = MaterialsToSave(scene);
+  if (const std::string why = SavingProblem(scene, materials); !why.empty()) {
+    return Status::Internal(path + ": " + why);
   }
 
-  if (!scene.view_layers.empty()) {
-    Json layers = Json::array();
-    for (const ViewLayerTextures& layer : scene.view_layers) {
-      const Eigen::Vector3d& c = layer.centre_world;
-      layers.push_back({{"centre", {c.x(), c.y(), c.z()}}, {"textures", layer.material_texture}});
-    }
-    root["extensionsUsed"] = Json::array({kViewLayersExtension});
-    root["extensions"][kViewLayersExtension] = {{"layers", layers}};
-  }
+  const fs::path gltf_path(path);
+  const fs::path dir = gltf_path.parent_path();
+  const std::string stem = SafeStem(gltf_path.stem().string());
+  if (!dir.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(dir.string()));
+
+  Json root = RootWithNode(scene);
+  const std::string bin_name = stem + ".bin";
+  BinaryWriter bin;
+  AddGeometry(scene.mesh, bin_name, &root, &bin);
+  root["materials"] = MaterialsJson(materials);
+  if (!scene.textures.empty()) FRESCO_RETURN_IF_ERROR(WriteTextures(scene, path, stem, &root));
+  if (!scene.view_layers.empty()) AddViewLayers(scene, &root);
 
   // Dependencies first, the .gltf last: a reader never sees a .gltf whose files are missing.
-  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(beside(bin_name), bin.data()));
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic((dir / bin_name).string(), bin.data()));
   return WriteFileAtomic(path, root.dump(2) + "\n");
 }
 

@@ -103,20 +103,122 @@ void BufferBackground::AccumulateGain(const BaseBuffer& buffer, const WarpedBuff
   }
 }
 
+namespace {
+
+// A chunk's texels are classified in runs (a chunk is one run: at most a tile's texels).
+constexpr int kRunMax = BaseBuffer::kTileTexels * BaseBuffer::kTileTexels;
+
+// One run of texels: where it is and how it is read (a full tile's texels are runs of the
+// buffer's rows, BaseBuffer::Chunk::full: read and written a row at a time; otherwise one at
+// a time through texel_index).
+struct TexelSpan {
+  const BaseBuffer& buffer;
+  const BaseBuffer::Chunk& chunk;
+  int begin = 0, n = 0;
+  bool rows = false;
+
+  const int32_t* Index() const { return buffer.texel_index.data() + begin; }
+  int TileWidth() const { return chunk.x1 - chunk.x0; }
+  size_t RowOf(int r) const { return static_cast<size_t>(chunk.y0 + r) * buffer.width + chunk.x0; }
+};
+
+// A run's samples (robust: divided by the gain) and what classifying them found.
+struct TexelRun {
+  alignas(32) float x[3][kRunMax];
+  alignas(32) uint8_t sampled[kRunMax], foreground[kRunMax], warm_up[kRunMax];
+  alignas(32) float distance2[kRunMax];
+};
+
+// The robust model's input: each texel's sample divided by the gain, and whether it has one.
+void GatherSamples(const TexelSpan& span, const WarpedBuffer& warped, float inv_gain,
+                   TexelRun* run) {
+  const uint8_t* valid = warped.valid.data;
+  if (span.rows) {
+    const int tile_w = span.TileWidth();
+    for (int r = 0, i = 0; i < span.n; ++r, i += tile_w) {
+      const size_t row = span.RowOf(r);
+      const uint8_t* v = valid + row;
+      const uint8_t* p = warped.bgr.data + 3 * row;
+      for (int c = 0; c < tile_w; ++c) {
+        run->sampled[i + c] = v[c] != 0;
+        run->x[0][i + c] = p[3 * c] * inv_gain;
+        run->x[1][i + c] = p[3 * c + 1] * inv_gain;
+        run->x[2][i + c] = p[3 * c + 2] * inv_gain;
+      }
+    }
+    return;
+  }
+  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
+  const int32_t* index = span.Index();
+  for (int i = 0; i < span.n; ++i) {
+    const int idx = index[i];
+    const cv::Vec3b s = src[idx];
+    run->sampled[i] = valid[idx] != 0;
+    for (int c = 0; c < 3; ++c) run->x[c][i] = s[c] * inv_gain;
+  }
+}
+
+// The average model: training texels learn (and paint provisionally); trained ones are
+// foreground where a channel differs from their mean by more than average_threshold.
+void ClassifyAverage(const TexelSpan& span, const WarpedBuffer& warped,
+                     const BackgroundOptions& options,
+                     std::vector<BufferBackground::AverageTexel>* average, TexelRun* run) {
+  const uint8_t* valid = warped.valid.data;
+  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
+  const int32_t* index = span.Index();
+  const float threshold = static_cast<float>(options.average_threshold);
+  for (int i = 0; i < span.n; ++i) {
+    const int idx = index[i];
+    run->sampled[i] = valid[idx] != 0;
+    run->foreground[i] = run->warm_up[i] = 0;
+    run->distance2[i] = 0;
+    if (!run->sampled[i]) continue;
+    const cv::Vec3b s = src[idx];
+    BufferBackground::AverageTexel& t = (*average)[span.begin + i];
+    if (t.count < options.training_frames) {  // training: learn, paint provisionally
+      for (int c = 0; c < 3; ++c) t.sum[c] += s[c];
+      ++t.count;
+      run->warm_up[i] = 1;
+    } else {
+      float largest = 0;
+      for (int c = 0; c < 3; ++c) {
+        const float e = s[c] - static_cast<float>(t.sum[c]) / t.count;
+        largest = std::max(largest, std::abs(e));
+        run->distance2[i] += e * e * (1.0f / 3.0f);
+      }
+      run->foreground[i] = largest > threshold;
+    }
+  }
+}
+
+// The run's foreground and warming texels into the masks `raw` and `warming` (buffer size).
+void WriteRunMasks(const TexelSpan& span, const TexelRun& run, uint8_t* raw, uint8_t* warming) {
+  if (span.rows) {
+    const int tile_w = span.TileWidth();
+    for (int r = 0, i = 0; i < span.n; ++r, i += tile_w) {
+      std::memcpy(raw + span.RowOf(r), run.foreground + i, tile_w);
+      std::memcpy(warming + span.RowOf(r), run.warm_up + i, tile_w);
+    }
+    return;
+  }
+  const int32_t* index = span.Index();
+  for (int i = 0; i < span.n; ++i) {
+    raw[index[i]] = run.foreground[i];
+    warming[index[i]] = run.warm_up[i];
+  }
+}
+
+}  // namespace
+
 void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& warped, float gain,
                                 bool debug, const BaseBuffer::Chunk& chunk, ChunkStats* stats,
                                 BackgroundFrame* frame) {
-  const uint8_t* valid = warped.valid.data;
-  const cv::Vec3b* src = warped.bgr.ptr<cv::Vec3b>();
   uint8_t* raw = raw_.data;
   uint8_t* warming = frame->warming.data;
   uint8_t* difference = debug ? frame->difference.data : nullptr;
   // The samples of a run of texels gathered (robust: divided by the gain), then classified
   // together (a chunk is one run: at most a tile's texels).
-  constexpr int kMax = BaseBuffer::kTileTexels * BaseBuffer::kTileTexels;
-  alignas(32) float x[3][kMax];
-  alignas(32) uint8_t sampled[kMax], foreground[kMax], warm_up[kMax];
-  alignas(32) float distance2[kMax];
+  TexelRun run;
   RobustUpdateParams params;
   params.k2 = static_cast<float>(options_.sigma_threshold * options_.sigma_threshold);
   params.min_var = static_cast<float>(options_.min_sigma * options_.min_sigma);
@@ -124,88 +226,31 @@ void BufferBackground::Classify(const BaseBuffer& buffer, const WarpedBuffer& wa
   params.warmup = options_.warmup_frames;
   params.majority = static_cast<float>(options_.majority);
   const float inv_gain = 1.0f / gain;
-  // A full tile's texels are runs of the buffer's rows (BaseBuffer::Chunk::full): read and
-  // written a row at a time; otherwise one at a time through texel_index.
-  const int tile_w = chunk.x1 - chunk.x0;
-  const auto row_of = [&](int r) {
-    return static_cast<size_t>(chunk.y0 + r) * buffer.width + chunk.x0;
-  };
-  for (int begin = chunk.begin; begin < chunk.end; begin += kMax) {
-    const int n = std::min(kMax, chunk.end - begin);
-    const int32_t* index = buffer.texel_index.data() + begin;
-    const bool rows = chunk.full && n == chunk.end - chunk.begin;
+  for (int begin = chunk.begin; begin < chunk.end; begin += kRunMax) {
+    const int n = std::min(kRunMax, chunk.end - begin);
+    const TexelSpan span{buffer, chunk, begin, n, chunk.full && n == chunk.end - chunk.begin};
     if (options_.mode == BackgroundMode::kRobust) {
-      if (rows) {
-        for (int r = 0, i = 0; i < n; ++r, i += tile_w) {
-          const size_t row = row_of(r);
-          const uint8_t* v = valid + row;
-          const uint8_t* p = warped.bgr.data + 3 * row;
-          for (int c = 0; c < tile_w; ++c) {
-            sampled[i + c] = v[c] != 0;
-            x[0][i + c] = p[3 * c] * inv_gain;
-            x[1][i + c] = p[3 * c + 1] * inv_gain;
-            x[2][i + c] = p[3 * c + 2] * inv_gain;
-          }
-        }
-      } else {
-        for (int i = 0; i < n; ++i) {
-          const int idx = index[i];
-          const cv::Vec3b s = src[idx];
-          sampled[i] = valid[idx] != 0;
-          for (int c = 0; c < 3; ++c) x[c][i] = s[c] * inv_gain;
-        }
-      }
-      UpdateRobustTexels(params, begin, n, x[0], x[1], x[2], sampled, &robust_, foreground, warm_up,
-                         distance2);
+      GatherSamples(span, warped, inv_gain, &run);
+      UpdateRobustTexels(params, begin, n, run.x[0], run.x[1], run.x[2], run.sampled, &robust_,
+                         run.foreground, run.warm_up, run.distance2);
     } else {
-      const float threshold = static_cast<float>(options_.average_threshold);
-      for (int i = 0; i < n; ++i) {
-        const int idx = index[i];
-        sampled[i] = valid[idx] != 0;
-        foreground[i] = warm_up[i] = 0;
-        distance2[i] = 0;
-        if (!sampled[i]) continue;
-        const cv::Vec3b s = src[idx];
-        AverageTexel& t = average_[begin + i];
-        if (t.count < options_.training_frames) {  // training: learn, paint provisionally
-          for (int c = 0; c < 3; ++c) t.sum[c] += s[c];
-          ++t.count;
-          warm_up[i] = 1;
-        } else {
-          float largest = 0;
-          for (int c = 0; c < 3; ++c) {
-            const float e = s[c] - static_cast<float>(t.sum[c]) / t.count;
-            largest = std::max(largest, std::abs(e));
-            distance2[i] += e * e * (1.0f / 3.0f);
-          }
-          foreground[i] = largest > threshold;
-        }
-      }
+      ClassifyAverage(span, warped, options_, &average_, &run);
     }
     // foreground and warm_up are 0 or 1, and 0 where not sampled.
     int observed = 0, warm = 0, fore = 0;
     for (int i = 0; i < n; ++i) {
-      observed += sampled[i];
-      warm += warm_up[i];
-      fore += foreground[i];
-      foreground[i] = static_cast<uint8_t>(-foreground[i]);  // 0 or 255
-      warm_up[i] = static_cast<uint8_t>(-warm_up[i]);
+      observed += run.sampled[i];
+      warm += run.warm_up[i];
+      fore += run.foreground[i];
+      run.foreground[i] = static_cast<uint8_t>(-run.foreground[i]);  // 0 or 255
+      run.warm_up[i] = static_cast<uint8_t>(-run.warm_up[i]);
     }
-    if (rows) {
-      for (int r = 0, i = 0; i < n; ++r, i += tile_w) {
-        std::memcpy(raw + row_of(r), foreground + i, tile_w);
-        std::memcpy(warming + row_of(r), warm_up + i, tile_w);
-      }
-    } else {
-      for (int i = 0; i < n; ++i) {
-        raw[index[i]] = foreground[i];
-        warming[index[i]] = warm_up[i];
-      }
-    }
+    WriteRunMasks(span, run, raw, warming);
     if (difference) {
+      const int32_t* index = span.Index();
       for (int i = 0; i < n; ++i)
-        if (sampled[i])
-          difference[index[i]] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(distance2[i]));
+        if (run.sampled[i])
+          difference[index[i]] = cv::saturate_cast<uint8_t>(2.0f * std::sqrt(run.distance2[i]));
     }
     stats->observed += observed, stats->warming += warm, stats->foreground += fore;
     // The foreground's bounds, to the tile (Clean works on a region around them: a larger

@@ -127,29 +127,29 @@ struct PlaneCoords {
   double a_min = 1e300, a_max = -1e300, b_min = 1e300, b_max = -1e300;
 };
 
-// Builds one buffer; triangles whose projection folds over others are returned in `folded`.
-BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
-                    double texel_size_m, const BaseBufferOptions& options,
-                    std::vector<int>* folded) {
-  BaseBuffer buffer;
-  buffer.triangles = triangles;
-  BaseBufferGroup tmp;
-  tmp.triangles = triangles;
-  ChooseAxes(GroupNormal(mesh, tmp), &buffer);
-  const Eigen::Vector3d anchor = mesh.Corner(triangles[0], 0);
+// The triangles' corners along the buffer's axes from `anchor`; sets the buffer's bounds.
+PlaneCoords PlaneExtent(const TriangleMesh& mesh, const std::vector<int>& triangles,
+                        const Eigen::Vector3d& anchor, BaseBuffer* buffer) {
   PlaneCoords pc;
-  buffer.bounds_min = Eigen::Vector3d::Constant(1e300);
-  buffer.bounds_max = Eigen::Vector3d::Constant(-1e300);
+  buffer->bounds_min = Eigen::Vector3d::Constant(1e300);
+  buffer->bounds_max = Eigen::Vector3d::Constant(-1e300);
   for (int t : triangles) {
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector3d p = mesh.Corner(t, k);
-      buffer.bounds_min = buffer.bounds_min.cwiseMin(p);
-      buffer.bounds_max = buffer.bounds_max.cwiseMax(p);
-      const double a = (p - anchor).dot(buffer.axis_u), b = (p - anchor).dot(buffer.axis_v);
+      buffer->bounds_min = buffer->bounds_min.cwiseMin(p);
+      buffer->bounds_max = buffer->bounds_max.cwiseMax(p);
+      const double a = (p - anchor).dot(buffer->axis_u), b = (p - anchor).dot(buffer->axis_v);
       pc.a_min = std::min(pc.a_min, a), pc.a_max = std::max(pc.a_max, a);
       pc.b_min = std::min(pc.b_min, b), pc.b_max = std::max(pc.b_max, b);
     }
   }
+  return pc;
+}
+
+// The buffer's texel size, width, height and origin for the extent `pc` (from `anchor`):
+// texels of texel_size_m, larger where the buffer would exceed the options' caps.
+void SizeTexels(const PlaneCoords& pc, const Eigen::Vector3d& anchor, double texel_size_m,
+                const BaseBufferOptions& options, BaseBuffer* buffer) {
   const int gutter = options.gutter_texels;
   // Texels larger than the group would leave no texel centre on it (never painted): at
   // least kMinTexelsAcross texels across its longer side.
@@ -174,98 +174,124 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
          1.01;
     dims(s);
   }
-  const int w = static_cast<int>(wd), h = static_cast<int>(hd);
-  buffer.texel_size_m = s;
-  buffer.width = w;
-  buffer.height = h;
-  buffer.origin =
-      anchor + (pc.a_min - gutter * s) * buffer.axis_u + (pc.b_min - gutter * s) * buffer.axis_v;
+  buffer->texel_size_m = s;
+  buffer->width = static_cast<int>(wd);
+  buffer->height = static_cast<int>(hd);
+  buffer->origin =
+      anchor + (pc.a_min - gutter * s) * buffer->axis_u + (pc.b_min - gutter * s) * buffer->axis_v;
+}
 
+// Texel (i, j)'s centre on the buffer's plane.
+Eigen::Vector3d PlanePoint(const BaseBuffer& buffer, int i, int j) {
+  const double s = buffer.texel_size_m;
+  return buffer.origin + ((i + 0.5) * s) * buffer.axis_u + ((j + 0.5) * s) * buffer.axis_v;
+}
+
+// The texels of a buffer being built. owner: the texel's triangle as its position in the
+// buffer's triangle list (-1: none); per-buffer arrays are indexed by that position, never
+// by the mesh's triangle id (10^4 charts of a 10^6 triangle mesh would otherwise clear 10^10
+// flags). point: the texel's point on that triangle.
+struct TexelOwners {
+  std::vector<int32_t> owner;
+  std::vector<Eigen::Vector3f> point;
+};
+
+// One triangle as placed on the buffer: its position in the buffer's list, its corners in
+// texel coordinates and in the mesh, and its normal.
+struct PlacedTriangle {
+  int li = 0;
+  Eigen::Vector2d q[3];
+  double sign = 1;  // of the texel-coordinate area
+  Eigen::Vector3d corner[3];
+  Eigen::Vector3d normal;
+};
+
+// Gives the triangle the free texels whose centres it covers, at their points on it
+// (along the buffer's normal); where another triangle holds a texel at another point, the
+// projection folds and `folded` is set. Returns whether it covers any texel centre.
+bool CoverCentres(const BaseBuffer& buffer, const PlacedTriangle& tri, TexelOwners* texels,
+                  uint8_t* folded) {
+  const Eigen::Vector2d* q = tri.q;
+  const int w = buffer.width, h = buffer.height;
+  const double s = buffer.texel_size_m;
   const Eigen::Vector3d& n = buffer.normal;
-  // owner: the texel's triangle as its position in `triangles` (-1: none); per-buffer arrays
-  // are indexed by that position, never by the mesh's triangle id (10^4 charts of a 10^6
-  // triangle mesh would otherwise clear 10^10 flags).
-  const int num_local = static_cast<int>(triangles.size());
-  std::vector<int32_t> owner(static_cast<size_t>(w) * h, -1);
-  std::vector<Eigen::Vector3f> point(static_cast<size_t>(w) * h);
-  std::vector<uint8_t> is_folded(num_local, 0);
-  std::vector<Eigen::Vector3d> normal_of(num_local);
-  for (int li = 0; li < num_local; ++li) normal_of[li] = mesh.Normal(triangles[li]);
-  auto plane_point = [&](int i, int j) -> Eigen::Vector3d {
-    return buffer.origin + ((i + 0.5) * s) * buffer.axis_u + ((j + 0.5) * s) * buffer.axis_v;
-  };
-  for (int li = 0; li < num_local; ++li) {
-    const int t = triangles[li];
-    const Eigen::Vector3d& nt = normal_of[li];
-    if (nt.dot(n) < kMinPlaneCos) {  // near edge-on or back-facing: cannot serve it well
-      is_folded[li] = 1;
-      continue;
-    }
-    Eigen::Vector2d q[3];
-    for (int k = 0; k < 3; ++k) q[k] = buffer.TexelCoords(mesh.Corner(t, k));
-    const double area2 =
-        (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
-    if (std::abs(area2) < 1e-18) continue;
-    const double sign = area2 > 0 ? 1.0 : -1.0;
-    const int i0 =
-        std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
-    const int i1 = std::min(
-        w - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
-    const int j0 =
-        std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
-    const int j1 = std::min(
-        h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
-    const Eigen::Vector3d A = mesh.Corner(t, 0);
-    const double denom = n.dot(nt);
-    bool covers_a_centre = false;
-    for (int j = j0; j <= j1; ++j) {
-      for (int i = i0; i <= i1; ++i) {
-        const Eigen::Vector2d c(i + 0.5, j + 0.5);
-        bool inside = true;
-        for (int k = 0; k < 3 && inside; ++k) {
-          const Eigen::Vector2d e = q[(k + 1) % 3] - q[k], r = c - q[k];
-          inside = sign * (e.x() * r.y() - e.y() * r.x()) >= 0;
-        }
-        if (!inside) continue;
-        covers_a_centre = true;
-        const Eigen::Vector3d pp = plane_point(i, j);
-        const Eigen::Vector3d m = pp + n * ((A - pp).dot(nt) / denom);
-        const size_t idx = static_cast<size_t>(j) * w + i;
-        if (owner[idx] >= 0) {
-          // Shared edge: same point. Different point: the projection folds here.
-          if ((point[idx].cast<double>() - m).norm() > 0.5 * s) is_folded[li] = 1;
-          continue;
-        }
-        owner[idx] = li;
-        point[idx] = m.cast<float>();
+  const int i0 =
+      std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+  const int i1 =
+      std::min(w - 1, static_cast<int>(std::ceil(std::max({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
+  const int j0 =
+      std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+  const int j1 =
+      std::min(h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
+  const Eigen::Vector3d& A = tri.corner[0];
+  const Eigen::Vector3d& nt = tri.normal;
+  const double denom = n.dot(nt);
+  bool covers_a_centre = false;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const Eigen::Vector2d c(i + 0.5, j + 0.5);
+      bool inside = true;
+      for (int k = 0; k < 3 && inside; ++k) {
+        const Eigen::Vector2d e = q[(k + 1) % 3] - q[k], r = c - q[k];
+        inside = tri.sign * (e.x() * r.y() - e.y() * r.x()) >= 0;
       }
-    }
-    if (!covers_a_centre) {
-      // A sliver thinner than a texel: the texel under its centroid, if free, serves it
-      // (at the centroid, which lies on it), so that no triangle goes unpainted.
-      const Eigen::Vector2d c = (q[0] + q[1] + q[2]) / 3.0;
-      const int i = std::clamp(static_cast<int>(std::floor(c.x())), 0, w - 1);
-      const int j = std::clamp(static_cast<int>(std::floor(c.y())), 0, h - 1);
+      if (!inside) continue;
+      covers_a_centre = true;
+      const Eigen::Vector3d pp = PlanePoint(buffer, i, j);
+      const Eigen::Vector3d m = pp + n * ((A - pp).dot(nt) / denom);
       const size_t idx = static_cast<size_t>(j) * w + i;
-      if (owner[idx] < 0) {
-        owner[idx] = li;
-        point[idx] =
-            ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0).cast<float>();
+      if (texels->owner[idx] >= 0) {
+        // Shared edge: same point. Different point: the projection folds here.
+        if ((texels->point[idx].cast<double>() - m).norm() > 0.5 * s) *folded = 1;
+        continue;
       }
+      texels->owner[idx] = tri.li;
+      texels->point[idx] = m.cast<float>();
     }
   }
-  for (int li = 0; li < num_local; ++li)
-    if (is_folded[li]) folded->push_back(triangles[li]);
-  if (!folded->empty()) {
-    // Drop folded triangles' texels; they go to another buffer.
-    for (size_t idx = 0; idx < owner.size(); ++idx)
-      if (owner[idx] >= 0 && is_folded[owner[idx]]) owner[idx] = -1;
-  }
-  std::vector<uint8_t> surface(owner.size(), 0);
-  for (size_t idx = 0; idx < owner.size(); ++idx) surface[idx] = owner[idx] >= 0;
+  return covers_a_centre;
+}
 
-  // Gutter: dilate ownership ring by ring; a gutter texel takes the closest point on the
-  // neighbouring texel's triangle.
+// Places triangle li of the buffer's list on its texels; `folded` is set where it cannot
+// serve them (edge-on, back-facing or folding over others).
+void PlaceTriangle(const TriangleMesh& mesh, const BaseBuffer& buffer, int li,
+                   const Eigen::Vector3d& normal, TexelOwners* texels, uint8_t* folded) {
+  const int t = buffer.triangles[li];
+  // Near edge-on or back-facing: it cannot serve the buffer well.
+  if (normal.dot(buffer.normal) < kMinPlaneCos) {
+    *folded = 1;
+    return;
+  }
+  PlacedTriangle tri;
+  tri.li = li;
+  tri.normal = normal;
+  Eigen::Vector2d* q = tri.q;
+  for (int k = 0; k < 3; ++k) q[k] = buffer.TexelCoords(mesh.Corner(t, k));
+  const double area2 =
+      (q[1] - q[0]).x() * (q[2] - q[0]).y() - (q[1] - q[0]).y() * (q[2] - q[0]).x();
+  if (std::abs(area2) < 1e-18) return;
+  tri.sign = area2 > 0 ? 1.0 : -1.0;
+  for (int k = 0; k < 3; ++k) tri.corner[k] = mesh.Corner(t, k);
+  if (CoverCentres(buffer, tri, texels, folded)) return;
+  // A sliver thinner than a texel: the texel under its centroid, if free, serves it
+  // (at the centroid, which lies on it), so that no triangle goes unpainted.
+  const Eigen::Vector2d c = (q[0] + q[1] + q[2]) / 3.0;
+  const int i = std::clamp(static_cast<int>(std::floor(c.x())), 0, buffer.width - 1);
+  const int j = std::clamp(static_cast<int>(std::floor(c.y())), 0, buffer.height - 1);
+  const size_t idx = static_cast<size_t>(j) * buffer.width + i;
+  if (texels->owner[idx] < 0) {
+    texels->owner[idx] = li;
+    texels->point[idx] =
+        ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0).cast<float>();
+  }
+}
+
+// Gutter: dilate ownership ring by ring; a gutter texel takes the closest point on the
+// neighbouring texel's triangle.
+void GrowGutter(const TriangleMesh& mesh, const BaseBuffer& buffer, int gutter,
+                TexelOwners* texels) {
+  const int w = buffer.width, h = buffer.height;
+  std::vector<int32_t>& owner = texels->owner;
   for (int ring = 0; ring < gutter; ++ring) {
     std::vector<int32_t> next = owner;
     for (int j = 0; j < h; ++j) {
@@ -281,79 +307,135 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
           }
         if (best < 0) continue;
         next[idx] = best;
-        const int t = triangles[best];
-        point[idx] = ClosestPointOnTriangle(plane_point(i, j), mesh.Corner(t, 0), mesh.Corner(t, 1),
-                                            mesh.Corner(t, 2))
-                         .cast<float>();
+        const int t = buffer.triangles[best];
+        texels->point[idx] = ClosestPointOnTriangle(PlanePoint(buffer, i, j), mesh.Corner(t, 0),
+                                                    mesh.Corner(t, 1), mesh.Corner(t, 2))
+                                 .cast<float>();
       }
     }
     owner.swap(next);
   }
+}
+
+// A coordinate quantized over [min, min + 65535 step], rounded (0 where the step is 0).
+uint16_t QuantizePoint(float value, float min, float step) {
+  if (!(step > 0.0f)) return uint16_t{0};
+  const float q = (value - min) / step;
+  return static_cast<uint16_t>(std::clamp(q, 0.0f, 65535.0f) + 0.5f);  // rounded
+}
+
+// A normal's component in kNormalScale steps, rounded half away from zero.
+int16_t QuantizeNormal(double value) {
+  const double q = std::clamp(value, -1.0, 1.0) * BaseBuffer::kNormalScale;
+  return static_cast<int16_t>(q >= 0 ? q + 0.5 : q - 0.5);
+}
+
+// Stores the owned texels of the tile at (ti, tj) as the buffer's next chunk (quantized
+// within the tile's bounds), with its cone and layout flags; an empty tile stores nothing.
+void StoreTile(const TexelOwners& texels, const std::vector<uint8_t>& surface,
+               const std::vector<Eigen::Vector3d>& normal_of, int ti, int tj, BaseBuffer* buffer) {
   const int tile = BaseBuffer::kTileTexels;
-  for (int tj = 0; tj < h; tj += tile) {
-    for (int ti = 0; ti < w; ti += tile) {
-      BaseBuffer::Chunk chunk;
-      chunk.begin = buffer.NumTexels();
-      chunk.x0 = ti, chunk.y0 = tj, chunk.x1 = std::min(ti + tile, w),
-      chunk.y1 = std::min(tj + tile, h);
-      chunk.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-      chunk.bounds_max = -chunk.bounds_min;
-      const int j1 = std::min(tj + tile, h), i1 = std::min(ti + tile, w);
-      for (int j = tj; j < j1; ++j) {
-        for (int i = ti; i < i1; ++i) {
-          const size_t idx = static_cast<size_t>(j) * w + i;
-          if (owner[idx] < 0) continue;
-          chunk.bounds_min = chunk.bounds_min.cwiseMin(point[idx]);
-          chunk.bounds_max = chunk.bounds_max.cwiseMax(point[idx]);
-        }
-      }
-      chunk.point_step = (chunk.bounds_max - chunk.bounds_min) / 65535.0f;
-      for (int j = tj; j < j1; ++j) {
-        for (int i = ti; i < i1; ++i) {
-          const size_t idx = static_cast<size_t>(j) * w + i;
-          if (owner[idx] < 0) continue;
-          buffer.texel_index.push_back(static_cast<int32_t>(idx));
-          const auto quantize_point = [&](int axis) {
-            const float step = chunk.point_step[axis];
-            if (!(step > 0.0f)) return uint16_t{0};
-            const float q = (point[idx][axis] - chunk.bounds_min[axis]) / step;
-            return static_cast<uint16_t>(std::clamp(q, 0.0f, 65535.0f) + 0.5f);  // rounded
-          };
-          buffer.point_qx.push_back(quantize_point(0));
-          buffer.point_qy.push_back(quantize_point(1));
-          buffer.point_qz.push_back(quantize_point(2));
-          const Eigen::Vector3d& n = normal_of[owner[idx]];
-          const auto quantize_normal = [](double value) {  // rounded half away from zero
-            const double q = std::clamp(value, -1.0, 1.0) * BaseBuffer::kNormalScale;
-            return static_cast<int16_t>(q >= 0 ? q + 0.5 : q - 0.5);
-          };
-          buffer.normal_qx.push_back(quantize_normal(n.x()));
-          buffer.normal_qy.push_back(quantize_normal(n.y()));
-          buffer.normal_qz.push_back(quantize_normal(n.z()));
-          buffer.on_surface.push_back(surface[idx]);
-          buffer.num_surface_texels += surface[idx];
-        }
-      }
-      chunk.end = buffer.NumTexels();
-      SetNormalCone(buffer, &chunk);
-      SetFullTile(buffer, &chunk);
-      SetAffineTile(buffer, &chunk);
-      if (chunk.end > chunk.begin) buffer.chunks.push_back(chunk);
+  const int w = buffer->width, h = buffer->height;
+  const std::vector<int32_t>& owner = texels.owner;
+  const std::vector<Eigen::Vector3f>& point = texels.point;
+  BaseBuffer::Chunk chunk;
+  chunk.begin = buffer->NumTexels();
+  chunk.x0 = ti, chunk.y0 = tj, chunk.x1 = std::min(ti + tile, w),
+  chunk.y1 = std::min(tj + tile, h);
+  chunk.bounds_min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  chunk.bounds_max = -chunk.bounds_min;
+  const int j1 = std::min(tj + tile, h), i1 = std::min(ti + tile, w);
+  for (int j = tj; j < j1; ++j) {
+    for (int i = ti; i < i1; ++i) {
+      const size_t idx = static_cast<size_t>(j) * w + i;
+      if (owner[idx] < 0) continue;
+      chunk.bounds_min = chunk.bounds_min.cwiseMin(point[idx]);
+      chunk.bounds_max = chunk.bounds_max.cwiseMax(point[idx]);
     }
   }
-  const int num_chunks = static_cast<int>(buffer.chunks.size());
+  chunk.point_step = (chunk.bounds_max - chunk.bounds_min) / 65535.0f;
+  for (int j = tj; j < j1; ++j) {
+    for (int i = ti; i < i1; ++i) {
+      const size_t idx = static_cast<size_t>(j) * w + i;
+      if (owner[idx] < 0) continue;
+      buffer->texel_index.push_back(static_cast<int32_t>(idx));
+      buffer->point_qx.push_back(
+          QuantizePoint(point[idx][0], chunk.bounds_min[0], chunk.point_step[0]));
+      buffer->point_qy.push_back(
+          QuantizePoint(point[idx][1], chunk.bounds_min[1], chunk.point_step[1]));
+      buffer->point_qz.push_back(
+          QuantizePoint(point[idx][2], chunk.bounds_min[2], chunk.point_step[2]));
+      const Eigen::Vector3d& n = normal_of[owner[idx]];
+      buffer->normal_qx.push_back(QuantizeNormal(n.x()));
+      buffer->normal_qy.push_back(QuantizeNormal(n.y()));
+      buffer->normal_qz.push_back(QuantizeNormal(n.z()));
+      buffer->on_surface.push_back(surface[idx]);
+      buffer->num_surface_texels += surface[idx];
+    }
+  }
+  chunk.end = buffer->NumTexels();
+  SetNormalCone(*buffer, &chunk);
+  SetFullTile(*buffer, &chunk);
+  SetAffineTile(*buffer, &chunk);
+  if (chunk.end > chunk.begin) buffer->chunks.push_back(chunk);
+}
+
+// Groups of kChunksPerGroup consecutive chunks with their joint bounds.
+void GroupChunks(BaseBuffer* buffer) {
+  const int num_chunks = static_cast<int>(buffer->chunks.size());
   for (int first = 0; first < num_chunks; first += BaseBuffer::kChunksPerGroup) {
     BaseBuffer::ChunkGroup group;
     group.first = first;
     group.last = std::min(num_chunks, first + BaseBuffer::kChunksPerGroup);
-    group.bounds_min = buffer.chunks[first].bounds_min;
-    group.bounds_max = buffer.chunks[first].bounds_max;
+    group.bounds_min = buffer->chunks[first].bounds_min;
+    group.bounds_max = buffer->chunks[first].bounds_max;
     for (int c = first + 1; c < group.last; ++c) {
-      group.bounds_min = group.bounds_min.cwiseMin(buffer.chunks[c].bounds_min);
-      group.bounds_max = group.bounds_max.cwiseMax(buffer.chunks[c].bounds_max);
+      group.bounds_min = group.bounds_min.cwiseMin(buffer->chunks[c].bounds_min);
+      group.bounds_max = group.bounds_max.cwiseMax(buffer->chunks[c].bounds_max);
     }
-    buffer.chunk_groups.push_back(group);
+    buffer->chunk_groups.push_back(group);
   }
+}
+
+// Builds one buffer; triangles whose projection folds over others are returned in `folded`.
+BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
+                    double texel_size_m, const BaseBufferOptions& options,
+                    std::vector<int>* folded) {
+  BaseBuffer buffer;
+  buffer.triangles = triangles;
+  BaseBufferGroup tmp;
+  tmp.triangles = triangles;
+  ChooseAxes(GroupNormal(mesh, tmp), &buffer);
+  const Eigen::Vector3d anchor = mesh.Corner(triangles[0], 0);
+  const PlaneCoords pc = PlaneExtent(mesh, triangles, anchor, &buffer);
+  SizeTexels(pc, anchor, texel_size_m, options, &buffer);
+  const int w = buffer.width, h = buffer.height;
+
+  const int num_local = static_cast<int>(triangles.size());
+  TexelOwners texels;
+  texels.owner.assign(static_cast<size_t>(w) * h, -1);
+  texels.point.resize(static_cast<size_t>(w) * h);
+  std::vector<uint8_t> is_folded(num_local, 0);
+  std::vector<Eigen::Vector3d> normal_of(num_local);
+  for (int li = 0; li < num_local; ++li) normal_of[li] = mesh.Normal(triangles[li]);
+  for (int li = 0; li < num_local; ++li)
+    PlaceTriangle(mesh, buffer, li, normal_of[li], &texels, &is_folded[li]);
+  for (int li = 0; li < num_local; ++li)
+    if (is_folded[li]) folded->push_back(triangles[li]);
+  std::vector<int32_t>& owner = texels.owner;
+  if (!folded->empty()) {
+    // Drop folded triangles' texels; they go to another buffer.
+    for (size_t idx = 0; idx < owner.size(); ++idx)
+      if (owner[idx] >= 0 && is_folded[owner[idx]]) owner[idx] = -1;
+  }
+  std::vector<uint8_t> surface(owner.size(), 0);
+  for (size_t idx = 0; idx < owner.size(); ++idx) surface[idx] = owner[idx] >= 0;
+
+  GrowGutter(mesh, buffer, options.gutter_texels, &texels);
+  const int tile = BaseBuffer::kTileTexels;
+  for (int tj = 0; tj < h; tj += tile)
+    for (int ti = 0; ti < w; ti += tile) StoreTile(texels, surface, normal_of, ti, tj, &buffer);
+  GroupChunks(&buffer);
   return buffer;
 }
 

@@ -154,6 +154,135 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   return mask;
 }
 
+// Per camera: the camera at the reduced size and its rasterizer (which holds each pixel's
+// ray).
+struct SmallCamera {
+  std::unique_ptr<Camera> camera;
+  std::unique_ptr<Rasterizer> rasterizer;
+};
+
+// One frame at the reduced size (SmallFrame) through its small camera.
+void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const SmallCamera& s,
+                    SmallFrame* d) {
+  d->camera = s.camera.get();
+  d->cam_from_local = in.cam_from_local;
+  const cv::Size size(s.camera->width, s.camera->height);
+  if (in.bgr.size() == size)
+    d->bgr = in.bgr;
+  else
+    cv::resize(in.bgr, d->bgr, size, 0, 0, cv::INTER_AREA);
+  const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::erode(d->bgr, d->low, box);
+  cv::dilate(d->bgr, d->high, box);
+  s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d->depth);
+  d->points.create(d->depth.size(), CV_32FC3);
+  d->surface = cv::Mat::zeros(d->depth.size(), CV_8U);
+  const Rigid3d local_from_cam = in.cam_from_local.Inverse();
+  for (int y = 0; y < d->depth.rows; ++y)
+    for (int x = 0; x < d->depth.cols; ++x) {
+      const float z = d->depth.at<float>(y, x);
+      const Eigen::Vector2f ray = s.rasterizer->Ray(x, y);
+      if (!std::isfinite(z) || !ray.allFinite()) {
+        d->points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
+        continue;
+      }
+      const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray.x() * z, ray.y() * z, z);
+      d->points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+      d->surface.at<uchar>(y, x) = 255;
+    }
+}
+
+// The frames at the reduced size (empty where a frame has no camera or colour image); the
+// small cameras they point to are kept in `small`.
+std::vector<SmallFrame> SmallFrames(const TriangleMesh& mesh,
+                                    const std::vector<MoverMaskFrame>& given,
+                                    const MoverMaskOptions& options,
+                                    std::map<const Camera*, SmallCamera>* small) {
+  std::vector<SmallFrame> frames(given.size());
+  for (size_t f = 0; f < given.size(); ++f) {
+    const MoverMaskFrame& in = given[f];
+    if (!in.camera || in.bgr.empty() || in.bgr.type() != CV_8UC3) continue;
+    SmallCamera& s = (*small)[in.camera];
+    if (!s.camera) {
+      const cv::Size size = MoverMaskSize(*in.camera, options);
+      s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
+      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
+    }
+    MakeSmallFrame(mesh, in, s, &frames[f]);
+  }
+  return frames;
+}
+
+// Progress after pass `done` of `passes`: the pixels masked and the frames whose masks changed.
+void ReportPass(const MoverMaskOptions& options, const MoverMaskResult& result, int done,
+                int passes, const std::vector<uint8_t>& changed) {
+  if (!options.progress) return;
+  long long masked = 0;
+  for (const cv::Mat& m : result.masks)
+    if (!m.empty()) masked += cv::countNonZero(m);
+  const long long frames_changed = std::count(changed.begin(), changed.end(), 1);
+  char line[160];
+  std::snprintf(line, sizeof line, "%d frames, %lld pixels masked, %lld frames changed",
+                static_cast<int>(result.masks.size()), masked, frames_changed);
+  options.progress(done, passes, line);
+}
+
+// The masks, joinable pixels and ringed regions the frames' judging gives.
+struct Judged {
+  std::vector<cv::Mat> joinable, ringed;
+};
+
+// A later pass judges a frame again only where a frame it is compared with had its mask
+// changed by the pass before (`changed`); returns the frames whose masks this pass changed.
+std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
+                                const MoverMaskOptions& options,
+                                const std::vector<uint8_t>& changed, Judged* judged,
+                                MoverMaskResult* result) {
+  const int n = static_cast<int>(frames.size());
+  const std::vector<cv::Mat> previous = result->masks;
+  std::vector<uint8_t> now_changed(n, 0);
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    for (int f = range.start; f < range.end; ++f) {
+      if (frames[f].points.empty()) continue;
+      bool any = false;
+      for (int offset : options.offsets)
+        for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
+      if (!any) continue;
+      long long unused = 0;
+      result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused,
+                                    &judged->joinable[f], &result->agreed[f], &judged->ringed[f]);
+      now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
+    }
+  });
+  return now_changed;
+}
+
+// The movers followed across frames over the pixels that may join them.
+void FollowAcrossFrames(const std::vector<SmallFrame>& frames, const Judged& judged,
+                        const MoverMaskOptions& options, MoverMaskResult* result) {
+  const int n = static_cast<int>(frames.size());
+  const std::vector<cv::Mat>& joinable = judged.joinable;
+  const std::vector<cv::Mat>& ringed = judged.ringed;
+  std::vector<FollowFrame> follow(n);
+  for (int f = 0; f < n; ++f)
+    if (!joinable[f].empty()) follow[f] = FollowFrame{frames[f].bgr, joinable[f]};
+  if (options.ringed_follow_frames > 0) {
+    // The regions the masks ring, followed over any pixel of the surface (their inside
+    // agrees with the frames near it), then what that found followed as the rest is.
+    std::vector<FollowFrame> any_surface(n);
+    std::vector<cv::Mat> found(n);
+    for (int f = 0; f < n; ++f) {
+      if (joinable[f].empty() || ringed[f].empty()) continue;
+      any_surface[f] = FollowFrame{frames[f].bgr, frames[f].surface};
+      found[f] = ringed[f].clone();
+    }
+    FollowMovers(any_surface, options.ringed_follow_frames, &found);
+    for (int f = 0; f < n; ++f)
+      if (!found[f].empty()) result->masks[f] |= found[f];
+  }
+  FollowMovers(follow, options.follow_frames, &result->masks);
+}
+
 }  // namespace
 
 cv::Mat MoverMaskResult::Packed(size_t k) const {
@@ -187,120 +316,34 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   *result = MoverMaskResult();
   const int n = static_cast<int>(given.size());
   result->masks.resize(n);
-  // Per camera: the camera at the reduced size and its rasterizer (which holds each pixel's
-  // ray).
-  struct Small {
-    std::unique_ptr<Camera> camera;
-    std::unique_ptr<Rasterizer> rasterizer;
-  };
-  std::map<const Camera*, Small> small;
-  std::vector<SmallFrame> frames(n);
-  for (int f = 0; f < n; ++f) {
-    const MoverMaskFrame& in = given[f];
-    if (!in.camera || in.bgr.empty() || in.bgr.type() != CV_8UC3) continue;
-    Small& s = small[in.camera];
-    if (!s.camera) {
-      const cv::Size size = MoverMaskSize(*in.camera, options);
-      s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
-      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
-    }
-    SmallFrame& d = frames[f];
-    d.camera = s.camera.get();
-    d.cam_from_local = in.cam_from_local;
-    const cv::Size size(s.camera->width, s.camera->height);
-    if (in.bgr.size() == size)
-      d.bgr = in.bgr;
-    else
-      cv::resize(in.bgr, d.bgr, size, 0, 0, cv::INTER_AREA);
-    const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
-    cv::erode(d.bgr, d.low, box);
-    cv::dilate(d.bgr, d.high, box);
-    s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d.depth);
-    d.points.create(d.depth.size(), CV_32FC3);
-    d.surface = cv::Mat::zeros(d.depth.size(), CV_8U);
-    const Rigid3d local_from_cam = in.cam_from_local.Inverse();
-    for (int y = 0; y < d.depth.rows; ++y)
-      for (int x = 0; x < d.depth.cols; ++x) {
-        const float z = d.depth.at<float>(y, x);
-        const Eigen::Vector2f ray = s.rasterizer->Ray(x, y);
-        if (!std::isfinite(z) || !ray.allFinite()) {
-          d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
-          continue;
-        }
-        const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray.x() * z, ray.y() * z, z);
-        d.points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
-        d.surface.at<uchar>(y, x) = 255;
-      }
-  }
+  std::map<const Camera*, SmallCamera> small;
+  const std::vector<SmallFrame> frames = SmallFrames(mesh, given, options, &small);
   std::vector<long long> judged(n, 0), flagged(n, 0);
-  std::vector<cv::Mat> joinable(n), ringed(n);
+  Judged judging;
+  judging.joinable.resize(n);
+  judging.ringed.resize(n);
   result->agreed.resize(n);
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
       if (!frames[f].points.empty())
         result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f],
-                                      &joinable[f], &result->agreed[f], &ringed[f]);
+                                      &judging.joinable[f], &result->agreed[f], &judging.ringed[f]);
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask
   // changed by the pass before (the first pass: any masked pixel); none once nothing changes.
   const bool later_passes = result->fraction() > options.later_passes_min_fraction;
   const int passes = later_passes ? std::max(1, options.passes) : 1;
-  const auto report = [&](int done, const std::vector<uint8_t>& changed) {
-    if (!options.progress) return;
-    long long masked = 0;
-    for (const cv::Mat& m : result->masks)
-      if (!m.empty()) masked += cv::countNonZero(m);
-    const long long frames_changed = std::count(changed.begin(), changed.end(), 1);
-    char line[160];
-    std::snprintf(line, sizeof line, "%d frames, %lld pixels masked, %lld frames changed", n,
-                  masked, frames_changed);
-    options.progress(done, passes, line);
-  };
   std::vector<uint8_t> changed(n, 0);
   for (int f = 0; f < n; ++f)
     changed[f] = !result->masks[f].empty() && cv::countNonZero(result->masks[f]) > 0;
-  report(1, changed);
+  ReportPass(options, *result, 1, passes, changed);
   for (int pass = 1; pass < passes; ++pass) {
-    const std::vector<cv::Mat> previous = result->masks;
-    std::vector<uint8_t> now_changed(n, 0);
-    cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
-      for (int f = range.start; f < range.end; ++f) {
-        if (frames[f].points.empty()) continue;
-        bool any = false;
-        for (int offset : options.offsets)
-          for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
-        if (!any) continue;
-        long long unused = 0;
-        result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused, &joinable[f],
-                                      &result->agreed[f], &ringed[f]);
-        now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
-      }
-    });
-    changed = now_changed;
-    report(pass + 1, changed);
+    changed = JudgeAgain(frames, options, changed, &judging, result);
+    ReportPass(options, *result, pass + 1, passes, changed);
     if (std::find(changed.begin(), changed.end(), 1) == changed.end()) break;
   }
-  if (passes > 1 && options.follow_frames > 0) {
-    std::vector<FollowFrame> follow(n);
-    for (int f = 0; f < n; ++f)
-      if (!joinable[f].empty()) follow[f] = FollowFrame{frames[f].bgr, joinable[f]};
-    if (options.ringed_follow_frames > 0) {
-      // The regions the masks ring, followed over any pixel of the surface (their inside
-      // agrees with the frames near it), then what that found followed as the rest is.
-      std::vector<FollowFrame> any_surface(n);
-      std::vector<cv::Mat> found(n);
-      for (int f = 0; f < n; ++f) {
-        if (joinable[f].empty() || ringed[f].empty()) continue;
-        any_surface[f] = FollowFrame{frames[f].bgr, frames[f].surface};
-        found[f] = ringed[f].clone();
-      }
-      FollowMovers(any_surface, options.ringed_follow_frames, &found);
-      for (int f = 0; f < n; ++f)
-        if (!found[f].empty()) result->masks[f] |= found[f];
-    }
-    FollowMovers(follow, options.follow_frames, &result->masks);
-  }
+  if (passes > 1 && options.follow_frames > 0) FollowAcrossFrames(frames, judging, options, result);
   for (int f = 0; f < n; ++f)
     if (!result->agreed[f].empty()) result->agreed[f].setTo(0, result->masks[f]);
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -227,11 +227,12 @@ void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overla
   const cv::TermCriteria stop(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01);
   // Both pyramids once, for both directions.
   std::vector<cv::Mat> pyramid_w, pyramid_b;
-  const int levels_w = cv::buildOpticalFlowPyramid(grey_w, pyramid_w, window, options.pyramid_levels);
-  const int levels_b = cv::buildOpticalFlowPyramid(grey_b, pyramid_b, window, options.pyramid_levels);
+  const int levels_w =
+      cv::buildOpticalFlowPyramid(grey_w, pyramid_w, window, options.pyramid_levels);
+  const int levels_b =
+      cv::buildOpticalFlowPyramid(grey_b, pyramid_b, window, options.pyramid_levels);
   const int levels = std::min(levels_w, levels_b);
-  cv::calcOpticalFlowPyrLK(pyramid_w, pyramid_b, corners, forward, ok_f, err, window, levels,
-                           stop);
+  cv::calcOpticalFlowPyrLK(pyramid_w, pyramid_b, corners, forward, ok_f, err, window, levels, stop);
   cv::calcOpticalFlowPyrLK(pyramid_b, pyramid_w, forward, backward, ok_b, err, window, levels,
                            stop);
   std::vector<size_t> tracked;  // corners the tracker followed both ways into the overlap
@@ -261,6 +262,135 @@ void MatchLk(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overla
     from->push_back(corners[i]);
     to->push_back(forward[i]);
   }
+}
+
+// Corners of the warped frame within `corner_mask`: Harris at full resolution for the
+// paper's mode, else Shi-Tomasi at half resolution (4x fewer texels): the positions only
+// seed the tracker, which refines them at full resolution.
+std::vector<cv::Point2f> FindCorners(const cv::Mat& grey_w, const cv::Mat& corner_mask,
+                                     const RefineOptions& options) {
+  std::vector<cv::Point2f> corners;
+  if (options.mode == RefineMode::kPaper) {  // Harris, full resolution
+    cv::goodFeaturesToTrack(grey_w, corners, options.max_corners, 0.01, options.window_px,
+                            corner_mask, 3, options.mode == RefineMode::kPaper, 0.04);
+  } else {
+    cv::Mat half, half_mask;
+    cv::pyrDown(grey_w, half);
+    cv::resize(corner_mask, half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
+    cv::goodFeaturesToTrack(half, corners, options.max_corners, 0.01,
+                            std::max(1, options.window_px / 2), half_mask, 3, false);
+    for (cv::Point2f& c : corners) c *= 2.0f;
+  }
+  return corners;
+}
+
+// Collinear (or clustered) corners cannot fix more than a translation reliably: false for
+// those; else true with the points' mean in `centre`.
+bool WellSpread(std::vector<cv::Point2f>* from, cv::Point2d* centre) {
+  cv::Mat points(static_cast<int>(from->size()), 2, CV_32F, from->data());
+  cv::Mat covariance, mean;
+  cv::calcCovarMatrix(points, covariance, mean,
+                      cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE);
+  cv::Mat eigen;
+  cv::eigen(covariance, eigen);
+  const double spread_min = std::sqrt(std::max(0.0, eigen.at<double>(1)));
+  const double spread_max = std::sqrt(std::max(0.0, eigen.at<double>(0)));
+  if (spread_min < 2.0 || spread_min < 0.05 * spread_max) return false;
+  *centre = cv::Point2d(mean.at<double>(0), mean.at<double>(1));
+  return true;
+}
+
+// Inliers: the paper takes every match; the robust mode, RANSAC on the most general model
+// allowed.
+std::vector<uchar> FindInliers(const std::vector<cv::Point2f>& from,
+                               const std::vector<cv::Point2f>& to, MotionModel most_general,
+                               const RefineOptions& options) {
+  std::vector<uchar> inlier(from.size(), 1);
+  if (options.mode != RefineMode::kRobust) return inlier;
+  cv::Mat mask;
+  if (most_general == MotionModel::kHomography)
+    cv::findHomography(from, to, cv::RANSAC, options.ransac_px, mask, 2000, 0.999);
+  else if (most_general == MotionModel::kAffine)
+    cv::estimateAffine2D(from, to, mask, cv::RANSAC, options.ransac_px);
+  else if (most_general == MotionModel::kSimilarity)
+    cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, options.ransac_px);
+  if (!mask.empty()) {
+    for (size_t i = 0; i < inlier.size(); ++i) inlier[i] = mask.at<uchar>(static_cast<int>(i));
+  } else {  // translation: within the threshold of the median displacement
+    std::vector<float> dx, dy;
+    for (size_t i = 0; i < from.size(); ++i)
+      dx.push_back(to[i].x - from[i].x), dy.push_back(to[i].y - from[i].y);
+    std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+    std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
+    const cv::Point2f median(dx[dx.size() / 2], dy[dy.size() / 2]);
+    for (size_t i = 0; i < from.size(); ++i)
+      inlier[i] = cv::norm(to[i] - from[i] - median) <= options.ransac_px;
+  }
+  return inlier;
+}
+
+// The model: the paper's affine, or the one BIC prefers among those allowed (each one's
+// BIC noted in `e`). False when the paper's fit is degenerate.
+bool ChooseModel(const std::vector<cv::Point2f>& in_from, const std::vector<cv::Point2f>& in_to,
+                 const cv::Point2d& centre, MotionModel most_general, const RefineOptions& options,
+                 RefineEstimate* e, cv::Matx33d* best_H) {
+  *best_H = cv::Matx33d::eye();
+  MotionModel best = MotionModel::kNone;
+  if (options.mode == RefineMode::kPaper) {
+    if (!FitModel(MotionModel::kAffine, in_from, in_to, centre, best_H)) return false;
+    best = MotionModel::kAffine;
+  } else {
+    // BIC with a noise floor (0.05 texel) so that exact data does not favour a model by log(0).
+    const double n2 = 2.0 * e->inliers;
+    double best_bic = std::numeric_limits<double>::infinity();
+    for (int m = 0; m <= static_cast<int>(most_general); ++m) {
+      const MotionModel model = static_cast<MotionModel>(m);
+      cv::Matx33d H;
+      if (!FitModel(model, in_from, in_to, centre, &H)) continue;
+      const double rss = SumSquared(H, in_from, in_to);
+      const double bic = n2 * std::log(rss / n2 + 0.05 * 0.05) + NumParams(model) * std::log(n2);
+      e->bic[MotionModelName(model)] = bic;
+      if (bic < best_bic) best_bic = bic, best = model, *best_H = H;
+    }
+  }
+  e->model = best;
+  return true;
+}
+
+// The matches between the warped frame and the buffer in the overlap (`region` of the
+// image), moved into image coordinates; how many were checked for ambiguity in `checked`.
+void MatchRegion(const cv::Mat& grey_w, const cv::Mat& grey_b, const cv::Mat& overlap,
+                 const std::vector<cv::Point2f>& corners, const RefineOptions& options,
+                 RefineEstimate* e, std::vector<cv::Point2f>* from, std::vector<cv::Point2f>* to,
+                 int* checked) {
+  if (options.mode == RefineMode::kPaper) {
+    MatchSsd(grey_w, grey_b, overlap, corners, options, from, to, &e->ambiguous);
+    *checked = e->ambiguous + static_cast<int>(from->size());
+  } else {
+    MatchLk(grey_w, grey_b, overlap, corners, options, from, to, &e->ambiguous, checked);
+  }
+  e->matches = static_cast<int>(from->size());
+  const cv::Point2f offset(static_cast<float>(e->region.x), static_cast<float>(e->region.y));
+  for (auto& p : *from) p += offset;
+  for (auto& p : *to) p += offset;
+}
+
+// Takes the model `H` when its correction passes the checks, and applies it when it is
+// large enough to matter.
+void Accept(const cv::Matx33d& H, const RefineOptions& options, RefineEstimate* e) {
+  const std::string problem = Check(H, e->region, options, &e->correction_px);
+  if (!problem.empty()) {
+    e->fallback = problem;
+    e->residual_after_px = e->residual_before_px;
+    return;
+  }
+  e->buffer_from_warped = H;
+  e->registered = true;
+  if (e->correction_px < options.min_correction_px) {
+    e->fallback = "none needed (below min_correction_px)";
+    return;
+  }
+  e->applied = true;
 }
 
 }  // namespace
@@ -314,20 +444,7 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
   const cv::Mat grey_w = Grey(warped_bgr(e.region)), grey_b = Grey(buffer_bgra(e.region));
   cv::Mat corner_mask;
   cv::erode(overlap, corner_mask, cv::Mat(), cv::Point(-1, -1), options.window_px + 1);
-  std::vector<cv::Point2f> corners;
-  if (options.mode == RefineMode::kPaper) {  // Harris, full resolution
-    cv::goodFeaturesToTrack(grey_w, corners, options.max_corners, 0.01, options.window_px,
-                            corner_mask, 3, options.mode == RefineMode::kPaper, 0.04);
-  } else {
-    // Shi-Tomasi at half resolution (4x fewer texels): the positions only seed the tracker,
-    // which refines them at full resolution.
-    cv::Mat half, half_mask;
-    cv::pyrDown(grey_w, half);
-    cv::resize(corner_mask, half_mask, half.size(), 0, 0, cv::INTER_NEAREST);
-    cv::goodFeaturesToTrack(half, corners, options.max_corners, 0.01,
-                            std::max(1, options.window_px / 2), half_mask, 3, false);
-    for (cv::Point2f& c : corners) c *= 2.0f;
-  }
+  const std::vector<cv::Point2f> corners = FindCorners(grey_w, corner_mask, options);
   e.corners = static_cast<int>(corners.size());
   if (e.corners < options.min_inliers) {
     e.fallback = "too few corners (textureless?)";
@@ -335,16 +452,7 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
   }
   std::vector<cv::Point2f> from, to;
   int checked = 0;  // matches checked for ambiguity
-  if (options.mode == RefineMode::kPaper) {
-    MatchSsd(grey_w, grey_b, overlap, corners, options, &from, &to, &e.ambiguous);
-    checked = e.ambiguous + static_cast<int>(from.size());
-  } else {
-    MatchLk(grey_w, grey_b, overlap, corners, options, &from, &to, &e.ambiguous, &checked);
-  }
-  e.matches = static_cast<int>(from.size());
-  const cv::Point2f offset(static_cast<float>(e.region.x), static_cast<float>(e.region.y));
-  for (auto& p : from) p += offset;
-  for (auto& p : to) p += offset;
+  MatchRegion(grey_w, grey_b, overlap, corners, options, &e, &from, &to, &checked);
   e.from = from;
   e.to = to;
   e.inlier.assign(from.size(), 1);
@@ -359,47 +467,15 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
     e.fallback = "too few matches";
     return e;
   }
-  // Collinear (or clustered) corners cannot fix more than a translation reliably.
-  cv::Mat points(static_cast<int>(from.size()), 2, CV_32F, from.data());
-  cv::Mat covariance, mean;
-  cv::calcCovarMatrix(points, covariance, mean,
-                      cv::COVAR_NORMAL | cv::COVAR_ROWS | cv::COVAR_SCALE);
-  cv::Mat eigen;
-  cv::eigen(covariance, eigen);
-  const double spread_min = std::sqrt(std::max(0.0, eigen.at<double>(1)));
-  const double spread_max = std::sqrt(std::max(0.0, eigen.at<double>(0)));
-  if (spread_min < 2.0 || spread_min < 0.05 * spread_max) {
+  cv::Point2d centre;
+  if (!WellSpread(&from, &centre)) {
     e.fallback = "corners (nearly) collinear";
     return e;
   }
-  const cv::Point2d centre(mean.at<double>(0), mean.at<double>(1));
 
-  // Inliers: the paper takes every match; the robust mode, RANSAC on the most general model
-  // allowed.
-  std::vector<uchar> inlier(from.size(), 1);
   const MotionModel most_general =
       static_cast<MotionModel>(static_cast<int>(options.max_model) + 1);
-  if (options.mode == RefineMode::kRobust) {
-    cv::Mat mask;
-    if (most_general == MotionModel::kHomography)
-      cv::findHomography(from, to, cv::RANSAC, options.ransac_px, mask, 2000, 0.999);
-    else if (most_general == MotionModel::kAffine)
-      cv::estimateAffine2D(from, to, mask, cv::RANSAC, options.ransac_px);
-    else if (most_general == MotionModel::kSimilarity)
-      cv::estimateAffinePartial2D(from, to, mask, cv::RANSAC, options.ransac_px);
-    if (!mask.empty()) {
-      for (size_t i = 0; i < inlier.size(); ++i) inlier[i] = mask.at<uchar>(static_cast<int>(i));
-    } else {  // translation: within the threshold of the median displacement
-      std::vector<float> dx, dy;
-      for (size_t i = 0; i < from.size(); ++i)
-        dx.push_back(to[i].x - from[i].x), dy.push_back(to[i].y - from[i].y);
-      std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
-      std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
-      const cv::Point2f median(dx[dx.size() / 2], dy[dy.size() / 2]);
-      for (size_t i = 0; i < from.size(); ++i)
-        inlier[i] = cv::norm(to[i] - from[i] - median) <= options.ransac_px;
-    }
-  }
+  const std::vector<uchar> inlier = FindInliers(from, to, most_general, options);
   std::vector<cv::Point2f> in_from, in_to;
   for (size_t i = 0; i < from.size(); ++i)
     if (inlier[i]) in_from.push_back(from[i]), in_to.push_back(to[i]);
@@ -409,51 +485,20 @@ RefineEstimate EstimateRefinement(const cv::Mat& warped_bgr, const cv::Mat& warp
     e.fallback = "too few inliers (repeated texture or movers?)";
     return e;
   }
-  const double n2 = 2.0 * e.inliers;
   e.residual_before_px = std::sqrt(SumSquared(cv::Matx33d::eye(), in_from, in_to) / e.inliers);
 
-  // The model: the paper's affine, or the one BIC prefers among those allowed.
-  cv::Matx33d best_H = cv::Matx33d::eye();
-  MotionModel best = MotionModel::kNone;
-  if (options.mode == RefineMode::kPaper) {
-    if (!FitModel(MotionModel::kAffine, in_from, in_to, centre, &best_H)) {
-      e.fallback = "degenerate fit";
-      return e;
-    }
-    best = MotionModel::kAffine;
-  } else {
-    // BIC with a noise floor (0.05 texel) so that exact data does not favour a model by log(0).
-    double best_bic = std::numeric_limits<double>::infinity();
-    for (int m = 0; m <= static_cast<int>(most_general); ++m) {
-      const MotionModel model = static_cast<MotionModel>(m);
-      cv::Matx33d H;
-      if (!FitModel(model, in_from, in_to, centre, &H)) continue;
-      const double rss = SumSquared(H, in_from, in_to);
-      const double bic = n2 * std::log(rss / n2 + 0.05 * 0.05) + NumParams(model) * std::log(n2);
-      e.bic[MotionModelName(model)] = bic;
-      if (bic < best_bic) best_bic = bic, best = model, best_H = H;
-    }
+  cv::Matx33d best_H;
+  if (!ChooseModel(in_from, in_to, centre, most_general, options, &e, &best_H)) {
+    e.fallback = "degenerate fit";
+    return e;
   }
-  e.model = best;
   e.residual_after_px = std::sqrt(SumSquared(best_H, in_from, in_to) / e.inliers);
-  if (best == MotionModel::kNone) {
+  if (e.model == MotionModel::kNone) {
     e.fallback = "none needed (model selection)";
     e.registered = true;
     return e;
   }
-  const std::string problem = Check(best_H, e.region, options, &e.correction_px);
-  if (!problem.empty()) {
-    e.fallback = problem;
-    e.residual_after_px = e.residual_before_px;
-    return e;
-  }
-  e.buffer_from_warped = best_H;
-  e.registered = true;
-  if (e.correction_px < options.min_correction_px) {
-    e.fallback = "none needed (below min_correction_px)";
-    return e;
-  }
-  e.applied = true;
+  Accept(best_H, options, &e);
   return e;
 }
 

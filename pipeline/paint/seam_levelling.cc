@@ -28,30 +28,28 @@ float MedianOf(std::vector<float>* v) {
   return *mid;
 }
 
-}  // namespace
+// The grid of cells over the warped buffer's valid box.
+struct CellGrid {
+  cv::Rect box;
+  int cell = 1;        // texels a side
+  int gx = 0, gy = 0;  // cells across and down
+  int Cells() const { return gx * gy; }
+};
 
-SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
-                          const SeamLevelOptions& options, WarpedBuffer* warped) {
-  SeamLevelStats stats;
-  const cv::Rect box = warped->valid_box;
-  if (box.empty() || kept.size() != warped->bgr.size() || kept.type() != CV_8U ||
-      painted.bgra.size() != warped->bgr.size())
-    return stats;
-  const int cell = std::max(1, options.cell_texels);
-  const int gx = (box.width + cell - 1) / cell, gy = (box.height + cell - 1) / cell;
-  const int cells = gx * gy;
-  const int width = warped->bgr.cols;
-  const uint8_t* valid = warped->valid.data;
-  cv::Vec3b* sample = warped->bgr.ptr<cv::Vec3b>();
+// Per cell and channel, log(stored / sample) over the kept texels (trusted stored samples,
+// values away from black and saturation, ratios within max_log_ratio of 1).
+std::vector<std::vector<float>> CellRatios(const PaintedBuffer& painted, const cv::Mat& kept,
+                                           const WarpedBuffer& warped, const CellGrid& grid,
+                                           float max_log) {
+  const cv::Rect& box = grid.box;
+  const int cell = grid.cell, gx = grid.gx;
+  const int width = warped.bgr.cols;
+  const cv::Vec3b* sample = warped.bgr.ptr<cv::Vec3b>();
   const cv::Vec4b* stored = painted.bgra.ptr<cv::Vec4b>();
   const float* stored_quality = painted.quality.ptr<float>();
   const std::array<float, 256>& log_of = LogTable();
-  const float max_log = static_cast<float>(options.max_log_ratio);
-
-  // Per cell and channel, log(stored / sample) over the kept texels (trusted stored samples,
-  // values away from black and saturation, ratios within max_log_ratio of 1).
   const uint8_t* keeps = kept.data;
-  std::vector<std::vector<float>> ratios(3 * static_cast<size_t>(cells));
+  std::vector<std::vector<float>> ratios(3 * static_cast<size_t>(grid.Cells()));
   for (int y = box.y; y < box.br().y; ++y) {
     const int cy = (y - box.y) / cell;
     for (int x = box.x; x < box.br().x; ++x) {
@@ -70,23 +68,16 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
       for (int c = 0; c < 3; ++c) ratios[at + c].push_back(d[c]);
     }
   }
+  return ratios;
+}
 
-  // The measured cells' medians; the others filled from their neighbours.
-  std::vector<float> value(3 * static_cast<size_t>(cells), 0.0f);
-  std::vector<int> set(cells, 0);  // 0 unset, 1 measured, 2 + round filled
-  for (int i = 0; i < cells; ++i) {
-    std::vector<float>* r = &ratios[3 * static_cast<size_t>(i)];
-    if (static_cast<int>(r->size()) < options.min_samples) continue;
-    set[i] = 1;
-    ++stats.cells_measured;
-    for (int c = 0; c < 3; ++c) {
-      value[3 * i + c] = MedianOf(&ratios[3 * static_cast<size_t>(i) + c]);
-      stats.abs_log_sum += std::abs(value[3 * i + c]);
-    }
-  }
-  if (stats.cells_measured == 0) return stats;
-  for (int round = 0; round < options.fill_cells; ++round) {
-    const std::vector<int> before = set;
+// Cells without a value take their measured (or earlier filled) neighbours' mean, for
+// `rounds` rounds. set: per cell, 0 unset, 1 measured, 2 + round filled.
+void FillCells(const CellGrid& grid, int rounds, std::vector<float>* value, std::vector<int>* set,
+               SeamLevelStats* stats) {
+  const int gx = grid.gx, gy = grid.gy;
+  for (int round = 0; round < rounds; ++round) {
+    const std::vector<int> before = *set;
     for (int cy = 0; cy < gy; ++cy)
       for (int cx = 0; cx < gx; ++cx) {
         const int i = cy * gx + cx;
@@ -98,22 +89,27 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
           if (nb[0] < 0 || nb[1] < 0 || nb[0] >= gx || nb[1] >= gy) continue;
           const int j = nb[1] * gx + nb[0];
           if (before[j] == 0) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += value[3 * j + c];
+          for (int c = 0; c < 3; ++c) sum[c] += (*value)[3 * j + c];
           ++n;
         }
         if (n == 0) continue;
-        for (int c = 0; c < 3; ++c) value[3 * i + c] = sum[c] / static_cast<float>(n);
-        set[i] = 2 + round;
-        ++stats.cells_filled;
+        for (int c = 0; c < 3; ++c) (*value)[3 * i + c] = sum[c] / static_cast<float>(n);
+        (*set)[i] = 2 + round;
+        ++stats->cells_filled;
       }
   }
+}
 
-  // Each valid sample times the gain interpolated between the cells' centres, drawn towards 1
-  // linearly with the texel's distance from the nearest kept texel (1 at fade_texels).
-  std::vector<float> gain(value.size());
-  for (size_t k = 0; k < value.size(); ++k) gain[k] = std::exp(value[k]);
+// Each valid sample times the gain interpolated between the cells' centres, drawn towards 1
+// linearly with the texel's distance from the nearest kept texel (1 at fade_texels).
+void ApplyGains(const CellGrid& grid, const std::vector<float>& gain, const cv::Mat& kept,
+                int fade_texels, WarpedBuffer* warped) {
+  const cv::Rect& box = grid.box;
+  const int gx = grid.gx, gy = grid.gy;
+  const int width = warped->bgr.cols;
+  const uint8_t* valid = warped->valid.data;
+  cv::Vec3b* sample = warped->bgr.ptr<cv::Vec3b>();
   // (City-block distances, in bytes where the fade is short: a fraction of the cost.)
-  const int fade_texels = std::max(1, options.fade_texels);
   cv::Mat not_kept = kept(box) == 0, distance;
   if (fade_texels < 255)
     cv::distanceTransform(not_kept, distance, cv::DIST_L1, 3, CV_8U);
@@ -121,7 +117,7 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
     cv::distanceTransform(not_kept, distance, cv::DIST_L1, 3, CV_32F);
   const bool bytes = distance.type() == CV_8U;
   const float inv_fade = 1.0f / static_cast<float>(fade_texels);
-  const float inv_cell = 1.0f / static_cast<float>(cell);
+  const float inv_cell = 1.0f / static_cast<float>(grid.cell);
   for (int y = box.y; y < box.br().y; ++y) {
     const float fy = std::clamp((static_cast<float>(y - box.y) + 0.5f) * inv_cell - 0.5f, 0.0f,
                                 static_cast<float>(gy - 1));
@@ -149,6 +145,45 @@ SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
       }
     }
   }
+}
+
+}  // namespace
+
+SeamLevelStats LevelSeams(const PaintedBuffer& painted, const cv::Mat& kept,
+                          const SeamLevelOptions& options, WarpedBuffer* warped) {
+  SeamLevelStats stats;
+  const cv::Rect box = warped->valid_box;
+  if (box.empty() || kept.size() != warped->bgr.size() || kept.type() != CV_8U ||
+      painted.bgra.size() != warped->bgr.size())
+    return stats;
+  CellGrid grid;
+  grid.box = box;
+  grid.cell = std::max(1, options.cell_texels);
+  grid.gx = (box.width + grid.cell - 1) / grid.cell;
+  grid.gy = (box.height + grid.cell - 1) / grid.cell;
+  const int cells = grid.Cells();
+  std::vector<std::vector<float>> ratios =
+      CellRatios(painted, kept, *warped, grid, static_cast<float>(options.max_log_ratio));
+
+  // The measured cells' medians; the others filled from their neighbours.
+  std::vector<float> value(3 * static_cast<size_t>(cells), 0.0f);
+  std::vector<int> set(cells, 0);  // 0 unset, 1 measured, 2 + round filled
+  for (int i = 0; i < cells; ++i) {
+    std::vector<float>* r = &ratios[3 * static_cast<size_t>(i)];
+    if (static_cast<int>(r->size()) < options.min_samples) continue;
+    set[i] = 1;
+    ++stats.cells_measured;
+    for (int c = 0; c < 3; ++c) {
+      value[3 * i + c] = MedianOf(&ratios[3 * static_cast<size_t>(i) + c]);
+      stats.abs_log_sum += std::abs(value[3 * i + c]);
+    }
+  }
+  if (stats.cells_measured == 0) return stats;
+  FillCells(grid, options.fill_cells, &value, &set, &stats);
+
+  std::vector<float> gain(value.size());
+  for (size_t k = 0; k < value.size(); ++k) gain[k] = std::exp(value[k]);
+  ApplyGains(grid, gain, kept, std::max(1, options.fade_texels), warped);
   return stats;
 }
 

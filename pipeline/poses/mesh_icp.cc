@@ -82,6 +82,132 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+using Vec7 = Eigen::Matrix<double, 7, 1>;
+using Mat7 = Eigen::Matrix<double, 7, 7>;
+
+// Most points lie close to a sample: a fine hash answers them, the coarse one the rest.
+struct SampleIndex {
+  const VoxelHash *fine, *coarse;
+  int Nearest(const Eigen::Vector3d& p, double* distance) const {
+    const int i = fine->Nearest(p, distance);
+    return i >= 0 ? i : coarse->Nearest(p, distance);
+  }
+};
+
+// What the alignment matches the points to.
+struct IcpProblem {
+  const std::vector<Eigen::Vector3d>& points_in_colmap;
+  const std::vector<Sample>& samples;
+  const SampleIndex& hash;
+  double spacing = 0;
+  const MeshIcpOptions& options;
+};
+
+// Each point's distance (along the sample's normal) from its nearest sample under `w`.
+std::vector<double> PlaneDistances(const IcpProblem& problem, const Sim3d& w) {
+  std::vector<double> d;
+  for (const Eigen::Vector3d& p : problem.points_in_colmap) {
+    double distance = 0.0;
+    const Eigen::Vector3d x = w * p;
+    const int i = problem.hash.Nearest(x, &distance);
+    if (i >= 0) d.push_back(std::abs(problem.samples[i].normal.dot(x - problem.samples[i].point)));
+  }
+  return d;
+}
+
+// Pairs: each point with its nearest sample; far pairs (3x the median) rejected.
+struct Pairs {
+  std::vector<Eigen::Vector3d> world;  // the points under the current transform
+  std::vector<int> nearest;            // their nearest samples (-1: none)
+  std::vector<double> distance;        // and the distances to them
+  std::vector<double> found;           // the distances of the points with a sample
+  double cutoff = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // of the pairs' points
+  int count = 0;
+
+  bool Kept(size_t i) const { return nearest[i] >= 0 && distance[i] <= cutoff; }
+};
+
+void FindPairs(const IcpProblem& problem, const Sim3d& current, Pairs* pairs) {
+  const std::vector<Eigen::Vector3d>& points = problem.points_in_colmap;
+  pairs->nearest.assign(points.size(), -1);
+  pairs->distance.assign(points.size(), 0.0);
+  pairs->found.clear();
+  for (size_t i = 0; i < points.size(); ++i) {
+    pairs->world[i] = current * points[i];
+    pairs->nearest[i] = problem.hash.Nearest(pairs->world[i], &pairs->distance[i]);
+    if (pairs->nearest[i] >= 0) pairs->found.push_back(pairs->distance[i]);
+  }
+  pairs->cutoff = std::max(3.0 * Median(pairs->found), 1e-3 * problem.spacing);
+  pairs->centre = Eigen::Vector3d::Zero();
+  pairs->count = 0;
+  for (size_t i = 0; i < pairs->world.size(); ++i) {
+    if (pairs->Kept(i)) pairs->centre += pairs->world[i], ++pairs->count;
+  }
+}
+
+// The Huber-weighted normal equations of the residuals n.(x' - q) with
+// x' = x + sigma (x - c) + omega x (x - c) + tau, about the pairs' centre c. Returns the mean
+// squared distance of the pairs' points from their centre.
+double NormalEquations(const IcpProblem& problem, const Pairs& pairs, double huber, Mat7* a,
+                       Vec7* b) {
+  double spread2 = 0.0;
+  *a = Mat7::Zero();
+  *b = Vec7::Zero();
+  for (size_t i = 0; i < pairs.world.size(); ++i) {
+    if (!pairs.Kept(i)) continue;
+    const Sample& s = problem.samples[pairs.nearest[i]];
+    const Eigen::Vector3d d = pairs.world[i] - pairs.centre;
+    spread2 += d.squaredNorm() / pairs.count;
+    Vec7 j;
+    j << d.cross(s.normal), s.normal, s.normal.dot(d);
+    const double r = s.normal.dot(pairs.world[i] - s.point);
+    const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
+    *a += w * j * j.transpose();
+    *b -= w * r * j;
+  }
+  return spread2;
+}
+
+// One Gauss-Newton step from `current`; `converged` when the step is negligible.
+Status IcpStep(const IcpProblem& problem, Pairs* pairs, Sim3d* current, bool* converged,
+               MeshIcpResult* result) {
+  FindPairs(problem, *current, pairs);
+  result->pairs = pairs->count;
+  if (pairs->count < problem.options.min_pairs) {
+    return Status::Error("mesh ICP: only " + std::to_string(pairs->count) +
+                         " sparse points lie near the model (within max_distance_m), needs " +
+                         std::to_string(problem.options.min_pairs));
+  }
+  pairs->centre /= pairs->count;
+  const Eigen::Vector3d& centre = pairs->centre;
+  const double huber = std::max(0.5 * Median(pairs->found), 1e-6);
+  Mat7 a;
+  Vec7 b;
+  const double spread2 = NormalEquations(problem, *pairs, huber, &a, &b);
+  if (!problem.options.estimate_scale) {
+    a.row(6).setZero(), a.col(6).setZero(), a(6, 6) = 1.0, b(6) = 0.0;
+  }
+  a.diagonal() += Vec7::Constant(1e-9 * a.diagonal().maxCoeff());
+  const Vec7 x = a.ldlt().solve(b);
+  if (!x.allFinite()) return Status::Error("mesh ICP: the linear system is degenerate");
+  // The update D(y) = (1 + sigma) R(omega) (y - c) + c + tau, composed after `current`.
+  const Eigen::Vector3d omega = x.head<3>(), tau = x.segment<3>(3);
+  const double step_scale = 1.0 + x(6);
+  const Eigen::Quaterniond step_rotation =
+      omega.norm() > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(omega.norm(), omega.normalized()))
+                       : Eigen::Quaterniond::Identity();
+  Sim3d next;
+  next.scale = step_scale * current->scale;
+  next.rotation = (step_rotation * current->rotation).normalized();
+  next.translation = step_scale * (step_rotation * (current->translation - centre)) + centre + tau;
+  *current = next;
+  ++result->iterations;
+  const double radius = std::max(std::sqrt(spread2), 1e-9);
+  *converged = omega.norm() + std::abs(x(6)) + tau.norm() / radius < 1e-6;
+  return Status::Ok();
+}
+
 }  // namespace
 
 Status MeshIcpOptions::Check() const {
@@ -105,94 +231,23 @@ Status AlignPointsToMesh(const std::vector<Eigen::Vector3d>& points_in_colmap, c
   // About 2 samples per spacing^2 of area on a barycentric grid: keep within max_samples.
   spacing = std::max(spacing, std::sqrt(2.0 * area / options.max_samples));
   const std::vector<Sample> samples = SampleMesh(scene, spacing);
-  // Most points lie close to a sample: a fine hash answers them, the coarse one the rest.
   const VoxelHash fine(&samples, std::min(2.0 * spacing, options.max_distance_m));
   const VoxelHash coarse(&samples, options.max_distance_m);
-  struct {
-    const VoxelHash *fine, *coarse;
-    int Nearest(const Eigen::Vector3d& p, double* distance) const {
-      const int i = fine->Nearest(p, distance);
-      return i >= 0 ? i : coarse->Nearest(p, distance);
-    }
-  } hash{&fine, &coarse};
+  const SampleIndex hash{&fine, &coarse};
+  const IcpProblem problem{points_in_colmap, samples, hash, spacing, options};
 
   Sim3d current = initial;
-  std::vector<Eigen::Vector3d> world(points_in_colmap.size());
-  auto distances = [&](const Sim3d& w) {
-    std::vector<double> d;
-    for (const Eigen::Vector3d& p : points_in_colmap) {
-      double distance = 0.0;
-      const Eigen::Vector3d x = w * p;
-      const int i = hash.Nearest(x, &distance);
-      if (i >= 0) d.push_back(std::abs(samples[i].normal.dot(x - samples[i].point)));
-    }
-    return d;
-  };
-  result->median_distance_before_m = Median(distances(current));
+  Pairs pairs;
+  pairs.world.resize(points_in_colmap.size());
+  result->median_distance_before_m = Median(PlaneDistances(problem, current));
   result->iterations = 0;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
-    // Pairs: each point with its nearest sample; far pairs (3x the median) rejected.
-    std::vector<int> nearest(points_in_colmap.size(), -1);
-    std::vector<double> distance(points_in_colmap.size(), 0.0);
-    std::vector<double> found;
-    for (size_t i = 0; i < points_in_colmap.size(); ++i) {
-      world[i] = current * points_in_colmap[i];
-      nearest[i] = hash.Nearest(world[i], &distance[i]);
-      if (nearest[i] >= 0) found.push_back(distance[i]);
-    }
-    const double cutoff = std::max(3.0 * Median(found), 1e-3 * spacing);
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    int pairs = 0;
-    double spread2 = 0.0;  // mean squared distance of the pairs' points from their centre
-    for (size_t i = 0; i < world.size(); ++i) {
-      if (nearest[i] >= 0 && distance[i] <= cutoff) centre += world[i], ++pairs;
-    }
-    result->pairs = pairs;
-    if (pairs < options.min_pairs) {
-      return Status::Error("mesh ICP: only " + std::to_string(pairs) +
-                           " sparse points lie near the model (within max_distance_m), needs " +
-                           std::to_string(options.min_pairs));
-    }
-    centre /= pairs;
-    // Residual n.(x' - q) with x' = x + sigma (x - c) + omega x (x - c) + tau.
-    const double huber = std::max(0.5 * Median(found), 1e-6);
-    Eigen::Matrix<double, 7, 7> a = Eigen::Matrix<double, 7, 7>::Zero();
-    Eigen::Matrix<double, 7, 1> b = Eigen::Matrix<double, 7, 1>::Zero();
-    for (size_t i = 0; i < world.size(); ++i) {
-      if (nearest[i] < 0 || distance[i] > cutoff) continue;
-      const Sample& s = samples[nearest[i]];
-      const Eigen::Vector3d d = world[i] - centre;
-      spread2 += d.squaredNorm() / pairs;
-      Eigen::Matrix<double, 7, 1> j;
-      j << d.cross(s.normal), s.normal, s.normal.dot(d);
-      const double r = s.normal.dot(world[i] - s.point);
-      const double w = std::abs(r) <= huber ? 1.0 : huber / std::abs(r);
-      a += w * j * j.transpose();
-      b -= w * r * j;
-    }
-    if (!options.estimate_scale) {
-      a.row(6).setZero(), a.col(6).setZero(), a(6, 6) = 1.0, b(6) = 0.0;
-    }
-    a.diagonal() += Eigen::Matrix<double, 7, 1>::Constant(1e-9 * a.diagonal().maxCoeff());
-    const Eigen::Matrix<double, 7, 1> x = a.ldlt().solve(b);
-    if (!x.allFinite()) return Status::Error("mesh ICP: the linear system is degenerate");
-    // The update D(y) = (1 + sigma) R(omega) (y - c) + c + tau, composed after `current`.
-    const Eigen::Vector3d omega = x.head<3>(), tau = x.segment<3>(3);
-    const double step_scale = 1.0 + x(6);
-    const Eigen::Quaterniond step_rotation =
-        omega.norm() > 0 ? Eigen::Quaterniond(Eigen::AngleAxisd(omega.norm(), omega.normalized()))
-                         : Eigen::Quaterniond::Identity();
-    Sim3d next;
-    next.scale = step_scale * current.scale;
-    next.rotation = (step_rotation * current.rotation).normalized();
-    next.translation = step_scale * (step_rotation * (current.translation - centre)) + centre + tau;
-    current = next;
-    ++result->iterations;
-    const double radius = std::max(std::sqrt(spread2), 1e-9);
-    if (omega.norm() + std::abs(x(6)) + tau.norm() / radius < 1e-6) break;
+    bool converged = false;
+    FRESCO_RETURN_IF_ERROR(IcpStep(problem, &pairs, &current, &converged, result));
+    if (converged) break;
   }
   result->world_from_colmap = current;
-  result->median_distance_after_m = Median(distances(current));
+  result->median_distance_after_m = Median(PlaneDistances(problem, current));
   return Status::Ok();
 }
 

@@ -121,73 +121,106 @@ void NoteWidened(const FrameVerdict& v, VerifyResult* out) {
       std::max(out->widest_tolerance_deg, v.drift_tolerance * out->rotation_threshold_deg);
 }
 
-}  // namespace
+// Marks a flagged frame as following the drift instead.
+void MarkFollowing(FrameVerdict* v, VerifyResult* out) {
+  v->flagged = false;
+  v->follows_drift = true;
+  ++out->following_drift;
+  NoteWidened(*v, out);
+}
 
-Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
-                   const VerifyOptions& options, VerifyResult* result) {
-  // Options are checked by the callers first (bad input there): here they are a broken
-  // invariant; an alignment that fails is failed work.
-  FRESCO_RETURN_IF_ERROR(options.Check().Reclassified(StatusKind::kInternal));
-  if (!(scene_size_m > 0)) return Status::Internal("scene size: must be > 0");
-  VerifyResult out;
-  out.scene_size_m = scene_size_m;
-  out.rotation_threshold_deg = options.rotation_threshold_deg;
-  out.position_threshold_m = options.position_threshold_rel * scene_size_m;
+// Sets a frame's errors and centres under `fit` and flags it beyond the thresholds.
+void Judge(const PosePair& pair, const PoseAlignment& fit, const VerifyResult& out,
+           FrameVerdict* v) {
+  const PoseError e = ComparePose(pair, fit.world_from_colmap);
+  v->rotation_error_deg = e.rotation_deg;
+  v->position_error_m = e.position_m;
+  SetCentres(pair, fit.world_from_colmap, v);
+  v->flagged =
+      e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
+}
 
-  std::vector<PosePair> pairs, others;  // keyframes' and the other frames' pose pairs
-  std::vector<int> frame_of_pair, frame_of_other, keyframes_before_other;
+// The frames' pose pairs where both poses are known: the keyframes' (reference frames) and
+// the other frames', with each one's frame index.
+struct FramePairs {
+  std::vector<PosePair> pairs, others;
+  std::vector<int> frame_of_pair, frame_of_other;
+  std::vector<int> keyframes_before_other;  // per other frame: the keyframes before it
+};
+
+// A verdict per frame (name, which poses it has) in `out`, and its pose pairs.
+FramePairs CollectPairs(const std::vector<VerifyFrameInput>& frames, VerifyResult* out) {
+  FramePairs split;
   for (size_t i = 0; i < frames.size(); ++i) {
     FrameVerdict v;
     v.name = frames[i].name;
     v.has_given = frames[i].given_cam_from_world != nullptr;
     v.registered = frames[i].colmap_cam_from_colmap != nullptr;
-    if (v.registered) ++out.registered;
+    if (v.registered) ++out->registered;
     if (v.has_given && v.registered) {
       const PosePair pair{v.name, *frames[i].given_cam_from_world,
                           *frames[i].colmap_cam_from_colmap};
       if (frames[i].reference) {
-        pairs.push_back(pair);
-        frame_of_pair.push_back(static_cast<int>(i));
+        split.pairs.push_back(pair);
+        split.frame_of_pair.push_back(static_cast<int>(i));
       } else {
-        others.push_back(pair);
-        frame_of_other.push_back(static_cast<int>(i));
-        keyframes_before_other.push_back(static_cast<int>(pairs.size()));
+        split.others.push_back(pair);
+        split.frame_of_other.push_back(static_cast<int>(i));
+        split.keyframes_before_other.push_back(static_cast<int>(split.pairs.size()));
       }
     }
-    out.frames.push_back(v);
+    out->frames.push_back(v);
   }
-  out.compared = static_cast<int>(pairs.size() + others.size());
+  out->compared = static_cast<int>(split.pairs.size() + split.others.size());
+  return split;
+}
 
-  PoseAlignmentOptions align;
-  align.inlier_position_m = options.inlier_fraction * out.position_threshold_m;
-  align.inlier_rotation_deg = options.inlier_fraction * options.rotation_threshold_deg;
-  align.seed = options.seed;
-  PoseAlignment global;
+// The global alignment of all keyframes, how many agree under it and how they disagree.
+Status AlignGlobally(const std::vector<PosePair>& pairs, const PoseAlignmentOptions& align,
+                     PoseAlignment* global, VerifyResult* out) {
   FRESCO_RETURN_IF_ERROR(
-      AlignColmapToPoses(pairs, align, &global).Reclassified(StatusKind::kFailed));
-  out.world_from_colmap = global.world_from_colmap;
-  out.global_inliers = global.num_inliers;
-  out.centres = global.centres;
-  out.rotation_from = global.rotation_from;
+      AlignColmapToPoses(pairs, align, global).Reclassified(StatusKind::kFailed));
+  out->world_from_colmap = global->world_from_colmap;
+  out->global_inliers = global->num_inliers;
+  out->centres = global->centres;
+  out->rotation_from = global->rotation_from;
   for (const PosePair& pair : pairs) {
-    const PoseError e = ComparePose(pair, global.world_from_colmap);
-    if (e.rotation_deg <= out.rotation_threshold_deg && e.position_m <= out.position_threshold_m) {
-      ++out.global_agreeing;
+    const PoseError e = ComparePose(pair, global->world_from_colmap);
+    if (e.rotation_deg <= out->rotation_threshold_deg &&
+        e.position_m <= out->position_threshold_m) {
+      ++out->global_agreeing;
     }
   }
-  out.weak_alignment = 2 * out.global_agreeing < static_cast<int>(pairs.size());
-  out.disagreement = MeasureDisagreement(pairs, global.world_from_colmap,
-                                         out.rotation_threshold_deg, out.position_threshold_m);
-  if (out.disagreement.Drifts()) {
-    out.drift_first = pairs[out.disagreement.first].name;
-    out.drift_last = pairs[out.disagreement.last].name;
+  out->weak_alignment = 2 * out->global_agreeing < static_cast<int>(pairs.size());
+  out->disagreement = MeasureDisagreement(pairs, global->world_from_colmap,
+                                          out->rotation_threshold_deg, out->position_threshold_m);
+  if (out->disagreement.Drifts()) {
+    out->drift_first = pairs[out->disagreement.first].name;
+    out->drift_last = pairs[out->disagreement.last].name;
   }
+  return Status::Ok();
+}
 
+// The keyframes' fits: one per window of window_frames keyframes (the global one when
+// windows are off or the capture is shorter), each keyframe's window and its disagreement
+// under its own fit.
+struct KeyframeFits {
+  std::map<int, PoseAlignment> fits;                      // by window start
+  std::vector<int> window_of;                             // each keyframe's window start
+  std::vector<Eigen::Matrix<double, 6, 1>> disagreement;  // under each keyframe's own fit
+};
+
+// Judges each keyframe by the fit of the window around it.
+KeyframeFits JudgeKeyframes(const FramePairs& split, const PoseAlignment& global,
+                            const PoseAlignmentOptions& align, const VerifyOptions& options,
+                            VerifyResult* out) {
+  const std::vector<PosePair>& pairs = split.pairs;
   const int n = static_cast<int>(pairs.size());
   const bool local = options.window_frames > 0 && n > options.window_frames;
-  std::map<int, PoseAlignment> fits;                         // by window start
-  std::vector<int> window_of(n, 0);                          // each frame's window start
-  std::vector<Eigen::Matrix<double, 6, 1>> disagreement(n);  // under each frame's own fit
+  KeyframeFits keyframes;
+  std::map<int, PoseAlignment>& fits = keyframes.fits;
+  keyframes.window_of.assign(n, 0);
+  keyframes.disagreement.resize(n);
   for (int k = 0; k < n; ++k) {
     int begin = 0, end = n;
     if (local) {
@@ -208,131 +241,171 @@ Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_siz
         fits[begin] = fit;
       }
     }
-    window_of[k] = begin;
+    keyframes.window_of[k] = begin;
     const PoseAlignment& fit = fits[begin];
-    const PoseError e = ComparePose(pairs[k], fit.world_from_colmap);
-    FrameVerdict& v = out.frames[frame_of_pair[k]];
-    v.rotation_error_deg = e.rotation_deg;
-    v.position_error_m = e.position_m;
-    SetCentres(pairs[k], fit.world_from_colmap, &v);
+    FrameVerdict& v = out->frames[split.frame_of_pair[k]];
+    Judge(pairs[k], fit, *out, &v);
     v.inlier = fit.inliers[k - begin];
-    v.flagged =
-        e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
-    disagreement[k] = DisagreementOf(pairs[k], fit.world_from_colmap, out.rotation_threshold_deg,
-                                     out.position_threshold_m);
+    keyframes.disagreement[k] = DisagreementOf(
+        pairs[k], fit.world_from_colmap, out->rotation_threshold_deg, out->position_threshold_m);
   }
-  out.windows = static_cast<int>(fits.size());
-  if (options.drift_neighbours > 0 && out.disagreement.Drifts()) {
-    // Judged against the neighbours' disagreement (the frame itself left out), a robust line
-    // through them per component (Theil-Sen: the median slope, then the median intercept;
-    // exact on a steady drift, even at the sequence's ends): a drift is smooth, a wrong
-    // given pose stands out from its neighbours.
-    out.drift_followed = true;
-    const int h = options.drift_neighbours;
-    for (int k = 0; k < n; ++k) {
-      FrameVerdict& v = out.frames[frame_of_pair[k]];
-      if (!v.flagged) continue;
-      std::vector<int> around;
-      for (int j = std::max(0, k - h); j <= std::min(n - 1, k + h); ++j)
-        if (j != k) around.push_back(j);
-      if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
-      std::vector<double> offsets;
-      for (int j : around) offsets.push_back(j - k);
-      if (FollowsDrift(pairs[k], disagreement[k], pairs, disagreement, around, offsets,
-                       out.rotation_threshold_deg, &v)) {
-        v.flagged = false;
-        v.follows_drift = true;
-        ++out.following_drift;
-        NoteWidened(v, &out);
-      }
-    }
-  }
-  // The other frames (between keyframes), each by the fit of the keyframe after it (or the
-  // last) and, where the disagreement drifts, against the keyframes around it: the line
-  // through theirs, or between the two on either side of it (in proportion to where it sits
-  // between them) where neither of those is flagged.
-  for (size_t o = 0; o < others.size() && n > 0; ++o) {
-    const int after = keyframes_before_other[o];  // it sits between keyframes after-1 and after
-    const PoseAlignment& fit = fits[window_of[std::min(after, n - 1)]];
-    const PoseError e = ComparePose(others[o], fit.world_from_colmap);
-    FrameVerdict& v = out.frames[frame_of_other[o]];
-    v.rotation_error_deg = e.rotation_deg;
-    v.position_error_m = e.position_m;
-    SetCentres(others[o], fit.world_from_colmap, &v);
-    v.flagged =
-        e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
-    if (!v.flagged || !out.drift_followed) continue;
-    const int h = options.drift_neighbours;
+  out->windows = static_cast<int>(fits.size());
+  return keyframes;
+}
+
+// Judged against the neighbours' disagreement (the frame itself left out), a robust line
+// through them per component (Theil-Sen: the median slope, then the median intercept;
+// exact on a steady drift, even at the sequence's ends): a drift is smooth, a wrong
+// given pose stands out from its neighbours.
+void FollowDriftOnKeyframes(const FramePairs& split, const KeyframeFits& keyframes,
+                            const VerifyOptions& options, VerifyResult* out) {
+  const int n = static_cast<int>(split.pairs.size());
+  const int h = options.drift_neighbours;
+  for (int k = 0; k < n; ++k) {
+    FrameVerdict& v = out->frames[split.frame_of_pair[k]];
+    if (!v.flagged) continue;
     std::vector<int> around;
-    for (int j = std::max(0, after - h); j < std::min(n, after + h); ++j) around.push_back(j);
-    if (static_cast<int>(around.size()) < std::min(h, n)) continue;
-    // Where it sits between keyframes after-1 and after (0.5 before the first or after the last).
-    double between = 0.5;
-    const bool inside = after > 0 && after < n;
-    if (inside) {
-      between = static_cast<double>(frame_of_other[o] - frame_of_pair[after - 1]) /
-                (frame_of_pair[after] - frame_of_pair[after - 1]);
-    }
+    for (int j = std::max(0, k - h); j <= std::min(n - 1, k + h); ++j)
+      if (j != k) around.push_back(j);
+    if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
     std::vector<double> offsets;
-    for (int j : around) offsets.push_back(j - (after - 1 + between));
-    const Eigen::Matrix<double, 6, 1> own = DisagreementOf(
-        others[o], fit.world_from_colmap, out.rotation_threshold_deg, out.position_threshold_m);
-    bool follows = FollowsDrift(others[o], own, pairs, disagreement, around, offsets,
-                                out.rotation_threshold_deg, &v);
-    if (!follows && inside && !out.frames[frame_of_pair[after - 1]].flagged &&
-        !out.frames[frame_of_pair[after]].flagged) {
-      const Eigen::Matrix<double, 6, 1> expected =
-          (1 - between) * DisagreementOf(pairs[after - 1], fit.world_from_colmap,
-                                         out.rotation_threshold_deg, out.position_threshold_m) +
-          between * DisagreementOf(pairs[after], fit.world_from_colmap, out.rotation_threshold_deg,
-                                   out.position_threshold_m);
-      const Eigen::Matrix<double, 6, 1> residual = own - expected;
-      follows = residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0;
-      if (follows) v.drift_tolerance = 1.0;
-    }
-    if (follows) {
-      v.flagged = false;
-      v.follows_drift = true;
-      ++out.following_drift;
-      NoteWidened(v, &out);
+    for (int j : around) offsets.push_back(j - k);
+    if (FollowsDrift(split.pairs[k], keyframes.disagreement[k], split.pairs, keyframes.disagreement,
+                     around, offsets, out->rotation_threshold_deg, &v)) {
+      MarkFollowing(&v, out);
     }
   }
-  // Flags where COLMAP's own pose rests on few points are not given.
+}
+
+// Whether other frame o, flagged under `fit`, follows the drift of the keyframes around it:
+// the line through theirs, or between the two on either side of it (in proportion to where
+// it sits between them) where neither of those is flagged.
+bool OtherFollowsDrift(const FramePairs& split, const KeyframeFits& keyframes, size_t o,
+                       const PoseAlignment& fit, const VerifyOptions& options, VerifyResult* out) {
+  const int n = static_cast<int>(split.pairs.size());
+  const int after = split.keyframes_before_other[o];  // between keyframes after-1 and after
+  FrameVerdict& v = out->frames[split.frame_of_other[o]];
+  const int h = options.drift_neighbours;
+  std::vector<int> around;
+  for (int j = std::max(0, after - h); j < std::min(n, after + h); ++j) around.push_back(j);
+  if (static_cast<int>(around.size()) < std::min(h, n)) return false;
+  // Where it sits between keyframes after-1 and after (0.5 before the first or after the last).
+  double between = 0.5;
+  const bool inside = after > 0 && after < n;
+  if (inside) {
+    between = static_cast<double>(split.frame_of_other[o] - split.frame_of_pair[after - 1]) /
+              (split.frame_of_pair[after] - split.frame_of_pair[after - 1]);
+  }
+  std::vector<double> offsets;
+  for (int j : around) offsets.push_back(j - (after - 1 + between));
+  const double rotation_threshold_deg = out->rotation_threshold_deg;
+  const double position_threshold_m = out->position_threshold_m;
+  const Eigen::Matrix<double, 6, 1> own = DisagreementOf(
+      split.others[o], fit.world_from_colmap, rotation_threshold_deg, position_threshold_m);
+  bool follows = FollowsDrift(split.others[o], own, split.pairs, keyframes.disagreement, around,
+                              offsets, rotation_threshold_deg, &v);
+  if (!follows && inside && !out->frames[split.frame_of_pair[after - 1]].flagged &&
+      !out->frames[split.frame_of_pair[after]].flagged) {
+    const Eigen::Matrix<double, 6, 1> expected =
+        (1 - between) * DisagreementOf(split.pairs[after - 1], fit.world_from_colmap,
+                                       rotation_threshold_deg, position_threshold_m) +
+        between * DisagreementOf(split.pairs[after], fit.world_from_colmap, rotation_threshold_deg,
+                                 position_threshold_m);
+    const Eigen::Matrix<double, 6, 1> residual = own - expected;
+    follows = residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0;
+    if (follows) v.drift_tolerance = 1.0;
+  }
+  return follows;
+}
+
+// The other frames (between keyframes), each by the fit of the keyframe after it (or the
+// last) and, where the disagreement drifts, against the keyframes around it.
+void JudgeOthers(const FramePairs& split, const KeyframeFits& keyframes,
+                 const VerifyOptions& options, VerifyResult* out) {
+  const int n = static_cast<int>(split.pairs.size());
+  for (size_t o = 0; o < split.others.size() && n > 0; ++o) {
+    const int after = split.keyframes_before_other[o];
+    const PoseAlignment& fit = keyframes.fits.at(keyframes.window_of[std::min(after, n - 1)]);
+    FrameVerdict& v = out->frames[split.frame_of_other[o]];
+    Judge(split.others[o], fit, *out, &v);
+    if (!v.flagged || !out->drift_followed) continue;
+    if (OtherFollowsDrift(split, keyframes, o, fit, options, out)) MarkFollowing(&v, out);
+  }
+}
+
+// Flags where COLMAP's own pose rests on few points are not given.
+void ExcuseWeakSupport(const std::vector<VerifyFrameInput>& frames, const VerifyOptions& options,
+                       VerifyResult* out) {
   std::vector<double> observations;
   for (size_t i = 0; i < frames.size(); ++i) {
-    out.frames[i].observations = frames[i].colmap_observations;
-    if (out.frames[i].registered && frames[i].colmap_observations >= 0)
+    out->frames[i].observations = frames[i].colmap_observations;
+    if (out->frames[i].registered && frames[i].colmap_observations >= 0)
       observations.push_back(frames[i].colmap_observations);
   }
-  out.median_observations = Median(observations);
-  out.weak_support_fraction = options.weak_support_fraction;
-  for (FrameVerdict& v : out.frames) {
+  out->median_observations = Median(observations);
+  out->weak_support_fraction = options.weak_support_fraction;
+  for (FrameVerdict& v : out->frames) {
     if (!v.flagged || v.observations < 0 ||
-        v.observations >= options.weak_support_fraction * out.median_observations)
+        v.observations >= options.weak_support_fraction * out->median_observations)
       continue;
     v.flagged = false;
     v.weak_support = true;
-    ++out.weak_support;
+    ++out->weak_support;
   }
+}
+
+// The counts of flagged and unflagged frames and the unflagged frames' error statistics.
+void CountVerdicts(VerifyResult* out) {
   std::vector<double> rotations, positions;
-  for (const FrameVerdict& v : out.frames) {
+  for (const FrameVerdict& v : out->frames) {
     if (!v.has_given || !v.registered) continue;
     if (v.flagged) {
-      ++out.flagged;
+      ++out->flagged;
       continue;
     }
     // Beyond the thresholds: not agreeing, not flagged.
     if (v.follows_drift || v.weak_support) continue;
-    ++out.unflagged;
+    ++out->unflagged;
     rotations.push_back(v.rotation_error_deg);
     positions.push_back(v.position_error_m);
-    out.max_unflagged_rotation_error_deg =
-        std::max(out.max_unflagged_rotation_error_deg, v.rotation_error_deg);
-    out.max_unflagged_position_error_m =
-        std::max(out.max_unflagged_position_error_m, v.position_error_m);
+    out->max_unflagged_rotation_error_deg =
+        std::max(out->max_unflagged_rotation_error_deg, v.rotation_error_deg);
+    out->max_unflagged_position_error_m =
+        std::max(out->max_unflagged_position_error_m, v.position_error_m);
   }
-  out.median_rotation_error_deg = Median(rotations);
-  out.median_position_error_m = Median(positions);
+  out->median_rotation_error_deg = Median(rotations);
+  out->median_position_error_m = Median(positions);
+}
+
+}  // namespace
+
+Status VerifyPoses(const std::vector<VerifyFrameInput>& frames, double scene_size_m,
+                   const VerifyOptions& options, VerifyResult* result) {
+  // Options are checked by the callers first (bad input there): here they are a broken
+  // invariant; an alignment that fails is failed work.
+  FRESCO_RETURN_IF_ERROR(options.Check().Reclassified(StatusKind::kInternal));
+  if (!(scene_size_m > 0)) return Status::Internal("scene size: must be > 0");
+  VerifyResult out;
+  out.scene_size_m = scene_size_m;
+  out.rotation_threshold_deg = options.rotation_threshold_deg;
+  out.position_threshold_m = options.position_threshold_rel * scene_size_m;
+  const FramePairs split = CollectPairs(frames, &out);
+
+  PoseAlignmentOptions align;
+  align.inlier_position_m = options.inlier_fraction * out.position_threshold_m;
+  align.inlier_rotation_deg = options.inlier_fraction * options.rotation_threshold_deg;
+  align.seed = options.seed;
+  PoseAlignment global;
+  FRESCO_RETURN_IF_ERROR(AlignGlobally(split.pairs, align, &global, &out));
+
+  const KeyframeFits keyframes = JudgeKeyframes(split, global, align, options, &out);
+  if (options.drift_neighbours > 0 && out.disagreement.Drifts()) {
+    out.drift_followed = true;
+    FollowDriftOnKeyframes(split, keyframes, options, &out);
+  }
+  JudgeOthers(split, keyframes, options, &out);
+  ExcuseWeakSupport(frames, options, &out);
+  CountVerdicts(&out);
   *result = std::move(out);
   return Status::Ok();
 }

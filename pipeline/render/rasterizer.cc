@@ -231,6 +231,15 @@ struct Rasterizer::RayTable {
     return FirstFrom<true>(row_y, row_origin, row_inv_step, 0, height, value);
   }
 
+  // Unprojects every sample of `camera` at n x n samples per pixel (by_sample).
+  void Unproject(const Camera& camera, int n);
+  // The bucket grid over the bounding box of the valid rays.
+  void PlaceBuckets();
+  // Counting sort of the valid rays into buckets; returns how many there are.
+  int SortIntoBuckets();
+  // Whether the rays lie on a grid (grid, col_x, row_y and their fits).
+  void FindGrid(int num_valid);
+
   int Col(double x) const {
     const double c = std::floor((x - x0) * inv_cell_w);
     return static_cast<int>(std::clamp(c, 0.0, static_cast<double>(cols - 1)));
@@ -240,6 +249,101 @@ struct Rasterizer::RayTable {
     return static_cast<int>(std::clamp(r, 0.0, static_cast<double>(rows - 1)));
   }
 };
+
+void Rasterizer::RayTable::Unproject(const Camera& camera, int n) {
+  width = camera.width * n;
+  height = camera.height * n;
+  by_sample.assign(static_cast<size_t>(width) * height, Eigen::Vector2f(kNaNf, kNaNf));
+  // Sample (c, r) of pixel (c/N, r/N) sits at subpixel offset ((c%N) + 0.5)/N - 0.5, with
+  // pixel (0,0) centred on the top-left pixel.
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r) {
+      const double py = r / n + ((r % n) + 0.5) / n - 0.5;
+      for (int c = 0; c < width; ++c) {
+        const double px = c / n + ((c % n) + 0.5) / n - 0.5;
+        Eigen::Vector2d normalized;
+        if (camera.Unproject(Eigen::Vector2d(px, py), &normalized) && normalized.allFinite())
+          by_sample[static_cast<size_t>(r) * width + c] = normalized.cast<float>();
+      }
+    }
+  });
+}
+
+void Rasterizer::RayTable::PlaceBuckets() {
+  double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
+  for (const Eigen::Vector2f& ray : by_sample) {
+    if (!std::isfinite(ray.x())) continue;
+    xmin = std::min(xmin, static_cast<double>(ray.x()));
+    xmax = std::max(xmax, static_cast<double>(ray.x()));
+    ymin = std::min(ymin, static_cast<double>(ray.y()));
+    ymax = std::max(ymax, static_cast<double>(ray.y()));
+  }
+  if (!(xmin <= xmax)) {  // no valid ray at all
+    xmin = ymin = 0;
+    xmax = ymax = 1;
+  }
+  cols = std::max(1, (width + kBucketSideRays - 1) / kBucketSideRays);
+  rows = std::max(1, (height + kBucketSideRays - 1) / kBucketSideRays);
+  x0 = xmin;
+  y0 = ymin;
+  cell_w = std::max((xmax - xmin) / cols, 1e-12);
+  cell_h = std::max((ymax - ymin) / rows, 1e-12);
+  inv_cell_w = 1.0 / cell_w;
+  inv_cell_h = 1.0 / cell_h;
+}
+
+// Stable: sample order within a bucket.
+int Rasterizer::RayTable::SortIntoBuckets() {
+  const int num_buckets = cols * rows;
+  std::vector<int> bucket_of(by_sample.size(), -1);
+  bucket_start.assign(num_buckets + 1, 0);
+  for (size_t i = 0; i < by_sample.size(); ++i) {
+    const Eigen::Vector2f& ray = by_sample[i];
+    if (!std::isfinite(ray.x())) continue;
+    bucket_of[i] = Row(ray.y()) * cols + Col(ray.x());
+    ++bucket_start[bucket_of[i] + 1];
+  }
+  for (int b = 0; b < num_buckets; ++b) bucket_start[b + 1] += bucket_start[b];
+  const int num_valid = bucket_start[num_buckets];
+  xs.resize(num_valid);
+  ys.resize(num_valid);
+  sample.resize(num_valid);
+  std::vector<int> fill(bucket_start.begin(), bucket_start.end() - 1);
+  for (size_t i = 0; i < by_sample.size(); ++i) {
+    if (bucket_of[i] < 0) continue;
+    const int k = fill[bucket_of[i]]++;
+    xs[k] = by_sample[i].x();
+    ys[k] = by_sample[i].y();
+    sample[k] = static_cast<int>(i);
+  }
+  return num_valid;
+}
+
+// Grid of rays? Every ray valid, x a function of the column alone and y of the row alone
+// (bit for bit), both strictly increasing.
+void Rasterizer::RayTable::FindGrid(int num_valid) {
+  col_x.resize(width);
+  row_y.resize(height);
+  bool is_grid = num_valid == width * height;
+  for (int c = 0; c < width && is_grid; ++c) col_x[c] = by_sample[c].x();
+  for (int r = 0; r < height && is_grid; ++r)
+    row_y[r] = by_sample[static_cast<size_t>(r) * width].y();
+  for (int c = 1; c < width && is_grid; ++c) is_grid = col_x[c] > col_x[c - 1];
+  for (int r = 1; r < height && is_grid; ++r) is_grid = row_y[r] > row_y[r - 1];
+  for (int r = 0; r < height && is_grid; ++r) {
+    const Eigen::Vector2f* row = &by_sample[static_cast<size_t>(r) * width];
+    for (int c = 0; c < width && is_grid; ++c)
+      is_grid = row[c].x() == col_x[c] && row[c].y() == row_y[r];
+  }
+  grid = is_grid;
+  if (!grid) {
+    col_x.clear(), row_y.clear();
+  } else {
+    col_origin = col_x.front(), row_origin = row_y.front();
+    if (width > 1) col_inv_step = (width - 1) / (static_cast<double>(col_x.back()) - col_origin);
+    if (height > 1) row_inv_step = (height - 1) / (static_cast<double>(row_y.back()) - row_origin);
+  }
+}
 
 Rasterizer::Rasterizer(const Camera& camera, const RasterOptions& options)
     : camera_(camera),
@@ -253,98 +357,10 @@ Rasterizer::Rasterizer(const Camera& camera, const RasterOptions& options)
                                 std::to_string(options.supersample));
   if (!(options.near_m > 0) || !std::isfinite(options.near_m))
     throw std::invalid_argument("Rasterizer: near_m must be positive and finite");
-
   RayTable& t = *rays_;
-  const int n = options.supersample;
-  t.width = camera.width * n;
-  t.height = camera.height * n;
-  t.by_sample.assign(static_cast<size_t>(t.width) * t.height, Eigen::Vector2f(kNaNf, kNaNf));
-
-  // Unproject every sample: sample (c, r) of pixel (c/N, r/N) sits at subpixel offset
-  // ((c%N) + 0.5)/N - 0.5, with pixel (0,0) centred on the top-left pixel.
-  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
-    for (int r = range.start; r < range.end; ++r) {
-      const double py = r / n + ((r % n) + 0.5) / n - 0.5;
-      for (int c = 0; c < t.width; ++c) {
-        const double px = c / n + ((c % n) + 0.5) / n - 0.5;
-        Eigen::Vector2d normalized;
-        if (camera_.Unproject(Eigen::Vector2d(px, py), &normalized) && normalized.allFinite())
-          t.by_sample[static_cast<size_t>(r) * t.width + c] = normalized.cast<float>();
-      }
-    }
-  });
-
-  // Bounding box of the valid rays.
-  double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
-  for (const Eigen::Vector2f& ray : t.by_sample) {
-    if (!std::isfinite(ray.x())) continue;
-    xmin = std::min(xmin, static_cast<double>(ray.x()));
-    xmax = std::max(xmax, static_cast<double>(ray.x()));
-    ymin = std::min(ymin, static_cast<double>(ray.y()));
-    ymax = std::max(ymax, static_cast<double>(ray.y()));
-  }
-  if (!(xmin <= xmax)) {  // no valid ray at all
-    xmin = ymin = 0;
-    xmax = ymax = 1;
-  }
-  t.cols = std::max(1, (t.width + kBucketSideRays - 1) / kBucketSideRays);
-  t.rows = std::max(1, (t.height + kBucketSideRays - 1) / kBucketSideRays);
-  t.x0 = xmin;
-  t.y0 = ymin;
-  t.cell_w = std::max((xmax - xmin) / t.cols, 1e-12);
-  t.cell_h = std::max((ymax - ymin) / t.rows, 1e-12);
-  t.inv_cell_w = 1.0 / t.cell_w;
-  t.inv_cell_h = 1.0 / t.cell_h;
-
-  // Counting sort of the samples into buckets (stable: sample order within a bucket).
-  const int num_buckets = t.cols * t.rows;
-  std::vector<int> bucket_of(t.by_sample.size(), -1);
-  t.bucket_start.assign(num_buckets + 1, 0);
-  for (size_t i = 0; i < t.by_sample.size(); ++i) {
-    const Eigen::Vector2f& ray = t.by_sample[i];
-    if (!std::isfinite(ray.x())) continue;
-    bucket_of[i] = t.Row(ray.y()) * t.cols + t.Col(ray.x());
-    ++t.bucket_start[bucket_of[i] + 1];
-  }
-  for (int b = 0; b < num_buckets; ++b) t.bucket_start[b + 1] += t.bucket_start[b];
-  const int num_valid = t.bucket_start[num_buckets];
-  t.xs.resize(num_valid);
-  t.ys.resize(num_valid);
-  t.sample.resize(num_valid);
-  std::vector<int> fill(t.bucket_start.begin(), t.bucket_start.end() - 1);
-  for (size_t i = 0; i < t.by_sample.size(); ++i) {
-    if (bucket_of[i] < 0) continue;
-    const int k = fill[bucket_of[i]]++;
-    t.xs[k] = t.by_sample[i].x();
-    t.ys[k] = t.by_sample[i].y();
-    t.sample[k] = static_cast<int>(i);
-  }
-
-  // Grid of rays? Every ray valid, x a function of the column alone and y of the row alone
-  // (bit for bit), both strictly increasing.
-  t.col_x.resize(t.width);
-  t.row_y.resize(t.height);
-  bool grid = num_valid == t.width * t.height;
-  for (int c = 0; c < t.width && grid; ++c) t.col_x[c] = t.by_sample[c].x();
-  for (int r = 0; r < t.height && grid; ++r)
-    t.row_y[r] = t.by_sample[static_cast<size_t>(r) * t.width].y();
-  for (int c = 1; c < t.width && grid; ++c) grid = t.col_x[c] > t.col_x[c - 1];
-  for (int r = 1; r < t.height && grid; ++r) grid = t.row_y[r] > t.row_y[r - 1];
-  for (int r = 0; r < t.height && grid; ++r) {
-    const Eigen::Vector2f* row = &t.by_sample[static_cast<size_t>(r) * t.width];
-    for (int c = 0; c < t.width && grid; ++c)
-      grid = row[c].x() == t.col_x[c] && row[c].y() == t.row_y[r];
-  }
-  t.grid = grid;
-  if (!grid) {
-    t.col_x.clear(), t.row_y.clear();
-  } else {
-    t.col_origin = t.col_x.front(), t.row_origin = t.row_y.front();
-    if (t.width > 1)
-      t.col_inv_step = (t.width - 1) / (static_cast<double>(t.col_x.back()) - t.col_origin);
-    if (t.height > 1)
-      t.row_inv_step = (t.height - 1) / (static_cast<double>(t.row_y.back()) - t.row_origin);
-  }
+  t.Unproject(camera_, options.supersample);
+  t.PlaceBuckets();
+  t.FindGrid(t.SortIntoBuckets());
 }
 
 Rasterizer::~Rasterizer() = default;

@@ -102,6 +102,125 @@ bool UsableTexture(const Texture& texture) {
   return !texture.rgba.empty() && texture.rgba.type() == CV_8UC4;
 }
 
+// Depth and triangle id at the centres of the pixels (`size`), from the n x n samples'
+// raster (odd n: sample (n-1)/2 of each pixel is its centre) or from `centre` (even n: a 1x
+// rasterization).
+void CentreDepth(const RasterOutput& raster, int n, const RasterOutput* centre, cv::Size size,
+                 RenderOutput* output) {
+  if (n == 1) {
+    output->depth = raster.depth;
+    output->triangle_id = raster.triangle_id;
+    return;
+  }
+  if (centre) {
+    output->depth = centre->depth;
+    output->triangle_id = centre->triangle_id;
+    return;
+  }
+  const int height = size.height, width = size.width;
+  output->depth.create(height, width, CV_32F);
+  output->triangle_id.create(height, width, CV_32S);
+  const int c = (n - 1) / 2;
+  for (int r = 0; r < height; ++r) {
+    for (int col = 0; col < width; ++col) {
+      output->depth.at<float>(r, col) = raster.depth.at<float>(r * n + c, col * n + c);
+      output->triangle_id.at<int>(r, col) = raster.triangle_id.at<int>(r * n + c, col * n + c);
+    }
+  }
+}
+
+// A material's factor (alpha clamped to [0,1]) and its texture, if usable.
+struct Shade {
+  double factor[4];
+  const Texture* texture;
+};
+
+// Per triangle: its material's shade, and whether its texture is sampled (it has UVs).
+struct TriangleShades {
+  std::vector<Shade> shades;  // per material, the last: default white
+  std::vector<const Shade*> shade_of;
+  std::vector<uint8_t> textured;
+};
+
+TriangleShades ShadesOf(const Scene& scene) {
+  const TriangleMesh& mesh = scene.mesh;
+  TriangleShades out;
+  std::vector<Shade>& shades = out.shades;
+  shades.resize(scene.materials.size() + 1);
+  for (size_t m = 0; m < shades.size(); ++m) {
+    const Material material = m < scene.materials.size() ? scene.materials[m] : Material();
+    Shade& shade = shades[m];
+    for (int k = 0; k < 4; ++k) shade.factor[k] = material.base_color_factor[k];
+    shade.factor[3] = std::clamp(shade.factor[3], 0.0, 1.0);
+    if (!std::isfinite(shade.factor[3])) shade.factor[3] = 0.0;
+    const int t = material.base_color_texture;
+    shade.texture =
+        t >= 0 && t < static_cast<int>(scene.textures.size()) && UsableTexture(scene.textures[t])
+            ? &scene.textures[t]
+            : nullptr;
+  }
+  const int num_triangles = mesh.NumTriangles();
+  out.shade_of.resize(num_triangles);
+  out.textured.resize(num_triangles);
+  for (int tri = 0; tri < num_triangles; ++tri) {
+    const int m = tri < static_cast<int>(mesh.material.size()) ? mesh.material[tri] : -1;
+    out.shade_of[tri] =
+        &shades[m >= 0 && m < static_cast<int>(scene.materials.size()) ? m
+                                                                       : scene.materials.size()];
+    out.textured[tri] = out.shade_of[tri]->texture && tri < static_cast<int>(mesh.has_uv.size()) &&
+                        mesh.has_uv[tri] && tri < static_cast<int>(mesh.uvs.size());
+  }
+  return out;
+}
+
+// Shading, one output row per task: per sample, alpha a = texture alpha x factor alpha and
+// premultiplied colour a x texture colour x factor colour; per pixel, the sums' ratio.
+void ShadePixels(const RasterOutput& raster, const TriangleMesh& mesh,
+                 const TriangleShades& shading, const RenderOptions& options, cv::Mat* rgba) {
+  const std::vector<const Shade*>& shade_of = shading.shade_of;
+  const std::vector<uint8_t>& textured = shading.textured;
+  const int n = options.raster.supersample;
+  const int height = rgba->rows, width = rgba->cols;
+  const TextureFilter filter = options.filter;
+  const double inv_samples = 1.0 / (n * n);
+  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+    for (int r = range.start; r < range.end; ++r) {
+      cv::Vec4b* out = rgba->ptr<cv::Vec4b>(r);
+      for (int col = 0; col < width; ++col) {
+        double sum[4] = {0, 0, 0, 0};  // premultiplied colour, alpha
+        for (int sr = r * n; sr < (r + 1) * n; ++sr) {
+          const int* ids = raster.triangle_id.ptr<int>(sr);
+          const cv::Vec2f* bary = raster.bary.ptr<cv::Vec2f>(sr);
+          for (int sc = col * n; sc < (col + 1) * n; ++sc) {
+            const int tri = ids[sc];
+            if (tri < 0) continue;
+            const Shade& shade = *shade_of[tri];
+            double sample[4] = {1, 1, 1, 1};
+            if (textured[tri]) {
+              const auto& uv = mesh.uvs[tri];
+              const double b1 = bary[sc][0], b2 = bary[sc][1], b0 = 1.0 - b1 - b2;
+              const double u = b0 * uv[0].x() + b1 * uv[1].x() + b2 * uv[2].x();
+              const double v = b0 * uv[0].y() + b1 * uv[1].y() + b2 * uv[2].y();
+              SamplePremultiplied(*shade.texture, u, v, filter, sample);
+            }
+            for (int k = 0; k < 3; ++k) sum[k] += sample[k] * shade.factor[k] * shade.factor[3];
+            sum[3] += sample[3] * shade.factor[3];
+          }
+        }
+        if (sum[3] * inv_samples >= 0.5) {
+          const double inv_alpha = 1.0 / sum[3];
+          for (int k = 0; k < 3; ++k)
+            out[col][k] =
+                cv::saturate_cast<uchar>(std::clamp(sum[k] * inv_alpha, 0.0, 1.0) * 255.0);
+          out[col][3] = 255;
+        } else {
+          out[col] = options.background;
+        }
+      }
+    }
+  });
+}
+
 }  // namespace
 
 Eigen::Vector4d SampleTexture(const Texture& texture, const Eigen::Vector2d& uv,
@@ -140,103 +259,19 @@ void Renderer::Render(const Scene& scene, const Rigid3d& cam_from_world,
   const TriangleMesh& mesh = scene.mesh;
   RasterOutput raster;
   rasterizer_.Rasterize(mesh, cam_from_local, &raster);
-
   const Camera& camera = rasterizer_.camera();
-  const int width = camera.width, height = camera.height;
+  const cv::Size size(camera.width, camera.height);
   const int n = options_.raster.supersample;
-
-  // Depth and triangle id at the pixel centres.
-  if (n == 1) {
-    output->depth = raster.depth;
-    output->triangle_id = raster.triangle_id;
-  } else if (centre_rasterizer_) {
+  if (n > 1 && centre_rasterizer_) {
     RasterOutput centre;
     centre_rasterizer_->Rasterize(mesh, cam_from_local, &centre);
-    output->depth = centre.depth;
-    output->triangle_id = centre.triangle_id;
-  } else {  // odd N: sample (N-1)/2 of each pixel is its centre
-    output->depth.create(height, width, CV_32F);
-    output->triangle_id.create(height, width, CV_32S);
-    const int c = (n - 1) / 2;
-    for (int r = 0; r < height; ++r) {
-      for (int col = 0; col < width; ++col) {
-        output->depth.at<float>(r, col) = raster.depth.at<float>(r * n + c, col * n + c);
-        output->triangle_id.at<int>(r, col) = raster.triangle_id.at<int>(r * n + c, col * n + c);
-      }
-    }
+    CentreDepth(raster, n, &centre, size, output);
+  } else {
+    CentreDepth(raster, n, nullptr, size, output);
   }
-
-  // Per material: its factor (alpha clamped to [0,1]) and its texture, if usable.
-  struct Shade {
-    double factor[4];
-    const Texture* texture;
-  };
-  std::vector<Shade> shades(scene.materials.size() + 1);  // the last: default white
-  for (size_t m = 0; m < shades.size(); ++m) {
-    const Material material = m < scene.materials.size() ? scene.materials[m] : Material();
-    Shade& shade = shades[m];
-    for (int k = 0; k < 4; ++k) shade.factor[k] = material.base_color_factor[k];
-    shade.factor[3] = std::clamp(shade.factor[3], 0.0, 1.0);
-    if (!std::isfinite(shade.factor[3])) shade.factor[3] = 0.0;
-    const int t = material.base_color_texture;
-    shade.texture =
-        t >= 0 && t < static_cast<int>(scene.textures.size()) && UsableTexture(scene.textures[t])
-            ? &scene.textures[t]
-            : nullptr;
-  }
-  const int num_triangles = mesh.NumTriangles();
-  std::vector<const Shade*> shade_of(num_triangles);
-  std::vector<uint8_t> textured(num_triangles);
-  for (int tri = 0; tri < num_triangles; ++tri) {
-    const int m = tri < static_cast<int>(mesh.material.size()) ? mesh.material[tri] : -1;
-    shade_of[tri] =
-        &shades[m >= 0 && m < static_cast<int>(scene.materials.size()) ? m
-                                                                       : scene.materials.size()];
-    textured[tri] = shade_of[tri]->texture && tri < static_cast<int>(mesh.has_uv.size()) &&
-                    mesh.has_uv[tri] && tri < static_cast<int>(mesh.uvs.size());
-  }
-
-  // Shading, one output row per task: per sample, alpha a = texture alpha x factor alpha and
-  // premultiplied colour a x texture colour x factor colour; per pixel, the sums' ratio.
-  const TextureFilter filter = options_.filter;
-  const double inv_samples = 1.0 / (n * n);
-  output->rgba.create(height, width, CV_8UC4);
-  cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
-    for (int r = range.start; r < range.end; ++r) {
-      cv::Vec4b* out = output->rgba.ptr<cv::Vec4b>(r);
-      for (int col = 0; col < width; ++col) {
-        double sum[4] = {0, 0, 0, 0};  // premultiplied colour, alpha
-        for (int sr = r * n; sr < (r + 1) * n; ++sr) {
-          const int* ids = raster.triangle_id.ptr<int>(sr);
-          const cv::Vec2f* bary = raster.bary.ptr<cv::Vec2f>(sr);
-          for (int sc = col * n; sc < (col + 1) * n; ++sc) {
-            const int tri = ids[sc];
-            if (tri < 0) continue;
-            const Shade& shade = *shade_of[tri];
-            double sample[4] = {1, 1, 1, 1};
-            if (textured[tri]) {
-              const auto& uv = mesh.uvs[tri];
-              const double b1 = bary[sc][0], b2 = bary[sc][1], b0 = 1.0 - b1 - b2;
-              const double u = b0 * uv[0].x() + b1 * uv[1].x() + b2 * uv[2].x();
-              const double v = b0 * uv[0].y() + b1 * uv[1].y() + b2 * uv[2].y();
-              SamplePremultiplied(*shade.texture, u, v, filter, sample);
-            }
-            for (int k = 0; k < 3; ++k) sum[k] += sample[k] * shade.factor[k] * shade.factor[3];
-            sum[3] += sample[3] * shade.factor[3];
-          }
-        }
-        if (sum[3] * inv_samples >= 0.5) {
-          const double inv_alpha = 1.0 / sum[3];
-          for (int k = 0; k < 3; ++k)
-            out[col][k] =
-                cv::saturate_cast<uchar>(std::clamp(sum[k] * inv_alpha, 0.0, 1.0) * 255.0);
-          out[col][3] = 255;
-        } else {
-          out[col] = options_.background;
-        }
-      }
-    }
-  });
+  const TriangleShades shading = ShadesOf(scene);
+  output->rgba.create(size, CV_8UC4);
+  ShadePixels(raster, mesh, shading, options_, &output->rgba);
 }
 
 }  // namespace fresco

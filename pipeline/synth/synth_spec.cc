@@ -149,6 +149,123 @@ Status ReadImageFile(const std::string& path, const std::string& what, const Obj
   return Status::Ok();
 }
 
+// A scene file (glTF, PLY or OBJ) as the scene.
+Status LoadSceneFile(const std::string& path, const ObjectReader& top, SynthJob* job,
+                     SceneInfo* info) {
+  if (!fs::is_regular_file(path)) return top.Error("scene", "no such file: " + path);
+  FRESCO_RETURN_IF_ERROR(LoadScene(path, SceneLoadOptions(), &job->scene));
+  job->scene_source = path;
+  job->texture_files.assign(job->scene.textures.size(), "");
+  info->kind = SceneKind::kObject;
+  return Status::Ok();
+}
+
+// The cube room's textures (image files per face, `files`) and their repeats.
+Status ReadCubeRoomTextures(ObjectReader* r, const std::string& base_dir, CubeRoomOptions* room,
+                            std::array<std::string, kCubeRoomFaces>* files) {
+  const std::string& file = r->file();
+  if (const json* textures = r->Get("textures")) {
+    if (!textures->is_object()) return r->Error("textures", "must be an object {face: file}");
+    ObjectReader t(*textures, "scene.textures", file);
+    for (int f = 0; f < kCubeRoomFaces; ++f) {
+      std::string name;
+      FRESCO_RETURN_IF_ERROR(t.String(CubeRoomFaceName(f), &name));
+      if (name.empty()) continue;
+      (*files)[f] = Resolve(base_dir, name);
+      FRESCO_RETURN_IF_ERROR(ReadImageFile((*files)[f], CubeRoomFaceName(f), t, &room->images[f]));
+      room->texture_names[f] = fs::path(name).stem().string();
+    }
+    FRESCO_RETURN_IF_ERROR(t.Finish());
+  }
+  if (const json* repeat = r->Get("repeat")) {
+    if (!repeat->is_object()) return r->Error("repeat", "must be an object {face: [u, v]}");
+    ObjectReader t(*repeat, "scene.repeat", file);
+    for (int f = 0; f < kCubeRoomFaces; ++f) {
+      FRESCO_RETURN_IF_ERROR(t.Vector<2>(CubeRoomFaceName(f), &room->repeat[f]));
+    }
+    FRESCO_RETURN_IF_ERROR(t.Finish());
+  }
+  return Status::Ok();
+}
+
+Status BuildCubeRoom(ObjectReader* r, const std::string& base_dir, SynthJob* job, SceneInfo* info) {
+  CubeRoomOptions room;
+  FRESCO_RETURN_IF_ERROR(r->Vector<3>("size_m", &room.size_m));
+  FRESCO_RETURN_IF_ERROR(r->Unsigned("seed", &room.seed));
+  FRESCO_RETURN_IF_ERROR(r->Int("texture_px", &room.procedural_texture_px));
+  std::array<std::string, kCubeRoomFaces> files;
+  FRESCO_RETURN_IF_ERROR(ReadCubeRoomTextures(r, base_dir, &room, &files));
+  FRESCO_RETURN_IF_ERROR(r->Finish());
+  Status s = MakeCubeRoomScene(room, &job->scene);
+  if (!s.ok()) return Status::Error(r->file() + ": scene: " + s.message());
+  job->texture_files.assign(files.begin(), files.end());
+  info->kind = SceneKind::kRoom;
+  info->room_size = room.size_m;
+  return Status::Ok();
+}
+
+Status BuildStreet(ObjectReader* r, SynthJob* job, SceneInfo* info) {
+  StreetOptions street;
+  FRESCO_RETURN_IF_ERROR(r->Number("length_m", &street.length_m));
+  FRESCO_RETURN_IF_ERROR(r->Number("street_width_m", &street.street_width_m));
+  FRESCO_RETURN_IF_ERROR(r->Int("buildings_per_side", &street.buildings_per_side));
+  FRESCO_RETURN_IF_ERROR(r->Number("min_height_m", &street.min_height_m));
+  FRESCO_RETURN_IF_ERROR(r->Number("max_height_m", &street.max_height_m));
+  FRESCO_RETURN_IF_ERROR(r->Int("texture_px", &street.texture_px));
+  FRESCO_RETURN_IF_ERROR(r->Unsigned("seed", &street.seed));
+  FRESCO_RETURN_IF_ERROR(r->Finish());
+  Status s = MakeStreetScene(street, &job->scene);
+  if (!s.ok()) return Status::Error(r->file() + ": scene: " + s.message());
+  job->texture_files.assign(job->scene.textures.size(), "");
+  info->kind = SceneKind::kStreet;
+  info->street = street;
+  return Status::Ok();
+}
+
+// A textured plane (width x height) or cube (edge), its texture from an image file.
+Status BuildPlaneOrCube(bool plane, ObjectReader* r, const std::string& base_dir, SynthJob* job,
+                        SceneInfo* info) {
+  double w = plane ? 2.0 : 1.0, h = 2.0;
+  FRESCO_RETURN_IF_ERROR(r->Number(plane ? "width_m" : "edge_m", &w));
+  if (plane) FRESCO_RETURN_IF_ERROR(r->Number("height_m", &h));
+  if (!(w > 0) || !(h > 0)) return r->Error(plane ? "width_m" : "edge_m", "must be > 0");
+  std::string texture_name;
+  FRESCO_RETURN_IF_ERROR(r->String("texture", &texture_name));
+  cv::Mat image;
+  std::string texture_file;
+  if (!texture_name.empty()) {
+    texture_file = Resolve(base_dir, texture_name);
+    FRESCO_RETURN_IF_ERROR(ReadImageFile(texture_file, "texture", *r, &image));
+  }
+  FRESCO_RETURN_IF_ERROR(r->Finish());
+  job->scene = plane ? MakeTexturedPlaneScene(w, h, RgbaFromImage(image))
+                     : MakeTexturedCubeScene(w, RgbaFromImage(image));
+  job->texture_files.assign(job->scene.textures.size(), texture_file);
+  info->kind = plane ? SceneKind::kPlane : SceneKind::kObject;
+  info->plane_w = w;
+  info->plane_h = h;
+  return Status::Ok();
+}
+
+Status BuildBlocks(ObjectReader* r, SynthJob* job, SceneInfo* info) {
+  BlocksOptions blocks;
+  FRESCO_RETURN_IF_ERROR(r->Number("ground_m", &blocks.ground_m));
+  FRESCO_RETURN_IF_ERROR(r->Int("blocks", &blocks.blocks));
+  FRESCO_RETURN_IF_ERROR(r->Number("area_m", &blocks.area_m));
+  FRESCO_RETURN_IF_ERROR(r->Number("min_size_m", &blocks.min_size_m));
+  FRESCO_RETURN_IF_ERROR(r->Number("max_size_m", &blocks.max_size_m));
+  FRESCO_RETURN_IF_ERROR(r->Number("max_height_m", &blocks.max_height_m));
+  FRESCO_RETURN_IF_ERROR(r->Int("texels_per_m", &blocks.texels_per_m));
+  FRESCO_RETURN_IF_ERROR(r->Unsigned("seed", &blocks.seed));
+  FRESCO_RETURN_IF_ERROR(r->Finish());
+  Status s = MakeBlocksScene(blocks, &job->scene);
+  if (!s.ok()) return Status::Error(r->file() + ": scene: " + s.message());
+  job->texture_files.assign(job->scene.textures.size(), "");
+  info->kind = SceneKind::kBlocks;
+  info->blocks = blocks;
+  return Status::Ok();
+}
+
 Status BuildScene(const json& value, const std::string& file, const std::string& base_dir,
                   SynthJob* job, SceneInfo* info) {
   static const json kEmpty = json::object();
@@ -157,17 +274,8 @@ Status BuildScene(const json& value, const std::string& file, const std::string&
   const json* object = nullptr;
   if (value.is_string()) {
     const std::string s = value.get<std::string>();
-    if (s.rfind("builtin:", 0) == 0) {
-      builtin = s.substr(8);
-    } else {
-      const std::string path = Resolve(base_dir, s);
-      if (!fs::is_regular_file(path)) return top.Error("scene", "no such file: " + path);
-      FRESCO_RETURN_IF_ERROR(LoadScene(path, SceneLoadOptions(), &job->scene));
-      job->scene_source = path;
-      job->texture_files.assign(job->scene.textures.size(), "");
-      info->kind = SceneKind::kObject;
-      return Status::Ok();
-    }
+    if (s.rfind("builtin:", 0) != 0) return LoadSceneFile(Resolve(base_dir, s), top, job, info);
+    builtin = s.substr(8);
   } else if (value.is_object()) {
     object = &value;
     if (!value.contains("builtin") || !value["builtin"].is_string()) {
@@ -182,96 +290,13 @@ Status BuildScene(const json& value, const std::string& file, const std::string&
   FRESCO_RETURN_IF_ERROR(r.String("builtin", &ignored));
   job->scene_source = "builtin:" + builtin;
 
-  if (builtin == "cube-room") {
-    CubeRoomOptions room;
-    FRESCO_RETURN_IF_ERROR(r.Vector<3>("size_m", &room.size_m));
-    FRESCO_RETURN_IF_ERROR(r.Unsigned("seed", &room.seed));
-    FRESCO_RETURN_IF_ERROR(r.Int("texture_px", &room.procedural_texture_px));
-    std::array<std::string, kCubeRoomFaces> files;
-    if (const json* textures = r.Get("textures")) {
-      if (!textures->is_object()) return r.Error("textures", "must be an object {face: file}");
-      ObjectReader t(*textures, "scene.textures", file);
-      for (int f = 0; f < kCubeRoomFaces; ++f) {
-        std::string name;
-        FRESCO_RETURN_IF_ERROR(t.String(CubeRoomFaceName(f), &name));
-        if (name.empty()) continue;
-        files[f] = Resolve(base_dir, name);
-        FRESCO_RETURN_IF_ERROR(ReadImageFile(files[f], CubeRoomFaceName(f), t, &room.images[f]));
-        room.texture_names[f] = fs::path(name).stem().string();
-      }
-      FRESCO_RETURN_IF_ERROR(t.Finish());
-    }
-    if (const json* repeat = r.Get("repeat")) {
-      if (!repeat->is_object()) return r.Error("repeat", "must be an object {face: [u, v]}");
-      ObjectReader t(*repeat, "scene.repeat", file);
-      for (int f = 0; f < kCubeRoomFaces; ++f) {
-        FRESCO_RETURN_IF_ERROR(t.Vector<2>(CubeRoomFaceName(f), &room.repeat[f]));
-      }
-      FRESCO_RETURN_IF_ERROR(t.Finish());
-    }
-    FRESCO_RETURN_IF_ERROR(r.Finish());
-    Status s = MakeCubeRoomScene(room, &job->scene);
-    if (!s.ok()) return Status::Error(file + ": scene: " + s.message());
-    job->texture_files.assign(files.begin(), files.end());
-    info->kind = SceneKind::kRoom;
-    info->room_size = room.size_m;
-  } else if (builtin == "street") {
-    StreetOptions street;
-    FRESCO_RETURN_IF_ERROR(r.Number("length_m", &street.length_m));
-    FRESCO_RETURN_IF_ERROR(r.Number("street_width_m", &street.street_width_m));
-    FRESCO_RETURN_IF_ERROR(r.Int("buildings_per_side", &street.buildings_per_side));
-    FRESCO_RETURN_IF_ERROR(r.Number("min_height_m", &street.min_height_m));
-    FRESCO_RETURN_IF_ERROR(r.Number("max_height_m", &street.max_height_m));
-    FRESCO_RETURN_IF_ERROR(r.Int("texture_px", &street.texture_px));
-    FRESCO_RETURN_IF_ERROR(r.Unsigned("seed", &street.seed));
-    FRESCO_RETURN_IF_ERROR(r.Finish());
-    Status s = MakeStreetScene(street, &job->scene);
-    if (!s.ok()) return Status::Error(file + ": scene: " + s.message());
-    job->texture_files.assign(job->scene.textures.size(), "");
-    info->kind = SceneKind::kStreet;
-    info->street = street;
-  } else if (builtin == "plane" || builtin == "cube") {
-    const bool plane = builtin == "plane";
-    double w = plane ? 2.0 : 1.0, h = 2.0;
-    FRESCO_RETURN_IF_ERROR(r.Number(plane ? "width_m" : "edge_m", &w));
-    if (plane) FRESCO_RETURN_IF_ERROR(r.Number("height_m", &h));
-    if (!(w > 0) || !(h > 0)) return r.Error(plane ? "width_m" : "edge_m", "must be > 0");
-    std::string texture_name;
-    FRESCO_RETURN_IF_ERROR(r.String("texture", &texture_name));
-    cv::Mat image;
-    std::string texture_file;
-    if (!texture_name.empty()) {
-      texture_file = Resolve(base_dir, texture_name);
-      FRESCO_RETURN_IF_ERROR(ReadImageFile(texture_file, "texture", r, &image));
-    }
-    FRESCO_RETURN_IF_ERROR(r.Finish());
-    job->scene = plane ? MakeTexturedPlaneScene(w, h, RgbaFromImage(image))
-                       : MakeTexturedCubeScene(w, RgbaFromImage(image));
-    job->texture_files.assign(job->scene.textures.size(), texture_file);
-    info->kind = plane ? SceneKind::kPlane : SceneKind::kObject;
-    info->plane_w = w;
-    info->plane_h = h;
-  } else if (builtin == "blocks") {
-    BlocksOptions blocks;
-    FRESCO_RETURN_IF_ERROR(r.Number("ground_m", &blocks.ground_m));
-    FRESCO_RETURN_IF_ERROR(r.Int("blocks", &blocks.blocks));
-    FRESCO_RETURN_IF_ERROR(r.Number("area_m", &blocks.area_m));
-    FRESCO_RETURN_IF_ERROR(r.Number("min_size_m", &blocks.min_size_m));
-    FRESCO_RETURN_IF_ERROR(r.Number("max_size_m", &blocks.max_size_m));
-    FRESCO_RETURN_IF_ERROR(r.Number("max_height_m", &blocks.max_height_m));
-    FRESCO_RETURN_IF_ERROR(r.Int("texels_per_m", &blocks.texels_per_m));
-    FRESCO_RETURN_IF_ERROR(r.Unsigned("seed", &blocks.seed));
-    FRESCO_RETURN_IF_ERROR(r.Finish());
-    Status s = MakeBlocksScene(blocks, &job->scene);
-    if (!s.ok()) return Status::Error(file + ": scene: " + s.message());
-    job->texture_files.assign(job->scene.textures.size(), "");
-    info->kind = SceneKind::kBlocks;
-    info->blocks = blocks;
-  } else {
-    return r.Error("builtin", "unknown built-in scene '" + builtin +
-                                  "' (cube-room, street, plane, cube, blocks)");
-  }
-  return Status::Ok();
+  if (builtin == "cube-room") return BuildCubeRoom(&r, base_dir, job, info);
+  if (builtin == "street") return BuildStreet(&r, job, info);
+  if (builtin == "plane" || builtin == "cube")
+    return BuildPlaneOrCube(builtin == "plane", &r, base_dir, job, info);
+  if (builtin == "blocks") return BuildBlocks(&r, job, info);
+  return r.Error("builtin", "unknown built-in scene '" + builtin +
+                                "' (cube-room, street, plane, cube, blocks)");
 }
 
 // Path and mover-region defaults that fit the scene.

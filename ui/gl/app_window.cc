@@ -178,59 +178,72 @@ void InstallQueuedInput(GLFWwindow* window, WindowEvents* events) {
   glfwSetCharCallback(window, ImGui_ImplGlfw_CharCallback);
 }
 
-}  // namespace
-
-int RunGuiApp(const GuiOptions& options) {
+// Opens the project named on the command line. False when the app must exit (code 2): the
+// project cannot be opened and either it names no missing file or the run is unattended.
+bool OpenStartProject(const GuiOptions& options, AppState* state) {
   const bool screenshot = !options.screenshot.empty();
-  AppState state;
   if (!screenshot) {
     const std::string config = ConfigDir();
-    if (!config.empty()) state.recent_file = config + "/recent.json";
-    state.LoadRecent();
+    if (!config.empty()) state->recent_file = config + "/recent.json";
+    state->LoadRecent();
   }
-  if (!options.project.empty()) {
-    if (Status s = state.Open(options.project); !s.ok()) {
-      std::fprintf(stderr, "error: %s\n", s.message().c_str());
-      // A file it names is missing: the app starts with the Project panel's path editor on
-      // it. Unattended (a screenshot run) it exits as the command line does.
-      if (!state.has_unopened || screenshot) return 2;
-      state.message = "error: " + s.message();
-    }
+  if (options.project.empty()) return true;
+  if (Status s = state->Open(options.project); !s.ok()) {
+    std::fprintf(stderr, "error: %s\n", s.message().c_str());
+    // A file it names is missing: the app starts with the Project panel's path editor on
+    // it. Unattended (a screenshot run) it exits as the command line does.
+    if (!state->has_unopened || screenshot) return false;
+    state->message = "error: " + s.message();
   }
+  return true;
+}
+
+// On a high-density monitor the default size grows with its content scale (1600 x 1000 is
+// 3200 x 2000 on a 4K screen at 192 dpi), within its work area.
+void WindowSize(const GuiOptions& options, int* width, int* height) {
+  *width = options.width, *height = options.height;
+  if (options.size_given) return;
+  GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+  if (!monitor) return;
+  float scale_x = 1, scale_y = 1;
+  glfwGetMonitorContentScale(monitor, &scale_x, &scale_y);
+  int area_x = 0, area_y = 0, area_w = 0, area_h = 0;
+  glfwGetMonitorWorkarea(monitor, &area_x, &area_y, &area_w, &area_h);
+  const float scale = std::clamp(std::max(scale_x, scale_y), 1.0f, kMaxUiScale);
+  *width = static_cast<int>(*width * scale), *height = static_cast<int>(*height * scale);
+  if (area_w > 0 && area_h > 0)
+    *width = std::min(*width, area_w), *height = std::min(*height, area_h);
+}
+
+// The app's OpenGL 3.3 window, made current; null (said on stderr) when there is none.
+GLFWwindow* OpenWindow(const GuiOptions& options) {
   glfwSetErrorCallback([](int code, const char* text) {
     std::fprintf(stderr, "fresco gui: GLFW error %d: %s\n", code, text);
   });
   if (!glfwInit()) {
     std::fprintf(stderr, "fresco gui: cannot open a window (no display? run under xvfb-run)\n");
-    return 1;
+    return nullptr;
   }
   glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
   glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
   glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
   glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
-  // On a high-density monitor the default size grows with its content scale (1600 x 1000 is
-  // 3200 x 2000 on a 4K screen at 192 dpi), within its work area.
-  int width = options.width, height = options.height;
-  if (!options.size_given) {
-    if (GLFWmonitor* monitor = glfwGetPrimaryMonitor()) {
-      float scale_x = 1, scale_y = 1;
-      glfwGetMonitorContentScale(monitor, &scale_x, &scale_y);
-      int area_x = 0, area_y = 0, area_w = 0, area_h = 0;
-      glfwGetMonitorWorkarea(monitor, &area_x, &area_y, &area_w, &area_h);
-      const float scale = std::clamp(std::max(scale_x, scale_y), 1.0f, kMaxUiScale);
-      width = static_cast<int>(width * scale), height = static_cast<int>(height * scale);
-      if (area_w > 0 && area_h > 0)
-        width = std::min(width, area_w), height = std::min(height, area_h);
-    }
-  }
+  int width = 0, height = 0;
+  WindowSize(options, &width, &height);
   GLFWwindow* window = glfwCreateWindow(width, height, "Fresco", nullptr, nullptr);
   if (!window) {
     std::fprintf(stderr, "fresco gui: cannot create an OpenGL 3.3 window\n");
     glfwTerminate();
-    return 1;
+    return nullptr;
   }
   glfwMakeContextCurrent(window);
-  glfwSwapInterval(screenshot ? 0 : 1);
+  glfwSwapInterval(options.screenshot.empty() ? 1 : 0);
+  return window;
+}
+
+// ImGui's context and its GLFW and OpenGL backends, with the window's input queued into
+// `events`.
+void StartImGui(GLFWwindow* window, bool screenshot, WindowEvents* events) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
@@ -244,106 +257,165 @@ int RunGuiApp(const GuiOptions& options) {
   ImGui::StyleColorsDark();
   ConfigureImGui(&io);
   ImGui_ImplGlfw_InitForOpenGL(window, false);
-  WindowEvents events;
-  InputState input;
-  InstallQueuedInput(window, &events);
+  InstallQueuedInput(window, events);
   ImGui_ImplOpenGL3_Init("#version 330 core");
+}
 
-  int code = 0;
-  {
-    PipelineRunner runner;
-    CalibrationRunner calibration;
-    PosesRunner poses;
-    GlTextures textures(/*crisp_pixels=*/true);
-    GlViewport viewport;
-    auto panels = MakePanels();
-    UiContext ui;
-    ui.state = &state;
-    ui.runner = &runner;
-    ui.calibration = &calibration;
-    ui.textures = &textures;
-    ui.viewport = &viewport;
-    ui.poses = &poses;
-    // The splitters and font scale as the last session left them (not for screenshots,
-    // which show the default layout).
-    const std::string layout_file =
-        screenshot || ConfigDir().empty() ? "" : ConfigDir() + "/layout.json";
-    SavedLayout saved;
-    if (!layout_file.empty()) {
-      if (Status s = LoadLayoutFile(layout_file, &saved); !s.ok())
-        std::fprintf(stderr, "fresco gui: %s (the default layout instead)\n", s.message().c_str());
-      ui.layout = saved.layout;
-      ui.scale.user = saved.font_scale;
-    }
-    if (state.has_project) {
-      runner.Restart(state.project);
-      ui.open_pending = true;  // a worker error then replaces "opened ..."
-    }
-    if (screenshot && state.has_project) {
-      runner.Seek(std::max(0, options.frames - 1));
-      runner.WaitIdle();
-    }
-    if (!options.calib_images.empty()) StartCalibration(options, &calibration, &panels);
-    if (!options.poses.empty() && state.has_project) StartPoses(options, ui, &panels);
-    int frames_drawn = 0;
+// The app while its window is open: the runners, the panels and what the frames share.
+class GuiApp {
+ public:
+  GuiApp(const GuiOptions& options, GLFWwindow* window, WindowEvents* events, AppState* state)
+      : options_(options),
+        screenshot_(!options.screenshot.empty()),
+        window_(window),
+        events_(events),
+        state_(*state),
+        panels_(MakePanels()) {
+    ui_.state = state;
+    ui_.runner = &runner_;
+    ui_.calibration = &calibration_;
+    ui_.textures = &textures_;
+    ui_.viewport = &viewport_;
+    ui_.poses = &poses_;
+  }
+
+  // Draws frames until the user quits or the screenshot is taken; returns the exit code.
+  int Run() {
+    LoadLayout();
+    StartWork();
+    int code = 0;
     while (true) {
-      glfwPollEvents();
-      if (glfwWindowShouldClose(window)) {
-        glfwSetWindowShouldClose(window, GLFW_FALSE);
-        state.pending_quit = true;
-      }
-      ui.snapshot = runner.Snapshot();
-      DropPaths(ui, events.dropped);
-      events.dropped.clear();
-      // The monitor's scale (it changes when the window moves to another monitor) and the
-      // user's: fonts and style rebuilt between frames when they change; the first frame's
-      // font texture is uploaded by the backend's first NewFrame.
-      float scale_x = 1, scale_y = 1;
-      glfwGetWindowContentScale(window, &scale_x, &scale_y);
-      ui.scale.content = std::max(scale_x, scale_y);
-      if (ApplyUiScale(ui.scale.Total(), &ui.scale_applied) && frames_drawn > 0) {
-        ImGui_ImplOpenGL3_DestroyFontsTexture();
-        ImGui_ImplOpenGL3_CreateFontsTexture();
-      }
-      ImGui_ImplOpenGL3_NewFrame();
-      ImGui_ImplGlfw_NewFrame();
-      events.input.NextFrame(&input);  // this frame's share of the queued input
-      CopyToImGui(input, &io);
-      if (screenshot) io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);  // no hover effects in pictures
-      ImGui::NewFrame();
-      DrawAppFrame(ui, panels);
-      ImGui::Render();
       int fb_width = 0, fb_height = 0;
-      glfwGetFramebufferSize(window, &fb_width, &fb_height);
-      glViewport(0, 0, fb_width, fb_height);
-      glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT);
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      textures.EndFrame();
-      ++frames_drawn;
+      DrawFrame(&fb_width, &fb_height);
+      ++frames_drawn_;
       // Screenshots: a few frames so that windows settle and textures are uploaded.
-      if (screenshot && frames_drawn >= 4) {
-        const cv::Mat pixels = ReadWindow(fb_width, fb_height);
-        Status s = WriteImageAtomic(options.screenshot, pixels);
-        if (s.ok()) s = WritePanelList(options.screenshot + ".json", panels);
-        if (!s.ok()) {
-          std::fprintf(stderr, "error: %s\n", s.message().c_str());
-          code = 1;
-        } else {
-          std::fprintf(stderr, "fresco gui: wrote %s (%dx%d, frame %d)\n",
-                       options.screenshot.c_str(), fb_width, fb_height, ui.snapshot->frame);
-        }
+      if (screenshot_ && frames_drawn_ >= 4) {
+        code = WriteScreenshot(fb_width, fb_height);
         break;
       }
-      glfwSwapBuffers(window);
-      if (ui.request_quit) break;
+      glfwSwapBuffers(window_);
+      if (ui_.request_quit) break;
     }
-    if (!layout_file.empty()) {
-      saved.layout = ui.layout;
-      saved.font_scale = ui.scale.user;
-      if (Status s = SaveLayoutFile(layout_file, saved); !s.ok())
-        std::fprintf(stderr, "fresco gui: %s\n", s.message().c_str());
+    SaveLayout();
+    return code;
+  }
+
+ private:
+  // The splitters and font scale as the last session left them (not for screenshots,
+  // which show the default layout).
+  void LoadLayout() {
+    layout_file_ = screenshot_ || ConfigDir().empty() ? "" : ConfigDir() + "/layout.json";
+    if (layout_file_.empty()) return;
+    if (Status s = LoadLayoutFile(layout_file_, &saved_); !s.ok())
+      std::fprintf(stderr, "fresco gui: %s (the default layout instead)\n", s.message().c_str());
+    ui_.layout = saved_.layout;
+    ui_.scale.user = saved_.font_scale;
+  }
+
+  // The project's pipeline, and the calibration or pose run asked for on the command line.
+  void StartWork() {
+    if (state_.has_project) {
+      runner_.Restart(state_.project);
+      ui_.open_pending = true;  // a worker error then replaces "opened ..."
     }
+    if (screenshot_ && state_.has_project) {
+      runner_.Seek(std::max(0, options_.frames - 1));
+      runner_.WaitIdle();
+    }
+    if (!options_.calib_images.empty()) StartCalibration(options_, &calibration_, &panels_);
+    if (!options_.poses.empty() && state_.has_project) StartPoses(options_, ui_, &panels_);
+  }
+
+  // One frame: the window's events, the panels, and the drawing; the framebuffer's size.
+  void DrawFrame(int* fb_width, int* fb_height) {
+    ImGuiIO& io = ImGui::GetIO();
+    glfwPollEvents();
+    if (glfwWindowShouldClose(window_)) {
+      glfwSetWindowShouldClose(window_, GLFW_FALSE);
+      state_.pending_quit = true;
+    }
+    ui_.snapshot = runner_.Snapshot();
+    DropPaths(ui_, events_->dropped);
+    events_->dropped.clear();
+    // The monitor's scale (it changes when the window moves to another monitor) and the
+    // user's: fonts and style rebuilt between frames when they change; the first frame's
+    // font texture is uploaded by the backend's first NewFrame.
+    float scale_x = 1, scale_y = 1;
+    glfwGetWindowContentScale(window_, &scale_x, &scale_y);
+    ui_.scale.content = std::max(scale_x, scale_y);
+    if (ApplyUiScale(ui_.scale.Total(), &ui_.scale_applied) && frames_drawn_ > 0) {
+      ImGui_ImplOpenGL3_DestroyFontsTexture();
+      ImGui_ImplOpenGL3_CreateFontsTexture();
+    }
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    events_->input.NextFrame(&input_);  // this frame's share of the queued input
+    CopyToImGui(input_, &io);
+    if (screenshot_) io.MousePos = ImVec2(-FLT_MAX, -FLT_MAX);  // no hover effects in pictures
+    ImGui::NewFrame();
+    DrawAppFrame(ui_, panels_);
+    ImGui::Render();
+    glfwGetFramebufferSize(window_, fb_width, fb_height);
+    glViewport(0, 0, *fb_width, *fb_height);
+    glClearColor(0.08f, 0.08f, 0.09f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    textures_.EndFrame();
+  }
+
+  // The window's pixels and the panels' list; returns the exit code.
+  int WriteScreenshot(int fb_width, int fb_height) {
+    const cv::Mat pixels = ReadWindow(fb_width, fb_height);
+    Status s = WriteImageAtomic(options_.screenshot, pixels);
+    if (s.ok()) s = WritePanelList(options_.screenshot + ".json", panels_);
+    if (!s.ok()) {
+      std::fprintf(stderr, "error: %s\n", s.message().c_str());
+      return 1;
+    }
+    std::fprintf(stderr, "fresco gui: wrote %s (%dx%d, frame %d)\n", options_.screenshot.c_str(),
+                 fb_width, fb_height, ui_.snapshot->frame);
+    return 0;
+  }
+
+  void SaveLayout() {
+    if (layout_file_.empty()) return;
+    saved_.layout = ui_.layout;
+    saved_.font_scale = ui_.scale.user;
+    if (Status s = SaveLayoutFile(layout_file_, saved_); !s.ok())
+      std::fprintf(stderr, "fresco gui: %s\n", s.message().c_str());
+  }
+
+  const GuiOptions& options_;
+  const bool screenshot_;
+  GLFWwindow* const window_;
+  WindowEvents* const events_;
+  AppState& state_;
+  InputState input_;
+  int frames_drawn_ = 0;
+  std::string layout_file_;
+  SavedLayout saved_;
+  PipelineRunner runner_;
+  CalibrationRunner calibration_;
+  PosesRunner poses_;
+  GlTextures textures_{/*crisp_pixels=*/true};
+  GlViewport viewport_;
+  std::vector<std::unique_ptr<Panel>> panels_;
+  UiContext ui_;
+};
+
+}  // namespace
+
+int RunGuiApp(const GuiOptions& options) {
+  AppState state;
+  if (!OpenStartProject(options, &state)) return 2;
+  GLFWwindow* window = OpenWindow(options);
+  if (!window) return 1;
+  WindowEvents events;
+  StartImGui(window, !options.screenshot.empty(), &events);
+  int code = 0;
+  {
+    GuiApp app(options, window, &events, &state);
+    code = app.Run();
   }
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();

@@ -218,6 +218,140 @@ struct LineVertex {
   float rgb[3];
 };
 
+// The orbit camera, in the scene's local frame.
+struct OrbitView {
+  Eigen::Vector3f eye;
+  Mat4 view_projection;
+  float radius = 0;  // of the model's bounding sphere
+};
+
+// The orbit camera, in the scene's local frame; fitted to the model on first use.
+OrbitView PlaceOrbit(const RunnerSnapshot& snapshot, ViewportView* view, int width, int height) {
+  const SessionGeometry& geo = *snapshot.geometry;
+  const Scene& scene = geo.painted_layout;
+  Eigen::Vector3d lo, hi;
+  scene.Bounds(&lo, &hi);
+  const Eigen::Vector3f centre = (0.5 * (lo + hi)).cast<float>();
+  const float radius = std::max(1e-3f, static_cast<float>(0.5 * (hi - lo).norm()));
+  const float fov = 50.0f * static_cast<float>(M_PI) / 180;
+  if (!view->target_set) {
+    for (int k = 0; k < 3; ++k) view->target[k] = centre[k];
+    view->target_set = true;
+  }
+  if (view->distance_m <= 0) view->distance_m = 1.3f * radius / std::sin(fov / 2);
+  const float yaw = view->yaw_deg * static_cast<float>(M_PI) / 180;
+  const float pitch = view->pitch_deg * static_cast<float>(M_PI) / 180;
+  const Eigen::Vector3f target(view->target[0], view->target[1], view->target[2]);
+  if (view->orbit_geometry_version != snapshot.geometry_version &&
+      (!geo.path.empty() || !snapshot.FirstLivePath().empty())) {
+    view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.FirstLivePath() : geo.path);
+    view->orbit_geometry_version = snapshot.geometry_version;
+  }
+  OrbitView orbit;
+  orbit.eye = target + view->distance_m * OrbitEyeDirection(view->orbit, yaw, pitch);
+  const float near = std::max(1e-3f, 0.01f * view->distance_m);
+  orbit.view_projection = Perspective(fov, static_cast<float>(width) / height, near,
+                                      10.0f * (view->distance_m + radius)) *
+                          LookAt(orbit.eye, target, view->orbit.up);
+  orbit.radius = radius;
+  return orbit;
+}
+
+// The current frame's camera (its stream's, when the project has several).
+const Camera& FrameCamera(const RunnerSnapshot& snapshot) {
+  const SessionGeometry& geo = *snapshot.geometry;
+  return static_cast<size_t>(snapshot.stream) < geo.stream_cameras.size()
+             ? geo.stream_cameras[snapshot.stream]
+             : geo.camera;
+}
+
+// The frame's projection for the preview: pixel * z = K [R|t] x_local (pinhole part).
+Eigen::Matrix4f FrameFromLocal(const Camera& cam, const Rigid3d& cam_from_local) {
+  Eigen::Matrix4f frame_from_local = Eigen::Matrix4f::Zero();
+  Eigen::Matrix3d K;
+  K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
+  frame_from_local.block<3, 3>(0, 0) = (K * cam_from_local.RotationMatrix()).cast<float>();
+  frame_from_local.block<3, 1>(0, 3) = (K * cam_from_local.translation).cast<float>();
+  frame_from_local(3, 3) = 1;
+  return frame_from_local;
+}
+
+void AddLine(const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, float g, float bl,
+             std::vector<LineVertex>* lines) {
+  lines->push_back({{a.x(), a.y(), a.z()}, {r, g, bl}});
+  lines->push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
+}
+
+// Each stream's path, given and live (stream 0 grey, the others in their own hues).
+void AddPaths(const RunnerSnapshot& snapshot, std::vector<LineVertex>* lines) {
+  const SessionGeometry& geo = *snapshot.geometry;
+  const Scene& scene = geo.painted_layout;
+  // The return type spelled out: deduced, it would be an Eigen expression over a temporary.
+  auto centre_of = [&](const Rigid3d& cam_from_world) -> Eigen::Vector3f {
+    return CamFromLocal(scene, cam_from_world).Centre().cast<float>();
+  };
+  static constexpr float kStreamColours[][3] = {
+      {0.6f, 0.6f, 0.65f}, {0.3f, 0.75f, 1.0f}, {1.0f, 0.45f, 0.8f}, {0.45f, 0.95f, 0.45f}};
+  std::vector<std::pair<const std::vector<Rigid3d>*, size_t>> paths;  // (path, stream)
+  if (geo.stream_paths.empty()) paths.push_back({&geo.path, 0});
+  for (size_t s = 0; s < geo.stream_paths.size(); ++s) paths.push_back({&geo.stream_paths[s], s});
+  for (size_t s = 0; s < snapshot.live_paths.size(); ++s)
+    paths.push_back({&snapshot.live_paths[s], s});
+  for (const auto& [path, stream] : paths) {
+    const float* colour = kStreamColours[stream % 4];
+    for (size_t i = 1; i < path->size(); ++i)
+      AddLine(centre_of((*path)[i - 1]), centre_of((*path)[i]), colour[0], colour[1], colour[2],
+              lines);
+  }
+}
+
+// COLMAP's path (orange) and each flagged frame's offset from its given centre (red).
+void AddPoseCheck(const ViewportView& view, const Scene& scene, std::vector<LineVertex>* lines) {
+  auto local_of = [&](const Eigen::Vector3d& world) -> Eigen::Vector3f {
+    return (world - scene.origin_in_world).cast<float>();
+  };
+  for (size_t i = 1; i < view.pose_check.size(); ++i)
+    AddLine(local_of(view.pose_check[i - 1].colmap), local_of(view.pose_check[i].colmap), 1.0f,
+            0.55f, 0.1f, lines);
+  for (const ViewportView::PoseCheckMark& mark : view.pose_check)
+    if (mark.flagged)
+      AddLine(local_of(mark.given), local_of(mark.colmap), 1.0f, 0.15f, 0.15f, lines);
+}
+
+// The current camera's frustum (yellow), `depth` deep.
+void AddFrustum(const Camera& cam, const Rigid3d& cam_from_local, float depth,
+                std::vector<LineVertex>* lines) {
+  const Rigid3d local_from_cam = cam_from_local.Inverse();
+  const Eigen::Vector3f c = local_from_cam.translation.cast<float>();
+  Eigen::Vector3f corners[4];
+  const double px[4][2] = {{-0.5, -0.5},
+                           {cam.width - 0.5, -0.5},
+                           {cam.width - 0.5, cam.height - 0.5},
+                           {-0.5, cam.height - 0.5}};
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector3d ray((px[k][0] - cam.cx) / cam.fx, (px[k][1] - cam.cy) / cam.fy, 1.0);
+    corners[k] = (local_from_cam * (ray * depth)).cast<float>();
+  }
+  for (int k = 0; k < 4; ++k) {
+    AddLine(c, corners[k], 1.0f, 0.85f, 0.1f, lines);
+    AddLine(corners[k], corners[(k + 1) % 4], 1.0f, 0.85f, 0.1f, lines);
+  }
+}
+
+// Lines: the path (grey), COLMAP's path after a pose verification (orange, flagged frames'
+// offsets red), the current camera's frustum (yellow).
+std::vector<LineVertex> OverlayLines(const RunnerSnapshot& snapshot, const ViewportView& view,
+                                     const Camera& cam, const Rigid3d& cam_from_local,
+                                     float radius) {
+  std::vector<LineVertex> lines;
+  if (view.show_path) AddPaths(snapshot, &lines);
+  if (view.show_pose_check && !view.pose_check.empty())
+    AddPoseCheck(view, snapshot.geometry->painted_layout, &lines);
+  if (view.show_frustum && snapshot.has_pose)
+    AddFrustum(cam, cam_from_local, 0.25f * radius, &lines);
+  return lines;
+}
+
 }  // namespace
 
 struct GlViewport::Impl {
@@ -242,6 +376,15 @@ struct GlViewport::Impl {
   // The layer uniforms' locations (looked up once, after linking) and the sort's scratch.
   GLint layered_at = -1, layer_centre_at[kLayersBound] = {-1, -1, -1, -1};
   std::vector<std::pair<float, size_t>> nearest_layers;
+
+  // Binds the offscreen framebuffer (colour and triangle ids) and clears it.
+  void BeginDraw(int w, int h);
+  // Draws the mesh, buffer by buffer, as `view` shows it (painted, groups or the frame
+  // projected with `frame_from_local`, for a frame from `frame_camera`).
+  void DrawMesh(const RunnerSnapshot& snapshot, const ViewportView& view, const OrbitView& orbit,
+                const Camera& frame_camera, const Eigen::Matrix4f& frame_from_local);
+  // Draws `lines` over the model.
+  void DrawLines(const std::vector<LineVertex>& lines, const Mat4& view_projection);
 
   void Build() {
     mesh_program = Link(kMeshVertex, kMeshFragment);
@@ -414,6 +557,77 @@ GlViewport::~GlViewport() {
   }
 }
 
+void GlViewport::Impl::BeginDraw(int w, int h) {
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  const GLenum outputs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glDrawBuffers(2, outputs);
+  glViewport(0, 0, w, h);
+  const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
+  const GLint no_triangle[4] = {-1, -1, -1, -1};
+  glClearBufferfv(GL_COLOR, 0, background);
+  glClearBufferiv(GL_COLOR, 1, no_triangle);
+  glClear(GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDisable(GL_BLEND);
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_SCISSOR_TEST);
+}
+
+void GlViewport::Impl::DrawMesh(const RunnerSnapshot& snapshot, const ViewportView& view,
+                                const OrbitView& orbit, const Camera& frame_camera,
+                                const Eigen::Matrix4f& frame_from_local) {
+  const Camera& cam = frame_camera;
+  const Eigen::Vector3f& eye = orbit.eye;
+  glUseProgram(mesh_program);
+  glUniformMatrix4fv(glGetUniformLocation(mesh_program, "view_projection"), 1, GL_FALSE,
+                     orbit.view_projection.data());
+  glUniformMatrix4fv(glGetUniformLocation(mesh_program, "frame_from_local"), 1, GL_FALSE,
+                     frame_from_local.data());
+  glUniform2f(glGetUniformLocation(mesh_program, "frame_size"), static_cast<float>(cam.width),
+              static_cast<float>(cam.height));
+  glUniform3f(glGetUniformLocation(mesh_program, "eye"), eye.x(), eye.y(), eye.z());
+  glUniform1i(glGetUniformLocation(mesh_program, "mode"), static_cast<int>(view.mode));
+  glUniform1i(glGetUniformLocation(mesh_program, "painted"), 0);
+  glUniform1i(glGetUniformLocation(mesh_program, "frame"), 1);
+  glActiveTexture(GL_TEXTURE1);
+  const bool projected = view.mode == ViewportView::Mode::kProjected && snapshot.has_pose &&
+                         !snapshot.frame_bgr.empty();
+  GLuint frame_texture = 0;
+  if (projected)
+    frame_texture = static_cast<GLuint>(
+        reinterpret_cast<intptr_t>(textures.Get("frame", snapshot.frame_bgr, snapshot.version)));
+  glBindTexture(GL_TEXTURE_2D, frame_texture);
+  glActiveTexture(GL_TEXTURE0);
+  glBindVertexArray(vao);
+  for (int i = 0; i < kLayersBound; ++i)
+    glUniform1i(glGetUniformLocation(mesh_program, ("layer" + std::to_string(i)).c_str()), 2 + i);
+  const bool layered = view.mode == ViewportView::Mode::kPainted && view.view_layers &&
+                       snapshot.layers && !snapshot.layers->empty();
+  glUniform1i(layered_at, 0);
+  for (size_t b = 0; b < first.size(); ++b) {
+    GLuint texture = 0;
+    if (snapshot.painted && b < snapshot.painted->size())
+      texture = static_cast<GLuint>(reinterpret_cast<intptr_t>(textures.Get(
+          "buffer/" + std::to_string(b), (*snapshot.painted)[b], snapshot.painted_version)));
+    if (layered && b < centre.size()) BindNearestLayers(snapshot, b, eye);
+    glBindTexture(GL_TEXTURE_2D, texture);
+    if (count[b] > 0) glDrawArrays(GL_TRIANGLES, first[b], count[b]);
+  }
+  if (ungrouped_count > 0) glDrawArrays(GL_TRIANGLES, ungrouped_first, ungrouped_count);
+}
+
+void GlViewport::Impl::DrawLines(const std::vector<LineVertex>& lines,
+                                 const Mat4& view_projection) {
+  glDisable(GL_DEPTH_TEST);  // drawn over the model: a path inside a room stays visible
+  glUseProgram(line_program);
+  glUniformMatrix4fv(glGetUniformLocation(line_program, "view_projection"), 1, GL_FALSE,
+                     view_projection.data());
+  glBindVertexArray(line_vao);
+  glBindBuffer(GL_ARRAY_BUFFER, line_vbo);
+  glBufferData(GL_ARRAY_BUFFER, lines.size() * sizeof(LineVertex), lines.data(), GL_STREAM_DRAW);
+  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size()));
+}
+
 ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& state,
                                ViewportView* view, int width, int height) {
   Impl& m = *impl_;
@@ -427,165 +641,18 @@ ImTextureID GlViewport::Render(const RunnerSnapshot& snapshot, const AppState& s
     m.selection = state.selected_triangles;
     m.selected_groups = state.selected_groups;
   }
-  // The orbit camera, in the scene's local frame; fitted to the model on first use.
-  const Scene& scene = geo.painted_layout;
-  Eigen::Vector3d lo, hi;
-  scene.Bounds(&lo, &hi);
-  const Eigen::Vector3f centre = (0.5 * (lo + hi)).cast<float>();
-  const float radius = std::max(1e-3f, static_cast<float>(0.5 * (hi - lo).norm()));
-  const float fov = 50.0f * static_cast<float>(M_PI) / 180;
-  if (!view->target_set) {
-    for (int k = 0; k < 3; ++k) view->target[k] = centre[k];
-    view->target_set = true;
-  }
-  if (view->distance_m <= 0) view->distance_m = 1.3f * radius / std::sin(fov / 2);
-  const float yaw = view->yaw_deg * static_cast<float>(M_PI) / 180;
-  const float pitch = view->pitch_deg * static_cast<float>(M_PI) / 180;
-  const Eigen::Vector3f target(view->target[0], view->target[1], view->target[2]);
-  if (view->orbit_geometry_version != snapshot.geometry_version &&
-      (!geo.path.empty() || !snapshot.FirstLivePath().empty())) {
-    view->orbit = OrbitFrameFromPoses(geo.path.empty() ? snapshot.FirstLivePath() : geo.path);
-    view->orbit_geometry_version = snapshot.geometry_version;
-  }
-  const Eigen::Vector3f eye =
-      target + view->distance_m * OrbitEyeDirection(view->orbit, yaw, pitch);
-  const float near = std::max(1e-3f, 0.01f * view->distance_m);
-  const Mat4 view_projection = Perspective(fov, static_cast<float>(width) / height, near,
-                                           10.0f * (view->distance_m + radius)) *
-                               LookAt(eye, target, view->orbit.up);
+  const OrbitView orbit = PlaceOrbit(snapshot, view, width, height);
 
   GLint previous_fbo = 0, previous_viewport[4];
   glGetIntegerv(GL_FRAMEBUFFER_BINDING, &previous_fbo);
   glGetIntegerv(GL_VIEWPORT, previous_viewport);
-  glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
-  const GLenum outputs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glDrawBuffers(2, outputs);
-  glViewport(0, 0, width, height);
-  const float background[4] = {0.12f, 0.12f, 0.14f, 1.0f};
-  const GLint no_triangle[4] = {-1, -1, -1, -1};
-  glClearBufferfv(GL_COLOR, 0, background);
-  glClearBufferiv(GL_COLOR, 1, no_triangle);
-  glClear(GL_DEPTH_BUFFER_BIT);
-  glEnable(GL_DEPTH_TEST);
-  glDisable(GL_BLEND);
-  glDisable(GL_CULL_FACE);
-  glDisable(GL_SCISSOR_TEST);
-
-  // The frame's projection for the preview: pixel * z = K [R|t] x_local (pinhole part).
-  const Rigid3d cam_from_local = CamFromLocal(scene, snapshot.cam_from_world);
-  Eigen::Matrix4f frame_from_local = Eigen::Matrix4f::Zero();
-  // The current frame's camera (its stream's, when the project has several).
-  const Camera& cam = static_cast<size_t>(snapshot.stream) < geo.stream_cameras.size()
-                          ? geo.stream_cameras[snapshot.stream]
-                          : geo.camera;
-  Eigen::Matrix3d K;
-  K << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1;
-  frame_from_local.block<3, 3>(0, 0) = (K * cam_from_local.RotationMatrix()).cast<float>();
-  frame_from_local.block<3, 1>(0, 3) = (K * cam_from_local.translation).cast<float>();
-  frame_from_local(3, 3) = 1;
-
-  glUseProgram(m.mesh_program);
-  glUniformMatrix4fv(glGetUniformLocation(m.mesh_program, "view_projection"), 1, GL_FALSE,
-                     view_projection.data());
-  glUniformMatrix4fv(glGetUniformLocation(m.mesh_program, "frame_from_local"), 1, GL_FALSE,
-                     frame_from_local.data());
-  glUniform2f(glGetUniformLocation(m.mesh_program, "frame_size"), static_cast<float>(cam.width),
-              static_cast<float>(cam.height));
-  glUniform3f(glGetUniformLocation(m.mesh_program, "eye"), eye.x(), eye.y(), eye.z());
-  glUniform1i(glGetUniformLocation(m.mesh_program, "mode"), static_cast<int>(view->mode));
-  glUniform1i(glGetUniformLocation(m.mesh_program, "painted"), 0);
-  glUniform1i(glGetUniformLocation(m.mesh_program, "frame"), 1);
-  glActiveTexture(GL_TEXTURE1);
-  const bool projected = view->mode == ViewportView::Mode::kProjected && snapshot.has_pose &&
-                         !snapshot.frame_bgr.empty();
-  GLuint frame_texture = 0;
-  if (projected)
-    frame_texture = static_cast<GLuint>(
-        reinterpret_cast<intptr_t>(m.textures.Get("frame", snapshot.frame_bgr, snapshot.version)));
-  glBindTexture(GL_TEXTURE_2D, frame_texture);
-  glActiveTexture(GL_TEXTURE0);
-  glBindVertexArray(m.vao);
-  for (int i = 0; i < Impl::kLayersBound; ++i)
-    glUniform1i(glGetUniformLocation(m.mesh_program, ("layer" + std::to_string(i)).c_str()), 2 + i);
-  const bool layered = view->mode == ViewportView::Mode::kPainted && view->view_layers &&
-                       snapshot.layers && !snapshot.layers->empty();
-  glUniform1i(m.layered_at, 0);
-  for (size_t b = 0; b < m.first.size(); ++b) {
-    GLuint texture = 0;
-    if (snapshot.painted && b < snapshot.painted->size())
-      texture = static_cast<GLuint>(reinterpret_cast<intptr_t>(m.textures.Get(
-          "buffer/" + std::to_string(b), (*snapshot.painted)[b], snapshot.painted_version)));
-    if (layered && b < m.centre.size()) m.BindNearestLayers(snapshot, b, eye);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    if (m.count[b] > 0) glDrawArrays(GL_TRIANGLES, m.first[b], m.count[b]);
-  }
-  if (m.ungrouped_count > 0) glDrawArrays(GL_TRIANGLES, m.ungrouped_first, m.ungrouped_count);
-
-  // Lines: the path (grey), COLMAP's path after a pose verification (orange, flagged frames'
-  // offsets red), the current camera's frustum (yellow).
-  std::vector<LineVertex> lines;
-  // The return type spelled out: deduced, it would be an Eigen expression over a temporary.
-  auto centre_of = [&](const Rigid3d& cam_from_world) -> Eigen::Vector3f {
-    return CamFromLocal(scene, cam_from_world).Centre().cast<float>();
-  };
-  auto add = [&](const Eigen::Vector3f& a, const Eigen::Vector3f& b, float r, float g, float bl) {
-    lines.push_back({{a.x(), a.y(), a.z()}, {r, g, bl}});
-    lines.push_back({{b.x(), b.y(), b.z()}, {r, g, bl}});
-  };
-  if (view->show_path) {
-    // Each stream's path, given and live (stream 0 grey, the others in their own hues).
-    static constexpr float kStreamColours[][3] = {
-        {0.6f, 0.6f, 0.65f}, {0.3f, 0.75f, 1.0f}, {1.0f, 0.45f, 0.8f}, {0.45f, 0.95f, 0.45f}};
-    std::vector<std::pair<const std::vector<Rigid3d>*, size_t>> paths;  // (path, stream)
-    if (geo.stream_paths.empty()) paths.push_back({&geo.path, 0});
-    for (size_t s = 0; s < geo.stream_paths.size(); ++s) paths.push_back({&geo.stream_paths[s], s});
-    for (size_t s = 0; s < snapshot.live_paths.size(); ++s)
-      paths.push_back({&snapshot.live_paths[s], s});
-    for (const auto& [path, stream] : paths) {
-      const float* colour = kStreamColours[stream % 4];
-      for (size_t i = 1; i < path->size(); ++i)
-        add(centre_of((*path)[i - 1]), centre_of((*path)[i]), colour[0], colour[1], colour[2]);
-    }
-  }
-  if (view->show_pose_check && !view->pose_check.empty()) {
-    // COLMAP's path (orange) and each flagged frame's offset from its given centre (red).
-    auto local_of = [&](const Eigen::Vector3d& world) -> Eigen::Vector3f {
-      return (world - scene.origin_in_world).cast<float>();
-    };
-    for (size_t i = 1; i < view->pose_check.size(); ++i)
-      add(local_of(view->pose_check[i - 1].colmap), local_of(view->pose_check[i].colmap), 1.0f,
-          0.55f, 0.1f);
-    for (const ViewportView::PoseCheckMark& mark : view->pose_check)
-      if (mark.flagged) add(local_of(mark.given), local_of(mark.colmap), 1.0f, 0.15f, 0.15f);
-  }
-  if (view->show_frustum && snapshot.has_pose) {
-    const Rigid3d local_from_cam = cam_from_local.Inverse();
-    const float depth = 0.25f * radius;
-    const Eigen::Vector3f c = local_from_cam.translation.cast<float>();
-    Eigen::Vector3f corners[4];
-    const double px[4][2] = {{-0.5, -0.5},
-                             {cam.width - 0.5, -0.5},
-                             {cam.width - 0.5, cam.height - 0.5},
-                             {-0.5, cam.height - 0.5}};
-    for (int k = 0; k < 4; ++k) {
-      const Eigen::Vector3d ray((px[k][0] - cam.cx) / cam.fx, (px[k][1] - cam.cy) / cam.fy, 1.0);
-      corners[k] = (local_from_cam * (ray * depth)).cast<float>();
-    }
-    for (int k = 0; k < 4; ++k) {
-      add(c, corners[k], 1.0f, 0.85f, 0.1f);
-      add(corners[k], corners[(k + 1) % 4], 1.0f, 0.85f, 0.1f);
-    }
-  }
-  if (!lines.empty()) {
-    glDisable(GL_DEPTH_TEST);  // drawn over the model: a path inside a room stays visible
-    glUseProgram(m.line_program);
-    glUniformMatrix4fv(glGetUniformLocation(m.line_program, "view_projection"), 1, GL_FALSE,
-                       view_projection.data());
-    glBindVertexArray(m.line_vao);
-    glBindBuffer(GL_ARRAY_BUFFER, m.line_vbo);
-    glBufferData(GL_ARRAY_BUFFER, lines.size() * sizeof(LineVertex), lines.data(), GL_STREAM_DRAW);
-    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(lines.size()));
-  }
+  m.BeginDraw(width, height);
+  const Rigid3d cam_from_local = CamFromLocal(geo.painted_layout, snapshot.cam_from_world);
+  const Camera& cam = FrameCamera(snapshot);
+  m.DrawMesh(snapshot, *view, orbit, cam, FrameFromLocal(cam, cam_from_local));
+  const std::vector<LineVertex> lines =
+      OverlayLines(snapshot, *view, cam, cam_from_local, orbit.radius);
+  if (!lines.empty()) m.DrawLines(lines, orbit.view_projection);
   glBindVertexArray(0);
   glUseProgram(0);
   glDisable(GL_DEPTH_TEST);
