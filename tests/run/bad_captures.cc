@@ -102,6 +102,23 @@ std::string MakeTwoStreamCapture() {
   return dir + "/two.json";
 }
 
+LiveBadCapture MakeLiveSmallFramesCapture(int pose_port) {
+  const std::string project_json = MakeBadCapture(BadCapture::kFramesSmallerThanCamera);
+  const std::string dir = fs::path(project_json).parent_path().string();
+  LiveBadCapture c;
+  bool is_tum = false;
+  EXPECT_TRUE(ReadPoses(dir + "/sparse/images.txt", &c.truth, &is_tum).ok());
+  nlohmann::json live = nlohmann::json::parse(ReadText(project_json));
+  live["poses"] = "tcp://127.0.0.1:" + std::to_string(pose_port);
+  live["live"] = {{"estimate_offset", true}, {"offset_window_frames", 8},
+                  {"offset_search_s", 0.1},  {"connect_timeout_s", 10},
+                  {"read_timeout_s", 2},     {"queue_frames", 50}};
+  c.project = dir + "/live.json";
+  WriteText(c.project, live.dump(2));
+  c.first_frame_error = dir + "/frames/: frame '000000.png' is 80x60 but the camera is 160x120";
+  return c;
+}
+
 std::string Describe(BadCapture how) {
   switch (how) {
     case BadCapture::kFramesSmallerThanCamera:

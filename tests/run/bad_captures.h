@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/poses.h"
+
 namespace fresco::testing {
 
 enum class BadCapture {
@@ -26,6 +28,17 @@ std::string MakeBadCapture(BadCapture how);
 // its poses, stream 1 with frame 3's pose missing (24 frames, 23 with a pose). Returns its
 // project file.
 std::string MakeTwoStreamCapture();
+
+// The frames-smaller-than-the-camera capture as a live project (live.json beside it): its
+// frames folder matched by time to poses from a feed at tcp://127.0.0.1:`pose_port`, the time
+// offset estimated over 8 frames before painting. `truth`: the poses a tracker sends (frame
+// i's at i / 30 s).
+struct LiveBadCapture {
+  std::string project;
+  std::vector<PosedImage> truth;
+  std::string first_frame_error;  // the frame policy's message for its first frame
+};
+LiveBadCapture MakeLiveSmallFramesCapture(int pose_port);
 
 // "frames smaller than the camera", ... (test output).
 std::string Describe(BadCapture how);

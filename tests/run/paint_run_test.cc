@@ -3,6 +3,7 @@
 // synthetic captures, max_frames, and several streams interleaved.
 #include <cmath>
 #include <filesystem>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -10,6 +11,7 @@
 #include "pipeline/run/frame_policy.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
+#include "tests/live/stream_support.h"
 #include "tests/run/bad_captures.h"
 #include "tests/test_support.h"
 
@@ -196,6 +198,20 @@ TEST(PaintRun, FramesSmallerThanTheCameraEndTheRunAtTheFirst) {
   const std::string frames = fs::path(project).parent_path().string() + "/frames/";
   EXPECT_EQ(r.status.message(), frames + ": frame '000000.png' is 80x60 but the camera is 160x120");
   EXPECT_EQ(r.stats.frames, 1);
+  EXPECT_EQ(r.stats.frames_painted, 0);
+}
+
+// Live, with the time offset estimated on the first frames before any is painted: the
+// estimate paints none of them (they are not the camera's size), and the run ends at the
+// first with the frame policy's message.
+TEST(PaintRun, LiveFramesSmallerThanTheCameraEndTheRunAtTheFirstWhileTheOffsetIsEstimated) {
+  testing::PoseServer server;
+  const testing::LiveBadCapture capture = testing::MakeLiveSmallFramesCapture(server.port());
+  std::thread tracker([&] { testing::ServeTrack(&server, capture.truth, 30.0, 0.0); });
+  const Ran r = RunJob(capture.project, PaintRunOptions());
+  tracker.join();
+  ASSERT_FALSE(r.status.ok());
+  EXPECT_EQ(r.status.message(), capture.first_frame_error);
   EXPECT_EQ(r.stats.frames_painted, 0);
 }
 

@@ -12,7 +12,6 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "pipeline/core/poses.h"
 #include "pipeline/core/project.h"
 #include "tests/live/stream_support.h"
 #include "tests/run/bad_captures.h"
@@ -151,34 +150,19 @@ INSTANTIATE_TEST_SUITE_P(BadCaptures, SameOutcomeTest,
 // of them, and `fresco run` and the app stop at the first frame with the frame policy's
 // message (exit 2 from the CLI).
 TEST(SameOutcome, LiveFramesSmallerThanTheCameraStopAtTheFirstFrameWhileTheOffsetIsEstimated) {
-  const std::string project_json = testing::MakeBadCapture(
-      testing::BadCapture::kFramesSmallerThanCamera);
-  const std::string dir = project_json.substr(0, project_json.rfind('/'));
-  std::vector<PosedImage> truth;
-  bool is_tum = false;
-  ASSERT_TRUE(ReadPoses(dir + "/sparse/images.txt", &truth, &is_tum).ok());
   testing::PoseServer server;
-  nlohmann::json live = nlohmann::json::parse(ReadText(project_json));
-  live["poses"] = "tcp://127.0.0.1:" + std::to_string(server.port());
-  live["live"] = {{"estimate_offset", true}, {"offset_window_frames", 8},
-                  {"offset_search_s", 0.1},  {"connect_timeout_s", 10},
-                  {"read_timeout_s", 2},     {"queue_frames", 50}};
-  const std::string live_json = dir + "/live.json";
-  testing::WriteText(live_json, live.dump(2));
-  const std::string expected =
-      dir + "/frames/: frame '000000.png' is 80x60 but the camera is 160x120";
-
-  std::thread tracker([&] { testing::ServeTrack(&server, truth, 30.0, 0.0); });
-  const CommandResult run =
-      RunFresco({"run", live_json, "--out", MakeTempDir("one-door-live") + "/out", "--quiet"});
+  const testing::LiveBadCapture capture = testing::MakeLiveSmallFramesCapture(server.port());
+  std::thread tracker([&] { testing::ServeTrack(&server, capture.truth, 30.0, 0.0); });
+  const CommandResult run = RunFresco(
+      {"run", capture.project, "--out", MakeTempDir("one-door-live") + "/out", "--quiet"});
   tracker.join();
   EXPECT_EQ(run.exit_code, 2) << run.err;
-  EXPECT_EQ(run.err, "error: " + expected + "\n");
+  EXPECT_EQ(run.err, "error: " + capture.first_frame_error + "\n");
 
-  std::thread tracker_again([&] { testing::ServeTrack(&server, truth, 30.0, 0.0); });
-  const Outcome app = AppWorker(live_json);
+  std::thread tracker_again([&] { testing::ServeTrack(&server, capture.truth, 30.0, 0.0); });
+  const Outcome app = AppWorker(capture.project);
   tracker_again.join();
-  EXPECT_EQ(app.error, expected);
+  EXPECT_EQ(app.error, capture.first_frame_error);
 }
 
 // Out of memory (0.5 mm texels on the room: several GB, in a 700 MB address space): the CLI
