@@ -645,26 +645,23 @@ void ScanGridTriangle(const Table& t, const TriangleSetup& s, int tri, int row_l
   }
 }
 
-template <bool kDirect, class Record, class BandRecord>
-void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                          const Record& record, const BandRecord* band_record) const {
-  const RayTable& t = *rays_;
-  const double near_m = options_.near_m;
-  const bool cull = options_.cull_back_faces;
+namespace {
 
-  // Clusters of consecutive triangles whose bounds lie outside the rays' frustum are skipped
-  // whole: the per-frame work follows the triangles in view, not the mesh's size.
-  const std::shared_ptr<const TriangleClusters> clusters = ClustersFor(mesh);
-  const int num_triangles = mesh.NumTriangles();
-  const Eigen::Matrix3d rotation = cam_from_local.RotationMatrix();
-  const Eigen::Vector3d translation = cam_from_local.translation;
+// The set-up slots of the clusters in view: slot_start[c] .. slot_start[c + 1] are cluster c's
+// triangles' (none for a cluster outside the rays' frustum). Clusters of consecutive triangles
+// whose bounds lie outside it are skipped whole: the per-frame work follows the triangles in
+// view, not the mesh's size.
+template <class Table, class Clusters>
+std::vector<int> SlotsInView(const Table& t, const Clusters& clusters, int num_triangles,
+                             const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
+                             double near_m) {
   const double grid_x1 = t.x0 + t.cell_w * t.cols, grid_y1 = t.y0 + t.cell_h * t.rows;
-  const int num_clusters = static_cast<int>(clusters->bounds_min.size());
-  std::vector<int> slot_start(num_clusters + 1, 0);  // set-up slots of the clusters in view
+  const int num_clusters = static_cast<int>(clusters.bounds_min.size());
+  std::vector<int> slot_start(num_clusters + 1, 0);
   cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
     for (int c = range.start; c < range.end; ++c) {
-      const Eigen::Vector3d& lo = clusters->bounds_min[c];
-      const Eigen::Vector3d& hi = clusters->bounds_max[c];
+      const Eigen::Vector3d& lo = clusters.bounds_min[c];
+      const Eigen::Vector3d& hi = clusters.bounds_max[c];
       // Outside when all 8 corners are beyond one of the frustum's planes (the near plane
       // and the four planes through the eye bounding the rays' normalized extent).
       int out[5] = {0, 0, 0, 0, 0};
@@ -686,6 +683,189 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
     }
   });
   for (int c = 0; c < num_clusters; ++c) slot_start[c + 1] += slot_start[c];
+  return slot_start;
+}
+
+// Sets up triangle `tri` in the camera frame (double): its edges, inverse depth, box and the
+// samples (grid) or buckets it may cover, `poly` its clipped corners on z = 1. False (and
+// s->num_poly 0) when it covers none: degenerate, behind the near plane, back-facing when
+// culled, outside the rays' extent, or between samples.
+template <class Table, class Clusters>
+inline bool SetUpTriangle(const Table& t, const Clusters& clusters, int tri,
+                          const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
+                          double near_m, bool cull, TriangleSetup* setup, double poly[4][2]) {
+  TriangleSetup& s = *setup;
+  const double grid_x1 = t.x0 + t.cell_w * t.cols, grid_y1 = t.y0 + t.cell_h * t.rows;
+  s.num_poly = 0;
+  const Eigen::Vector3i& idx = clusters.triangles[tri];
+  if ((idx.array() < 0).any()) return false;
+  const Eigen::Vector3d v[3] = {rotation * clusters.vertices[idx[0]] + translation,
+                                rotation * clusters.vertices[idx[1]] + translation,
+                                rotation * clusters.vertices[idx[2]] + translation};
+  if (!v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) return false;
+  if (v[0].z() < near_m && v[1].z() < near_m && v[2].z() < near_m) return false;
+  const Eigen::Vector3d normal = (v[1] - v[0]).cross(v[2] - v[0]);
+  const double det = normal.dot(v[0]);  // det(v0, v1, v2): < 0 when front-facing
+  if (!(det != 0.0) || !std::isfinite(det)) return false;  // plane through the eye
+  if (cull && det > 0) return false;
+  const int n = ClipAndProject(v, near_m, poly);
+  if (n < 3) return false;
+  double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
+  for (int i = 0; i < n; ++i) {
+    xmin = std::min(xmin, poly[i][0]);
+    xmax = std::max(xmax, poly[i][0]);
+    ymin = std::min(ymin, poly[i][1]);
+    ymax = std::max(ymax, poly[i][1]);
+  }
+  // Margin for rounding (the float inside test may accept rays a hair outside).
+  const double margin = 1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax),
+                                                std::abs(ymin), std::abs(ymax)});
+  xmin -= margin, ymin -= margin, xmax += margin, ymax += margin;
+  if (!(xmax >= t.x0 && xmin <= grid_x1 && ymax >= t.y0 && ymin <= grid_y1)) return false;
+  const double sign = det > 0 ? 1.0 : -1.0;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d e = sign * v[(i + 1) % 3].cross(v[(i + 2) % 3]);
+    for (int k = 0; k < 3; ++k) s.edge[i][k] = static_cast<float>(e[k]);
+  }
+  for (int k = 0; k < 3; ++k) s.inv_depth[k] = normal[k] / det;
+  s.bbox[0] = xmin, s.bbox[1] = ymin, s.bbox[2] = xmax, s.bbox[3] = ymax;
+  if (t.grid) {  // the columns and rows of samples inside the box
+    s.col0 = t.FirstColAtLeast(0, t.width, xmin);
+    s.col1 = t.FirstColAbove(s.col0, t.width, xmax) - 1;
+    s.row0 = t.FirstRowAtLeast(ymin);
+    s.row1 = t.FirstRowAbove(ymax) - 1;
+    if (s.col0 > s.col1 || s.row0 > s.row1) return false;  // between samples: covers none
+  } else {
+    s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
+    s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
+  }
+  s.num_poly = n;
+  return true;
+}
+
+// Binned: the set-ups per bin of rows (grid: a band of kBandRows sample rows; else a bucket
+// row), in ascending triangle order (counting sort): bin r's slots are
+// row_triangles[row_start[r] .. row_start[r + 1]).
+void BinByRows(const TriangleSetup* setups, int num_slots, int num_bins, int bin_div,
+               std::vector<int>* row_start, std::vector<int>* row_triangles) {
+  row_start->assign(num_bins + 1, 0);
+  for (int slot = 0; slot < num_slots; ++slot) {
+    const TriangleSetup& s = setups[slot];
+    if (s.num_poly == 0) continue;
+    for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) ++(*row_start)[r + 1];
+  }
+  for (int r = 0; r < num_bins; ++r) (*row_start)[r + 1] += (*row_start)[r];
+  row_triangles->resize((*row_start)[num_bins]);
+  std::vector<int> fill(row_start->begin(), row_start->end() - 1);
+  for (int slot = 0; slot < num_slots; ++slot) {
+    const TriangleSetup& s = setups[slot];
+    if (s.num_poly == 0) continue;
+    for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) (*row_triangles)[fill[r]++] = slot;
+  }
+}
+
+// Binned, rays not on a grid: bucket rows [row_lo, row_hi), each with its triangles
+// (BinByRows). RasterizeDepth (NearestInverseDepth): a bucket row's rays are consecutive; their
+// nearest hits are kept in a local array while the row's triangles are scanned, then written to
+// their samples.
+template <class Table, class Polygon, class Record>
+void ScanBucketRows(const Table& t, int row_lo, int row_hi, const TriangleSetup* setups,
+                    const Polygon* polygons, const int* triangle_of_slot,
+                    const std::vector<int>& row_start, const std::vector<int>& row_triangles,
+                    const Record& record) {
+  constexpr bool kDepthOnly = std::is_same_v<Record, NearestInverseDepth>;
+  thread_local std::vector<float> row_best;
+  for (int row = row_lo; row < row_hi; ++row) {
+      const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
+      const int row_begin = t.bucket_start[row * t.cols];
+      const int row_end = t.bucket_start[(row + 1) * t.cols];
+      if constexpr (kDepthOnly) row_best.assign(row_end - row_begin, 0.0f);
+      for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
+        const int slot = row_triangles[j];
+        const TriangleSetup& s = setups[slot];
+        const int tri = triangle_of_slot[slot];
+        int col0 = s.col0, col1 = s.col1;
+        if (s.row0 != s.row1 && col0 != col1) {
+          // Tighten to the polygon's extent within this bucket row.
+          const double m = 1e-6 + 1e-7 * std::max(std::abs(slab_lo), std::abs(slab_hi));
+          double xlo, xhi;
+          if (!PolygonSlabRange(s, polygons[slot], slab_lo - m, slab_hi + m, &xlo, &xhi))
+            continue;
+          const double mx = 1e-6 + 1e-7 * std::max(std::abs(xlo), std::abs(xhi));
+          col0 = std::max(col0, t.Col(xlo - mx));
+          col1 = std::min(col1, t.Col(xhi + mx));
+        }
+        const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
+        const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
+        const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
+        const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
+        for (int col = col0; col <= col1; ++col) {
+          const int bucket = row * t.cols + col;
+          const int begin = t.bucket_start[bucket], end = t.bucket_start[bucket + 1];
+          if (begin == end) continue;
+          // The bucket's rectangle (every ray of the bucket is inside it, up to rounding)
+          // against each edge: entirely outside one edge -> skip the bucket; well inside all
+          // three -> every ray hits the plane inside the triangle, skip the edge tests.
+          const double bx0 = t.x0 + col * t.cell_w, bx1 = bx0 + t.cell_w;
+          bool outside = false, inside = true;
+          for (int i = 0; i < 3 && !outside; ++i) {
+            const double ex = s.edge[i][0], ey = s.edge[i][1], ez = s.edge[i][2];
+            const double w_max =
+                ex * (ex > 0 ? bx1 : bx0) + ey * (ey > 0 ? slab_hi : slab_lo) + ez;
+            const double w_min =
+                ex * (ex > 0 ? bx0 : bx1) + ey * (ey > 0 ? slab_lo : slab_hi) + ez;
+            const double tolerance =
+                1e-6 * (std::abs(ex) * std::max({std::abs(bx0), std::abs(bx1), 1.0}) +
+                        std::abs(ey) * std::max({std::abs(slab_lo), std::abs(slab_hi), 1.0}) +
+                        std::abs(ez));
+            outside = w_max < -tolerance;
+            inside = inside && w_min > tolerance;
+          }
+          if (outside) continue;
+          if constexpr (kDepthOnly) {
+            MaxInverseDepthBucket(t.xs.data() + begin, t.ys.data() + begin, end - begin, inside,
+                                  s, record.inv_near, row_best.data() + (begin - row_begin));
+            continue;
+          }
+          if (inside) {
+            for (int k = begin; k < end; ++k) {
+              const float x = t.xs[k], y = t.ys[k];
+              record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
+            }
+            continue;
+          }
+          for (int k = begin; k < end; ++k) {
+            const float x = t.xs[k], y = t.ys[k];
+            const float w0 = e00 * x + e01 * y + e02;
+            const float w1 = e10 * x + e11 * y + e12;
+            const float w2 = e20 * x + e21 * y + e22;
+            if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
+            record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
+          }
+        }
+      }
+      if constexpr (kDepthOnly) {  // each sample's ray lies in one bucket: plain stores
+        for (int k = row_begin; k < row_end; ++k)
+          record.inv[t.sample[k]] = row_best[k - row_begin];
+      }
+    }
+}
+
+}  // namespace
+
+template <bool kDirect, class Record, class BandRecord>
+void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                          const Record& record, const BandRecord* band_record) const {
+  const RayTable& t = *rays_;
+  const double near_m = options_.near_m;
+  const bool cull = options_.cull_back_faces;
+  const std::shared_ptr<const TriangleClusters> clusters = ClustersFor(mesh);
+  const int num_triangles = mesh.NumTriangles();
+  const Eigen::Matrix3d rotation = cam_from_local.RotationMatrix();
+  const Eigen::Vector3d translation = cam_from_local.translation;
+  const int num_clusters = static_cast<int>(clusters->bounds_min.size());
+  const std::vector<int> slot_start =
+      SlotsInView(t, *clusters, num_triangles, rotation, translation, near_m);
   const int num_slots = slot_start[num_clusters];
 
   // Triangle set-up (independent per triangle, so parallel and deterministic), in the camera
@@ -721,53 +901,11 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
         TriangleSetup direct_setup;
         TriangleSetup& s = kDirect ? direct_setup : setups[slot];
         if constexpr (!kDirect) triangle_of_slot[slot] = tri;
-        s.num_poly = 0;
-        const Eigen::Vector3i& idx = clusters->triangles[tri];
-        if ((idx.array() < 0).any()) continue;
-        const Eigen::Vector3d v[3] = {rotation * clusters->vertices[idx[0]] + translation,
-                                      rotation * clusters->vertices[idx[1]] + translation,
-                                      rotation * clusters->vertices[idx[2]] + translation};
-        if (!v[0].allFinite() || !v[1].allFinite() || !v[2].allFinite()) continue;
-        if (v[0].z() < near_m && v[1].z() < near_m && v[2].z() < near_m) continue;
-        const Eigen::Vector3d normal = (v[1] - v[0]).cross(v[2] - v[0]);
-        const double det = normal.dot(v[0]);  // det(v0, v1, v2): < 0 when front-facing
-        if (!(det != 0.0) || !std::isfinite(det)) continue;  // plane through the eye
-        if (cull && det > 0) continue;
         double poly[4][2];
-        const int n = ClipAndProject(v, near_m, poly);
-        if (n < 3) continue;
-        double xmin = kInf, ymin = kInf, xmax = -kInf, ymax = -kInf;
-        for (int i = 0; i < n; ++i) {
-          xmin = std::min(xmin, poly[i][0]);
-          xmax = std::max(xmax, poly[i][0]);
-          ymin = std::min(ymin, poly[i][1]);
-          ymax = std::max(ymax, poly[i][1]);
-        }
-        // Margin for rounding (the float inside test may accept rays a hair outside).
-        const double margin = 1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax),
-                                                      std::abs(ymin), std::abs(ymax)});
-        xmin -= margin, ymin -= margin, xmax += margin, ymax += margin;
-        if (!(xmax >= t.x0 && xmin <= grid_x1 && ymax >= t.y0 && ymin <= grid_y1)) continue;
-        const double sign = det > 0 ? 1.0 : -1.0;
-        for (int i = 0; i < 3; ++i) {
-          const Eigen::Vector3d e = sign * v[(i + 1) % 3].cross(v[(i + 2) % 3]);
-          for (int k = 0; k < 3; ++k) s.edge[i][k] = static_cast<float>(e[k]);
-        }
-        for (int k = 0; k < 3; ++k) s.inv_depth[k] = normal[k] / det;
-        s.bbox[0] = xmin, s.bbox[1] = ymin, s.bbox[2] = xmax, s.bbox[3] = ymax;
-        if (t.grid) {  // the columns and rows of samples inside the box
-          s.col0 = t.FirstColAtLeast(0, t.width, xmin);
-          s.col1 = t.FirstColAbove(s.col0, t.width, xmax) - 1;
-          s.row0 = t.FirstRowAtLeast(ymin);
-          s.row1 = t.FirstRowAbove(ymax) - 1;
-          if (s.col0 > s.col1 || s.row0 > s.row1) continue;  // between samples: covers none
-        } else {
-          s.col0 = t.Col(xmin), s.col1 = t.Col(xmax);
-          s.row0 = t.Row(ymin), s.row1 = t.Row(ymax);
-          if constexpr (!kDirect)
-            std::copy(&poly[0][0], &poly[0][0] + 8, &polygons[slot].corner[0][0]);
-        }
-        s.num_poly = n;
+        if (!SetUpTriangle(t, *clusters, tri, rotation, translation, near_m, cull, &s, poly))
+          continue;
+        if constexpr (!kDirect)
+          if (!t.grid) std::copy(&poly[0][0], &poly[0][0] + 8, &polygons[slot].corner[0][0]);
         if constexpr (kDirect) {
           const long long samples =
               static_cast<long long>(s.row1 - s.row0 + 1) * (s.col1 - s.col0 + 1);
@@ -796,30 +934,10 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
         }
       }
     });
-    return;
   } else {  // binned
-
-    // Set-ups per bucket row (grid: per band of kBandRows sample rows), in ascending triangle
-    // order (counting sort).
     const int num_bins = t.grid ? (t.height + kBandRows - 1) / kBandRows : t.rows;
-    const int bin_div = t.grid ? kBandRows : 1;
-    std::vector<int> row_start(num_bins + 1, 0);
-    for (int slot = 0; slot < num_slots; ++slot) {
-      const TriangleSetup& s = setups[slot];
-      if (s.num_poly == 0) continue;
-      for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) ++row_start[r + 1];
-    }
-    for (int r = 0; r < num_bins; ++r) row_start[r + 1] += row_start[r];
-    std::vector<int> row_triangles(row_start[num_bins]);
-    {
-      std::vector<int> fill(row_start.begin(), row_start.end() - 1);
-      for (int slot = 0; slot < num_slots; ++slot) {
-        const TriangleSetup& s = setups[slot];
-        if (s.num_poly == 0) continue;
-        for (int r = s.row0 / bin_div; r <= s.row1 / bin_div; ++r) row_triangles[fill[r]++] = slot;
-      }
-    }
-
+    std::vector<int> row_start, row_triangles;
+    BinByRows(setups, num_slots, num_bins, t.grid ? kBandRows : 1, &row_start, &row_triangles);
     if (t.grid) {
       cv::parallel_for_(cv::Range(0, num_bins), [&](const cv::Range& range) {
         for (int band = range.start; band < range.end; ++band) {
@@ -831,86 +949,9 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
       });
       return;
     }
-
-    // RasterizeDepth: a bucket row's rays are consecutive; their nearest hits are kept in a
-    // local array while the row's triangles are scanned, then written to their samples.
-    constexpr bool kDepthOnly = std::is_same_v<Record, NearestInverseDepth>;
     cv::parallel_for_(cv::Range(0, t.rows), [&](const cv::Range& range) {
-      thread_local std::vector<float> row_best;
-      for (int row = range.start; row < range.end; ++row) {
-        const double slab_lo = t.y0 + row * t.cell_h, slab_hi = slab_lo + t.cell_h;
-        const int row_begin = t.bucket_start[row * t.cols];
-        const int row_end = t.bucket_start[(row + 1) * t.cols];
-        if constexpr (kDepthOnly) row_best.assign(row_end - row_begin, 0.0f);
-        for (int j = row_start[row]; j < row_start[row + 1]; ++j) {
-          const int slot = row_triangles[j];
-          const TriangleSetup& s = setups[slot];
-          const int tri = triangle_of_slot[slot];
-          int col0 = s.col0, col1 = s.col1;
-          if (s.row0 != s.row1 && col0 != col1) {
-            // Tighten to the polygon's extent within this bucket row.
-            const double m = 1e-6 + 1e-7 * std::max(std::abs(slab_lo), std::abs(slab_hi));
-            double xlo, xhi;
-            if (!PolygonSlabRange(s, polygons[slot], slab_lo - m, slab_hi + m, &xlo, &xhi))
-              continue;
-            const double mx = 1e-6 + 1e-7 * std::max(std::abs(xlo), std::abs(xhi));
-            col0 = std::max(col0, t.Col(xlo - mx));
-            col1 = std::min(col1, t.Col(xhi + mx));
-          }
-          const float e00 = s.edge[0][0], e01 = s.edge[0][1], e02 = s.edge[0][2];
-          const float e10 = s.edge[1][0], e11 = s.edge[1][1], e12 = s.edge[1][2];
-          const float e20 = s.edge[2][0], e21 = s.edge[2][1], e22 = s.edge[2][2];
-          const double ia = s.inv_depth[0], ib = s.inv_depth[1], ic = s.inv_depth[2];
-          for (int col = col0; col <= col1; ++col) {
-            const int bucket = row * t.cols + col;
-            const int begin = t.bucket_start[bucket], end = t.bucket_start[bucket + 1];
-            if (begin == end) continue;
-            // The bucket's rectangle (every ray of the bucket is inside it, up to rounding)
-            // against each edge: entirely outside one edge -> skip the bucket; well inside all
-            // three -> every ray hits the plane inside the triangle, skip the edge tests.
-            const double bx0 = t.x0 + col * t.cell_w, bx1 = bx0 + t.cell_w;
-            bool outside = false, inside = true;
-            for (int i = 0; i < 3 && !outside; ++i) {
-              const double ex = s.edge[i][0], ey = s.edge[i][1], ez = s.edge[i][2];
-              const double w_max =
-                  ex * (ex > 0 ? bx1 : bx0) + ey * (ey > 0 ? slab_hi : slab_lo) + ez;
-              const double w_min =
-                  ex * (ex > 0 ? bx0 : bx1) + ey * (ey > 0 ? slab_lo : slab_hi) + ez;
-              const double tolerance =
-                  1e-6 * (std::abs(ex) * std::max({std::abs(bx0), std::abs(bx1), 1.0}) +
-                          std::abs(ey) * std::max({std::abs(slab_lo), std::abs(slab_hi), 1.0}) +
-                          std::abs(ez));
-              outside = w_max < -tolerance;
-              inside = inside && w_min > tolerance;
-            }
-            if (outside) continue;
-            if constexpr (kDepthOnly) {
-              MaxInverseDepthBucket(t.xs.data() + begin, t.ys.data() + begin, end - begin, inside,
-                                    s, record.inv_near, row_best.data() + (begin - row_begin));
-              continue;
-            }
-            if (inside) {
-              for (int k = begin; k < end; ++k) {
-                const float x = t.xs[k], y = t.ys[k];
-                record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
-              }
-              continue;
-            }
-            for (int k = begin; k < end; ++k) {
-              const float x = t.xs[k], y = t.ys[k];
-              const float w0 = e00 * x + e01 * y + e02;
-              const float w1 = e10 * x + e11 * y + e12;
-              const float w2 = e20 * x + e21 * y + e22;
-              if (w0 < 0.f || w1 < 0.f || w2 < 0.f) continue;
-              record(tri, t.sample[k], x, y, ia * x + ib * y + ic, s);
-            }
-          }
-        }
-        if constexpr (kDepthOnly) {  // each sample's ray lies in one bucket: plain stores
-          for (int k = row_begin; k < row_end; ++k)
-            record.inv[t.sample[k]] = row_best[k - row_begin];
-        }
-      }
+      ScanBucketRows(t, range.start, range.end, setups, polygons, triangle_of_slot, row_start,
+                     row_triangles, record);
     });
   }
 }
