@@ -1,6 +1,7 @@
 // Virtual rephotography (accuracy without ground truth): the painted model is rendered at a
 // frame's pose and compared with the frame itself, where the model's surface is seen and
-// painted. `fresco bench` holds some frames out of painting and scores them this way.
+// painted. The held-out scorer (pipeline/rephoto/holdout_scorer.h) scores this way the frames
+// `fresco bench`, `rephoto` and `eval` hold out of painting.
 #pragma once
 
 #include <opencv2/core.hpp>
