@@ -152,7 +152,9 @@ void PipelineRunner::OpenSession(const Project& project) {
   job_options.poll_ms = options_.live_poll_ms;
   const auto progress = [this](const char* what) {
     return [this, what](int done, int total, const std::string&) {
-      working_.status = std::string(what) + " " + std::to_string(done) + "/" + std::to_string(total);
+      // A seek back reopens the project: its progress stays a seek's.
+      working_.status = std::string(seek_target_ >= 0 ? "seeking: " : "") + what + " " +
+                        std::to_string(done) + "/" + std::to_string(total);
       Publish(false);
     };
   };
