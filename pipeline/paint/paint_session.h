@@ -267,11 +267,7 @@ class PaintSession {
   double frame_explained_px_ = -1;
 };
 
-// Whether the exposure and select stages run: pipeline.select.enabled, with `update: quality`
-// and refinement off (refinement registers each frame to the buffers and moves them; keeping
-// stored samples would keep the offsets it corrects: on refine_paint_test's capture it
-// recovered 60 % of the PSNR lost to pose noise instead of 75 %).
-bool SelectActive(const PipelineOptions& options);
+// SelectActive (whether the exposure and select stages run): paint_stages.h.
 
 // The background model's warm-up for these inputs: pipeline.background.warmup_frames, but with
 // view selection on (SelectActive) at most a third of the frames the poses promise (at

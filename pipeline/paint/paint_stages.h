@@ -26,6 +26,10 @@
 
 namespace fresco {
 
+// Whether the exposure and select stages run: pipeline.select.enabled, with `update: quality`
+// and refinement off (refinement registers each frame to the buffers and moves them; keeping
+// stored samples would keep the offsets it corrects: on refine_paint_test's capture it
+// recovered 60 % of the PSNR lost to pose noise instead of 75 %).
 bool SelectActive(const PipelineOptions& options);  // select_stages.cc
 
 // The fused warp-paint path: when no stage between Warp and Paint runs on the warped samples
