@@ -102,6 +102,8 @@ class LiveFrames {
   // Stops the capture thread (Next returns false once the queue is empty).
   void Stop();
   LiveFramesStats stats() const;
+  // The video is a camera or a stream (not a file or folder replayed).
+  bool RealTime() const { return live_; }
 
  private:
   void CaptureLoop();

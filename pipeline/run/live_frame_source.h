@@ -21,6 +21,7 @@ class LiveFrameSource : public PosedFrameSource {
   const FrameOrigin& Origin(int stream) const override { return origin_; }
   std::string EndReason() const override;
   void Stop() override { inputs_->frames->Stop(); }
+  bool RealTime() const override { return inputs_->frames->RealTime(); }
 
  private:
   LiveInputs* inputs_;

@@ -1,5 +1,6 @@
 #include "pipeline/run/merged_frame_source.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace fresco {
@@ -7,6 +8,8 @@ namespace fresco {
 MergedFrameSource::MergedFrameSource(std::vector<std::unique_ptr<PosedFrameSource>> streams,
                                      int poll_ms)
     : streams_(std::move(streams)), slots_(streams_.size()), poll_ms_(poll_ms) {
+  strict_turns_ = std::none_of(streams_.begin(), streams_.end(),
+                               [](const auto& stream) { return stream->RealTime(); });
   for (size_t s = 0; s < streams_.size(); ++s)
     pumps_.emplace_back([this, s] { Pump(static_cast<int>(s)); });
 }
@@ -71,6 +74,7 @@ FrameRead MergedFrameSource::Next(SourcedFrame* frame, Status* status) {
         return FrameRead::kFrame;
       }
       all_ended = all_ended && slot.ended;
+      if (strict_turns_ && !slot.ended) break;  // its turn: wait for it
     }
     if (all_ended) return FrameRead::kEnded;
     if (poll_ms_ < 0)

@@ -2,7 +2,10 @@
 // live camera and one file stream, or several live cameras). Each stream has its own source
 // (a LiveFrameSource or a one-stream FileFrameSource) read on its own thread into a slot
 // that holds one frame; Next hands out a waiting frame, taking the streams in turn among
-// those that have one, so a stream that delivers often cannot starve a slower one. While a
+// those that have one, so a stream that delivers often cannot starve a slower one. When no
+// stream is real time (files and folders, replayed with or without live pose feeds), the
+// turns are strict: Next waits for the stream whose turn it is (unless it ended), so a replay
+// paints its frames in the same order on every run and in every client. While a
 // stream's frame waits in its slot, its live queue goes on filling (and drops its oldest
 // frames when the painter is slower than the camera: live_frames.h), so every stream is
 // painted at its share of the painter's rate.
@@ -60,6 +63,7 @@ class MergedFrameSource : public PosedFrameSource {
   bool stopping_ = false;
   int next_ = 0;  // the stream to look at first
   int poll_ms_ = -1;
+  bool strict_turns_ = false;  // no stream is real time
 };
 
 // The source of a run over several streams: `sources[i]` is stream i's own source. One

@@ -53,6 +53,9 @@ class PosedFrameSource {
   virtual std::string EndReason() const { return "end of video"; }
   // Stops reading (threads, live captures); Next then ends.
   virtual void Stop() {}
+  // Frames arrive on a camera's or a stream's clock (and are dropped when the painter is
+  // behind); false for files and folders, live pose feeds or not: a replay.
+  virtual bool RealTime() const { return false; }
 };
 
 }  // namespace fresco

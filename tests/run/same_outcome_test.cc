@@ -1,5 +1,6 @@
-// `fresco run`, `fresco bench` and the app's painting worker (PipelineRunner, headless) are
-// thin clients of one painting job, so on the same bad capture they come to the same outcome:
+// `fresco run`, `fresco bench`, `fresco eval` and the app's painting worker (PipelineRunner,
+// headless) are thin clients of one painting job, so on the same bad capture they come to
+// the same outcome:
 // the same one-line error (exit 2 for the CLI, "error: ..." as the app's status), or the same
 // counts of frames read, painted and without a pose; live, with the time offset estimated
 // before painting, too.
@@ -163,6 +164,34 @@ TEST(SameOutcome, LiveFramesSmallerThanTheCameraStopAtTheFirstFrameWhileTheOffse
   const Outcome app = AppWorker(capture.project);
   tracker_again.join();
   EXPECT_EQ(app.error, capture.first_frame_error);
+}
+
+// `fresco eval` makes its own captures (no bad one can reach it), and paints and scores them
+// through the same job and held-out scorer as bench: on the capture it generated, with the
+// same held-out frames, the two give the same counts and the same figures.
+TEST(SameOutcome, EvalScoresItsCaptureAsBenchDoes) {
+  const std::string dir = MakeTempDir("same-eval");
+  testing::WriteText(dir + "/suite.json", R"({"fresco_eval_suite": 1,
+      "defaults": {"size": [96, 72], "supersample": 1, "lens": "pinhole", "hfov_deg": 70},
+      "captures": [{"name": "room", "family": "room", "seeds": [5],
+        "synth": {"scene": "builtin:cube-room", "path": {"kind": "handheld", "turns": 0.25},
+                  "frames": 20, "random_movers": 1, "pose_noise_deg": 0.3}}]})");
+  const CommandResult eval = RunFresco(
+      {"eval", dir + "/suite.json", "--out", dir + "/eval", "--holdout", "5", "--quiet"});
+  ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  const nlohmann::json e =
+      nlohmann::json::parse(ReadText(dir + "/eval/eval.json"))["captures"].at(0);
+  const CommandResult bench = RunFresco(
+      {"bench", dir + "/eval/captures/room-s5/project.json", "--out", dir + "/bench", "--holdout",
+       "5", "--sweep", "pipeline.sampling=bilinear", "--no-baseline", "--quiet"});
+  ASSERT_EQ(bench.exit_code, 0) << bench.err;
+  const nlohmann::json b = nlohmann::json::parse(ReadText(dir + "/bench/bench.json")).at(0);
+  EXPECT_EQ(e["frames"], b["frames"]);
+  EXPECT_EQ(e["painted_frames"], b["frames_painted"]);
+  EXPECT_EQ(e["holdout_frames"], b["holdout_frames"]);
+  EXPECT_EQ(b["holdout_frames"], 4);
+  for (const char* figure : {"psnr_db", "one_minus_ncc", "coverage", "completeness"})
+    EXPECT_DOUBLE_EQ(e[figure].get<double>(), b[figure].get<double>()) << figure;
 }
 
 // Out of memory (0.5 mm texels on the room: several GB, in a 700 MB address space): the CLI
