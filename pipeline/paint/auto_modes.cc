@@ -21,6 +21,12 @@ std::string AutoDecision::Describe() const {
   if (state == State::kDeciding)
     std::snprintf(line, sizeof line, "deciding: %.3g %s %.3g over %d frames so far", evidence,
                   relation, threshold, frames_measured);
+  else if (basis == "held_back")
+    std::snprintf(line, sizeof line,
+                  "%s: the mean of every view scores %+.2f dB against the sharpest view "
+                  "on %d frames held back (decided at frame %d)",
+                  state == State::kOn ? "mean" : "quality", evidence, frames_measured,
+                  decided_at_frame);
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
                   "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
@@ -47,8 +53,12 @@ nlohmann::json DecisionJson(const AutoDecision& d) {
 }  // namespace
 
 std::string AutoDecisionsJson(const AutoDecisions& decisions) {
+  nlohmann::json update = DecisionJson(decisions.update);
+  if (decisions.update.is_auto() && decisions.update.state != AutoDecision::State::kDeciding)
+    update["decision"] = decisions.update.state == AutoDecision::State::kOn ? "mean" : "quality";
   const nlohmann::json j = {{"refine", DecisionJson(decisions.refine)},
-                            {"background", DecisionJson(decisions.background)}};
+                            {"background", DecisionJson(decisions.background)},
+                            {"update", update}};
   return j.dump();
 }
 

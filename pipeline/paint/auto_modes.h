@@ -55,7 +55,8 @@ constexpr double kBackgroundAcrossViewsThreshold = 0.008;
 constexpr int kBackgroundAutoFrames = 8;
 constexpr int kBackgroundAutoMaxFrames = 60;
 
-// {"refine": D, "background": D} as JSON text, D = {"decision", "evidence", "threshold",
+// {"refine": D, "background": D, "update": D} as JSON text (the update's decision
+// "mean" or "quality"), D = {"decision", "evidence", "threshold",
 // "frames_measured", "decided_at_frame"} or null when that mode is not auto (metrics.json,
 // eval.json).
 std::string AutoDecisionsJson(const AutoDecisions& decisions);

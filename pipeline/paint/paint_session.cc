@@ -66,6 +66,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->scene_ = inputs.scene;
   s->options_ = inputs.pipeline;
   s->requested_refine_ = inputs.pipeline.refine.mode;
+  s->requested_update_ = inputs.pipeline.update;
   s->requested_background_ = inputs.pipeline.background.mode;
   s->expected_frames_ = static_cast<int>(inputs.expected_poses.size());
   s->options_.background.warmup_frames = EffectiveWarmupFrames(inputs);
@@ -118,6 +119,18 @@ void PaintSession::ResetPainting() {
 }
 
 void PaintSession::StartAutoModes() {
+  options_.update = requested_update_;
+  update_auto_ = AutoDecision();
+  if (requested_update_ == UpdatePolicy::kAuto) {
+    update_auto_.basis = "held_back";
+    update_auto_.threshold = 0;
+    update_auto_.state = AutoDecision::State::kDeciding;
+    if (options_.select.enabled) {  // view selection keeps views by its own score
+      options_.update = UpdatePolicy::kQuality;
+      update_auto_.state = AutoDecision::State::kOff;
+      update_auto_.decided_at_frame = 0;
+    }
+  }
   const bool refine_auto = requested_refine_ == RefineMode::kAuto;
   const bool background_auto = requested_background_ == BackgroundMode::kAuto;
   options_.refine.mode = refine_auto ? RefineMode::kRobust : requested_refine_;

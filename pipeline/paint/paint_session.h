@@ -78,6 +78,13 @@ struct FrameWork {
   double measured_misalignment_px = -1;
 };
 
+// A frame the run held back from painting for PaintSession::DecideUpdate.
+struct HeldBackFrame {
+  cv::Mat bgr;  // the camera's size
+  const Camera* camera = nullptr;
+  Rigid3d cam_from_world;
+};
+
 class PaintSession {
  public:
   // Groups the mesh, builds the base buffers. Errors name the grouping edit or setting.
@@ -137,8 +144,15 @@ class PaintSession {
   // frame by frame. Kept through ResetPainting.
   void DecideBackgroundAcrossViews(double fraction, int frames);
   AutoDecisions auto_decisions() const {
-    return {refine_auto_.decision(), background_auto_.decision()};
+    return {refine_auto_.decision(), background_auto_.decision(), update_auto_};
   }
+  // `update: auto` (pipeline_options.h): until decided, every texel keeps the sharpest view
+  // (as `quality`) and the sums of every view (as `mean`); the run holds a few frames back
+  // (paint_run.h) and gives them here: the model painted each way is rendered at their poses,
+  // and the one that agrees better with them (PSNR, mean over the frames) paints on. No frame
+  // with painted surface in view: `quality`.
+  bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }
+  void DecideUpdate(const std::vector<HeldBackFrame>& frames);
 
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
@@ -226,6 +240,8 @@ class PaintSession {
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
   RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)
+  UpdatePolicy requested_update_ = UpdatePolicy::kQuality;  // likewise
+  AutoDecision update_auto_;  // on: `mean`, off: `quality`
   BackgroundMode requested_background_ = BackgroundMode::kOff;
   // DecideBackgroundAcrossViews' evidence (fraction, frames); frames < 0: none.
   std::pair<double, int> background_across_views_{0.0, -1};

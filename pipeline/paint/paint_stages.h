@@ -41,7 +41,8 @@ inline bool StagesReadWarpedSamples(const PipelineOptions& options) {
          SelectActive(options) ||                            // Exposure and Select
          options.background.mode != BackgroundMode::kOff ||  // Background
          options.layers.count > 0 ||                         // Layers
-         options.update == UpdatePolicy::kMean;              // Paint's sums per texel
+         options.update == UpdatePolicy::kMean ||            // Paint's sums per texel
+         options.update == UpdatePolicy::kAuto;
 }
 
 }  // namespace fresco

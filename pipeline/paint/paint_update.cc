@@ -33,7 +33,7 @@ struct PaintArrays {
   const uint8_t* provisional;  // null: no sample is provisional
   uint8_t* dst;
   float* stored_quality;
-  float* mean_sum;  // `update: mean` (4 floats per texel), null otherwise
+  float* mean_sum;  // `update: mean` and `auto` (4 floats per texel), null otherwise
 
   PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
               PaintedBuffer* painted)
@@ -51,13 +51,17 @@ struct PaintArrays {
 [[gnu::always_inline]] inline void PaintTexel(const PaintArrays& a, int idx, bool on_surface,
                                               const TexelUpdateRule& rule,
                                               PaintUpdateStats* stats) {
-  if (a.mean_sum) {  // every sample counts, provisional or not: nothing to give way
-    if (a.valid[idx] && !(a.skip && a.skip[idx]))
+  const bool take = a.valid[idx] && !(a.skip && a.skip[idx]);
+  if (a.mean_sum && !rule.mean_too) {  // every sample counts, provisional or not
+    if (take)
       MeanTexel(a.src + 3 * static_cast<size_t>(idx), a.quality[idx], on_surface,
                 a.dst + 4 * static_cast<size_t>(idx), a.stored_quality + idx,
                 a.mean_sum + 4 * static_cast<size_t>(idx), stats);
     return;
   }
+  if (take && rule.mean_too)  // `auto` deciding: the mean beside the sharpest
+    AddToMean(a.src + 3 * static_cast<size_t>(idx), a.quality[idx],
+              a.mean_sum + 4 * static_cast<size_t>(idx));
   const bool provisional = a.provisional && a.provisional[idx];
   if (a.valid[idx] && !(a.skip && a.skip[idx])) {
     const float stored = a.stored_quality[idx];
@@ -118,7 +122,7 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
                              const cv::Mat& mask, const PipelineOptions& options,
                              PaintedBuffer* painted, const cv::Mat& warming) {
   const TexelUpdateRule rule = TexelUpdateRule::From(options);
-  if (rule.policy == UpdatePolicy::kMean && painted->mean_sum.empty())
+  if ((rule.policy == UpdatePolicy::kMean || rule.mean_too) && painted->mean_sum.empty())
     painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling

@@ -46,7 +46,8 @@ StageReport PaintSession::CorrectExposure(const std::vector<size_t>& seen) {
 
 bool SelectActive(const PipelineOptions& options) {
   // refine.mode auto gives way to view selection (it decides off at once).
-  return options.select.enabled && options.update == UpdatePolicy::kQuality &&
+  return options.select.enabled &&
+         (options.update == UpdatePolicy::kQuality || options.update == UpdatePolicy::kAuto) &&
          (options.refine.mode == RefineMode::kOff || options.refine.mode == RefineMode::kAuto);
 }
 

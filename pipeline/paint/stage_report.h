@@ -115,6 +115,9 @@ struct AutoDecisions {
   // evidence: the share of the pixels masked across views (basis "across_views"), or the
   // foreground fraction of the warmed-up texels ("texels")
   AutoDecision background;
+  // update `auto`: on = `mean`, off = `quality`; evidence: how many dB more PSNR the
+  // mean scores than the sharpest view at the frames held back (basis "held_back")
+  AutoDecision update;
 };
 
 struct FrameReport {

@@ -48,10 +48,16 @@ struct TexelUpdateRule {
   UpdatePolicy policy = UpdatePolicy::kQuality;
   float keep = 0.8f;  // kQuality: a sample at least this fraction as sharp overwrites
   int weight = 256;   // the new sample's weight out of 256 (256 = replace)
+  // `update: auto` while deciding: kQuality into the texels, kMean into the sums too.
+  bool mean_too = false;
 
   static TexelUpdateRule From(const PipelineOptions& options) {
     TexelUpdateRule rule;
     rule.policy = options.update;
+    if (options.update == UpdatePolicy::kAuto) {
+      rule.policy = UpdatePolicy::kQuality;
+      rule.mean_too = true;
+    }
     rule.keep = static_cast<float>(1.0 - options.quality_slack);
     rule.weight = std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
     return rule;
@@ -94,13 +100,18 @@ inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, floa
 
 // `update: mean`: adds the sample, weighted by its quality, to the texel's sums (`sum`: B, G,
 // R, weight) and stores their mean; the stored quality is the best seen. Counts into `stats`.
+// The sums alone (`update: auto` while deciding).
+inline void AddToMean(const uint8_t* sample, float quality, float* sum) {
+  const float w = std::max(quality, 1e-3f);
+  for (int c = 0; c < 3; ++c) sum[c] += w * sample[c];
+  sum[3] += w;
+}
+
 inline void MeanTexel(const uint8_t* sample, float quality, bool on_surface, uint8_t* texel,
                       float* stored_quality, float* sum, PaintUpdateStats* stats) {
   CompareWithStored(sample, texel, stats);
   if (texel[3] == 0 && on_surface) ++stats->newly_painted;
-  const float w = std::max(quality, 1e-3f);
-  for (int c = 0; c < 3; ++c) sum[c] += w * sample[c];
-  sum[3] += w;
+  AddToMean(sample, quality, sum);
   for (int c = 0; c < 3; ++c) texel[c] = cv::saturate_cast<uint8_t>(sum[c] / sum[3]);
   texel[3] = 255;
   *stored_quality = std::max(*stored_quality, quality);

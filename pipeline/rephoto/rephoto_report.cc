@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/paint/auto_modes.h"
+
 namespace fresco {
 namespace {
 
@@ -68,7 +70,8 @@ std::string RephotoToJson(const RephotoResult& result, const std::vector<std::st
                       {"pixels", f.pixels},
                       {"frames_painted", f.frames_painted},
                       {"view_layers", f.view_layers},
-                      {"paint_seconds", f.paint_seconds}});
+                      {"paint_seconds", f.paint_seconds},
+                      {"auto", json::parse(AutoDecisionsJson(f.decisions))}});
   }
   const json doc = {{"project", result.project},
                     {"settings", settings},

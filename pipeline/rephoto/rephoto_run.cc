@@ -85,6 +85,7 @@ Status ScoreOneOut(const Project& project, const PosedFrameId& id, const Rephoto
   result->frames_painted = run.stats().frames_painted;
   result->view_layers = static_cast<int>(scorer.painted().view_layers.size());
   result->paint_seconds = run.stats().seconds;
+  result->decisions = job->session->auto_decisions();
   result->pixels = score.rephoto.pixels;
   // Nothing compared: no PSNR, uncorrelated.
   result->psnr_db =

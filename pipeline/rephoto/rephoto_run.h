@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/core/status.h"
+#include "pipeline/paint/stage_report.h"
 
 namespace fresco {
 
@@ -40,6 +41,7 @@ struct RephotoFrame {
   int frames_painted = 0;     // frames painted from (the others)
   int view_layers = 0;        // view-dependent layers the render blended (pipeline.layers)
   double paint_seconds = 0;   // wall time of that paint run (reading and painting)
+  AutoDecisions decisions;    // what that run's `auto` modes decided
   double psnr_db = 0;         // over the compared pixels (NaN: none)
   double one_minus_ncc = 1;   // local 9 x 9, eroded mask (1 when nothing compared)
   double completeness = 0;    // surface pixels of the view that are painted

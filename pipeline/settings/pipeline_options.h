@@ -18,14 +18,16 @@ enum class SamplingMode { kNearest, kBilinear, kArea };
 // kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
 // when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
 // kMean: each texel the mean of every sample it took, weighted by pixels per texel.
-enum class UpdatePolicy { kLatest, kQuality, kMean };
+// kAuto: kQuality or kMean, whichever paints the frames the run holds back more alike
+// (PaintSession::DecideUpdate).
+enum class UpdatePolicy { kLatest, kQuality, kMean, kAuto };
 
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
   int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
   int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
-  UpdatePolicy update = UpdatePolicy::kQuality;
+  UpdatePolicy update = UpdatePolicy::kAuto;
   double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
   // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
   // below 1 = running average, which averages out the frames' residual misalignment).
@@ -57,6 +59,7 @@ inline const EnumNames<UpdatePolicy>& UpdatePolicyNames() {
       {UpdatePolicy::kLatest, "latest"},
       {UpdatePolicy::kQuality, "quality"},
       {UpdatePolicy::kMean, "mean"},
+      {UpdatePolicy::kAuto, "auto"},
   };
   return names;
 }
@@ -81,7 +84,9 @@ void Fields(PipelineOptions& o, V& v) {
          "only if at least `1 - quality_slack` as sharp, in pixels per texel) or `mean` (each "
          "texel the mean of every sample it took, weighted by pixels per texel: for still photos "
          "of a static scene, whose views disagree in light and by a few pixels; 16 more bytes "
-         "per texel)");
+         "per texel) or `auto` (`quality` or `mean`, whichever agrees better with a few frames "
+         "held back from the first ones painted, which are painted in after; the choice and "
+         "its evidence in metrics.json)");
   v.Field(
       "quality_slack", o.quality_slack,
       {.min = 0,

@@ -77,6 +77,30 @@ TEST(PaintUpdate, MeanWeighsEverySampleByItsQuality) {
   EXPECT_EQ(t.Stored(), 10);
 }
 
+// `update: auto` while deciding: the texels as `quality` paints them, the sums as `mean`
+// keeps them (masked samples left out of both).
+TEST(PaintUpdate, AutoWhileDecidingKeepsTheSharpestAndTheMean) {
+  PipelineOptions options;
+  ASSERT_EQ(options.update, UpdatePolicy::kAuto);  // the default
+  TwoTexels deciding, quality;
+  PipelineOptions quality_options;
+  quality_options.update = UpdatePolicy::kQuality;
+  for (const auto& [grey, q] : {std::pair{100, 0.5f}, {200, 0.45f}, {0, 0.3f}, {40, 1.0f}}) {
+    deciding.warped.quality.setTo(q);
+    deciding.Paint(grey, options);
+    quality.warped.quality.setTo(q);
+    quality.Paint(grey, quality_options);
+  }
+  EXPECT_EQ(deciding.Stored(), 40);
+  EXPECT_EQ(cv::norm(deciding.painted.bgra, quality.painted.bgra, cv::NORM_INF), 0.0);
+  ASSERT_FALSE(deciding.painted.mean_sum.empty());
+  const cv::Vec4f sum = deciding.painted.mean_sum.at<cv::Vec4f>(0, 1);
+  EXPECT_NEAR(sum[0] / sum[3], (50 + 90 + 0 + 40) / 2.25, 1e-3);
+  const cv::Mat masked(1, 2, CV_8U, cv::Scalar(255));
+  PaintBuffer(deciding.buffer, deciding.warped, masked, options, &deciding.painted);
+  EXPECT_FLOAT_EQ(deciding.painted.mean_sum.at<cv::Vec4f>(0, 1)[3], 2.25f);
+}
+
 // While a texel's background model warms up its samples are provisional (PaintBuffer's `warming`):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
 // rule), a trusted one whatever its quality, even one showing nearly the same (per-texel
