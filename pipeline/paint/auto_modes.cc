@@ -27,6 +27,11 @@ std::string AutoDecision::Describe() const {
                   "on %d frames held back (decided at frame %d)",
                   state == State::kOn ? "mean" : "quality", evidence, frames_measured,
                   decided_at_frame);
+  else if (basis == "held_back_without_model")
+    std::snprintf(line, sizeof line,
+                  "off: the mean of every view without the model scores %+.2f dB against the "
+                  "best with it on %d frames held back (decided at frame %d)",
+                  evidence, frames_measured, decided_at_frame);
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
                   "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
@@ -60,6 +65,15 @@ std::string AutoDecisionsJson(const AutoDecisions& decisions) {
                             {"background", DecisionJson(decisions.background)},
                             {"update", update}};
   return j.dump();
+}
+
+void BackgroundAutoDecider::OffByFramesHeldBack(int frame_number, double gain_db, int frames) {
+  decision_.state = AutoDecision::State::kOff;
+  decision_.basis = "held_back_without_model";
+  decision_.evidence = gain_db;
+  decision_.threshold = 0;
+  decision_.frames_measured = frames;
+  decision_.decided_at_frame = frame_number;
 }
 
 void RefineAutoDecider::Start(bool enabled) {

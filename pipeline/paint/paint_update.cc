@@ -17,6 +17,7 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->quality.setTo(0);
   painted->painted_surface_texels = 0;
   painted->mean_sum.release();
+  painted->unmasked_sum.release();
   painted->texel_kind = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   for (int k = 0; k < buffer.NumTexels(); ++k)
     painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
@@ -34,6 +35,7 @@ struct PaintArrays {
   uint8_t* dst;
   float* stored_quality;
   float* mean_sum;  // `update: mean` and `auto` (4 floats per texel), null otherwise
+  float* unmasked_sum;  // `auto` with the background model on, null otherwise
 
   PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
               PaintedBuffer* painted)
@@ -44,7 +46,9 @@ struct PaintArrays {
         provisional(warming.empty() ? nullptr : warming.data),
         dst(painted->bgra.data),
         stored_quality(painted->quality.ptr<float>()),
-        mean_sum(painted->mean_sum.empty() ? nullptr : painted->mean_sum.ptr<float>()) {}
+        mean_sum(painted->mean_sum.empty() ? nullptr : painted->mean_sum.ptr<float>()),
+        unmasked_sum(painted->unmasked_sum.empty() ? nullptr
+                                                   : painted->unmasked_sum.ptr<float>()) {}
 };
 
 // One texel (rectangle index `idx`).
@@ -62,6 +66,9 @@ struct PaintArrays {
   if (take && rule.mean_too)  // `auto` deciding: the mean beside the sharpest
     AddToMean(a.src + 3 * static_cast<size_t>(idx), a.quality[idx],
               a.mean_sum + 4 * static_cast<size_t>(idx));
+  if (a.unmasked_sum && a.valid[idx])  // ... and without the background model's mask
+    AddToMean(a.src + 3 * static_cast<size_t>(idx), a.quality[idx],
+              a.unmasked_sum + 4 * static_cast<size_t>(idx));
   const bool provisional = a.provisional && a.provisional[idx];
   if (a.valid[idx] && !(a.skip && a.skip[idx])) {
     const float stored = a.stored_quality[idx];
@@ -124,6 +131,8 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
   const TexelUpdateRule rule = TexelUpdateRule::From(options);
   if ((rule.policy == UpdatePolicy::kMean || rule.mean_too) && painted->mean_sum.empty())
     painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  if (rule.unmasked_too && painted->unmasked_sum.empty())
+    painted->unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
     stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);

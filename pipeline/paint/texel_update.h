@@ -26,6 +26,9 @@ struct PaintedBuffer {
   // `update: mean`: per texel the sum of the samples taken, each weighted by its quality
   // (CV_32FC4: B, G, R and the weights' sum; made on the first frame painted, empty otherwise).
   cv::Mat mean_sum;
+  // `update: auto` while deciding with the background model on: the same sums over every
+  // sample, the model's foreground too (what the mean would be without the model).
+  cv::Mat unmasked_sum;
 };
 
 struct PaintUpdateStats {
@@ -50,6 +53,7 @@ struct TexelUpdateRule {
   int weight = 256;   // the new sample's weight out of 256 (256 = replace)
   // `update: auto` while deciding: kQuality into the texels, kMean into the sums too.
   bool mean_too = false;
+  bool unmasked_too = false;  // ... and with the background model on, PaintedBuffer::unmasked_sum
 
   static TexelUpdateRule From(const PipelineOptions& options) {
     TexelUpdateRule rule;
@@ -57,6 +61,7 @@ struct TexelUpdateRule {
     if (options.update == UpdatePolicy::kAuto) {
       rule.policy = UpdatePolicy::kQuality;
       rule.mean_too = true;
+      rule.unmasked_too = options.background.mode != BackgroundMode::kOff;
     }
     rule.keep = static_cast<float>(1.0 - options.quality_slack);
     rule.weight = std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);

@@ -34,7 +34,7 @@ FrameRead PaintRun::End(FrameRead read) {
 }
 
 bool PaintRun::HoldBack(const RunFrame& frame) {
-  if (options_.naive || !session_->DecidingUpdate()) return false;
+  if (options_.naive || !session_ || !session_->DecidingUpdate()) return false;
   const int k = to_paint_++;
   if (held_back_.size() >= static_cast<size_t>(kHoldBackFrames) ||
       k % kHoldBackEvery != kHoldBackEvery / 2)
@@ -45,6 +45,7 @@ bool PaintRun::HoldBack(const RunFrame& frame) {
 }
 
 bool PaintRun::DecideUpdateWhenDue(bool at_end) {
+  if (!session_) return false;  // a run that paints nothing (tests of the policy)
   if (session_->DecidingUpdate() &&
       (at_end || (held_back_.size() == static_cast<size_t>(kHoldBackFrames) &&
                   to_paint_ > kHoldBackEvery * kHoldBackFrames))) {

@@ -27,7 +27,7 @@ struct PipelineOptions {
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
   int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
   int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
-  UpdatePolicy update = UpdatePolicy::kAuto;
+  UpdatePolicy update = UpdatePolicy::kQuality;
   double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
   // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
   // below 1 = running average, which averages out the frames' residual misalignment).
@@ -81,12 +81,15 @@ void Fields(PipelineOptions& o, V& v) {
           {.min = 1, .help = "paint every N-th frame (the paper's §4)"});
   v.Enum("update", o.update, UpdatePolicyNames(),
          "`latest` (the paper: every visible sample overwrites), `quality` (a sample overwrites "
-         "only if at least `1 - quality_slack` as sharp, in pixels per texel) or `mean` (each "
-         "texel the mean of every sample it took, weighted by pixels per texel: for still photos "
-         "of a static scene, whose views disagree in light and by a few pixels; 16 more bytes "
-         "per texel) or `auto` (`quality` or `mean`, whichever agrees better with a few frames "
-         "held back from the first ones painted, which are painted in after; the choice and "
-         "its evidence in metrics.json)");
+         "only if at least `1 - quality_slack` as sharp, in pixels per texel), `mean` (each "
+         "texel the mean of every sample it took, weighted by pixels per texel: for views of a "
+         "static scene that disagree in light, noise and by a few pixels; 16 more bytes per "
+         "texel) or `auto`: while the first frames are painted both ways, every 4th of them "
+         "(up to 6) is held back; the model painted each way is rendered at their poses and "
+         "the one that agrees better with them paints on (where `background.mode` `auto` turned "
+         "the model on, the mean without it is a third candidate, which turns it off); the "
+         "held-back frames are then painted in. The choice and its evidence (dB gained at the "
+         "frames held back) are in metrics.json under `auto.update`");
   v.Field(
       "quality_slack", o.quality_slack,
       {.min = 0,

@@ -81,7 +81,7 @@ TEST(PaintUpdate, MeanWeighsEverySampleByItsQuality) {
 // keeps them (masked samples left out of both).
 TEST(PaintUpdate, AutoWhileDecidingKeepsTheSharpestAndTheMean) {
   PipelineOptions options;
-  ASSERT_EQ(options.update, UpdatePolicy::kAuto);  // the default
+  options.update = UpdatePolicy::kAuto;
   TwoTexels deciding, quality;
   PipelineOptions quality_options;
   quality_options.update = UpdatePolicy::kQuality;

@@ -272,3 +272,59 @@ TEST(PaintRun, TwoStreamsInterleaveAndCountPerStream) {
 
 }  // namespace
 }  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// `update: auto` through the one frame loop: on a capture whose frames change exposure, the
+// frames held back agree better with the mean of every view (decided at the 20th frame, on
+// the 6 frames held back); every frame is still read, painted and counted once, the held-back
+// ones after the decision; and what the run paints is what `update: mean` paints but for
+// the frames' order.
+TEST(PaintRun, UpdateAutoHoldsFramesBackDecidesOnThemAndPaintsThemIn) {
+  const std::string dir = testing::MakeTempDir("update-auto") + "/capture";
+  const testing::CommandResult synth = testing::RunFresco(
+      {"synth", "--scene", "builtin:cube-room", "--out", dir, "--frames", "40", "--size",
+       "160x120", "--exposure", "0.1", "--seed", "7", "--supersample", "1"});
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  Project project;
+  ASSERT_TRUE(LoadProject(dir + "/project.json", {"pipeline.update=auto"}, &project).ok());
+  std::unique_ptr<PaintJob> job;
+  ASSERT_TRUE(OpenPaintJob(project, PaintJobOptions(), &job).ok());
+  PaintRun run(job->session.get(), job->source.get(), PaintRunOptions());
+  std::vector<int> order;
+  PaintRunHooks hooks;
+  hooks.after_frame = [&](const RunFrame& frame, const FrameReport* report) {
+    if (report) order.push_back(frame.counter);
+    return Status::Ok();
+  };
+  ASSERT_TRUE(RunToEnd(&run, hooks).ok());
+  EXPECT_EQ(run.stats().frames, 40);
+  EXPECT_EQ(run.stats().frames_painted, 40);
+  ASSERT_EQ(order.size(), 40u);
+  // Frames 2, 6, ..., 22 held back and painted after frame 24, in their order.
+  const std::vector<int> after_decision(order.begin() + 19, order.begin() + 25);
+  EXPECT_EQ(after_decision, (std::vector<int>{2, 6, 10, 14, 18, 22}));
+  const AutoDecision decided = job->session->auto_decisions().update;
+  EXPECT_EQ(decided.state, AutoDecision::State::kOn);  // the mean
+  EXPECT_EQ(decided.frames_measured, 6);
+  EXPECT_EQ(decided.decided_at_frame, 19);
+  EXPECT_GT(decided.evidence, 0.3);
+  EXPECT_EQ(job->session->options().update, UpdatePolicy::kMean);
+
+  Project mean = project;
+  mean.pipeline.update = UpdatePolicy::kMean;
+  std::unique_ptr<PaintJob> mean_job;
+  ASSERT_TRUE(OpenPaintJob(mean, PaintJobOptions(), &mean_job).ok());
+  PaintRun mean_run(mean_job->session.get(), mean_job->source.get(), PaintRunOptions());
+  ASSERT_TRUE(RunToEnd(&mean_run, PaintRunHooks()).ok());
+  EXPECT_DOUBLE_EQ(mean_job->session->Coverage(), job->session->Coverage());
+  for (size_t b = 0; b < job->session->painted().size(); ++b)
+    EXPECT_LE(cv::norm(job->session->painted()[b].bgra, mean_job->session->painted()[b].bgra,
+                       cv::NORM_INF),
+              1.0)
+        << "buffer " << b;  // the sums in another order: at most 1 grey level apart
+}
+
+}  // namespace
+}  // namespace fresco
