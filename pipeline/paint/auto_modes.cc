@@ -21,16 +21,16 @@ std::string AutoDecision::Describe() const {
   if (state == State::kDeciding)
     std::snprintf(line, sizeof line, "deciding: %.3g %s %.3g over %d frames so far", evidence,
                   relation, threshold, frames_measured);
-  else if (basis == "held_back")
+  else if (basis == "held_out")
     std::snprintf(line, sizeof line,
                   "%s: the mean of every view scores %+.2f dB against the sharpest view "
-                  "on %d frames held back (decided at frame %d)",
+                  "on %d frames held out (decided at frame %d)",
                   state == State::kOn ? "mean" : "quality", evidence, frames_measured,
                   decided_at_frame);
-  else if (basis == "held_back_without_model")
+  else if (basis == "held_out_without_model")
     std::snprintf(line, sizeof line,
                   "off: the mean of every view without the model scores %+.2f dB against the "
-                  "best with it on %d frames held back (decided at frame %d)",
+                  "best with it on %d frames held out (decided at frame %d)",
                   evidence, frames_measured, decided_at_frame);
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
@@ -67,9 +67,9 @@ std::string AutoDecisionsJson(const AutoDecisions& decisions) {
   return j.dump();
 }
 
-void BackgroundAutoDecider::OffByFramesHeldBack(int frame_number, double gain_db, int frames) {
+void BackgroundAutoDecider::OffByFramesHeldOut(int frame_number, double gain_db, int frames) {
   decision_.state = AutoDecision::State::kOff;
-  decision_.basis = "held_back_without_model";
+  decision_.basis = "held_out_without_model";
   decision_.evidence = gain_db;
   decision_.threshold = 0;
   decision_.frames_measured = frames;

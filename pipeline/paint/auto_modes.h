@@ -91,9 +91,9 @@ class BackgroundAutoDecider {
   // Decides before the first frame from the movers found across views: `fraction` of the
   // pixels judged over `frames` frames masked.
   void DecideAcrossViews(double fraction, int frames);
-  // Off, whatever was decided, because the frames held back agree better with the mean of
+  // Off, whatever was decided, because the frames held out agree better with the mean of
   // every view painted without the model (`gain_db` more PSNR; PaintSession::DecideUpdate).
-  void OffByFramesHeldBack(int frame_number, double gain_db, int frames);
+  void OffByFramesHeldOut(int frame_number, double gain_db, int frames);
   const AutoDecision& decision() const { return decision_; }
   bool deciding() const { return decision_.state == AutoDecision::State::kDeciding; }
 

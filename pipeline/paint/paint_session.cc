@@ -121,8 +121,9 @@ void PaintSession::ResetPainting() {
 void PaintSession::StartAutoModes() {
   options_.update = requested_update_;
   update_auto_ = AutoDecision();
+  update_held_out_.clear();
   if (requested_update_ == UpdatePolicy::kAuto) {
-    update_auto_.basis = "held_back";
+    update_auto_.basis = "held_out";
     update_auto_.threshold = 0;
     update_auto_.state = AutoDecision::State::kDeciding;
     if (options_.select.enabled) {  // view selection keeps views by its own score
@@ -281,9 +282,15 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   work.number = frame_number;
   work.debug = options_.debug_images;
   work.report = report;
+  work.held_out = DecidingUpdate() &&
+                  frame_number % kUpdateHoldOutEvery == kUpdateHoldOutEvery / 2 &&
+                  update_held_out_.size() < static_cast<size_t>(kUpdateHeldOutFrames);
+  if (work.held_out)
+    update_held_out_.push_back({frame.bgr.clone(), frame.movers.clone(), camera, cam_from_world});
 #define FRESCO_RUN_STAGE(Name) Name##Stage(&work);
   FRESCO_PAINT_STAGES(FRESCO_RUN_STAGE)
 #undef FRESCO_RUN_STAGE
+  if (frame_number + 1 >= kUpdateHoldOutEvery * kUpdateHeldOutFrames) DecideUpdate();
   UpdateAutoModes(frame_number, work.measured_misalignment_px, work.seen, report);
   report->painted = true;
   report->total_ms = MsSince(frame_start);

@@ -72,17 +72,11 @@ struct FrameWork {
   std::vector<size_t> in_frustum;
   std::vector<bool> seen;
   bool paint_in_warp = false;
+  bool held_out = false;  // update `auto` deciding: held out of the decision's shadows
   std::vector<PaintUpdateStats> paint_stats;
   // refine.mode auto, deciding: the misalignment a correction would remove this frame,
   // measured by refinement (< 0: none).
   double measured_misalignment_px = -1;
-};
-
-// A frame the run held back from painting for PaintSession::DecideUpdate.
-struct HeldBackFrame {
-  cv::Mat bgr;  // the camera's size
-  const Camera* camera = nullptr;
-  Rigid3d cam_from_world;
 };
 
 class PaintSession {
@@ -147,12 +141,17 @@ class PaintSession {
     return {refine_auto_.decision(), background_auto_.decision(), update_auto_};
   }
   // `update: auto` (pipeline_options.h): until decided, every texel keeps the sharpest view
-  // (as `quality`) and the sums of every view (as `mean`); the run holds a few frames back
-  // (paint_run.h) and gives them here: the model painted each way is rendered at their poses,
-  // and the one that agrees better with them (PSNR, mean over the frames) paints on. No frame
-  // with painted surface in view: `quality`.
+  // (as `quality`) and the sums of every view (as `mean`; with the background model that
+  // `auto` turned on, also without its mask), and the same without frames 2, 6, ..., 22
+  // (held out of the decision, painted as every frame). After frame 23, or at the end of a
+  // shorter capture (the job's frame loop calls DecideUpdate there), the model painted each
+  // way without the held-out frames is rendered at their poses and compared with them (PSNR
+  // over the pixels every way paints, less the movers found across views); the way that
+  // agrees better paints on, from what every frame painted. No frame compared: `quality`.
+  static constexpr int kUpdateHoldOutEvery = 4;
+  static constexpr int kUpdateHeldOutFrames = 6;
   bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }
-  void DecideUpdate(const std::vector<HeldBackFrame>& frames);
+  void DecideUpdate();
 
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
@@ -242,6 +241,12 @@ class PaintSession {
   RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)
   UpdatePolicy requested_update_ = UpdatePolicy::kQuality;  // likewise
   AutoDecision update_auto_;  // on: `mean`, off: `quality`
+  struct HeldOutFrame {
+    cv::Mat bgr, movers;
+    Camera camera;
+    Rigid3d cam_from_world;
+  };
+  std::vector<HeldOutFrame> update_held_out_;
   BackgroundMode requested_background_ = BackgroundMode::kOff;
   // DecideBackgroundAcrossViews' evidence (fraction, frames); frames < 0: none.
   std::pair<double, int> background_across_views_{0.0, -1};

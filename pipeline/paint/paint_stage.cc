@@ -35,7 +35,8 @@ void PaintSession::PaintStage(FrameWork* work) {
                                   ? cv::Mat()
                                   : background_frame_[b].warming;
       work->paint_stats[b] =
-          PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b], warming);
+          PaintBuffer(set_.buffers[b], warped_[b], mask, options_, &painted_[b], warming,
+                      work->held_out);
     });
   }
   for (size_t b : seen) {

@@ -18,6 +18,10 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->painted_surface_texels = 0;
   painted->mean_sum.release();
   painted->unmasked_sum.release();
+  painted->shadow_bgra.release();
+  painted->shadow_quality.release();
+  painted->held_sum.release();
+  painted->held_unmasked_sum.release();
   painted->texel_kind = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   for (int k = 0; k < buffer.NumTexels(); ++k)
     painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
@@ -36,6 +40,10 @@ struct PaintArrays {
   float* stored_quality;
   float* mean_sum;  // `update: mean` and `auto` (4 floats per texel), null otherwise
   float* unmasked_sum;  // `auto` with the background model on, null otherwise
+  uint8_t* shadow_dst;  // `auto` deciding: PaintedBuffer's shadows, null otherwise
+  float* shadow_quality;
+  float* held_sum;
+  float* held_unmasked_sum;
 
   PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
               PaintedBuffer* painted)
@@ -47,9 +55,38 @@ struct PaintArrays {
         dst(painted->bgra.data),
         stored_quality(painted->quality.ptr<float>()),
         mean_sum(painted->mean_sum.empty() ? nullptr : painted->mean_sum.ptr<float>()),
-        unmasked_sum(painted->unmasked_sum.empty() ? nullptr
-                                                   : painted->unmasked_sum.ptr<float>()) {}
+        unmasked_sum(Floats(painted->unmasked_sum)),
+        shadow_dst(painted->shadow_bgra.empty() ? nullptr : painted->shadow_bgra.data),
+        shadow_quality(Floats(painted->shadow_quality)),
+        held_sum(Floats(painted->held_sum)),
+        held_unmasked_sum(Floats(painted->held_unmasked_sum)) {}
+  static float* Floats(cv::Mat& m) { return m.empty() ? nullptr : m.ptr<float>(); }
 };
+
+// One texel by the quality rule into `dst` and `stored_quality` (the texels or, for `auto`
+// deciding, their shadows).
+[[gnu::always_inline]] inline void QualityTexel(const PaintArrays& a, int idx, bool on_surface,
+                                                const TexelUpdateRule& rule, uint8_t* dst,
+                                                float* stored_quality, PaintUpdateStats* stats) {
+  const bool provisional = a.provisional && a.provisional[idx];
+  if (a.valid[idx] && !(a.skip && a.skip[idx])) {
+    const float stored = stored_quality[idx];
+    uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
+    const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
+    if (stored >= 0.0f) {
+      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, stored_quality + idx, stats);
+    } else {
+      // A provisional stored sample: against a trusted sample it counts as nothing; against
+      // another provisional one, by its quality.
+      float compared_with = provisional ? -stored : 0.0f;
+      const int written_before = stats->written;
+      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, &compared_with, stats);
+      if (stats->written > written_before) stored_quality[idx] = compared_with;
+    }
+  }
+  // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
+  if (provisional) stored_quality[idx] = -std::abs(stored_quality[idx]);
+}
 
 // One texel (rectangle index `idx`).
 [[gnu::always_inline]] inline void PaintTexel(const PaintArrays& a, int idx, bool on_surface,
@@ -63,30 +100,19 @@ struct PaintArrays {
                 a.mean_sum + 4 * static_cast<size_t>(idx), stats);
     return;
   }
-  if (take && rule.mean_too)  // `auto` deciding: the mean beside the sharpest
-    AddToMean(a.src + 3 * static_cast<size_t>(idx), a.quality[idx],
-              a.mean_sum + 4 * static_cast<size_t>(idx));
-  if (a.unmasked_sum && a.valid[idx])  // ... and without the background model's mask
-    AddToMean(a.src + 3 * static_cast<size_t>(idx), a.quality[idx],
-              a.unmasked_sum + 4 * static_cast<size_t>(idx));
-  const bool provisional = a.provisional && a.provisional[idx];
-  if (a.valid[idx] && !(a.skip && a.skip[idx])) {
-    const float stored = a.stored_quality[idx];
-    uint8_t* texel = a.dst + 4 * static_cast<size_t>(idx);
+  if (rule.mean_too) {  // `auto` deciding: the means beside the sharpest
     const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
-    if (stored >= 0.0f) {
-      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, a.stored_quality + idx, stats);
-    } else {
-      // A provisional stored sample: against a trusted sample it counts as nothing; against
-      // another provisional one, by its quality.
-      float compared_with = provisional ? -stored : 0.0f;
-      const int written_before = stats->written;
-      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, &compared_with, stats);
-      if (stats->written > written_before) a.stored_quality[idx] = compared_with;
-    }
+    const size_t at = 4 * static_cast<size_t>(idx);
+    if (take) AddToMean(sample, a.quality[idx], a.mean_sum + at);
+    if (take && rule.held_out) AddToMean(sample, a.quality[idx], a.held_sum + at);
+    if (a.unmasked_sum && a.valid[idx]) AddToMean(sample, a.quality[idx], a.unmasked_sum + at);
+    if (a.held_unmasked_sum && a.valid[idx] && rule.held_out)
+      AddToMean(sample, a.quality[idx], a.held_unmasked_sum + at);
+    PaintUpdateStats ignored;
+    if (!rule.held_out && a.shadow_dst)
+      QualityTexel(a, idx, on_surface, rule, a.shadow_dst, a.shadow_quality, &ignored);
   }
-  // Negated: the sign marks the stored sample provisional, the magnitude keeps its quality.
-  if (provisional) a.stored_quality[idx] = -std::abs(a.stored_quality[idx]);
+  QualityTexel(a, idx, on_surface, rule, a.dst, a.stored_quality, stats);
 }
 
 // Rows [y0, y1) of the warped box `box`, left to right: every array is read and written in
@@ -127,12 +153,20 @@ PaintUpdateStats PaintTexels(const BaseBuffer& buffer, const WarpedBuffer& warpe
 
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const PipelineOptions& options,
-                             PaintedBuffer* painted, const cv::Mat& warming) {
-  const TexelUpdateRule rule = TexelUpdateRule::From(options);
+                             PaintedBuffer* painted, const cv::Mat& warming, bool held_out) {
+  TexelUpdateRule rule = TexelUpdateRule::From(options);
+  rule.held_out = held_out && rule.mean_too;
   if ((rule.policy == UpdatePolicy::kMean || rule.mean_too) && painted->mean_sum.empty())
     painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
   if (rule.unmasked_too && painted->unmasked_sum.empty())
     painted->unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  if (rule.mean_too && painted->shadow_bgra.empty()) {
+    painted->shadow_bgra = painted->bgra.clone();  // the fused warp paints none while deciding
+    painted->shadow_quality = painted->quality.clone();
+    painted->held_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  }
+  if (rule.unmasked_too && painted->held_unmasked_sum.empty())
+    painted->held_unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
     stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);

@@ -23,6 +23,7 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted);
 // the ones shown, and the first trusted sample replaces them.
 PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warped,
                              const cv::Mat& mask, const PipelineOptions& options,
-                             PaintedBuffer* painted, const cv::Mat& warming = cv::Mat());
+                             PaintedBuffer* painted, const cv::Mat& warming = cv::Mat(),
+                             bool held_out = false);
 
 }  // namespace fresco

@@ -116,7 +116,7 @@ struct AutoDecisions {
   // foreground fraction of the warmed-up texels ("texels")
   AutoDecision background;
   // update `auto`: on = `mean`, off = `quality`; evidence: how many dB more PSNR the
-  // mean scores than the sharpest view at the frames held back (basis "held_back")
+  // mean scores than the sharpest view at the frames held out (basis "held_out")
   AutoDecision update;
 };
 

@@ -29,6 +29,10 @@ struct PaintedBuffer {
   // `update: auto` while deciding with the background model on: the same sums over every
   // sample, the model's foreground too (what the mean would be without the model).
   cv::Mat unmasked_sum;
+  // `update: auto` while deciding, without the frames held out of the decision (painted as
+  // every other frame into the stores above): the texels and qualities `quality` would
+  // hold, and the held-out frames' own part of mean_sum and unmasked_sum (subtracted).
+  cv::Mat shadow_bgra, shadow_quality, held_sum, held_unmasked_sum;
 };
 
 struct PaintUpdateStats {
@@ -54,6 +58,7 @@ struct TexelUpdateRule {
   // `update: auto` while deciding: kQuality into the texels, kMean into the sums too.
   bool mean_too = false;
   bool unmasked_too = false;  // ... and with the background model on, PaintedBuffer::unmasked_sum
+  bool held_out = false;      // ... and this frame is held out of the decision (the shadows)
 
   static TexelUpdateRule From(const PipelineOptions& options) {
     TexelUpdateRule rule;

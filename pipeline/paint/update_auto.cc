@@ -1,100 +1,135 @@
-// `update: auto`: the sharpest view or the mean of every view, decided on the frames the run
-// held back (PaintSession::DecideUpdate, paint_session.h).
+// `update: auto`: the sharpest view or the mean of every view (with or without the background
+// model), decided on frames held out of the decision (PaintSession::DecideUpdate,
+// paint_session.h).
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
-#include <memory>
 
+#include <opencv2/imgproc.hpp>
+
+#include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
-#include "pipeline/paint/rephotography.h"
 #include "pipeline/render/renderer.h"
 
 namespace fresco {
 
 namespace {
 
-// The texels as `update: mean` would hold them with `sums`: their mean where they have a
-// weight, what the texel holds elsewhere.
-cv::Mat MeanTexels(const PaintedBuffer& painted, const cv::Mat& sums) {
-  cv::Mat bgra = painted.bgra.clone();
+// `base` where `sums` (less `held`, when given) have no weight, their mean elsewhere.
+cv::Mat MeanTexels(const cv::Mat& base, const cv::Mat& sums, const cv::Mat& held = cv::Mat()) {
+  cv::Mat bgra = base.clone();
   if (sums.empty()) return bgra;
   for (int y = 0; y < bgra.rows; ++y) {
     const cv::Vec4f* sum = sums.ptr<cv::Vec4f>(y);
+    const cv::Vec4f* less = held.empty() ? nullptr : held.ptr<cv::Vec4f>(y);
     cv::Vec4b* texel = bgra.ptr<cv::Vec4b>(y);
     for (int x = 0; x < bgra.cols; ++x) {
-      if (sum[x][3] <= 0) continue;
-      for (int c = 0; c < 3; ++c) texel[x][c] = cv::saturate_cast<uint8_t>(sum[x][c] / sum[x][3]);
+      const cv::Vec4f s = less ? sum[x] - less[x] : sum[x];
+      if (s[3] <= 1e-6f) continue;
+      for (int c = 0; c < 3; ++c) texel[x][c] = cv::saturate_cast<uint8_t>(s[c] / s[3]);
       texel[x][3] = 255;
     }
   }
   return bgra;
 }
 
+// PSNR of each rendering against `frame` over the pixels all of them paint, less `movers`
+// (kMoverPixel, any size); false when there is none.
+bool ComparedPsnr(const std::vector<RenderOutput>& rendered, const cv::Mat& frame,
+                  const cv::Mat& movers, std::vector<double>* psnr) {
+  cv::Mat compared(frame.size(), CV_8U, cv::Scalar(255));
+  for (const RenderOutput& r : rendered) {
+    cv::Mat alpha;
+    cv::extractChannel(r.rgba, alpha, 3);
+    compared &= alpha == 255;
+  }
+  if (!movers.empty()) {
+    cv::Mat at_size;
+    cv::resize(movers, at_size, frame.size(), 0, 0, cv::INTER_NEAREST);
+    compared &= at_size != kMoverPixel;
+  }
+  const int pixels = cv::countNonZero(compared);
+  if (pixels == 0) return false;
+  psnr->clear();
+  for (const RenderOutput& r : rendered) {
+    cv::Mat bgr, diff;
+    cv::cvtColor(r.rgba, bgr, cv::COLOR_RGBA2BGR);
+    cv::absdiff(bgr, frame, diff);
+    diff.convertTo(diff, CV_32F);
+    diff = diff.mul(diff);
+    diff.setTo(cv::Scalar::all(0), ~compared);
+    const cv::Scalar sum = cv::sum(diff);
+    const double mse = (sum[0] + sum[1] + sum[2]) / (3.0 * pixels);
+    psnr->push_back(10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10)));
+  }
+  return true;
+}
+
 }  // namespace
 
-void PaintSession::DecideUpdate(const std::vector<HeldBackFrame>& frames) {
+void PaintSession::DecideUpdate() {
   if (!DecidingUpdate()) return;
-  // The candidates: what the texels hold (the sharpest view), the mean of every view and,
-  // with the background model on where `auto` turned it on, that mean without the model.
+  // The candidates, without the frames held out: the sharpest view, the mean of every view
+  // and, with the background model `auto` turned on, that mean without the model.
   const bool without_model = requested_background_ == BackgroundMode::kAuto &&
                              options_.background.mode != BackgroundMode::kOff;
-  std::vector<std::vector<cv::Mat>> texels(without_model ? 3 : 2);
-  for (const PaintedBuffer& painted : painted_) {
-    texels[0].push_back(painted.bgra);
-    texels[1].push_back(MeanTexels(painted, painted.mean_sum));
-    if (without_model) texels[2].push_back(MeanTexels(painted, painted.unmasked_sum));
-  }
+  const size_t n = without_model ? 3 : 2;
   std::vector<Scene> scenes;
-  for (const std::vector<cv::Mat>& candidate : texels) {
-    std::vector<cv::Mat> shown;
-    for (const cv::Mat& bgra : candidate) shown.push_back(AtMeanExposure(bgra));
-    scenes.push_back(PaintedScene(shown));
-  }
-  std::map<const Camera*, std::unique_ptr<Renderer>> renderers;
-  std::vector<double> psnr_sum(scenes.size(), 0.0);
-  int measured = 0;
-  for (const HeldBackFrame& frame : frames) {
-    auto& renderer = renderers[frame.camera];
-    if (!renderer) renderer = std::make_unique<Renderer>(*frame.camera, RenderOptions());
-    std::vector<double> psnr;
-    for (const Scene& scene : scenes) {
-      const RephotoScore s = ScoreRephoto(*renderer, scene, frame.cam_from_world, frame.bgr);
-      if (s.pixels > 0 && std::isfinite(s.psnr_db)) psnr.push_back(s.psnr_db);
+  for (size_t c = 0; c < n; ++c) {
+    std::vector<cv::Mat> texels;
+    for (const PaintedBuffer& p : painted_) {
+      const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
+      texels.push_back(AtMeanExposure(c == 0   ? base
+                                      : c == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
+                                               : MeanTexels(base, p.unmasked_sum,
+                                                            p.held_unmasked_sum)));
     }
-    if (psnr.size() != scenes.size()) continue;  // no painted surface in view
-    for (size_t c = 0; c < psnr.size(); ++c) psnr_sum[c] += psnr[c];
+    scenes.push_back(PaintedScene(texels));
+  }
+  std::vector<double> psnr_sum(n, 0.0), psnr;
+  int measured = 0;
+  for (const HeldOutFrame& frame : update_held_out_) {
+    const Renderer renderer(frame.camera, RenderOptions());
+    std::vector<RenderOutput> rendered(n);
+    for (size_t c = 0; c < n; ++c)
+      renderer.Render(scenes[c], frame.cam_from_world, &rendered[c]);
+    if (!ComparedPsnr(rendered, frame.bgr, frame.movers, &psnr)) continue;
+    for (size_t c = 0; c < n; ++c) psnr_sum[c] += psnr[c];
     ++measured;
   }
-  // The best candidate by mean PSNR; the sharpest view where none was measured.
+  update_held_out_.clear();
   size_t best = 0;
-  for (size_t c = 1; c < scenes.size() && measured > 0; ++c)
+  for (size_t c = 1; c < n && measured > 0; ++c)
     if (psnr_sum[c] > psnr_sum[best]) best = c;
-  const double best_mean = *std::max_element(psnr_sum.begin() + 1, psnr_sum.end());
   update_auto_.frames_measured = measured;
   update_auto_.decided_at_frame = frames_seen_;
-  update_auto_.evidence = measured > 0 ? (best_mean - psnr_sum[0]) / measured
-                                       : std::numeric_limits<double>::quiet_NaN();
+  update_auto_.evidence =
+      measured > 0
+          ? (*std::max_element(psnr_sum.begin() + 1, psnr_sum.end()) - psnr_sum[0]) / measured
+          : std::numeric_limits<double>::quiet_NaN();
   const bool mean = best > 0;
   update_auto_.state = mean ? AutoDecision::State::kOn : AutoDecision::State::kOff;
   options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
   if (best == 2) {  // the model off from now on, its sums the mean's
-    background_auto_.OffByFramesHeldBack(frames_seen_, (psnr_sum[2] - psnr_sum[1]) / measured,
-                                         measured);
+    background_auto_.OffByFramesHeldOut(frames_seen_, (psnr_sum[2] - psnr_sum[1]) / measured,
+                                        measured);
     options_.background.mode = BackgroundMode::kOff;
     background_.clear();
     background_frame_.clear();
   }
-  for (size_t b = 0; b < painted_.size(); ++b) {
-    PaintedBuffer& painted = painted_[b];
+  // What every frame painted, the chosen way.
+  for (PaintedBuffer& p : painted_) {
     if (mean) {
-      painted.bgra = texels[best][b];
-      if (best == 2) painted.mean_sum = painted.unmasked_sum;
-      cv::absdiff(painted.quality, 0, painted.quality);  // none provisional: every view counts
+      const cv::Mat& sums = best == 2 ? p.unmasked_sum : p.mean_sum;
+      p.bgra = MeanTexels(p.bgra, sums);
+      p.mean_sum = sums;
+      cv::absdiff(p.quality, 0, p.quality);  // none provisional: every view counts
     } else {
-      painted.mean_sum.release();
+      p.mean_sum.release();
     }
-    painted.unmasked_sum.release();
+    for (cv::Mat* m : {&p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum,
+                       &p.held_unmasked_sum})
+      m->release();
   }
 }
 

@@ -28,33 +28,11 @@ FrameRead PaintRun::End(FrameRead read) {
   if (read == FrameRead::kEnded) {
     ended_ = true;
     source_->Stop();
+    // `update: auto` on a capture shorter than its decision: on the frames held out so far.
+    if (session_ && status_.ok()) session_->DecideUpdate();
   }
   stats_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   return read;
-}
-
-bool PaintRun::HoldBack(const RunFrame& frame) {
-  if (options_.naive || !session_ || !session_->DecidingUpdate()) return false;
-  const int k = to_paint_++;
-  if (held_back_.size() >= static_cast<size_t>(kHoldBackFrames) ||
-      k % kHoldBackEvery != kHoldBackEvery / 2)
-    return false;
-  held_back_.push_back(frame);
-  held_back_.back().posed.frame.bgr = frame.posed.frame.bgr.clone();  // sources reuse theirs
-  return true;
-}
-
-bool PaintRun::DecideUpdateWhenDue(bool at_end) {
-  if (!session_) return false;  // a run that paints nothing (tests of the policy)
-  if (session_->DecidingUpdate() &&
-      (at_end || (held_back_.size() == static_cast<size_t>(kHoldBackFrames) &&
-                  to_paint_ > kHoldBackEvery * kHoldBackFrames))) {
-    std::vector<HeldBackFrame> frames;
-    for (const RunFrame& f : held_back_)
-      frames.push_back({f.posed.frame.bgr, f.camera, f.posed.cam_from_world});
-    session_->DecideUpdate(frames);
-  }
-  return !session_->DecidingUpdate() && handed_out_ < held_back_.size();
 }
 
 FrameRead PaintRun::Next(RunFrame* frame) {
@@ -63,20 +41,11 @@ FrameRead PaintRun::Next(RunFrame* frame) {
     started_ = true;
     start_ = std::chrono::steady_clock::now();
   }
-  const bool at_end = options_.max_frames > 0 && stats_.frames >= options_.max_frames;
-  if (DecideUpdateWhenDue(at_end)) {  // the frames held back, painted now
-    *frame = std::move(held_back_[handed_out_++]);
-    return End(FrameRead::kFrame);
-  }
-  if (at_end) {
+  if (options_.max_frames > 0 && stats_.frames >= options_.max_frames) {
     max_frames_reached_ = true;
     return End(FrameRead::kEnded);
   }
   const FrameRead read = source_->Next(frame, &status_);
-  if (read == FrameRead::kEnded && status_.ok() && DecideUpdateWhenDue(true)) {
-    *frame = std::move(held_back_[handed_out_++]);
-    return End(FrameRead::kFrame);
-  }
   if (read != FrameRead::kFrame) return End(read);
   frame->counter = stats_.frames++;
   StreamRunStats& stream = stats_.streams[frame->stream];
@@ -91,8 +60,6 @@ FrameRead PaintRun::Next(RunFrame* frame) {
              frame->counter == options_.holdout_counter) {
     frame->fate = FrameFate::kHeldOut;
     ++stats_.frames_held_out;
-  } else if (frame->fate == FrameFate::kPaint && HoldBack(*frame)) {
-    return Next(frame);
   }
   return End(FrameRead::kFrame);
 }

@@ -108,15 +108,6 @@ class PaintRun {
 
  private:
   FrameRead End(FrameRead read);
-  // `update: auto` (PaintSession::DecideUpdate): while the session decides, every
-  // kHoldBackEvery-th frame to paint (from the third) is held back, up to kHoldBackFrames;
-  // the session decides once it has them and the frames after the last, or at the end (of
-  // the source or of max_frames); then they are handed out to paint, before reading on.
-  static constexpr int kHoldBackEvery = 4;
-  static constexpr int kHoldBackFrames = 6;
-  bool HoldBack(const RunFrame& frame);
-  bool DecideUpdateWhenDue(bool at_end);
-
   PaintSession* session_;
   PosedFrameSource* source_;
   PaintRunOptions options_;
@@ -125,9 +116,6 @@ class PaintRun {
   bool ended_ = false;
   bool max_frames_reached_ = false;
   bool started_ = false;
-  int to_paint_ = 0;                // frames read with fate kPaint while deciding
-  std::vector<RunFrame> held_back_;  // for the decision; handed out after it
-  size_t handed_out_ = 0;
   std::chrono::steady_clock::time_point start_;
 };
 

@@ -18,7 +18,7 @@ enum class SamplingMode { kNearest, kBilinear, kArea };
 // kLatest: every visible sample overwrites (the paper). kQuality: a sample overwrites only
 // when it is at least (1 - quality_slack) as sharp (pixels per texel) as the stored one.
 // kMean: each texel the mean of every sample it took, weighted by pixels per texel.
-// kAuto: kQuality or kMean, whichever paints the frames the run holds back more alike
+// kAuto: kQuality or kMean, whichever agrees better with frames held out of the decision
 // (PaintSession::DecideUpdate).
 enum class UpdatePolicy { kLatest, kQuality, kMean, kAuto };
 
@@ -84,12 +84,12 @@ void Fields(PipelineOptions& o, V& v) {
          "only if at least `1 - quality_slack` as sharp, in pixels per texel), `mean` (each "
          "texel the mean of every sample it took, weighted by pixels per texel: for views of a "
          "static scene that disagree in light, noise and by a few pixels; 16 more bytes per "
-         "texel) or `auto`: while the first frames are painted both ways, every 4th of them "
-         "(up to 6) is held back; the model painted each way is rendered at their poses and "
-         "the one that agrees better with them paints on (where `background.mode` `auto` turned "
-         "the model on, the mean without it is a third candidate, which turns it off); the "
-         "held-back frames are then painted in. The choice and its evidence (dB gained at the "
-         "frames held back) are in metrics.json under `auto.update`");
+         "texel) or `auto`: the first 24 frames are painted both ways, and also both ways "
+         "without frames 2, 6, ..., 22; the model painted each way without them is rendered at "
+         "their poses, and the way that agrees better with them paints on (where "
+         "`background.mode` `auto` turned the model on, the mean without it is a third way, "
+         "which turns it off). The choice and its evidence (dB gained) are in metrics.json "
+         "under `auto.update`");
   v.Field(
       "quality_slack", o.quality_slack,
       {.min = 0,
