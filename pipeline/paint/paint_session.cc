@@ -207,6 +207,7 @@ void PaintSession::UpdateAutoModes(int frame_number, double misalignment_px,
   if (StageReport* refine = report->Stage("refine")) report->decisions.refine.PutInto(refine);
   if (StageReport* background = report->Stage("background"))
     report->decisions.background.PutInto(background);
+  if (StageReport* paint = report->Stage("paint")) report->decisions.update.PutInto(paint);
 }
 
 const PaintSession::CameraCache& PaintSession::CacheFor(const Camera& camera) {
