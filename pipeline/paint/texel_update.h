@@ -108,15 +108,15 @@ inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, floa
   ++stats->written;
 }
 
-// `update: mean`: adds the sample, weighted by its quality, to the texel's sums (`sum`: B, G,
-// R, weight) and stores their mean; the stored quality is the best seen. Counts into `stats`.
-// The sums alone (`update: auto` while deciding).
+// Adds the sample, weighted by its quality, to a texel's sums (`sum`: B, G, R, weight).
 inline void AddToMean(const uint8_t* sample, float quality, float* sum) {
   const float w = std::max(quality, 1e-3f);
   for (int c = 0; c < 3; ++c) sum[c] += w * sample[c];
   sum[3] += w;
 }
 
+// `update: mean`: AddToMean, and the texel their mean; the stored quality is the best seen.
+// Counts into `stats`.
 inline void MeanTexel(const uint8_t* sample, float quality, bool on_surface, uint8_t* texel,
                       float* stored_quality, float* sum, PaintUpdateStats* stats) {
   CompareWithStored(sample, texel, stats);

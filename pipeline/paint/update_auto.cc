@@ -52,14 +52,9 @@ bool ComparedPsnr(const std::vector<RenderOutput>& rendered, const cv::Mat& fram
   if (pixels == 0) return false;
   psnr->clear();
   for (const RenderOutput& r : rendered) {
-    cv::Mat bgr, diff;
+    cv::Mat bgr;
     cv::cvtColor(r.rgba, bgr, cv::COLOR_RGBA2BGR);
-    cv::absdiff(bgr, frame, diff);
-    diff.convertTo(diff, CV_32F);
-    diff = diff.mul(diff);
-    diff.setTo(cv::Scalar::all(0), ~compared);
-    const cv::Scalar sum = cv::sum(diff);
-    const double mse = (sum[0] + sum[1] + sum[2]) / (3.0 * pixels);
+    const double mse = cv::norm(bgr, frame, cv::NORM_L2SQR, compared) / (3.0 * pixels);
     psnr->push_back(10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10)));
   }
   return true;
