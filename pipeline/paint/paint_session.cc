@@ -126,10 +126,19 @@ void PaintSession::StartAutoModes() {
     update_auto_.basis = "held_out";
     update_auto_.threshold = 0;
     update_auto_.state = AutoDecision::State::kDeciding;
-    if (options_.select.enabled) {  // view selection keeps views by its own score
+    // View selection keeps views by its own score; refinement registers each frame to the
+    // buffers, which must stay the sharpest views (the mean of misregistered views blurs them).
+    // The background model on by hand: the mean would take in what it lets through.
+    const auto on = [](auto mode, auto off, auto automatic) { return mode != off && mode != automatic; };
+    const bool refine_on = on(requested_refine_, RefineMode::kOff, RefineMode::kAuto);
+    const bool model_on = on(requested_background_, BackgroundMode::kOff, BackgroundMode::kAuto);
+    if (options_.select.enabled || refine_on || model_on) {
       options_.update = UpdatePolicy::kQuality;
       update_auto_.state = AutoDecision::State::kOff;
       update_auto_.decided_at_frame = 0;
+      update_auto_.basis = refine_on ? "refinement_on"
+                           : model_on ? "background_model_on"
+                                      : "view_selection";
     }
   }
   const bool refine_auto = requested_refine_ == RefineMode::kAuto;

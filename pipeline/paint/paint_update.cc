@@ -93,9 +93,10 @@ struct PaintArrays {
                                               const TexelUpdateRule& rule,
                                               PaintUpdateStats* stats) {
   const bool take = a.valid[idx] && !(a.skip && a.skip[idx]);
-  if (a.mean_sum && !rule.mean_too) {  // every sample counts, provisional or not
+  const bool provisional = a.provisional && a.provisional[idx];
+  if (a.mean_sum && !rule.mean_too) {
     if (take)
-      MeanTexel(a.src + 3 * static_cast<size_t>(idx), a.quality[idx], on_surface,
+      MeanTexel(a.src + 3 * static_cast<size_t>(idx), a.quality[idx], provisional, on_surface,
                 a.dst + 4 * static_cast<size_t>(idx), a.stored_quality + idx,
                 a.mean_sum + 4 * static_cast<size_t>(idx), stats);
     return;
@@ -103,11 +104,12 @@ struct PaintArrays {
   if (rule.mean_too) {  // `auto` deciding: the means beside the sharpest
     const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
     const size_t at = 4 * static_cast<size_t>(idx);
-    if (take) AddToMean(sample, a.quality[idx], a.mean_sum + at);
-    if (take && rule.held_out) AddToMean(sample, a.quality[idx], a.held_sum + at);
-    if (a.unmasked_sum && a.valid[idx]) AddToMean(sample, a.quality[idx], a.unmasked_sum + at);
-    if (a.held_unmasked_sum && a.valid[idx] && rule.held_out)
-      AddToMean(sample, a.quality[idx], a.held_unmasked_sum + at);
+    if (take)
+      AddToMean(sample, a.quality[idx], provisional, a.mean_sum + at,
+                a.held_sum ? a.held_sum + at : nullptr, rule.held_out);
+    if (a.unmasked_sum && a.valid[idx])  // without the model: no sample is provisional
+      AddToMean(sample, a.quality[idx], false, a.unmasked_sum + at,
+                a.held_unmasked_sum ? a.held_unmasked_sum + at : nullptr, rule.held_out);
     PaintUpdateStats ignored;
     if (!rule.held_out && a.shadow_dst)
       QualityTexel(a, idx, on_surface, rule, a.shadow_dst, a.shadow_quality, &ignored);

@@ -108,21 +108,41 @@ inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, floa
   ++stats->written;
 }
 
-// Adds the sample, weighted by its quality, to a texel's sums (`sum`: B, G, R, weight).
-inline void AddToMean(const uint8_t* sample, float quality, float* sum) {
+// Adds the sample, weighted by its quality, to a texel's sums (`sum`: B, G, R, weight). A
+// provisional sample (the background model still learning the texel: it may show a mover)
+// counts only until the texel's first trusted one, which replaces them: the weight of sums
+// of provisional samples only is kept negative. `held` (optional): the part of `sum` taken
+// from frames held out of `update: auto`'s decision; it follows `sum`'s replacements and
+// takes the sample too when `held_out`.
+inline void AddToMean(const uint8_t* sample, float quality, bool provisional, float* sum,
+                      float* held = nullptr, bool held_out = false) {
+  if (provisional && sum[3] > 0) return;  // trusted samples are in: it counts as nothing
+  if (!provisional && sum[3] < 0) {       // the first trusted one: the provisional ones go
+    std::fill(sum, sum + 4, 0.0f);
+    if (held) std::fill(held, held + 4, 0.0f);
+  }
   const float w = std::max(quality, 1e-3f);
-  for (int c = 0; c < 3; ++c) sum[c] += w * sample[c];
-  sum[3] += w;
+  for (float* s : {sum, held_out ? held : nullptr}) {
+    if (!s) continue;
+    for (int c = 0; c < 3; ++c) s[c] += w * sample[c];
+    s[3] += provisional ? -w : w;
+  }
+}
+
+// The mean a texel's sums (AddToMean) hold, into `texel`'s B, G, R.
+inline void MeanOfSums(const float* sum, uint8_t* texel) {
+  const float weight = std::abs(sum[3]);
+  for (int c = 0; c < 3; ++c) texel[c] = cv::saturate_cast<uint8_t>(sum[c] / weight);
 }
 
 // `update: mean`: AddToMean, and the texel their mean; the stored quality is the best seen.
 // Counts into `stats`.
-inline void MeanTexel(const uint8_t* sample, float quality, bool on_surface, uint8_t* texel,
-                      float* stored_quality, float* sum, PaintUpdateStats* stats) {
+inline void MeanTexel(const uint8_t* sample, float quality, bool provisional, bool on_surface,
+                      uint8_t* texel, float* stored_quality, float* sum, PaintUpdateStats* stats) {
   CompareWithStored(sample, texel, stats);
   if (texel[3] == 0 && on_surface) ++stats->newly_painted;
-  AddToMean(sample, quality, sum);
-  for (int c = 0; c < 3; ++c) texel[c] = cv::saturate_cast<uint8_t>(sum[c] / sum[3]);
+  AddToMean(sample, quality, provisional, sum);
+  MeanOfSums(sum, texel);
   texel[3] = 255;
   *stored_quality = std::max(*stored_quality, quality);
   ++stats->written;

@@ -27,7 +27,7 @@ struct PipelineOptions {
   double texel_size_m = 0.0;            // base-buffer texel edge in metres; 0 = automatic
   int max_buffer_texels = 1024 * 1024;  // per base buffer; bigger groups get coarser texels
   int update_every = 1;  // paint every N-th frame (the paper used 20 with refinement)
-  UpdatePolicy update = UpdatePolicy::kQuality;
+  UpdatePolicy update = UpdatePolicy::kAuto;
   double quality_slack = 0.2;  // kQuality: accept samples this much blurrier than stored
   // Weight of an accepted sample against what the texel holds (1 = replace, the paper's;
   // below 1 = running average, which averages out the frames' residual misalignment).
@@ -86,10 +86,11 @@ void Fields(PipelineOptions& o, V& v) {
          "static scene that disagree in light, noise and by a few pixels; 16 more bytes per "
          "texel) or `auto`: the first 24 frames are painted both ways, and also both ways "
          "without frames 2, 6, ..., 22; the model painted each way without them is rendered at "
-         "their poses, and the way that agrees better with them paints on (where "
-         "`background.mode` `auto` turned the model on, the mean without it is a third way, "
-         "which turns it off). The choice and its evidence (dB gained) are in metrics.json "
-         "under `auto.update`");
+         "their poses, and the way that agrees better with them paints on. The mean is for a "
+         "static scene: where `background.mode` `auto` turned the model on, the mean is "
+         "painted without it (winning turns the model off); with the model on by hand, "
+         "refinement on or view selection, `auto` keeps `quality`. The choice and its "
+         "evidence (dB gained) are in metrics.json under `auto.update`");
   v.Field(
       "quality_slack", o.quality_slack,
       {.min = 0,

@@ -216,7 +216,7 @@ TEST(ProjectTest, SavedFileListsEverySetting) {
                           "\"texel_size_m\"",
                           "\"max_buffer_texels\"",
                           "\"update_every\": 1",
-                          "\"update\": \"quality\"",
+                          "\"update\": \"auto\"",
                           "\"quality_slack\"",
                           "\"update_weight\"",
                           "\"max_frames\"",

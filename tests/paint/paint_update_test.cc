@@ -49,8 +49,7 @@ TEST(PaintUpdate, WeightOneReplacesLowerWeightsAverage) {
 }
 
 // `update: mean`: each texel the mean of every sample it took, weighted by the samples'
-// quality (pixels per texel); masked samples do not count, provisional ones do; the sums go
-// with InitPaintedBuffer.
+// quality (pixels per texel); masked samples do not count; the sums go with InitPaintedBuffer.
 TEST(PaintUpdate, MeanWeighsEverySampleByItsQuality) {
   PipelineOptions options;
   options.update = UpdatePolicy::kMean;
@@ -68,13 +67,35 @@ TEST(PaintUpdate, MeanWeighsEverySampleByItsQuality) {
   t.warped.bgr.setTo(cv::Scalar::all(0));
   PaintBuffer(t.buffer, t.warped, masked, options, &t.painted, masked);
   EXPECT_EQ(t.Stored(), 129);
-  t.warped.quality.setTo(1.0f);
-  PaintBuffer(t.buffer, t.warped, cv::Mat(), options, &t.painted, masked);  // provisional
-  EXPECT_EQ(t.Stored(), 92);                                                // (322.5 + 0) / 3.5
-  EXPECT_GT(t.painted.quality.at<float>(0, 1), 0.0f);  // nothing marked provisional
   InitPaintedBuffer(t.buffer, &t.painted);
   t.Paint(10, options);
   EXPECT_EQ(t.Stored(), 10);
+}
+
+// While the background model learns a texel its samples are provisional (they may show a
+// mover): in the mean they count among themselves until the texel's first trusted sample,
+// which replaces them; after it, a provisional sample counts as nothing.
+TEST(PaintUpdate, MeanKeepsProvisionalSamplesOnlyUntilATrustedOne) {
+  PipelineOptions options;
+  options.update = UpdatePolicy::kMean;
+  TwoTexels t;
+  const cv::Mat warming(1, 2, CV_8U, cv::Scalar(255));
+  const auto paint = [&](int grey, bool provisional) {
+    t.warped.bgr = cv::Mat(1, 2, CV_8UC3, cv::Scalar::all(grey));
+    PaintBuffer(t.buffer, t.warped, cv::Mat(), options, &t.painted,
+                provisional ? warming : cv::Mat());
+  };
+  paint(0, true);  // a mover passing while the model learns
+  EXPECT_EQ(t.Stored(), 0);
+  paint(40, true);
+  EXPECT_EQ(t.Stored(), 20);  // provisional ones average among themselves
+  paint(200, false);
+  EXPECT_EQ(t.Stored(), 200);  // the first trusted one replaces them
+  paint(100, false);
+  EXPECT_EQ(t.Stored(), 150);
+  paint(0, true);
+  EXPECT_EQ(t.Stored(), 150);  // after it, a provisional one counts as nothing
+  EXPECT_FLOAT_EQ(t.painted.mean_sum.at<cv::Vec4f>(0, 1)[3], 2.0f);
 }
 
 // `update: auto` while deciding: the texels as `quality` paints them, the sums as `mean`
