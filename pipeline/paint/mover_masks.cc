@@ -232,18 +232,23 @@ std::vector<SmallFrame> SmallFrames(const TriangleMesh& mesh,
                                     const std::vector<MoverMaskFrame>& given,
                                     const MoverMaskOptions& options,
                                     std::map<const Camera*, SmallCamera>* small) {
-  std::vector<SmallFrame> frames(given.size());
-  for (size_t f = 0; f < given.size(); ++f) {
-    const MoverMaskFrame& in = given[f];
-    if (!in.camera || in.bgr.empty() || in.bgr.type() != CV_8UC3) continue;
+  const auto usable = [](const MoverMaskFrame& in) {
+    return in.camera && !in.bgr.empty() && in.bgr.type() == CV_8UC3;
+  };
+  for (const MoverMaskFrame& in : given) {
+    if (!usable(in)) continue;
     SmallCamera& s = (*small)[in.camera];
-    if (!s.camera) {
-      const cv::Size size = MoverMaskSize(*in.camera, options);
-      s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
-      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
-    }
-    MakeSmallFrame(mesh, in, s, &frames[f]);
+    if (s.camera) continue;
+    const cv::Size size = MoverMaskSize(*in.camera, options);
+    s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
+    s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
   }
+  // Frames at once (a frame's rasterizing is mostly on one core).
+  std::vector<SmallFrame> frames(given.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(given.size())), [&](const cv::Range& range) {
+    for (int f = range.start; f < range.end; ++f)
+      if (usable(given[f])) MakeSmallFrame(mesh, given[f], small->at(given[f].camera), &frames[f]);
+  });
   return frames;
 }
 
