@@ -173,6 +173,10 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                               {"not_run", a.not_run},
                               {"matches", a.matches},
                               {"inliers", a.inliers},
+                              {"check_matches", a.check_matches},
+                              {"check_before_px", a.check_before_px},
+                              {"check_after_px", a.check_after_px},
+                              {"check_seconds", a.check_seconds},
                               {"rms_before_px", a.rms_before_px},
                               {"rms_after_px", a.rms_after_px},
                               {"median_rotation_deg", a.median_rotation_deg},
@@ -339,14 +343,14 @@ void PrintJobSummary(const PaintJob& job, size_t streams) {
   } else if (job.joint_poses) {
     const PoseAdjustResult& a = *job.joint_poses;
     std::fprintf(stderr,
-                 "fresco run: poses adjusted together (%d tracks, %.1f s): %s, RMS %.3f -> "
-                 "%.3f px, median correction %.3f deg, %.1f mm\n",
-                 a.inliers, a.seconds,
-                 a.applied ? "applied"
-                           : "not applied (the given poses "
-                             "explain the tracks nearly as well)",
-                 a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
-                 1000 * a.median_translation_m);
+                 "fresco run: poses adjusted together: the frames left out agree %.3f -> %.3f px "
+                 "(%d tracks, %.1f s): %s",
+                 a.check_before_px, a.check_after_px, a.check_matches, a.check_seconds,
+                 a.applied ? "applied" : "not applied (no better by the check)\n");
+    if (a.applied)
+      std::fprintf(stderr, "; %d tracks, RMS %.3f -> %.3f px, median correction %.3f deg, %.1f mm (%.1f s)\n",
+                   a.inliers, a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
+                   1000 * a.median_translation_m, a.seconds);
   }
   if (job.mover_masks && !job.mover_masks->not_run.empty())
     std::fprintf(stderr, "fresco run: background decided frame by frame: %s\n",

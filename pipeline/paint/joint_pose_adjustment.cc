@@ -1,6 +1,7 @@
 #include "pipeline/paint/joint_pose_adjustment.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -306,15 +307,26 @@ void MatchPair(const View& a, const View& b, const cv::Mat& surface_i, const Rig
   }
 }
 
+// Deterministic order whatever the threads did.
+void SortMatches(std::vector<Match>* matches) {
+  std::sort(matches->begin(), matches->end(), [](const Match& x, const Match& y) {
+    if (x.i != y.i) return x.i < y.i;
+    if (x.j != y.j) return x.j < y.j;
+    if (x.ray.x() != y.ray.x()) return x.ray.x() < y.ray.x();
+    return x.ray.y() < y.ray.y();
+  });
+}
+
 // Matches: frame j is reprojected into frame i's view through the mesh at the given poses
 // (so that what both see looks alike there, but for the pose errors), frame i's corners are
 // tracked into it, and a track's end is carried back to frame j's pixel through the mesh.
 // Kept when the track comes back and the point is visible in frame j.
+// Frame i is matched to i + each of `offsets` (increasing); `rays`: RayTables(frames).
 std::vector<Match> FindMatches(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& frames,
                                const std::vector<FrameData>& data,
-                               const PoseAdjustOptions& options) {
+                               const std::map<const Camera*, cv::Mat>& rays,
+                               const std::vector<int>& offsets, const PoseAdjustOptions& options) {
   const int n = static_cast<int>(frames.size());
-  const std::map<const Camera*, cv::Mat> rays = RayTables(frames);
   std::vector<Match> matches;
   std::mutex matches_mutex;
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
@@ -325,7 +337,7 @@ std::vector<Match> FindMatches(const TriangleMesh& mesh, const std::vector<PoseA
       const Rigid3d local_from_i = frames[i].cam_from_local.Inverse();
       const cv::Mat surface =
           SurfacePoints(mesh, frames[i].cam_from_local, a.triangle, rays.at(frames[i].camera));
-      for (int offset : options.offsets) {
+      for (int offset : offsets) {
         const int j = i + offset;
         if (j >= n) break;
         if (data[j].grey.empty()) continue;
@@ -336,14 +348,33 @@ std::vector<Match> FindMatches(const TriangleMesh& mesh, const std::vector<PoseA
     std::lock_guard<std::mutex> lock(matches_mutex);
     matches.insert(matches.end(), local.begin(), local.end());
   });
-  // Deterministic order whatever the threads did.
-  std::sort(matches.begin(), matches.end(), [](const Match& x, const Match& y) {
-    if (x.i != y.i) return x.i < y.i;
-    if (x.j != y.j) return x.j < y.j;
-    if (x.ray.x() != y.ray.x()) return x.ray.x() < y.ray.x();
-    return x.ray.y() < y.ray.y();
-  });
+  SortMatches(&matches);
   return matches;
+}
+
+// Each match's residual (pixels; 1e9 where it cannot be predicted) at the corrections `x`.
+void Residuals(const std::vector<PoseAdjustFrame>& frames, const std::vector<Match>& matches,
+               const std::vector<Vec6>& x, std::vector<double>* residual) {
+  std::vector<Rigid3d> poses(frames.size());
+  for (size_t f = 0; f < frames.size(); ++f) poses[f] = Corrected(x[f], frames[f].cam_from_local);
+  residual->resize(matches.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(matches.size())), [&](const cv::Range& r) {
+    for (int k = r.start; k < r.end; ++k) {
+      const Match& m = matches[k];
+      Eigen::Vector2d p;
+      (*residual)[k] = Predict(m, *frames[m.j].camera, poses[m.i], poses[m.j], &p)
+                           ? (p - m.pixel_j).norm()
+                           : 1e9;
+    }
+  });
+}
+
+// Where a track counts as wrong at the start: residuals beyond max(3 px, 4 x their median).
+double WrongTrackLimit(const std::vector<double>& residual) {
+  std::vector<double> finite;
+  for (double r : residual)
+    if (r < 1e8) finite.push_back(r);
+  return std::max(3.0, 4.0 * Median(finite));
 }
 
 // Gauss-Newton over all corrections (6 per frame), Huber-weighted, with the prior.
@@ -381,19 +412,7 @@ class CorrectionSolver {
   }
 
   // Each match's residual (pixels; 1e9 where it cannot be predicted) at the corrections.
-  void UpdateResiduals() {
-    std::vector<Rigid3d> poses(n_);
-    for (int f = 0; f < n_; ++f) poses[f] = Corrected(x_[f], frames_[f].cam_from_local);
-    cv::parallel_for_(cv::Range(0, static_cast<int>(matches_.size())), [&](const cv::Range& r) {
-      for (int k = r.start; k < r.end; ++k) {
-        const Match& m = matches_[k];
-        Eigen::Vector2d p;
-        residual_[k] = Predict(m, *frames_[m.j].camera, poses[m.i], poses[m.j], &p)
-                           ? (p - m.pixel_j).norm()
-                           : 1e9;
-      }
-    });
-  }
+  void UpdateResiduals() { Residuals(frames_, matches_, x_, &residual_); }
 
   // Whether match k counts as an inlier at the last residuals.
   bool Inlier(size_t k) const { return use_[k] && residual_[k] < 3 * options_.huber_px; }
@@ -417,10 +436,7 @@ class CorrectionSolver {
   // Matches far off at the start (wrong tracks, movers) stay out.
   void KeepStartingInliers() {
     use_.assign(matches_.size(), 0);
-    std::vector<double> finite;
-    for (double r : residual_)
-      if (r < 1e8) finite.push_back(r);
-    const double limit = std::max(3.0, 4.0 * Median(finite));
+    const double limit = WrongTrackLimit(residual_);
     for (size_t k = 0; k < matches_.size(); ++k) use_[k] = residual_[k] < limit;
   }
 
@@ -558,16 +574,14 @@ class CorrectionSolver {
 // The result's figures from the solve: inliers, whether the corrections are applied, the
 // corrected poses and the corrections' medians.
 void Summarise(const std::vector<PoseAdjustFrame>& frames, const std::vector<Match>& matches,
-               const CorrectionSolver& solver, const PoseAdjustOptions& options,
-               PoseAdjustResult* result) {
+               const CorrectionSolver& solver, PoseAdjustResult* result) {
   for (size_t k = 0; k < matches.size(); ++k)
     if (solver.Inlier(k)) {
       ++result->inliers;
       ++result->frame_matches[matches[k].i];
       ++result->frame_matches[matches[k].j];
     }
-  result->applied = result->rms_after_px > 0 &&
-                    result->rms_before_px >= options.min_improvement * result->rms_after_px;
+  result->applied = true;
   const std::vector<Vec6>& x = solver.corrections();
   std::vector<double> rotations, translations;
   for (size_t f = 0; f < frames.size(); ++f) {
@@ -579,6 +593,69 @@ void Summarise(const std::vector<PoseAdjustFrame>& frames, const std::vector<Mat
   result->translation_prior_m = solver.translation_sigma();
   result->median_rotation_deg = Median(rotations);
   result->median_translation_m = Median(translations);
+}
+
+// The frames as tracked (TrackedFrames), each prepared (PrepareFrame).
+struct Prepared {
+  std::map<const Camera*, std::unique_ptr<Camera>> scaled_cameras;
+  std::vector<PoseAdjustFrame> frames;
+  std::vector<FrameData> data;
+  std::map<const Camera*, cv::Mat> rays;  // RayTables(frames)
+};
+
+void Prepare(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& given,
+             const PoseAdjustOptions& options, Prepared* prepared) {
+  const int n = static_cast<int>(given.size());
+  prepared->frames = TrackedFrames(given, options.max_side_px, &prepared->scaled_cameras);
+  std::map<const Camera*, std::unique_ptr<Rasterizer>> rasterizers;
+  for (const PoseAdjustFrame& frame : prepared->frames) {
+    auto& rasterizer = rasterizers[frame.camera];
+    if (!rasterizer) rasterizer = std::make_unique<Rasterizer>(*frame.camera, RasterOptions());
+  }
+  prepared->data.resize(n);
+  // Frames at once (a frame's rasterizing and corner finding are mostly on one core).
+  std::atomic<int> done{0};
+  std::mutex progress_mutex;
+  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+    for (int f = range.start; f < range.end; ++f) {
+      const PoseAdjustFrame& frame = prepared->frames[f];
+      PrepareFrame(mesh, frame, *rasterizers.at(frame.camera), options, &prepared->data[f]);
+      const int count = ++done;
+      if (options.progress && (count % std::max(1, n / 4) == 0 || count == n)) {
+        std::lock_guard<std::mutex> lock(progress_mutex);
+        options.progress(count, 2 * n + options.iterations, "frames prepared");
+      }
+    }
+  });
+  prepared->rays = RayTables(prepared->frames);
+}
+
+// PoseAdjustOptions' check from `tracks` (over check_offsets): the even and the odd frames each
+// adjusted from the tracks between their own frames only, the tracks between the halves
+// measured at the given poses and at those corrections (the RMS of each residual capped at
+// WrongTrackLimit at the given poses, over the tracks within it at either).
+void CheckOnFramesLeftOut(const std::vector<PoseAdjustFrame>& frames,
+                          const std::vector<Match>& tracks, const PoseAdjustOptions& options,
+                          PoseAdjustResult* result) {
+  std::vector<Match> within, between;
+  for (const Match& m : tracks) ((m.j - m.i) % 2 == 0 ? within : between).push_back(m);
+  if (within.empty() || between.empty()) return;
+  CorrectionSolver halves(frames, within, options);
+  halves.Run();
+  std::vector<double> before, after;
+  Residuals(frames, between, std::vector<Vec6>(frames.size(), Vec6::Zero()), &before);
+  Residuals(frames, between, halves.corrections(), &after);
+  const double limit = WrongTrackLimit(before);
+  double sum_before = 0, sum_after = 0;
+  for (size_t k = 0; k < between.size(); ++k) {
+    if (before[k] >= limit && after[k] >= limit) continue;
+    sum_before += std::pow(std::min(before[k], limit), 2);
+    sum_after += std::pow(std::min(after[k], limit), 2);
+    ++result->check_matches;
+  }
+  if (result->check_matches == 0) return;
+  result->check_before_px = std::sqrt(sum_before / result->check_matches);
+  result->check_after_px = std::sqrt(sum_after / result->check_matches);
 }
 
 }  // namespace
@@ -602,36 +679,52 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   }
   result->not_run = TooManyFramesToAdjust(n, options);
   if (!result->not_run.empty()) return Status::Ok();
-
-  std::map<const Camera*, std::unique_ptr<Camera>> scaled_cameras;
-  const std::vector<PoseAdjustFrame> frames =
-      TrackedFrames(given, options.max_side_px, &scaled_cameras);
-
-  std::map<const Camera*, std::unique_ptr<Rasterizer>> rasterizers;
-  std::vector<FrameData> data(n);
-  for (int f = 0; f < n; ++f) {
-    auto& rasterizer = rasterizers[frames[f].camera];
-    if (!rasterizer) rasterizer = std::make_unique<Rasterizer>(*frames[f].camera, RasterOptions());
-    if (!PrepareFrame(mesh, frames[f], *rasterizer, options, &data[f])) continue;
-    if (options.progress && ((f + 1) % std::max(1, n / 4) == 0 || f + 1 == n))
-      options.progress(f + 1, 2 * n + options.iterations, "frames prepared");
+  const auto seconds = [&start] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  Prepared prepared;
+  Prepare(mesh, given, options, &prepared);
+  // The check's tracks first (over check_offsets), then the others'.
+  const bool check = options.check_min_improvement > 0;
+  std::vector<int> first, rest;
+  for (int offset : options.offsets)
+    (check && std::count(options.check_offsets.begin(), options.check_offsets.end(), offset)
+         ? first
+         : rest)
+        .push_back(offset);
+  std::vector<Match> matches =
+      FindMatches(mesh, prepared.frames, prepared.data, prepared.rays, first, options);
+  if (check) {
+    CheckOnFramesLeftOut(prepared.frames, matches, options, result);
+    result->check_seconds = seconds();
+    const bool passed = result->check_after_px > 0 &&
+                        result->check_before_px >= options.check_min_improvement *
+                                                       result->check_after_px;
+    if (!passed) {
+      if (options.progress) options.progress(1, 1, "checked: not adjusted");
+      result->seconds = seconds();
+      return Status::Ok();
+    }
   }
-
-  const std::vector<Match> matches = FindMatches(mesh, frames, data, options);
+  const std::vector<Match> more =
+      FindMatches(mesh, prepared.frames, prepared.data, prepared.rays, rest, options);
+  matches.insert(matches.end(), more.begin(), more.end());
+  SortMatches(&matches);
+  prepared.data.clear();
   result->matches = static_cast<int>(matches.size());
   if (options.progress)
     options.progress(2 * n, 2 * n + options.iterations, std::to_string(matches.size()) + " tracks");
   if (matches.empty()) return Status::Ok();
 
-  CorrectionSolver solver(frames, matches, options);
+  CorrectionSolver solver(prepared.frames, matches, options);
   result->rms_before_px = solver.Rms();
   solver.Run();
   solver.UpdateResiduals();
   result->rms_after_px = solver.Rms();
   if (options.progress)
     options.progress(2 * n + options.iterations, 2 * n + options.iterations, "adjusted");
-  Summarise(frames, matches, solver, options, result);
-  result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  Summarise(prepared.frames, matches, solver, result);
+  result->seconds = seconds();
   return Status::Ok();
 }
 

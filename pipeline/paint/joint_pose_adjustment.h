@@ -43,7 +43,7 @@ struct PoseAdjustOptions {
   int window_px = 15;                // tracking window (pixels, square)
   // Frames whose longer side exceeds this are tracked at half (a quarter, ...) resolution;
   // pixel figures below are then at that resolution. 0: always at full resolution.
-  int max_side_px = 720;
+  int max_side_px = 400;
   // The given poses' assumed error: a prior on each correction. Weaker priors let the image
   // noise move what the matches hardly see (a camera's sideways step against its turn).
   double rotation_prior_deg = 0.5;
@@ -60,11 +60,19 @@ struct PoseAdjustOptions {
   // spread at the time (0: all matches weigh the same).
   int weigh_gaps_after = 2;
   bool translation = true;  // false: rotations only
-  // The corrections are applied only when they explain the matches this many times better
-  // than the given poses (RMS before / after): at exact poses the ratio is about 1 (0.6-1.4
-  // on the evaluation suites' clean captures, where the matches' own errors would otherwise
-  // move the poses), with 0.5 degree of noise 2.5-11.
-  double min_improvement = 2.2;
+  // The check that decides whether the corrections are applied, made first: the tracks over
+  // check_offsets (those of `offsets` in it) are split into those between frames of one parity
+  // (even offsets) and those between the even and the odd frames (odd offsets); the even and the
+  // odd frames are adjusted each from the tracks between their own frames only, and the tracks
+  // between the two halves, left out of both estimates, measured at the given poses and at those
+  // corrections. Only when they agree check_min_improvement times better (RMS) are the other
+  // tracks made and all poses adjusted together from every track, the corrections applied; else
+  // the given poses stand and nothing more is done. Corrections fitted to the tracks' own errors
+  // (exact poses) make the frames left out agree worse, whatever they do to the tracks they were
+  // fitted to: at exact poses the ratio is below 1, with 0.3-0.5 degree or 2-5 cm of noise
+  // 2-10 (docs/results.md). 0: no check, the corrections are always applied.
+  std::vector<int> check_offsets = {1, 2, 4};
+  double check_min_improvement = 1.1;
   // Captures with more frames are not adjusted (not_run says so): every frame is held in
   // memory, with its depth and triangle maps (a few MB a frame).
   int max_frames = 500;
@@ -73,11 +81,18 @@ struct PoseAdjustOptions {
 };
 
 struct PoseAdjustResult {
-  bool applied = false;                 // false: the given poses stand (min_improvement)
+  bool applied = false;                 // false: the given poses stand (the check)
   std::string not_run;                  // why nothing was tried ("" when it ran)
   std::vector<Rigid3d> cam_from_local;  // corrected (or given), one per frame
   std::vector<int> frame_matches;       // matches each frame takes part in
   int matches = 0, inliers = 0;
+  // The check (PoseAdjustOptions::check_*): the tracks between the halves, their RMS at the
+  // given poses and at the halves' corrections (pixels at the check's size, each residual
+  // capped where a track counts as wrong), and what it took.
+  int check_matches = 0;
+  double check_before_px = 0, check_after_px = 0;
+  double check_seconds = 0;
+  // The adjustment (when the check passes): its tracks' RMS at the given and corrected poses.
   double rms_before_px = 0, rms_after_px = 0;                // over the inliers
   double median_rotation_deg = 0, median_translation_m = 0;  // corrections found
   double rotation_prior_deg = 0, translation_prior_m = 0;    // the priors of the last round

@@ -26,6 +26,7 @@ struct SmallFrame {
   cv::Mat depth;           // CV_32F camera z, +inf off the surface
   cv::Mat points;          // CV_32FC3 local
   cv::Mat surface;         // CV_8U, 255 where `points` has one (the pixel shows the mesh)
+  std::vector<int> surface_pixels;  // their indices (y * cols + x), in order
   const Camera* camera = nullptr;
   Rigid3d cam_from_local;
 };
@@ -56,47 +57,79 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
     (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
 }
 
+// What frame `self`'s comparison with one frame near it found, per pixel of its surface
+// (SmallFrame::surface_pixels): the other frame's pixel index times 2, plus 1 where the colours
+// differ; -1 where the other frame does not see the point. The passes all judge from the same
+// comparisons (only the other frames' masks change): the first pass makes them, the later
+// ones read them (4 bytes a surface pixel and comparison: 3 MB a frame at most at 320 x 240).
+struct Comparison {
+  int other = 0;
+  std::vector<int> seen;
+};
+
+Comparison Compare(const SmallFrame& self, int other_index, const SmallFrame& other,
+                   const MoverMaskOptions& options) {
+  std::vector<int> where;
+  std::array<float, 3> gain;
+  Correspond(self, other, options.depth_tolerance, &where, &gain);
+  Comparison comparison;
+  comparison.other = other_index;
+  comparison.seen.resize(self.surface_pixels.size());
+  const float limit = static_cast<float>(options.difference);
+  const cv::Vec3b* self_bgr = self.bgr.ptr<cv::Vec3b>();
+  const cv::Vec3b* low = other.low.ptr<cv::Vec3b>();
+  const cv::Vec3b* high = other.high.ptr<cv::Vec3b>();
+  for (size_t s = 0; s < self.surface_pixels.size(); ++s) {
+    const int p = self.surface_pixels[s], k = where[p];
+    if (k < 0) {
+      comparison.seen[s] = -1;
+      continue;
+    }
+    const cv::Vec3b a = self_bgr[p], lo = low[k], hi = high[k];
+    float worst = 0;
+    for (int c = 0; c < 3; ++c) {
+      const float value = a[c], below = gain[c] * lo[c] - value, above = value - gain[c] * hi[c];
+      worst = std::max(worst, std::max(below, above));
+    }
+    comparison.seen[s] = 2 * k + (worst > limit ? 1 : 0);
+  }
+  return comparison;
+}
+
 // Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
-// whose masked pixels do not judge. `joinable`: the surface pixels that may join a mover by
+// whose masked pixels do not judge. `comparisons`: its comparisons with the frames near it
+// (made here when empty). `joinable`: the surface pixels that may join a mover by
 // their colour (those that differ from a frame that sees them, or are seen by too few);
 // `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed);
 // `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h).
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
-                   long long* judged, long long* flagged, cv::Mat* joinable, cv::Mat* agreed,
-                   cv::Mat* ringed_regions) {
+                   std::vector<Comparison>* comparisons, long long* judged, long long* flagged,
+                   cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
+  if (comparisons->empty())
+    for (int offset : options.offsets)
+      for (int sign : {-1, 1}) {
+        const int o = self_index + sign * offset;
+        if (o < 0 || o >= n || frames[o].points.empty()) continue;
+        comparisons->push_back(Compare(self, o, frames[o], options));
+      }
   cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
       differing(self.bgr.size(), CV_8U, cv::Scalar(0));
-  std::vector<int> where;
-  for (int offset : options.offsets)
-    for (int sign : {-1, 1}) {
-      const int o = self_index + sign * offset;
-      if (o < 0 || o >= n || frames[o].points.empty()) continue;
-      const SmallFrame& other = frames[o];
-      std::array<float, 3> gain;
-      Correspond(self, other, options.depth_tolerance, &where, &gain);
-      const uchar* other_masked =
-          previous && !(*previous)[o].empty() ? (*previous)[o].data : nullptr;
-      const float limit = static_cast<float>(options.difference);
-      for (int y = 0; y < self.bgr.rows; ++y)
-        for (int x = 0; x < self.bgr.cols; ++x) {
-          const int k = where[y * self.bgr.cols + x];
-          if (k < 0 || (other_masked && other_masked[k])) continue;
-          ++seeing.at<uchar>(y, x);
-          const cv::Vec3b a = self.bgr.at<cv::Vec3b>(y, x);
-          const cv::Vec3b lo = other.low.at<cv::Vec3b>(k / other.low.cols, k % other.low.cols);
-          const cv::Vec3b hi = other.high.at<cv::Vec3b>(k / other.high.cols, k % other.high.cols);
-          float worst = 0;
-          for (int c = 0; c < 3; ++c) {
-            const float value = a[c], below = gain[c] * lo[c] - value,
-                        above = value - gain[c] * hi[c];
-            worst = std::max(worst, std::max(below, above));
-          }
-          if (worst > limit) ++differing.at<uchar>(y, x);
-        }
+  uchar* seeing_data = seeing.data;
+  uchar* differing_data = differing.data;
+  for (const Comparison& comparison : *comparisons) {
+    const int o = comparison.other;
+    const uchar* other_masked = previous && !(*previous)[o].empty() ? (*previous)[o].data : nullptr;
+    for (size_t s = 0; s < self.surface_pixels.size(); ++s) {
+      const int seen = comparison.seen[s];
+      if (seen < 0 || (other_masked && other_masked[seen >> 1])) continue;
+      const int p = self.surface_pixels[s];
+      ++seeing_data[p];
+      if (seen & 1) ++differing_data[p];
     }
+  }
   cv::Mat mask(self.bgr.size(), CV_8U, cv::Scalar(0));
   long long seen_pixels = 0;
   for (int y = 0; y < mask.rows; ++y)
@@ -168,7 +201,7 @@ void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const Sm
   d->cam_from_local = in.cam_from_local;
   const cv::Size size(s.camera->width, s.camera->height);
   if (in.bgr.size() == size)
-    d->bgr = in.bgr;
+    d->bgr = in.bgr.isContinuous() ? in.bgr : in.bgr.clone();
   else
     cv::resize(in.bgr, d->bgr, size, 0, 0, cv::INTER_AREA);
   const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
@@ -189,6 +222,7 @@ void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const Sm
       const Eigen::Vector3d p = local_from_cam * Eigen::Vector3d(ray.x() * z, ray.y() * z, z);
       d->points.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
       d->surface.at<uchar>(y, x) = 255;
+      d->surface_pixels.push_back(y * d->depth.cols + x);
     }
 }
 
@@ -198,18 +232,23 @@ std::vector<SmallFrame> SmallFrames(const TriangleMesh& mesh,
                                     const std::vector<MoverMaskFrame>& given,
                                     const MoverMaskOptions& options,
                                     std::map<const Camera*, SmallCamera>* small) {
-  std::vector<SmallFrame> frames(given.size());
-  for (size_t f = 0; f < given.size(); ++f) {
-    const MoverMaskFrame& in = given[f];
-    if (!in.camera || in.bgr.empty() || in.bgr.type() != CV_8UC3) continue;
+  const auto usable = [](const MoverMaskFrame& in) {
+    return in.camera && !in.bgr.empty() && in.bgr.type() == CV_8UC3;
+  };
+  for (const MoverMaskFrame& in : given) {
+    if (!usable(in)) continue;
     SmallCamera& s = (*small)[in.camera];
-    if (!s.camera) {
-      const cv::Size size = MoverMaskSize(*in.camera, options);
-      s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
-      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
-    }
-    MakeSmallFrame(mesh, in, s, &frames[f]);
+    if (s.camera) continue;
+    const cv::Size size = MoverMaskSize(*in.camera, options);
+    s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
+    s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
   }
+  // Frames at once (a frame's rasterizing is mostly on one core).
+  std::vector<SmallFrame> frames(given.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(given.size())), [&](const cv::Range& range) {
+    for (int f = range.start; f < range.end; ++f)
+      if (usable(given[f])) MakeSmallFrame(mesh, given[f], small->at(given[f].camera), &frames[f]);
+  });
   return frames;
 }
 
@@ -227,9 +266,11 @@ void ReportPass(const MoverMaskOptions& options, const MoverMaskResult& result, 
   options.progress(done, passes, line);
 }
 
-// The masks, joinable pixels and ringed regions the frames' judging gives.
+// The joinable pixels and ringed regions the frames' judging gives, and each frame's
+// comparisons with the frames near it (kept for the later passes).
 struct Judged {
   std::vector<cv::Mat> joinable, ringed;
+  std::vector<std::vector<Comparison>> comparisons;
 };
 
 // A later pass judges a frame again only where a frame it is compared with had its mask
@@ -249,7 +290,8 @@ std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
         for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
       if (!any) continue;
       long long unused = 0;
-      result->masks[f] = JudgeFrame(frames, f, options, &previous, &unused, &unused,
+      result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f],
+                                    &unused, &unused,
                                     &judged->joinable[f], &result->agreed[f], &judged->ringed[f]);
       now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
     }
@@ -322,12 +364,17 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   Judged judging;
   judging.joinable.resize(n);
   judging.ringed.resize(n);
+  judging.comparisons.resize(n);
   result->agreed.resize(n);
+  const bool keep_comparisons = options.passes > 1;
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
-    for (int f = range.start; f < range.end; ++f)
-      if (!frames[f].points.empty())
-        result->masks[f] = JudgeFrame(frames, f, options, nullptr, &judged[f], &flagged[f],
-                                      &judging.joinable[f], &result->agreed[f], &judging.ringed[f]);
+    for (int f = range.start; f < range.end; ++f) {
+      if (frames[f].points.empty()) continue;
+      result->masks[f] =
+          JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f], &flagged[f],
+                     &judging.joinable[f], &result->agreed[f], &judging.ringed[f]);
+      if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
+    }
   });
   for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask

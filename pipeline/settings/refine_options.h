@@ -44,8 +44,8 @@ struct RefineOptions {
   // buffer's correction from it (refine_pose.h), instead of one homography per buffer.
   bool pose = true;
   // Before painting, correct all the given poses together against the mesh (captures read
-  // from files only; joint_pose_adjustment.h). Its own evidence decides whether the
-  // corrections are used (PoseAdjustOptions::min_improvement), as `auto` does elsewhere.
+  // from files only; joint_pose_adjustment.h). A check on frames left out of the estimate
+  // decides whether the corrections are used (PoseAdjustOptions::check_min_improvement).
   bool joint = true;
   int anchor_min_frames = 3;
   int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
@@ -118,8 +118,10 @@ void Fields(RefineOptions& o, V& v) {
                    "adjustment of every pose (`fresco run`, `bench`, `rephoto` and `eval` on "
                    "captures from files; live captures and the app's frame-by-frame painting "
                    "ignore it); "
-                   "the corrections are used only when they explain the tracks over twice as "
-                   "well as the given poses (exact poses stay as given); on by default"});
+                   "first a check: the even and the odd frames are adjusted apart, and only when "
+                   "the tracks between them, which neither saw, agree 1.1 times better at the "
+                   "corrected poses are the poses adjusted and the corrections used (exact "
+                   "poses stay as given, and cost the check only); on by default"});
   v.Field("anchor_min_frames", o.anchor_min_frames,
           {.min = 2, .help = "frames that must agree before a buffer is moved"});
   v.Field("anchor_window_frames", o.anchor_window_frames,
