@@ -147,10 +147,9 @@ class PaintSession {
   // shorter capture (the job's frame loop calls DecideUpdate there), the model painted each
   // way without the held-out frames is rendered at their poses and compared with them (PSNR
   // over the pixels every way paints, less the movers found across views); the way that
-  // agrees better paints on, from what every frame painted. The mean is a candidate only
-  // without the background model (where `auto` turned the model on, the mean without it: it
-  // turns the model off), and neither with refinement on (it registers frames to the
-  // sharpest views) nor view selection. No frame compared: `quality`.
+  // agrees better paints on, from what every frame painted. With the background model on by
+  // hand, refinement on (it registers frames to the sharpest views) or view selection:
+  // `quality`, as without frames compared.
   static constexpr int kUpdateHoldOutEvery = 4;
   static constexpr int kUpdateHeldOutFrames = 6;
   bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }

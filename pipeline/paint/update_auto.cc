@@ -79,46 +79,52 @@ void PaintSession::DecideUpdate() {
   if (!DecidingUpdate()) return;
   // Refinement `auto` came on (as StartAutoModes with refinement on).
   if (options_.refine.mode != RefineMode::kOff) return KeepSharpestViews("refinement_on");
-  // The mean of every view is for a static scene: where the background model is on, it would
-  // take in whatever the model lets through and keep what stood still for a while (a parked
-  // car). So the other candidate is the mean without the model: where the model is on
-  // because background `auto` turned it on, that mean (winning turns the model off); where
-  // it is off, the mean.
+  // The candidates, without the frames held out: the sharpest view, the mean of every view
+  // and, where background `auto` turned the model on, that mean without the model (winning
+  // turns it off). A model on by hand stays as the paper paints with it: the sharpest view.
   const bool model_on = options_.background.mode != BackgroundMode::kOff;
   const bool without_model = model_on && requested_background_ == BackgroundMode::kAuto;
   if (model_on && !without_model) return KeepSharpestViews("background_model_on");
+  const size_t n = without_model ? 3 : 2;
   std::vector<Scene> scenes;
-  for (int c = 0; c < 2; ++c) {
+  for (size_t c = 0; c < n; ++c) {
     std::vector<cv::Mat> texels;
     for (const PaintedBuffer& p : painted_) {
       const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
-      texels.push_back(AtMeanExposure(
-          c == 0 ? base
-                 : without_model ? MeanTexels(base, p.unmasked_sum, p.held_unmasked_sum)
-                                 : MeanTexels(base, p.mean_sum, p.held_sum)));
+      texels.push_back(AtMeanExposure(c == 0   ? base
+                                      : c == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
+                                               : MeanTexels(base, p.unmasked_sum,
+                                                            p.held_unmasked_sum)));
     }
     scenes.push_back(PaintedScene(texels));
   }
-  std::vector<double> psnr_sum(2, 0.0), psnr;
+  std::vector<double> psnr_sum(n, 0.0), psnr;
   int measured = 0;
   for (const HeldOutFrame& frame : update_held_out_) {
     const Renderer renderer(frame.camera, RenderOptions());
-    std::vector<RenderOutput> rendered(2);
-    for (int c = 0; c < 2; ++c) renderer.Render(scenes[c], frame.cam_from_world, &rendered[c]);
+    std::vector<RenderOutput> rendered(n);
+    for (size_t c = 0; c < n; ++c)
+      renderer.Render(scenes[c], frame.cam_from_world, &rendered[c]);
     if (!ComparedPsnr(rendered, frame.bgr, frame.movers, &psnr)) continue;
-    for (int c = 0; c < 2; ++c) psnr_sum[c] += psnr[c];
+    for (size_t c = 0; c < n; ++c) psnr_sum[c] += psnr[c];
     ++measured;
   }
   update_held_out_.clear();
-  const bool mean = measured > 0 && psnr_sum[1] > psnr_sum[0];
+  size_t best = 0;
+  for (size_t c = 1; c < n && measured > 0; ++c)
+    if (psnr_sum[c] > psnr_sum[best]) best = c;
   update_auto_.frames_measured = measured;
   update_auto_.decided_at_frame = frames_seen_;
-  update_auto_.evidence = measured > 0 ? (psnr_sum[1] - psnr_sum[0]) / measured
-                                       : std::numeric_limits<double>::quiet_NaN();
+  update_auto_.evidence =
+      measured > 0
+          ? (*std::max_element(psnr_sum.begin() + 1, psnr_sum.end()) - psnr_sum[0]) / measured
+          : std::numeric_limits<double>::quiet_NaN();
+  const bool mean = best > 0;
   update_auto_.state = mean ? AutoDecision::State::kOn : AutoDecision::State::kOff;
   options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
-  if (mean && without_model) {  // the model off from now on, its sums the mean's
-    background_auto_.OffByFramesHeldOut(frames_seen_, update_auto_.evidence, measured);
+  if (best == 2) {  // the model off from now on, its sums the mean's
+    background_auto_.OffByFramesHeldOut(frames_seen_, (psnr_sum[2] - psnr_sum[1]) / measured,
+                                        measured);
     options_.background.mode = BackgroundMode::kOff;
     background_.clear();
     background_frame_.clear();
@@ -126,7 +132,7 @@ void PaintSession::DecideUpdate() {
   // What every frame painted, the chosen way.
   for (PaintedBuffer& p : painted_) {
     if (mean) {
-      if (without_model) p.mean_sum = p.unmasked_sum;
+      if (best == 2) p.mean_sum = p.unmasked_sum;
       p.bgra = MeanTexels(p.bgra, p.mean_sum);
       cv::absdiff(p.quality, 0, p.quality);  // none provisional: every view counts
     } else {

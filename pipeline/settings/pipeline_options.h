@@ -86,11 +86,11 @@ void Fields(PipelineOptions& o, V& v) {
          "static scene that disagree in light, noise and by a few pixels; 16 more bytes per "
          "texel) or `auto`: the first 24 frames are painted both ways, and also both ways "
          "without frames 2, 6, ..., 22; the model painted each way without them is rendered at "
-         "their poses, and the way that agrees better with them paints on. The mean is for a "
-         "static scene: where `background.mode` `auto` turned the model on, the mean is "
-         "painted without it (winning turns the model off); with the model on by hand, "
-         "refinement on or view selection, `auto` keeps `quality`. The choice and its "
-         "evidence (dB gained) are in metrics.json under `auto.update`");
+         "their poses, and the way that agrees better with them paints on (where "
+         "`background.mode` `auto` turned the model on, the mean without it is a third way, "
+         "which turns it off; with the model on by hand, refinement on or view selection, "
+         "`auto` keeps `quality`). The choice and its evidence (dB gained) are in "
+         "metrics.json under `auto.update`");
   v.Field(
       "quality_slack", o.quality_slack,
       {.min = 0,
