@@ -574,14 +574,16 @@ class CorrectionSolver {
 // The result's figures from the solve: inliers, whether the corrections are applied, the
 // corrected poses and the corrections' medians.
 void Summarise(const std::vector<PoseAdjustFrame>& frames, const std::vector<Match>& matches,
-               const CorrectionSolver& solver, PoseAdjustResult* result) {
+               const CorrectionSolver& solver, const PoseAdjustOptions& options,
+               PoseAdjustResult* result) {
   for (size_t k = 0; k < matches.size(); ++k)
     if (solver.Inlier(k)) {
       ++result->inliers;
       ++result->frame_matches[matches[k].i];
       ++result->frame_matches[matches[k].j];
     }
-  result->applied = true;
+  result->applied = result->rms_after_px > 0 &&
+                    result->rms_before_px >= options.min_improvement * result->rms_after_px;
   const std::vector<Vec6>& x = solver.corrections();
   std::vector<double> rotations, translations;
   for (size_t f = 0; f < frames.size(); ++f) {
@@ -723,7 +725,7 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   result->rms_after_px = solver.Rms();
   if (options.progress)
     options.progress(2 * n + options.iterations, 2 * n + options.iterations, "adjusted");
-  Summarise(prepared.frames, matches, solver, result);
+  Summarise(prepared.frames, matches, solver, options, result);
   result->seconds = seconds();
   return Status::Ok();
 }
