@@ -112,8 +112,8 @@ void PaintSession::ResetPainting() {
     InitRefineAnchor(set_.buffers[b], &anchors_[b]);
   }
   layers_.clear();
-  StartAutoModes();
   frames_seen_ = 0;
+  StartAutoModes();
   exposure_gain_sum_ = exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
   exposure_frames_ = 0;
 }
@@ -129,17 +129,13 @@ void PaintSession::StartAutoModes() {
     // View selection keeps views by its own score; refinement registers each frame to the
     // buffers, which must stay the sharpest views (the mean of misregistered views blurs them).
     // The background model on by hand: the mean would take in what it lets through.
-    const auto on = [](auto mode, auto off, auto automatic) { return mode != off && mode != automatic; };
-    const bool refine_on = on(requested_refine_, RefineMode::kOff, RefineMode::kAuto);
-    const bool model_on = on(requested_background_, BackgroundMode::kOff, BackgroundMode::kAuto);
-    if (options_.select.enabled || refine_on || model_on) {
-      options_.update = UpdatePolicy::kQuality;
-      update_auto_.state = AutoDecision::State::kOff;
-      update_auto_.decided_at_frame = 0;
-      update_auto_.basis = refine_on ? "refinement_on"
-                           : model_on ? "background_model_on"
-                                      : "view_selection";
-    }
+    const bool refine_on =
+        requested_refine_ != RefineMode::kOff && requested_refine_ != RefineMode::kAuto;
+    const bool model_on = requested_background_ != BackgroundMode::kOff &&
+                          requested_background_ != BackgroundMode::kAuto;
+    if (refine_on) KeepSharpestViews("refinement_on");
+    else if (model_on) KeepSharpestViews("background_model_on");
+    else if (options_.select.enabled) KeepSharpestViews("view_selection");
   }
   const bool refine_auto = requested_refine_ == RefineMode::kAuto;
   const bool background_auto = requested_background_ == BackgroundMode::kAuto;
