@@ -7,6 +7,45 @@
 
 namespace fresco {
 
+namespace {
+
+// A texel averaged from every view shows a mover where movers are at least this share of
+// the weight it holds: a quarter of a mover's contrast to the background, or more.
+constexpr double kMoverShare = 0.25;
+
+// The weight channel of `sums` (CV_32FC4: negative while provisional samples only), or
+// empty.
+cv::Mat Weights(const cv::Mat& sums) {
+  cv::Mat w;
+  if (!sums.empty()) cv::extractChannel(sums, w, 3);
+  return w;
+}
+
+// What each texel's sums took this frame (weights `before` -> `after`) into `shares`
+// (mover weight, total weight), the flag `mover` (CV_8U) telling whether it showed a mover.
+// The first trusted sample replaces provisional ones (texel_update.h, AddToMean): so do the
+// shares.
+void TakeShares(const cv::Mat& before, const cv::Mat& after, const cv::Mat& mover,
+                cv::Mat* shares) {
+  if (after.empty()) return;
+  for (int y = 0; y < after.rows; ++y) {
+    const float* a = after.ptr<float>(y);
+    const float* b = before.empty() ? nullptr : before.ptr<float>(y);
+    const uchar* m = mover.ptr<uchar>(y);
+    cv::Vec2f* s = shares->ptr<cv::Vec2f>(y);
+    for (int x = 0; x < after.cols; ++x) {
+      float was = b ? b[x] : 0.0f;
+      if (was < 0 && a[x] > 0) s[x] = cv::Vec2f(0, 0), was = 0;
+      const float taken = std::abs(a[x]) - std::abs(was);
+      if (taken <= 1e-6f) continue;
+      s[x][1] += taken;
+      if (m[x]) s[x][0] += taken;
+    }
+  }
+}
+
+}  // namespace
+
 MoverProvenance::MoverProvenance(const Scene& world_scene, const std::vector<MoverOptions>& movers,
                                  const Scene& painted_scene, const Camera& camera,
                                  const PaintSession& session)
@@ -22,12 +61,23 @@ MoverProvenance::MoverProvenance(const Scene& world_scene, const std::vector<Mov
     n_open_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
     open_written_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
     open_passed_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
+    for (MeanShares* m : {&mean_, &unmasked_})
+      m->shares.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_32FC2));
   }
   before_.resize(buffers.size());
+  mean_.before.resize(buffers.size());
+  unmasked_.before.resize(buffers.size());
 }
 
 void MoverProvenance::BeforeFrame(const PaintSession& session) {
-  for (size_t b = 0; b < before_.size(); ++b) session.painted()[b].bgra.copyTo(before_[b]);
+  for (size_t b = 0; b < before_.size(); ++b) {
+    const PaintedBuffer& painted = session.painted()[b];
+    painted.bgra.copyTo(before_[b]);
+    mean_.before[b] = Weights(painted.mean_sum);
+    unmasked_.before[b] = Weights(painted.unmasked_sum);
+  }
+  deciding_before_ = session.DecidingUpdate();
+  model_before_ = session.options().background.mode != BackgroundMode::kOff;
 }
 
 void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
@@ -55,6 +105,11 @@ void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
   WarpOptions warp_options;
   warp_options.sampling = session.options().sampling;
   warp_options.occlusion = session.options().occlusion;
+  // `update: auto` decided this frame for the mean without the model: the sums the texels
+  // hold from now on are the unmasked ones (with this frame's sample).
+  const bool took_unmasked = deciding_before_ && model_before_ && !session.DecidingUpdate() &&
+                             session.options().background.mode == BackgroundMode::kOff &&
+                             session.options().update == UpdatePolicy::kMean;
   const std::vector<BaseBuffer>& buffers = session.buffers();
   for (size_t b = 0; b < buffers.size(); ++b) {
     WarpedBuffer warped;
@@ -74,7 +129,22 @@ void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
     open_written_[b].setTo(255, open & written);
     const cv::Mat kept_out = session.KeptOutOfPainting(b);
     open_passed_[b].setTo(255, kept_out.empty() ? open & ~written : open & ~written & ~kept_out);
+    const PaintedBuffer& painted = session.painted()[b];
+    if (took_unmasked) {  // mean_sum holds the unmasked sums now
+      TakeShares(unmasked_.before[b], Weights(painted.mean_sum), mover_texel, &unmasked_.shares[b]);
+    } else {
+      TakeShares(mean_.before[b], Weights(painted.mean_sum), mover_texel, &mean_.shares[b]);
+      TakeShares(unmasked_.before[b], Weights(painted.unmasked_sum), mover_texel,
+                 &unmasked_.shares[b]);
+    }
   }
+  if (took_unmasked) mean_.shares = unmasked_.shares;
+}
+
+bool MoverProvenance::ShowsMover(const PaintSession& session, size_t b, int idx) const {
+  if (session.options().update != UpdatePolicy::kMean) return shows_mover_[b].data[idx] != 0;
+  const cv::Vec2f share = mean_.shares[b].ptr<cv::Vec2f>()[idx];
+  return share[0] > 0 && share[0] >= kMoverShare * share[1];
 }
 
 MoverProvenance::Figures MoverProvenance::Count(const PaintSession& session) const {
@@ -89,7 +159,7 @@ MoverProvenance::Figures MoverProvenance::Count(const PaintSession& session) con
       if (!buffer.on_surface[k]) continue;
       const int idx = buffer.texel_index[k];
       const bool painted = bgra[idx][3] == 255;
-      const bool mover = painted && shows_mover_[b].data[idx];
+      const bool mover = painted && ShowsMover(session, b, idx);
       f.painted += painted;
       f.painted_mover += mover;
       f.mover_dominated += mover && n_mover[idx] >= n_open[idx];
@@ -115,7 +185,9 @@ std::vector<cv::Mat> MoverProvenance::MaskImages(const PaintSession& session) co
   for (size_t b = 0; b < images.size(); ++b) {
     cv::Mat alpha;
     cv::extractChannel(session.painted()[b].bgra, alpha, 3);
-    const cv::Mat& m = shows_mover_[b];
+    cv::Mat m = cv::Mat::zeros(shows_mover_[b].size(), CV_8U);
+    for (int idx = 0; idx < static_cast<int>(m.total()); ++idx)
+      m.data[idx] = ShowsMover(session, b, idx) ? 255 : 0;
     cv::merge(std::vector<cv::Mat>{m, m, m, alpha}, images[b]);
   }
   return images;

@@ -7,6 +7,11 @@
 // "painted-mover fraction", in texel space (Figures) and, rendered as a texture
 // (MaskImages), in any view.
 //
+// `update: mean` rewrites a texel with every sample, so which sample came last says nothing
+// there: each sample's weight in the texel's sums (PaintedBuffer::mean_sum, and
+// unmasked_sum while `update: auto` decides) is followed instead, and a texel shows a mover
+// where movers are kMoverShare or more of the weight its mean holds.
+//
 // A texel the refinement's anchoring moved counts as written by that frame (its flag is the
 // frame's, not carried along): only captures with refinement on are affected.
 #pragma once
@@ -70,6 +75,14 @@ class MoverProvenance {
   // without a mover on it; whether a sample without a mover was painted, and whether one was
   // neither painted nor kept out of painting.
   std::vector<cv::Mat> shows_mover_, n_mover_, n_open_, open_written_, open_passed_;
+  // `update: mean`: per buffer, the weight of a sums' samples that showed a mover and of all
+  // (CV_32FC2), for mean_sum and unmasked_sum; their weights before the frame (CV_32F).
+  struct MeanShares {
+    std::vector<cv::Mat> shares, before;
+  };
+  MeanShares mean_, unmasked_;
+  bool deciding_before_ = false, model_before_ = false;
+  bool ShowsMover(const PaintSession& session, size_t b, int idx) const;
 };
 
 }  // namespace fresco
