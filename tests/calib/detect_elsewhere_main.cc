@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   int views = 40;
   std::vector<unsigned> seeds = {1, 2, 3};
   ElsewhereBoard board;
-  bool solve = false, verbose = false;
+  bool solve = false, verbose = false, truth_corners = false;
   std::string save;
   DetectOptions options;
   for (int i = 1; i < argc; ++i) {
@@ -49,6 +49,8 @@ int main(int argc, char** argv) {
       save = next, ++i;
     } else if (a == "--solve") {
       solve = true;
+    } else if (a == "--truth-corners") {  // solve from the true corners (the solve's floor)
+      truth_corners = true;
     } else if (a == "--verbose") {
       verbose = true;
     } else if (a == "--no-second-look") {
@@ -79,7 +81,7 @@ int main(int argc, char** argv) {
         double ms = 0, ms_max = 0, sq_px = 0, worst_px = 0;
         int corners = 0;
         Eigen::Vector2d sum_px = Eigen::Vector2d::Zero();
-        double sum_radial_px = 0;
+        double sum_radial_px = 0, sum_outward_px = 0;
         std::vector<BoardView> used_views;
         const std::string name = "seed " + std::to_string(seed) +
                                  (surround < 128 ? " dark " : " light") +
@@ -117,8 +119,18 @@ int main(int argc, char** argv) {
             sum_px += c.pixel - view.truth[c.id];
             const Eigen::Vector2d out = view.truth[c.id] - Eigen::Vector2d(511.5, 383.5);
             sum_radial_px += (c.pixel - view.truth[c.id]).dot(out.normalized());
+            const int t0 = c.id / 4 * 4;
+            const Eigen::Vector2d tag_centre = 0.25 * (view.truth[t0] + view.truth[t0 + 1] +
+                                                       view.truth[t0 + 2] + view.truth[t0 + 3]);
+            sum_outward_px += (c.pixel - view.truth[c.id]).dot((view.truth[c.id] - tag_centre).normalized());
           }
-          if (d.found) used_views.push_back({"view" + std::to_string(v), d.corners});
+          if (truth_corners) {
+            std::vector<CornerObservation> truth;
+            for (int id = 0; id < spec.NumCorners(); ++id) truth.push_back({id, view.truth[id]});
+            used_views.push_back({"view" + std::to_string(v), truth});
+          } else if (d.found) {
+            used_views.push_back({"view" + std::to_string(v), d.corners});
+          }
           if (verbose || (!d.found && aruco_reads))
             std::printf("  %s view %2zu: ours %2d tags (%s), aruco %2zu, %.0f ms\n", name.c_str(),
                         v, d.tags, d.found ? "used" : d.reason.c_str(), aruco.size(), t_ms);
@@ -127,11 +139,11 @@ int main(int argc, char** argv) {
         std::printf(
             "%s: %zu views, used %d, lost %d (aruco >= 4 tags in %d), tags ours %d aruco %d, "
             "detect %.0f ms/view (max %.0f), corners rms %.3f px (worst %.2f, mean %.3f %.3f, "
-            "radial %.3f)",
+            "radial %.3f, out of the tag %.3f)",
             name.c_str(), poses.size(), used, lost, aruco_ok, tags_ours, tags_aruco,
             ms / std::max<size_t>(1, poses.size()), ms_max, std::sqrt(sq_px / std::max(1, corners)),
             worst_px, sum_px.x() / std::max(1, corners), sum_px.y() / std::max(1, corners),
-            sum_radial_px / std::max(1, corners));
+            sum_radial_px / std::max(1, corners), sum_outward_px / std::max(1, corners));
         if (solve && used >= kMinViews) {
           CalibrateRequest request;
           request.board = spec;
