@@ -219,8 +219,17 @@ bool DetectImage(const std::string& path, const CalibrateRequest& request, Calib
   }
   BoardDetection detection = DetectBoard(gray, request.board, request.detect);
   if (detection_out) *detection_out = detection;
+  run->detections.push_back({name, detection.found, detection.reason, detection.tags,
+                             detection.tags_library, detection.tags_aruco,
+                             detection.tags_second_look, static_cast<int>(detection.corners.size()),
+                             detection.detect_ms, detection.tag_centres});
   if (!detection.found) {
     run->rejected.push_back({name, detection.reason});
+    if (std::max(detection.tags_library, detection.tags_aruco) >= kWarnRejectedTags)
+      run->warnings.push_back(name + ": rejected (" + detection.reason +
+                              ") although the apriltag library read " +
+                              std::to_string(detection.tags_library) + " and OpenCV's aruco " +
+                              std::to_string(detection.tags_aruco) + " of the board's tags");
     return false;
   }
   run->views.push_back({name, std::move(detection.corners)});

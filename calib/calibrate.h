@@ -45,10 +45,26 @@ struct SplitTest {
   double ratio = 0;           // joint / split; 0 when a solve failed
 };
 
+// What detection found in one image, used or not (the report's per-image lines).
+struct ViewDetection {
+  std::string name;
+  bool used = false;
+  std::string reason;  // why not used ("" when used)
+  int tags = 0, tags_library = 0, tags_aruco = 0, tags_second_look = 0;  // BoardDetection's
+  int corners = 0;
+  double detect_ms = 0;
+  std::vector<Eigen::Vector2d> tag_centres;  // BoardDetection::tag_centres
+};
+
+// A warning when an image is rejected though a detector read `kWarnRejectedTags` or more of
+// the board's tags in it (the tags were then left out: corners dropped as out of place).
+constexpr int kWarnRejectedTags = 2;
+
 struct CalibrationRun {
   int width = 0, height = 0;
   std::vector<BoardView> views;  // images used, sorted by name
   std::vector<RejectedImage> rejected;
+  std::vector<ViewDetection> detections;   // every image detected, in order
   std::vector<std::string> excluded;       // names matched by CalibrateRequest::exclude
   std::map<std::string, int> image_sizes;  // "WxH" -> images of that size (every image read)
   // Signs that the folder mixes cameras (image sizes; one camera's fit worse than two

@@ -1,6 +1,7 @@
 #include "calib/detect.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <vector>
@@ -8,11 +9,13 @@
 #include <Eigen/Dense>
 
 #include <apriltag/apriltag.h>
+#include <apriltag/tag36h11.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "calib/detect_aruco.h"
 #include "calib/kalibr_tag_family.h"
+#include "calib/tag_corner_edges.h"
 #include "calib/tags_around_found.h"
 
 namespace fresco::calib {
@@ -168,9 +171,15 @@ int DropCornersTheirNeighboursPlaceElsewhere(const BoardSpec& spec,
 
 std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
                                         const DetectOptions& options) {
-  KalibrTagFamily family;
+  // Kalibr's tags (2-bit border) and the library's own tag36h11 (1-bit border): the same
+  // codes; the detector decodes every quad against both.
+  KalibrTagFamily kalibr;
+  apriltag_family_t* one_bit = tag36h11_create();
   apriltag_detector_t* detector = apriltag_detector_create();
-  apriltag_detector_add_family_bits(detector, family.get(), options.max_hamming);
+  if (options.border_bits != 1)
+    apriltag_detector_add_family_bits(detector, kalibr.get(), options.max_hamming);
+  if (options.border_bits != 2)
+    apriltag_detector_add_family_bits(detector, one_bit, options.max_hamming);
   detector->quad_decimate = static_cast<float>(options.quad_decimate);
   detector->nthreads = 1;
   detector->refine_edges = 1;
@@ -185,11 +194,28 @@ std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
     if (det->id >= num_ids || det->hamming > options.max_hamming) continue;
     TagQuad quad;
     quad.id = det->id;
+    quad.border_bits = det->family == one_bit ? 1 : 2;
     for (int k = 0; k < 4; ++k) quad.p[k] = Eigen::Vector2d(det->p[k][0], det->p[k][1]);
     quads.push_back(quad);
   }
   apriltag_detections_destroy(detections);
   apriltag_detector_destroy(detector);
+  tag36h11_destroy(one_bit);
+  // A Kalibr tag whose border thinned (a thinned image, blur) can read as a 1-bit tag of the
+  // same id inside it: one tag, the outer square its outline.
+  const auto area = [](const TagQuad& q) {
+    return std::abs((q.p[2] - q.p[0]).x() * (q.p[3] - q.p[1]).y() -
+                    (q.p[2] - q.p[0]).y() * (q.p[3] - q.p[1]).x());
+  };
+  const auto centre = [](const TagQuad& q) { return 0.25 * (q.p[0] + q.p[1] + q.p[2] + q.p[3]); };
+  for (size_t i = 0; i < quads.size(); ++i)
+    for (size_t j = i + 1; j < quads.size(); ++j) {
+      if (quads[i].id != quads[j].id || quads[i].border_bits == quads[j].border_bits) continue;
+      const double edge = std::sqrt(std::max(area(quads[i]), area(quads[j])) / 2);
+      if ((centre(quads[i]) - centre(quads[j])).norm() > 0.25 * edge) continue;
+      if (area(quads[j]) > area(quads[i])) std::swap(quads[i], quads[j]);
+      quads.erase(quads.begin() + j--);
+    }
   std::map<int, int> count_by_id;
   for (const TagQuad& q : quads) ++count_by_id[q.id];
   quads.erase(std::remove_if(quads.begin(), quads.end(),
@@ -210,19 +236,41 @@ int AddMissing(const std::vector<TagQuad>& quads, std::map<int, TagQuad>* found)
   return added;
 }
 
+// The border the tags read so far have (the most of them), or 0 when none was read.
+int BorderBitsOf(const std::map<int, TagQuad>& found) {
+  int by_bits[3] = {0, 0, 0};
+  for (const auto& [id, quad] : found) ++by_bits[quad.border_bits == 1 ? 1 : 2];
+  if (by_bits[1] + by_bits[2] == 0) return 0;
+  return by_bits[1] > by_bits[2] ? 1 : 2;
+}
+
 BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
                                const DetectOptions& options) {
   BoardDetection out;
   const int num_ids = spec.cols * spec.rows;
   std::map<int, TagQuad> found;
-  AddMissing(DetectTagsApriltag(gray, num_ids, options), &found);
+  out.tags_library = AddMissing(DetectTagsApriltag(gray, num_ids, options), &found);
+  // OpenCV's aruco on every image: it thresholds and traces contours differently and reads
+  // tags the library misses (and the other way round). With the border the library's tags
+  // have, or the one asked for; both when neither tells.
+  std::vector<int> aruco_borders = {options.border_bits};
+  if (!options.second_look) {
+    aruco_borders.clear();
+  } else if (options.border_bits == 0) {
+    const int seen = BorderBitsOf(found);
+    aruco_borders = seen ? std::vector<int>{seen} : std::vector<int>{2, 1};
+  }
+  for (int bits : aruco_borders) {
+    const std::vector<TagQuad> aruco = DetectTagsAruco(gray, num_ids, bits);
+    out.tags_aruco += static_cast<int>(aruco.size());
+    out.tags_aruco_only += AddMissing(aruco, &found);
+  }
   if (options.second_look && static_cast<int>(found.size()) < num_ids) {
     // Second look for the missing tags. Kalibr prints a black square where the gaps between
     // tags cross; it touches the corners of 4 tags, so the library's segmentation merges the
     // board's black into one blob and finds few tag outlines (a whole board under a strong
     // barrel distortion: 1 tag of 36). Thinning the black (a grey dilation) cuts those
     // contacts; the quads found on the thinned image are refined on the original below.
-    // Then OpenCV's aruco, which thresholds and traces contours differently.
     for (int grow : {3, 5}) {
       if (static_cast<int>(found.size()) >= num_ids) break;
       cv::Mat thinned;
@@ -230,19 +278,33 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       out.tags_second_look += AddMissing(DetectTagsApriltag(thinned, num_ids, options), &found);
     }
     if (static_cast<int>(found.size()) < num_ids)
-      out.tags_second_look += AddMissing(DetectTagsAruco(gray, num_ids), &found);
-    if (static_cast<int>(found.size()) < num_ids)
       out.tags_second_look += FindTagsAroundFound(
           gray, spec,
           [&](const cv::Mat& patch) { return DetectTagsApriltag(patch, num_ids, options); },
           &found);
   }
+  out.border_bits = BorderBitsOf(found);
+  for (const auto& [id, quad] : found)
+    out.tag_centres.push_back(0.25 * (quad.p[0] + quad.p[1] + quad.p[2] + quad.p[3]));
   for (const auto& [id, quad] : found) {
     std::vector<cv::Point2f> corners;
     for (int k = 0; k < 4; ++k)
       corners.emplace_back(static_cast<float>(quad.p[k].x()), static_cast<float>(quad.p[k].y()));
     bool refined[4] = {true, true, true, true};
-    if (options.refine_tag_corners) RefineTagCorners(gray, quad, &corners, refined);
+    if (options.refine_tag_corners) {
+      RefineTagCorners(gray, quad, &corners, refined);
+      // Where the board has no black square at a corner, cornerSubPix's saddle is not there:
+      // the corner from the tag's edges (calib/tag_corner_edges.h).
+      std::array<Eigen::Vector2d, 4> p;
+      for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
+      for (int k = 0; k < 4; ++k) {
+        Eigen::Vector2d corner;
+        if (!refined[k] || CrossingSquareAt(gray, p, k) || !CornerFromEdges(gray, p, k, &corner))
+          continue;
+        corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
+        ++out.corners_from_edges;
+      }
+    }
     for (int k = 0; k < 4; ++k)
       if (refined[k])
         out.corners.push_back({id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
@@ -269,8 +331,12 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
 
 BoardDetection DetectBoard(const cv::Mat& gray, const BoardSpec& spec,
                            const DetectOptions& options) {
-  if (spec.kind == BoardKind::kChessboard) return DetectChessboard(gray, spec, options);
-  return DetectAprilGrid(gray, spec, options);
+  const auto start = std::chrono::steady_clock::now();
+  BoardDetection out = spec.kind == BoardKind::kChessboard ? DetectChessboard(gray, spec, options)
+                                                           : DetectAprilGrid(gray, spec, options);
+  out.detect_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
 }
 
 }  // namespace fresco::calib

@@ -1,8 +1,9 @@
 // Board detection in one image: per-corner pixel observations with their corner ids
-// (calib/board.h), partial boards included. AprilGrid: the apriltag library (Kalibr's
-// tag36h11); when it misses some of the board's tags, a second look for the missing ones
-// (the apriltag library with blurred quads, then OpenCV's aruco, then around the tags found:
-// calib/tags_around_found.h); then optionally
+// (calib/board.h), partial boards included. AprilGrid: the apriltag library and OpenCV's
+// aruco on every image, every tag either reads kept (tag36h11 with Kalibr's 2-bit black
+// border or the 1-bit border OpenCV and the apriltag library draw); when they miss some of
+// the board's tags, a second look for the missing ones (the apriltag library on a thinned
+// image, then around the tags found: calib/tags_around_found.h); then optionally
 // cv::cornerSubPix on each tag corner, whichever detector found it. Chessboard: OpenCV's
 // findChessboardCornersSB, falling back to findChessboardCorners + cornerSubPix.
 // Pixel convention: (0,0) is the centre of the top-left pixel (apriltag, OpenCV and mrcal).
@@ -29,7 +30,18 @@ struct BoardDetection {
   std::string reason;  // why not found (one line), empty when found
   std::vector<CornerObservation> corners;
   int tags = 0;              // AprilGrid: tags kept
-  int tags_second_look = 0;  // AprilGrid: of those, found by the second look
+  int tags_library = 0;      // AprilGrid: tags the apriltag library read on the image itself
+  int tags_aruco = 0;        // AprilGrid: tags OpenCV's aruco read
+  int tags_aruco_only = 0;   // AprilGrid: of the tags kept, read by aruco alone
+  int tags_second_look = 0;  // AprilGrid: of the tags kept, found by the second look
+  int border_bits = 0;       // AprilGrid: the tags' black border (1 or 2; 0: no tag read)
+  // AprilGrid: corners placed where the tag's edges meet (no black square at the corner:
+  // calib/tag_corner_edges.h) instead of on cornerSubPix's saddle.
+  int corners_from_edges = 0;
+  double detect_ms = 0;  // wall time of this detection
+  // AprilGrid: the centre of every tag read (before corners were left out), for marking
+  // where a rejected image saw the board.
+  std::vector<Eigen::Vector2d> tag_centres;
   // AprilGrid: corners dropped because the corners near them on the board place them more
   // than 1.5 px (or 4 % of a tag pitch) elsewhere (settled on a tag's edge, not its corner).
   int corners_inconsistent = 0;
@@ -44,15 +56,20 @@ struct DetectOptions {
   double quad_decimate = 1.0;  // apriltag: 1 keeps full resolution (small tags need it)
   int max_hamming = 1;         // apriltag: bit errors accepted per tag
   int min_corners = 8;         // fewer than this: not found
-  // AprilGrid: when the apriltag library misses tags of the board, look again for the missing
-  // ones. Under a strong lens distortion the library loses whole boards (tag edges bent away
-  // from its straight quad sides: the bits it samples drift off their cells); see
-  // tests/calib/calib_detect_test.cc for the figures.
+  // AprilGrid: the tags' black border in bits: 0 reads either, 2 only Kalibr's, 1 only the
+  // one OpenCV (GridBoard, drawMarker) and the apriltag library's own images have.
+  int border_bits = 0;
+  // AprilGrid: OpenCV's aruco besides the apriltag library, and when they miss tags of the
+  // board, look again for the missing ones (false: the library alone). Under a strong lens
+  // distortion the library loses whole boards (tag edges bent away from its straight quad
+  // sides: the bits it samples drift off their cells); see tests/calib/calib_detect_test.cc
+  // and tests/calib/calib_detect_elsewhere_test.cc for the figures.
   bool second_look = true;
 };
 
-// One run of the apriltag library (Kalibr's tag36h11): tags with ids < num_ids and at most
-// options.max_hamming bit errors, unrefined; an id found twice is dropped (trust neither).
+// One run of the apriltag library (tag36h11 with the black border options.border_bits
+// allows): tags with ids < num_ids and at most options.max_hamming bit errors, unrefined; an
+// id found twice is dropped (trust neither).
 std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
                                         const DetectOptions& options = {});
 

@@ -6,9 +6,9 @@ namespace fresco::calib {
 
 const int kArucoToApriltag[4] = {1, 0, 3, 2};
 
-std::vector<TagQuad> DetectTagsAruco(const cv::Mat& gray, int num_ids) {
+std::vector<TagQuad> DetectTagsAruco(const cv::Mat& gray, int num_ids, int border_bits) {
   cv::Ptr<cv::aruco::DetectorParameters> params = cv::aruco::DetectorParameters::create();
-  params->markerBorderBits = 2;  // Kalibr's tags
+  params->markerBorderBits = border_bits;
   params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
   const cv::Ptr<cv::aruco::Dictionary> dictionary =
       cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11);
@@ -20,6 +20,7 @@ std::vector<TagQuad> DetectTagsAruco(const cv::Mat& gray, int num_ids) {
     if (ids[i] < 0 || ids[i] >= num_ids || corners[i].size() != 4) continue;
     TagQuad quad;
     quad.id = ids[i];
+    quad.border_bits = border_bits;
     for (int k = 0; k < 4; ++k)
       quad.p[kArucoToApriltag[k]] = Eigen::Vector2d(corners[i][k].x, corners[i][k].y);
     out.push_back(quad);

@@ -92,10 +92,21 @@ cv::Mat DrawCoverage(const CalibrationRun& run) {
       else
         cv::circle(canvas, p, 2, ViewColour(v), cv::FILLED, cv::LINE_AA);
     }
+  // Images rejected: where their tags were read (a view lost, and the part of the imager it
+  // would have covered).
+  int lost = 0;
+  for (const ViewDetection& d : run.detections) {
+    lost += !d.used && !d.tag_centres.empty();
+    if (d.used) continue;
+    for (const Eigen::Vector2d& c : d.tag_centres)
+      cv::drawMarker(canvas, cv::Point(int(c.x() * s), int(c.y() * s)), cv::Scalar(0, 140, 255),
+                     cv::MARKER_TILTED_CROSS, 10, 2);
+  }
   cv::putText(
       canvas,
       "coverage " + Text("%.0f %%", 100 * CoverageFraction(run.views, run.width, run.height)) +
-          " of 16x12 cells, " + std::to_string(run.views.size()) + " images; shaded: no corner",
+          " of 16x12 cells, " + std::to_string(run.views.size()) + " images; shaded: no corner" +
+          (lost ? "; orange x: tags of " + std::to_string(lost) + " rejected images" : ""),
       cv::Point(5, h + 20), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   return canvas;
 }

@@ -139,6 +139,23 @@ std::string ReportJson(const CalibrateRequest& request, const CalibrationRun& ru
   for (const RejectedImage& r : run.rejected)
     rejected.push_back({{"image", r.name}, {"reason", r.reason}});
   j["images_rejected"] = rejected;
+  // Per image: tags each detector read, tags kept, and the detection's wall time.
+  nlohmann::json detections = nlohmann::json::array();
+  double detect_ms = 0;
+  for (const ViewDetection& d : run.detections) {
+    detections.push_back({{"image", d.name},
+                          {"used", d.used},
+                          {"tags_apriltag", d.tags_library},
+                          {"tags_aruco", d.tags_aruco},
+                          {"tags_second_look", d.tags_second_look},
+                          {"tags_kept", d.tags},
+                          {"corners", d.corners},
+                          {"detect_ms", d.detect_ms}});
+    if (!d.used) detections.back()["reason"] = d.reason;
+    detect_ms += d.detect_ms;
+  }
+  j["detections"] = detections;
+  j["detect_ms_total"] = detect_ms;
   j["images_excluded"] = run.excluded;  // by name or glob (--exclude, the app's checkboxes)
   nlohmann::json splits = nlohmann::json::array();
   for (const SplitTest& t : run.split_tests)

@@ -1,0 +1,30 @@
+// A tag corner where no saddle is: Kalibr prints a black square where the gaps between tags
+// cross, so each tag corner is a saddle cv::cornerSubPix finds without bias; boards drawn
+// without those squares (OpenCV's GridBoard, most home-made AprilGrids) leave each tag corner
+// the convex corner of a black square on white, which blur and anti-aliasing round off and
+// cornerSubPix pulls into the tag (0.17 px sharp, 0.31 px blurred 1 px: the tag shrinks
+// against the board's pitch, and a solve takes that for lens distortion). There the corner
+// is the meeting point of the tag's two edges: each edge located to sub-pixel along its
+// normal (the steepest grey gradient) over the part of the edge near the corner, fitted by a
+// line, and the two lines intersected.
+#pragma once
+
+#include <array>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+namespace fresco::calib {
+
+// Whether the board has a black square at tag corner k (the tag's corners `p`, in order
+// around it): the grey just outside the corner, on the diagonal away from the tag's centre,
+// is nearer the tag's black than the white of its gap. `gray` is CV_8U.
+bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k);
+
+// Corner k as the intersection of the tag's two edges through it, or false (then `corner`
+// is untouched) when an edge shows too little contrast or the result lies more than
+// max(1.5 px, 5 % of the tag's edge) from p[k].
+bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
+                     Eigen::Vector2d* corner);
+
+}  // namespace fresco::calib
