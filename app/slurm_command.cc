@@ -57,10 +57,12 @@ std::string ThisExecutable() {
   return error ? std::string("fresco") : self.string();
 }
 
+// A job script's head: its #SBATCH lines (`own` then the user's `extra`), before any command.
 std::string Header(const std::string& name, const std::string& log,
-                   const std::vector<std::string>& extra) {
+                   const std::vector<std::string>& own, const std::vector<std::string>& extra) {
   std::string s = "#!/bin/bash\n# Written by `fresco slurm` (docs/guide/slurm.md).\n";
   s += "#SBATCH --job-name=" + name + "\n#SBATCH --output=" + log + "\n";
+  for (const std::string& option : own) s += "#SBATCH " + option + "\n";
   for (const std::string& option : extra) s += "#SBATCH " + option + "\n";
   return s + "set -euo pipefail\n";
 }
@@ -115,12 +117,14 @@ int RunVerbSlurm(const CommandArgs& argv) {
   std::string sets;
   for (const std::string& set : args.All("--set")) sets += " --set " + Quote(set);
   const std::string n = std::to_string(shards);
-  std::string paint = Header("fresco-paint", dir + "/logs/paint-%a.out", extra);
-  paint += "#SBATCH --array=0-" + std::to_string(shards - 1) + "\n";
+  std::string paint = Header("fresco-paint", dir + "/logs/paint-%a.out",
+                             {"--array=0-" + std::to_string(shards - 1)}, extra);
   paint += "I=${SLURM_ARRAY_TASK_ID:?run as a Slurm array task}\n";
   paint += "exec " + Quote(fresco) + " run " + Quote(project_path) + " --out " +
            Quote(dir + "/parts/") + "\"$I\" --shard \"$I/" + n + "\" --quiet" + sets + "\n";
-  std::string merge = Header("fresco-merge", dir + "/logs/merge.out", extra);
+  // A failed shard cancels the merge (else it would wait forever, DependencyNeverSatisfied).
+  std::string merge =
+      Header("fresco-merge", dir + "/logs/merge.out", {"--kill-on-invalid-dep=yes"}, extra);
   merge += "exec " + Quote(fresco) + " merge";
   for (int i = 0; i < shards; ++i) merge += " " + Quote(dir + "/parts/" + std::to_string(i));
   merge += " --out " + Quote(dir) + " --quiet\n";
