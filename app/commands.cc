@@ -12,6 +12,8 @@ namespace fresco {
 const std::vector<Command>& AllCommands() {
   static const std::vector<Command> kCommands = {
       {"run", "paint a project's video onto its model (headless)", RunVerbRun},
+      {"merge", "join the parts `run --shard I/N` painted into one run's outputs", RunVerbMerge},
+      {"slurm", "write (and submit) Slurm jobs painting a project in shards, then merging", RunVerbSlurm},
       {"render", "render a (painted or original) glTF, PLY or OBJ model through a camera", RunVerbRender},
       {"synth", "make a synthetic capture from a glTF scene", RunVerbSynth},
       {"group", "show, or store in the project, the base-buffer grouping", RunVerbGroup},

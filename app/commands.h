@@ -43,6 +43,8 @@ int Fail(const Status& status);
 
 int RunVerbRun(const CommandArgs& args);
 int RunVerbRender(const CommandArgs& args);
+int RunVerbMerge(const CommandArgs& args);
+int RunVerbSlurm(const CommandArgs& args);
 int RunVerbGroup(const CommandArgs& args);
 int RunVerbSynth(const CommandArgs& args);
 int RunVerbCalib(const CommandArgs& args);

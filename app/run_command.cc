@@ -23,6 +23,7 @@
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
+#include "pipeline/run/shard.h"
 
 namespace fresco {
 namespace {
@@ -31,7 +32,7 @@ ArgSpec RunSpec() {
   ArgSpec spec;
   spec.usage =
       "fresco run PROJECT.json --out DIR [--set KEY=VALUE ...] [--debug-images] [--quiet]\n"
-      "       [--record DIR]";
+      "       [--record DIR] [--shard I/N]";
   spec.help =
       "Replays the project headless: streams its video, paints every frame into the base\n"
       "buffers, and writes DIR/painted.gltf (+ .bin and one PNG per texture atlas page;\n"
@@ -43,7 +44,11 @@ ArgSpec RunSpec() {
       "  --debug-images    write per-stage debug images under DIR/stages/ (costs time)\n"
       "  --quiet           no progress on stderr\n"
       "  --record DIR      (live sources) also write the session as a project to replay:\n"
-      "                    DIR/frames/, DIR/poses.txt, DIR/project.json\n\n"
+      "                    DIR/frames/, DIR/poses.txt, DIR/project.json\n"
+      "  --shard I/N       paint only shard I (0..N-1) of N: its charts (balanced by texels),\n"
+      "                    reading only the frames that see them; DIR holds a part that\n"
+      "                    `fresco merge` joins with the others into exactly this run's\n"
+      "                    outputs (docs/guide/slurm.md; captures from files)\n\n"
       "Live sources (docs/guide/live.md): `video` may be device:N or a stream URL\n"
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
@@ -57,7 +62,7 @@ ArgSpec RunSpec() {
       "taken in turn (none starves another), and metrics.json has a \"live\" object per\n"
       "live stream in \"streams\". --record needs a project with one stream.";
   spec.min_positional = spec.max_positional = 1;
-  spec.options = {"--out", "--record"};
+  spec.options = {"--out", "--record", "--shard"};
   spec.repeatable = {"--set"};
   spec.switches = {"--debug-images", "--quiet"};
   spec.required = {"--out"};
@@ -156,6 +161,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   metrics["frames"] = stats.frames;
   metrics["frames_painted"] = stats.frames_painted;
   metrics["frames_without_pose"] = stats.frames_without_pose;
+  if (stats.frames_skipped > 0) metrics["frames_skipped"] = stats.frames_skipped;
   metrics["seconds"] = stats.seconds;
   metrics["fps"] = stats.Fps();
   metrics["paint_fps"] = stats.PaintFps();
@@ -215,6 +221,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
          {"frames", stream.frames},
          {"frames_painted", stream.painted},
          {"frames_without_pose", stream.without_pose},
+         {"frames_skipped", stream.skipped},
          {"masked_fraction", std::isnan(masked) ? nlohmann::json() : nlohmann::json(masked)}});
   }
   metrics["streams"] = streams;
@@ -249,6 +256,55 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
     if (!metrics.contains("live")) metrics["live"] = live;
   }
   return metrics;
+}
+
+// The process's CPU time so far (user + system), seconds.
+double CpuSeconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
+         1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+// --shard I/N: metrics.json's "shard" (CONTRACT.md: index, count), with what `fresco merge`
+// needs: the project and settings it was painted with, the buffers it painted and where they
+// lie in the atlas pages (with their padding), and what it cost.
+nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const ShardSpec& shard,
+                            const PaintRunStats& stats) {
+  const PaintSession& session = *job.session;
+  const TextureAtlas& atlas = session.atlas();
+  nlohmann::json buffers = nlohmann::json::array(), rects = nlohmann::json::array();
+  long long texels = 0, painted = 0;
+  for (size_t b = 0; b < job.buffer_shard.size(); ++b) {
+    if (job.buffer_shard[b] != shard.index) continue;
+    const BaseBuffer& buffer = session.buffers()[b];
+    buffers.push_back(b);
+    texels += buffer.num_surface_texels;
+    painted += session.painted()[b].painted_surface_texels;
+    const AtlasPlacement& place = atlas.placements[b];
+    if (place.page < 0) continue;
+    const cv::Rect padded =
+        cv::Rect(place.x - atlas.padding, place.y - atlas.padding,
+                 buffer.width + 2 * atlas.padding, buffer.height + 2 * atlas.padding) &
+        cv::Rect(cv::Point(0, 0), atlas.pages[place.page]);
+    rects.push_back({place.page, padded.x, padded.y, padded.width, padded.height});
+  }
+  std::string fingerprint = ProjectToJsonText(project);
+  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a
+  for (unsigned char c : fingerprint) hash = (hash ^ c) * 1099511628211ULL;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", hash);
+  return {{"index", shard.index},
+          {"count", shard.count},
+          {"project", project.file_path},
+          {"settings_hash", hex},
+          {"buffers", buffers},
+          {"page_rects", rects},
+          {"texels", texels},
+          {"texels_painted", painted},
+          {"frames_skipped", stats.frames_skipped},
+          {"frames_painted_whole", session.frames_painted_whole()},
+          {"cpu_seconds", CpuSeconds()}};
 }
 
 using Clock = std::chrono::steady_clock;
@@ -379,9 +435,15 @@ int RunVerbRun(const CommandArgs& argv) {
 
   const std::vector<StreamSpec> specs = project.Streams();
   const std::string record_dir = args.Get("--record");
+  ShardSpec shard;
+  if (args.Has("--shard"))
+    if (Status s = ParseShardSpec(args.Get("--shard"), "--shard", &shard); !s.ok()) return Fail(s);
+  if (shard.sharded() && !record_dir.empty())
+    return Fail(Status::Error("--shard: not with --record (a shard paints a capture from files)"));
   if (Status s = CheckRecording(project, project_path, record_dir); !s.ok()) return Fail(s);
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
+  job_options.shard = shard;
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
@@ -440,6 +502,7 @@ int RunVerbRun(const CommandArgs& argv) {
   // Where the memory goes: the process's peak after set-up (mesh, charts, buffers) and after
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
+  if (shard.sharded()) metrics["shard"] = ShardMetrics(project, *job, shard, stats);
   if (Status s = WriteRunOutputs(out_dir, *job, stats, start, std::move(metrics)); !s.ok()) {
     return Fail(s);
   }

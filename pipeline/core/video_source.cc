@@ -114,6 +114,17 @@ class FolderSource : public VideoSource {
   int FrameCount() const override { return static_cast<int>(names_.size()); }
   std::vector<std::string> FrameNames() const override { return names_; }
   double Fps() const override { return kDefaultFolderFps; }
+  bool PeekNext(Frame* header) const override {
+    if (next_ >= names_.size()) return false;
+    header->index = static_cast<int>(next_);
+    header->name = names_[next_];
+    header->timestamp_s = next_ / kDefaultFolderFps;
+    header->bgr.release();
+    return true;
+  }
+  void SkipNext() override {
+    if (next_ < names_.size()) ++next_;
+  }
 
  private:
   std::string folder_;

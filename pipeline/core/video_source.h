@@ -44,6 +44,11 @@ class VideoSource {
   // Frame names in order when known (folders), else empty.
   virtual std::vector<std::string> FrameNames() const = 0;
   virtual double Fps() const = 0;
+  // The next frame's index, name and timestamp without reading it, where they are known
+  // before decoding (folders); false otherwise (nothing to skip without decoding).
+  virtual bool PeekNext(Frame* /*header*/) const { return false; }
+  // Passes over the next frame without reading it (after PeekNext said true).
+  virtual void SkipNext() {}
   // A camera or a stream (frames arrive on their own clock; reading may time out).
   virtual bool IsLive() const { return false; }
   // Which clock timestamp_s follows: "index" (folders), "stream" or "arrival".

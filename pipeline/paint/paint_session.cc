@@ -114,6 +114,8 @@ void PaintSession::ResetPainting() {
   layers_.clear();
   frames_seen_ = 0;
   StartAutoModes();
+  own_only_.store(false);
+  UpdateOwnOnly();
   exposure_gain_sum_ = exposure_offset_sum_ = cv::Vec3d(0, 0, 0);
   exposure_frames_ = 0;
 }
@@ -165,10 +167,44 @@ void PaintSession::DecideBackgroundAcrossViews(double fraction, int frames) {
   background_across_views_ = {fraction, frames};
   if (!background_auto_.deciding()) return;
   background_auto_.DecideAcrossViews(fraction, frames);
-  if (background_auto_.decision().state != AutoDecision::State::kOff) return;
-  options_.background.mode = BackgroundMode::kOff;
-  background_.clear();
-  background_frame_.clear();
+  if (background_auto_.decision().state == AutoDecision::State::kOff) {
+    options_.background.mode = BackgroundMode::kOff;
+    background_.clear();
+    background_frame_.clear();
+  }
+  UpdateOwnOnly();
+}
+
+void PaintSession::SetOwnBuffers(std::vector<bool> own) {
+  if (!own.empty() && own.size() != set_.buffers.size())
+    throw std::invalid_argument("PaintSession::SetOwnBuffers: " + std::to_string(own.size()) +
+                                " flags for " + std::to_string(set_.buffers.size()) + " buffers");
+  own_ = std::move(own);
+  own_only_.store(false);
+  UpdateOwnOnly();
+}
+
+bool PaintSession::CouplesBuffers() const {
+  return DecidingUpdate() || refine_auto_.deciding() || background_auto_.deciding() ||
+         options_.refine.mode != RefineMode::kOff || SelectActive(options_) ||
+         options_.layers.count > 0 ||
+         (options_.background.mode == BackgroundMode::kRobust &&
+          options_.background.normalize_gain);
+}
+
+bool PaintSession::ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
+                                       const Rigid3d& cam_from_world) const {
+  FrameView view;
+  view.camera = &camera;
+  view.cam_from_local = CamFromLocal(*scene_, cam_from_world);
+  view.centre_local = view.cam_from_local.Centre();
+  view.bounds = bounds;
+  const double near_m = WarpOptions().near_m;
+  for (size_t b = 0; b < set_.buffers.size(); ++b)
+    if ((own_.empty() || own_[b]) &&
+        !BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view, near_m))
+      return true;
+  return false;
 }
 
 std::vector<BufferBackground>& PaintSession::StreamBackground(int stream) {
@@ -298,6 +334,8 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
 #undef FRESCO_RUN_STAGE
   if (frame_number + 1 >= kUpdateHoldOutEvery * kUpdateHeldOutFrames) DecideUpdate();
   UpdateAutoModes(frame_number, work.measured_misalignment_px, work.seen, report);
+  if (!own_.empty() && !own_only_.load()) ++frames_painted_whole_;
+  UpdateOwnOnly();
   report->painted = true;
   report->total_ms = MsSince(frame_start);
 }

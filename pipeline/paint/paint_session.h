@@ -18,6 +18,7 @@
 // FrameReport that the CLI and the GUI both consume.
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
@@ -155,6 +156,35 @@ class PaintSession {
   bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }
   void DecideUpdate();
 
+  // Painting in shards (`fresco run --shard I/N`, pipeline/run/shard.h): `own[b]` true for
+  // the buffers this session paints for its shard (empty: every buffer, the default). The
+  // session still paints every buffer a frame sees while a frame's outcome in one buffer
+  // depends on the others (CouplesBuffers): so the shards' buffers come out exactly as one
+  // session over every buffer paints them.
+  void SetOwnBuffers(std::vector<bool> own);
+  // True while painting one buffer depends on the frame's other buffers: an `auto` mode
+  // deciding (its evidence spans the frame), refinement on (one pose correction from every
+  // buffer's matches), view selection (one exposure gain per frame), view-dependent layers
+  // (a frame's layer depends on every frame before it), the background model dividing out
+  // the frame's gain (one gain over every buffer seen).
+  bool CouplesBuffers() const;
+  // Own buffers set and none coupled: frames paint only the own buffers, and a frame whose
+  // view meets none of them may be skipped (SkipFrame) without being read. Once true, stays
+  // true. Safe to read from another thread (a source reading ahead).
+  bool PaintsOwnBuffersOnly() const { return own_only_.load(); }
+  // Whether the view of `camera` at `cam_from_world` meets the bounds of some own buffer
+  // (every buffer when none set): the frustum test of the warp stage. `bounds`:
+  // ComputeNormalizedBounds(camera). Const, for a source reading ahead.
+  bool ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
+                           const Rigid3d& cam_from_world) const;
+  // A frame the source skipped (PaintsOwnBuffersOnly, its view meets no own buffer): counted
+  // as painted frames are (the frame numbers the stages and `update_every` use) and nothing
+  // else; painting it would have changed no own buffer.
+  void SkipFrame() { ++frames_seen_; }
+  // Frames painted over every buffer they see while own buffers were set (CouplesBuffers).
+  int frames_painted_whole() const { return frames_painted_whole_; }
+  const std::vector<bool>& own_buffers() const { return own_; }
+
   const std::vector<BaseBuffer>& buffers() const { return set_.buffers; }
   const std::vector<PaintedBuffer>& painted() const { return painted_; }
   // The texels of buffer b that the last frame's background stage kept out of painting
@@ -239,6 +269,11 @@ class PaintSession {
   // frame's transform (select_stages.cc). The buffer itself when the stage is off.
   cv::Mat AtMeanExposure(const cv::Mat& bgra) const;
 
+  // Sharded painting (SetOwnBuffers): the own buffers, and whether only they are painted.
+  void UpdateOwnOnly() { own_only_.store(own_only_.load() || (!own_.empty() && !CouplesBuffers())); }
+  std::vector<bool> own_;
+  std::atomic<bool> own_only_{false};
+  int frames_painted_whole_ = 0;
   const Scene* scene_ = nullptr;
   PipelineOptions options_;
   RefineMode requested_refine_ = RefineMode::kOff;  // as given (auto resolves in options_)

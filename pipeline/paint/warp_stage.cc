@@ -42,8 +42,10 @@ void PaintSession::WarpStage(FrameWork* work) {
   // clearing their warped images: later stages look only at buffers seen).
   std::vector<size_t>& in_frustum = work->in_frustum;
   in_frustum.clear();
+  const bool own_only = own_only_.load();  // sharded: only the shard's buffers (SetOwnBuffers)
   for (size_t b = 0; b < set_.buffers.size(); ++b)
-    if (!BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view,
+    if ((!own_only || own_[b]) &&
+        !BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view,
                            warp_options.near_m))
       in_frustum.push_back(b);
   // When no stage looks at the warped samples before the paint stage (paint_stages.h) and no

@@ -4,12 +4,22 @@
 
 namespace fresco {
 
-FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams)
+FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
+                                 SkipFrame skip)
     : streams_(streams), ended_(streams.size(), false), read_(streams.size(), 0) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < streams_.size(); ++s) {
     origins_.push_back({project.Resolve(specs[s].video), project.Resolve(specs[s].poses)});
-    readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get()));
+    std::function<bool(const Frame&)> skip_frame;
+    if (skip)
+      skip_frame = [this, s, skip](const Frame& header) {
+        SourcedFrame f;
+        f.posed.frame = header;
+        f.stream = static_cast<int>(s);
+        MatchPose(static_cast<int>(s), &f);
+        return f.posed.has_pose && f.camera && skip(f);
+      };
+    readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get(), skip_frame));
     fps_.push_back(specs[s].fps);
   }
   if (std::any_of(fps_.begin(), fps_.end(), [](double fps) { return !(fps > 0); })) fps_.clear();
@@ -43,7 +53,7 @@ int FileFrameSource::FrameCount() const {
 
 FrameRead FileFrameSource::Next(SourcedFrame* frame, Status* status) {
   for (int s = PickStream(); s >= 0; s = PickStream()) {
-    if (!readers_[s]->Next(&frame->posed.frame, status)) {
+    if (!readers_[s]->Next(&frame->posed.frame, status, &frame->skipped)) {
       if (!status->ok()) return FrameRead::kEnded;
       ended_[s] = true;
       continue;

@@ -7,6 +7,7 @@
 // thread (read_ahead.h).
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -21,7 +22,12 @@ class FileFrameSource : public PosedFrameSource {
  public:
   // `streams[i]`: stream i of `project` (Project::Streams() order) loaded with its video
   // open (LoadCapture); each must outlive the source.
-  FileFrameSource(const Project& project, const std::vector<const Capture*>& streams);
+  // `skip` (optional; folders only, whose frame names are known before decoding): asked, on
+  // the reading thread, with a posed frame's header (pose, camera; no pixels); true: the frame
+  // is not read and comes out with `skipped` set.
+  using SkipFrame = std::function<bool(const SourcedFrame& header)>;
+  FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
+                  SkipFrame skip = nullptr);
 
   FrameRead Next(SourcedFrame* frame, Status* status) override;
   int NumStreams() const override { return static_cast<int>(streams_.size()); }

@@ -24,6 +24,8 @@ enum class FrameFate {
   kPaint,    // posed, its camera known, its size the camera's
   kNoPose,   // skipped and counted
   kHeldOut,  // posed, but held out of painting (`fresco bench` scores it; PaintRunOptions)
+  kSkipped,  // a shard's frame whose view meets none of its buffers: not read, not painted
+
 };
 
 // kPaint or kNoPose, or an error naming `origin`'s file and the frame.

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <future>
 #include <map>
+#include <memory>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -197,12 +198,33 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
   seconds.cameras = SecondsSince(start) - seconds.load;
+  if (options.shard.sharded() && j.live)
+    return Status::Error(project.file_path +
+                         ": --shard paints captures from files (a live stream cannot be split)");
   if (!j.live) {
     if (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background))
       FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
-    j.source = std::make_unique<FileFrameSource>(project, streams);
+    FileFrameSource::SkipFrame skip;
+    if (options.shard.sharded()) {
+      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), options.shard.count);
+      std::vector<bool> own(j.buffer_shard.size());
+      for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
+      j.session->SetOwnBuffers(std::move(own));
+      // Each camera's frustum bounds, computed here: the skip runs on the reading threads.
+      auto bounds = std::make_shared<std::map<const Camera*, NormalizedBounds>>();
+      for (const Capture& capture : j.captures)
+        for (const auto& [id, camera] : capture.cameras)
+          (*bounds)[&camera] = ComputeNormalizedBounds(camera);
+      const PaintSession* session = j.session.get();
+      skip = [session, bounds](const SourcedFrame& f) {
+        const auto it = bounds->find(f.camera);
+        return it != bounds->end() && session->PaintsOwnBuffersOnly() &&
+               !session->ViewMeetsOwnBuffers(*f.camera, it->second, f.posed.cam_from_world);
+      };
+    }
+    j.source = std::make_unique<FileFrameSource>(project, streams, skip);
     seconds.total = SecondsSince(start);
     *job = std::move(result);
     return Status::Ok();

@@ -19,6 +19,7 @@
 #include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
 #include "pipeline/run/posed_frame_source.h"
+#include "pipeline/run/shard.h"
 
 namespace fresco {
 
@@ -50,6 +51,10 @@ struct PaintJobOptions {
   // of its given ones: what exact poses would give (`fresco eval --recovery`). A pose without
   // a true one of its name keeps the given pose.
   bool paint_at_truth_poses = false;
+  // Paint only shard `shard.index` of `shard.count` (shard.h; captures from files only): the
+  // session paints that shard's buffers and the source skips, unread, the frames whose view
+  // meets none of them (folders; a video file's frames are decoded still).
+  ShardSpec shard;
 };
 
 struct PaintJob {
@@ -64,6 +69,8 @@ struct PaintJob {
   // background.mode auto: the movers found across views before painting, which decided it
   // (`masks` is empty).
   std::optional<MoverMaskResult> mover_masks;
+  // Sharded (PaintJobOptions::shard): the shard of every buffer (AssignBuffersToShards).
+  std::vector<int> buffer_shard;
   // Where opening the job spent its wall time, seconds (what a user waits for before the
   // first frame paints; `fresco run` reports them in metrics.json's "wall").
   struct OpenSeconds {

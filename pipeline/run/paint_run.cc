@@ -50,6 +50,13 @@ FrameRead PaintRun::Next(RunFrame* frame) {
   frame->counter = stats_.frames++;
   StreamRunStats& stream = stats_.streams[frame->stream];
   ++stream.frames;
+  if (frame->skipped) {  // a shard's frame that meets none of its buffers (shard.h)
+    frame->fate = FrameFate::kSkipped;
+    ++stats_.frames_skipped;
+    ++stream.skipped;
+    if (session_) session_->SkipFrame();
+    return End(FrameRead::kFrame);
+  }
   status_ = ApplyFramePolicy(*frame, source_->Origin(frame->stream), &frame->fate);
   if (!status_.ok()) return End(FrameRead::kEnded);
   const int every = options_.holdout_every;

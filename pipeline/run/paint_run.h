@@ -53,6 +53,7 @@ struct StreamRunStats {
   int frames = 0;
   int painted = 0;
   int without_pose = 0;
+  int skipped = 0;  // a shard's frames not read: their view meets none of its buffers
   // Summed over the stream's painted frames (BackgroundFigures; 0 when the stage was off).
   long long texels_observed = 0;  // texels the background stage classified
   long long texels_masked = 0;    // ... masked as foreground
@@ -68,6 +69,7 @@ struct PaintRunStats {
   int frames_painted = 0;               // painted (PaintSession said so: FrameReport::painted)
   int frames_without_pose = 0;          // skipped for want of a pose
   int frames_held_out = 0;              // held out of painting (PaintRunOptions::holdout_every)
+  int frames_skipped = 0;               // a shard's frames not read (FrameFate::kSkipped)
   double seconds = 0.0;                 // wall time from the first read to the last
   std::vector<StreamRunStats> streams;  // per stream, in Project::Streams() order
   // Per stage: milliseconds summed over the painted frames.

@@ -25,6 +25,9 @@ struct SourcedFrame {
   std::string pose_name;           // the pose's image name as the poses file lists it
   int pose_index = -1;             // index into the stream's Capture::poses (file sources)
   int stream = 0;                  // index into Project::Streams()
+  // Passed over unread (no pixels): a shard's source skips the frames whose view meets none
+  // of its buffers (FileFrameSource's `skip`).
+  bool skipped = false;
 };
 
 // The files (or addresses) one stream's frames and poses come from, as messages name them.

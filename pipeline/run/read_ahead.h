@@ -3,6 +3,7 @@
 // starts reading the one after it.
 #pragma once
 
+#include <functional>
 #include <future>
 #include <utility>
 
@@ -13,7 +14,13 @@ namespace fresco {
 
 class ReadAhead {
  public:
-  explicit ReadAhead(VideoSource* video) : video_(video) { Start(); }
+  // `skip` (optional): asked with the next frame's header (index, name, timestamp; no
+  // pixels) where the source knows it before decoding (VideoSource::PeekNext); true: the
+  // frame is passed over unread and handed out without pixels, as skipped.
+  explicit ReadAhead(VideoSource* video, std::function<bool(const Frame&)> skip = nullptr)
+      : video_(video), skip_(std::move(skip)) {
+    Start();
+  }
   ~ReadAhead() {
     if (pending_.valid()) pending_.wait();
   }
@@ -21,12 +28,14 @@ class ReadAhead {
   ReadAhead& operator=(const ReadAhead&) = delete;
 
   // False at the end of the video, or on an error (then in `status`); stays so after it.
-  bool Next(Frame* frame, Status* status) {
+  // `skipped` (optional): set when the frame was passed over unread (the `skip` above).
+  bool Next(Frame* frame, Status* status, bool* skipped = nullptr) {
     if (!pending_.valid()) return false;
     Result r = pending_.get();
     *status = r.status;
     if (!r.ok) return false;
     *frame = std::move(r.frame);
+    if (skipped) *skipped = r.skipped;
     Start();
     return true;
   }
@@ -34,17 +43,24 @@ class ReadAhead {
  private:
   struct Result {
     bool ok = false;
+    bool skipped = false;
     Frame frame;
     Status status;
   };
   void Start() {
     pending_ = std::async(std::launch::async, [this] {
       Result r;
+      if (skip_ && video_->PeekNext(&r.frame) && skip_(r.frame)) {
+        video_->SkipNext();
+        r.ok = r.skipped = true;
+        return r;
+      }
       r.ok = video_->Next(&r.frame, &r.status);
       return r;
     });
   }
   VideoSource* video_;
+  std::function<bool(const Frame&)> skip_;
   std::future<Result> pending_;
 };
 

@@ -40,6 +40,8 @@ HEAD
 "$fresco" --help
 printf '```\n\n`fresco --version` prints `fresco X.Y.Z`.\n\n'
 block "fresco run" run
+block "fresco merge" merge
+block "fresco slurm" slurm
 block "fresco render" render
 block "fresco synth" synth
 block "fresco group" group

@@ -1,0 +1,253 @@
+#include "pipeline/run/merge_parts.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "pipeline/core/atomic_file.h"
+
+namespace fresco {
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+struct Part {
+  std::string dir;
+  Json metrics;
+  int index = -1, count = 0;
+  std::vector<std::string> files;  // every file of the part but metrics.json, sorted
+};
+
+Status ReadPart(const std::string& dir, Part* part) {
+  part->dir = dir;
+  const std::string path = dir + "/metrics.json";
+  std::string text;
+  if (!fs::is_directory(dir)) return Status::Error(dir + ": not a folder (a shard's part)");
+  if (!fs::exists(path))
+    return Status::Error(path + ": missing (not a finished part of `fresco run --shard`)");
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &text));
+  part->metrics = Json::parse(text, nullptr, false);
+  if (part->metrics.is_discarded()) return Status::Error(path + ": not valid JSON");
+  const Json& shard = part->metrics.contains("shard") ? part->metrics["shard"] : Json();
+  if (!shard.is_object() || !shard.contains("index") || !shard.contains("count") ||
+      !shard.contains("page_rects") || !shard.contains("buffers"))
+    return Status::Error(path + ": shard: missing (not written by `fresco run --shard I/N`)");
+  part->index = shard["index"].get<int>();
+  part->count = shard["count"].get<int>();
+  for (const fs::directory_entry& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && e.path().filename() != "metrics.json")
+      part->files.push_back(e.path().filename().string());
+  std::sort(part->files.begin(), part->files.end());
+  return Status::Ok();
+}
+
+// The parts in shard order, checked: one project and settings, every shard once.
+Status CheckParts(std::vector<Part>* parts) {
+  const Part& first = parts->front();
+  const Json& a = first.metrics["shard"];
+  std::map<int, std::string> seen;
+  for (const Part& part : *parts) {
+    const Json& b = part.metrics["shard"];
+    const std::string where = part.dir + "/metrics.json: shard.";
+    if (b["project"] != a["project"])
+      return Status::Error(where + "project: " + b["project"].dump() + ", but " + first.dir +
+                           " is a part of " + a["project"].dump());
+    if (b["settings_hash"] != a["settings_hash"])
+      return Status::Error(where + "settings_hash: painted with other settings than " +
+                           first.dir + " (" + b["settings_hash"].dump() + " against " +
+                           a["settings_hash"].dump() + ")");
+    if (part.count != first.count)
+      return Status::Error(where + "count: " + std::to_string(part.count) + " shards, but " +
+                           first.dir + " is one of " + std::to_string(first.count));
+    if (part.index < 0 || part.index >= part.count)
+      return Status::Error(where + "index: " + std::to_string(part.index) + " out of 0.." +
+                           std::to_string(part.count - 1));
+    if (const auto it = seen.find(part.index); it != seen.end())
+      return Status::Error(part.dir + ": shard " + std::to_string(part.index) + " of " +
+                           std::to_string(part.count) + " repeated (also " + it->second + ")");
+    seen[part.index] = part.dir;
+  }
+  for (int i = 0; i < first.count; ++i)
+    if (!seen.count(i))
+      return Status::Error("shard " + std::to_string(i) + " of " + std::to_string(first.count) +
+                           " missing (parts given: " + std::to_string(parts->size()) + ")");
+  std::sort(parts->begin(), parts->end(),
+            [](const Part& x, const Part& y) { return x.index < y.index; });
+  return Status::Ok();
+}
+
+bool IsTexture(const std::string& name) {
+  return name.size() > 4 && name.compare(name.size() - 4, 4, ".png") == 0;
+}
+
+// The files every part must hold alike (painted.gltf, its .bin: the layout), checked.
+Status CheckSameLayout(const std::vector<Part>& parts) {
+  const Part& first = parts.front();
+  std::map<std::string, std::string> contents;
+  for (const std::string& name : first.files) {
+    if (IsTexture(name)) continue;
+    FRESCO_RETURN_IF_ERROR(ReadFileToString(first.dir + "/" + name, &contents[name]));
+  }
+  for (const Part& part : parts) {
+    if (part.files != first.files)
+      return Status::Error(part.dir + ": holds other files than " + first.dir +
+                           " (not parts of one run)");
+    for (const auto& [name, text] : contents) {
+      std::string other;
+      FRESCO_RETURN_IF_ERROR(ReadFileToString(part.dir + "/" + name, &other));
+      if (other != text)
+        return Status::Error(part.dir + "/" + name + ": differs from " + first.dir + "/" + name +
+                             " (not parts of one layout)");
+    }
+  }
+  return Status::Ok();
+}
+
+// Texture file `name` (painted_textureT.png): each shard's rectangles on its page.
+Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int num_pages,
+                   const std::string& out_path) {
+  const size_t end = name.size() - 4;  // before ".png"
+  const size_t first = name.find_last_not_of("0123456789", end - 1) + 1;
+  if (first >= end) return Status::Error(parts.front().dir + "/" + name + ": not a page's name");
+  const int texture = std::stoi(name.substr(first, end - first));
+  const int page = num_pages > 0 ? texture % num_pages : 0;
+  cv::Mat joined;
+  for (const Part& part : parts) {
+    const std::string path = part.dir + "/" + name;
+    cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (image.empty()) return Status::Error(path + ": cannot read the PNG");
+    if (joined.empty()) joined = image;
+    if (image.size() != joined.size() || image.type() != joined.type())
+      return Status::Error(path + ": page size differs from " + parts.front().dir + "'s");
+    for (const Json& r : part.metrics["shard"]["page_rects"]) {
+      if (r[0].get<int>() != page) continue;
+      const cv::Rect rect(r[1].get<int>(), r[2].get<int>(), r[3].get<int>(), r[4].get<int>());
+      if ((rect & cv::Rect(cv::Point(), image.size())) != rect)
+        return Status::Error(part.dir + "/metrics.json: shard.page_rects: a rectangle outside " +
+                             name);
+      image(rect).copyTo(joined(rect));
+    }
+  }
+  std::vector<unsigned char> png;
+  if (!cv::imencode(".png", joined, png)) return Status::Internal(out_path + ": PNG encoding failed");
+  return WriteFileAtomic(out_path, std::string(png.begin(), png.end()));
+}
+
+double Number(const Json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : 0.0;
+}
+
+// metrics.json of the joined run (see the header).
+Json JoinMetrics(const std::vector<Part>& parts, MergeResult* result) {
+  Json m = parts.front().metrics;
+  m.erase("shard");
+  m.erase("frames_skipped");
+  // Each buffer's figures from the shard that painted it.
+  long long painted = 0;
+  for (const Part& part : parts)
+    for (const Json& b : part.metrics["shard"]["buffers"]) {
+      const size_t id = b.get<size_t>();
+      m["buffers"][id] = part.metrics["buffers"][id];
+      painted += part.metrics["buffers"][id]["painted"].get<long long>();
+    }
+  const long long texels = m["texels"].get<long long>();
+  m["texels_painted"] = painted;
+  m["coverage"] = texels > 0 ? static_cast<double>(painted) / texels : 0.0;
+  // Frames: every shard read (or skipped) every frame; a frame is painted where some shard
+  // painted it (the most any shard painted, with the frames it skipped, as one run paints).
+  int frames_painted = 0;
+  for (const Part& part : parts)
+    frames_painted = std::max(
+        frames_painted, part.metrics["frames_painted"].get<int>() +
+                            static_cast<int>(Number(part.metrics["shard"], "frames_skipped")));
+  m["frames_painted"] = frames_painted;
+  for (size_t s = 0; s < m["streams"].size(); ++s) {
+    int most = 0;
+    for (const Part& part : parts) {
+      const Json& stream = part.metrics["streams"][s];
+      most = std::max(most, stream["frames_painted"].get<int>() +
+                                static_cast<int>(Number(stream, "frames_skipped")));
+    }
+    m["streams"][s]["frames_painted"] = most;
+    m["streams"][s].erase("frames_skipped");
+  }
+  // Time: the slowest shard's painting loop; stage times per frame summed over the shards.
+  double seconds = 0, cpu = 0, rss = 0, wall = 0;
+  std::map<std::string, double> stage_sum;
+  Json shards = Json::array();
+  for (const Part& part : parts) {
+    const Json& pm = part.metrics;
+    seconds = std::max(seconds, Number(pm, "seconds"));
+    cpu += Number(pm["shard"], "cpu_seconds");
+    if (pm.contains("peak_rss_mb")) rss = std::max(rss, Number(pm["peak_rss_mb"], "painting"));
+    if (pm.contains("wall") && Number(pm["wall"], "seconds") >= wall) {
+      wall = Number(pm["wall"], "seconds");
+      m["wall"] = pm["wall"];
+    }
+    for (const auto& [stage, ms] : pm["stage_ms"].items())
+      stage_sum[stage] += ms.get<double>() * pm["frames_painted"].get<int>();
+    Json shard = pm["shard"];
+    shard.erase("page_rects");
+    shard["buffers"] = pm["shard"]["buffers"].size();
+    shard["part"] = part.dir;
+    shard["seconds"] = Number(pm, "seconds");
+    shard["frames_painted"] = pm["frames_painted"];
+    if (pm.contains("peak_rss_mb")) shard["peak_rss_mb"] = pm["peak_rss_mb"];
+    if (pm.contains("wall")) shard["wall_seconds"] = pm["wall"]["seconds"];
+    shards.push_back(shard);
+    result->mean_shard_seconds += Number(pm, "seconds") / parts.size();
+  }
+  m["seconds"] = seconds;
+  const int frames = m["frames"].get<int>();
+  m["fps"] = seconds > 0 ? frames / seconds : 0.0;
+  m["paint_fps"] = seconds > 0 ? frames_painted / seconds : 0.0;
+  for (const auto& [stage, sum] : stage_sum)
+    m["stage_ms"][stage] = frames_painted > 0 ? sum / frames_painted : 0.0;
+  if (m.contains("peak_rss_mb")) m["peak_rss_mb"]["painting"] = rss;
+  m["shards"] = shards;
+  m["merge"] = {{"shards", parts.size()},
+                {"cpu_seconds", cpu},
+                {"largest_shard_seconds", seconds},
+                {"mean_shard_seconds", result->mean_shard_seconds}};
+  result->cpu_seconds = cpu;
+  result->largest_shard_seconds = seconds;
+  return m;
+}
+
+}  // namespace
+
+Status MergeParts(const std::vector<std::string>& part_dirs, const std::string& out_dir,
+                  MergeResult* result) {
+  if (part_dirs.empty()) return Status::Error("fresco merge: no parts given");
+  std::vector<Part> parts(part_dirs.size());
+  for (size_t i = 0; i < part_dirs.size(); ++i)
+    FRESCO_RETURN_IF_ERROR(ReadPart(part_dirs[i], &parts[i]));
+  FRESCO_RETURN_IF_ERROR(CheckParts(&parts));
+  FRESCO_RETURN_IF_ERROR(CheckSameLayout(parts));
+  *result = MergeResult();
+  result->shards = static_cast<int>(parts.size());
+  const int num_pages = parts.front().metrics["atlas"]["pages"].get<int>();
+  FRESCO_RETURN_IF_ERROR(MakeDirectories(out_dir));
+  StagedFolder outputs;
+  FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
+  for (const std::string& name : parts.front().files) {
+    const std::string to = outputs.path() + "/" + name;
+    if (IsTexture(name)) {
+      FRESCO_RETURN_IF_ERROR(JoinTexture(parts, name, num_pages, to));
+      ++result->textures;
+      continue;
+    }
+    std::string contents;
+    FRESCO_RETURN_IF_ERROR(ReadFileToString(parts.front().dir + "/" + name, &contents));
+    FRESCO_RETURN_IF_ERROR(WriteFileAtomic(to, contents));
+  }
+  const Json metrics = JoinMetrics(parts, result);
+  FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
+  return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
+}
+
+}  // namespace fresco

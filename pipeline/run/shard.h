@@ -1,0 +1,33 @@
+// Painting one project in shards (`fresco run --shard I/N`, `fresco merge`, `fresco slurm`):
+// the atlas is laid out once from the whole mesh, identically in every shard; each shard
+// paints the buffers (charts) assigned to it, balanced by their texels, and skips the frames
+// whose view meets none of them before reading them. Whole-capture decisions (the joint pose
+// adjustment, the movers found across views, the `auto` modes) are taken by every shard over
+// the whole capture, the same way, and while a frame's outcome in one buffer depends on the
+// others a shard paints every buffer (PaintSession::CouplesBuffers): so the shards' buffers,
+// joined, are exactly those of one run.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/core/status.h"
+#include "pipeline/paint/base_buffer.h"
+
+namespace fresco {
+
+struct ShardSpec {
+  int index = 0;  // 0 <= index < count
+  int count = 0;  // 0: not sharded
+  bool sharded() const { return count > 0; }
+};
+
+// Reads "I/N" (0 <= I < N, N >= 1): an error naming `what` (e.g. "--shard") and the value.
+Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpec* spec);
+
+// The shard each buffer goes to (size: buffers): the largest buffers first (surface texels,
+// then id), each to the shard holding the fewest texels so far (the lowest index at a tie).
+// Deterministic: every shard computes the same assignment.
+std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers, int count);
+
+}  // namespace fresco
