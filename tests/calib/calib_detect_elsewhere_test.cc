@@ -125,8 +125,8 @@ TEST(ElsewhereBoardTest, ArucoReadsTheTagsWhereTheTruthPutsThem) {
 // library's own tag images) have a 1-bit border: the library decoded almost none of their
 // tags and aruco, asked for 2 bits, few. Measured before the fix with calib_detect_elsewhere
 // --border-bits 1 (seed 1, 40 views a variant): 5 of 80 views lost, 288 of 1440 tags read.
-// Here (one view a variant, 12 views): 12 used, 432 of 432 tags read; their corners 0.13 px
-// rms sharp, 0.23 px blurred + JPEG (a thin border: the tag's bits blur into it).
+// Here (one view a variant, 12 views): 12 used, 432 of 432 tags read; their corners 0.15 px
+// rms sharp, 0.22 px blurred + JPEG (a thin border: the tag's bits blur into it).
 TEST(ElsewhereDetectTest, TagsWithAOneBitBorderAreRead) {
   const Counts c = Detect(1, DetectOptions());
   EXPECT_EQ(c.lost, 0);
@@ -136,7 +136,7 @@ TEST(ElsewhereDetectTest, TagsWithAOneBitBorderAreRead) {
   EXPECT_LT(c.corner_rms_px[0], 0.16);
   EXPECT_LT(c.corner_rms_px[1], 0.3);
   EXPECT_GT(c.corner_out_px[0], -0.05);
-  EXPECT_GT(c.corner_out_px[1], -0.1);
+  EXPECT_LT(std::abs(c.corner_out_px[1]), 0.05);
   // The apriltag library alone reads them too.
   ElsewhereBoard board;
   board.border_bits = 1;
@@ -153,7 +153,10 @@ TEST(ElsewhereDetectTest, TagsWithAOneBitBorderAreRead) {
 // Kalibr's 2-bit border without the crossing squares: no view lost, every tag read; the
 // corners where the tag's edges meet, not pulled into the tag. Before the corner fix
 // (cornerSubPix's saddle) 0.223 px rms sharp, 0.33 px blurred + JPEG, 0.17 / 0.31 px into the
-// tag (calib_detect_elsewhere, seed 1); now 0.12 / 0.16 px, 0.02 / 0.06 px.
+// tag (calib_detect_elsewhere, seed 1). Here: 0.12 / 0.16 px, 0.02 / 0.064 px into the tag
+// with the edges' crossings halfway between each cut's own ends (small blurred tags: see
+// tests/calib/tag_corner_edges_test.cc); halfway between the edge's levels 0.12 / 0.14 px,
+// 0.02 / 0.03 px.
 TEST(ElsewhereDetectTest, KalibrBorderWithoutCrossingSquaresLosesNoView) {
   const Counts c = Detect(2, DetectOptions());
   EXPECT_EQ(c.lost, 0);
@@ -161,9 +164,9 @@ TEST(ElsewhereDetectTest, KalibrBorderWithoutCrossingSquaresLosesNoView) {
   EXPECT_GE(c.tags, 0.97 * c.views * 36);
   EXPECT_GE(c.corners[0] + c.corners[1], 0.95 * c.tags * 4);
   EXPECT_LT(c.corner_rms_px[0], 0.15);
-  EXPECT_LT(c.corner_rms_px[1], 0.2);
+  EXPECT_LT(c.corner_rms_px[1], 0.16);
   EXPECT_GT(c.corner_out_px[0], -0.05);
-  EXPECT_GT(c.corner_out_px[1], -0.1);
+  EXPECT_GT(c.corner_out_px[1], -0.05);
 }
 
 // The report says what each detector read in each image, and warns when an image is

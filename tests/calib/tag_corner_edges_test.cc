@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <opencv2/aruco.hpp>
@@ -89,12 +90,12 @@ struct Errors {
   int corners = 0, from_edges = 0, crossing_squares = 0;
 };
 
-// Over tags of 40-96 px at several turns: cornerSubPix's corners, and the edges' meeting
+// Over tags of `sizes_px` at several turns: cornerSubPix's corners, and the edges' meeting
 // point started from them (as the detector does).
-Errors Measure(double blur_sigma_px) {
+Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 64, 96}) {
   Errors e;
   unsigned seed = 1;
-  for (double edge_px : {40.0, 64.0, 96.0})
+  for (double edge_px : sizes_px)
     for (double turn_rad : {0.05, 0.4, 0.9, 1.3}) {
       const Tag tag = Render(edge_px, turn_rad, blur_sigma_px, seed++);
       const std::array<Eigen::Vector2d, 4> saddle = CornerSubPix(tag);
@@ -116,9 +117,11 @@ Errors Measure(double blur_sigma_px) {
   e.saddle_rms_px = std::sqrt(e.saddle_rms_px / n), e.edges_rms_px = std::sqrt(e.edges_rms_px / n);
   e.saddle_out_px /= n, e.edges_out_px /= n;
   std::printf(
-      "blur %.1f px: %d corners, cornerSubPix %.3f px rms (out %.3f), edges %.3f px rms "
+      "blur %.1f px, tags %.0f-%.0f px: %d corners, cornerSubPix %.3f px rms (out %.3f), edges "
+      "%.3f px rms "
       "(out %.3f)\n",
-      blur_sigma_px, e.corners, e.saddle_rms_px, e.saddle_out_px, e.edges_rms_px, e.edges_out_px);
+      blur_sigma_px, sizes_px.front(), sizes_px.back(), e.corners, e.saddle_rms_px, e.saddle_out_px,
+      e.edges_rms_px, e.edges_out_px);
   return e;
 }
 
@@ -141,6 +144,18 @@ TEST(TagCornerEdgesTest, BlurredCornerWhereTheEdgesMeet) {
   EXPECT_GT(e.saddle_rms_px, 0.2);
   EXPECT_LT(e.saddle_out_px, -0.15);
   EXPECT_LT(e.edges_rms_px, 0.15);
+  EXPECT_LT(std::abs(e.edges_out_px), 0.05);
+}
+
+// Small tags blurred 1 px: a cut across the edge a few pixels long does not reach the
+// border's black (nor, a 1-bit border of 3-4 px, past the tag's bits behind it), so halfway
+// between its own ends put the edge 0.13 px into a 24-32 px tag on average (0.17 px rms);
+// halfway between the edge's dark and light levels: 0.06 px rms, 0.01 px out.
+TEST(TagCornerEdgesTest, SmallBlurredTagCornerNotPulledIn) {
+  const Errors e = Measure(1, {24, 32});
+  EXPECT_EQ(e.crossing_squares, 0);
+  EXPECT_EQ(e.corners, 32);
+  EXPECT_LT(e.edges_rms_px, 0.1);
   EXPECT_LT(std::abs(e.edges_out_px), 0.05);
 }
 
