@@ -13,6 +13,9 @@ constexpr double kFirst = 0.06, kLast = 0.4;  // the part of the edge used, from
 constexpr double kStepPx = 0.25;              // along the normal
 constexpr double kMinContrastGrey = 20;       // an edge weaker than this is not trusted
 constexpr int kMinPoints = 5;
+constexpr double kNone = 1e9;  // no crossing
+// The second sampling reaches this far to each side of the edge: past a 1 px blur's ramp.
+constexpr double kPlateauPx = 3;
 
 // Bilinear grey at (x, y); -1 outside the image.
 double Grey(const cv::Mat& gray, double x, double y) {
@@ -25,42 +28,88 @@ double Grey(const cv::Mat& gray, double x, double y) {
          fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
 }
 
+// The grey along `normal` through `base`, at offsets centre - half_px .. centre + half_px
+// every kStepPx; false when it leaves the image.
+bool Profile(const cv::Mat& gray, const Eigen::Vector2d& base, const Eigen::Vector2d& normal,
+             double centre, double half_px, std::vector<double>* grey) {
+  const int steps = static_cast<int>(std::lround(2 * half_px / kStepPx));
+  grey->resize(steps + 1);
+  for (int i = 0; i <= steps; ++i) {
+    const Eigen::Vector2d q = base + (centre - half_px + i * kStepPx) * normal;
+    (*grey)[i] = Grey(gray, q.x(), q.y());
+    if ((*grey)[i] < 0) return false;
+  }
+  return true;
+}
+
+// Where `grey` (Profile's, half_px each side) crosses `level`, as an offset from its middle:
+// the crossing nearest the middle; kNone when none.
+double Crossing(const std::vector<double>& grey, double half_px, double level) {
+  double best = kNone;
+  for (size_t i = 0; i + 1 < grey.size(); ++i) {
+    if ((grey[i] - level) * (grey[i + 1] - level) > 0 || grey[i] == grey[i + 1]) continue;
+    const double at = -half_px + (i + (level - grey[i]) / (grey[i + 1] - grey[i])) * kStepPx;
+    if (std::abs(at) < std::abs(best)) best = at;
+  }
+  return best;
+}
+
+// The q-quantile of `values` (0 <= q <= 1); `values` is reordered.
+double Quantile(std::vector<double>* values, double q) {
+  const size_t k = static_cast<size_t>(q * (values->size() - 1));
+  std::nth_element(values->begin(), values->begin() + k, values->end());
+  return (*values)[k];
+}
+
 // The edge from `from` towards `to` near `from`, as a point on it and its direction; false
 // when too few points show an edge.
+//
+// Each cut across the edge is first placed where its grey crosses halfway between its own
+// darkest and lightest samples, then sampled again centred there and placed where it crosses
+// halfway between the edge's dark and light levels: the darkest quarter of the cuts' inner
+// ends and the lightest quarter of their outer ends, kPlateauPx or more from the edge. A cut's
+// own ends are not the levels on a small blurred tag: centred on a chord pulled into the tag,
+// or reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
+// border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
+// 1 px); the border's black shows where the bits behind it are black too.
 bool EdgeLine(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
               Eigen::Vector2d* point, Eigen::Vector2d* direction) {
   const double length = (to - from).norm();
   if (length < 8) return false;
   const Eigen::Vector2d along = (to - from) / length, normal(-along.y(), along.x());
   const double reach = std::clamp(0.08 * length, 1.5, 4.0);
-  const int steps = static_cast<int>(2 * reach / kStepPx);
-  std::vector<Eigen::Vector2d> points;
-  std::vector<double> profile(steps + 1);
+  const double half = std::max(reach, kPlateauPx);  // the second sampling, each side
+  struct Cut {
+    Eigen::Vector2d base;
+    double first = 0;  // the crossing, along `normal` from base
+    std::vector<double> grey;
+  };
+  std::vector<Cut> cuts;
+  std::vector<double> dark_ends, light_ends, grey;
   for (double t = std::max(kFirst, (reach + 1.5) / length); t <= kLast; t += 1.0 / length) {
-    const Eigen::Vector2d base = from + t * length * along;
-    bool inside = true;
-    for (int i = 0; i <= steps && inside; ++i) {
-      const Eigen::Vector2d q = base + (-reach + i * kStepPx) * normal;
-      profile[i] = Grey(gray, q.x(), q.y());
-      inside = profile[i] >= 0;
-    }
-    if (!inside) continue;
-    // Where the grey crosses halfway between the profile's dark and light ends (unbiased for a
-    // symmetric blur), the crossing nearest the chord.
-    const double lo = *std::min_element(profile.begin(), profile.end());
-    const double hi = *std::max_element(profile.begin(), profile.end());
+    Cut cut;
+    cut.base = from + t * length * along;
+    if (!Profile(gray, cut.base, normal, 0, reach, &grey)) continue;
+    const double lo = *std::min_element(grey.begin(), grey.end());
+    const double hi = *std::max_element(grey.begin(), grey.end());
     if (hi - lo < kMinContrastGrey) continue;
-    const double half = 0.5 * (lo + hi);
-    double best = -1, best_off = 1e9;
-    for (int i = 0; i < steps; ++i) {
-      if ((profile[i] - half) * (profile[i + 1] - half) > 0 || profile[i] == profile[i + 1])
-        continue;
-      const double at = i + (half - profile[i]) / (profile[i + 1] - profile[i]);
-      const double off = std::abs(-reach + at * kStepPx);
-      if (off < best_off) best_off = off, best = at;
-    }
-    if (best < 0) continue;
-    points.push_back(base + (-reach + best * kStepPx) * normal);
+    cut.first = Crossing(grey, reach, 0.5 * (lo + hi));
+    if (cut.first == kNone || !Profile(gray, cut.base, normal, cut.first, half, &cut.grey))
+      continue;
+    const int n = static_cast<int>(cut.grey.size()), ends = std::max(1, n / 6);
+    double a = 0, b = 0;
+    for (int i = 0; i < ends; ++i) a += cut.grey[i], b += cut.grey[n - 1 - i];
+    dark_ends.push_back(std::min(a, b) / ends);
+    light_ends.push_back(std::max(a, b) / ends);
+    cuts.push_back(std::move(cut));
+  }
+  if (static_cast<int>(cuts.size()) < kMinPoints) return false;
+  const double dark = Quantile(&dark_ends, 0.25), light = Quantile(&light_ends, 0.75);
+  if (light - dark < kMinContrastGrey) return false;
+  std::vector<Eigen::Vector2d> points;
+  for (const Cut& cut : cuts) {
+    const double second = Crossing(cut.grey, half, 0.5 * (dark + light));
+    if (second != kNone) points.push_back(cut.base + (cut.first + second) * normal);
   }
   if (static_cast<int>(points.size()) < kMinPoints) return false;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();

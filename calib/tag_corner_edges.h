@@ -5,8 +5,9 @@
 // cornerSubPix pulls into the tag (0.17 px sharp, 0.31 px blurred 1 px: the tag shrinks
 // against the board's pitch, and a solve takes that for lens distortion). There the corner
 // is the meeting point of the tag's two edges: each edge located to sub-pixel along its
-// normal (the steepest grey gradient) over the part of the edge near the corner, fitted by a
-// line, and the two lines intersected.
+// normal (where the grey crosses halfway between the edge's dark and light levels, taken
+// 2.5 px or more to either side, so that blur moves it neither way) over the part of the edge
+// near the corner, fitted by a line, and the two lines intersected.
 #pragma once
 
 #include <array>

@@ -1,0 +1,173 @@
+// A tag corner where no black square is (calib/tag_corner_edges.h), on one synthetic tag36h11
+// tag: OpenCV's marker (1-bit border) warped by a homography onto a white gap at 8 x 8
+// samples a pixel (box-filtered: each pixel the mean grey over its area), then optionally
+// blurred, with grey noise. The corners are known exactly; the detector's earlier refinement
+// (cv::cornerSubPix, which looks for a saddle) pulls these convex corners into the tag; the
+// meeting point of the tag's edges does not.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/aruco.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "calib/tag_corner_edges.h"
+
+namespace fresco::calib {
+namespace {
+
+constexpr int kImagePx = 192, kSamples = 8, kMarkerPx = 80;
+constexpr int kBlack = 25, kWhite = 235;
+
+struct Tag {
+  cv::Mat gray;                           // CV_8U
+  std::array<Eigen::Vector2d, 4> corner;  // the true corners, in order around the tag
+};
+
+// A tag of about `edge_px` turned by `turn_rad`, its corners moved up to 8 % of the edge
+// (perspective), blurred by `blur_sigma_px` (0: sharp), grey noise sigma 2.
+Tag Render(double edge_px, double turn_rad, double blur_sigma_px, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.08 * edge_px, 0.08 * edge_px);
+  Tag tag;
+  const Eigen::Vector2d centre(0.5 * kImagePx + 0.37, 0.5 * kImagePx - 0.21);
+  const double c = std::cos(turn_rad), s = std::sin(turn_rad);
+  const double unit[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  std::vector<cv::Point2f> from, to;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d u(0.5 * edge_px * unit[k][0], 0.5 * edge_px * unit[k][1]);
+    tag.corner[k] = centre + Eigen::Vector2d(c * u.x() - s * u.y(), s * u.x() + c * u.y()) +
+                    Eigen::Vector2d(jitter(rng), jitter(rng));
+    // The marker's outer corners (pixel centres at integers) and where they land in the
+    // oversampled image (pixel x there covers x_fine = kSamples x + (kSamples - 1) / 2).
+    from.emplace_back(static_cast<float>((unit[k][0] + 1) / 2 * kMarkerPx - 0.5),
+                      static_cast<float>((unit[k][1] + 1) / 2 * kMarkerPx - 0.5));
+    to.emplace_back(static_cast<float>(kSamples * tag.corner[k].x() + 0.5 * (kSamples - 1)),
+                    static_cast<float>(kSamples * tag.corner[k].y() + 0.5 * (kSamples - 1)));
+  }
+  cv::Mat marker, fine;
+  cv::aruco::drawMarker(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11), 7,
+                        kMarkerPx, marker, 1);
+  marker.convertTo(marker, CV_32F, (kWhite - kBlack) / 255.0, kBlack);
+  cv::warpPerspective(marker, fine, cv::getPerspectiveTransform(from, to),
+                      cv::Size(kSamples * kImagePx, kSamples * kImagePx), cv::INTER_LINEAR,
+                      cv::BORDER_CONSTANT, cv::Scalar(kWhite));
+  cv::Mat image;
+  cv::resize(fine, image, cv::Size(kImagePx, kImagePx), 0, 0, cv::INTER_AREA);
+  if (blur_sigma_px > 0) cv::GaussianBlur(image, image, cv::Size(0, 0), blur_sigma_px);
+  cv::Mat noise(image.size(), CV_32F);
+  cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0, 2);
+  image += noise;
+  image.convertTo(tag.gray, CV_8U);
+  return tag;
+}
+
+// The detector's refinement before the edges (calib/detect.cc): cornerSubPix, its half window
+// an eighth of the tag's shortest edge, from the true corners moved 0.6 px.
+std::array<Eigen::Vector2d, 4> CornerSubPix(const Tag& tag) {
+  double shortest = 1e9;
+  for (int k = 0; k < 4; ++k)
+    shortest = std::min(shortest, (tag.corner[(k + 1) % 4] - tag.corner[k]).norm());
+  const int half = std::clamp(static_cast<int>(shortest / 8), 2, 6);
+  std::vector<cv::Point2f> p;
+  for (int k = 0; k < 4; ++k)
+    p.emplace_back(static_cast<float>(tag.corner[k].x() + 0.6 * std::cos(k + 0.3)),
+                   static_cast<float>(tag.corner[k].y() + 0.6 * std::sin(k + 0.3)));
+  cv::cornerSubPix(tag.gray, p, cv::Size(half, half), cv::Size(-1, -1),
+                   cv::TermCriteria(cv::TermCriteria::EPS | cv::TermCriteria::COUNT, 40, 1e-3));
+  std::array<Eigen::Vector2d, 4> out;
+  for (int k = 0; k < 4; ++k) out[k] = Eigen::Vector2d(p[k].x, p[k].y);
+  return out;
+}
+
+struct Errors {
+  double saddle_rms_px = 0, edges_rms_px = 0;  // from the truth
+  double saddle_out_px = 0, edges_out_px = 0;  // mean, out of the tag (negative: into it)
+  int corners = 0, from_edges = 0, crossing_squares = 0;
+};
+
+// Over tags of `sizes_px` at several turns: cornerSubPix's corners, and the edges' meeting
+// point started from them (as the detector does).
+Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 64, 96}) {
+  Errors e;
+  unsigned seed = 1;
+  for (double edge_px : sizes_px)
+    for (double turn_rad : {0.05, 0.4, 0.9, 1.3}) {
+      const Tag tag = Render(edge_px, turn_rad, blur_sigma_px, seed++);
+      const std::array<Eigen::Vector2d, 4> saddle = CornerSubPix(tag);
+      const Eigen::Vector2d centre =
+          0.25 * (tag.corner[0] + tag.corner[1] + tag.corner[2] + tag.corner[3]);
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector2d out = (tag.corner[k] - centre).normalized();
+        Eigen::Vector2d corner;
+        e.crossing_squares += CrossingSquareAt(tag.gray, saddle, k);
+        if (!CornerFromEdges(tag.gray, saddle, k, &corner)) continue;
+        ++e.corners, ++e.from_edges;
+        e.saddle_rms_px += (saddle[k] - tag.corner[k]).squaredNorm();
+        e.edges_rms_px += (corner - tag.corner[k]).squaredNorm();
+        e.saddle_out_px += (saddle[k] - tag.corner[k]).dot(out);
+        e.edges_out_px += (corner - tag.corner[k]).dot(out);
+      }
+    }
+  const int n = std::max(1, e.corners);
+  e.saddle_rms_px = std::sqrt(e.saddle_rms_px / n), e.edges_rms_px = std::sqrt(e.edges_rms_px / n);
+  e.saddle_out_px /= n, e.edges_out_px /= n;
+  std::printf(
+      "blur %.1f px, tags %.0f-%.0f px: %d corners, cornerSubPix %.3f px rms (out %.3f), edges "
+      "%.3f px rms "
+      "(out %.3f)\n",
+      blur_sigma_px, sizes_px.front(), sizes_px.back(), e.corners, e.saddle_rms_px, e.saddle_out_px,
+      e.edges_rms_px, e.edges_out_px);
+  return e;
+}
+
+// Sharp: cornerSubPix is 0.1-0.2 px off, into the tag; the edges' meeting point well under.
+TEST(TagCornerEdgesTest, SharpCornerWhereTheEdgesMeet) {
+  const Errors e = Measure(0);
+  EXPECT_EQ(e.crossing_squares, 0);  // no black square at any corner
+  EXPECT_EQ(e.corners, 48);          // every corner's edges found
+  EXPECT_GT(e.saddle_rms_px, 0.1);   // the old refinement
+  EXPECT_LT(e.edges_rms_px, 0.1);
+  EXPECT_LT(std::abs(e.edges_out_px), 0.04);
+}
+
+// Blurred 1 px: cornerSubPix rounds the corner off, 0.25-0.35 px into the tag; the edges'
+// meeting point stays within 0.15 px.
+TEST(TagCornerEdgesTest, BlurredCornerWhereTheEdgesMeet) {
+  const Errors e = Measure(1);
+  EXPECT_EQ(e.crossing_squares, 0);
+  EXPECT_EQ(e.corners, 48);
+  EXPECT_GT(e.saddle_rms_px, 0.2);
+  EXPECT_LT(e.saddle_out_px, -0.15);
+  EXPECT_LT(e.edges_rms_px, 0.15);
+  EXPECT_LT(std::abs(e.edges_out_px), 0.05);
+}
+
+// Small tags blurred 1 px: a cut across the edge a few pixels long does not reach the
+// border's black (nor, a 1-bit border of 3-4 px, past the tag's bits behind it), so halfway
+// between its own ends put the edge 0.13 px into a 24-32 px tag on average (0.17 px rms);
+// halfway between the edge's dark and light levels: 0.06 px rms, 0.01 px out.
+TEST(TagCornerEdgesTest, SmallBlurredTagCornerNotPulledIn) {
+  const Errors e = Measure(1, {24, 32});
+  EXPECT_EQ(e.crossing_squares, 0);
+  EXPECT_EQ(e.corners, 32);
+  EXPECT_LT(e.edges_rms_px, 0.1);
+  EXPECT_LT(std::abs(e.edges_out_px), 0.05);
+}
+
+// A tag whose edge shows no contrast (a flat image) gives no corner and leaves it untouched.
+TEST(TagCornerEdgesTest, NoEdgeNoCorner) {
+  const cv::Mat flat(kImagePx, kImagePx, CV_8U, cv::Scalar(128));
+  const std::array<Eigen::Vector2d, 4> p = {Eigen::Vector2d(50, 50), Eigen::Vector2d(110, 50),
+                                            Eigen::Vector2d(110, 110), Eigen::Vector2d(50, 110)};
+  Eigen::Vector2d corner(-7, -7);
+  EXPECT_FALSE(CornerFromEdges(flat, p, 0, &corner));
+  EXPECT_EQ(corner, Eigen::Vector2d(-7, -7));
+}
+
+}  // namespace
+}  // namespace fresco::calib
