@@ -90,6 +90,14 @@ void DrawUnsavedPrompt(UiContext& ui) {
   }
 }
 
+// File > Open and Save As: a project file's path, wide enough to read one (a menu is only as
+// wide as what it holds).
+PathFieldOptions MenuPath(UiContext& ui) {
+  return {.extensions = {".json"},
+          .min_width_px = ImGui::GetFontSize() * 30,
+          .last_folder = &ui.state->last_folder};
+}
+
 void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   AppState& state = *ui.state;
   if (!ImGui::BeginMainMenuBar()) return;
@@ -97,7 +105,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
     if (ImGui::MenuItem("New project...")) ui.new_project_requested = true;
     // Open and Save As take a path (typed, or picked with "..." from the folder typed so far).
     if (ImGui::BeginMenu("Open...")) {
-      PathField("project", "##menu_open", "project.json to open", &ui.menu_path, {".json"});
+      PathField("project", "##menu_open", "project.json to open", &ui.menu_path, MenuPath(ui));
       if (ImGui::MenuItem("Open", nullptr, false, !ui.menu_path.empty()))
         RequestOpen(ui, ui.menu_path);
       ImGui::EndMenu();
@@ -105,7 +113,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
     if (ImGui::MenuItem("Save", "Ctrl+S", false, state.has_project))
       if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
     if (ImGui::BeginMenu("Save As...", state.has_project)) {
-      PathField("as", "##menu_save_as", "path for Save As", &ui.menu_path, {".json"});
+      PathField("as", "##menu_save_as", "path for Save As", &ui.menu_path, MenuPath(ui));
       if (ImGui::MenuItem("Save As", nullptr, false, !ui.menu_path.empty()))
         if (Status s = state.Save(ui.menu_path); !s.ok()) state.message = "error: " + s.message();
       ImGui::EndMenu();

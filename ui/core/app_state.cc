@@ -147,6 +147,7 @@ void AppState::LoadRecent() {
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
     for (const auto& p : j.at("recent")) recent.push_back(p.get<std::string>());
+    if (j.contains("last_folder")) last_folder = j.at("last_folder").get<std::string>();
   } catch (const std::exception&) {
     recent.clear();  // a damaged list is not worth an error
   }
@@ -169,7 +170,8 @@ void AppState::SaveRecent() const {
   if (recent_file.empty()) return;
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(recent_file).parent_path(), ec);
-  WriteFileAtomic(recent_file, nlohmann::json{{"recent", recent}}.dump(2) + "\n");
+  WriteFileAtomic(recent_file,
+                  nlohmann::json{{"recent", recent}, {"last_folder", last_folder}}.dump(2) + "\n");
 }
 
 Status MergeGroups(const std::vector<GroupSpec>& current, int num_triangles,

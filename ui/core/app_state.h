@@ -20,6 +20,9 @@ struct AppState {
   std::string message;              // the last status or error, shown in the status bar
   std::vector<std::string> recent;  // most recent first
   std::string recent_file;          // where `recent` is kept ("" = not kept)
+  // The folder the path lists ("..." beside a path) were last used in (absolute, ending in
+  // '/'; "" = none yet): an empty field's list starts there. Kept with `recent`.
+  std::string last_folder;
 
   // Selection (viewport picks and the grouping table).
   std::set<int> selected_triangles;

@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cstdio>
 
+#include <imgui_internal.h>  // PushOverrideID
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/pictures.h"
 #include "ui/panels/panels.h"
+#include "ui/panels/path_field.h"
 
 namespace fresco {
 namespace {
@@ -61,7 +63,7 @@ class CalibrationPanel : public Panel {
   void Draw(UiContext& ui) override {
     if (!BeginOverlayPanel(*this, ui.calibration != nullptr, "calibration worker")) return;
     const auto snap = ui.calibration->Snapshot();
-    if (snap->has_request && folder_[0] == 0) TakeInputs(snap->request);
+    if (snap->has_request && folder_.empty()) TakeInputs(snap->request);
     if (ImGui::BeginTable("calibration", 3,
                           ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
       ImGui::TableSetupColumn("controls", ImGuiTableColumnFlags_WidthStretch, 0.27f);
@@ -69,7 +71,11 @@ class CalibrationPanel : public Panel {
       ImGui::TableSetupColumn("results", ImGuiTableColumnFlags_WidthStretch, 0.38f);
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
+      // The controls' IDs as at the window's root, whatever the table pushed (the tests and
+      // keyboard navigation name them "##folder", "Attach to project").
+      ImGui::PushOverrideID(ImGui::GetCurrentWindow()->ID);
       DrawControls(ui, *snap);
+      ImGui::PopID();
       ImGui::TableSetColumnIndex(1);
       DrawPictures(ui, *snap);
       ImGui::TableSetColumnIndex(2);
@@ -82,7 +88,7 @@ class CalibrationPanel : public Panel {
 
  private:
   void TakeInputs(const calib::CalibrateRequest& request) {
-    std::snprintf(folder_, sizeof(folder_), "%s", request.images_dir.c_str());
+    folder_ = request.images_dir;
     std::snprintf(board_, sizeof(board_), "%s", request.board.text.c_str());
     const auto& names = calib::LensModelShortNames();
     const auto it = std::find(names.begin(), names.end(), request.model);
@@ -94,8 +100,10 @@ class CalibrationPanel : public Panel {
   }
 
   void DrawControls(UiContext& ui, const CalibrationSnapshot& snap) {
-    ImGui::SetNextItemWidth(-60);
-    ImGui::InputText("folder", folder_, sizeof(folder_));
+    PathField("Folder", "##folder", "the calibration pictures' folder/", &folder_,
+              {.extensions = {},
+               .folder_of_images = true,
+               .last_folder = ui.state ? &ui.state->last_folder : nullptr});
     ImGui::SetNextItemWidth(-60);
     ImGui::InputText("board", board_, sizeof(board_));
     if (ImGui::IsItemHovered())
@@ -356,6 +364,7 @@ class CalibrationPanel : public Panel {
                {"excluded", std::to_string(snap.run.excluded.size())},
                {"camera_doubts", std::to_string(snap.run.camera_doubts.size())},
                {"readiness", kLevels[static_cast<int>(snap.readiness.level)]}};
+    report_["folder"] = folder_;
     if (snap.solved) {
       report_["model"] = snap.run.Chosen().short_name;
       report_["lensmodel"] = snap.run.Chosen().lensmodel;
@@ -367,7 +376,7 @@ class CalibrationPanel : public Panel {
     }
   }
 
-  char folder_[1024] = "";
+  std::string folder_;
   char board_[256] = "";
   char save_path_[1100] = "";
   int attach_stream_ = 0;  // version-2 projects: which stream's camera
