@@ -403,17 +403,7 @@ TEST(UiInput, AKeyTapWithinOneFrameIsStillSeen) {
   app.state.BeginEdit();  // something to save
   app.state.project.pipeline.update_every = 3;
   ASSERT_TRUE(app.state.dirty);
-  // Ctrl+S pressed and released between two frames.
-  InputQueue queue;
-  for (auto [key, down] :
-       {std::pair{kKeyLeftControl, true}, {'S', true}, {'S', false}, {kKeyLeftControl, false}}) {
-    InputEvent e;
-    e.kind = InputEvent::Kind::kKey;
-    e.code = key;
-    e.down = down;
-    queue.Push(e);
-  }
-  app.Drain(&queue);
+  app.CtrlTap('S');  // pressed and released between two frames
   EXPECT_FALSE(app.state.dirty) << "Ctrl+S was lost";
   EXPECT_EQ(app.state.message.rfind("saved ", 0), 0u) << app.state.message;
 }

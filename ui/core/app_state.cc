@@ -127,6 +127,7 @@ bool AppState::Undo() {
   project = undo.back();
   undo.pop_back();
   dirty = true;
+  message = "undone: " + DescribeProjectChange(redo.back(), project, "back to");
   return true;
 }
 
@@ -136,7 +137,32 @@ bool AppState::Redo() {
   project = redo.back();
   redo.pop_back();
   dirty = true;
+  message = "redone: " + DescribeProjectChange(undo.back(), project, "to");
   return true;
+}
+
+std::string DescribeProjectChange(const Project& before, const Project& after,
+                                  const std::string& to) {
+  std::string said;
+  const auto say = [&](const std::string& what) { said += (said.empty() ? "" : "; ") + what; };
+  if (before.scene != after.scene) say("scene " + to + " " + after.scene);
+  const std::vector<StreamSpec> a = before.Streams(), b = after.Streams();
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const int index = static_cast<int>(i);
+    if (a[i].camera != b[i].camera)
+      say(after.StreamKey(index, "camera") + " " + to + " " + b[i].camera);
+    if (a[i].video != b[i].video)
+      say(after.StreamKey(index, "video") + " " + to + " " + b[i].video);
+    if (a[i].poses != b[i].poses)
+      say(after.StreamKey(index, "poses") + " " + to + " " + b[i].poses);
+  }
+  if (a.size() != b.size()) say("the streams");
+  if (!(before.grouping == after.grouping)) say("the grouping");
+  if (!(before.pipeline == after.pipeline)) say("the pipeline settings");
+  if (!(before.live == after.live) || !(before.truth == after.truth) ||
+      before.time_offset_s != after.time_offset_s)
+    say("settings");
+  return said.empty() ? "the last edit" : said;
 }
 
 void AppState::LoadRecent() {

@@ -55,6 +55,8 @@ struct AppState {
   // nothing changes. The open project's paths change as an undoable edit (its other unsaved
   // edits stay unsaved); a project that did not open is then ready to Open (`*file`).
   Status RepairPaths(const ProjectPaths& typed, std::string* file);
+  // Undo and redo say what they changed back in `message` (DescribeProjectChange), so the
+  // status bar never keeps describing an edit that was undone.
   bool Undo();
   bool Redo();
 
@@ -63,6 +65,12 @@ struct AppState {
   void AddRecent(const std::string& path);
   void RemoveRecent(const std::string& path);  // a project that failed to open
 };
+
+// What differs between two versions of the project, as undo and redo say it: with `to`
+// "back to", "camera back to cameras.txt"; "the grouping", ... ("the last edit" when nothing
+// differs).
+std::string DescribeProjectChange(const Project& before, const Project& after,
+                                  const std::string& to);
 
 // Grouping edits as the app makes them: on the groups the current session built (one per
 // base buffer), stored in the project as explicit groups (grouping.groups) so that
