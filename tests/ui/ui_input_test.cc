@@ -235,6 +235,13 @@ TEST(UiInput, GroupColoursStayAcrossEditsAndASplitBackIsExplained) {
       EXPECT_EQ(after, before) << "split back: every wall in its old colour";
       EXPECT_NE(message.find("split back apart"), std::string::npos) << message;
       EXPECT_NE(app.state.message.find("split back apart"), std::string::npos) << app.state.message;
+      // Ctrl+Z: the status line goes with the merge it described (issue 58, item 6).
+      app.CtrlTap('Z');
+      EXPECT_EQ(app.state.message, "undone: the grouping");
+      app.runner.WaitIdle();
+      app.Frames(2);
+      EXPECT_EQ(app.ReportOf("Grouping", "split"), "");
+      EXPECT_EQ(app.state.message, "undone: the grouping");
     }
     EXPECT_EQ(app.runner.Snapshot()->frame, 2) << "the edit kept the frame";
   }
