@@ -200,5 +200,50 @@ TEST(UiLayout, FontScaleScalesTheText) {
       << "tiles start below the taller menu bar";
 }
 
+// The font scale steps (issue 58, item 8): A+ and A- in the status bar and Ctrl+= / Ctrl+-
+// move one step each; the View menu only says where they are, so a stray click there (where
+// a slider was) changes nothing.
+TEST(UiLayout, FontScaleStepsFromTheStatusBarNotTheViewMenu) {
+  EXPECT_EQ(StepFontScale(1.0f, +1), 1.25f);
+  EXPECT_EQ(StepFontScale(2.0f, +1), 2.0f);
+  EXPECT_EQ(StepFontScale(0.75f, -1), 0.75f);
+  EXPECT_EQ(StepFontScale(1.1f, -1), 1.0f);  // between steps: the next one that way
+  EXPECT_EQ(StepFontScale(1.1f, +1), 1.25f);
+  LayoutApp app({1280, 800});
+  // The View menu: a click on each of its last rows, where the slider was.
+  const float line = ImGui::GetFrameHeight();
+  app.Click(ImVec2(ImGui::CalcTextSize("File").x + ImGui::CalcTextSize("Edit").x + 50, line / 2));
+  ImGuiWindow* view = ImGui::FindWindowByName("##Menu_00");
+  ASSERT_NE(view, nullptr);
+  ASSERT_TRUE(view->Active) << "the View menu is open";
+  // Two font sizes in from the left, on the last row: inside the slider's frame as it was.
+  const ImVec2 bottom(view->Pos.x + ImGui::GetStyle().WindowPadding.x + 2 * ImGui::GetFontSize(),
+                      view->Pos.y + view->Size.y - 0.6f * line);
+  app.Click(bottom);
+  EXPECT_EQ(app.ui.scale.user, 1.0f) << "a stray click in the View menu changed the font scale";
+  app.MouseTo(5, 400);
+  app.Frames(2);
+
+  const auto press = [&](const char* button) {
+    testing::Activate(app, "##status", button);
+    app.Frames(2);
+  };
+  press("A+");
+  press("A+");
+  EXPECT_EQ(app.ui.scale.user, 1.5f);
+  EXPECT_NEAR(ImGui::GetFontSize(), 1.5f * 13, 0.5f);
+  press("A-");
+  EXPECT_EQ(app.ui.scale.user, 1.25f);
+  app.CtrlTap('=');
+  EXPECT_EQ(app.ui.scale.user, 1.5f);
+  app.CtrlTap('-');
+  app.CtrlTap('-');
+  EXPECT_EQ(app.ui.scale.user, 1.0f);
+  for (int i = 0; i < 8; ++i) app.CtrlTap('=');
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "held at the largest step";
+  app.CtrlTap('0');
+  EXPECT_EQ(app.ui.scale.user, 1.0f);
+}
+
 }  // namespace
 }  // namespace fresco
