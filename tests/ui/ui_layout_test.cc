@@ -200,6 +200,34 @@ TEST(UiLayout, FontScaleScalesTheText) {
       << "tiles start below the taller menu bar";
 }
 
+// A narrow panel (issue 58, item 8): its captions do not stand one letter per line; they
+// wrap at eight font sizes at least and run past a narrower edge.
+struct CaptionPanel : Panel {
+  const char* Title() const override { return "Caption"; }
+  void Draw(UiContext&) override {
+    if (BeginPanel(*this)) {
+      ImGui::TextWrapped("automatic: 6 groups for 12 triangles");
+      caption_height = ImGui::GetItemRectSize().y;
+    }
+    ImGui::End();
+  }
+  float caption_height = 0;
+};
+
+TEST(UiLayout, ANarrowPanelKeepsItsCaptionsOnAFewLines) {
+  LayoutApp app({1280, 800});
+  CaptionPanel panel;  // a tile of the layout, 60 pixels wide, then 600
+  panel.tiled = true;
+  panel.tile_pos = ImVec2(0, 40);
+  const auto caption_lines = [&](float width) {
+    panel.tile_size = ImVec2(width, 300);
+    for (int i = 0; i < 2; ++i) testing::ImGuiHeadless::DrawPanel(app.ui, panel, {width, 300});
+    return panel.caption_height / ImGui::GetTextLineHeight();
+  };
+  EXPECT_LE(caption_lines(60), 4) << "a 60-pixel tile stacks its caption letter by letter";
+  EXPECT_LT(caption_lines(600), 1.5f) << "one line where it fits";
+}
+
 // The font scale steps (issue 58, item 8): A+ and A- in the status bar and Ctrl+= / Ctrl+-
 // move one step each; the View menu only says where they are, so a stray click there (where
 // a slider was) changes nothing.
