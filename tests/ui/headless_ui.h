@@ -143,6 +143,20 @@ struct HeadlessApp {
     input.mouse_down[0] = false;
     Frame();
   }
+  // Ctrl+`key` pressed and released between two frames (queued as the window's callbacks
+  // queue them), then the frames that take the events in.
+  void CtrlTap(int key) {
+    InputQueue queue;
+    for (auto [code, down] :
+         {std::pair{kKeyLeftControl, true}, {key, true}, {key, false}, {kKeyLeftControl, false}}) {
+      InputEvent e;
+      e.kind = InputEvent::Kind::kKey;
+      e.code = code;
+      e.down = down;
+      queue.Push(e);
+    }
+    Drain(&queue);
+  }
   // Presses and releases mouse `button` (0 left, 1 right) at `at`.
   void Click(ImVec2 at, int button = 0) {
     MouseTo(at.x, at.y);

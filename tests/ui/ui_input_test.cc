@@ -27,6 +27,7 @@
 #include "ui/core/input_queue.h"
 #include "ui/core/project_paths.h"
 #include "ui/panels/panels.h"
+#include "ui/panels/path_field.h"
 
 namespace fresco {
 namespace {
@@ -234,6 +235,13 @@ TEST(UiInput, GroupColoursStayAcrossEditsAndASplitBackIsExplained) {
       EXPECT_EQ(after, before) << "split back: every wall in its old colour";
       EXPECT_NE(message.find("split back apart"), std::string::npos) << message;
       EXPECT_NE(app.state.message.find("split back apart"), std::string::npos) << app.state.message;
+      // Ctrl+Z: the status line goes with the merge it described (issue 58, item 6).
+      app.CtrlTap('Z');
+      EXPECT_EQ(app.state.message, "undone: the grouping");
+      app.runner.WaitIdle();
+      app.Frames(2);
+      EXPECT_EQ(app.ReportOf("Grouping", "split"), "");
+      EXPECT_EQ(app.state.message, "undone: the grouping");
     }
     EXPECT_EQ(app.runner.Snapshot()->frame, 2) << "the edit kept the frame";
   }
@@ -402,17 +410,7 @@ TEST(UiInput, AKeyTapWithinOneFrameIsStillSeen) {
   app.state.BeginEdit();  // something to save
   app.state.project.pipeline.update_every = 3;
   ASSERT_TRUE(app.state.dirty);
-  // Ctrl+S pressed and released between two frames.
-  InputQueue queue;
-  for (auto [key, down] :
-       {std::pair{kKeyLeftControl, true}, {'S', true}, {'S', false}, {kKeyLeftControl, false}}) {
-    InputEvent e;
-    e.kind = InputEvent::Kind::kKey;
-    e.code = key;
-    e.down = down;
-    queue.Push(e);
-  }
-  app.Drain(&queue);
+  app.CtrlTap('S');  // pressed and released between two frames
   EXPECT_FALSE(app.state.dirty) << "Ctrl+S was lost";
   EXPECT_EQ(app.state.message.rfind("saved ", 0), 0u) << app.state.message;
 }
@@ -664,6 +662,70 @@ TEST(UiInput, TheFileMenuSavesAsAndOpensATypedPath) {
   app.Frames(2);
   EXPECT_EQ(app.state.project.file_path, first) << app.state.message;
   EXPECT_EQ(app.state.message.rfind("opened ", 0), 0u) << app.state.message;
+}
+
+// Paths (issue 58, item 4): an empty field's "..." starts in the last folder used (not the
+// launch folder), in every form: New project, the Calibration folder (which has a browser
+// now) and File > Open, whose field is wide enough to read a path; a folder of frames says
+// what it holds instead of "nothing here fits".
+TEST(UiInput, EveryPathListStartsInTheLastFolderUsed) {
+  App app(0);
+  const std::string browse = fs::absolute(app.dir + "/browse").lexically_normal().string() + "/";
+  fs::create_directories(browse + "frames");
+  std::ofstream(browse + "mesh.ply") << "ply\n";
+  for (const char* name : {"000000.png", "000001.png", "000002.png"})
+    std::ofstream(browse + "frames/" + name) << "png";
+  const auto list = [] {
+    for (ImGuiWindow* w : GImGui->Windows)
+      if ((w->Flags & ImGuiWindowFlags_Popup) && w->Active) return w;
+    return static_cast<ImGuiWindow*>(nullptr);
+  };
+  const auto browse_of = [&](const std::string& window, const char* id) {
+    ImGui::ActivateItem(ImHashStr("...", 0, App::Window(window)->GetID(id)));
+    app.Frames(2);
+  };
+  const auto pick = [&](const char* label) {
+    ImGuiWindow* popup = list();
+    ASSERT_NE(popup, nullptr) << "the list is not open to pick " << label;
+    ImGui::ActivateItem(popup->GetID(label));
+    app.Frames(2);
+  };
+  Activate(app, "Project", "New");
+  app.Frame();
+  TypeInto(app, kNewProjectTitle, "##scene", browse);
+  browse_of(kNewProjectTitle, "##scene");
+  pick("mesh.ply");
+  EXPECT_EQ(app.state.last_folder, browse);
+  // The video field is empty: its list opens in that folder, and a frame folder is a choice.
+  browse_of(kNewProjectTitle, "##video");
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "video"), browse);
+  ASSERT_NE(list(), nullptr);
+  pick("frames/");
+  EXPECT_EQ(app.ReportOf(kNewProjectTitle, "video"), browse + "frames/");
+  PathFieldOptions video;
+  video.folder_of_images = true;
+  EXPECT_EQ(BrowseNote(browse + "frames/", video, 0), "this folder: 3 images (chosen)");
+  EXPECT_EQ(BrowseNote(browse + "frames/", {}, 0), "nothing here fits");
+  EXPECT_EQ(app.state.last_folder, browse + "frames/");
+  ImGui::ClosePopupsOverWindow(nullptr, false);
+  app.Frames(2);
+
+  // The Calibration panel's folder has a browser, starting there too.
+  app.Find(kCalibrationPanelTitle).open = true;
+  app.Frames(2);
+  browse_of(kCalibrationPanelTitle, "##folder");
+  EXPECT_EQ(app.ReportOf(kCalibrationPanelTitle, "folder"), browse + "frames/");
+  ImGui::ClosePopupsOverWindow(nullptr, false);
+  app.Frames(2);
+
+  // File > Open...: the field is a path's width, and its list starts there.
+  app.ui.menu_path.clear();
+  ImGuiWindow* open = OpenFileSubmenu(app, 1);
+  ASSERT_NE(open, nullptr);
+  EXPECT_GE(open->Size.x, 30 * ImGui::GetFontSize()) << "File > Open's field is too narrow";
+  ImGui::ActivateItem(ImHashStr("...", 0, open->GetID("##menu_open")));
+  app.Frames(2);
+  EXPECT_EQ(app.ui.menu_path, browse + "frames/");
 }
 
 // The "..." beside a path field browses: a folder opens in place (the list stays open), the

@@ -200,5 +200,78 @@ TEST(UiLayout, FontScaleScalesTheText) {
       << "tiles start below the taller menu bar";
 }
 
+// A narrow panel (issue 58, item 8): its captions do not stand one letter per line; they
+// wrap at eight font sizes at least and run past a narrower edge.
+struct CaptionPanel : Panel {
+  const char* Title() const override { return "Caption"; }
+  void Draw(UiContext&) override {
+    if (BeginPanel(*this)) {
+      ImGui::TextWrapped("automatic: 6 groups for 12 triangles");
+      caption_height = ImGui::GetItemRectSize().y;
+    }
+    ImGui::End();
+  }
+  float caption_height = 0;
+};
+
+TEST(UiLayout, ANarrowPanelKeepsItsCaptionsOnAFewLines) {
+  LayoutApp app({1280, 800});
+  CaptionPanel panel;  // a tile of the layout, 60 pixels wide, then 600
+  panel.tiled = true;
+  panel.tile_pos = ImVec2(0, 40);
+  const auto caption_lines = [&](float width) {
+    panel.tile_size = ImVec2(width, 300);
+    for (int i = 0; i < 2; ++i) testing::ImGuiHeadless::DrawPanel(app.ui, panel, {width, 300});
+    return panel.caption_height / ImGui::GetTextLineHeight();
+  };
+  EXPECT_LE(caption_lines(60), 4) << "a 60-pixel tile stacks its caption letter by letter";
+  EXPECT_LT(caption_lines(600), 1.5f) << "one line where it fits";
+}
+
+// The font scale steps (issue 58, item 8): A+ and A- in the status bar and Ctrl+= / Ctrl+-
+// move one step each; the View menu only says where they are, so a stray click there (where
+// a slider was) changes nothing.
+TEST(UiLayout, FontScaleStepsFromTheStatusBarNotTheViewMenu) {
+  EXPECT_EQ(StepFontScale(1.0f, +1), 1.25f);
+  EXPECT_EQ(StepFontScale(2.0f, +1), 2.0f);
+  EXPECT_EQ(StepFontScale(0.75f, -1), 0.75f);
+  EXPECT_EQ(StepFontScale(1.1f, -1), 1.0f);  // between steps: the next one that way
+  EXPECT_EQ(StepFontScale(1.1f, +1), 1.25f);
+  LayoutApp app({1280, 800});
+  // The View menu: a click on each of its last rows, where the slider was.
+  const float line = ImGui::GetFrameHeight();
+  app.Click(ImVec2(ImGui::CalcTextSize("File").x + ImGui::CalcTextSize("Edit").x + 50, line / 2));
+  ImGuiWindow* view = ImGui::FindWindowByName("##Menu_00");
+  ASSERT_NE(view, nullptr);
+  ASSERT_TRUE(view->Active) << "the View menu is open";
+  // Two font sizes in from the left, on the last row: inside the slider's frame as it was.
+  const ImVec2 bottom(view->Pos.x + ImGui::GetStyle().WindowPadding.x + 2 * ImGui::GetFontSize(),
+                      view->Pos.y + view->Size.y - 0.6f * line);
+  app.Click(bottom);
+  EXPECT_EQ(app.ui.scale.user, 1.0f) << "a stray click in the View menu changed the font scale";
+  app.MouseTo(5, 400);
+  app.Frames(2);
+
+  const auto press = [&](const char* button) {
+    testing::Activate(app, "##status", button);
+    app.Frames(2);
+  };
+  press("A+");
+  press("A+");
+  EXPECT_EQ(app.ui.scale.user, 1.5f);
+  EXPECT_NEAR(ImGui::GetFontSize(), 1.5f * 13, 0.5f);
+  press("A-");
+  EXPECT_EQ(app.ui.scale.user, 1.25f);
+  app.CtrlTap('=');
+  EXPECT_EQ(app.ui.scale.user, 1.5f);
+  app.CtrlTap('-');
+  app.CtrlTap('-');
+  EXPECT_EQ(app.ui.scale.user, 1.0f);
+  for (int i = 0; i < 8; ++i) app.CtrlTap('=');
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "held at the largest step";
+  app.CtrlTap('0');
+  EXPECT_EQ(app.ui.scale.user, 1.0f);
+}
+
 }  // namespace
 }  // namespace fresco

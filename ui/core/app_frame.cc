@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <string>
 
 #include "ui/panels/panels.h"
@@ -15,10 +16,11 @@ const ImVec4 kErrorColour(1.0f, 0.4f, 0.4f, 1.0f);
 // ImGui 1.86 indexes io.KeysDown by the backend's key codes: GLFW_KEY_F5 (letters are
 // their ASCII capitals there, as 'S' below).
 constexpr int kKeyF5 = 294;
+// GLFW's codes for the font-scale shortcuts: "=" (with shift "+"), "-", keypad + and -.
+constexpr int kKeyEqual = 61, kKeyMinus = 45, kKeyKeypadAdd = 334, kKeyKeypadSubtract = 333;
 constexpr float kSplitterPx = 5;  // the bars between tiled panels
 constexpr const char* kSwapPopup = "##swap places";
 constexpr float kMinTilePx = 120;  // a splitter stops before a side gets narrower
-constexpr float kMinFontScale = 0.75f, kMaxFontScale = 2.0f;
 
 bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
 
@@ -90,6 +92,14 @@ void DrawUnsavedPrompt(UiContext& ui) {
   }
 }
 
+// File > Open and Save As: a project file's path, wide enough to read one (a menu is only as
+// wide as what it holds).
+PathFieldOptions MenuPath(UiContext& ui) {
+  return {.extensions = {".json"},
+          .min_width_px = ImGui::GetFontSize() * 30,
+          .last_folder = &ui.state->last_folder};
+}
+
 void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   AppState& state = *ui.state;
   if (!ImGui::BeginMainMenuBar()) return;
@@ -97,7 +107,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
     if (ImGui::MenuItem("New project...")) ui.new_project_requested = true;
     // Open and Save As take a path (typed, or picked with "..." from the folder typed so far).
     if (ImGui::BeginMenu("Open...")) {
-      PathField("project", "##menu_open", "project.json to open", &ui.menu_path, {".json"});
+      PathField("project", "##menu_open", "project.json to open", &ui.menu_path, MenuPath(ui));
       if (ImGui::MenuItem("Open", nullptr, false, !ui.menu_path.empty()))
         RequestOpen(ui, ui.menu_path);
       ImGui::EndMenu();
@@ -105,7 +115,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
     if (ImGui::MenuItem("Save", "Ctrl+S", false, state.has_project))
       if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();
     if (ImGui::BeginMenu("Save As...", state.has_project)) {
-      PathField("as", "##menu_save_as", "path for Save As", &ui.menu_path, {".json"});
+      PathField("as", "##menu_save_as", "path for Save As", &ui.menu_path, MenuPath(ui));
       if (ImGui::MenuItem("Save As", nullptr, false, !ui.menu_path.empty()))
         if (Status s = state.Save(ui.menu_path); !s.ok()) state.message = "error: " + s.message();
       ImGui::EndMenu();
@@ -140,9 +150,9 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
     if (ImGui::MenuItem("Restore", nullptr, false, !layout.maximised().empty()))
       layout.ToggleMaximised(layout.maximised());
     if (ImGui::MenuItem("Default layout")) layout = DefaultTileLayout();
-    ImGui::SetNextItemWidth(ImGui::GetFontSize() * 8);
-    // Applied from the next frame on (ApplyUiScale), times the monitor's content scale.
-    ImGui::SliderFloat("font scale", &ui.scale.user, kMinFontScale, kMaxFontScale, "%.2f");
+    // No control here, where a stray click would change it: the status bar's A- and A+.
+    ImGui::Separator();
+    ImGui::TextDisabled("font scale %.2f: A- A+ in the status bar, Ctrl+- Ctrl+=", ui.scale.user);
     ImGui::EndMenu();
   }
   const auto& snap = *ui.snapshot;
@@ -171,6 +181,12 @@ void HandleShortcuts(UiContext& ui) {
       ui.runner->Play();
   }
   if (io.KeyCtrl && ImGui::IsKeyPressed('Q')) state.pending_quit = true;
+  // The font scale, a step at a time (applied from the next frame on: ApplyUiScale).
+  if (io.KeyCtrl && (ImGui::IsKeyPressed(kKeyEqual) || ImGui::IsKeyPressed(kKeyKeypadAdd)))
+    ui.scale.user = StepFontScale(ui.scale.user, +1);
+  if (io.KeyCtrl && (ImGui::IsKeyPressed(kKeyMinus) || ImGui::IsKeyPressed(kKeyKeypadSubtract)))
+    ui.scale.user = StepFontScale(ui.scale.user, -1);
+  if (io.KeyCtrl && ImGui::IsKeyPressed('0')) ui.scale.user = 1;
   if (ImGui::IsKeyPressed(kKeyF5, false) && state.has_project) ApplyProject(ui);
   // Left: back one frame (a file source repaints from the start); Right: the next frame.
   const RunnerSnapshot& snap = *ui.snapshot;
@@ -181,13 +197,42 @@ void HandleShortcuts(UiContext& ui) {
     ui.runner->Step();
 }
 
+// The font scale at the status bar's right end: A- and A+ step it (kFontScaleSteps). Drawn
+// first, the message then starts at the left.
+void DrawFontScaleSteps(UiContext& ui) {
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const std::string label = std::to_string(static_cast<int>(ui.scale.user * 100 + 0.5f)) + " %";
+  const float width = ImGui::CalcTextSize("A-").x + ImGui::CalcTextSize("A+").x +
+                      ImGui::CalcTextSize(label.c_str()).x + 4 * style.FramePadding.x +
+                      2 * style.ItemSpacing.x;
+  const ImVec2 start = ImGui::GetCursorPos();
+  ImGui::SetCursorPosX(ImGui::GetWindowContentRegionMax().x - width);
+  const float smallest = kFontScaleSteps[0];
+  const float largest = kFontScaleSteps[std::size(kFontScaleSteps) - 1];
+  ImGui::BeginDisabled(ui.scale.user <= smallest);
+  if (ImGui::SmallButton("A-")) ui.scale.user = StepFontScale(ui.scale.user, -1);
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("smaller text (Ctrl+-; Ctrl+0: 100 %%)");
+  ImGui::SameLine();
+  ImGui::TextUnformatted(label.c_str());
+  ImGui::SameLine();
+  ImGui::BeginDisabled(ui.scale.user >= largest);
+  if (ImGui::SmallButton("A+")) ui.scale.user = StepFontScale(ui.scale.user, +1);
+  ImGui::EndDisabled();
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+    ImGui::SetTooltip("larger text (Ctrl+=; Ctrl+0: 100 %%)");
+  ImGui::SetCursorPos(start);
+}
+
 void DrawStatusBar(UiContext& ui) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   ImGui::SetNextWindowPos(ImVec2(0, display.y - StatusBarHeight()));
   ImGui::SetNextWindowSize(ImVec2(display.x, StatusBarHeight()));
   ImGui::Begin("##status", nullptr,
-               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs |
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoScrollWithMouse |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
+  DrawFontScaleSteps(ui);
   // One message: the worker's error replaces "opened ..." (the project named a file it
   // could not read); other messages (saved, grouping edited) stay beside it.
   const std::string& message = ui.state->message;

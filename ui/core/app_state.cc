@@ -127,6 +127,7 @@ bool AppState::Undo() {
   project = undo.back();
   undo.pop_back();
   dirty = true;
+  message = "undone: " + DescribeProjectChange(redo.back(), project, "back to");
   return true;
 }
 
@@ -136,7 +137,32 @@ bool AppState::Redo() {
   project = redo.back();
   redo.pop_back();
   dirty = true;
+  message = "redone: " + DescribeProjectChange(undo.back(), project, "to");
   return true;
+}
+
+std::string DescribeProjectChange(const Project& before, const Project& after,
+                                  const std::string& to) {
+  std::string said;
+  const auto say = [&](const std::string& what) { said += (said.empty() ? "" : "; ") + what; };
+  if (before.scene != after.scene) say("scene " + to + " " + after.scene);
+  const std::vector<StreamSpec> a = before.Streams(), b = after.Streams();
+  for (size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const int index = static_cast<int>(i);
+    if (a[i].camera != b[i].camera)
+      say(after.StreamKey(index, "camera") + " " + to + " " + b[i].camera);
+    if (a[i].video != b[i].video)
+      say(after.StreamKey(index, "video") + " " + to + " " + b[i].video);
+    if (a[i].poses != b[i].poses)
+      say(after.StreamKey(index, "poses") + " " + to + " " + b[i].poses);
+  }
+  if (a.size() != b.size()) say("the streams");
+  if (!(before.grouping == after.grouping)) say("the grouping");
+  if (!(before.pipeline == after.pipeline)) say("the pipeline settings");
+  if (!(before.live == after.live) || !(before.truth == after.truth) ||
+      before.time_offset_s != after.time_offset_s)
+    say("settings");
+  return said.empty() ? "the last edit" : said;
 }
 
 void AppState::LoadRecent() {
@@ -147,6 +173,7 @@ void AppState::LoadRecent() {
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
     for (const auto& p : j.at("recent")) recent.push_back(p.get<std::string>());
+    if (j.contains("last_folder")) last_folder = j.at("last_folder").get<std::string>();
   } catch (const std::exception&) {
     recent.clear();  // a damaged list is not worth an error
   }
@@ -169,7 +196,8 @@ void AppState::SaveRecent() const {
   if (recent_file.empty()) return;
   std::error_code ec;
   std::filesystem::create_directories(std::filesystem::path(recent_file).parent_path(), ec);
-  WriteFileAtomic(recent_file, nlohmann::json{{"recent", recent}}.dump(2) + "\n");
+  WriteFileAtomic(recent_file,
+                  nlohmann::json{{"recent", recent}, {"last_folder", last_folder}}.dump(2) + "\n");
 }
 
 Status MergeGroups(const std::vector<GroupSpec>& current, int num_triangles,

@@ -20,6 +20,9 @@ struct AppState {
   std::string message;              // the last status or error, shown in the status bar
   std::vector<std::string> recent;  // most recent first
   std::string recent_file;          // where `recent` is kept ("" = not kept)
+  // The folder the path lists ("..." beside a path) were last used in (absolute, ending in
+  // '/'; "" = none yet): an empty field's list starts there. Kept with `recent`.
+  std::string last_folder;
 
   // Selection (viewport picks and the grouping table).
   std::set<int> selected_triangles;
@@ -52,6 +55,8 @@ struct AppState {
   // nothing changes. The open project's paths change as an undoable edit (its other unsaved
   // edits stay unsaved); a project that did not open is then ready to Open (`*file`).
   Status RepairPaths(const ProjectPaths& typed, std::string* file);
+  // Undo and redo say what they changed back in `message` (DescribeProjectChange), so the
+  // status bar never keeps describing an edit that was undone.
   bool Undo();
   bool Redo();
 
@@ -60,6 +65,12 @@ struct AppState {
   void AddRecent(const std::string& path);
   void RemoveRecent(const std::string& path);  // a project that failed to open
 };
+
+// What differs between two versions of the project, as undo and redo say it: with `to`
+// "back to", "camera back to cameras.txt"; "the grouping", ... ("the last edit" when nothing
+// differs).
+std::string DescribeProjectChange(const Project& before, const Project& after,
+                                  const std::string& to);
 
 // Grouping edits as the app makes them: on the groups the current session built (one per
 // base buffer), stored in the project as explicit groups (grouping.groups) so that

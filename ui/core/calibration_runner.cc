@@ -6,7 +6,6 @@
 #include "calib/camera_consistency.h"
 #include "calib/pictures.h"
 #include "calib/report.h"
-#include "ui/core/app_state.h"
 
 namespace fresco {
 
@@ -246,30 +245,6 @@ std::string DefaultCameraModelPath(const std::string& images_dir, const std::str
   const fs::path beside = project_file.empty() ? fs::absolute(folder).parent_path()
                                                : fs::path(project_file).parent_path();
   return (beside / (name + ".cameramodel")).string();
-}
-
-Status AttachCameraToProject(const std::string& cameramodel_path, int stream, AppState* state) {
-  namespace fs = std::filesystem;
-  if (!state->has_project) return Status::Error("no project open");
-  if (cameramodel_path.empty()) return Status::Error("save the calibration first");
-  const int streams = static_cast<int>(state->project.Streams().size());
-  if (state->project.fresco_version >= 2 && (stream < 0 || stream >= streams))
-    return Status::Error("the project has no stream " + std::to_string(stream));
-  const fs::path project_dir = fs::absolute(state->project.file_path).parent_path();
-  const fs::path model = fs::absolute(cameramodel_path).lexically_normal();
-  const fs::path relative = model.lexically_relative(project_dir);
-  const bool below = !relative.empty() && relative.begin()->string() != "..";
-  const std::string written = below ? relative.string() : model.string();
-  state->BeginEdit();
-  if (state->project.fresco_version >= 2) {
-    state->project.streams[stream].camera = written;
-    state->message = "streams[" + std::to_string(stream) + "].camera: " + written;
-  } else {
-    state->project.camera = written;
-    state->message = "camera: " + written;
-  }
-  state->message += " (from the calibration; undo restores the previous camera)";
-  return Status::Ok();
 }
 
 }  // namespace fresco

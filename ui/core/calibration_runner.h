@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "calib/calibrate.h"
+#include "ui/core/camera_attach.h"  // AttachCameraToProject
 
 namespace fresco {
 
@@ -94,11 +95,5 @@ class CalibrationRunner {
 // folder: PROJECT_DIR/cam0.cameramodel), or with no project beside the image folder
 // (PARENT/cam0.cameramodel); never inside the image folder.
 std::string DefaultCameraModelPath(const std::string& images_dir, const std::string& project_file);
-
-// Points the open project's camera at `cameramodel_path` (relative to the project's folder
-// when it is below it): `camera` of a version-1 project, `streams[stream].camera` of a
-// version-2 one. Undo restores the previous camera.
-struct AppState;
-Status AttachCameraToProject(const std::string& cameramodel_path, int stream, AppState* state);
 
 }  // namespace fresco

@@ -7,6 +7,22 @@
 
 namespace fresco {
 
+namespace {
+
+// A panel's text wraps at its edge, but never narrower than kMinWrapEm font sizes: in a
+// panel narrower than that, a caption runs out of sight (the title's tooltip and a wider
+// tile show it) instead of standing one letter per line.
+constexpr float kMinWrapEm = 8;
+
+void PushPanelTextWrap() {
+  const float min_px = kMinWrapEm * ImGui::GetFontSize();
+  const float start = ImGui::GetCursorPosX();
+  ImGui::PushTextWrapPos(ImGui::GetWindowContentRegionMax().x - start < min_px ? start + min_px
+                                                                               : 0.0f);
+}
+
+}  // namespace
+
 bool BeginPanel(Panel& panel) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   if (panel.tiled) {
@@ -18,7 +34,7 @@ bool BeginPanel(Panel& panel) {
                          ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
     // Text wraps at the panel's edge instead of running out of a narrow tile (ImGui resets
     // the wrap position at every Begin, so nothing needs popping).
-    ImGui::PushTextWrapPos(0.0f);
+    PushPanelTextWrap();
     const float title_bottom = ImGui::GetWindowPos().y + ImGui::GetFrameHeight();
     const bool on_title = ImGui::IsWindowHovered() && ImGui::GetIO().MousePos.y < title_bottom;
     if (on_title && ImGui::IsMouseDoubleClicked(ImGuiMouseButton_Left))
@@ -35,7 +51,7 @@ bool BeginPanel(Panel& panel) {
   ImGui::SetNextWindowSize(ImVec2(panel.default_size.x * sx, panel.default_size.y * sy),
                            ImGuiCond_FirstUseEver);
   const bool visible = ImGui::Begin(panel.Title(), &panel.open);
-  ImGui::PushTextWrapPos(0.0f);
+  PushPanelTextWrap();
   // However it was dragged, the title bar stays below the menu bar and on screen.
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
   const LayoutBand band{display.x, display.y, ImGui::GetFrameHeight(), StatusBarHeight()};

@@ -69,7 +69,8 @@ std::shared_ptr<const SessionGeometry> MakeGeometry(const PaintJob& job) {
   geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
   geometry->groups = paint.grouping().groups;
   geometry->buffer_of_triangle = paint.grouping().group_of_triangle;
-  for (const BaseBuffer& b : paint.buffers()) geometry->buffer_texels.push_back(b.num_surface_texels);
+  for (const BaseBuffer& b : paint.buffers())
+    geometry->buffer_texels.push_back(b.num_surface_texels);
   for (const Capture& c : job.captures) {
     std::vector<Rigid3d>& path = geometry->stream_paths.emplace_back();
     for (const PosedImage& p : c.poses) path.push_back(p.cam_from_world);
@@ -260,6 +261,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   }
   s.paint()->set_debug_images(show && options_.debug_images);
   s.run->Paint(f, &working_.report);
+  working_.report_has_images = show && options_.debug_images;
   if (working_.report.painted) {
     working_.frames_painted.push_back(frame.index);
     for (const StageReport& st : working_.report.stages)

@@ -31,8 +31,8 @@
 #include "pipeline/core/rigid3.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
-#include "pipeline/run/paint_run.h"
 #include "pipeline/run/live_status.h"
+#include "pipeline/run/paint_run.h"
 
 namespace fresco {
 
@@ -71,6 +71,9 @@ struct RunnerSnapshot {
   int stream = 0;                      // ... its stream
   std::vector<cv::Mat> stream_frames;  // per stream, its latest input frame shown (or empty)
   FrameReport report;                  // stages with metrics and debug images
+  // `report`'s frame was painted with debug images (a frame shown: paused, stepped or sought
+  // to); false for one painted while playing between two publishes.
+  bool report_has_images = false;
   std::shared_ptr<const std::vector<cv::Mat>> painted;  // per buffer BGRA (alpha 0 = never)
   // View-dependent layers (pipeline.layers), published with `painted`: each layer's mean
   // camera centre (the scene's local frame) and its buffers (BGRA); null or empty when off.

@@ -1,11 +1,24 @@
 #include "ui/core/ui_scale.h"
 
+#include <iterator>
+
 #include <algorithm>
 #include <cmath>
 
 #include <imgui.h>
 
 namespace fresco {
+
+float StepFontScale(float current, int direction) {
+  if (direction > 0) {
+    for (float step : kFontScaleSteps)
+      if (step > current + 1e-3f) return step;
+    return kFontScaleSteps[std::size(kFontScaleSteps) - 1];
+  }
+  for (size_t i = std::size(kFontScaleSteps); i-- > 0;)
+    if (kFontScaleSteps[i] < current - 1e-3f) return kFontScaleSteps[i];
+  return kFontScaleSteps[0];
+}
 
 float UiScale::Total() const { return std::clamp(content * user, kMinUiScale, kMaxUiScale); }
 

@@ -1,5 +1,6 @@
 // Calibration for the operator: the folder, board and lens model; Detect, Solve and
-// Save (beside the project by default) and Attach to project; the "enough data yet?" light
+// Save (beside the project by default) and Attach to project (checked against the project's
+// frames, then confirmed); the "enough data yet?" light
 // that follows the detections image by image (never green for a folder that mixes cameras);
 // the images (used, rejected with the reason, or excluded by their checkbox); the selected
 // image with its detections; the coverage
@@ -7,15 +8,20 @@
 #include <algorithm>
 #include <cstdio>
 
+#include <imgui_internal.h>  // PushOverrideID
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/pictures.h"
+#include "ui/core/camera_attach.h"
 #include "ui/panels/panels.h"
+#include "ui/panels/path_field.h"
 
 namespace fresco {
 namespace {
 
 using calib::DataReadiness;
+
+constexpr const char* kAttachPopup = "Attach camera?";
 
 std::string Format(const char* format, double value) {
   char buffer[64];
@@ -61,7 +67,7 @@ class CalibrationPanel : public Panel {
   void Draw(UiContext& ui) override {
     if (!BeginOverlayPanel(*this, ui.calibration != nullptr, "calibration worker")) return;
     const auto snap = ui.calibration->Snapshot();
-    if (snap->has_request && folder_[0] == 0) TakeInputs(snap->request);
+    if (snap->has_request && folder_.empty()) TakeInputs(snap->request);
     if (ImGui::BeginTable("calibration", 3,
                           ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
       ImGui::TableSetupColumn("controls", ImGuiTableColumnFlags_WidthStretch, 0.27f);
@@ -69,7 +75,11 @@ class CalibrationPanel : public Panel {
       ImGui::TableSetupColumn("results", ImGuiTableColumnFlags_WidthStretch, 0.38f);
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
+      // The controls' IDs as at the window's root, whatever the table pushed (the tests and
+      // keyboard navigation name them "##folder", "Attach to project...").
+      ImGui::PushOverrideID(ImGui::GetCurrentWindow()->ID);
       DrawControls(ui, *snap);
+      ImGui::PopID();
       ImGui::TableSetColumnIndex(1);
       DrawPictures(ui, *snap);
       ImGui::TableSetColumnIndex(2);
@@ -82,7 +92,7 @@ class CalibrationPanel : public Panel {
 
  private:
   void TakeInputs(const calib::CalibrateRequest& request) {
-    std::snprintf(folder_, sizeof(folder_), "%s", request.images_dir.c_str());
+    folder_ = request.images_dir;
     std::snprintf(board_, sizeof(board_), "%s", request.board.text.c_str());
     const auto& names = calib::LensModelShortNames();
     const auto it = std::find(names.begin(), names.end(), request.model);
@@ -94,8 +104,10 @@ class CalibrationPanel : public Panel {
   }
 
   void DrawControls(UiContext& ui, const CalibrationSnapshot& snap) {
-    ImGui::SetNextItemWidth(-60);
-    ImGui::InputText("folder", folder_, sizeof(folder_));
+    PathField("Folder", "##folder", "the calibration pictures' folder/", &folder_,
+              {.extensions = {},
+               .folder_of_images = true,
+               .last_folder = ui.state ? &ui.state->last_folder : nullptr});
     ImGui::SetNextItemWidth(-60);
     ImGui::InputText("board", board_, sizeof(board_));
     if (ImGui::IsItemHovered())
@@ -170,24 +182,77 @@ class CalibrationPanel : public Panel {
     ImGui::EndPopup();
   }
 
-  // "Attach to project": the saved .cameramodel becomes the open project's camera.
+  // "Attach to project": a .cameramodel (the one just saved, or any other) becomes the open
+  // project's camera. Nothing changes until the checks pass (the camera's size against the
+  // project's frames, the lens's plausibility) and the user confirms that the painting
+  // starts over; Ctrl+Z restores the previous camera.
   void DrawAttach(UiContext& ui, const CalibrationSnapshot& snap) {
-    if (snap.saved_path.empty() || !ui.state->has_project) return;
+    if (!ui.state || !ui.state->has_project) return;
+    if (snap.saved_path != attach_saved_) {  // a new Save: that file, checked afresh
+      attach_saved_ = snap.saved_path;
+      attach_path_ = snap.saved_path;
+      attach_error_.clear();
+    }
+    ImGui::Separator();
+    if (PathField("Attach", "##attach", ".cameramodel (Save writes one)", &attach_path_,
+                  {.extensions = {".cameramodel"}, .last_folder = &ui.state->last_folder}))
+      attach_error_.clear();
     const bool v2 = ui.state->project.fresco_version >= 2;
     if (v2) {
       ImGui::SetNextItemWidth(80);
       ImGui::InputInt("stream", &attach_stream_);
       ImGui::SameLine();
     }
-    if (ImGui::Button("Attach to project")) {
-      if (Status s = AttachCameraToProject(snap.saved_path, attach_stream_, ui.state); !s.ok())
+    ImGui::BeginDisabled(attach_path_.empty());
+    if (ImGui::Button("Attach to project...")) {
+      const Status s =
+          CheckCameraForProject(attach_path_, v2 ? attach_stream_ : 0, ui.state->project, &check_);
+      if (!s.ok()) {
+        attach_error_ = s.message();
+        ui.state->message = "error: " + s.message();
+      } else {
+        attach_error_.clear();
+        ImGui::OpenPopup(kAttachPopup);
+      }
+    }
+    ImGui::EndDisabled();
+    if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
+      ImGui::SetTooltip(
+          "checks the camera against the project's frames, then asks before the "
+          "project's %s changes (Ctrl+Z undoes)",
+          v2 ? "streams[i].camera" : "camera");
+    if (!attach_error_.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.4f, 0.4f, 1));
+      ImGui::TextWrapped("%s", attach_error_.c_str());
+      ImGui::PopStyleColor();
+    }
+    DrawAttachConfirm(ui, v2 ? attach_stream_ : 0);
+  }
+
+  // The confirmation: what the camera is, and that the painting starts over.
+  void DrawAttachConfirm(UiContext& ui, int stream) {
+    ImGui::SetNextWindowSize(ImVec2(ImGui::GetFontSize() * 34, 0), ImGuiCond_Appearing);
+    if (!ImGui::BeginPopupModal(kAttachPopup, nullptr)) return;
+    ImGui::TextWrapped("%s: %s.", attach_path_.c_str(), check_.summary.c_str());
+    const int painted = ui.snapshot ? static_cast<int>(ui.snapshot->frames_painted.size()) : 0;
+    ImGui::TextWrapped(
+        "Attaching makes it the project's %s and paints again through it: the %d frame%s "
+        "painted so far %s painted again. Ctrl+Z returns to the previous camera.",
+        ui.state->project.StreamKey(stream, "camera").c_str(), painted, painted == 1 ? "" : "s",
+        painted == 1 ? "is" : "are");
+    if (ImGui::Button("Attach and repaint")) {
+      if (Status s = AttachCameraToProject(attach_path_, stream, ui.state); !s.ok())
         ui.state->message = "error: " + s.message();
       else
         ApplyProject(ui);  // repaint through the new camera
+      ImGui::CloseCurrentPopup();
     }
-    if (ImGui::IsItemHovered())
-      ImGui::SetTooltip("the project's %s becomes %s (Ctrl+Z undoes)",
-                        v2 ? "streams[i].camera" : "camera", snap.saved_path.c_str());
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape))) {
+      ui.state->message = "camera not attached; the painting goes on as it was";
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
   }
 
   void DrawImageList(UiContext& ui, const CalibrationSnapshot& snap) {
@@ -356,6 +421,9 @@ class CalibrationPanel : public Panel {
                {"excluded", std::to_string(snap.run.excluded.size())},
                {"camera_doubts", std::to_string(snap.run.camera_doubts.size())},
                {"readiness", kLevels[static_cast<int>(snap.readiness.level)]}};
+    report_["folder"] = folder_;
+    report_["attach"] = attach_path_;
+    if (!attach_error_.empty()) report_["attach_error"] = attach_error_;
     if (snap.solved) {
       report_["model"] = snap.run.Chosen().short_name;
       report_["lensmodel"] = snap.run.Chosen().lensmodel;
@@ -367,11 +435,15 @@ class CalibrationPanel : public Panel {
     }
   }
 
-  char folder_[1024] = "";
+  std::string folder_;
   char board_[256] = "";
   char save_path_[1100] = "";
-  int attach_stream_ = 0;  // version-2 projects: which stream's camera
-  int model_ = 0;          // 0 = auto, else LensModelShortNames()[model_ - 1]
+  int attach_stream_ = 0;     // version-2 projects: which stream's camera
+  std::string attach_path_;   // the .cameramodel Attach checks and attaches
+  std::string attach_saved_;  // the snapshot's saved_path attach_path_ last took
+  std::string attach_error_;  // why the last Attach was refused ("" when it was not)
+  CameraAttachCheck check_;   // the last check that passed (the confirmation shows it)
+  int model_ = 0;             // 0 = auto, else LensModelShortNames()[model_ - 1]
   int selected_ = -1;
   int drawn_image_ = -1;
   uint64_t drawn_version_ = 0;

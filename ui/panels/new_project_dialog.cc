@@ -67,7 +67,7 @@ class NewProjectDialog : public Panel {
 
   void Draw(UiContext& ui) override {
     if (PollBootstrap(ui)) return;  // the bootstrapped project was just made, the form closed
-    if (!open && runner_) {  // hidden (View menu) while COLMAP runs: as closing it, below
+    if (!open && runner_) {         // hidden (View menu) while COLMAP runs: as closing it, below
       runner_->Cancel();
       open = true;
     }
@@ -80,15 +80,16 @@ class NewProjectDialog : public Panel {
       open = true;
     }
     ImGui::BeginDisabled(runner_ != nullptr);
-    SceneVideoCameraFields(&form_);
+    SceneVideoCameraFields(&form_, &ui.state->last_folder);
     if (ui.calibration) {
       const std::string calibrated = ui.calibration->Snapshot()->saved_path;
       if (!calibrated.empty() &&
           ImGui::SmallButton(("Use the camera just calibrated: " + calibrated).c_str()))
         form_.camera = calibrated;
     }
-    DrawPosesChoice();
-    PathField("Save to", "##project", "project.json to create", &form_.project_file, {".json"});
+    DrawPosesChoice(&ui.state->last_folder);
+    PathField("Save to", "##project", "project.json to create", &form_.project_file,
+              {.extensions = {".json"}, .last_folder = &ui.state->last_folder});
     if (ImGui::Button("Create")) Create(ui);
     ImGui::EndDisabled();
     ImGui::SameLine();
@@ -116,7 +117,7 @@ class NewProjectDialog : public Panel {
  private:
   // Poses from a file (or live feed), or bootstrapped with COLMAP: then the control points
   // (or rough poses) that place them on the mesh and COLMAP's speed options.
-  void DrawPosesChoice() {
+  void DrawPosesChoice(std::string* last_folder) {
     ImGui::TextUnformatted("Poses from");
     ImGui::SameLine(80);
     int choice = form_.bootstrap ? 1 : 0;
@@ -125,14 +126,15 @@ class NewProjectDialog : public Panel {
     ImGui::RadioButton("bootstrap with COLMAP", &choice, 1);
     form_.bootstrap = choice == 1;
     if (!form_.bootstrap) {
-      PosesField(&form_.poses);
+      PosesField(&form_.poses, last_folder);
       return;
     }
     NewProjectBootstrapOptions& o = form_.colmap;
     PathField("Control", "##control",
               "control points: >= 3 known points on the mesh, NAME X Y Z IMAGE U V ...",
-              &o.control_points, {".txt"});
-    PosesField(&form_.poses, "optional: rough poses that place COLMAP's (without control points)");
+              &o.control_points, {.extensions = {".txt"}, .last_folder = last_folder});
+    PosesField(&form_.poses, last_folder,
+               "optional: rough poses that place COLMAP's (without control points)");
     ImGui::Indent(80);
     ImGui::Checkbox("fit to the mesh (ICP)", &o.refine_mesh);
     if (ImGui::IsItemHovered())

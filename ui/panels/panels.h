@@ -18,6 +18,10 @@ std::unique_ptr<Panel> MakeViewportPanel();
 std::unique_ptr<Panel> MakeGroupingPanel();
 // A stage panel shows one pipeline stage's metrics and debug images for the current frame.
 std::unique_ptr<Panel> MakeStagePanel(const std::string& stage, const std::string& title);
+// What a stage panel with no debug image says instead, true to the worker's state: they come
+// when paused (while playing or seeking), this frame was painted without them (paused after
+// playing: Step or F5 paints one with them), or the stage drew none for this frame.
+std::string NoDebugImagesNote(const RunnerSnapshot& snap);
 std::unique_ptr<Panel> MakeInputFramePanel();
 std::unique_ptr<Panel> MakePaintedBuffersPanel();
 std::unique_ptr<Panel> MakeTimingPanel();

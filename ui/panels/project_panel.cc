@@ -94,7 +94,7 @@ class ProjectPanel : public Panel {
     if (state.has_unopened || show_paths_) ImGui::SetNextItemOpen(true);
     show_paths_ = false;
     if (!ImGui::CollapsingHeader("Paths")) return;
-    ProjectPathFields(&paths_);
+    ProjectPathFields(&paths_, &ui.state->last_folder);
     ImGui::BeginDisabled(paths_ == shown_ && !state.has_unopened);
     if (ImGui::Button("Apply and save")) ApplyPaths(ui);
     ImGui::SameLine();

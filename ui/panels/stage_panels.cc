@@ -29,6 +29,19 @@ std::string DefaultImage(const std::map<std::string, cv::Mat>& images,
   return names.front();
 }
 
+}  // namespace
+
+std::string NoDebugImagesNote(const RunnerSnapshot& snap) {
+  if (snap.playing || snap.seek_target >= 0) return "(debug images appear when paused or stepping)";
+  if (!snap.report_has_images)
+    return "(frame " + std::to_string(snap.report.frame) +
+           " was painted while playing, without debug images: Step or Apply (F5) paints one "
+           "with them)";
+  return "(this stage drew no debug image for this frame)";
+}
+
+namespace {
+
 class StagePanel : public Panel {
  public:
   StagePanel(std::string stage, std::string title)
@@ -60,6 +73,7 @@ class StagePanel : public Panel {
       return;
     }
     ImGui::Text("frame %d: %.2f ms", snap.report.frame, stage->wall_ms);
+    note_.clear();
     std::vector<std::string> names;
     for (const auto& [name, image] : stage->images) names.push_back(name);
     SortNaturally(&names);
@@ -80,7 +94,8 @@ class StagePanel : public Panel {
       view_.Draw(ui, stage_ + "/" + selected_, stage->images.at(selected_), snap.version,
                  false_colour ? &scale : nullptr);
     } else {
-      ImGui::TextDisabled("(debug images appear when paused or stepping)");
+      note_ = NoDebugImagesNote(snap);
+      ImGui::TextDisabled("%s", note_.c_str());
     }
     std::vector<std::string> note_keys;  // buffer2 before buffer19
     for (const auto& [key, text] : stage->notes) note_keys.push_back(key);
@@ -92,13 +107,14 @@ class StagePanel : public Panel {
   }
 
   std::map<std::string, std::string> Report() const override {
-    std::map<std::string, std::string> report{{"image", selected_}};
+    std::map<std::string, std::string> report{{"image", selected_}, {"note", note_}};
     view_.ReportInto(&report);
     return report;
   }
 
  private:
   std::string stage_, title_, selected_;
+  std::string note_;  // why no debug image is shown ("" when one is)
   ImageView view_;
 };
 
