@@ -44,13 +44,6 @@ ArgSpec SlurmSpec() {
   return spec;
 }
 
-// `text` quoted for bash (single quotes).
-std::string Quote(const std::string& text) {
-  std::string q = "'";
-  for (char c : text) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
 std::string ThisExecutable() {
   std::error_code error;
   const fs::path self = fs::read_symlink("/proc/self/exe", error);
@@ -115,19 +108,19 @@ int RunVerbSlurm(const CommandArgs& argv) {
   }
   const std::string fresco = ThisExecutable();
   std::string sets;
-  for (const std::string& set : args.All("--set")) sets += " --set " + Quote(set);
+  for (const std::string& set : args.All("--set")) sets += " --set " + ShellQuote(set);
   const std::string n = std::to_string(shards);
   std::string paint = Header("fresco-paint", dir + "/logs/paint-%a.out",
                              {"--array=0-" + std::to_string(shards - 1)}, extra);
   paint += "I=${SLURM_ARRAY_TASK_ID:?run as a Slurm array task}\n";
-  paint += "exec " + Quote(fresco) + " run " + Quote(project_path) + " --out " +
-           Quote(dir + "/parts/") + "\"$I\" --shard \"$I/" + n + "\" --quiet" + sets + "\n";
+  paint += "exec " + ShellQuote(fresco) + " run " + ShellQuote(project_path) + " --out " +
+           ShellQuote(dir + "/parts/") + "\"$I\" --shard \"$I/" + n + "\" --quiet" + sets + "\n";
   // A failed shard cancels the merge (else it would wait forever, DependencyNeverSatisfied).
   std::string merge =
       Header("fresco-merge", dir + "/logs/merge.out", {"--kill-on-invalid-dep=yes"}, extra);
-  merge += "exec " + Quote(fresco) + " merge";
-  for (int i = 0; i < shards; ++i) merge += " " + Quote(dir + "/parts/" + std::to_string(i));
-  merge += " --out " + Quote(dir) + " --quiet\n";
+  merge += "exec " + ShellQuote(fresco) + " merge";
+  for (int i = 0; i < shards; ++i) merge += " " + ShellQuote(dir + "/parts/" + std::to_string(i));
+  merge += " --out " + ShellQuote(dir) + " --quiet\n";
   if (Status s = MakeDirectories(dir + "/logs"); !s.ok()) return Fail(s);
   if (Status s = WriteFileAtomic(dir + "/paint.sbatch", paint); !s.ok()) return Fail(s);
   if (Status s = WriteFileAtomic(dir + "/merge.sbatch", merge); !s.ok()) return Fail(s);
@@ -137,15 +130,16 @@ int RunVerbSlurm(const CommandArgs& argv) {
   }
   const std::string sbatch = FindProgram("sbatch");
   if (sbatch.empty())
-    return Fail(Status::Error("--submit: sbatch not found on PATH (install Slurm's client, or "
-                              "submit DIR/paint.sbatch and DIR/merge.sbatch by hand)"));
+    return Fail(
+        Status::Error("--submit: sbatch not found on PATH (install Slurm's client, or "
+                      "submit DIR/paint.sbatch and DIR/merge.sbatch by hand)"));
   const std::string log = dir + "/logs/sbatch.log";
   std::string paint_id, merge_id;
   if (Status s = Submit({sbatch, "--parsable", dir + "/paint.sbatch"}, log, &paint_id); !s.ok())
     return Fail(s);
-  if (Status s = Submit({sbatch, "--parsable", "--dependency=afterok:" + paint_id,
-                         dir + "/merge.sbatch"},
-                        log, &merge_id);
+  if (Status s =
+          Submit({sbatch, "--parsable", "--dependency=afterok:" + paint_id, dir + "/merge.sbatch"},
+                 log, &merge_id);
       !s.ok())
     return Fail(s);
   std::printf("paint %s\nmerge %s\n", paint_id.c_str(), merge_id.c_str());

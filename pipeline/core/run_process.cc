@@ -12,6 +12,14 @@
 
 namespace fresco {
 
+std::string ShellQuote(const std::string& arg) {
+  if (!arg.empty() && arg.find_first_of(" \t\n\"'\\$`;&|<>()*?[]{}~#!") == std::string::npos)
+    return arg;
+  std::string out = "'";
+  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
 std::string FindProgram(const std::string& name) {
   if (name.empty()) return "";
   if (name.find('/') != std::string::npos) {
@@ -30,8 +38,8 @@ std::string FindProgram(const std::string& name) {
   return "";
 }
 
-Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path,
-                  int* exit_code, const std::atomic<bool>* cancel) {
+Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path, int* exit_code,
+                  const std::atomic<bool>* cancel) {
   if (argv.empty()) return Status::Error("RunProcess: empty command");
   const int log_fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   if (log_fd < 0) {
@@ -89,8 +97,8 @@ Status RunProcess(const std::vector<std::string>& argv, const std::string& log_p
   if (got == static_cast<ssize_t>(sizeof(exec_errno))) {
     return Status::Error(argv[0] + ": cannot run: " + std::strerror(exec_errno));
   }
-  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status)
-                                 : (WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 1);
+  *exit_code =
+      WIFEXITED(status) ? WEXITSTATUS(status) : (WIFSIGNALED(status) ? 128 + WTERMSIG(status) : 1);
   return Status::Ok();
 }
 

@@ -17,6 +17,10 @@ namespace fresco {
 Status RunProcess(const std::vector<std::string>& argv, const std::string& log_path,
                   int* exit_code, const std::atomic<bool>* cancel = nullptr);
 
+// `arg` as one word for bash: as it is when it holds nothing bash would read, else in single
+// quotes (for the commands Fresco logs and the job scripts it writes).
+std::string ShellQuote(const std::string& arg);
+
 // The absolute path of `name` on PATH (or `name` itself when it holds a '/' and is
 // executable); "" when not found.
 std::string FindProgram(const std::string& name);

@@ -17,13 +17,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Quote(const std::string& arg) {
-  if (!arg.empty() && arg.find_first_of(" \t\"'\\$`;&|<>()*?") == std::string::npos) return arg;
-  std::string out = "'";
-  for (char c : arg) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 std::string JoinParams(const std::vector<double>& params) {
   std::ostringstream out;
   out.precision(17);
@@ -86,7 +79,7 @@ struct StepRunner {
     std::string line;
     for (const std::string& a : argv) {
       if (!line.empty()) line += ' ';
-      line += Quote(a);
+      line += ShellQuote(a);
     }
     const std::string commands_path = (ws->root / "commands.txt").string();
     std::string commands;

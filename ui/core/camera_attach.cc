@@ -22,7 +22,10 @@ std::string Number(const char* format, double value) {
   return buffer;
 }
 
-constexpr double kPi = 3.14159265358979323846;
+// The field of view across the image's width, degrees.
+double FieldOfViewDeg(const Camera& camera) {
+  return 2 * std::atan(0.5 * camera.width / camera.fx) * 180 / M_PI;
+}
 
 }  // namespace
 
@@ -38,7 +41,7 @@ Status CheckLensPlausible(const Camera& camera, const std::string& what) {
   if (aspect < 0.5 || aspect > 2)
     return Status::Error(what + ": fx / fy is " + Number("%.2f", aspect) +
                          " (plausible: 0.5 to 2): not a plausible lens");
-  const double fov_deg = 2 * std::atan(0.5 * camera.width / camera.fx) * 180 / kPi;
+  const double fov_deg = FieldOfViewDeg(camera);
   if (fov_deg < 1 || fov_deg > 170)
     return Status::Error(what + ": fx " + Number("%.1f", camera.fx) +
                          " px gives a field of view of " + Number("%.1f", fov_deg) +
@@ -70,7 +73,7 @@ Status CheckCameraForProject(const std::string& cameramodel_path, int stream,
   result.camera = model.camera;
   const Camera& camera = result.camera;
   if (Status s = CheckLensPlausible(camera, cameramodel_path); !s.ok()) return s;
-  const double fov_deg = 2 * std::atan(0.5 * camera.width / camera.fx) * 180 / kPi;
+  const double fov_deg = FieldOfViewDeg(camera);
   result.summary = "the camera is " + Size(camera.width, camera.height) + ", fx " +
                    Number("%.1f", camera.fx) + " px (" + Number("%.0f", fov_deg) + " deg across)";
   const std::string& video = streams[stream].video;
