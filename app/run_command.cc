@@ -189,6 +189,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                               {"median_translation_m", a.median_translation_m},
                               {"rotation_prior_deg", a.rotation_prior_deg},
                               {"translation_prior_m", a.translation_prior_m},
+                              {"decided_on_frames", a.decided_on_frames},
                               {"seconds", a.seconds}};
   }
   if (job.mover_masks) {  // background.mode auto: movers found across views before painting
@@ -398,11 +399,20 @@ void PrintJobSummary(const PaintJob& job, size_t streams) {
                  job.joint_poses->not_run.c_str());
   } else if (job.joint_poses) {
     const PoseAdjustResult& a = *job.joint_poses;
+    const int frames = static_cast<int>(a.cam_from_local.size());
+    const std::string on = a.decided_on_frames < frames
+                               ? " on the first " + std::to_string(a.decided_on_frames) + " frames"
+                               : "";
     std::fprintf(stderr,
-                 "fresco run: poses adjusted together: the frames left out agree %.3f -> %.3f px "
+                 "fresco run: poses adjusted together%s: the frames left out agree %.3f -> %.3f px "
                  "(%d tracks, %.1f s): %s",
-                 a.check_before_px, a.check_after_px, a.check_matches, a.check_seconds,
-                 a.applied ? "applied" : "not applied (no better by the check)\n");
+                 on.c_str(), a.check_before_px, a.check_after_px, a.check_matches, a.check_seconds,
+                 a.applied ? "applied" : "not applied");
+    if (!a.applied && a.rms_after_px > 0)
+      std::fprintf(stderr, " (all tracks %.3f -> %.3f px: not %.1f times better)\n",
+                   a.rms_before_px, a.rms_after_px, PoseAdjustOptions().min_improvement);
+    else if (!a.applied)
+      std::fprintf(stderr, " (no better by the check)\n");
     if (a.applied)
       std::fprintf(stderr, "; %d tracks, RMS %.3f -> %.3f px, median correction %.3f deg, %.1f mm (%.1f s)\n",
                    a.inliers, a.rms_before_px, a.rms_after_px, a.median_rotation_deg,

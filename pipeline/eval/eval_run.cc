@@ -135,6 +135,14 @@ Status PaintCapture(const Project& project, const GeneratedCapture& g, const Eva
   result->coverage = session.Coverage();
   result->decisions = session.auto_decisions();
   if (job->mover_masks) result->movers_across_views = job->mover_masks->fraction();
+  if (const auto& joint = job->joint_poses; joint && joint->not_run.empty()) {
+    const auto ratio = [](double before, double after) { return after > 0 ? before / after : 0; };
+    result->joint_ran = true;
+    result->joint_applied = joint->applied;
+    result->joint_decided_on_frames = joint->decided_on_frames;
+    result->joint_check_ratio = ratio(joint->check_before_px, joint->check_after_px);
+    result->joint_tracks_ratio = ratio(joint->rms_before_px, joint->rms_after_px);
+  }
   return Status::Ok();
 }
 

@@ -67,6 +67,11 @@ struct CaptureEval {
   // when not run).
   double movers_across_views = std::numeric_limits<double>::quiet_NaN();
   bool noisy_poses = false;  // the given poses differ from the true ones
+  // refine.joint: whether the poses' joint adjustment ran and was applied, on how many frames
+  // it decided, and its two ratios (the frames left out; all tracks: RMS before / after).
+  bool joint_ran = false, joint_applied = false;
+  int joint_decided_on_frames = 0;
+  double joint_check_ratio = 0, joint_tracks_ratio = 0;
   // With EvalOptions::recovery (NaN otherwise): truth PSNR with refinement off at the given
   // poses, with the setting at the true poses (noisy captures only), and the share of the
   // PSNR lost to pose noise that the setting recovers (where at least 0.5 dB is lost).

@@ -135,6 +135,11 @@ std::string EvalToJson(const std::vector<std::string>& settings,
     row["auto"] = json::parse(AutoDecisionsJson(c.decisions));
     if (std::isfinite(c.movers_across_views)) row["movers_across_views"] = c.movers_across_views;
     row["noisy_poses"] = c.noisy_poses;
+    if (c.joint_ran)
+      row["joint_poses"] = {{"applied", c.joint_applied},
+                            {"decided_on_frames", c.joint_decided_on_frames},
+                            {"check_ratio", c.joint_check_ratio},
+                            {"tracks_ratio", c.joint_tracks_ratio}};
     if (std::isfinite(c.unrefined_truth_psnr_db)) {
       const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
       row["refinement"] = {{"unrefined_truth_psnr_db", number(c.unrefined_truth_psnr_db)},

@@ -684,6 +684,29 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   const auto seconds = [&start] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
+  result->decided_on_frames = n;
+  if (const int first = options.decide_on_first_frames; first >= 2 && 2 * n > 3 * first) {
+    PoseAdjustOptions on_first = options;
+    on_first.decide_on_first_frames = 0;
+    if (options.progress)  // the first frames' steps, then the whole capture's
+      on_first.progress = [&options](int done, int total, const std::string& line) {
+        options.progress(done, total, "first frames: " + line);
+      };
+    PoseAdjustResult trial;
+    const std::vector<PoseAdjustFrame> first_frames(given.begin(), given.begin() + first);
+    FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(mesh, first_frames, on_first, &trial));
+    if (!trial.applied && trial.not_run.empty()) {
+      const std::vector<Rigid3d> poses = result->cam_from_local;
+      std::vector<int> frame_matches = trial.frame_matches;
+      frame_matches.resize(n, 0);
+      *result = trial;
+      result->cam_from_local = poses;
+      result->frame_matches = frame_matches;
+      result->seconds = seconds();
+      if (options.progress) options.progress(1, 1, "decided on the first frames: not adjusted");
+      return Status::Ok();
+    }
+  }
   Prepared prepared;
   Prepare(mesh, given, options, &prepared);
   // The check's tracks first (over check_offsets), then the others'.

@@ -80,6 +80,12 @@ struct PoseAdjustOptions {
   // (20.22 against 20.70 dB); this ratio is 2.0 there (2.3 when tracked at 400 pixels: the rule
   // depends on the tracking size, open work), 2.5-11 with 0.5 degree of noise.
   double min_improvement = 2.2;
+  // Captures of more than 1.5 times this many frames are decided on their first this many
+  // first: when those frames' adjustment is not applied (the check, min_improvement), the rest
+  // is not tracked and the given poses stand (most of the cost saved where nothing is
+  // corrected); when it is, the whole capture is adjusted and decided as above. 0: the whole
+  // capture at once.
+  int decide_on_first_frames = 32;
   // Captures with more frames are not adjusted (not_run says so): every frame is held in
   // memory, with its depth and triangle maps (a few MB a frame).
   int max_frames = 500;
@@ -104,6 +110,9 @@ struct PoseAdjustResult {
   double median_rotation_deg = 0, median_translation_m = 0;  // corrections found
   double rotation_prior_deg = 0, translation_prior_m = 0;    // the priors of the last round
   double seconds = 0;
+  // The frames the figures above come from: all of them, or the first ones when the decision
+  // on those ended it (PoseAdjustOptions::decide_on_first_frames).
+  int decided_on_frames = 0;
 };
 
 // Why a capture of `frames` frames is not adjusted ("" when it is): more than max_frames.

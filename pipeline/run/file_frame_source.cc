@@ -5,19 +5,20 @@
 namespace fresco {
 
 FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
-                                 SkipFrame skip)
+                                 SkipFrame skip, bool read_frames_without_pose)
     : streams_(streams), ended_(streams.size(), false), read_(streams.size(), 0) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < streams_.size(); ++s) {
     origins_.push_back({project.Resolve(specs[s].video), project.Resolve(specs[s].poses)});
     std::function<bool(const Frame&)> skip_frame;
-    if (skip)
-      skip_frame = [this, s, skip](const Frame& header) {
+    if (skip || !read_frames_without_pose)
+      skip_frame = [this, s, skip, read_frames_without_pose](const Frame& header) {
         SourcedFrame f;
         f.posed.frame = header;
         f.stream = static_cast<int>(s);
         MatchPose(static_cast<int>(s), &f);
-        return f.posed.has_pose && f.camera && skip(f);
+        if (!f.posed.has_pose) return !read_frames_without_pose;
+        return f.camera && skip && skip(f);
       };
     readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get(), skip_frame));
     fps_.push_back(specs[s].fps);
@@ -61,6 +62,7 @@ FrameRead FileFrameSource::Next(SourcedFrame* frame, Status* status) {
     ++read_[s];
     frame->stream = s;
     MatchPose(s, frame);
+    if (!frame->posed.has_pose) frame->skipped = false;  // not decoded: a frame without a pose
     return FrameRead::kFrame;
   }
   return FrameRead::kEnded;  // every stream ended

@@ -25,9 +25,11 @@ class FileFrameSource : public PosedFrameSource {
   // `skip` (optional; folders only, whose frame names are known before decoding): asked, on
   // the reading thread, with a posed frame's header (pose, camera; no pixels); true: the frame
   // is not read and comes out with `skipped` set.
+  // `read_frames_without_pose` false (folders only): a frame without a pose is not decoded and
+  // comes out without pixels (nothing paints it; the app shows it, so reads it).
   using SkipFrame = std::function<bool(const SourcedFrame& header)>;
   FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
-                  SkipFrame skip = nullptr);
+                  SkipFrame skip = nullptr, bool read_frames_without_pose = true);
 
   FrameRead Next(SourcedFrame* frame, Status* status) override;
   int NumStreams() const override { return static_cast<int>(streams_.size()); }

@@ -106,7 +106,7 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   PaintJob::OpenSeconds& seconds = j->open_seconds;
   auto step = std::chrono::steady_clock::now();
   {
-    FileFrameSource source(project, streams);
+    FileFrameSource source(project, streams, nullptr, /*read_frames_without_pose=*/false);
     SourcedFrame f;
     Status status;
     for (int read = 0; (project.pipeline.max_frames <= 0 || read < project.pipeline.max_frames) &&
@@ -224,7 +224,8 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                !session->ViewMeetsOwnBuffers(*f.camera, it->second, f.posed.cam_from_world);
       };
     }
-    j.source = std::make_unique<FileFrameSource>(project, streams, skip);
+    j.source =
+        std::make_unique<FileFrameSource>(project, streams, skip, options.read_frames_without_pose);
     seconds.total = SecondsSince(start);
     *job = std::move(result);
     return Status::Ok();

@@ -55,6 +55,9 @@ struct PaintJobOptions {
   // session paints that shard's buffers and the source skips, unread, the frames whose view
   // meets none of them (folders; a video file's frames are decoded still).
   ShardSpec shard;
+  // Decode the frames without a pose too (the app shows them); false: folders' frames without
+  // a pose come out without pixels, undecoded (nothing paints them).
+  bool read_frames_without_pose = false;
 };
 
 struct PaintJob {

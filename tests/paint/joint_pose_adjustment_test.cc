@@ -229,6 +229,40 @@ TEST(JointPoseAdjustment, TheCheckOnFramesLeftOutAppliesNoisyPoses) {
     EXPECT_EQ(always.cam_from_local[i].translation, result.cam_from_local[i].translation);
 }
 
+// A long capture is decided on its first frames first: at exact poses nothing more is
+// tracked (the given poses stand, the figures are those frames'); with noisy poses the first
+// frames pass and the whole capture is adjusted exactly as without the first decision.
+TEST(JointPoseAdjustment, ALongCaptureIsDecidedOnItsFirstFrames) {
+  PoseAdjustOptions first16;
+  first16.decide_on_first_frames = 16;  // the orbit has 40 frames
+  PoseAdjustOptions whole;
+  whole.decide_on_first_frames = 0;
+  const Orbit exact = MakeOrbit(0, 0);
+  const std::vector<PoseAdjustFrame> frames = Frames(exact);
+  PoseAdjustResult kept;
+  ASSERT_TRUE(AdjustPosesOnMesh(exact.scene.mesh, frames, first16, &kept).ok());
+  EXPECT_FALSE(kept.applied);
+  EXPECT_EQ(kept.decided_on_frames, 16);
+  EXPECT_GT(kept.check_matches, 50);
+  ASSERT_EQ(kept.cam_from_local.size(), frames.size());
+  ASSERT_EQ(kept.frame_matches.size(), frames.size());
+  for (size_t i = 0; i < frames.size(); ++i)
+    EXPECT_EQ(kept.cam_from_local[i].translation, frames[i].cam_from_local.translation);
+  for (size_t i = 16; i < frames.size(); ++i) EXPECT_EQ(kept.frame_matches[i], 0);
+  const Orbit noisy = MakeOrbit(0.5, 0.01);
+  PoseAdjustResult decided_first, at_once;
+  double before = 0, after = 0;
+  ASSERT_NO_FATAL_FAILURE(AdjustOrbit(noisy, first16, &decided_first, &before, &after));
+  ASSERT_NO_FATAL_FAILURE(AdjustOrbit(noisy, whole, &at_once, &before, &after));
+  EXPECT_TRUE(decided_first.applied);
+  EXPECT_EQ(decided_first.decided_on_frames, 40);
+  EXPECT_EQ(at_once.decided_on_frames, 40);
+  EXPECT_EQ(decided_first.matches, at_once.matches);
+  for (size_t i = 0; i < at_once.cam_from_local.size(); ++i)
+    EXPECT_EQ(decided_first.cam_from_local[i].translation, at_once.cam_from_local[i].translation);
+  EXPECT_LT(after, 0.1 * before);
+}
+
 TEST(JointPoseAdjustment, FewerThanTwoFramesChangeNothing) {
   const Orbit o = MakeOrbit(0.5, 0.01);
   std::vector<PoseAdjustFrame> frames = Frames(o);

@@ -110,13 +110,14 @@ struct Ran {
   std::string end_reason;             // PaintRun::EndReason()
 };
 Ran RunJob(const std::string& project_json, const PaintRunOptions& options,
-           const std::vector<std::string>& overrides = {}) {
+           const std::vector<std::string>& overrides = {},
+           const PaintJobOptions& job_options = PaintJobOptions()) {
   Project project;
   Ran ran;
   ran.status = LoadProject(project_json, overrides, &project);
   if (!ran.status.ok()) return ran;
   std::unique_ptr<PaintJob> job;
-  ran.status = OpenPaintJob(project, PaintJobOptions(), &job);
+  ran.status = OpenPaintJob(project, job_options, &job);
   if (!ran.status.ok()) return ran;
   PaintRun run(job->session.get(), job->source.get(), options);
   PaintRunHooks hooks;
@@ -168,6 +169,25 @@ TEST(PaintRun, MaxFramesEndsTheRunWithoutAnError) {
   EXPECT_EQ(r.stats.frames, 4);
   EXPECT_EQ(r.stats.frames_painted, 4);
   EXPECT_EQ(r.end_reason, "pipeline.max_frames (4) reached");
+}
+
+// A folder's frame without a pose is not decoded (nothing paints it): a broken file there
+// passes, counted as a frame without a pose, before painting and while painting. The app,
+// which shows every frame, reads it and stops at it.
+TEST(PaintRun, AFrameWithoutAPoseIsNotDecoded) {
+  const std::string project = MakeBadCapture(BadCapture::kMissingPose);
+  const std::string file = fs::path(project).parent_path().string() + "/frames/000003.png";
+  testing::WriteText(file, "this is not a PNG");
+  const Ran r = RunJob(project, PaintRunOptions());
+  ASSERT_TRUE(r.status.ok()) << r.status.message();
+  EXPECT_EQ(r.stats.frames, 12);
+  EXPECT_EQ(r.stats.frames_without_pose, 1);
+  EXPECT_EQ(r.stats.frames_painted, 11);
+  PaintJobOptions as_the_app;
+  as_the_app.read_frames_without_pose = true;
+  const Ran shown = RunJob(project, PaintRunOptions(), {}, as_the_app);
+  ASSERT_FALSE(shown.status.ok());
+  EXPECT_EQ(shown.status.message().rfind(file + ": ", 0), 0u) << shown.status.message();
 }
 
 // Painting frame by frame, the run ends at the broken frame; with the joint pose adjustment

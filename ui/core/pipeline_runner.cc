@@ -151,6 +151,7 @@ void PipelineRunner::OpenSession(const Project& project) {
   // polled so that the worker stays responsive while it stalls.
   PaintJobOptions job_options;
   job_options.poll_ms = options_.live_poll_ms;
+  job_options.read_frames_without_pose = true;  // shown while playing
   const auto progress = [this](const char* what) {
     return [this, what](int done, int total, const std::string&) {
       // A seek back reopens the project: its progress stays a seek's.
