@@ -66,24 +66,26 @@ double RelativeRotationDeg(const PosePair& self, const std::vector<PosePair>& pa
   return at_k.norm() * 180.0 / M_PI;
 }
 
-// Whether a flagged frame (`self`, its disagreement `own`) disagrees as the frames `around`
-// it (at `offsets` from it) do: within the thresholds of the robust line through their
-// disagreements (Theil-Sen per component), its rotation also by the rotations between it and
-// them (alignment-free; set in `v`). Where the neighbours themselves scatter about that line
-// by more than the thresholds, in rotation or position (a reconstruction that bends faster
-// and faster, degrees a frame), the tolerance (in units of the thresholds, set in `v`) widens
-// by kDriftScatter times the excess of their median distance from it: a frame stands out only
-// from what its neighbours do. Neighbours within the thresholds (given poses with noise below
-// them) leave it at 1.
+// Judges frame `self` (its disagreement under its window's fit `own`) after the local
+// alignment the frames `around` it (at `offsets` from it) give: a robust line through their
+// disagreements (Theil-Sen per component) says how the reconstruction drifts there, and the
+// frame's own is measured from it; its rotation through the rotations between it and them
+// (alignment-free, relative_rotation_deg), which a reconstruction that bends faster than a
+// line still moves little. These are the errors shown (`v`), with COLMAP's centre under the
+// local alignment. Where the neighbours themselves scatter about their line by more than the
+// thresholds, in rotation or position (a reconstruction that bends faster and faster, degrees
+// a frame), the tolerance (in units of the thresholds) widens by kDriftScatter times the excess
+// of their median distance from it: a frame stands out only from what its neighbours do.
+// Neighbours within the thresholds (given poses with noise below them) leave it at 1.
 constexpr double kDriftScatter = 3.0;
 double DriftTolerance(const std::vector<double>& scatter) {
   return 1.0 + kDriftScatter * std::max(0.0, Median(scatter) - 1.0);
 }
-bool FollowsDrift(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
+void JudgeLocally(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
                   const std::vector<PosePair>& pairs,
                   const std::vector<Eigen::Matrix<double, 6, 1>>& disagreement,
                   const std::vector<int>& around, const std::vector<double>& offsets,
-                  double rotation_threshold_deg, FrameVerdict* v) {
+                  const VerifyResult& out, FrameVerdict* v) {
   RobustLine lines[6];
   for (int c = 0; c < 6; ++c) {
     std::vector<double> values;
@@ -99,13 +101,30 @@ bool FollowsDrift(const PosePair& self, const Eigen::Matrix<double, 6, 1>& own,
   }
   const double tolerance =
       std::max(DriftTolerance(scatter_rotation), DriftTolerance(scatter_position));
-  v->drift_tolerance = tolerance;
   Eigen::Matrix<double, 6, 1> residual;
   for (int c = 0; c < 6; ++c) residual[c] = own[c] - lines[c].at_zero;
+  const double threshold_deg = out.rotation_threshold_deg;
+  // Three alignments near the frame: its window's fit, that fit corrected by the line through
+  // the neighbours' disagreement, and (rotation only) the rotations between it and its
+  // neighbours. The one it agrees with best gives its error: where the drift has a kink, a
+  // line through the neighbours fails there, and where it bends fast, the window's fit.
   v->relative_rotation_deg = RelativeRotationDeg(self, pairs, around, offsets);
-  const bool rotation_follows =
-      residual.head<3>().norm() <= tolerance || v->relative_rotation_deg <= rotation_threshold_deg;
-  return rotation_follows && residual.tail<3>().norm() <= tolerance;
+  const double rotation_deg = std::min({v->fit_rotation_error_deg, v->relative_rotation_deg,
+                                        residual.head<3>().norm() * threshold_deg});
+  const double threshold_m = out.position_threshold_m;
+  const bool beyond_fit =
+      v->fit_rotation_error_deg > threshold_deg || v->fit_position_error_m > threshold_m;
+  v->judged_locally = true;
+  v->drift_tolerance = tolerance;
+  v->rotation_error_deg = rotation_deg;
+  if (residual.tail<3>().norm() * threshold_m < v->fit_position_error_m) {
+    v->position_error_m = residual.tail<3>().norm() * threshold_m;
+    v->colmap_centre_m = v->given_centre_m + residual.tail<3>() * threshold_m;
+  }
+  const bool beyond_local = rotation_deg > threshold_deg || v->position_error_m > threshold_m;
+  v->flagged =
+      rotation_deg > tolerance * threshold_deg || v->position_error_m > tolerance * threshold_m;
+  v->follows_drift = !v->flagged && (beyond_fit || beyond_local);
 }
 
 void SetCentres(const PosePair& pair, const Sim3d& world_from_colmap, FrameVerdict* v) {
@@ -113,28 +132,12 @@ void SetCentres(const PosePair& pair, const Sim3d& world_from_colmap, FrameVerdi
   v->colmap_centre_m = world_from_colmap.TransformPose(pair.colmap_cam_from_colmap).Centre();
 }
 
-// Counts a frame let through as following the drift with a widened tolerance.
-void NoteWidened(const FrameVerdict& v, VerifyResult* out) {
-  if (v.drift_tolerance <= 1.0) return;
-  ++out->widened;
-  out->widest_tolerance_deg =
-      std::max(out->widest_tolerance_deg, v.drift_tolerance * out->rotation_threshold_deg);
-}
-
-// Marks a flagged frame as following the drift instead.
-void MarkFollowing(FrameVerdict* v, VerifyResult* out) {
-  v->flagged = false;
-  v->follows_drift = true;
-  ++out->following_drift;
-  NoteWidened(*v, out);
-}
-
 // Sets a frame's errors and centres under `fit` and flags it beyond the thresholds.
 void Judge(const PosePair& pair, const PoseAlignment& fit, const VerifyResult& out,
            FrameVerdict* v) {
   const PoseError e = ComparePose(pair, fit.world_from_colmap);
-  v->rotation_error_deg = e.rotation_deg;
-  v->position_error_m = e.position_m;
+  v->rotation_error_deg = v->fit_rotation_error_deg = e.rotation_deg;
+  v->position_error_m = v->fit_position_error_m = e.position_m;
   SetCentres(pair, fit.world_from_colmap, v);
   v->flagged =
       e.rotation_deg > out.rotation_threshold_deg || e.position_m > out.position_threshold_m;
@@ -253,69 +256,55 @@ KeyframeFits JudgeKeyframes(const FramePairs& split, const PoseAlignment& global
   return keyframes;
 }
 
-// Judged against the neighbours' disagreement (the frame itself left out), a robust line
-// through them per component (Theil-Sen: the median slope, then the median intercept;
-// exact on a steady drift, even at the sequence's ends): a drift is smooth, a wrong
-// given pose stands out from its neighbours.
+// Each keyframe judged against its neighbours' disagreement (the frame itself left out), a
+// robust line through them per component (Theil-Sen: the median slope, then the median
+// intercept; exact on a steady drift, even at the sequence's ends): a drift is smooth, a
+// wrong given pose stands out from its neighbours.
 void FollowDriftOnKeyframes(const FramePairs& split, const KeyframeFits& keyframes,
                             const VerifyOptions& options, VerifyResult* out) {
   const int n = static_cast<int>(split.pairs.size());
   const int h = options.drift_neighbours;
   for (int k = 0; k < n; ++k) {
     FrameVerdict& v = out->frames[split.frame_of_pair[k]];
-    if (!v.flagged) continue;
     std::vector<int> around;
-    for (int j = std::max(0, k - h); j <= std::min(n - 1, k + h); ++j)
+    // 2h neighbours, also at the sequence's ends (the window shifted inwards: a line
+    // extrapolated from h frames on one side is too unsure).
+    const int first = std::clamp(k - h, 0, std::max(0, n - 1 - 2 * h));
+    for (int j = first; j <= std::min(n - 1, first + 2 * h); ++j)
       if (j != k) around.push_back(j);
     if (static_cast<int>(around.size()) < std::min(h, n - 1)) continue;
     std::vector<double> offsets;
     for (int j : around) offsets.push_back(j - k);
-    if (FollowsDrift(split.pairs[k], keyframes.disagreement[k], split.pairs, keyframes.disagreement,
-                     around, offsets, out->rotation_threshold_deg, &v)) {
-      MarkFollowing(&v, out);
-    }
+    JudgeLocally(split.pairs[k], keyframes.disagreement[k], split.pairs, keyframes.disagreement,
+                 around, offsets, *out, &v);
   }
 }
 
-// Whether other frame o, flagged under `fit`, follows the drift of the keyframes around it:
-// the line through theirs, or between the two on either side of it (in proportion to where
-// it sits between them) where neither of those is flagged.
-bool OtherFollowsDrift(const FramePairs& split, const KeyframeFits& keyframes, size_t o,
+// Other frame o (between keyframes after-1 and after), judged under `fit` against the
+// keyframes around it (at their offsets from where it sits between its two).
+void JudgeOtherLocally(const FramePairs& split, const KeyframeFits& keyframes, size_t o,
                        const PoseAlignment& fit, const VerifyOptions& options, VerifyResult* out) {
   const int n = static_cast<int>(split.pairs.size());
-  const int after = split.keyframes_before_other[o];  // between keyframes after-1 and after
+  const int after = split.keyframes_before_other[o];
   FrameVerdict& v = out->frames[split.frame_of_other[o]];
   const int h = options.drift_neighbours;
   std::vector<int> around;
-  for (int j = std::max(0, after - h); j < std::min(n, after + h); ++j) around.push_back(j);
-  if (static_cast<int>(around.size()) < std::min(h, n)) return false;
+  const int first = std::clamp(after - h, 0, std::max(0, n - 2 * h));
+  for (int j = first; j < std::min(n, first + 2 * h); ++j) around.push_back(j);
+  if (static_cast<int>(around.size()) < std::min(h, n)) return;
   // Where it sits between keyframes after-1 and after (0.5 before the first or after the last).
   double between = 0.5;
-  const bool inside = after > 0 && after < n;
-  if (inside) {
+  if (after > 0 && after < n) {
     between = static_cast<double>(split.frame_of_other[o] - split.frame_of_pair[after - 1]) /
               (split.frame_of_pair[after] - split.frame_of_pair[after - 1]);
   }
   std::vector<double> offsets;
   for (int j : around) offsets.push_back(j - (after - 1 + between));
-  const double rotation_threshold_deg = out->rotation_threshold_deg;
-  const double position_threshold_m = out->position_threshold_m;
-  const Eigen::Matrix<double, 6, 1> own = DisagreementOf(
-      split.others[o], fit.world_from_colmap, rotation_threshold_deg, position_threshold_m);
-  bool follows = FollowsDrift(split.others[o], own, split.pairs, keyframes.disagreement, around,
-                              offsets, rotation_threshold_deg, &v);
-  if (!follows && inside && !out->frames[split.frame_of_pair[after - 1]].flagged &&
-      !out->frames[split.frame_of_pair[after]].flagged) {
-    const Eigen::Matrix<double, 6, 1> expected =
-        (1 - between) * DisagreementOf(split.pairs[after - 1], fit.world_from_colmap,
-                                       rotation_threshold_deg, position_threshold_m) +
-        between * DisagreementOf(split.pairs[after], fit.world_from_colmap, rotation_threshold_deg,
-                                 position_threshold_m);
-    const Eigen::Matrix<double, 6, 1> residual = own - expected;
-    follows = residual.head<3>().norm() <= 1.0 && residual.tail<3>().norm() <= 1.0;
-    if (follows) v.drift_tolerance = 1.0;
-  }
-  return follows;
+  const Eigen::Matrix<double, 6, 1> own =
+      DisagreementOf(split.others[o], fit.world_from_colmap, out->rotation_threshold_deg,
+                     out->position_threshold_m);
+  JudgeLocally(split.others[o], own, split.pairs, keyframes.disagreement, around, offsets, *out,
+               &v);
 }
 
 // The other frames (between keyframes), each by the fit of the keyframe after it (or the
@@ -328,8 +317,7 @@ void JudgeOthers(const FramePairs& split, const KeyframeFits& keyframes,
     const PoseAlignment& fit = keyframes.fits.at(keyframes.window_of[std::min(after, n - 1)]);
     FrameVerdict& v = out->frames[split.frame_of_other[o]];
     Judge(split.others[o], fit, *out, &v);
-    if (!v.flagged || !out->drift_followed) continue;
-    if (OtherFollowsDrift(split, keyframes, o, fit, options, out)) MarkFollowing(&v, out);
+    if (out->drift_followed) JudgeOtherLocally(split, keyframes, o, fit, options, out);
   }
 }
 
@@ -354,17 +342,31 @@ void ExcuseWeakSupport(const std::vector<VerifyFrameInput>& frames, const Verify
   }
 }
 
-// The counts of flagged and unflagged frames and the unflagged frames' error statistics.
+// The counts of flagged, following, weak and agreeing frames (they add up to the compared
+// ones), the stretch following the drift, and the agreeing frames' error statistics.
 void CountVerdicts(VerifyResult* out) {
   std::vector<double> rotations, positions;
+  if (out->drift_followed) out->drift_first = out->drift_last = "";
   for (const FrameVerdict& v : out->frames) {
     if (!v.has_given || !v.registered) continue;
+    out->judged_locally += v.judged_locally;
     if (v.flagged) {
       ++out->flagged;
       continue;
     }
-    // Beyond the thresholds: not agreeing, not flagged.
-    if (v.follows_drift || v.weak_support) continue;
+    if (v.weak_support) continue;  // beyond the thresholds: not agreeing, not flagged
+    if (v.follows_drift) {
+      ++out->following_drift;
+      if (out->following_drift == 1) out->drift_first = v.name;
+      out->drift_last = v.name;
+      if (v.drift_tolerance > 1.0 && (v.rotation_error_deg > out->rotation_threshold_deg ||
+                                      v.position_error_m > out->position_threshold_m)) {
+        ++out->widened;
+        out->widest_tolerance_deg =
+            std::max(out->widest_tolerance_deg, v.drift_tolerance * out->rotation_threshold_deg);
+      }
+      continue;
+    }
     ++out->unflagged;
     rotations.push_back(v.rotation_error_deg);
     positions.push_back(v.position_error_m);
@@ -430,31 +432,43 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result) {
                   result.global_agreeing, result.compared);
     notes.push_back(text);
   }
-  if (result.disagreement.Drifts()) {
+  if (result.drift_followed) {
+    // The counts add up to the compared frames.
+    std::string note = "The disagreement drifts smoothly along the sequence";
+    if (result.following_drift > 0) {
+      note += " from " + result.drift_first + " to " + result.drift_last;
+    }
     std::snprintf(text, sizeof(text),
-                  "%d of the %d frames beyond the thresholds disagree smoothly along the "
-                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there",
-                  result.disagreement.smooth, result.disagreement.disagreeing,
-                  result.drift_first.c_str(), result.drift_last.c_str());
-    std::string note = text;
-    if (result.drift_followed) {
-      std::snprintf(text, sizeof(text),
-                    ". Each frame was judged against its neighbours: %d disagree as they do "
-                    "(following the drift, not flagged), %d stand out (flagged).",
-                    result.following_drift, result.flagged);
+                  ": COLMAP's reconstruction or the given poses drift there. Each frame was "
+                  "judged after aligning it to its neighbours (the angles shown are after that "
+                  "alignment): of the %d compared, %d agree, %d follow the drift (beyond the "
+                  "thresholds only under one fit for their window, or within the spread of "
+                  "their neighbours), %d stand out (flagged)",
+                  result.compared, result.unflagged, result.following_drift, result.flagged);
+    note += text;
+    if (result.weak_support > 0) {
+      std::snprintf(text, sizeof(text), " and %d were not judged (weak COLMAP pose)",
+                    result.weak_support);
       note += text;
-      if (result.widened > 0) {
-        std::snprintf(text, sizeof(text),
-                      " Where the neighbours themselves scatter beyond the thresholds (a "
-                      "reconstruction bending unevenly), %d of them were judged only to within "
-                      "%.2g deg.",
-                      result.widened, result.widest_tolerance_deg);
-        note += text;
-      }
-    } else {
-      note += ", and flags in that stretch may be the reconstruction's.";
+    }
+    note += ".";
+    if (result.widened > 0) {
+      std::snprintf(text, sizeof(text),
+                    " Where the neighbours themselves scatter beyond the thresholds (a "
+                    "reconstruction bending unevenly), %d frames were judged only to within "
+                    "%.2g deg.",
+                    result.widened, result.widest_tolerance_deg);
+      note += text;
     }
     notes.push_back(note);
+  } else if (result.disagreement.Drifts()) {
+    std::snprintf(text, sizeof(text),
+                  "%d of the %d frames beyond the thresholds disagree smoothly along the "
+                  "sequence (%s to %s): COLMAP's reconstruction or the given poses drift there, "
+                  "and flags in that stretch may be the reconstruction's.",
+                  result.disagreement.smooth, result.disagreement.disagreeing,
+                  result.drift_first.c_str(), result.drift_last.c_str());
+    notes.push_back(text);
   }
   if (result.weak_support > 0) {
     std::snprintf(text, sizeof(text),

@@ -45,12 +45,23 @@ struct VerifyOptions {
 
 struct FrameVerdict {
   std::string name;
-  bool has_given = false;           // the project gives a pose for it
-  bool registered = false;          // COLMAP registered it
-  double rotation_error_deg = 0.0;  // when both
+  bool has_given = false;   // the project gives a pose for it
+  bool registered = false;  // COLMAP registered it
+  // When both: the disagreement the verdict used. Where judged against the drift
+  // (`judged_locally`), after the local alignment its neighbours give (the rotation through
+  // the rotations between it and them, relative_rotation_deg; the centre against the line
+  // through their offsets); else under the fit of its window.
+  double rotation_error_deg = 0.0;
   double position_error_m = 0.0;
+  // The same under the fit of its window alone (where a reconstruction drifts, mostly the
+  // drift's).
+  double fit_rotation_error_deg = 0.0;
+  double fit_position_error_m = 0.0;
+  bool judged_locally = false;
   bool flagged = false;
-  bool follows_drift = false;  // beyond the thresholds, but as its neighbours (not flagged)
+  // Beyond the thresholds under its window's fit (or within a widened tolerance locally),
+  // but as its neighbours: not flagged.
+  bool follows_drift = false;
   // Where judged against the drift: how far the frame's given rotation turns from what its
   // neighbours' given rotations and COLMAP's rotations between them imply (alignment-free;
   // < 0: not measured).
@@ -59,7 +70,8 @@ struct FrameVerdict {
   // units of the thresholds (1, or more where the neighbours scatter more; 0: not judged).
   double drift_tolerance = 0.0;
   // Where compared: the camera centres, given and COLMAP's under the alignment the frame was
-  // judged by (world, metres; their distance is position_error_m).
+  // judged by, local where judged locally (world, metres; their distance is
+  // position_error_m).
   Eigen::Vector3d given_centre_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d colmap_centre_m = Eigen::Vector3d::Zero();
   int observations = -1;      // COLMAP's 2D points with a 3D point (-1: unknown)
@@ -90,13 +102,16 @@ struct VerifyResult {
   int global_agreeing = 0;
   bool weak_alignment = false;
   // How the frames beyond the thresholds disagree with the global alignment: smoothly along
-  // the sequence (a drift, pose_alignment.h) from frame `drift_first` to `drift_last`, or
-  // frame by frame.
+  // the sequence (a drift, pose_alignment.h), or frame by frame.
   Disagreement disagreement;
+  // Where the drift is followed: the first and last frame following it (the stretch where
+  // only a local alignment agrees); else the first and last smooth frame of `disagreement`.
   std::string drift_first, drift_last;
-  // The flags were judged against the drift (VerifyOptions::drift_neighbours), and how many
-  // frames beyond the thresholds were let through as following it.
+  // The frames were judged against the drift (VerifyOptions::drift_neighbours): each after
+  // the local alignment its neighbours give (`judged_locally`, how many), and of the compared
+  // frames `flagged` + `following_drift` + `weak_support` + `unflagged` = `compared`.
   bool drift_followed = false;
+  int judged_locally = 0;
   int following_drift = 0;
   // Of the frames following the drift, those judged with a wider tolerance (their neighbours
   // scatter beyond the thresholds: a reconstruction bending unevenly), and the widest, as a

@@ -65,6 +65,9 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
     if (v.has_given && v.registered) {
       f["rotation_error_deg"] = v.rotation_error_deg;
       f["position_error_m"] = v.position_error_m;
+      f["judged_locally"] = v.judged_locally;
+      f["fit_rotation_error_deg"] = v.fit_rotation_error_deg;
+      f["fit_position_error_m"] = v.fit_position_error_m;
       f["inlier"] = v.inlier;
       f["given_centre_m"] = {v.given_centre_m.x(), v.given_centre_m.y(), v.given_centre_m.z()};
       f["colmap_centre_m"] = {v.colmap_centre_m.x(), v.colmap_centre_m.y(), v.colmap_centre_m.z()};
@@ -116,6 +119,7 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
         {"first", result.drift_first},
         {"last", result.drift_last},
         {"followed", result.drift_followed},
+        {"judged_locally", result.judged_locally},
         {"following_frames", result.following_drift},
         {"widened_frames", result.widened},
         {"widest_tolerance_deg", result.widest_tolerance_deg}}},

@@ -6,6 +6,7 @@
 // saves and opens a project or shows the command line's error and writes nothing, the
 // Project panel repairs a project whose video moved (or edits the open one's paths, undoably),
 // and dropped files fill the New project form or the path editor, or open a project.
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -391,6 +392,32 @@ TEST(UiInput, SeekingBackPublishesItsProgress) {
   EXPECT_EQ(seen.back().seek_target, -1);
   EXPECT_EQ(seen.back().frame, 6);
   EXPECT_EQ(seen.back().status, "paused");
+}
+
+// A seek can be stopped (Pause, the panel's Stop): it ends at the last frame it painted,
+// paused, with no seek under way.
+TEST(SeekProgress, PauseStopsASeekWhereItGotTo) {
+  PipelineRunner* runner_ptr = nullptr;
+  std::atomic<bool> paused{false};
+  RunnerOptions options;
+  options.publish_interval_ms = 0;  // publish after every frame painted
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    // The worker itself asks to stop once the seek painted frame 2.
+    if (s.seek_target == 9 && s.frame >= 2 && !paused.exchange(true)) runner_ptr->Pause();
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  PipelineRunner runner(options);
+  runner_ptr = &runner;
+  runner.Restart(state.project);
+  runner.Seek(9);
+  runner.WaitIdle();
+  const auto snap = runner.Snapshot();
+  EXPECT_TRUE(paused);
+  EXPECT_EQ(snap->seek_target, -1);
+  EXPECT_GE(snap->frame, 2);
+  EXPECT_LT(snap->frame, 9);
+  EXPECT_EQ(snap->status, "paused");
 }
 
 TEST(UiInput, SeekProgressIsNamedNotFrameMinusOne) {

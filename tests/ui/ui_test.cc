@@ -417,6 +417,28 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
   EXPECT_TRUE(runner.Snapshot()->run.excluded.empty());
 }
 
+// Cancel stops a solve before its next fit: nothing solved, the detections kept, the status
+// says so; a solve afterwards runs to its end.
+TEST(CalibrationRunner, ASolveCanBeCancelled) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  CalibrationRunner runner;
+  auto snap = DetectChessboard(ChessboardLeftImages(), &runner);
+  ASSERT_EQ(snap->run.views.size(), 13u);
+  runner.Solve();
+  runner.Cancel();
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_FALSE(snap->solved);
+  EXPECT_FALSE(snap->solving);
+  EXPECT_EQ(snap->status.rfind("cancelled: the solve stopped after ", 0), 0u) << snap->status;
+  EXPECT_EQ(snap->run.views.size(), 13u);
+  runner.Solve();
+  runner.WaitIdle();
+  snap = runner.Snapshot();
+  EXPECT_TRUE(snap->solved) << snap->status;
+  EXPECT_GT(snap->solves_total, 0);
+}
+
 // A folder with both cameras of opencv-chessboard-stereo (left and right images, one size):
 // after Detect, before any solve, the light is off green and the panel's reason says two
 // cameras; once the right images are ticked off (13 in a row, checked once after the last),

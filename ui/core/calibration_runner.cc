@@ -22,7 +22,11 @@ void CalibrationRunner::Detect(const calib::CalibrateRequest& request) {
   cancel_ = true;  // the worker drops a detection under way
   Post(Command::kDetect, request);
 }
-void CalibrationRunner::Solve() { Post(Command::kSolve); }
+void CalibrationRunner::Solve() {
+  cancel_ = false;
+  Post(Command::kSolve);
+}
+void CalibrationRunner::Cancel() { cancel_ = true; }
 void CalibrationRunner::Save(const std::string& path) { Post(Command::kSave, {}, path); }
 void CalibrationRunner::Exclude(const std::string& name, bool excluded) {
   Post(excluded ? Command::kExclude : Command::kInclude, {}, name);
@@ -122,7 +126,12 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
     working_.status = "detecting " + std::to_string(working_.images_done + 1) + "/" +
                       std::to_string(working_.images.size());
     Publish();
-    if (cancel_) return;
+    if (cancel_) {  // a newer detection replaces this status, a Cancel keeps it
+      working_.status = "cancelled: detection stopped after " +
+                        std::to_string(working_.images_done) + " of " +
+                        std::to_string(working_.images.size()) + " images";
+      return;
+    }
     image.excluded = calib::IsExcluded(image.name, request.exclude);
     const size_t views_before = working_.run.views.size();
     const bool found = calib::DetectImage(image.path, request, &working_.run);
@@ -201,13 +210,31 @@ void CalibrationRunner::RunSolve() {
   run.choice = {};
   run.warnings.clear();
   calib::CalibrateRequest request = working_.request;
+  struct Cancelled {};  // thrown from the progress call between two fits
   request.progress = [this](const std::string&, int done, int total, const std::string& what) {
+    working_.solves_done = done;
+    working_.solves_total = total;
+    if (cancel_) throw Cancelled{};
     working_.status =
         "solving " + std::to_string(done + 1) + "/" + std::to_string(total) + ": " + what;
     Publish();
   };
-  if (Status s = calib::SolveViews(request, &run); !s.ok()) {
-    working_.status = "error: " + s.message();
+  working_.solving = true;
+  working_.solves_done = working_.solves_total = 0;
+  working_.solve_started = std::chrono::steady_clock::now();
+  Status solved;
+  try {
+    solved = calib::SolveViews(request, &run);
+  } catch (const Cancelled&) {
+    working_.solving = false;
+    working_.status = "cancelled: the solve stopped after " + std::to_string(working_.solves_done) +
+                      " of " + std::to_string(working_.solves_total) +
+                      " fits; the detections are kept";
+    return;
+  }
+  working_.solving = false;
+  if (!solved.ok()) {
+    working_.status = "error: " + solved.message();
     return;
   }
   working_.run = std::move(run);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -45,6 +46,11 @@ struct CalibrationSnapshot {
   cv::Mat residuals_picture;    // after a solve
   cv::Mat uncertainty_picture;  // after a solve: projection uncertainty map
   std::string saved_path;       // the last .cameramodel written
+  // A solve under way: its fits finished of all it will make, and when it started (the panel
+  // shows elapsed and remaining time from these).
+  bool solving = false;
+  int solves_done = 0, solves_total = 0;
+  std::chrono::steady_clock::time_point solve_started;
 };
 
 class CalibrationRunner {
@@ -55,6 +61,10 @@ class CalibrationRunner {
   // Starts over on this folder and board (a detection under way stops after its image).
   void Detect(const calib::CalibrateRequest& request);
   void Solve();  // on the views detected so far, with the request's model
+  // Stops a detection or solve under way: a detection after its image, a solve before its
+  // next fit (one lens model's fit runs to its end). The detections are kept, an earlier
+  // solve's results too; nothing is written. Status "cancelled: ...".
+  void Cancel();
   // Leaves image `name` out of (or puts it back into) the views; an earlier solve is stale.
   void Exclude(const std::string& name, bool excluded);
   void Save(const std::string& cameramodel_path);

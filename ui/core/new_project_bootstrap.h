@@ -22,15 +22,19 @@
 
 namespace fresco {
 
+// The app's SIFT features per image (New project's bootstrap and the Poses panel): the
+// guide's advice, much faster than COLMAP's default 8192 and enough for most captures.
+constexpr int kAppMaxFeatures = 2000;
+
 struct NewProjectBootstrapOptions {
   // >= 3 known points on the mesh and where frames see them (pipeline/poses/bootstrap.h's
   // file: NAME X Y Z IMAGE U V [IMAGE U V ...]) that place COLMAP's reconstruction on the
   // mesh; "" = place it by the rough poses of the form's Poses field instead.
   std::string control_points;
-  bool refine_mesh = false;    // then fit COLMAP's sparse points to the mesh (ICP)
-  int max_features = 0;        // SIFT features per image; 0 = COLMAP's default (8192)
-  int max_image_size = 0;      // longest side for feature extraction; 0 = COLMAP's (3200)
-  std::string colmap_program;  // "" = `colmap` on PATH
+  bool refine_mesh = false;            // then fit COLMAP's sparse points to the mesh (ICP)
+  int max_features = kAppMaxFeatures;  // SIFT features per image; 0 = COLMAP's default (8192)
+  int max_image_size = 0;              // longest side for feature extraction; 0 = COLMAP's (3200)
+  std::string colmap_program;          // "" = `colmap` on PATH
 };
 
 // The file the bootstrapped poses go to, beside the project file.

@@ -2,6 +2,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "pipeline/poses/colmap_log_progress.h"
+#include "ui/core/job_estimate.h"
 #include "ui/core/layout.h"
 #include "ui/core/panel.h"
 
@@ -144,11 +146,21 @@ void ColmapProgressBar(const PosesSnapshot& snap) {
   const double seconds =
       std::chrono::duration<double>(now - (snap.steps > 0 ? snap.step_started : snap.started))
           .count();
-  char text[160];
-  std::snprintf(text, sizeof(text), "%s%s%.0f s", snap.steps > 0 ? snap.step_name.c_str() : "",
-                snap.steps > 0 ? ", " : "", seconds);
-  const float fraction = snap.steps > 0 ? (snap.step - 1) / float(snap.steps) : 0.0f;
-  ImGui::ProgressBar(fraction, ImVec2(-1, 0), text);
+  if (snap.steps == 0) {
+    ImGui::ProgressBar(0.0f, ImVec2(-1, 0), (DurationText(seconds) + " elapsed").c_str());
+    return;
+  }
+  // How far the step has got, from the progress lines COLMAP writes to its log.
+  const ColmapStepProgress step =
+      ReadColmapStepProgress(ReadFileTail(snap.step_log, 4096), snap.step_images);
+  std::string text =
+      "step " + std::to_string(snap.step) + "/" + std::to_string(snap.steps) + " " + snap.step_name;
+  if (step.known)
+    text += " " + std::to_string(step.done) + "/" + std::to_string(step.total) + " images";
+  text += ": " + ElapsedAndRemainingText(seconds, step.Fraction());
+  if (RemainingSeconds(seconds, step.Fraction()) >= 0) text += " in this step";
+  const float fraction = (snap.step - 1 + static_cast<float>(step.Fraction())) / snap.steps;
+  ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
 }
 
 }  // namespace fresco

@@ -369,8 +369,9 @@ bool PipelineRunner::Handle(Command command, Clock::time_point* last_publish) {
       playing_ = session_ != nullptr && !session_->ended;
       Publish(false);
       break;
-    case Command::kPause:
+    case Command::kPause:  // also stops a seek where it got to (a whole frame painted)
       playing_ = false;
+      seek_target_ = -1;
       Publish(true);
       break;
     case Command::kStep:

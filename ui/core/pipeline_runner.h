@@ -137,7 +137,7 @@ class PipelineRunner {
   // (Re)opens the project with these settings and starts from frame 0, paused.
   void Restart(const Project& project);
   void Play();
-  void Pause();
+  void Pause();          // also stops a seek under way at the last frame it painted
   void Step();           // paints the next frame, then pauses
   void Seek(int frame);  // paints up to `frame` (restarting when it lies behind), pauses
   // Live projects: records the frames painted from now on (with their poses) to `dir` as

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/poses/colmap_log_progress.h"
 #include "pipeline/poses/verify_report.h"
 
 namespace fresco {
@@ -119,11 +120,23 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   ProjectColmapOptions options = request.colmap;
   options.out_dir = (fs::path(request.out_dir) / "colmap").string();
   options.colmap.cancel = &cancel_;
-  options.colmap.progress = [this](const std::string& step, int index, int total) {
+  const std::string options_out_dir = options.out_dir;
+  options.colmap.progress = [this, options_out_dir](const std::string& step, int index, int total) {
     working_.step = index + 1;
     working_.steps = total;
     working_.step_name = step;
     working_.step_started = std::chrono::steady_clock::now();
+    const fs::path logs = fs::path(options_out_dir) / "logs";
+    char prefix[16];
+    std::snprintf(prefix, sizeof(prefix), "%02d_", index + 1);
+    working_.step_log = (logs / (prefix + step + ".log")).string();
+    if (index > 0 && working_.step_images == 0) {  // the feature extractor's count
+      std::error_code ec;
+      for (const auto& entry : fs::directory_iterator(logs, ec))
+        if (entry.path().filename().string().rfind("01_", 0) == 0)
+          working_.step_images =
+              ReadColmapStepProgress(ReadFileTail(entry.path().string(), 4096), 0).total;
+    }
     working_.status = std::string("colmap ") + std::to_string(index + 1) + "/" +
                       std::to_string(total) + ": " + step;
     Publish();

@@ -47,6 +47,10 @@ struct PosesSnapshot {
   int step = 0, steps = 0;
   std::string step_name;
   std::chrono::steady_clock::time_point started, step_started;
+  // The running step's log (its progress lines: colmap_log_progress.h) and the images COLMAP
+  // was given (read from the first step's log once it ran; 0: not known yet).
+  std::string step_log;
+  int step_images = 0;
 
   // The reconstruction (after a run).
   bool reconstructed = false;

@@ -6,6 +6,7 @@
 // image with its detections; the coverage
 // map; per-image residuals, the models tried and the one chosen; the warnings.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
 #include <imgui_internal.h>  // PushOverrideID
@@ -13,6 +14,7 @@
 
 #include "calib/pictures.h"
 #include "ui/core/camera_attach.h"
+#include "ui/core/job_estimate.h"
 #include "ui/panels/panels.h"
 #include "ui/panels/path_field.h"
 
@@ -136,8 +138,22 @@ class CalibrationPanel : public Panel {
       ImGui::OpenPopup("Save calibration");
     }
     ImGui::EndDisabled();
+    if (snap.busy) {
+      ImGui::SameLine();
+      if (ImGui::Button("Cancel")) ui.calibration->Cancel();
+    }
     DrawSavePopup(ui);
     DrawAttach(ui, snap);
+    if (snap.solving && snap.solves_total > 0) {
+      const double elapsed_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - snap.solve_started)
+              .count();
+      const float fraction = snap.solves_done / float(snap.solves_total);
+      const std::string text = std::to_string(snap.solves_done) + "/" +
+                               std::to_string(snap.solves_total) + " fits, " +
+                               ElapsedAndRemainingText(elapsed_s, fraction);
+      ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
+    }
     if (!snap.images.empty())
       ImGui::ProgressBar(
           snap.images_done / float(snap.images.size()), ImVec2(-1, 0),

@@ -3,8 +3,10 @@
 // made from its declaration (setting_widgets.h), edited in the project (undoable) and
 // applied by restarting the worker.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 
+#include "ui/core/job_estimate.h"
 #include "ui/core/panel.h"
 #include "ui/panels/live_status_section.h"
 #include "ui/panels/panels.h"
@@ -74,7 +76,20 @@ class PipelinePanel : public Panel {
       const float done = snap.frame < 0 ? 0.0f
                                         : static_cast<float>(snap.frame + 1) /
                                               static_cast<float>(snap.seek_target + 1);
-      ImGui::ProgressBar(done, ImVec2(-1, 0), FrameLabel(snap).c_str());
+      // Elapsed and remaining time, from when this panel first saw the seek.
+      if (seek_seen_ != snap.seek_target) {
+        seek_seen_ = snap.seek_target;
+        seek_started_ = std::chrono::steady_clock::now();
+      }
+      const double elapsed_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - seek_started_).count();
+      ImGui::ProgressBar(
+          done, ImVec2(-60, 0),
+          (FrameLabel(snap) + ", " + ElapsedAndRemainingText(elapsed_s, done)).c_str());
+      ImGui::SameLine();
+      if (ImGui::Button("Stop")) ui.runner->Pause();  // keeps the frames painted so far
+    } else {
+      seek_seen_ = -1;
     }
     ImGui::TextWrapped("%s", snap.status.c_str());
     if (snap.geometry)
@@ -138,11 +153,13 @@ class PipelinePanel : public Panel {
   }
 
   int seek_ = 0;
+  int seek_seen_ = -1;  // the seek target whose progress is shown, and when it was first seen
+  std::chrono::steady_clock::time_point seek_started_;
   int posted_seek_ = -1;         // a seek posted, not yet in a snapshot
   uint64_t posted_version_ = 0;  // the snapshot version when it was posted
   bool slider_active_ = false;
   float slider_rect_[4] = {0, 0, 0, 0};
-  Project edit_;  // its pipeline: the settings being edited
+  Project edit_;                   // its pipeline: the settings being edited
   std::vector<Setting> settings_;  // edit_'s settings, bound to its fields
   LiveStatusSection live_;
 };

@@ -10,6 +10,7 @@
 
 #include <imgui.h>
 
+#include "ui/core/new_project_bootstrap.h"  // kAppMaxFeatures
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -149,7 +150,7 @@ class PosesPanel : public Panel {
     every_ = r.colmap.every_n_frames;
     max_frames_ = r.colmap.max_frames;
     max_image_size_ = r.colmap.colmap.max_image_size;
-    max_features_ = r.colmap.colmap.max_num_features;
+    if (r.colmap.colmap.max_num_features > 0) max_features_ = r.colmap.colmap.max_num_features;
     matcher_ = static_cast<int>(r.colmap.colmap.matcher);
     keyframe_step_pct_ = static_cast<float>(100 * r.colmap.keyframe_step_rel);
     keyframe_turn_deg_ = static_cast<float>(r.colmap.keyframe_rotation_deg);
@@ -415,7 +416,7 @@ class PosesPanel : public Panel {
   }
 
   void UpdateReport(const UiContext& ui, const PosesSnapshot& snap) {
-    report_ = {{"status", snap.status}};
+    report_ = {{"status", snap.status}, {"max_features", std::to_string(max_features_)}};
     if (snap.verified) {
       std::string flagged;
       for (size_t i = 0; i < snap.verify.frames.size(); ++i)
@@ -449,7 +450,8 @@ class PosesPanel : public Panel {
   char out_dir_[1024] = "";
   char model_[1024] = "";
   char control_[1024] = "";
-  int every_ = 1, max_frames_ = 0, max_image_size_ = 0, max_features_ = 0, matcher_ = 0;
+  int every_ = 1, max_frames_ = 0, max_image_size_ = 0, max_features_ = kAppMaxFeatures,
+      matcher_ = 0;
   float rotation_threshold_ = 0.5f, position_threshold_pct_ = 1.0f;
   float keyframe_step_pct_ = 0.5f, keyframe_turn_deg_ = 2.0f;
   bool flagged_only_ = false, scroll_to_selected_ = false, apply_anyway_ = false;
