@@ -176,20 +176,6 @@ TEST(UiInput, PaintedBuffersStartOnTheLargestBuffer) {
   EXPECT_EQ(app.ReportOf("Painted buffers", "buffer"), std::to_string(largest));
 }
 
-// Stored groups after a merge of groups `a` and `b`, applied as the Grouping panel does.
-void MergeAndApply(App& app, int a, int b) {
-  const auto geometry = app.runner.Snapshot()->geometry;
-  std::vector<GroupSpec> merged;
-  ASSERT_TRUE(MergeGroups(geometry->groups, static_cast<int>(geometry->buffer_of_triangle.size()),
-                          {a, b}, &merged)
-                  .ok());
-  app.state.BeginEdit();
-  app.state.project.grouping.groups = merged;
-  ApplyProject(app.ui);
-  app.runner.WaitIdle();
-  app.Frames(2);
-}
-
 std::set<std::string> Tokens(const std::string& text) {
   std::istringstream in(text);
   std::set<std::string> s;
@@ -210,7 +196,7 @@ TEST(UiInput, GroupColoursStayAcrossEditsAndASplitBackIsExplained) {
     ApplyProject(app.ui);
     app.runner.WaitIdle();
     app.Frames(1);
-    MergeAndApply(app, 0, other);
+    testing::MergeAndApply(app, 0, other);
     const std::set<std::string> after = Tokens(app.ReportOf("Grouping", "colours"));
     const std::string message = app.ReportOf("Grouping", "split");
     if (after.size() == 5u) {

@@ -262,10 +262,11 @@ bool OpenOrBusy(const Panel& panel) { return panel.open || panel.Busy(); }
 // comes to the front of its tab group.
 void ShowOpenedTabs(UiContext& ui, const std::vector<std::unique_ptr<Panel>>& panels) {
   std::set<std::string> open;
-  for (const auto& panel : panels)
-    if (OpenOrBusy(*panel)) open.insert(panel->Title());
-  for (const std::string& title : open)
-    if (!ui.open_last_frame.count(title)) ui.layout.ShowTab(title);
+  for (const auto& panel : panels) {  // in menu order: tools opened with the app come last
+    if (!OpenOrBusy(*panel)) continue;
+    open.insert(panel->Title());
+    if (!ui.open_last_frame.count(panel->Title())) ui.layout.ShowTab(panel->Title());
+  }
   ui.open_last_frame = std::move(open);
 }
 
