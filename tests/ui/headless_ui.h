@@ -214,4 +214,19 @@ inline void TypeInto(HeadlessApp& app, const std::string& window, const char* id
   app.Frame();
 }
 
+// Groups `a` and `b` merged (as the Grouping panel's "Merge groups" does) and painted again
+// at the same frame.
+inline void MergeAndApply(HeadlessApp& app, int a, int b) {
+  const auto geometry = app.runner.Snapshot()->geometry;
+  std::vector<GroupSpec> merged;
+  ASSERT_TRUE(MergeGroups(geometry->groups, static_cast<int>(geometry->buffer_of_triangle.size()),
+                          {a, b}, &merged)
+                  .ok());
+  app.state.BeginEdit();
+  app.state.project.grouping.groups = merged;
+  ApplyProject(app.ui);
+  app.runner.WaitIdle();
+  app.Frames(2);
+}
+
 }  // namespace fresco::testing

@@ -39,6 +39,19 @@ TEST(NaturalSort, NumbersCompareByValue) {
   EXPECT_TRUE(NaturalLess("a99999999999999999999", "a100000000000000000000"));  // no overflow
 }
 
+// Picked triangles are drawn in a colour no group has: at least 0.7 (in RGB 0..1) from every
+// colour a group can get; the yellow they were drawn in was 0.15 from the nearest.
+TEST(GroupColour, PickedTrianglesAreFarFromEveryGroupColour) {
+  EXPECT_EQ(AllGroupColours().size(), 3600u);
+  EXPECT_GT(DistanceToNearestGroupColour(kPickedRgb), 0.7f);
+  EXPECT_GT(DistanceToNearestGroupColour(kPickedStripeRgb), 0.7f);
+  EXPECT_LT(DistanceToNearestGroupColour({1.0f, 0.85f, 0.1f}), 0.3f) << "the old yellow";
+  for (int key = 0; key < 2000; ++key) {
+    const auto c = GroupColour(key);
+    EXPECT_LT(DistanceToNearestGroupColour(c), 1e-6f) << key;
+  }
+}
+
 TEST(GroupColour, KeyIsTheLowestTriangleAndColoursDiffer) {
   EXPECT_EQ(StableGroupKey(GroupSpec{{7, 3, 9}}), 3);
   EXPECT_EQ(StableGroupKey(GroupSpec{}), -1);
@@ -235,7 +248,8 @@ TEST(GroupingSplitBack, SaysWhichStoredGroupWasSplitAndWhy) {
   const std::vector<GroupSpec> built = {{{0, 1}}, {{4, 5}}, {{2, 3}}};
   const std::string message = DescribeGroupsSplitBack(stored, built, 6);
   EXPECT_NE(message.find("split back apart"), std::string::npos) << message;
-  EXPECT_NE(message.find("group 0"), std::string::npos) << message;
+  // Named by the numbers the Grouping panel lists after the split: 0 and 2.
+  EXPECT_NE(message.find("now groups 0 and 2"), std::string::npos) << message;
   EXPECT_NE(message.find("became 2 buffers"), std::string::npos) << message;
   EXPECT_NE(message.find("fold over"), std::string::npos) << message;
 }

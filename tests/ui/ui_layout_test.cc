@@ -30,18 +30,23 @@ TEST(UiLayout, EveryTiledPanelExistsAndTheLayoutCoversTheBand) {
   auto panels = MakePanels();
   int tiled = 0;
   for (const auto& p : panels) tiled += layout.Contains(p->Title());
-  // All but Calibration, Poses and New project.
-  EXPECT_EQ(tiled, static_cast<int>(panels.size()) - 3);
+  EXPECT_EQ(tiled, static_cast<int>(panels.size())) << "every panel, the tools too";
   std::vector<TileLayout::Tile> tiles;
   std::vector<TileLayout::Splitter> splitters;
+  std::vector<TileLayout::TabStrip> strips;
   layout.Compute(
-      {0, 20, 1600, 956}, 5, [](const std::string&) { return true; }, &tiles, &splitters);
-  EXPECT_EQ(tiles.size(), static_cast<size_t>(tiled));
+      {0, 20, 1600, 956}, 5, [](const std::string&) { return true; }, &tiles, &splitters, &strips,
+      24);
+  // All open: Calibration, Poses and New project wait behind the stage row's tab.
+  EXPECT_EQ(tiles.size(), static_cast<size_t>(tiled) - 3);
   EXPECT_EQ(splitters.size(), tiles.size() - 1);
-  double area = 0;
+  ASSERT_EQ(strips.size(), 1u);
+  EXPECT_EQ(strips[0].names,
+            (std::vector<std::string>{"Stages", "Poses", "Calibration", "New project"}));
+  double area = strips[0].rect.w * strips[0].rect.h;
   for (const auto& t : tiles) area += t.rect.w * t.rect.h;
   for (const auto& s : splitters) area += s.rect.w * s.rect.h;
-  EXPECT_NEAR(area, 1600.0 * 956, 1600.0 * 956 * 0.005) << "tiles and bars fill the band";
+  EXPECT_NEAR(area, 1600.0 * 956, 1600.0 * 956 * 0.005) << "tiles, bars and tabs fill the band";
 }
 
 void ExpectUsable(ImVec2 display, float content_scale = 1) {

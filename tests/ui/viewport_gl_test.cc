@@ -1,9 +1,9 @@
 // The 3D view's OpenGL renderer on a real context: in "groups" mode every group is drawn in
 // its stable colour (ui/core/group_colour.h), the triangles of selected groups are tinted
-// cyan and picked triangles yellow, and nothing else changes; a view-dependent layer shows
-// where it has paint; after a pose verification COLMAP's path and the flagged frames' offsets
-// are drawn over the model. Without a display the test
-// runs itself again under xvfb-run (and skips when there is none).
+// cyan and picked triangles striped white and black, and nothing else changes; a view-dependent
+// layer shows where it has paint; after a pose verification COLMAP's path and the flagged frames'
+// offsets are drawn over the model. Without a display the test runs itself again under xvfb-run
+// (and skips when there is none).
 #include <unistd.h>
 
 #include <array>
@@ -137,21 +137,25 @@ TEST(ViewportGl, GroupsInStableColoursSelectionTinted) {
     EXPECT_GT(changed, pixels_of_group[selected] * 9 / 10);
     EXPECT_GT(cyan_gain / std::max(1, changed), 15.0) << "towards cyan (0.2, 0.9, 1.0)";
 
-    // Picking a triangle of it instead: yellow (red and green up, blue down).
+    // Picking a triangle of it instead: white and black stripes over it, every such pixel
+    // far from every group colour (the yellow it was drawn in sat between two of them).
     state.selected_groups.clear();
     state.selected_triangles = {geo.groups[selected].triangles.front()};
     const Rendered picked = Render(viewport, *snap, state, &view);
-    int yellow = 0;
+    int white = 0, black = 0;
     for (int i = 0; i < kW * kH; ++i) {
       if (picked.triangle[i] != geo.groups[selected].triangles.front()) {
         EXPECT_EQ(picked.rgba[i], plain.rgba[i]) << i;
         continue;
       }
-      const auto& a = plain.rgba[i];
-      const auto& b = picked.rgba[i];
-      yellow += (b[0] + b[1]) / 2 - b[2] > (a[0] + a[1]) / 2 - a[2] + 20;
+      const std::array<float, 3> rgb = {picked.rgba[i][0] / 255.0f, picked.rgba[i][1] / 255.0f,
+                                        picked.rgba[i][2] / 255.0f};
+      EXPECT_GT(DistanceToNearestGroupColour(rgb), 0.7f) << "pixel " << i;
+      white += picked.rgba[i][0] > 250 && picked.rgba[i][1] > 250 && picked.rgba[i][2] > 250;
+      black += picked.rgba[i][0] < 5 && picked.rgba[i][1] < 5 && picked.rgba[i][2] < 5;
     }
-    EXPECT_GT(yellow, 0);
+    EXPECT_GT(white, 0);
+    EXPECT_GT(black, 0);
 
     // Painted mode with a view-dependent layer: where the layer has paint the view shows it
     // (here solid green over grey buffers); with the layers switched off, the single texture.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <set>
 #include <string>
 
 #include "ui/panels/panels.h"
@@ -20,7 +21,8 @@ constexpr int kKeyF5 = 294;
 constexpr int kKeyEqual = 61, kKeyMinus = 45, kKeyKeypadAdd = 334, kKeyKeypadSubtract = 333;
 constexpr float kSplitterPx = 5;  // the bars between tiled panels
 constexpr const char* kSwapPopup = "##swap places";
-constexpr float kMinTilePx = 120;  // a splitter stops before a side gets narrower
+constexpr float kMinTilePx = 120;        // a splitter stops before a side gets narrower
+constexpr float kTabStripPaddingPx = 2;  // around the tabs of a tab group
 
 bool IsError(const std::string& text) { return text.rfind("error: ", 0) == 0; }
 
@@ -254,21 +256,37 @@ void DrawStatusBar(UiContext& ui) {
   ImGui::End();
 }
 
+bool OpenOrBusy(const Panel& panel) { return panel.open || panel.Busy(); }
+
+// A panel opened since the last frame (View menu, File > New project..., the command line)
+// comes to the front of its tab group.
+void ShowOpenedTabs(UiContext& ui, const std::vector<std::unique_ptr<Panel>>& panels) {
+  std::set<std::string> open;
+  for (const auto& panel : panels) {  // in menu order: tools opened with the app come last
+    if (!OpenOrBusy(*panel)) continue;
+    open.insert(panel->Title());
+    if (!ui.open_last_frame.count(panel->Title())) ui.layout.ShowTab(panel->Title());
+  }
+  ui.open_last_frame = std::move(open);
+}
+
 // The tiled panels' places this frame (between the menu bar and the status bar); returns the
-// splitters.
+// splitters and the tab groups' strips.
 std::vector<TileLayout::Splitter> PlaceTiles(const TileLayout& layout,
-                                             std::vector<std::unique_ptr<Panel>>& panels) {
+                                             std::vector<std::unique_ptr<Panel>>& panels,
+                                             std::vector<TileLayout::TabStrip>* strips) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   const float top = std::ceil(ImGui::GetFrameHeight());  // the menu bar's height
   const LayoutRect band{0, top, display.x, std::max(0.0f, display.y - top - StatusBarHeight())};
   auto is_open = [&](const std::string& title) {
     for (const auto& p : panels)
-      if (title == p->Title()) return p->open;
+      if (title == p->Title()) return OpenOrBusy(*p);
     return false;
   };
   std::vector<TileLayout::Tile> tiles;
   std::vector<TileLayout::Splitter> splitters;
-  layout.Compute(band, kSplitterPx, is_open, &tiles, &splitters);
+  layout.Compute(band, kSplitterPx, is_open, &tiles, &splitters, strips,
+                 std::round(ImGui::GetFrameHeight() + 2 * kTabStripPaddingPx));
   for (auto& panel : panels) {
     panel->tiled = false;
     for (const TileLayout::Tile& t : tiles) {
@@ -279,6 +297,34 @@ std::vector<TileLayout::Splitter> PlaceTiles(const TileLayout& layout,
     }
   }
   return splitters;
+}
+
+// The strips of tab groups with two or more sides open: a click on a tab brings its side to
+// the front; the others stay open behind their tabs.
+void DrawTabStrips(UiContext& ui, const std::vector<TileLayout::TabStrip>& strips) {
+  ui.tabs_drawn.clear();
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(kTabStripPaddingPx, kTabStripPaddingPx));
+  ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1, 1));
+  for (const TileLayout::TabStrip& strip : strips) {
+    ImGui::SetNextWindowPos(ImVec2(strip.rect.x, strip.rect.y));
+    ImGui::SetNextWindowSize(ImVec2(strip.rect.w, strip.rect.h));
+    ImGui::Begin(("##tabs" + std::to_string(strip.node)).c_str(), nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoBringToFrontOnFocus | ImGuiWindowFlags_NoScrollWithMouse);
+    for (size_t k = 0; k < strip.names.size(); ++k) {
+      const bool shown = static_cast<int>(k) == strip.shown;
+      if (k > 0) ImGui::SameLine(0, 2);
+      ImGui::PushStyleColor(ImGuiCol_Button,
+                            ImGui::GetStyleColorVec4(shown ? ImGuiCol_TabActive : ImGuiCol_Tab));
+      ImGui::PushStyleColor(ImGuiCol_ButtonHovered, ImGui::GetStyleColorVec4(ImGuiCol_TabHovered));
+      if (ImGui::Button(strip.names[k].c_str())) ui.layout.ShowTabNamed(strip.node, strip.names[k]);
+      ImGui::PopStyleColor(2);
+      const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+      ui.tabs_drawn[strip.names[k]] = {lo.x, lo.y, hi.x - lo.x, hi.y - lo.y};
+    }
+    ImGui::End();
+  }
+  ImGui::PopStyleVar(2);
 }
 
 // The bars between tiles: drag to resize the panels on both sides.
@@ -372,10 +418,13 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
       if (std::string(panel->Title()) == kNewProjectTitle) panel->open = true;
     ui.new_project_requested = false;
   }
-  const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels);
+  ShowOpenedTabs(ui, panels);
+  std::vector<TileLayout::TabStrip> strips;
+  const std::vector<TileLayout::Splitter> splitters = PlaceTiles(ui.layout, panels, &strips);
+  DrawTabStrips(ui, strips);
   for (auto& panel : panels) {
-    // A tiled panel without a tile is hidden behind a maximised one.
-    if ((panel->open || panel->Busy()) && (panel->tiled || !ui.layout.Contains(panel->Title())))
+    // A tiled panel without a tile is hidden behind a maximised one or behind another tab.
+    if (OpenOrBusy(*panel) && (panel->tiled || !ui.layout.Contains(panel->Title())))
       panel->Draw(ui);
     if (panel->maximise_requested) ui.layout.ToggleMaximised(panel->Title());
     panel->maximise_requested = false;

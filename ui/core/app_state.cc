@@ -243,23 +243,30 @@ std::string DescribeGroupsSplitBack(const std::vector<GroupSpec>& stored,
     for (int t : built[g].triangles)
       if (t >= 0 && t < num_triangles) built_of[t] = static_cast<int>(g);
   int split = 0, pieces = 0;
-  std::string first;
+  std::string first;  // the first split group's numbers now, as the Grouping panel lists them
   for (size_t g = 0; g < stored.size(); ++g) {
     std::set<int> parts;
     for (int t : stored[g].triangles)
       if (t >= 0 && t < num_triangles && built_of[t] >= 0) parts.insert(built_of[t]);
     if (parts.size() < 2) continue;
-    if (split == 0) first = std::to_string(g);
+    if (split == 0) {
+      const std::vector<int> numbers(parts.begin(), parts.end());
+      for (size_t k = 0; k < numbers.size(); ++k)
+        first += std::string(k == 0                    ? ""
+                             : k + 1 == numbers.size() ? " and "
+                                                       : ", ") +
+                 std::to_string(numbers[k]);
+    }
     ++split;
     pieces += static_cast<int>(parts.size());
   }
   if (split == 0) return "";
   return "split back apart: " + std::to_string(split) + " stored group" +
-         (split > 1 ? "s (first: group " : " (group ") + first + ") became " +
-         std::to_string(pieces) +
-         " buffers while painting, because some of their triangles face away from the "
-         "group's mean plane (they would fold over in one buffer); merge only surfaces that "
-         "face the same way";
+         (split > 1 ? "s became " : " became ") + std::to_string(pieces) +
+         " buffers while painting (" + (split > 1 ? "the first is now groups " : "now groups ") +
+         first +
+         "), because some of their triangles face away from the group's mean plane (they "
+         "would fold over in one buffer); merge only surfaces that face the same way";
 }
 
 }  // namespace fresco

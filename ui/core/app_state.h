@@ -90,7 +90,8 @@ Status SetGroupTexelSize(const std::vector<GroupSpec>& current, int num_triangle
 // Why the painting shows more groups than the project stores, or "" when it does not: a
 // stored group (a merge, typically) whose triangles fold over on its own projection plane
 // is split back apart when the buffers are built (BuildBaseBuffers). `stored`: the
-// project's explicit groups; `built`: the session's groups (one per base buffer).
+// project's explicit groups; `built`: the session's groups (one per base buffer). The split
+// group is named by its numbers in `built` (what the Grouping panel lists after the split).
 std::string DescribeGroupsSplitBack(const std::vector<GroupSpec>& stored,
                                     const std::vector<GroupSpec>& built, int num_triangles);
 

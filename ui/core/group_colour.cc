@@ -10,15 +10,11 @@ int StableGroupKey(const GroupSpec& group) {
   return *std::min_element(group.triangles.begin(), group.triangles.end());
 }
 
-std::array<float, 3> GroupColour(int key) {
-  // A 32-bit integer hash (xorshift-multiply) spreads consecutive keys over the hue circle.
-  uint32_t h = static_cast<uint32_t>(key) + 0x9e3779b9u;
-  h ^= h >> 16;
-  h *= 0x7feb352du;
-  h ^= h >> 15;
-  h *= 0x846ca68bu;
-  h ^= h >> 16;
-  const float hue = static_cast<float>(h % 3600u) / 3600.0f;
+namespace {
+
+constexpr uint32_t kHueSteps = 3600;
+
+std::array<float, 3> ColourOfHue(float hue) {
   std::array<float, 3> rgb;
   const float offsets[3] = {0.0f, 2.0f / 3.0f, 1.0f / 3.0f};
   for (int c = 0; c < 3; ++c) {
@@ -28,6 +24,33 @@ std::array<float, 3> GroupColour(int key) {
     rgb[c] = ramp * 0.65f + 0.25f;
   }
   return rgb;
+}
+
+}  // namespace
+
+std::array<float, 3> GroupColour(int key) {
+  // A 32-bit integer hash (xorshift-multiply) spreads consecutive keys over the hue circle.
+  uint32_t h = static_cast<uint32_t>(key) + 0x9e3779b9u;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return ColourOfHue(static_cast<float>(h % kHueSteps) / kHueSteps);
+}
+
+std::vector<std::array<float, 3>> AllGroupColours() {
+  std::vector<std::array<float, 3>> colours;
+  for (uint32_t i = 0; i < kHueSteps; ++i)
+    colours.push_back(ColourOfHue(static_cast<float>(i) / kHueSteps));
+  return colours;
+}
+
+float DistanceToNearestGroupColour(const std::array<float, 3>& rgb) {
+  float nearest = 2;
+  for (const auto& c : AllGroupColours())
+    nearest = std::min(nearest, std::hypot(c[0] - rgb[0], c[1] - rgb[1], c[2] - rgb[2]));
+  return nearest;
 }
 
 std::vector<int> StableGroupKeys(const std::vector<GroupSpec>& groups) {

@@ -19,6 +19,18 @@ int StableGroupKey(const GroupSpec& group);
 // unrelated hues; saturation and value fixed so that the shading stays readable.
 std::array<float, 3> GroupColour(int key);
 
+// Every colour GroupColour can give (its hue takes 3600 steps), for checks against them.
+std::vector<std::array<float, 3>> AllGroupColours();
+
+// Picked triangles in the 3D view: stripes of kPickedRgb (white) and kPickedStripeRgb
+// (black), drawn over the triangle rather than mixed with it, so that no group colour
+// (saturated, with channels between 0.25 and 0.9) looks like a picked triangle.
+inline constexpr std::array<float, 3> kPickedRgb = {1.0f, 1.0f, 1.0f};
+inline constexpr std::array<float, 3> kPickedStripeRgb = {0.0f, 0.0f, 0.0f};
+
+// The RGB distance (0..sqrt 3) of `rgb` to the nearest group colour.
+float DistanceToNearestGroupColour(const std::array<float, 3>& rgb);
+
 // (G) the key of every group, in order.
 std::vector<int> StableGroupKeys(const std::vector<GroupSpec>& groups);
 

@@ -8,7 +8,9 @@
 
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -89,6 +91,9 @@ struct UiContext {
   float scale_applied = 0;     // what the fonts and style were last built for (ApplyUiScale)
   std::string menu_path = {};  // File > Open... / Save As...: the path typed there
   std::string swapping = {};   // the panel whose "swap places" menu is open
+  std::set<std::string> open_last_frame = {};  // panels open (or busy) last frame
+  // Each tab of a tab group's strip as drawn this frame (screen pixels), by its name.
+  std::map<std::string, LayoutRect> tabs_drawn = {};
 };
 
 class Panel {
@@ -131,8 +136,8 @@ inline float StatusBarHeight() { return std::round(ImGui::GetFrameHeight() + 5);
 // maximise or restore it); else at its default place the first time (scaled to the
 // display), its title bar kept below the menu bar and on screen.
 bool BeginPanel(Panel& panel);
-// The same for a large window over other panels (opaque) that shows a worker: false, with
-// the window already ended, when it is collapsed or there is no worker (it says so).
+// The same for a tool panel that shows a worker (Poses, Calibration; tiled as a tab below the
+// 3D view): false, with the window already ended, when there is no worker (it says so).
 bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker);
 // An image scaled to fit `max_width` (0 = the available width), keeping its aspect.
 void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint64_t version,

@@ -69,8 +69,11 @@ std::shared_ptr<const SessionGeometry> MakeGeometry(const PaintJob& job) {
   geometry->painted_layout.textures.clear();  // the layout only: textures come per publish
   geometry->groups = paint.grouping().groups;
   geometry->buffer_of_triangle = paint.grouping().group_of_triangle;
-  for (const BaseBuffer& b : paint.buffers())
+  for (const BaseBuffer& b : paint.buffers()) {
     geometry->buffer_texels.push_back(b.num_surface_texels);
+    geometry->buffer_texel_size_m.push_back(b.texel_size_m);
+    geometry->buffer_size_texels.push_back(int64_t{b.width} * b.height);
+  }
   for (const Capture& c : job.captures) {
     std::vector<Rigid3d>& path = geometry->stream_paths.emplace_back();
     for (const PosedImage& p : c.poses) path.push_back(p.cam_from_world);

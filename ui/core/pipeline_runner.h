@@ -43,8 +43,10 @@ struct SessionGeometry {
   std::vector<int> buffer_of_triangle;  // (T) base buffer of each triangle, -1 for none
   std::vector<GroupSpec> groups;        // one per base buffer, as the session built them
   std::vector<int> buffer_texels;       // on-surface texels per buffer
-  std::vector<Rigid3d> path;            // cam_from_world of every posed frame, in order
-  Camera camera;                        // the first camera (frustum drawing, preview)
+  std::vector<double> buffer_texel_size_m;  // each buffer's texel edge (coarser where capped)
+  std::vector<int64_t> buffer_size_texels;  // each buffer's width x height, gutter included
+  std::vector<Rigid3d> path;                // cam_from_world of every posed frame, in order
+  Camera camera;                            // the first camera (frustum drawing, preview)
   // Per stream (Project::Streams(); `path` and `camera` are stream 0's): its posed frames'
   // cam_from_world in order, and its first camera.
   std::vector<std::vector<Rigid3d>> stream_paths;

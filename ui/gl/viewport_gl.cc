@@ -60,6 +60,7 @@ uniform sampler2D frame;     // the current frame
 uniform mat4 frame_from_local;  // pixel * z = K [R|t] x (pinhole part)
 uniform vec2 frame_size;
 uniform vec3 eye;
+uniform vec3 picked_rgb, picked_stripe_rgb;  // kPickedRgb, kPickedStripeRgb
 // View-dependent layers (painted mode): the four whose cameras are nearest this draw's
 // chart, their cameras' centres; per pixel the two nearest the viewer's direction among those
 // painted there, the third as the cut-off (unstructured lumigraph weights, as
@@ -123,10 +124,11 @@ void main() {
     else
       base = vec3(0.3) * shade;
   }
-  // Selected triangles in yellow, triangles of selected groups in cyan (both striped).
+  // Picked triangles in white and black stripes (group_colour.h: unlike every group colour),
+  // triangles of selected groups tinted cyan (striped).
   bool stripe = (int(floor((gl_FragCoord.x + gl_FragCoord.y) / 6.0)) & 1) == 1;
   if (v_selected > 1.5) base = mix(base, vec3(0.2, 0.9, 1.0), stripe ? 0.65 : 0.4);
-  else if (v_selected > 0.5) base = mix(base, vec3(1.0, 0.85, 0.1), 0.55);
+  else if (v_selected > 0.5) base = stripe ? picked_rgb : picked_stripe_rgb;
   colour = vec4(base, 1.0);
   triangle = v_triangle;
 })";
@@ -587,6 +589,10 @@ void GlViewport::Impl::DrawMesh(const RunnerSnapshot& snapshot, const ViewportVi
               static_cast<float>(cam.height));
   glUniform3f(glGetUniformLocation(mesh_program, "eye"), eye.x(), eye.y(), eye.z());
   glUniform1i(glGetUniformLocation(mesh_program, "mode"), static_cast<int>(view.mode));
+  glUniform3f(glGetUniformLocation(mesh_program, "picked_rgb"), kPickedRgb[0], kPickedRgb[1],
+              kPickedRgb[2]);
+  glUniform3f(glGetUniformLocation(mesh_program, "picked_stripe_rgb"), kPickedStripeRgb[0],
+              kPickedStripeRgb[1], kPickedStripeRgb[2]);
   glUniform1i(glGetUniformLocation(mesh_program, "painted"), 0);
   glUniform1i(glGetUniformLocation(mesh_program, "frame"), 1);
   glActiveTexture(GL_TEXTURE1);

@@ -8,6 +8,7 @@
 
 #include "ui/core/group_colour.h"
 #include "ui/core/panel.h"
+#include "ui/core/texel_cap_note.h"
 #include "ui/panels/panels.h"
 
 namespace fresco {
@@ -37,7 +38,14 @@ class GroupingPanel : public Panel {
       split_message_ = explicit_groups ? DescribeGroupsSplitBack(state.project.grouping.groups,
                                                                  geo.groups, num_triangles)
                                        : "";
-      if (!split_message_.empty()) state.message = "grouping: " + split_message_;
+      coarse_message_ =
+          DescribeCoarsenedGroups({geo.groups, geo.buffer_texel_size_m, geo.texel_size_m,
+                                   state.project.pipeline.max_buffer_texels});
+      // After an edit (stored groups) the status bar says what the painting made of it.
+      std::string said = split_message_;
+      if (explicit_groups && !coarse_message_.empty())
+        said += (said.empty() ? "" : "; ") + coarse_message_;
+      if (!said.empty()) state.message = "grouping: " + said;
       colours_.clear();
       for (const GroupSpec& g : geo.groups) {
         const auto rgb = GroupColour(StableGroupKey(g));
@@ -51,6 +59,11 @@ class GroupingPanel : public Panel {
     if (!split_message_.empty())
       ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "%s", "Grouping changed when painting:");
     if (!split_message_.empty()) ImGui::TextWrapped("%s", split_message_.c_str());
+    if (!coarse_message_.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.75f, 0.3f, 1.0f));
+      ImGui::TextWrapped("%s", coarse_message_.c_str());
+      ImGui::PopStyleColor();
+    }
     ImGui::TextWrapped("%s: %zu groups for %d triangles (%d split for fold-over)",
                        explicit_groups ? "stored groups" : "automatic", geo.groups.size(),
                        num_triangles, geo.folds_split);
@@ -124,7 +137,13 @@ class GroupingPanel : public Panel {
         ImGui::TableSetColumnIndex(2);
         ImGui::Text("%d", geo.buffer_texels[g]);
         ImGui::TableSetColumnIndex(3);
-        if (geo.groups[g].texel_size_m > 0)
+        const double asked =
+            geo.groups[g].texel_size_m > 0 ? geo.groups[g].texel_size_m : geo.texel_size_m;
+        const double built =
+            g < geo.buffer_texel_size_m.size() ? geo.buffer_texel_size_m[g] : asked;
+        if (built > asked * 1.001)  // enlarged to fit the buffer's cap: said in amber
+          ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "%.4f (capped)", built);
+        else if (geo.groups[g].texel_size_m > 0)
           ImGui::Text("%.4f", geo.groups[g].texel_size_m);
         else
           ImGui::TextDisabled("default");
@@ -172,7 +191,7 @@ class GroupingPanel : public Panel {
   }
 
   std::map<std::string, std::string> Report() const override {
-    return {{"colours", colours_}, {"split", split_message_}};
+    return {{"colours", colours_}, {"split", split_message_}, {"coarser", coarse_message_}};
   }
 
  private:
@@ -193,8 +212,9 @@ class GroupingPanel : public Panel {
 
   float angle_ = 20, texel_ = 0, group_texel_ = 0.01f;
   uint64_t checked_geometry_ = 0;
-  std::string split_message_;  // why stored groups were split back apart ("" = they held)
-  std::string colours_;        // "KEY#rrggbb ..." per group, for Report()
+  std::string split_message_;   // why stored groups were split back apart ("" = they held)
+  std::string coarse_message_;  // which groups got coarser texels than asked ("" = none)
+  std::string colours_;         // "KEY#rrggbb ..." per group, for Report()
   int target_group_ = 0;
 };
 

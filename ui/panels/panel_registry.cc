@@ -1,7 +1,7 @@
-// Every panel of the app, in the View menu's order, with where it starts in a 1600 x 1000
-// window (five columns, nothing overlapping; scaled to the real window): one line each.
-// Calibration and Poses are the exceptions: large windows over columns 2-5, closed at first;
-// New project is a form over the middle, closed until File > New project... opens it.
+// Every panel of the app, in the View menu's order, with where it would start floating in a
+// 1600 x 1000 window (scaled to the real window): one line each. The tiled layout
+// (DefaultTileLayout) places them all: Calibration, Poses and New project, closed at first,
+// open as tabs in the stage row's place below the 3D view.
 #include "ui/panels/panels.h"
 
 namespace fresco {
