@@ -77,8 +77,10 @@ TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   EXPECT_FALSE(snap.report.Stage("warp")->images.empty());
   EXPECT_FALSE(snap.rephoto_bgr.empty());
   EXPECT_FALSE(snap.difference_heat.empty());
-  // Every panel is a visible window, and images went through the texture backend.
+  // Every panel is a visible window (brought to the front of its tab group first: the tools
+  // share the stage row's place), and images went through the texture backend.
   for (const auto& panel : panels) {
+    if (ui.layout.ShowTab(panel->Title())) imgui.Frame(ui, panels);
     ImGuiWindow* window = ImGui::FindWindowByName(panel->Title());
     ASSERT_NE(window, nullptr) << panel->Title();
     EXPECT_TRUE(window->Active || window->WasActive) << panel->Title();
