@@ -324,15 +324,23 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
   work.number = frame_number;
   work.debug = options_.debug_images;
   work.report = report;
-  work.held_out = DecidingUpdate() &&
-                  frame_number % kUpdateHoldOutEvery == kUpdateHoldOutEvery / 2 &&
+  // `update: auto`'s frames held out of the comparison: with the capture's length known, spread
+  // over the whole capture, the choice made as it nears its end (early on the mean holds few,
+  // near views, and movers that linger are where the held-out frames' own movers hide them:
+  // on the suites the first 24 frames chose the mean, or the model off, where the whole
+  // capture is better without); else (live) every 4th of the first 24 frames.
+  const int hold_every =
+      expected_frames_ > 0
+          ? std::max(kUpdateHoldOutEvery, expected_frames_ / (kUpdateHeldOutFrames + 1))
+          : kUpdateHoldOutEvery;
+  work.held_out = DecidingUpdate() && frame_number % hold_every == hold_every / 2 &&
                   update_held_out_.size() < static_cast<size_t>(kUpdateHeldOutFrames);
   if (work.held_out)
     update_held_out_.push_back({frame.bgr.clone(), frame.movers.clone(), camera, cam_from_world});
 #define FRESCO_RUN_STAGE(Name) Name##Stage(&work);
   FRESCO_PAINT_STAGES(FRESCO_RUN_STAGE)
 #undef FRESCO_RUN_STAGE
-  if (frame_number + 1 >= kUpdateHoldOutEvery * kUpdateHeldOutFrames) DecideUpdate();
+  if (frame_number + 1 >= hold_every * kUpdateHeldOutFrames) DecideUpdate();
   UpdateAutoModes(frame_number, work.measured_misalignment_px, work.seen, report);
   if (!own_.empty() && !own_only_.load()) ++frames_painted_whole_;
   UpdateOwnOnly();

@@ -143,10 +143,11 @@ class PaintSession {
   }
   // `update: auto` (pipeline_options.h): until decided, every texel keeps the sharpest view
   // (as `quality`) and the sums of every view (as `mean`; with the background model that
-  // `auto` turned on, also without its mask), and the same without frames 2, 6, ..., 22
-  // (held out of the decision, painted as every frame). After frame 23, or at the end of a
-  // shorter capture (the job's frame loop calls DecideUpdate there), the model painted each
-  // way without the held-out frames is rendered at their poses and compared with them (PSNR
+  // `auto` turned on, also without its mask), and the same without 6 frames held out of the
+  // decision (painted as every frame): spread over the capture when its length is known
+  // (every N / 7-th frame, at least every 4th), else frames 2, 6, ..., 22. After the 6th, or at
+  // the end of a shorter capture (the job's frame loop calls DecideUpdate there), the model painted
+  // each way without the held-out frames is rendered at their poses and compared with them (PSNR
   // over the pixels every way paints, less the movers found across views); the way that
   // agrees better paints on, from what every frame painted. With the background model on by
   // hand, refinement on (it registers frames to the sharpest views) or view selection:
