@@ -112,12 +112,30 @@ ElsewhereView ElsewhereRenderer::Render(const std::array<double, 6>& rt,
   cv::remap(texture_, fine, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
             cv::Scalar(shot.surround));
   cv::resize(fine, out.gray, cv::Size(lens_.width, lens_.height), 0, 0, cv::INTER_AREA);
+  if (shot.vignette > 0) {
+    const double cx = 0.5 * (lens_.width - 1), cy = 0.5 * (lens_.height - 1);
+    const double corner_sq = cx * cx + cy * cy;
+    for (int j = 0; j < out.gray.rows; ++j)
+      for (int i = 0; i < out.gray.cols; ++i) {
+        const double r_sq = ((i - cx) * (i - cx) + (j - cy) * (j - cy)) / corner_sq;
+        uchar& g = out.gray.at<uchar>(j, i);
+        g = cv::saturate_cast<uchar>(g * (1 - shot.vignette * r_sq));
+      }
+  }
   if (shot.blur_sigma_px > 0)
     cv::GaussianBlur(out.gray, out.gray, cv::Size(0, 0), shot.blur_sigma_px);
   if (shot.noise_grey > 0) {  // whole grey levels, saturated
     cv::Mat_<int16_t> noise(out.gray.size());
     cv::RNG(shot.seed).fill(noise, cv::RNG::NORMAL, 0, shot.noise_grey);
     cv::add(out.gray, noise, out.gray, cv::noArray(), CV_8U);
+  }
+  if (shot.contrast != 1 || shot.gamma != 1) {
+    cv::Mat_<uchar> curve(1, 256);
+    for (int g = 0; g < 256; ++g) {
+      const double c = std::clamp(128 + shot.contrast * (g - 128), 0.0, 255.0);
+      curve(0, g) = cv::saturate_cast<uchar>(255 * std::pow(c / 255, shot.gamma));
+    }
+    cv::LUT(out.gray, curve, out.gray);
   }
   if (shot.jpeg_quality > 0) {
     std::vector<uchar> bytes;
