@@ -303,10 +303,7 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector2d corner;
-        // cornerSubPix's window can reach past a narrow paper margin onto the surround and
-        // settle 2-6 px off, on the paper's edge: then the tag's outline as read.
-        if (!refined[k] || CrossingSquareAt(gray, p, k) ||
-            (!CornerFromEdges(gray, p, k, &corner) && !CornerFromEdges(gray, quad.p, k, &corner)))
+        if (!refined[k] || CrossingSquareAt(gray, p, k) || !CornerFromEdges(gray, p, k, &corner))
           continue;
         corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
         ++out.corners_from_edges;

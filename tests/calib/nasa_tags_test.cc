@@ -106,7 +106,14 @@ TEST(NasaAprilTagPhotosTest, BothDetectorsReadTheReferenceTags) {
       "read, %d matched (median %.3f px)\n",
       reference_tags, library_read, library_matched, Median(library_err), aruco_read, aruco_matched,
       Median(aruco_err));
-  EXPECT_GT(library_matched, 0);
+  // Measured: 47 reference tags; the library 45 read, all on a reference tag, corners median
+  // 0.33 px from it (refine_edges on, quad_decimate 1: not the reference's settings); aruco
+  // (1-bit border, unrefined) 22 read, 20 matched, median 1.0 px.
+  EXPECT_GE(library_matched, 44);
+  EXPECT_EQ(library_read, library_matched);
+  EXPECT_LT(Median(library_err), 0.5);
+  EXPECT_GE(aruco_matched, 18);
+  EXPECT_LT(Median(aruco_err), 1.5);
 }
 
 }  // namespace
