@@ -63,6 +63,10 @@ BoardDetection DetectChessboard(const cv::Mat& gray, const BoardSpec& spec,
   return out;
 }
 
+// A tag corner cornerSubPix moved further than this from the outline read (no black square
+// at it: calib/tag_corner_edges.h) is looked for from the outline.
+constexpr double kStrayedPx = 1.0;
+
 // Half-size of cornerSubPix's window for a tag: a quarter of its shortest edge in the image
 // (so the window never reaches the next corner of the same tag), at least 2, at most 6.
 int RefineHalfWindow(const TagQuad& quad) {
@@ -303,8 +307,17 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector2d corner;
-        if (!refined[k] || CrossingSquareAt(gray, p, k) || !CornerFromEdges(gray, p, k, &corner))
+        // A saddle more than 1 px from the tag's outline as read is no saddle of the tag: near
+        // a narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
+        // paper's edge, and the square and edges looked for from there are the paper's. Then
+        // both are looked for from the outline.
+        const bool strayed = (p[k] - quad.p[k]).norm() > kStrayedPx;
+        const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
+        if (!refined[k] || CrossingSquareAt(gray, from, k)) continue;
+        if (!CornerFromEdges(gray, from, k, &corner)) {
+          refined[k] = !strayed;  // a stray saddle and no edges: left out
           continue;
+        }
         corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
         ++out.corners_from_edges;
         edged_ids.insert(id * 4 + k);
