@@ -307,13 +307,13 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector2d corner;
-        // A saddle more than 1 px from the tag's outline as read is no saddle of the tag: near
-        // a narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
-        // paper's edge, and the square and edges looked for from there are the paper's. Then
-        // both are looked for from the outline.
+        // No square, and the saddle more than 1 px from the tag's outline as read: near a
+        // narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
+        // paper's edge, and edges looked for from there are the paper's. Then the edges are
+        // looked for from the outline.
         const bool strayed = (p[k] - quad.p[k]).norm() > kStrayedPx;
         const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
-        if (!refined[k] || CrossingSquareAt(gray, from, k)) continue;
+        if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
         if (!CornerFromEdges(gray, from, k, &corner)) {
           refined[k] = !strayed;  // a stray saddle and no edges: left out
           continue;
