@@ -311,7 +311,8 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
         // narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
         // paper's edge, and edges looked for from there are the paper's. Then the edges are
         // looked for from the outline.
-        const bool strayed = (p[k] - quad.p[k]).norm() > kStrayedPx;
+        const bool strayed =
+            options.edges_from_outline_when_strayed && (p[k] - quad.p[k]).norm() > kStrayedPx;
         const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
         if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
         if (!CornerFromEdges(gray, from, k, &corner)) {

@@ -68,6 +68,10 @@ struct DetectOptions {
   // sides: the bits it samples drift off their cells); see tests/calib/calib_detect_test.cc
   // and tests/calib/calib_detect_elsewhere_test.cc for the figures.
   bool second_look = true;
+  // AprilGrid: where no black square is at a tag corner and cornerSubPix moved it more than
+  // 1 px from the outline read, its edges are looked for from the outline (the corner left
+  // out when none show) instead of from the saddle (on a paper's or a tag's edge).
+  bool edges_from_outline_when_strayed = true;
   // DetectTagsApriltag: keep every tag read, an id read twice too (photos of scattered tags
   // of one id; a board has each id once, so by default both are dropped).
   bool keep_repeated_ids = false;
