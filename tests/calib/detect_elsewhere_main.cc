@@ -9,6 +9,7 @@
 //   calib_detect_elsewhere [--views N] [--seeds S1,S2,..] [--border-bits 1|2]
 //                          [--margin TAGS] [--gamma G] [--contrast C] [--vignette V]
 //                          [--solve] [--save DIR] [--verbose] [--no-second-look]
+// --verbose also lists every corner more than 2 px from the truth.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
