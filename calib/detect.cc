@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <set>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -16,6 +17,7 @@
 #include "calib/detect_aruco.h"
 #include "calib/kalibr_tag_family.h"
 #include "calib/tag_corner_edges.h"
+#include "calib/tag_dilation.h"
 #include "calib/tags_around_found.h"
 
 namespace fresco::calib {
@@ -60,6 +62,10 @@ BoardDetection DetectChessboard(const cv::Mat& gray, const BoardSpec& spec,
   out.found = true;
   return out;
 }
+
+// A tag corner cornerSubPix moved further than this from the outline read (no black square
+// at it: calib/tag_corner_edges.h) is looked for from the outline.
+constexpr double kStrayedPx = 1.0;
 
 // Half-size of cornerSubPix's window for a tag: a quarter of its shortest edge in the image
 // (so the window never reaches the next corner of the same tag), at least 2, at most 6.
@@ -216,6 +222,7 @@ std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
       if (area(quads[j]) > area(quads[i])) std::swap(quads[i], quads[j]);
       quads.erase(quads.begin() + j--);
     }
+  if (options.keep_repeated_ids) return quads;
   std::map<int, int> count_by_id;
   for (const TagQuad& q : quads) ++count_by_id[q.id];
   quads.erase(std::remove_if(quads.begin(), quads.end(),
@@ -286,6 +293,7 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   out.border_bits = BorderBitsOf(found);
   for (const auto& [id, quad] : found)
     out.tag_centres.push_back(0.25 * (quad.p[0] + quad.p[1] + quad.p[2] + quad.p[3]));
+  std::set<int> edged_ids;  // corners taken from the tag's edges
   for (const auto& [id, quad] : found) {
     std::vector<cv::Point2f> corners;
     for (int k = 0; k < 4; ++k)
@@ -299,10 +307,21 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector2d corner;
-        if (!refined[k] || CrossingSquareAt(gray, p, k) || !CornerFromEdges(gray, p, k, &corner))
+        // No square, and the saddle more than 1 px from the tag's outline as read: near a
+        // narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
+        // paper's edge, and edges looked for from there are the paper's. Then the edges are
+        // looked for from the outline.
+        const bool strayed =
+            options.edges_from_outline_when_strayed && (p[k] - quad.p[k]).norm() > kStrayedPx;
+        const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
+        if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
+        if (!CornerFromEdges(gray, from, k, &corner)) {
+          refined[k] = !strayed;  // a stray saddle and no edges: left out
           continue;
+        }
         corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
         ++out.corners_from_edges;
+        edged_ids.insert(id * 4 + k);
       }
     }
     for (int k = 0; k < 4; ++k)
@@ -312,6 +331,12 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   }
   std::sort(out.corners.begin(), out.corners.end(),
             [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+  if (!edged_ids.empty()) {  // a tone curve grows or shrinks the tags: calib/tag_dilation.h
+    std::vector<bool> from_edges;
+    for (const CornerObservation& c : out.corners) from_edges.push_back(edged_ids.count(c.id) > 0);
+    out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
+    ShiftTagEdges(spec, out.tag_edge_shift_px, from_edges, &out.corners);
+  }
   if (options.refine_tag_corners && options.drop_inconsistent_corners)
     out.corners_inconsistent = DropCornersTheirNeighboursPlaceElsewhere(spec, &out.corners);
   if (out.tags == 0) {

@@ -38,6 +38,9 @@ struct BoardDetection {
   // AprilGrid: corners placed where the tag's edges meet (no black square at the corner:
   // calib/tag_corner_edges.h) instead of on cornerSubPix's saddle.
   int corners_from_edges = 0;
+  // AprilGrid: how far (px, outwards) a tone curve moved the edges those corners were taken
+  // from, undone (calib/tag_dilation.h); 0 when not measured.
+  double tag_edge_shift_px = 0;
   double detect_ms = 0;  // wall time of this detection
   // AprilGrid: the centre of every tag read (before corners were left out), for marking
   // where a rejected image saw the board.
@@ -65,11 +68,18 @@ struct DetectOptions {
   // sides: the bits it samples drift off their cells); see tests/calib/calib_detect_test.cc
   // and tests/calib/calib_detect_elsewhere_test.cc for the figures.
   bool second_look = true;
+  // AprilGrid: where no black square is at a tag corner and cornerSubPix moved it more than
+  // 1 px from the outline read, its edges are looked for from the outline (the corner left
+  // out when none show) instead of from the saddle (on a paper's or a tag's edge).
+  bool edges_from_outline_when_strayed = true;
+  // DetectTagsApriltag: keep every tag read, an id read twice too (photos of scattered tags
+  // of one id; a board has each id once, so by default both are dropped).
+  bool keep_repeated_ids = false;
 };
 
 // One run of the apriltag library (tag36h11 with the black border options.border_bits
 // allows): tags with ids < num_ids and at most options.max_hamming bit errors, unrefined; an
-// id found twice is dropped (trust neither).
+// id found twice is dropped (trust neither) unless options.keep_repeated_ids.
 std::vector<TagQuad> DetectTagsApriltag(const cv::Mat& gray, int num_ids,
                                         const DetectOptions& options = {});
 

@@ -99,8 +99,15 @@ bool EdgeLine(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vec
     const int n = static_cast<int>(cut.grey.size()), ends = std::max(1, n / 6);
     double a = 0, b = 0;
     for (int i = 0; i < ends; ++i) a += cut.grey[i], b += cut.grey[n - 1 - i];
-    dark_ends.push_back(std::min(a, b) / ends);
-    light_ends.push_back(std::max(a, b) / ends);
+    // A narrow light band (a paper margin under kPlateauPx before a dark surround): the light
+    // end is dark again; its level is the band's lightest grey.
+    const bool light_last = grey.back() > grey.front();  // from the first, shorter cut
+    double light_end = (light_last ? b : a) / ends;
+    const auto half_begin = cut.grey.begin() + (light_last ? n / 2 : 0);
+    const double band = *std::max_element(half_begin, half_begin + n / 2);
+    if (band - light_end > kMinContrastGrey) light_end = band;
+    dark_ends.push_back((light_last ? a : b) / ends);
+    light_ends.push_back(light_end);
     cuts.push_back(std::move(cut));
   }
   if (static_cast<int>(cuts.size()) < kMinPoints) return false;
@@ -136,10 +143,19 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
   const Eigen::Vector2d middle = 0.5 * (p[k] + p[(k + 1) % 4]);
   const Eigen::Vector2d beside =
       middle + 0.12 * (p[k] - p[(k + 1) % 4]).norm() * (middle - centre).normalized();
+  // Kalibr's square has the gaps' white on both its sides: halfway across each gap, 0.15 tag
+  // edges along the tag's edge from the corner. Beyond a narrow paper margin (under 0.15 tag
+  // edges) on a dark surround one of them is dark, and so is the diagonal: no square there.
+  const Eigen::Vector2d a = p[(k + 1) % 4] - p[k], b = p[(k + 3) % 4] - p[k];
+  const Eigen::Vector2d gap_a = p[k] + 0.15 * (a - b), gap_b = p[k] + 0.15 * (b - a);
   const double g = Grey(gray, square.x(), square.y()), dark = Grey(gray, black.x(), black.y());
   const double light = Grey(gray, beside.x(), beside.y());
-  if (g < 0 || dark < 0 || light < 0) return true;  // cannot tell: keep the saddle refinement
-  return std::abs(g - dark) < std::abs(g - light);
+  const double ga = Grey(gray, gap_a.x(), gap_a.y()), gb = Grey(gray, gap_b.x(), gap_b.y());
+  if (g < 0 || dark < 0 || light < 0 || ga < 0 || gb < 0)
+    return true;  // cannot tell: keep the saddle refinement
+  const double white = std::max({light, ga, gb});
+  const auto nearer_dark = [&](double v) { return std::abs(v - dark) < std::abs(v - white); };
+  return nearer_dark(g) && !nearer_dark(ga) && !nearer_dark(gb);
 }
 
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,

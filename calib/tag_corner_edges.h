@@ -19,7 +19,8 @@ namespace fresco::calib {
 
 // Whether the board has a black square at tag corner k (the tag's corners `p`, in order
 // around it): the grey just outside the corner, on the diagonal away from the tag's centre,
-// is nearer the tag's black than the white of its gap. `gray` is CV_8U.
+// is nearer the tag's black than the white of its gap, and the gaps on either side of the
+// square (halfway across each, next to the corner) are white. `gray` is CV_8U.
 bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k);
 
 // Corner k as the intersection of the tag's two edges through it, or false (then `corner`

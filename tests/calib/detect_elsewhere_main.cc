@@ -3,9 +3,13 @@
 // variant (seed x dark/light surround x sharp / blurred 1 px + JPEG 80), the views the
 // detector loses where OpenCV's aruco (default parameters) reads 4 or more of the board's
 // tags, tags read by each, and detection time; --solve also solves the views (opencv4) and
-// prints the lens's RMS distance from the truth over the imager (5-95 %, 40 x 30 points).
+// prints the lens's RMS distance from the truth over the imager (5-95 %, 40 x 30 points) and
+// where the boards were seen (those of the points inside the convex hull of every corner
+// the solve used).
 //   calib_detect_elsewhere [--views N] [--seeds S1,S2,..] [--border-bits 1|2]
-//                          [--margin TAGS] [--solve] [--save DIR] [--verbose] [--no-second-look]
+//                          [--margin TAGS] [--gamma G] [--contrast C] [--vignette V]
+//                          [--solve] [--save DIR] [--verbose] [--no-second-look]
+// --verbose also lists every corner more than 2 px from the truth.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -15,6 +19,7 @@
 #include <string>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "calib/calibrate.h"
 #include "calib/detect.h"
@@ -31,6 +36,7 @@ int main(int argc, char** argv) {
   bool solve = false, verbose = false, truth_corners = false;
   std::string save;
   DetectOptions options;
+  ElsewhereShot look;  // the tone curve and vignetting every view gets
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* next = i + 1 < argc ? argv[i + 1] : "0";
@@ -45,6 +51,12 @@ int main(int argc, char** argv) {
       board.border_bits = std::atoi(next), ++i;
     } else if (a == "--margin") {
       board.margin_tags = std::atof(next), ++i;
+    } else if (a == "--gamma") {
+      look.gamma = std::atof(next), ++i;
+    } else if (a == "--contrast") {
+      look.contrast = std::atof(next), ++i;
+    } else if (a == "--vignette") {
+      look.vignette = std::atof(next), ++i;
     } else if (a == "--save") {
       save = next, ++i;
     } else if (a == "--solve") {
@@ -58,7 +70,8 @@ int main(int argc, char** argv) {
     } else {
       std::fprintf(stderr,
                    "usage: calib_detect_elsewhere [--views N] [--seeds S1,S2] [--border-bits 1|2] "
-                   "[--margin TAGS] [--solve] [--save DIR] [--verbose] [--no-second-look]\n");
+                   "[--margin TAGS] [--gamma G] [--contrast C] [--vignette V] [--solve] "
+                   "[--save DIR] [--verbose] [--no-second-look]\n");
       return 2;
     }
   }
@@ -93,7 +106,7 @@ int main(int argc, char** argv) {
           std::filesystem::create_directories(dir);
         }
         for (size_t v = 0; v < poses.size(); ++v) {
-          ElsewhereShot shot;
+          ElsewhereShot shot = look;
           shot.surround = surround;
           shot.seed = seed * 1000 + static_cast<unsigned>(v);
           if (degraded) shot.blur_sigma_px = 1, shot.jpeg_quality = 80;
@@ -115,6 +128,9 @@ int main(int argc, char** argv) {
           if (!d.found && aruco_reads) ++lost;
           for (const CornerObservation& c : d.corners) {
             const double e = (c.pixel - view.truth[c.id]).norm();
+            if (verbose && e > 2)
+              std::printf("  %s view %2zu: corner %d (tag %d, k %d) %.2f px off\n", name.c_str(), v,
+                          c.id, c.id / 4, c.id % 4, e);
             sq_px += e * e, worst_px = std::max(worst_px, e), ++corners;
             sum_px += c.pixel - view.truth[c.id];
             const Eigen::Vector2d out = view.truth[c.id] - Eigen::Vector2d(511.5, 383.5);
@@ -156,8 +172,21 @@ int main(int argc, char** argv) {
             const double rms =
                 ProjectionDifference_px("LENSMODEL_OPENCV4", lens.intrinsics,
                                         run.Chosen().lensmodel, run.Chosen().fit.intrinsics, grid);
-            std::printf(", lens vs truth %.3f px rms (fx %.2f)", rms,
-                        run.Chosen().fit.intrinsics[0]);
+            std::vector<cv::Point2f> seen, hull;
+            for (const BoardView& bv : used_views)
+              for (const CornerObservation& c : bv.corners)
+                seen.emplace_back(static_cast<float>(c.pixel.x()), static_cast<float>(c.pixel.y()));
+            cv::convexHull(seen, hull);
+            std::vector<Eigen::Vector2d> inside;
+            for (const Eigen::Vector2d& g : grid)
+              if (cv::pointPolygonTest(hull, cv::Point2f(g.x(), g.y()), false) >= 0)
+                inside.push_back(g);
+            const double rms_seen = ProjectionDifference_px("LENSMODEL_OPENCV4", lens.intrinsics,
+                                                            run.Chosen().lensmodel,
+                                                            run.Chosen().fit.intrinsics, inside);
+            std::printf(
+                ", lens vs truth %.3f px rms (where seen %.3f, %zu of %zu points) (fx %.2f)", rms,
+                rms_seen, inside.size(), grid.size(), run.Chosen().fit.intrinsics[0]);
           } else {
             std::printf(", solve failed: %s", s.message().c_str());
           }

@@ -6,7 +6,8 @@
 // where the gaps cross, on white paper with a margin of any width. The board is seen through
 // an OpenCV lens (k1, k2, p1, p2: mrcal's LENSMODEL_OPENCV4) from a known pose: cv::remap
 // with rays from cv::undistortPoints, 2 x 2 samples per pixel, over a dark or light
-// surround; then optional blur, grey noise and JPEG. The true pixel of every corner comes
+// surround; then optional vignetting, blur, grey noise, a tone curve (contrast, gamma) and
+// JPEG. The true pixel of every corner comes
 // from cv::projectPoints. Nothing of Fresco's own renderer (calib/sample_views.h) is used.
 #pragma once
 
@@ -39,6 +40,13 @@ struct ElsewhereShot {
   double noise_grey = 2;     // Gaussian noise sigma, grey levels
   int jpeg_quality = 0;      // 0: no JPEG round trip
   unsigned seed = 1;         // the noise
+  // Light falling off towards the imager's corners (optical, before blur and noise): the
+  // grey times 1 - vignette * (r / r_corner)^2, r from the imager's centre.
+  double vignette = 0;
+  // The camera's tone curve (after noise, before JPEG): the grey about mid-grey 128 times
+  // `contrast`, then 255 * (grey / 255)^gamma.
+  double contrast = 1;
+  double gamma = 1;
 };
 
 struct ElsewhereView {
