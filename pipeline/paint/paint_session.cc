@@ -69,6 +69,8 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   s->requested_update_ = inputs.pipeline.update;
   s->requested_background_ = inputs.pipeline.background.mode;
   s->expected_frames_ = static_cast<int>(inputs.expected_poses.size());
+  if (inputs.pipeline.max_frames > 0)  // the run stops there
+    s->expected_frames_ = std::min(s->expected_frames_, inputs.pipeline.max_frames);
   s->options_.background.warmup_frames = EffectiveWarmupFrames(inputs);
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");

@@ -88,7 +88,8 @@ TEST(ShardMerge, DefaultProjectMergedEqualsUnsharded) {
   const testing::CommandResult synth =
       RunFresco({"synth", root + "/synth.json", "--if-changed"});
   ASSERT_EQ(synth.exit_code, 0) << synth.err;
-  // The first 48 frames: the `auto` modes decide within them (update at frame 24).
+  // The first 48 frames: the `auto` modes decide within them (update at frame 36, after its
+  // 6th frame held out, every 6th of the 48).
   ExpectMergedEqualsUnsharded(root + "/project.json", "shard-cube-room",
                               {"pipeline.max_frames=48"});
 }
