@@ -153,11 +153,17 @@ void ColmapProgressBar(const PosesSnapshot& snap) {
   // How far the step has got, from the progress lines COLMAP writes to its log.
   const ColmapStepProgress step =
       ReadColmapStepProgress(ReadFileTail(snap.step_log, 4096), snap.step_images);
-  std::string text =
-      "step " + std::to_string(snap.step) + "/" + std::to_string(snap.steps) + " " + snap.step_name;
+  // Appended piece by piece (GCC 12 warns, wrongly, on "literal" + std::string here).
+  std::string text = "step ";
+  text.append(std::to_string(snap.step)).append("/").append(std::to_string(snap.steps));
+  text.append(" ").append(snap.step_name);
   if (step.known)
-    text += " " + std::to_string(step.done) + "/" + std::to_string(step.total) + " images";
-  text += ": " + ElapsedAndRemainingText(seconds, step.Fraction());
+    text.append(" ")
+        .append(std::to_string(step.done))
+        .append("/")
+        .append(std::to_string(step.total))
+        .append(" images");
+  text.append(": ").append(ElapsedAndRemainingText(seconds, step.Fraction()));
   if (RemainingSeconds(seconds, step.Fraction()) >= 0) text += " in this step";
   const float fraction = (snap.step - 1 + static_cast<float>(step.Fraction())) / snap.steps;
   ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
