@@ -22,6 +22,58 @@ struct Part {
   std::vector<std::string> files;  // every file of the part but metrics.json, sorted
 };
 
+// Member `key` of `j` (null when `j` is no object or has none).
+const Json* Member(const Json& j, const std::string& key) {
+  if (!j.is_object()) return nullptr;
+  const auto it = j.find(key);
+  return it == j.end() ? nullptr : &*it;
+}
+
+// The fields merging reads, each of the type it needs: the first that is not, named.
+Status CheckFieldsMergeReads(const std::string& path, const Json& m) {
+  const auto wrong = [&](const std::string& field, const char* want) {
+    return Status::Error(path + ": " + field + ": missing or not " + want);
+  };
+  const auto is_count = [](const Json* v) { return v && v->is_number_integer() && *v >= 0; };
+  const Json& shard = *Member(m, "shard");
+  for (const char* key : {"index", "count"})
+    if (!is_count(Member(shard, key))) return wrong(std::string("shard.") + key, "a count");
+  const Json* rects = Member(shard, "page_rects");
+  if (!rects || !rects->is_array()) return wrong("shard.page_rects", "an array");
+  for (size_t k = 0; k < rects->size(); ++k) {
+    const Json& r = (*rects)[k];
+    bool ok = r.is_array() && r.size() == 5;
+    for (size_t i = 0; ok && i < 5; ++i) ok = is_count(&r[i]);
+    if (!ok) return wrong("shard.page_rects[" + std::to_string(k) + "]", "5 counts");
+  }
+  const Json* buffers = Member(m, "buffers");
+  if (!buffers || !buffers->is_array()) return wrong("buffers", "an array");
+  const Json* own = Member(shard, "buffers");
+  if (!own || !own->is_array()) return wrong("shard.buffers", "an array");
+  for (size_t k = 0; k < own->size(); ++k) {
+    const Json& id = (*own)[k];
+    const std::string field = "shard.buffers[" + std::to_string(k) + "]";
+    if (!is_count(&id) || id.get<size_t>() >= buffers->size())
+      return wrong(field, "a buffer's index");
+    if (!is_count(Member((*buffers)[id.get<size_t>()], "painted")))
+      return wrong("buffers[" + id.dump() + "].painted", "a count");
+  }
+  for (const char* key : {"texels", "frames", "frames_painted"})
+    if (!is_count(Member(m, key))) return wrong(key, "a count");
+  const Json* atlas = Member(m, "atlas");
+  if (!atlas || !is_count(Member(*atlas, "pages"))) return wrong("atlas.pages", "a count");
+  const Json* streams = Member(m, "streams");
+  if (!streams || !streams->is_array()) return wrong("streams", "an array");
+  for (size_t s = 0; s < streams->size(); ++s)
+    if (!is_count(Member((*streams)[s], "frames_painted")))
+      return wrong("streams[" + std::to_string(s) + "].frames_painted", "a count");
+  const Json* stage_ms = Member(m, "stage_ms");
+  if (!stage_ms || !stage_ms->is_object()) return wrong("stage_ms", "an object");
+  for (const auto& [stage, ms] : stage_ms->items())
+    if (!ms.is_number()) return wrong("stage_ms." + stage, "a number");
+  return Status::Ok();
+}
+
 Status ReadPart(const std::string& dir, Part* part) {
   part->dir = dir;
   const std::string path = dir + "/metrics.json";
@@ -36,6 +88,7 @@ Status ReadPart(const std::string& dir, Part* part) {
   if (!shard.is_object() || !shard.contains("index") || !shard.contains("count") ||
       !shard.contains("page_rects") || !shard.contains("buffers"))
     return Status::Error(path + ": shard: missing (not written by `fresco run --shard I/N`)");
+  FRESCO_RETURN_IF_ERROR(CheckFieldsMergeReads(path, part->metrics));
   part->index = shard["index"].get<int>();
   part->count = shard["count"].get<int>();
   for (const fs::directory_entry& e : fs::directory_iterator(dir))

@@ -62,7 +62,9 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
       merge.push_back(part);
     }
     EXPECT_EQ(texels_sum, whole_metrics["texels"].get<long long>()) << "N = " << n;
-    if (n == 4) EXPECT_GT(skipped, 0) << "no shard skipped a frame";
+    if (n == 4) {
+      EXPECT_GT(skipped, 0) << "no shard skipped a frame";
+    }
     const std::string merged = work + "/n" + std::to_string(n) + "/merged";
     merge.insert(merge.end(), {"--out", merged, "--quiet"});
     const testing::CommandResult r = RunFresco(merge);
@@ -136,6 +138,15 @@ TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
                        "--quiet"})
                 .exit_code,
             0);
+  // A part whose metrics.json has a field of the wrong type: named, exit 2, not a crash.
+  fs::copy(work + "/p1", work + "/typed", fs::copy_options::recursive);
+  json typed = Metrics(work + "/typed");
+  typed["frames_painted"] = "six";
+  WriteText(work + "/typed/metrics.json", typed.dump());
+  fs::copy(work + "/p1", work + "/typed-rect", fs::copy_options::recursive);
+  json rect = Metrics(work + "/typed-rect");
+  rect["shard"]["page_rects"] = json::array({json::array({0, 1, "x", 3, 4})});
+  WriteText(work + "/typed-rect/metrics.json", rect.dump());
   const std::string out = work + "/merged";
   struct Case {
     std::vector<std::string> parts;
@@ -147,6 +158,10 @@ TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
       {{work + "/p0", work + "/other"}, "settings"},
       {{work + "/p0", work + "/whole"}, "whole/metrics.json: shard: missing"},
       {{work + "/p0", work + "/none"}, "none: not a folder"},
+      {{work + "/p0", work + "/typed"},
+       "typed/metrics.json: frames_painted: missing or not a count"},
+      {{work + "/p0", work + "/typed-rect"},
+       "typed-rect/metrics.json: shard.page_rects[0]: missing or not 5 counts"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"merge"};
