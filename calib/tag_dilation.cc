@@ -83,9 +83,8 @@ double TagEdgeShift_px(const BoardSpec& spec, const std::vector<CornerObservatio
   return shifts[shifts.size() / 2];
 }
 
-void ShiftTagEdges(const BoardSpec& spec, double shift_px, const std::vector<bool>& from_edges,
+void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
                    std::vector<CornerObservation>* corners) {
-  (void)spec;
   if (shift_px == 0) return;
   const std::vector<CornerObservation> before = *corners;
   const Lookup l = MakeLookup(before, from_edges);

@@ -26,7 +26,7 @@ double TagEdgeShift_px(const BoardSpec& spec, const std::vector<CornerObservatio
 // Moves each corner with from_edges[i] set as if both its tag's edges through it moved by
 // -shift_px along their outward normals (the tag's other corners give the edges' directions;
 // a corner whose neighbours on the tag are missing is left as it is).
-void ShiftTagEdges(const BoardSpec& spec, double shift_px, const std::vector<bool>& from_edges,
+void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
                    std::vector<CornerObservation>* corners);
 
 }  // namespace fresco::calib

@@ -245,7 +245,7 @@ TEST(TagDilationTest, TheEdgeShiftOfGrownTagsIsMeasuredAndUndone) {
     const std::vector<bool> from_edges(grown.size(), true);
     const double shift = TagEdgeShift_px(spec, grown, from_edges);
     EXPECT_NEAR(shift, grow_px, 0.1 * std::abs(grow_px));
-    ShiftTagEdges(spec, shift, from_edges, &grown);
+    ShiftTagEdges(shift, from_edges, &grown);
     double worst = 0;
     for (size_t i = 0; i < grown.size(); ++i)
       worst = std::max(worst, (grown[i].pixel - truth[i].pixel).norm());
