@@ -182,6 +182,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                               {"check_matches", a.check_matches},
                               {"check_before_px", a.check_before_px},
                               {"check_after_px", a.check_after_px},
+                              {"check_one_end_px", a.check_one_end_px},
                               {"check_seconds", a.check_seconds},
                               {"rms_before_px", a.rms_before_px},
                               {"rms_after_px", a.rms_after_px},
@@ -404,15 +405,12 @@ void PrintJobSummary(const PaintJob& job, size_t streams) {
                                ? " on the first " + std::to_string(a.decided_on_frames) + " frames"
                                : "";
     std::fprintf(stderr,
-                 "fresco run: poses adjusted together%s: the frames left out agree %.3f -> %.3f px "
-                 "(%d tracks, %.1f s): %s",
-                 on.c_str(), a.check_before_px, a.check_after_px, a.check_matches, a.check_seconds,
-                 a.applied ? "applied" : "not applied");
-    if (!a.applied && a.rms_after_px > 0)
-      std::fprintf(stderr, " (all tracks %.3f -> %.3f px: not %.1f times better)\n",
-                   a.rms_before_px, a.rms_after_px, PoseAdjustOptions().min_improvement);
-    else if (!a.applied)
-      std::fprintf(stderr, " (no better by the check)\n");
+                 "fresco run: poses adjusted together%s: a frame left out against the corrected "
+                 "ones agrees %.3f -> %.3f px (%d tracks, %.1f s): %s",
+                 on.c_str(), a.check_before_px, a.check_one_end_px, a.check_matches,
+                 a.check_seconds, a.applied ? "applied" : "not applied");
+    if (!a.applied)
+      std::fprintf(stderr, " (not %.1f times better)\n", PoseAdjustOptions().check_min_improvement);
     if (a.applied)
       std::fprintf(stderr, "; %d tracks, RMS %.3f -> %.3f px, median correction %.3f deg, %.1f mm (%.1f s)\n",
                    a.inliers, a.rms_before_px, a.rms_after_px, a.median_rotation_deg,

@@ -142,6 +142,7 @@ Status PaintCapture(const Project& project, const GeneratedCapture& g, const Eva
     result->joint_decided_on_frames = joint->decided_on_frames;
     result->joint_check_ratio = ratio(joint->check_before_px, joint->check_after_px);
     result->joint_tracks_ratio = ratio(joint->rms_before_px, joint->rms_after_px);
+    result->joint_one_end_ratio = ratio(joint->check_before_px, joint->check_one_end_px);
   }
   return Status::Ok();
 }

@@ -72,6 +72,7 @@ struct CaptureEval {
   bool joint_ran = false, joint_applied = false;
   int joint_decided_on_frames = 0;
   double joint_check_ratio = 0, joint_tracks_ratio = 0;
+  double joint_one_end_ratio = 0;  // check_before_px / check_one_end_px
   // With EvalOptions::recovery (NaN otherwise): truth PSNR with refinement off at the given
   // poses, with the setting at the true poses (noisy captures only), and the share of the
   // PSNR lost to pose noise that the setting recovers (where at least 0.5 dB is lost).

@@ -139,6 +139,7 @@ std::string EvalToJson(const std::vector<std::string>& settings,
       row["joint_poses"] = {{"applied", c.joint_applied},
                             {"decided_on_frames", c.joint_decided_on_frames},
                             {"check_ratio", c.joint_check_ratio},
+                            {"one_end_ratio", c.joint_one_end_ratio},
                             {"tracks_ratio", c.joint_tracks_ratio}};
     if (std::isfinite(c.unrefined_truth_psnr_db)) {
       const auto number = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };

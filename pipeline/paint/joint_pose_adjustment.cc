@@ -352,19 +352,27 @@ std::vector<Match> FindMatches(const TriangleMesh& mesh, const std::vector<PoseA
   return matches;
 }
 
-// Each match's residual (pixels; 1e9 where it cannot be predicted) at the corrections `x`.
+// Which ends of a track take their correction when its residual is measured.
+enum class CorrectedEnds { kBoth, kFirst, kSecond };
+
+// Each match's residual (pixels; 1e9 where it cannot be predicted) at the corrections `x`
+// (at the given pose, the end `ends` leaves out).
 void Residuals(const std::vector<PoseAdjustFrame>& frames, const std::vector<Match>& matches,
-               const std::vector<Vec6>& x, std::vector<double>* residual) {
+               const std::vector<Vec6>& x, std::vector<double>* residual,
+               CorrectedEnds ends = CorrectedEnds::kBoth) {
   std::vector<Rigid3d> poses(frames.size());
   for (size_t f = 0; f < frames.size(); ++f) poses[f] = Corrected(x[f], frames[f].cam_from_local);
   residual->resize(matches.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(matches.size())), [&](const cv::Range& r) {
     for (int k = r.start; k < r.end; ++k) {
       const Match& m = matches[k];
+      const Rigid3d& pose_i =
+          ends == CorrectedEnds::kSecond ? frames[m.i].cam_from_local : poses[m.i];
+      const Rigid3d& pose_j =
+          ends == CorrectedEnds::kFirst ? frames[m.j].cam_from_local : poses[m.j];
       Eigen::Vector2d p;
-      (*residual)[k] = Predict(m, *frames[m.j].camera, poses[m.i], poses[m.j], &p)
-                           ? (p - m.pixel_j).norm()
-                           : 1e9;
+      (*residual)[k] =
+          Predict(m, *frames[m.j].camera, pose_i, pose_j, &p) ? (p - m.pixel_j).norm() : 1e9;
     }
   });
 }
@@ -582,8 +590,7 @@ void Summarise(const std::vector<PoseAdjustFrame>& frames, const std::vector<Mat
       ++result->frame_matches[matches[k].i];
       ++result->frame_matches[matches[k].j];
     }
-  result->applied = result->rms_after_px > 0 &&
-                    result->rms_before_px >= options.min_improvement * result->rms_after_px;
+  result->applied = result->rms_after_px > 0;
   const std::vector<Vec6>& x = solver.corrections();
   std::vector<double> rotations, translations;
   for (size_t f = 0; f < frames.size(); ++f) {
@@ -634,8 +641,9 @@ void Prepare(const TriangleMesh& mesh, const std::vector<PoseAdjustFrame>& given
 
 // PoseAdjustOptions' check from `tracks` (over check_offsets): the even and the odd frames each
 // adjusted from the tracks between their own frames only, the tracks between the halves
-// measured at the given poses and at those corrections (the RMS of each residual capped at
-// WrongTrackLimit at the given poses, over the tracks within it at either).
+// measured at the given poses, with one end at its half's correction (both ways) and with both
+// (the RMS of each residual capped at WrongTrackLimit at the given poses, over the tracks
+// within it at the given poses or with both corrected).
 void CheckOnFramesLeftOut(const std::vector<PoseAdjustFrame>& frames,
                           const std::vector<Match>& tracks, const PoseAdjustOptions& options,
                           PoseAdjustResult* result) {
@@ -644,20 +652,25 @@ void CheckOnFramesLeftOut(const std::vector<PoseAdjustFrame>& frames,
   if (within.empty() || between.empty()) return;
   CorrectionSolver halves(frames, within, options);
   halves.Run();
-  std::vector<double> before, after;
+  std::vector<double> before, after, first, second;
   Residuals(frames, between, std::vector<Vec6>(frames.size(), Vec6::Zero()), &before);
   Residuals(frames, between, halves.corrections(), &after);
+  Residuals(frames, between, halves.corrections(), &first, CorrectedEnds::kFirst);
+  Residuals(frames, between, halves.corrections(), &second, CorrectedEnds::kSecond);
   const double limit = WrongTrackLimit(before);
-  double sum_before = 0, sum_after = 0;
+  double sum_before = 0, sum_after = 0, sum_one_end = 0;
   for (size_t k = 0; k < between.size(); ++k) {
     if (before[k] >= limit && after[k] >= limit) continue;
     sum_before += std::pow(std::min(before[k], limit), 2);
     sum_after += std::pow(std::min(after[k], limit), 2);
+    sum_one_end +=
+        0.5 * (std::pow(std::min(first[k], limit), 2) + std::pow(std::min(second[k], limit), 2));
     ++result->check_matches;
   }
   if (result->check_matches == 0) return;
   result->check_before_px = std::sqrt(sum_before / result->check_matches);
   result->check_after_px = std::sqrt(sum_after / result->check_matches);
+  result->check_one_end_px = std::sqrt(sum_one_end / result->check_matches);
 }
 
 }  // namespace
@@ -722,9 +735,9 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   if (check) {
     CheckOnFramesLeftOut(prepared.frames, matches, options, result);
     result->check_seconds = seconds();
-    const bool passed = result->check_after_px > 0 &&
-                        result->check_before_px >= options.check_min_improvement *
-                                                       result->check_after_px;
+    const bool passed =
+        result->check_one_end_px > 0 &&
+        result->check_before_px >= options.check_min_improvement * result->check_one_end_px;
     if (!passed) {
       if (options.progress) options.progress(1, 1, "checked: not adjusted");
       result->seconds = seconds();

@@ -4,21 +4,53 @@
 
 namespace fresco {
 
+void DecodedFrames::Keep(int stream, int pose_index, cv::Mat bgr) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  bytes_ += bgr.total() * bgr.elemSize();
+  frames_[stream][pose_index] = std::move(bgr);
+}
+
+bool DecodedFrames::Has(int stream, int pose_index) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return frames_[stream].count(pose_index) > 0;
+}
+
+cv::Mat DecodedFrames::Take(int stream, int pose_index) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto found = frames_[stream].find(pose_index);
+  if (found == frames_[stream].end()) return cv::Mat();
+  cv::Mat bgr = std::move(found->second);
+  frames_[stream].erase(found);
+  bytes_ -= bgr.total() * bgr.elemSize();
+  return bgr;
+}
+
+size_t DecodedFrames::bytes() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return bytes_;
+}
+
 FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
-                                 SkipFrame skip, bool read_frames_without_pose)
-    : streams_(streams), ended_(streams.size(), false), read_(streams.size(), 0) {
+                                 SkipFrame skip, bool read_frames_without_pose,
+                                 std::shared_ptr<DecodedFrames> decoded)
+    : streams_(streams),
+      skip_(std::move(skip)),
+      decoded_(std::move(decoded)),
+      ended_(streams.size(), false),
+      read_(streams.size(), 0) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < streams_.size(); ++s) {
     origins_.push_back({project.Resolve(specs[s].video), project.Resolve(specs[s].poses)});
     std::function<bool(const Frame&)> skip_frame;
-    if (skip || !read_frames_without_pose)
-      skip_frame = [this, s, skip, read_frames_without_pose](const Frame& header) {
+    if (skip_ || decoded_ || !read_frames_without_pose)
+      skip_frame = [this, s, read_frames_without_pose](const Frame& header) {
         SourcedFrame f;
         f.posed.frame = header;
         f.stream = static_cast<int>(s);
         MatchPose(static_cast<int>(s), &f);
         if (!f.posed.has_pose) return !read_frames_without_pose;
-        return f.camera && skip && skip(f);
+        if (f.camera && skip_ && skip_(f)) return true;
+        return decoded_ && decoded_->Has(f.stream, f.pose_index);  // Next() takes it
       };
     readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get(), skip_frame));
     fps_.push_back(specs[s].fps);
@@ -63,6 +95,13 @@ FrameRead FileFrameSource::Next(SourcedFrame* frame, Status* status) {
     frame->stream = s;
     MatchPose(s, frame);
     if (!frame->posed.has_pose) frame->skipped = false;  // not decoded: a frame without a pose
+    // Passed over because it was decoded before (unless `skip` passes it over too).
+    if (frame->skipped && decoded_ && frame->posed.has_pose)
+      if (cv::Mat bgr = decoded_->Take(s, frame->pose_index);
+          !bgr.empty() && !(frame->camera && skip_ && skip_(*frame))) {
+        frame->posed.frame.bgr = std::move(bgr);
+        frame->skipped = false;
+      }
     return FrameRead::kFrame;
   }
   return FrameRead::kEnded;  // every stream ended

@@ -8,8 +8,12 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <vector>
+
+#include <opencv2/core.hpp>
 
 #include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
@@ -17,6 +21,23 @@
 #include "pipeline/run/read_ahead.h"
 
 namespace fresco {
+
+// Frames already decoded (the whole-capture pre-pass keeps them: paint_job.h), each handed out
+// once instead of decoded again; by stream and pose index. Safe to read from the reading
+// threads while the painting thread takes.
+class DecodedFrames {
+ public:
+  explicit DecodedFrames(size_t streams) : frames_(streams) {}
+  void Keep(int stream, int pose_index, cv::Mat bgr);
+  bool Has(int stream, int pose_index) const;
+  cv::Mat Take(int stream, int pose_index);  // empty when not kept (or taken)
+  size_t bytes() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::vector<std::map<int, cv::Mat>> frames_;
+  size_t bytes_ = 0;
+};
 
 class FileFrameSource : public PosedFrameSource {
  public:
@@ -27,9 +48,11 @@ class FileFrameSource : public PosedFrameSource {
   // is not read and comes out with `skipped` set.
   // `read_frames_without_pose` false (folders only): a frame without a pose is not decoded and
   // comes out without pixels (nothing paints it; the app shows it, so reads it).
+  // `decoded` (optional; folders only): a frame kept there is taken from it, not decoded.
   using SkipFrame = std::function<bool(const SourcedFrame& header)>;
   FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
-                  SkipFrame skip = nullptr, bool read_frames_without_pose = true);
+                  SkipFrame skip = nullptr, bool read_frames_without_pose = true,
+                  std::shared_ptr<DecodedFrames> decoded = nullptr);
 
   FrameRead Next(SourcedFrame* frame, Status* status) override;
   int NumStreams() const override { return static_cast<int>(streams_.size()); }
@@ -43,6 +66,8 @@ class FileFrameSource : public PosedFrameSource {
   int PickStream();
 
   std::vector<const Capture*> streams_;
+  SkipFrame skip_;
+  std::shared_ptr<DecodedFrames> decoded_;
   std::vector<FrameOrigin> origins_;
   std::vector<std::unique_ptr<ReadAhead>> readers_;
   std::vector<bool> ended_;

@@ -23,6 +23,8 @@
 
 namespace fresco {
 
+class DecodedFrames;  // file_frame_source.h
+
 struct PaintJobOptions {
   // Non-empty: the project must have one stream, else an error naming `streams` and this
   // ("fresco bench").
@@ -72,6 +74,9 @@ struct PaintJob {
   // background.mode auto: the movers found across views before painting, which decided it
   // (`masks` is empty).
   std::optional<MoverMaskResult> mover_masks;
+  // The frames the whole-capture pre-pass decoded, kept for painting to take (up to
+  // 256 MB; folders only; null without a pre-pass).
+  std::shared_ptr<DecodedFrames> decoded;
   // Sharded (PaintJobOptions::shard): the shard of every buffer (AssignBuffersToShards).
   std::vector<int> buffer_shard;
   // Where opening the job spent its wall time, seconds (what a user waits for before the

@@ -45,8 +45,7 @@ struct RefineOptions {
   bool pose = true;
   // Before painting, correct all the given poses together against the mesh (captures read
   // from files only; joint_pose_adjustment.h). A check on frames left out of the estimate
-  // (PoseAdjustOptions::check_min_improvement), then the tracks explained better
-  // (min_improvement), decide whether the corrections are used.
+  // (PoseAdjustOptions::check_min_improvement) decides whether the corrections are used.
   bool joint = true;
   int anchor_min_frames = 3;
   int anchor_window_frames = 100;  // samples fade with this time constant (0: never)
@@ -120,10 +119,11 @@ void Fields(RefineOptions& o, V& v) {
                    "captures from files; live captures and the app's frame-by-frame painting "
                    "ignore it); "
                    "first a check: the even and the odd frames are adjusted apart, and only when "
-                   "the tracks between them, which neither saw, agree 1.1 times better at the "
-                   "corrected poses are all the poses adjusted; the corrections are used where "
-                   "they also explain every track 2.2 times better (exact poses stay as given, "
-                   "and cost the check only); on by default"});
+                   "the tracks between them, which neither saw, agree 1.1 times better with one "
+                   "frame of each at its given pose and the other corrected (a view at a given "
+                   "pose against what the corrected frames paint) are all the poses adjusted "
+                   "and the corrections used (exact poses, or poses fitted to an error of the "
+                   "mesh, stay as given and cost the check only); on by default"});
   v.Field("anchor_min_frames", o.anchor_min_frames,
           {.min = 2, .help = "frames that must agree before a buffer is moved"});
   v.Field("anchor_window_frames", o.anchor_window_frames,

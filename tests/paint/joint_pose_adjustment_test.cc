@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include "pipeline/core/capture.h"
 #include "pipeline/core/project.h"
 #include "pipeline/eval/eval_suite.h"
 #include "pipeline/paint/joint_pose_adjustment.h"
@@ -176,7 +177,9 @@ TEST(JointPoseAdjustment, PosesNoisierThanThePriorsAreCorrectedInFull) {
     error[rounds > 0] = centre_error(result.cam_from_local);
     std::printf("prior rounds %d: translation prior %.4f m, cameras %.4f m off (given %.4f)\n",
                 rounds, result.translation_prior_m, error[rounds > 0], centre_error(given));
-    if (rounds > 0) EXPECT_GT(result.translation_prior_m, 0.02);
+    if (rounds > 0) {
+      EXPECT_GT(result.translation_prior_m, 0.02);
+    }
   }
   EXPECT_LT(error[1], 0.75 * error[0]);  // 20.5 -> 12.2 mm
 }
@@ -189,12 +192,12 @@ TEST(JointPoseAdjustment, ExactPosesStay) {
   const std::vector<PoseAdjustFrame> frames = Frames(o);
   PoseAdjustResult result;
   ASSERT_TRUE(AdjustPosesOnMesh(o.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
-  std::printf("check: %d tracks, %.3f -> %.3f px\n", result.check_matches,
-              result.check_before_px, result.check_after_px);
+  std::printf("check: %d tracks, %.3f -> %.3f px (one end), %.3f px (both)\n", result.check_matches,
+              result.check_before_px, result.check_one_end_px, result.check_after_px);
   EXPECT_FALSE(result.applied);
   EXPECT_GT(result.check_matches, 200);
   EXPECT_LT(result.check_before_px, 0.5);
-  EXPECT_GT(result.check_after_px, result.check_before_px / 1.1);
+  EXPECT_GT(result.check_one_end_px, result.check_before_px / 1.1);
   EXPECT_EQ(result.matches, 0);  // the adjustment itself did not run
   for (size_t i = 0; i < frames.size(); ++i) {
     EXPECT_EQ(result.cam_from_local[i].translation, frames[i].cam_from_local.translation);
@@ -212,10 +215,15 @@ TEST(JointPoseAdjustment, TheCheckOnFramesLeftOutAppliesNoisyPoses) {
   PoseAdjustResult result;
   double before = 0, after = 0;
   ASSERT_NO_FATAL_FAILURE(AdjustOrbit(o, PoseAdjustOptions(), &result, &before, &after));
-  std::printf("check: %d tracks, %.3f -> %.3f px; mesh points %.3f -> %.3f px off\n",
-              result.check_matches, result.check_before_px, result.check_after_px, before, after);
+  std::printf(
+      "check: %d tracks, %.3f -> %.3f px (one end), %.3f px (both); mesh points %.3f -> "
+      "%.3f px off\n",
+      result.check_matches, result.check_before_px, result.check_one_end_px, result.check_after_px,
+      before, after);
   EXPECT_TRUE(result.applied);
   EXPECT_GT(result.check_matches, 200);
+  // The frame left out keeps its own error, the corrected one loses its: about sqrt(2) better.
+  EXPECT_GT(result.check_before_px, 1.25 * result.check_one_end_px);
   EXPECT_GT(result.check_before_px, 3 * result.check_after_px);
   EXPECT_LT(after, 0.15 * before);
   PoseAdjustOptions unchecked;
@@ -362,6 +370,45 @@ TEST(JointPoseAdjustment, APaintJobPaintsWithTheAdjustedPoses) {
   EXPECT_EQ(held_out[5].translation, given[5].translation);
   EXPECT_EQ(held_out[5].rotation.coeffs(), given[5].rotation.coeffs());
   EXPECT_NE(held_out[6].translation, given[6].translation);
+}
+
+// Real data: the TUM teddy's motion-capture poses are painted best as given (applied, the
+// adjustment loses 0.8 dB at the photos left out: docs/results.md): fitted to the fused mesh's
+// error, the corrections make a frame left out of the estimate agree worse. The check says so
+// on the 110k-triangle crop and on the whole 435k-triangle scene alike, well short of its
+// threshold (a decision that flips between two meshes of one scene is a defect).
+TEST(JointPoseAdjustmentRealData, TheTeddysGivenPosesStandOnItsCropAndOnTheWholeScene) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string data = testing::SharedDataDir() + "/tum-rgbd-fr3-teddy/";
+  std::vector<double> ratios;
+  for (const char* mesh : {"mesh_tsdf_v5mm_teddy_crop.ply", "mesh_tsdf_v10mm.ply"}) {
+    Project project;
+    ASSERT_TRUE(
+        LoadProject(testing::SourceDir() + "/projects/tum-teddy/project.json", {}, &project).ok());
+    project.scene = data + mesh;
+    Capture capture;
+    const Status loaded = LoadCapture(project, CaptureLoadOptions(), &capture);
+    ASSERT_TRUE(loaded.ok()) << loaded.message();
+    std::vector<PoseAdjustFrame> frames;  // the first 32 posed frames, as a run decides on
+    Frame frame;
+    Status read;
+    while (frames.size() < 32 && capture.video->Next(&frame, &read))
+      if (const PosedImage* pose = capture.PoseForFrame(frame))
+        frames.push_back({frame.bgr.clone(), capture.CameraFor(*pose),
+                          CamFromLocal(capture.scene, pose->cam_from_world)});
+    ASSERT_EQ(frames.size(), 32u);
+    PoseAdjustResult result;
+    ASSERT_TRUE(AdjustPosesOnMesh(capture.scene.mesh, frames, PoseAdjustOptions(), &result).ok());
+    std::printf("%s: %d tracks, %.3f -> %.3f px (one end), %.3f px (both)\n", mesh,
+                result.check_matches, result.check_before_px, result.check_one_end_px,
+                result.check_after_px);
+    EXPECT_FALSE(result.applied) << mesh;
+    EXPECT_GT(result.check_matches, 1000) << mesh;
+    ratios.push_back(result.check_before_px / result.check_one_end_px);
+    EXPECT_LT(ratios.back(), 0.95) << mesh;                                  // the threshold is 1.1
+    EXPECT_GT(result.check_before_px, 1.8 * result.check_after_px) << mesh;  // fooled, both ends
+  }
+  EXPECT_NEAR(ratios[0], ratios[1], 0.1);
 }
 
 }  // namespace

@@ -190,6 +190,23 @@ TEST(PaintRun, AFrameWithoutAPoseIsNotDecoded) {
   EXPECT_EQ(shown.status.message().rfind(file + ": ", 0), 0u) << shown.status.message();
 }
 
+// A frame the whole-capture pre-pass decoded is painted from what it decoded, not read again:
+// broken on disk after the job opened, it still paints.
+TEST(PaintRun, AFrameDecodedBeforePaintingIsNotDecodedAgain) {
+  const std::string project_json = MakeBadCapture(BadCapture::kMissingPose);
+  Project project;
+  ASSERT_TRUE(LoadProject(project_json, {}, &project).ok());
+  ASSERT_TRUE(project.pipeline.refine.joint);  // the defaults read the capture before painting
+  std::unique_ptr<PaintJob> job;
+  ASSERT_TRUE(OpenPaintJob(project, PaintJobOptions(), &job).ok());
+  testing::WriteText(fs::path(project_json).parent_path().string() + "/frames/000005.png",
+                     "this is not a PNG");
+  PaintRun run(job->session.get(), job->source.get(), PaintRunOptions());
+  const Status status = RunToEnd(&run, PaintRunHooks());
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(run.stats().frames_painted, 11);  // all but the frame without a pose
+}
+
 // Painting frame by frame, the run ends at the broken frame; with the joint pose adjustment
 // or the background's `auto` and `across_views` (the defaults for captures from files) the
 // capture is read before painting, and the same error comes before any frame is painted.

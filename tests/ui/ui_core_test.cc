@@ -159,6 +159,40 @@ TEST(InputQueue, ATapWithinOneFrameIsSeenOverTwoFrames) {
   EXPECT_EQ(queue.NextFrame(&state), 0);
 }
 
+// Text typed right after a click lands in the frame after the click (the field clicked has
+// the focus by then), and a key pressed after typing comes after the text.
+TEST(InputQueue, TextTypedRightAfterAClickWaitsForTheClickAndKeysForTheText) {
+  InputQueue queue;
+  InputState state;
+  const auto typed = [](unsigned int c) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kChar;
+    e.code = static_cast<int>(c);
+    return e;
+  };
+  queue.Push(Button(true));
+  queue.Push(Button(false));
+  queue.Push(typed('a'));
+  queue.Push(typed('b'));
+  queue.Push(Key('X', true));
+  EXPECT_EQ(queue.NextFrame(&state), 1);  // the press
+  EXPECT_TRUE(state.chars.empty());
+  EXPECT_EQ(queue.NextFrame(&state), 1);  // the release
+  EXPECT_TRUE(state.chars.empty());
+  EXPECT_EQ(queue.NextFrame(&state), 2);  // the text, in order; the key after it waits
+  EXPECT_EQ(state.chars, (std::vector<unsigned int>{'a', 'b'}));
+  EXPECT_FALSE(state.keys_down['X']);
+  EXPECT_EQ(queue.NextFrame(&state), 1);
+  EXPECT_TRUE(state.chars.empty());  // per frame
+  EXPECT_TRUE(state.keys_down['X']);
+  ImGui::CreateContext();
+  state.chars = {'z'};
+  CopyToImGui(state, &ImGui::GetIO());
+  ASSERT_EQ(ImGui::GetIO().InputQueueCharacters.Size, 1);
+  EXPECT_EQ(ImGui::GetIO().InputQueueCharacters[0], 'z');
+  ImGui::DestroyContext();
+}
+
 TEST(InputQueue, AFastDragIsPressMovesAndReleaseInFramesOfTheirOwn) {
   InputQueue queue;
   InputState state;

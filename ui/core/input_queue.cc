@@ -6,9 +6,10 @@ namespace fresco {
 
 int InputQueue::NextFrame(InputState* state) {
   state->wheel_x = state->wheel_y = 0;
+  state->chars.clear();
   std::array<bool, 5> button_changed{};
   std::array<bool, 512> key_changed{};
-  bool any_button_changed = false, any_key_changed = false, moved = false;
+  bool any_button_changed = false, any_key_changed = false, moved = false, typed = false;
   int taken = 0;
   while (!events_.empty()) {
     const InputEvent& e = events_.front();
@@ -32,11 +33,15 @@ int InputQueue::NextFrame(InputState* state) {
         break;
       case InputEvent::Kind::kKey:
         if (e.code < 0 || e.code >= static_cast<int>(state->keys_down.size())) break;
-        take = !key_changed[e.code] && !any_button_changed;
+        take = !key_changed[e.code] && !any_button_changed && !typed;
         if (take && state->keys_down[e.code] != e.down) {
           state->keys_down[e.code] = e.down;
           key_changed[e.code] = any_key_changed = true;
         }
+        break;
+      case InputEvent::Kind::kChar:
+        take = !any_button_changed && !moved;
+        if (take) state->chars.push_back(static_cast<unsigned int>(e.code)), typed = true;
         break;
     }
     if (!take) break;
@@ -59,6 +64,7 @@ void CopyToImGui(const InputState& state, ImGuiIO* io) {
   io->KeyShift = keys[kKeyLeftShift] || keys[kKeyRightShift];
   io->KeyAlt = keys[kKeyLeftAlt] || keys[kKeyRightAlt];
   io->KeySuper = keys[kKeyLeftSuper] || keys[kKeyRightSuper];
+  for (unsigned int c : state.chars) io->AddInputCharacter(c);
 }
 
 }  // namespace fresco

@@ -175,7 +175,12 @@ void InstallQueuedInput(GLFWwindow* window, WindowEvents* events) {
     Events(w)->input.Push(e);
   });
   glfwSetWindowFocusCallback(window, ImGui_ImplGlfw_WindowFocusCallback);
-  glfwSetCharCallback(window, ImGui_ImplGlfw_CharCallback);
+  glfwSetCharCallback(window, [](GLFWwindow* w, unsigned int code_point) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kChar;
+    e.code = static_cast<int>(code_point);
+    Events(w)->input.Push(e);
+  });
 }
 
 // Opens the project named on the command line. False when the app must exit (code 2): the
