@@ -11,7 +11,7 @@ namespace fresco {
 namespace {
 
 // Values this far from black and saturation carry the colour (as the exposure fit's).
-constexpr int kMinValue = 4, kMaxValue = 251;
+constexpr int kMinUsableValue = 4, kMaxUsableValue = 251;
 
 const std::array<float, 256>& LogTable() {
   static const std::array<float, 256> table = [] {
@@ -59,7 +59,8 @@ std::vector<std::vector<float>> CellRatios(const PaintedBuffer& painted, const c
       bool usable = true;
       for (int c = 0; c < 3 && usable; ++c) {
         const int s = sample[idx][c], o = stored[idx][c];
-        usable = s >= kMinValue && s <= kMaxValue && o >= kMinValue && o <= kMaxValue;
+        usable = s >= kMinUsableValue && s <= kMaxUsableValue && o >= kMinUsableValue &&
+                 o <= kMaxUsableValue;
         d[c] = log_of[o] - log_of[s];
         usable = usable && std::abs(d[c]) <= max_log;
       }

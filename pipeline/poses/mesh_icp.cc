@@ -76,7 +76,7 @@ class VoxelHash {
   std::unordered_map<int64_t, std::vector<int>> cells_;
 };
 
-double Median(std::vector<double> v) {
+double MedianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
@@ -138,7 +138,7 @@ void FindPairs(const IcpProblem& problem, const Sim3d& current, Pairs* pairs) {
     pairs->nearest[i] = problem.hash.Nearest(pairs->world[i], &pairs->distance[i]);
     if (pairs->nearest[i] >= 0) pairs->found.push_back(pairs->distance[i]);
   }
-  pairs->cutoff = std::max(3.0 * Median(pairs->found), 1e-3 * problem.spacing);
+  pairs->cutoff = std::max(3.0 * MedianOf(pairs->found), 1e-3 * problem.spacing);
   pairs->centre = Eigen::Vector3d::Zero();
   pairs->count = 0;
   for (size_t i = 0; i < pairs->world.size(); ++i) {
@@ -181,7 +181,7 @@ Status IcpStep(const IcpProblem& problem, Pairs* pairs, Sim3d* current, bool* co
   }
   pairs->centre /= pairs->count;
   const Eigen::Vector3d& centre = pairs->centre;
-  const double huber = std::max(0.5 * Median(pairs->found), 1e-6);
+  const double huber = std::max(0.5 * MedianOf(pairs->found), 1e-6);
   Mat7 a;
   Vec7 b;
   const double spread2 = NormalEquations(problem, *pairs, huber, &a, &b);
@@ -239,7 +239,7 @@ Status AlignPointsToMesh(const std::vector<Eigen::Vector3d>& points_in_colmap, c
   Sim3d current = initial;
   Pairs pairs;
   pairs.world.resize(points_in_colmap.size());
-  result->median_distance_before_m = Median(PlaneDistances(problem, current));
+  result->median_distance_before_m = MedianOf(PlaneDistances(problem, current));
   result->iterations = 0;
   for (int iteration = 0; iteration < options.iterations; ++iteration) {
     bool converged = false;
@@ -247,7 +247,7 @@ Status AlignPointsToMesh(const std::vector<Eigen::Vector3d>& points_in_colmap, c
     if (converged) break;
   }
   result->world_from_colmap = current;
-  result->median_distance_after_m = Median(PlaneDistances(problem, current));
+  result->median_distance_after_m = MedianOf(PlaneDistances(problem, current));
   return Status::Ok();
 }
 

@@ -18,7 +18,7 @@
 namespace fresco {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 RenderOptions MakeRenderOptions(const SynthOptions& options) {
   RenderOptions r;
@@ -148,7 +148,7 @@ Status PlanSynthCapture(const Scene& scene, const SynthOptions& options, SynthCa
   // Given poses: rotation noise about a random axis (per-axis sigma so that the RMS angle is
   // pose_noise_deg), camera-centre noise in a random direction (RMS pose_noise_m).
   SynthRandom pose_random(options.seed, 21);
-  const double sigma_r = options.pose_noise_deg * kDegToRad / std::sqrt(3.0);
+  const double sigma_r = options.pose_noise_deg * kRadiansPerDegree / std::sqrt(3.0);
   const double sigma_t = options.pose_noise_m / std::sqrt(3.0);
   for (const PosedImage& truth : plan->true_poses) {
     PosedImage given = truth;
