@@ -409,8 +409,11 @@ void PrintJobSummary(const PaintJob& job, size_t streams) {
                  "ones agrees %.3f -> %.3f px (%d tracks, %.1f s): %s",
                  on.c_str(), a.check_before_px, a.check_one_end_px, a.check_matches,
                  a.check_seconds, a.applied ? "applied" : "not applied");
-    if (!a.applied)
-      std::fprintf(stderr, " (not %.1f times better)\n", PoseAdjustOptions().check_min_improvement);
+    const double needed = PoseAdjustOptions().check_min_improvement;
+    if (!a.applied && a.check_one_end_px > 0 && a.check_before_px >= needed * a.check_one_end_px)
+      std::fprintf(stderr, " (no tracks to adjust every pose from)\n");
+    else if (!a.applied)
+      std::fprintf(stderr, " (not %.1f times better)\n", needed);
     if (a.applied)
       std::fprintf(stderr, "; %d tracks, RMS %.3f -> %.3f px, median correction %.3f deg, %.1f mm (%.1f s)\n",
                    a.inliers, a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
