@@ -32,6 +32,12 @@ std::string AutoDecision::Describe() const {
                   "off: the mean of every view without the model scores %+.2f dB against the "
                   "best with it on %d frames held out (decided at frame %d)",
                   evidence, frames_measured, decided_at_frame);
+  else if (basis == "held_out_poses")
+    std::snprintf(line, sizeof line,
+                  "off: the first frames look misaligned, but frames left out of the pose "
+                  "corrections agree %.2f times better with the corrected frames (%.2f needed; "
+                  "%d frames; decided at frame %d)",
+                  evidence, threshold, frames_measured, decided_at_frame);
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
                   "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
@@ -105,7 +111,19 @@ bool RefineAutoDecider::AddFrame(int frame_number, double misalignment_px) {
   decision_.state = decision_.evidence > decision_.threshold ? AutoDecision::State::kOn
                                                              : AutoDecision::State::kOff;
   decision_.decided_at_frame = frame_number;
+  if (decision_.state == AutoDecision::State::kOn && pose_check_.frames >= 0 &&
+      pose_check_.ratio < pose_check_.threshold) {
+    decision_.state = AutoDecision::State::kOff;
+    decision_.basis = "held_out_poses";
+    decision_.evidence = pose_check_.ratio;
+    decision_.threshold = pose_check_.threshold;
+    decision_.frames_measured = pose_check_.frames;
+  }
   return true;
+}
+
+void RefineAutoDecider::SetPoseCheck(double ratio, double threshold, int frames) {
+  pose_check_ = {ratio, threshold, frames};
 }
 
 void RefineAutoDecider::DecideOff(int frame_number) {

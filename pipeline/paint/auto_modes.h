@@ -71,12 +71,22 @@ class RefineAutoDecider {
   bool AddFrame(int frame_number, double misalignment_px);
   // Decides now (off) without evidence, e.g. when view selection excludes refinement.
   void DecideOff(int frame_number);
+  // The joint pose adjustment's check, before painting (joint_pose_adjustment.h): frames left
+  // out of the pose corrections agree `ratio` times better with the corrected frames, over
+  // `frames` frames. Below `threshold` it vetoes `on`: where the misalignment measured says on,
+  // the decision is off (basis "held_out_poses", evidence the ratio): a correction of the same
+  // kind, per frame, would not make the frames agree better either. Kept through Start.
+  void SetPoseCheck(double ratio, double threshold, int frames);
   const AutoDecision& decision() const { return decision_; }
   bool deciding() const { return decision_.state == AutoDecision::State::kDeciding; }
 
  private:
   AutoDecision decision_;
   std::vector<double> samples_;
+  struct PoseCheck {
+    double ratio = 0, threshold = 0;
+    int frames = -1;  // < 0: none
+  } pose_check_;
 };
 
 // Collects the background evidence frame by frame and decides once.

@@ -177,6 +177,10 @@ void PaintSession::DecideBackgroundAcrossViews(double fraction, int frames) {
   UpdateOwnOnly();
 }
 
+void PaintSession::SetRefinePoseCheck(double ratio, double threshold, int frames) {
+  refine_auto_.SetPoseCheck(ratio, threshold, frames);
+}
+
 void PaintSession::SetOwnBuffers(std::vector<bool> own) {
   if (!own.empty() && own.size() != set_.buffers.size())
     throw std::invalid_argument("PaintSession::SetOwnBuffers: " + std::to_string(own.size()) +

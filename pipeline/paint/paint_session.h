@@ -138,6 +138,11 @@ class PaintSession {
   // (`fraction` of the pixels judged over `frames` frames masked; mover_masks.h) instead of
   // frame by frame. Kept through ResetPainting.
   void DecideBackgroundAcrossViews(double fraction, int frames);
+  // refine.mode auto, before the first frame: the joint pose adjustment's check (frames left
+  // out of the corrections agree `ratio` times better with the corrected frames, over
+  // `frames` frames), which below `threshold` keeps refinement off
+  // (RefineAutoDecider::SetPoseCheck). Kept through ResetPainting.
+  void SetRefinePoseCheck(double ratio, double threshold, int frames);
   AutoDecisions auto_decisions() const {
     return {refine_auto_.decision(), background_auto_.decision(), update_auto_};
   }

@@ -111,7 +111,10 @@ struct AutoDecision {
 };
 
 struct AutoDecisions {
-  AutoDecision refine;  // evidence: median misalignment of the first frames, texels
+  // evidence: median misalignment of the first frames, texels; or (basis "held_out_poses",
+  // decided off before painting) how many times better frames left out of the joint pose
+  // adjustment agree with the corrected frames (joint_pose_adjustment.h)
+  AutoDecision refine;
   // evidence: the share of the pixels masked across views (basis "across_views"), or the
   // foreground fraction of the warmed-up texels ("texels")
   AutoDecision background;

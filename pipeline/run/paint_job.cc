@@ -152,6 +152,13 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     PoseAdjustResult adjusted;
     FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(j->scene().mesh, frames, adjust_options, &adjusted));
     j->joint_poses = adjusted;
+    // Where the check found corrections that frames left out do not agree better with,
+    // refinement (a correction of the same kind, per frame) is not switched on either.
+    if (adjusted.not_run.empty() && adjust_options.check_min_improvement > 0 &&
+        adjusted.check_one_end_px > 0)
+      j->session->SetRefinePoseCheck(adjusted.check_before_px / adjusted.check_one_end_px,
+                                     adjust_options.check_min_improvement,
+                                     adjusted.decided_on_frames);
     cam_from_local = adjusted.cam_from_local;
     const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
     for (size_t k = 0; k < where.size(); ++k)

@@ -189,8 +189,10 @@ TEST(AutoBackground, GrowthIsNoEvidence) {
 
 // The evidence is the misalignment a pose correction removes, not the residual: movers and
 // exposure changes leave a residual at exact poses that no correction explains, while a few
-// centimetres of camera-centre noise (no rotation noise) is explained by one.
-AutoDecision RefineDecision(double exposure_jitter, double pose_noise_m, double* residual_px) {
+// centimetres of camera-centre noise (no rotation noise) is explained by one. `pose_check`
+// >= 0: the joint pose adjustment's check ratio the session is given before painting.
+AutoDecision RefineDecision(double exposure_jitter, double pose_noise_m, double* residual_px,
+                            double pose_check = -1) {
   const Scene scene = RoomScene();
   SynthOptions o = RoomCaptureWithMovers(20, exposure_jitter);
   o.pose_noise_m = pose_noise_m;
@@ -200,6 +202,7 @@ AutoDecision RefineDecision(double exposure_jitter, double pose_noise_m, double*
   options.refine.mode = RefineMode::kAuto;
   options.background.mode = BackgroundMode::kRobust;
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
+  if (pose_check >= 0) session->SetRefinePoseCheck(pose_check, 1.1, 20);
   FrameReport report;
   std::vector<double> residuals;
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
@@ -231,6 +234,41 @@ TEST(AutoRefine, MoversAndExposureAreNotTakenForPoseErrorCentreNoiseIs) {
   const AutoDecision noisy = RefineDecision(0.15, 0.01, &residual);
   EXPECT_EQ(noisy.state, State::kOn);
   EXPECT_GT(noisy.evidence, 2 * kRefineAutoThresholdPx);
+}
+
+// The joint pose adjustment's check on frames left out of its corrections vetoes `on`: where
+// they do not agree 1.1 times better with the corrected frames (a mesh's error, exact poses),
+// misalignment measured on the first frames does not switch a per-frame correction on; where
+// they do, it decides as before.
+TEST(AutoRefine, APoseCheckThatFramesLeftOutFailKeepsItOff) {
+  double residual = 0;
+  const AutoDecision vetoed = RefineDecision(0.15, 0.01, &residual, 0.87);
+  EXPECT_EQ(vetoed.state, State::kOff);
+  EXPECT_EQ(vetoed.basis, "held_out_poses");
+  EXPECT_DOUBLE_EQ(vetoed.evidence, 0.87);
+  EXPECT_DOUBLE_EQ(vetoed.threshold, 1.1);
+  EXPECT_EQ(vetoed.frames_measured, 20);
+  EXPECT_GT(vetoed.decided_at_frame, 0);
+  const AutoDecision passed = RefineDecision(0.15, 0.01, &residual, 1.4);
+  EXPECT_EQ(passed.state, State::kOn);
+  EXPECT_EQ(passed.basis, "");
+  EXPECT_GT(passed.evidence, 2 * kRefineAutoThresholdPx);
+  // Measured below the threshold: off as before, on the misalignment.
+  RefineAutoDecider aligned;
+  aligned.SetPoseCheck(0.87, 1.1, 20);
+  aligned.Start(true);  // the check is kept through Start
+  for (int f = 1; f <= kRefineAutoFrames; ++f) aligned.AddFrame(f, 0.05);
+  EXPECT_EQ(aligned.decision().state, State::kOff);
+  EXPECT_EQ(aligned.decision().basis, "");
+  RefineAutoDecider misaligned;
+  misaligned.SetPoseCheck(0.87, 1.1, 20);
+  misaligned.Start(true);
+  for (int f = 1; f <= kRefineAutoFrames; ++f) misaligned.AddFrame(f, 0.6);
+  EXPECT_EQ(misaligned.decision().state, State::kOff);
+  EXPECT_EQ(misaligned.decision().Describe(),
+            "off: the first frames look misaligned, but frames left out of the pose corrections "
+            "agree 0.87 times better with the corrected frames (1.10 needed; 20 frames; decided "
+            "at frame 6)");
 }
 
 TEST(AutoRefine, FramesThatCannotBeRegisteredDecideOffEarly) {
