@@ -547,6 +547,27 @@ TEST(UiInput, AProjectWithAMovedVideoIsRepairedInTheProjectPanelAndOpens) {
   EXPECT_EQ(app.state.recent.front(), bad);
 }
 
+// A project that did not open beside one still open: the Project panel says which one the
+// other panels show, and "Keep the open project" puts the failed one's paths aside.
+TEST(UiInput, AFailedOpenSaysWhichProjectTheOtherPanelsShow) {
+  App app(0);
+  const std::string bad = BrokenCopy(app), good = app.dir + "/capture/project.json";
+  app.ui.layout.ToggleMaximised("Project");  // room for the editor and what follows it
+  RequestOpen(app.ui, bad);
+  app.Frames(2);
+  ASSERT_TRUE(app.state.has_unopened);
+  EXPECT_EQ(app.ReportOf("Project", "paths of"), bad);
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/broken/frames/");
+  Activate(app, "Project", "Keep the open project");
+  app.Frame();
+  EXPECT_FALSE(app.state.has_unopened);
+  EXPECT_EQ(app.state.project.file_path, good);
+  // The path editor is the open project's again, as every other panel is.
+  EXPECT_EQ(app.ReportOf("Project", "paths of"), good);
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/capture/frames/");
+  EXPECT_EQ(testing::ReadText(bad).find("frames-moved"), std::string::npos) << "nothing written";
+}
+
 TEST(UiInput, APathEditOfTheOpenProjectIsSavedRepaintedAndUndone) {
   App app(2);
   const std::string file = app.dir + "/capture/project.json";
