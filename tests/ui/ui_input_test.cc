@@ -327,6 +327,32 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
 
 // Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
 // where the seek goes and how far it got, never a bare "frame -1".
+// A long step before painting (here the joint adjustment of the poses) says, beside how far
+// it got, how long it has run and, once that can be told, about how long is left.
+TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
+  std::mutex mutex;
+  std::vector<std::string> statuses;
+  RunnerOptions options;
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    statuses.push_back(s.status);
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  state.project.pipeline.refine.joint = true;
+  PipelineRunner runner(options);
+  runner.Restart(state.project);
+  runner.WaitIdle();
+  std::lock_guard<std::mutex> lock(mutex);
+  int adjusting = 0;
+  for (const std::string& status : statuses) {
+    if (status.rfind("adjusting poses ", 0) != 0) continue;
+    ++adjusting;
+    EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
+  }
+  EXPECT_GT(adjusting, 0) << "the joint adjustment published its progress";
+}
+
 TEST(UiInput, SeekingBackPublishesItsProgress) {
   struct Seen {
     int seek_target, frame;

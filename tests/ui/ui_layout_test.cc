@@ -278,6 +278,28 @@ TEST(UiLayout, FontScaleStepsFromTheStatusBarNotTheViewMenu) {
   EXPECT_EQ(app.ui.scale.user, 1.0f);
 }
 
+// Six Ctrl+key chords typed faster than the frames, in the order xdotool sends them (Ctrl
+// released before the key), all queued before the next frame: each one arrives.
+TEST(UiLayout, SixFastCtrlChordsAllArrive) {
+  LayoutApp app({1280, 800});
+  InputQueue queue;
+  const auto key = [&](int code, bool down) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kKey;
+    e.code = code;
+    e.down = down;
+    queue.Push(e);
+  };
+  for (int k : {'-', '=', '=', '=', '=', '='}) {
+    key(kKeyLeftControl, true);
+    key(k, true);
+    key(kKeyLeftControl, false);
+    key(k, false);
+  }
+  app.Drain(&queue);
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "0.75 after Ctrl+-, then five steps up";
+}
+
 // At the largest font scale on a 1280 x 800 window the Grouping panel keeps its table and
 // sliders readable: each column as wide as its header (the table scrolls sideways instead),
 // and the sliders wide enough for their values (their labels above them when the panel is
