@@ -300,6 +300,31 @@ TEST(UiLayout, SixFastCtrlChordsAllArrive) {
   EXPECT_EQ(app.ui.scale.user, 2.0f) << "0.75 after Ctrl+-, then five steps up";
 }
 
+// Six Ctrl+key chords whose Ctrl is let go right after the key goes down, as fast typing
+// and xdotool do: Ctrl's press reaches one frame, the key's press and Ctrl's release the
+// next. Each chord applies (Ctrl was seen released in the frame its key went down).
+TEST(UiLayout, ACtrlChordLetGoCtrlFirstWithinAFrameStillApplies) {
+  LayoutApp app({1280, 800});
+  InputQueue queue;
+  const auto key = [&](int code, bool down) {
+    InputEvent e;
+    e.kind = InputEvent::Kind::kKey;
+    e.code = code;
+    e.down = down;
+    queue.Push(e);
+  };
+  for (int k : {'-', '=', '=', '=', '=', '='}) {
+    key(kKeyLeftControl, true);
+    queue.NextFrame(&app.input);  // Ctrl's press, a frame before the rest arrives
+    app.Frame();
+    key(k, true);
+    key(kKeyLeftControl, false);
+    key(k, false);
+    app.Drain(&queue);
+  }
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "0.75 after Ctrl+-, then five steps up";
+}
+
 // At the largest font scale on a 1280 x 800 window the Grouping panel keeps its table and
 // sliders readable: each column as wide as its header (the table scrolls sideways instead),
 // and the sliders wide enough for their values (their labels above them when the panel is
