@@ -278,18 +278,21 @@ TEST(UiLayout, FontScaleStepsFromTheStatusBarNotTheViewMenu) {
   EXPECT_EQ(app.ui.scale.user, 1.0f);
 }
 
+// A key's press or release, as the window's callback queues it.
+void PushKey(InputQueue* queue, int code, bool down) {
+  InputEvent e;
+  e.kind = InputEvent::Kind::kKey;
+  e.code = code;
+  e.down = down;
+  queue->Push(e);
+}
+
 // Six Ctrl+key chords typed faster than the frames, in the order xdotool sends them (Ctrl
 // released before the key), all queued before the next frame: each one arrives.
 TEST(UiLayout, SixFastCtrlChordsAllArrive) {
   LayoutApp app({1280, 800});
   InputQueue queue;
-  const auto key = [&](int code, bool down) {
-    InputEvent e;
-    e.kind = InputEvent::Kind::kKey;
-    e.code = code;
-    e.down = down;
-    queue.Push(e);
-  };
+  const auto key = [&](int code, bool down) { PushKey(&queue, code, down); };
   for (int k : {'-', '=', '=', '=', '=', '='}) {
     key(kKeyLeftControl, true);
     key(k, true);
@@ -306,13 +309,7 @@ TEST(UiLayout, SixFastCtrlChordsAllArrive) {
 TEST(UiLayout, ACtrlChordLetGoCtrlFirstWithinAFrameStillApplies) {
   LayoutApp app({1280, 800});
   InputQueue queue;
-  const auto key = [&](int code, bool down) {
-    InputEvent e;
-    e.kind = InputEvent::Kind::kKey;
-    e.code = code;
-    e.down = down;
-    queue.Push(e);
-  };
+  const auto key = [&](int code, bool down) { PushKey(&queue, code, down); };
   for (int k : {'-', '=', '=', '=', '=', '='}) {
     key(kKeyLeftControl, true);
     queue.NextFrame(&app.input);  // Ctrl's press, a frame before the rest arrives
