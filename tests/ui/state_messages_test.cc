@@ -1,6 +1,8 @@
 // Messages true to the state, the app driven headless (issue 58, item 6). Also there: a
 // fold-over status line goes with its Undo (UiInput.GroupColoursStayAcrossEdits...) and
 // undo says what it changed back (CameraAttach.*).
+#include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -13,6 +15,7 @@ namespace fresco {
 namespace {
 
 using testing::HeadlessApp;
+namespace fs = std::filesystem;
 
 // A stage panel without a debug image says why, true to the worker's state (issue 58, item
 // 6): never "they appear when paused" while paused with none shown.
@@ -50,6 +53,52 @@ TEST(StateMessages, AStagePanelSaysWhyItShowsNoDebugImage) {
   if (paused->report_has_images) {
     EXPECT_NE(app.ReportOf(depth, "image"), "");
   }
+}
+
+// The calibration light is never green before the two-camera check has seen the views: not
+// while the images are still being detected, not while the check runs; green after it.
+TEST(StateMessages, TheCalibrationLightIsNotGreenBeforeTheOneCameraCheck) {
+  FRESCO_REQUIRE_SHARED_DATA();
+  const std::string dir = testing::MakeTempDir("ui-light") + "/left";
+  fs::create_directories(dir);
+  for (const auto& e :
+       fs::directory_iterator(testing::SharedDataDir() + "/opencv-chessboard-stereo"))
+    if (e.path().filename().string().rfind("left", 0) == 0 && e.path().extension() == ".jpg")
+      fs::copy(e.path(), dir + "/" + e.path().filename().string());
+  CalibrationRunner runner;
+  testing::NullTextures textures;
+  UiContext ui{nullptr, nullptr, &runner, &textures, nullptr, nullptr, false};
+  testing::ImGuiHeadless imgui;
+  std::unique_ptr<Panel> panel;
+  for (auto& p : MakePanels())
+    if (std::string(p->Title()) == kCalibrationPanelTitle) panel = std::move(p);
+  ASSERT_TRUE(panel);
+  calib::CalibrateRequest request;
+  request.images_dir = dir;
+  ASSERT_TRUE(calib::ParseBoardSpec("chessboard:9x6:0.025", "board", &request.board).ok());
+  request.model = "opencv4";
+  runner.Detect(request);
+  // The panel drawn as the app draws it while the worker detects and checks.
+  int detecting = 0, checking = 0;
+  std::string green_while;  // the first status shown with a green light before the end
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(2);
+  std::map<std::string, std::string> report;
+  while (std::chrono::steady_clock::now() < deadline) {
+    testing::ImGuiHeadless::DrawPanel(ui, *panel, ImVec2(900, 1400));
+    report = panel->Report();
+    const std::string& status = report["status"];
+    if (status.rfind("detected", 0) == 0) break;
+    const bool working = status.rfind("detecting", 0) == 0 || status.rfind("checking", 0) == 0;
+    detecting += status.rfind("detecting", 0) == 0;
+    checking += status.rfind("checking", 0) == 0;
+    if (working && report["readiness"] == "green" && green_while.empty()) green_while = status;
+  }
+  EXPECT_EQ(green_while, "") << "green with " << report["views"] << " views";
+  EXPECT_GT(detecting, 0);
+  EXPECT_EQ(report["views"], "13");
+  EXPECT_EQ(report["camera_doubts"], "0");
+  EXPECT_EQ(report["readiness"], "green") << "after the check";
+  std::printf("frames drawn while detecting %d, while checking %d\n", detecting, checking);
 }
 
 }  // namespace

@@ -327,6 +327,32 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
 
 // Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
 // where the seek goes and how far it got, never a bare "frame -1".
+// A long step before painting (here the joint adjustment of the poses) says, beside how far
+// it got, how long it has run and, once that can be told, about how long is left.
+TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
+  std::mutex mutex;
+  std::vector<std::string> statuses;
+  RunnerOptions options;
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    statuses.push_back(s.status);
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  state.project.pipeline.refine.joint = true;
+  PipelineRunner runner(options);
+  runner.Restart(state.project);
+  runner.WaitIdle();
+  std::lock_guard<std::mutex> lock(mutex);
+  int adjusting = 0;
+  for (const std::string& status : statuses) {
+    if (status.rfind("adjusting poses ", 0) != 0) continue;
+    ++adjusting;
+    EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
+  }
+  EXPECT_GT(adjusting, 0) << "the joint adjustment published its progress";
+}
+
 TEST(UiInput, SeekingBackPublishesItsProgress) {
   struct Seen {
     int seek_target, frame;
@@ -545,6 +571,27 @@ TEST(UiInput, AProjectWithAMovedVideoIsRepairedInTheProjectPanelAndOpens) {
   EXPECT_EQ(app.state.message, "opened " + bad) << "the worker read it";
   ASSERT_FALSE(app.state.recent.empty());
   EXPECT_EQ(app.state.recent.front(), bad);
+}
+
+// A project that did not open beside one still open: the Project panel says which one the
+// other panels show, and "Keep the open project" puts the failed one's paths aside.
+TEST(UiInput, AFailedOpenSaysWhichProjectTheOtherPanelsShow) {
+  App app(0);
+  const std::string bad = BrokenCopy(app), good = app.dir + "/capture/project.json";
+  app.ui.layout.ToggleMaximised("Project");  // room for the editor and what follows it
+  RequestOpen(app.ui, bad);
+  app.Frames(2);
+  ASSERT_TRUE(app.state.has_unopened);
+  EXPECT_EQ(app.ReportOf("Project", "paths of"), bad);
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/broken/frames/");
+  Activate(app, "Project", "Keep the open project");
+  app.Frame();
+  EXPECT_FALSE(app.state.has_unopened);
+  EXPECT_EQ(app.state.project.file_path, good);
+  // The path editor is the open project's again, as every other panel is.
+  EXPECT_EQ(app.ReportOf("Project", "paths of"), good);
+  EXPECT_EQ(app.ReportOf("Project", "video"), app.dir + "/capture/frames/");
+  EXPECT_EQ(testing::ReadText(bad).find("frames-moved"), std::string::npos) << "nothing written";
 }
 
 TEST(UiInput, APathEditOfTheOpenProjectIsSavedRepaintedAndUndone) {

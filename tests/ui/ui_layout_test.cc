@@ -278,5 +278,83 @@ TEST(UiLayout, FontScaleStepsFromTheStatusBarNotTheViewMenu) {
   EXPECT_EQ(app.ui.scale.user, 1.0f);
 }
 
+// A key's press or release, as the window's callback queues it.
+void PushKey(InputQueue* queue, int code, bool down) {
+  InputEvent e;
+  e.kind = InputEvent::Kind::kKey;
+  e.code = code;
+  e.down = down;
+  queue->Push(e);
+}
+
+// Six Ctrl+key chords typed faster than the frames, in the order xdotool sends them (Ctrl
+// released before the key), all queued before the next frame: each one arrives.
+TEST(UiLayout, SixFastCtrlChordsAllArrive) {
+  LayoutApp app({1280, 800});
+  InputQueue queue;
+  const auto key = [&](int code, bool down) { PushKey(&queue, code, down); };
+  for (int k : {'-', '=', '=', '=', '=', '='}) {
+    key(kKeyLeftControl, true);
+    key(k, true);
+    key(kKeyLeftControl, false);
+    key(k, false);
+  }
+  app.Drain(&queue);
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "0.75 after Ctrl+-, then five steps up";
+}
+
+// Six Ctrl+key chords whose Ctrl is let go right after the key goes down, as fast typing
+// and xdotool do: Ctrl's press reaches one frame, the key's press and Ctrl's release the
+// next. Each chord applies (Ctrl was seen released in the frame its key went down).
+TEST(UiLayout, ACtrlChordLetGoCtrlFirstWithinAFrameStillApplies) {
+  LayoutApp app({1280, 800});
+  InputQueue queue;
+  const auto key = [&](int code, bool down) { PushKey(&queue, code, down); };
+  for (int k : {'-', '=', '=', '=', '=', '='}) {
+    key(kKeyLeftControl, true);
+    queue.NextFrame(&app.input);  // Ctrl's press, a frame before the rest arrives
+    app.Frame();
+    key(k, true);
+    key(kKeyLeftControl, false);
+    key(k, false);
+    app.Drain(&queue);
+  }
+  EXPECT_EQ(app.ui.scale.user, 2.0f) << "0.75 after Ctrl+-, then five steps up";
+}
+
+// At the largest font scale on a 1280 x 800 window the Grouping panel keeps its table and
+// sliders readable: each column as wide as its header (the table scrolls sideways instead),
+// and the sliders wide enough for their values (their labels above them when the panel is
+// too narrow for both); the Pipeline panel's settings too.
+TEST(UiLayout, AtTheLargestFontScaleTheGroupingTableAndSlidersKeepTheirText) {
+  LayoutApp app({1280, 800});
+  app.ui.scale.user = kFontScaleSteps[std::size(kFontScaleSteps) - 1];
+  app.Frames(4);
+  const float em = ImGui::GetFontSize();
+  ASSERT_NEAR(em, 26, 0.5f);
+  ImGuiWindow* grouping = LayoutApp::Window("Grouping");
+  ImGuiTable* table = ImGui::TableFindByID(grouping->GetID("groups"));
+  ASSERT_NE(table, nullptr);
+  // Scrolled down the panel until the table is drawn (below the sliders and messages).
+  for (float y = 0; y <= grouping->ScrollMax.y && table->LastFrameActive < ImGui::GetFrameCount();
+       y += 100) {
+    ImGui::SetScrollY(grouping, y);
+    app.Frames(3);
+  }
+  ASSERT_EQ(table->LastFrameActive, ImGui::GetFrameCount()) << "the table is drawn";
+  const char* headers[] = {"group", "triangles", "texels", "texel m"};
+  for (int c = 0; c < table->ColumnsCount; ++c)
+    for (int c = 0; c < table->ColumnsCount; ++c)
+      EXPECT_GE(table->Columns[c].WidthGiven, ImGui::CalcTextSize(headers[c]).x)
+          << headers[c] << " cut in a " << grouping->Size.x << " px panel";
+  EXPECT_GE(std::stof(app.ReportOf("Grouping", "angle slider px")), 5 * em);  // "90.0" and room
+  EXPECT_LE(std::stof(app.ReportOf("Grouping", "angle slider px")),
+            grouping->ContentRegionRect.GetWidth() + 0.5f);
+  // The same at the default scale: the labels stay beside their sliders.
+  app.ui.scale.user = 1;
+  app.Frames(4);
+  EXPECT_GE(std::stof(app.ReportOf("Grouping", "angle slider px")), 5 * 13.0f);
+}
+
 }  // namespace
 }  // namespace fresco

@@ -95,11 +95,17 @@ void CalibrationRunner::UpdateReadiness() {
                                           calib::SeedCalibration(run.views, working_.request.board,
                                                                  run.width, run.height, &seed)
                                               .ok());
+  // Until the split test has seen these views the light is not green: one doubt more.
+  std::vector<std::string> doubts = run.camera_doubts;
+  if (!cameras_checked_ && static_cast<int>(run.views.size()) >= calib::kMinViews)
+    doubts.push_back(working_.images_done < static_cast<int>(working_.images.size())
+                         ? "one camera? checked after the last image is detected"
+                         : "one camera? being checked now");
   working_.readiness = calib::AssessReadiness(run.views, run.width, run.height,
                                               working_.solved ? &run.seed
                                               : seeded        ? &seed
                                                               : nullptr,
-                                              run.camera_doubts);
+                                              doubts);
   if (!run.views.empty()) working_.coverage_picture = calib::DrawCoverage(run);
 }
 
@@ -110,6 +116,7 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
   working_.has_request = true;
   working_.request = request;
   working_.busy = true;
+  cameras_checked_ = false;
   std::vector<std::string> paths;
   if (Status s = calib::ListImages(request.images_dir, &paths); !s.ok()) {
     working_.status = "error: " + s.message();
@@ -157,8 +164,11 @@ void CalibrationRunner::RunDetect(const calib::CalibrateRequest& request) {
 void CalibrationRunner::CheckOneCamera() {
   working_.status =
       "checking that the " + std::to_string(working_.run.views.size()) + " images are one camera's";
+  cameras_checked_ = false;
+  UpdateReadiness();
   Publish();
   calib::CheckOneCameraBeforeSolving(working_.request, &working_.run);
+  cameras_checked_ = true;
 }
 
 void CalibrationRunner::RebuildViews() {
@@ -196,7 +206,10 @@ void CalibrationRunner::RunExclude(const std::string& name, bool excluded) {
     for (const Command& later : queue_)
       more_queued |= later.kind == Command::kExclude || later.kind == Command::kInclude;
   }
-  if (!more_queued) CheckOneCamera();
+  if (more_queued)
+    cameras_checked_ = false;  // checked after the last one
+  else
+    CheckOneCamera();
   UpdateReadiness();
   working_.status = (excluded ? "excluded " : "included ") + name + ": " +
                     std::to_string(working_.run.views.size()) + " images used; solve again";
@@ -239,6 +252,7 @@ void CalibrationRunner::RunSolve() {
   }
   working_.run = std::move(run);
   working_.solved = true;
+  cameras_checked_ = true;  // the solve ran the split test with the chosen model
   working_.residuals_picture = calib::DrawResiduals(working_.run);
   working_.uncertainty_picture = calib::DrawUncertainty(working_.run);
   UpdateReadiness();

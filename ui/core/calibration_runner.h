@@ -98,6 +98,9 @@ class CalibrationRunner {
   std::atomic<bool> cancel_{false};
   std::shared_ptr<const CalibrationSnapshot> snapshot_;
   CalibrationSnapshot working_;  // worker only
+  // The split test has run on the views as they are (worker only): until then the light is
+  // never green, whatever the views' count and coverage.
+  bool cameras_checked_ = false;
   std::thread thread_;
 };
 

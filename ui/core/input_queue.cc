@@ -4,12 +4,19 @@
 
 namespace fresco {
 
+namespace {
+
+bool IsModifier(int code) { return code >= kKeyLeftShift && code <= kKeyRightSuper; }
+
+}  // namespace
+
 int InputQueue::NextFrame(InputState* state) {
   state->wheel_x = state->wheel_y = 0;
   state->chars.clear();
   std::array<bool, 5> button_changed{};
   std::array<bool, 512> key_changed{};
   bool any_button_changed = false, any_key_changed = false, moved = false, typed = false;
+  bool other_key_pressed = false;  // a key that is not a modifier went down
   int taken = 0;
   while (!events_.empty()) {
     const InputEvent& e = events_.front();
@@ -33,10 +40,12 @@ int InputQueue::NextFrame(InputState* state) {
         break;
       case InputEvent::Kind::kKey:
         if (e.code < 0 || e.code >= static_cast<int>(state->keys_down.size())) break;
-        take = !key_changed[e.code] && !any_button_changed && !typed;
+        take = !key_changed[e.code] && !any_button_changed && !typed &&
+               !(IsModifier(e.code) && other_key_pressed);
         if (take && state->keys_down[e.code] != e.down) {
           state->keys_down[e.code] = e.down;
           key_changed[e.code] = any_key_changed = true;
+          other_key_pressed |= e.down && !IsModifier(e.code);
         }
         break;
       case InputEvent::Kind::kChar:

@@ -46,8 +46,10 @@ class InputQueue {
   // second time, a button would change after the mouse moved, the mouse would move after a
   // button or key changed, or a key would change after a button changed (so a press, each
   // drag step and the release land in frames of their own, at the positions they happened,
-  // and a ctrl-click's release still sees ctrl held). Typed text waits after a button changed
-  // or the mouse moved (a click into a field moves the focus first: the text lands in the
+  // and a ctrl-click's release still sees ctrl held), or a modifier (Ctrl, Shift, Alt, Super)
+  // would change after another key went down (a chord whose Ctrl is let go right after its
+  // key still has Ctrl held in the frame its key goes down). Typed text waits after a button
+  // changed or the mouse moved (a click into a field moves the focus first: the text lands in the
   // field clicked, not the one before), and a key waits after typed text (as typed). The
   // wheel is this frame's sum.
   // Returns how many events this frame took; the rest stay queued.

@@ -151,6 +151,12 @@ std::string FrameLabel(const RunnerSnapshot& snap);
 // SameLine only when an item `next_width` wide fits after the last one (else a new line).
 void FitNextItem(const char* following = nullptr, float min_px = 40);
 void SameLineIfFits(float next_width);
+// A labelled widget (slider, drag, combo) that keeps its value readable in a narrow panel or
+// at a large font scale: when the width it has beside its label (CalcItemWidth) is less than
+// kMinFieldEm font sizes, `label` goes on a line of its own above and the widget takes the
+// whole width. Returns the label to pass to the widget ("##" + label when it went above).
+inline constexpr float kMinFieldEm = 5;
+std::string FitLabelledItem(const std::string& label);
 float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);

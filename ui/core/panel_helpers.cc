@@ -100,6 +100,14 @@ void FitNextItem(const char* following, float min_px) {
   ImGui::SetNextItemWidth(std::max(min_px, width));
 }
 
+std::string FitLabelledItem(const std::string& label) {
+  if (ImGui::CalcItemWidth() >= kMinFieldEm * ImGui::GetFontSize()) return label;
+  const size_t hidden = label.find("##");
+  ImGui::TextUnformatted(label.substr(0, hidden).c_str());
+  ImGui::SetNextItemWidth(ImGui::GetContentRegionAvail().x);
+  return hidden == std::string::npos ? "##" + label : label.substr(hidden);
+}
+
 void SameLineIfFits(float next_width) {
   const float x = ImGui::GetItemRectMax().x + ImGui::GetStyle().ItemSpacing.x;
   if (x + next_width <= ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x)

@@ -15,6 +15,7 @@
 #include "pipeline/render/renderer.h"
 #include "pipeline/run/frame_policy.h"
 #include "pipeline/run/paint_job.h"
+#include "ui/core/job_estimate.h"
 
 namespace fresco {
 
@@ -155,11 +156,18 @@ void PipelineRunner::OpenSession(const Project& project) {
   PaintJobOptions job_options;
   job_options.poll_ms = options_.live_poll_ms;
   job_options.read_frames_without_pose = true;  // shown while playing
+  // Each step before painting says how far it got, how long it has run and, once that can
+  // be told, about how long is left (at its pace so far).
   const auto progress = [this](const char* what) {
-    return [this, what](int done, int total, const std::string&) {
+    auto started = std::make_shared<Clock::time_point>();
+    return [this, what, started](int done, int total, const std::string&) {
+      if (*started == Clock::time_point()) *started = Clock::now();
+      const double elapsed_s = std::chrono::duration<double>(Clock::now() - *started).count();
+      const double fraction = total > 0 ? static_cast<double>(done) / total : 0;
       // A seek back reopens the project: its progress stays a seek's.
       working_.status = std::string(seek_target_ >= 0 ? "seeking: " : "") + what + " " +
-                        std::to_string(done) + "/" + std::to_string(total);
+                        std::to_string(done) + "/" + std::to_string(total) + ", " +
+                        ElapsedAndRemainingText(elapsed_s, fraction);
       Publish(false);
     };
   };

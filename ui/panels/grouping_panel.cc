@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include <imgui_internal.h>  // TableSetColumnWidthAutoAll
+
 #include "ui/core/group_colour.h"
 #include "ui/core/panel.h"
 #include "ui/core/texel_cap_note.h"
@@ -75,9 +77,11 @@ class GroupingPanel : public Panel {
     }
     ImGui::PushItemWidth(-ImGui::CalcTextSize("texel m (0 = auto)").x -
                          ImGui::GetStyle().ItemInnerSpacing.x);
-    ImGui::SliderFloat("angle deg", &angle_, 0.0f, 90.0f, "%.1f");
+    ImGui::SliderFloat(FitLabelledItem("angle deg").c_str(), &angle_, 0.0f, 90.0f, "%.1f");
     const bool angle_done = ImGui::IsItemDeactivatedAfterEdit();
-    ImGui::DragFloat("texel m (0 = auto)", &texel_, 0.0005f, 0.0f, 1.0f, "%.4f");
+    slider_px_ = ImGui::GetItemRectSize().x;
+    ImGui::DragFloat(FitLabelledItem("texel m (0 = auto)").c_str(), &texel_, 0.0005f, 0.0f, 1.0f,
+                     "%.4f");
     const bool texel_done = ImGui::IsItemDeactivatedAfterEdit();
     ImGui::PopItemWidth();
     if (angle_done || texel_done) {
@@ -103,10 +107,18 @@ class GroupingPanel : public Panel {
     }
 
     // The groups; click to select (ctrl-click adds).
-    if (ImGui::BeginTable(
-            "groups", 4,
-            ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY | ImGuiTableFlags_BordersInnerV,
-            ImVec2(0, 200))) {
+    // Columns as wide as their headers and values (the table scrolls sideways in a narrow
+    // panel or at a large font scale rather than cutting them to a letter), about twelve
+    // rows high at any font scale.
+    if (ImGui::BeginTable("groups", 4,
+                          ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY |
+                              ImGuiTableFlags_ScrollX | ImGuiTableFlags_SizingFixedFit |
+                              ImGuiTableFlags_BordersInnerV,
+                          ImVec2(0, 12 * ImGui::GetTextLineHeightWithSpacing()))) {
+      if (table_font_px_ != ImGui::GetFontSize()) {  // the font scale changed: fit again
+        ImGui::TableSetColumnWidthAutoAll(ImGui::GetCurrentTable());
+        table_font_px_ = ImGui::GetFontSize();
+      }
       ImGui::TableSetupColumn("group");
       ImGui::TableSetupColumn("triangles");
       ImGui::TableSetupColumn("texels");
@@ -191,7 +203,10 @@ class GroupingPanel : public Panel {
   }
 
   std::map<std::string, std::string> Report() const override {
-    return {{"colours", colours_}, {"split", split_message_}, {"coarser", coarse_message_}};
+    return {{"colours", colours_},
+            {"split", split_message_},
+            {"coarser", coarse_message_},
+            {"angle slider px", std::to_string(slider_px_)}};
   }
 
  private:
@@ -211,6 +226,8 @@ class GroupingPanel : public Panel {
   }
 
   float angle_ = 20, texel_ = 0, group_texel_ = 0.01f;
+  float slider_px_ = 0;      // the angle slider's width as last drawn, for Report()
+  float table_font_px_ = 0;  // the font size the table's columns were last fitted to
   uint64_t checked_geometry_ = 0;
   std::string split_message_;   // why stored groups were split back apart ("" = they held)
   std::string coarse_message_;  // which groups got coarser texels than asked ("" = none)

@@ -18,11 +18,8 @@ class ProjectPanel : public Panel {
  public:
   const char* Title() const override { return kProjectPanelTitle; }
   std::map<std::string, std::string> Report() const override {
-    return {{"scene", paths_.scene},
-            {"video", paths_.video},
-            {"camera", paths_.camera},
-            {"poses", paths_.poses},
-            {"paths error", paths_error_}};
+    return {{"scene", paths_.scene}, {"video", paths_.video},       {"camera", paths_.camera},
+            {"poses", paths_.poses}, {"paths error", paths_error_}, {"paths of", shown_file_}};
   }
   bool AcceptDrop(const DroppedFile& file) override {
     std::string* field = FieldFor(file.kind, &paths_);
@@ -37,7 +34,17 @@ class ProjectPanel : public Panel {
       return;
     }
     AppState& state = *ui.state;
-    if (state.has_unopened) DrawPaths(ui);  // first: what the user came to fix
+    if (state.has_unopened) {  // first: what the user came to fix
+      DrawPaths(ui);
+      // The other panels show the project still open, not this one: say so, and let the
+      // user put this one aside.
+      if (state.has_project)
+        ImGui::TextWrapped("Every other panel still shows %s, which stays open.",
+                           state.project.file_path.c_str());
+      if (ImGui::Button(state.has_project ? "Keep the open project" : "Dismiss"))
+        state.has_unopened = false;  // the path editor follows the open project again
+      ImGui::Separator();
+    }
     if (state.has_project) {
       ImGui::TextWrapped("%s%s", state.project.file_path.c_str(), state.dirty ? "  (unsaved)" : "");
       if (ImGui::Button("Save")) Report(state, state.Save());

@@ -7,6 +7,8 @@
 
 #include <imgui.h>
 
+#include "ui/core/panel.h"
+
 namespace fresco {
 namespace {
 
@@ -35,7 +37,8 @@ std::string SettingLabel(const Setting& setting) {
 }
 
 bool DrawSettingWidget(const Setting& s) {
-  const std::string label = SettingLabel(s);
+  const bool fits_beside = s.kind == Setting::Kind::kBool || s.kind == Setting::Kind::kText;
+  const std::string label = fits_beside ? SettingLabel(s) : FitLabelledItem(SettingLabel(s));
   bool done = false;
   switch (s.kind) {
     case Setting::Kind::kBool:
