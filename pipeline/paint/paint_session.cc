@@ -126,6 +126,7 @@ void PaintSession::StartAutoModes() {
   options_.update = requested_update_;
   update_auto_ = AutoDecision();
   update_held_out_.clear();
+  model_decided_early_ = false;
   if (requested_update_ == UpdatePolicy::kAuto) {
     update_auto_.basis = "held_out";
     update_auto_.threshold = 0;
@@ -346,6 +347,7 @@ void PaintSession::PaintFrame(const Frame& frame, const Camera& camera,
 #define FRESCO_RUN_STAGE(Name) Name##Stage(&work);
   FRESCO_PAINT_STAGES(FRESCO_RUN_STAGE)
 #undef FRESCO_RUN_STAGE
+  if (frame_number + 1 >= hold_every * kModelHeldOutFrames) DecideModelEarly();
   if (frame_number + 1 >= hold_every * kUpdateHeldOutFrames) DecideUpdate();
   UpdateAutoModes(frame_number, work.measured_misalignment_px, work.seen, report);
   if (!own_.empty() && !own_only_.load()) ++frames_painted_whole_;

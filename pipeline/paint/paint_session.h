@@ -161,6 +161,14 @@ class PaintSession {
   static constexpr int kUpdateHeldOutFrames = 6;
   bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }
   void DecideUpdate();
+  // With background `auto`'s model on while the update decides, the model is judged first on
+  // the first half of the frames held out (kModelHeldOutFrames, as soon as they are in): the
+  // mean without the model scoring above the mean with it and the sharpest view turns the model
+  // off from then on (what it would cost for the rest of the capture is saved; the update still
+  // decides on all of them). Else the choice waits for the update's, as before.
+  static constexpr int kModelHeldOutFrames = 3;
+  bool DecidingModelOnHeldOut() const;
+  void DecideModelEarly();
 
   // Painting in shards (`fresco run --shard I/N`, pipeline/run/shard.h): `own[b]` true for
   // the buffers this session paints for its shard (empty: every buffer, the default). The
@@ -291,6 +299,12 @@ class PaintSession {
     Rigid3d cam_from_world;
   };
   std::vector<HeldOutFrame> update_held_out_;
+  bool model_decided_early_ = false;  // DecideModelEarly ran
+  // The candidates (the sharpest view, the mean, the mean without the model: the first `n`)
+  // without the frames held out, scored at those frames (PSNR summed into `psnr_sum`);
+  // returns the frames measured.
+  int ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const;
+  void TurnModelOffByFramesHeldOut(double gain_db, int measured);
   BackgroundMode requested_background_ = BackgroundMode::kOff;
   // DecideBackgroundAcrossViews' evidence (fraction, frames); frames < 0: none.
   std::pair<double, int> background_across_views_{0.0, -1};

@@ -75,17 +75,9 @@ void PaintSession::KeepSharpestViews(const char* why) {
       m->release();
 }
 
-void PaintSession::DecideUpdate() {
-  if (!DecidingUpdate()) return;
-  // Refinement `auto` came on (as StartAutoModes with refinement on).
-  if (options_.refine.mode != RefineMode::kOff) return KeepSharpestViews("refinement_on");
-  // The candidates, without the frames held out: the sharpest view, the mean of every view
-  // and, where background `auto` turned the model on, that mean without the model (winning
-  // turns it off). A model on by hand stays as the paper paints with it: the sharpest view.
-  const bool model_on = options_.background.mode != BackgroundMode::kOff;
-  const bool without_model = model_on && requested_background_ == BackgroundMode::kAuto;
-  if (model_on && !without_model) return KeepSharpestViews("background_model_on");
-  const size_t n = without_model ? 3 : 2;
+// The candidates painted without the frames held out, rendered at those frames' poses:
+// `psnr_sum[c]` over the frames measured (the return value).
+int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const {
   std::vector<Scene> scenes;
   for (size_t c = 0; c < n; ++c) {
     std::vector<cv::Mat> texels;
@@ -98,7 +90,8 @@ void PaintSession::DecideUpdate() {
     }
     scenes.push_back(PaintedScene(texels));
   }
-  std::vector<double> psnr_sum(n, 0.0), psnr;
+  psnr_sum->assign(n, 0.0);
+  std::vector<double> psnr;
   int measured = 0;
   for (const HeldOutFrame& frame : update_held_out_) {
     const Renderer renderer(frame.camera, RenderOptions());
@@ -106,9 +99,57 @@ void PaintSession::DecideUpdate() {
     for (size_t c = 0; c < n; ++c)
       renderer.Render(scenes[c], frame.cam_from_world, &rendered[c]);
     if (!ComparedPsnr(rendered, frame.bgr, frame.movers, &psnr)) continue;
-    for (size_t c = 0; c < n; ++c) psnr_sum[c] += psnr[c];
+    for (size_t c = 0; c < n; ++c) (*psnr_sum)[c] += psnr[c];
     ++measured;
   }
+  return measured;
+}
+
+// The model off from now on (its sums the mean's), on `gain_db` over `measured` frames.
+void PaintSession::TurnModelOffByFramesHeldOut(double gain_db, int measured) {
+  background_auto_.OffByFramesHeldOut(frames_seen_, gain_db, measured);
+  options_.background.mode = BackgroundMode::kOff;
+  background_.clear();
+  background_frame_.clear();
+  for (PaintedBuffer& p : painted_) {
+    // No sample is provisional without the model: every view counts.
+    cv::absdiff(p.quality, 0, p.quality);
+    if (!p.shadow_quality.empty()) cv::absdiff(p.shadow_quality, 0, p.shadow_quality);
+    p.mean_sum = p.unmasked_sum;
+    p.held_sum = p.held_unmasked_sum;
+    p.unmasked_sum.release();
+    p.held_unmasked_sum.release();
+  }
+}
+
+bool PaintSession::DecidingModelOnHeldOut() const {
+  return DecidingUpdate() && options_.refine.mode == RefineMode::kOff &&
+         options_.background.mode != BackgroundMode::kOff &&
+         requested_background_ == BackgroundMode::kAuto;
+}
+
+void PaintSession::DecideModelEarly() {
+  if (!DecidingModelOnHeldOut() || model_decided_early_) return;
+  model_decided_early_ = true;
+  std::vector<double> psnr_sum;
+  const int measured = ScoreHeldOut(3, &psnr_sum);
+  if (measured > 0 && psnr_sum[2] > std::max(psnr_sum[0], psnr_sum[1]))
+    TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
+}
+
+void PaintSession::DecideUpdate() {
+  if (!DecidingUpdate()) return;
+  // Refinement `auto` came on (as StartAutoModes with refinement on).
+  if (options_.refine.mode != RefineMode::kOff) return KeepSharpestViews("refinement_on");
+  // The candidates, without the frames held out: the sharpest view, the mean of every view
+  // and, where background `auto` turned the model on, that mean without the model (winning
+  // turns it off). A model on by hand stays as the paper paints with it: the sharpest view.
+  const bool model_on = options_.background.mode != BackgroundMode::kOff;
+  const bool without_model = model_on && requested_background_ == BackgroundMode::kAuto;
+  if (model_on && !without_model) return KeepSharpestViews("background_model_on");
+  const size_t n = without_model ? 3 : 2;
+  std::vector<double> psnr_sum;
+  const int measured = ScoreHeldOut(n, &psnr_sum);
   update_held_out_.clear();
   size_t best = 0;
   for (size_t c = 1; c < n && measured > 0; ++c)
@@ -122,17 +163,10 @@ void PaintSession::DecideUpdate() {
   const bool mean = best > 0;
   update_auto_.state = mean ? AutoDecision::State::kOn : AutoDecision::State::kOff;
   options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
-  if (best == 2) {  // the model off from now on, its sums the mean's
-    background_auto_.OffByFramesHeldOut(frames_seen_, (psnr_sum[2] - psnr_sum[1]) / measured,
-                                        measured);
-    options_.background.mode = BackgroundMode::kOff;
-    background_.clear();
-    background_frame_.clear();
-  }
+  if (best == 2) TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
   // What every frame painted, the chosen way.
   for (PaintedBuffer& p : painted_) {
     if (mean) {
-      if (best == 2) p.mean_sum = p.unmasked_sum;
       p.bgra = MeanTexels(p.bgra, p.mean_sum);
       cv::absdiff(p.quality, 0, p.quality);  // none provisional: every view counts
     } else {

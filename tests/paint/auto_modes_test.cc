@@ -176,6 +176,52 @@ TEST(AutoBackground, CapturesFromFilesDecideBeforePaintingFromMoversAcrossViews)
   EXPECT_TRUE(as_off);
 }
 
+// Where the movers found across views turned the model on but the capture has none, the frames
+// held out of `update: auto` turn it off on their first half (kModelHeldOutFrames), not at the
+// update's decision near the end: what the model would cost for the rest is saved, and the mean
+// painted is the one a session without the model paints.
+TEST(AutoBackground, FramesHeldOutTurnAModelWithoutMoversOffOnTheirFirstHalf) {
+  const Scene scene = RoomScene();
+  SynthCapture capture;
+  SynthOptions o = RoomCaptureWithMovers(40, 0.1);  // exposure changes, no movers
+  o.movers.clear();
+  ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kAuto;
+  options.update = UpdatePolicy::kAuto;
+  std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
+  session->DecideBackgroundAcrossViews(4 * kBackgroundAcrossViewsThreshold, 40);  // fooled
+  ASSERT_EQ(session->auto_decisions().background.state, State::kOn);
+  FrameReport report;
+  int model_off_at = -1;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i) {
+    PaintCaptureFrame(session.get(), capture, i, &report);
+    if (model_off_at < 0 && report.decisions.background.state == State::kOff)
+      model_off_at = static_cast<int>(i) + 1;
+  }
+  const AutoDecision model = session->auto_decisions().background;
+  const AutoDecision update = session->auto_decisions().update;
+  std::printf("background %s; update %s\n", model.Describe().c_str(), update.Describe().c_str());
+  EXPECT_EQ(model.state, State::kOff);
+  EXPECT_EQ(model.basis, "held_out_without_model");
+  EXPECT_EQ(model.frames_measured, PaintSession::kModelHeldOutFrames);
+  // Held out every 40 / 7 = 5th frame: the third is frame 12, the decision after frame 15.
+  EXPECT_EQ(model_off_at, 15);
+  EXPECT_EQ(model.decided_at_frame, 15);
+  EXPECT_GT(model.evidence, 0);
+  EXPECT_EQ(update.state, State::kOn);  // the mean
+  EXPECT_EQ(update.frames_measured, 6);
+  options.background.mode = BackgroundMode::kOff;
+  std::unique_ptr<PaintSession> off = SessionForCapture(scene, capture, options);
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    PaintCaptureFrame(off.get(), capture, i, &report);
+  EXPECT_EQ(off->auto_decisions().update.state, State::kOn);
+  for (size_t b = 0; b < off->painted().size(); ++b)
+    EXPECT_LE(cv::norm(session->painted()[b].bgra, off->painted()[b].bgra, cv::NORM_INF), 1.0)
+        << "buffer " << b;
+}
+
 // The evidence is the model's own verdict (its cleaned mask), not the mask grown by colour:
 // growth spreads whatever was flagged, e.g. over a uniform road from the few texels of a
 // high-frequency pavement that a closer view flags, and would decide a static scene on.
