@@ -335,7 +335,7 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
     std::vector<bool> from_edges;
     for (const CornerObservation& c : out.corners) from_edges.push_back(edged_ids.count(c.id) > 0);
     out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
-    ShiftTagEdges(out.tag_edge_shift_px, from_edges, &out.corners);
+    ShiftTagEdges(out.tag_edge_shift_px, from_edges, &out.corners, &found);
   }
   if (options.refine_tag_corners && options.drop_inconsistent_corners)
     out.corners_inconsistent = DropCornersTheirNeighboursPlaceElsewhere(spec, &out.corners);
