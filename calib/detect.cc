@@ -1,6 +1,7 @@
 #include "calib/detect.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -305,6 +306,8 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
       // the corner from the tag's edges (calib/tag_corner_edges.h).
       std::array<Eigen::Vector2d, 4> p;
       for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
+      std::array<std::array<double, 2>, 4> levels;
+      bool placed[4] = {false, false, false, false};
       for (int k = 0; k < 4; ++k) {
         Eigen::Vector2d corner;
         // No square, and the saddle more than 1 px from the tag's outline as read: near a
@@ -315,11 +318,25 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
             options.edges_from_outline_when_strayed && (p[k] - quad.p[k]).norm() > kStrayedPx;
         const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
         if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
-        if (!CornerFromEdges(gray, from, k, &corner)) {
-          refined[k] = !strayed;  // a stray saddle and no edges: left out
+        bool left_out = false;
+        if (!CornerFromEdges(gray, from, k, &corner, &left_out, &levels[k])) {
+          refined[k] = !strayed && !left_out;  // a stray saddle and no edges: left out
           continue;
         }
         corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
+        placed[k] = true;
+      }
+      // The board's own corners: both edges beside the paper margin, no gap's white beside
+      // either to tell a margin too narrow for its blur by; the tag's other corners' is.
+      double tag_light = 0;
+      for (int k = 0; k < 4; ++k)
+        if (placed[k]) tag_light = std::max(tag_light, levels[k][1]);
+      for (int k = 0; k < 4; ++k) {
+        if (!placed[k]) continue;
+        if (tag_light - levels[k][1] > kMaxEdgeLightDeficit * (tag_light - levels[k][0])) {
+          refined[k] = false;
+          continue;
+        }
         ++out.corners_from_edges;
         edged_ids.insert(id * 4 + k);
       }
@@ -335,7 +352,7 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
     std::vector<bool> from_edges;
     for (const CornerObservation& c : out.corners) from_edges.push_back(edged_ids.count(c.id) > 0);
     out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
-    ShiftTagEdges(out.tag_edge_shift_px, from_edges, &out.corners);
+    ShiftTagEdges(out.tag_edge_shift_px, from_edges, &out.corners, &found);
   }
   if (options.refine_tag_corners && options.drop_inconsistent_corners)
     out.corners_inconsistent = DropCornersTheirNeighboursPlaceElsewhere(spec, &out.corners);

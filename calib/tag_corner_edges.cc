@@ -72,22 +72,42 @@ double Quantile(std::vector<double>* values, double q) {
 // or reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
 // border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
 // 1 px); the border's black shows where the bits behind it are black too.
-bool EdgeLine(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
-              Eigen::Vector2d* point, Eigen::Vector2d* direction) {
-  const double length = (to - from).norm();
-  if (length < 8) return false;
-  const Eigen::Vector2d along = (to - from) / length, normal(-along.y(), along.x());
-  const double reach = std::clamp(0.08 * length, 1.5, 4.0);
-  const double half = std::max(reach, kPlateauPx);  // the second sampling, each side
+struct EdgeCuts {
   struct Cut {
     Eigen::Vector2d base;
     double first = 0;  // the crossing, along `normal` from base
     std::vector<double> grey;
   };
   std::vector<Cut> cuts;
+  Eigen::Vector2d normal;
+  double half = 0;             // the second sampling's reach, each side
+  double dark = 0, light = 0;  // the edge's levels
+};
+
+// The cuts across the edge from `from` towards `to` near `from` and the edge's levels; false
+// when too few cuts show an edge.
+//
+// Each cut across the edge is first placed where its grey crosses halfway between its own
+// darkest and lightest samples, then sampled again centred there; the edge's levels are the
+// darkest quarter of the cuts' inner ends and the lightest quarter of their outer ends,
+// kPlateauPx or more from the edge. A cut's own ends are not the levels on a small blurred
+// tag: centred on a chord pulled into the tag, or reaching the tag's bits behind a thin
+// border, the dark end is darker or lighter than the border's black and the halfway crossing
+// moves (0.1-0.17 px into a 24-32 px tag blurred 1 px); the border's black shows where the
+// bits behind it are black too.
+bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
+                EdgeCuts* edge) {
+  const double length = (to - from).norm();
+  if (length < 8) return false;
+  const Eigen::Vector2d along = (to - from) / length, normal(-along.y(), along.x());
+  const double reach = std::clamp(0.08 * length, 1.5, 4.0);
+  const double half = std::max(reach, kPlateauPx);  // the second sampling, each side
+  edge->normal = normal, edge->half = half;
+  std::vector<EdgeCuts::Cut>& cuts = edge->cuts;
+  cuts.clear();
   std::vector<double> dark_ends, light_ends, grey;
   for (double t = std::max(kFirst, (reach + 1.5) / length); t <= kLast; t += 1.0 / length) {
-    Cut cut;
+    EdgeCuts::Cut cut;
     cut.base = from + t * length * along;
     if (!Profile(gray, cut.base, normal, 0, reach, &grey)) continue;
     const double lo = *std::min_element(grey.begin(), grey.end());
@@ -111,12 +131,18 @@ bool EdgeLine(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vec
     cuts.push_back(std::move(cut));
   }
   if (static_cast<int>(cuts.size()) < kMinPoints) return false;
-  const double dark = Quantile(&dark_ends, 0.25), light = Quantile(&light_ends, 0.75);
-  if (light - dark < kMinContrastGrey) return false;
+  edge->dark = Quantile(&dark_ends, 0.25), edge->light = Quantile(&light_ends, 0.75);
+  return edge->light - edge->dark >= kMinContrastGrey;
+}
+
+// The edge as a point on it and its direction: each cut placed where it crosses halfway
+// between `dark` and `light`; false when too few do.
+bool EdgeLine(const EdgeCuts& edge, double dark, double light, Eigen::Vector2d* point,
+              Eigen::Vector2d* direction) {
   std::vector<Eigen::Vector2d> points;
-  for (const Cut& cut : cuts) {
-    const double second = Crossing(cut.grey, half, 0.5 * (dark + light));
-    if (second != kNone) points.push_back(cut.base + (cut.first + second) * normal);
+  for (const EdgeCuts::Cut& cut : edge.cuts) {
+    const double second = Crossing(cut.grey, edge.half, 0.5 * (dark + light));
+    if (second != kNone) points.push_back(cut.base + (cut.first + second) * edge.normal);
   }
   if (static_cast<int>(points.size()) < kMinPoints) return false;
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -159,10 +185,28 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
 }
 
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
-                     Eigen::Vector2d* corner) {
+                     Eigen::Vector2d* corner, bool* left_out, std::array<double, 2>* levels) {
+  if (left_out != nullptr) *left_out = false;
+  EdgeCuts cuts_a, cuts_b;
+  if (!EdgeCutsOf(gray, p[k], p[(k + 1) % 4], &cuts_a) ||
+      !EdgeCutsOf(gray, p[k], p[(k + 3) % 4], &cuts_b))
+    return false;
+  // The two edges' light levels differ: beside the lighter one is the gap's white, beside the
+  // other a paper margin of a few pixels blurred onto a dark surround, whose white is never
+  // reached; no level places that edge (0.10-0.18 px into the tag whichever is taken, the
+  // other edge's included: calib_detect_elsewhere --margin 0.1 --gamma 2 --solve, dark,
+  // blurred). Such a corner is left out.
+  const double lighter = std::max(cuts_a.light, cuts_b.light);
+  const double darker_light = std::min(cuts_a.light, cuts_b.light);
+  const double dark = std::min(cuts_a.dark, cuts_b.dark);
+  if (levels != nullptr) *levels = {dark, lighter};
+  if (lighter - darker_light > kMaxEdgeLightDeficit * (lighter - dark)) {
+    if (left_out != nullptr) *left_out = true;
+    return false;
+  }
   Eigen::Vector2d a, da, b, db;
-  if (!EdgeLine(gray, p[k], p[(k + 1) % 4], &a, &da) ||
-      !EdgeLine(gray, p[k], p[(k + 3) % 4], &b, &db))
+  if (!EdgeLine(cuts_a, cuts_a.dark, cuts_a.light, &a, &da) ||
+      !EdgeLine(cuts_b, cuts_b.dark, cuts_b.light, &b, &db))
     return false;
   // a + s da = b + u db
   Eigen::Matrix2d m;

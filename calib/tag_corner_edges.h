@@ -25,8 +25,18 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
 
 // Corner k as the intersection of the tag's two edges through it, or false (then `corner`
 // is untouched) when an edge shows too little contrast or the result lies more than
-// max(1.5 px, 5 % of the tag's edge) from p[k].
+// max(1.5 px, 5 % of the tag's edge) from p[k]. Also false, with `left_out` set, when the
+// two edges' light levels differ by more than 8 % of the range (an outer tag's edge beside a
+// paper margin of a few pixels blurred onto a dark surround: no level places it): the corner
+// is to be left out, not refined otherwise.
+// `levels`, when given and both edges were found: the edges' dark level and the lighter one's
+// light level.
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
-                     Eigen::Vector2d* corner);
+                     Eigen::Vector2d* corner, bool* left_out = nullptr,
+                     std::array<double, 2>* levels = nullptr);
+
+// An edge whose light level lies more than this part of the dark-to-light range below that of
+// the other edges of its tag is beside a margin too narrow for its blur: its corner is left out.
+constexpr double kMaxEdgeLightDeficit = 0.08;
 
 }  // namespace fresco::calib

@@ -84,7 +84,8 @@ double TagEdgeShift_px(const BoardSpec& spec, const std::vector<CornerObservatio
 }
 
 void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
-                   std::vector<CornerObservation>* corners) {
+                   std::vector<CornerObservation>* corners,
+                   const std::map<int, TagQuad>* outlines) {
   if (shift_px == 0) return;
   const std::vector<CornerObservation> before = *corners;
   const Lookup l = MakeLookup(before, from_edges);
@@ -93,9 +94,20 @@ void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
     const int tag = before[i].id / 4, k = before[i].id % 4;
     const Eigen::Vector2d* next = l.At(4 * tag + (k + 1) % 4);
     const Eigen::Vector2d* prev = l.At(4 * tag + (k + 3) % 4);
-    if (next == nullptr || prev == nullptr) continue;
     const Eigen::Vector2d c = before[i].pixel;
-    const Eigen::Vector2d d1 = (*next - c).normalized(), d2 = (*prev - c).normalized();
+    Eigen::Vector2d d1, d2;
+    if (next != nullptr && prev != nullptr) {
+      d1 = (*next - c).normalized(), d2 = (*prev - c).normalized();
+    } else {
+      // A neighbour left out: the directions of the outline as read (1-2 px off over an edge
+      // of 20 px or more: the shift, under 1 px, moves a few hundredths of a pixel less
+      // or more). Before, such corners kept the whole shift (the inner corners of the outer
+      // tags beside a narrow margin on a dark surround: 0.07-0.15 px out of the tag).
+      if (outlines == nullptr || outlines->count(tag) == 0) continue;
+      const auto it = outlines->find(tag);
+      const std::array<Eigen::Vector2d, 4>& q = it->second.p;
+      d1 = (q[(k + 1) % 4] - q[k]).normalized(), d2 = (q[(k + 3) % 4] - q[k]).normalized();
+    }
     Eigen::Vector2d n1(-d1.y(), d1.x()), n2(-d2.y(), d2.x());  // into the tag
     if (n1.dot(d2) < 0) n1 = -n1;
     if (n2.dot(d1) < 0) n2 = -n2;

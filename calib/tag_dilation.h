@@ -10,6 +10,7 @@
 // the image's tag pairs one figure for the image; each edge-derived corner is then moved back.
 #pragma once
 
+#include <map>
 #include <vector>
 
 #include "calib/board.h"
@@ -24,9 +25,11 @@ double TagEdgeShift_px(const BoardSpec& spec, const std::vector<CornerObservatio
                        const std::vector<bool>& from_edges, int min_pairs = 6);
 
 // Moves each corner with from_edges[i] set as if both its tag's edges through it moved by
-// -shift_px along their outward normals (the tag's other corners give the edges' directions;
-// a corner whose neighbours on the tag are missing is left as it is).
+// -shift_px along their outward normals. The tag's other corners give the edges' directions;
+// where one is missing (left out: an outer tag's corner beside a narrow paper margin), the
+// tag's outline as read (`outlines`, by tag id), and without that the corner is left as it is.
 void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
-                   std::vector<CornerObservation>* corners);
+                   std::vector<CornerObservation>* corners,
+                   const std::map<int, TagQuad>* outlines = nullptr);
 
 }  // namespace fresco::calib

@@ -9,7 +9,10 @@
 //   calib_detect_elsewhere [--views N] [--seeds S1,S2,..] [--border-bits 1|2]
 //                          [--margin TAGS] [--gamma G] [--contrast C] [--vignette V]
 //                          [--solve] [--save DIR] [--verbose] [--no-second-look]
-// --verbose also lists every corner more than 2 px from the truth.
+//                          [--only dark_sharp|dark_blur|light_sharp|light_blur] [--per-view]
+// --verbose also lists every corner more than 2 px from the truth; the corners' errors are
+// also given apart for those on the board's outline (an outer tag's outer edge through them);
+// --per-view gives them for each view, with its tag edge shift.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,8 +36,8 @@ int main(int argc, char** argv) {
   int views = 40;
   std::vector<unsigned> seeds = {1, 2, 3};
   ElsewhereBoard board;
-  bool solve = false, verbose = false, truth_corners = false;
-  std::string save;
+  bool solve = false, verbose = false, truth_corners = false, per_view = false;
+  std::string save, only;
   DetectOptions options;
   ElsewhereShot look;  // the tone curve and vignetting every view gets
   for (int i = 1; i < argc; ++i) {
@@ -63,15 +66,20 @@ int main(int argc, char** argv) {
       solve = true;
     } else if (a == "--truth-corners") {  // solve from the true corners (the solve's floor)
       truth_corners = true;
+    } else if (a == "--only") {  // one variant: dark_sharp, dark_blur, light_sharp, light_blur
+      only = next, ++i;
+    } else if (a == "--per-view") {  // each view's edge shift and corner errors
+      per_view = true;
     } else if (a == "--verbose") {
       verbose = true;
     } else if (a == "--no-second-look") {
       options.second_look = false;
     } else {
-      std::fprintf(stderr,
-                   "usage: calib_detect_elsewhere [--views N] [--seeds S1,S2] [--border-bits 1|2] "
-                   "[--margin TAGS] [--gamma G] [--contrast C] [--vignette V] [--solve] "
-                   "[--save DIR] [--verbose] [--no-second-look]\n");
+      std::fprintf(
+          stderr,
+          "usage: calib_detect_elsewhere [--views N] [--seeds S1,S2] [--border-bits 1|2] "
+          "[--margin TAGS] [--gamma G] [--contrast C] [--vignette V] [--solve] "
+          "[--save DIR] [--verbose] [--no-second-look] [--only dark_blur|...] [--per-view]\n");
       return 2;
     }
   }
@@ -90,7 +98,14 @@ int main(int argc, char** argv) {
     const auto poses = renderer.Poses(views, seed);
     for (int surround : {20, 225})
       for (bool degraded : {false, true}) {
+        if (!only.empty() && only != std::string(surround < 128 ? "dark_" : "light_") +
+                                         (degraded ? "blur" : "sharp"))
+          continue;
         int used = 0, lost = 0, aruco_ok = 0, tags_ours = 0, tags_aruco = 0;
+        // Corners on the board's outline (an outer tag's outer edge through them) and the
+        // others: squared error, count, mean out of the tag.
+        double outline_sq = 0, outline_out = 0, inner_sq = 0, inner_out = 0;
+        int outline_n = 0, inner_n = 0;
         double ms = 0, ms_max = 0, sq_px = 0, worst_px = 0;
         int corners = 0;
         Eigen::Vector2d sum_px = Eigen::Vector2d::Zero();
@@ -126,6 +141,8 @@ int main(int argc, char** argv) {
           tags_ours += d.tags;
           tags_aruco += static_cast<int>(aruco.size());
           if (!d.found && aruco_reads) ++lost;
+          double view_out[2] = {0, 0}, view_sq[2] = {0, 0};
+          int view_n[2] = {0, 0};
           for (const CornerObservation& c : d.corners) {
             const double e = (c.pixel - view.truth[c.id]).norm();
             if (verbose && e > 2)
@@ -138,8 +155,27 @@ int main(int argc, char** argv) {
             const int t0 = c.id / 4 * 4;
             const Eigen::Vector2d tag_centre = 0.25 * (view.truth[t0] + view.truth[t0 + 1] +
                                                        view.truth[t0 + 2] + view.truth[t0 + 3]);
-            sum_outward_px += (c.pixel - view.truth[c.id]).dot((view.truth[c.id] - tag_centre).normalized());
+            const double out_of_tag =
+                (c.pixel - view.truth[c.id]).dot((view.truth[c.id] - tag_centre).normalized());
+            sum_outward_px += out_of_tag;
+            const int tag = c.id / 4, k = c.id % 4, tr = tag / spec.cols, tc = tag % spec.cols;
+            const bool outline = (tr == 0 && k < 2) || (tr == spec.rows - 1 && k >= 2) ||
+                                 (tc == 0 && (k == 0 || k == 3)) ||
+                                 (tc == spec.cols - 1 && (k == 1 || k == 2));
+            (outline ? outline_sq : inner_sq) += e * e;
+            (outline ? outline_out : inner_out) += out_of_tag;
+            ++(outline ? outline_n : inner_n);
+            view_out[outline] += out_of_tag, view_sq[outline] += e * e, ++view_n[outline];
           }
+          if (per_view)
+            std::printf(
+                "  view %2zu shift %.3f edged %d dropped %d | outline %d rms %.3f out %.3f "
+                "| others %d rms %.3f out %.3f\n",
+                v, d.tag_edge_shift_px, d.corners_from_edges, d.corners_inconsistent, view_n[1],
+                std::sqrt(view_sq[1] / std::max(1, view_n[1])),
+                view_out[1] / std::max(1, view_n[1]), view_n[0],
+                std::sqrt(view_sq[0] / std::max(1, view_n[0])),
+                view_out[0] / std::max(1, view_n[0]));
           if (truth_corners) {
             std::vector<CornerObservation> truth;
             for (int id = 0; id < spec.NumCorners(); ++id) truth.push_back({id, view.truth[id]});
@@ -160,6 +196,10 @@ int main(int argc, char** argv) {
             ms / std::max<size_t>(1, poses.size()), ms_max, std::sqrt(sq_px / std::max(1, corners)),
             worst_px, sum_px.x() / std::max(1, corners), sum_px.y() / std::max(1, corners),
             sum_radial_px / std::max(1, corners), sum_outward_px / std::max(1, corners));
+        std::printf(", outline corners %d rms %.3f out %.3f, others %d rms %.3f out %.3f",
+                    outline_n, std::sqrt(outline_sq / std::max(1, outline_n)),
+                    outline_out / std::max(1, outline_n), inner_n,
+                    std::sqrt(inner_sq / std::max(1, inner_n)), inner_out / std::max(1, inner_n));
         if (solve && used >= kMinViews) {
           CalibrateRequest request;
           request.board = spec;
