@@ -363,10 +363,13 @@ int FramesToRead(const PaintJob& job, const Project& project) {
 // The last line of a run (unless --quiet).
 void PrintRunSummary(const PaintRunStats& stats, const PaintSession& session,
                      const std::string& out_dir, double wall_s) {
-  // Refinement turned down by the pose check says so (its other decisions are in metrics.json).
-  if (const AutoDecision& refine = session.auto_decisions().refine;
-      refine.basis == "held_out_poses")
-    std::fprintf(stderr, "fresco run: refinement %s\n", refine.Describe().c_str());
+  // Refinement turned down by the pose check, and a model the frames held out turned off after
+  // the line before painting said on, say so (the other decisions are in metrics.json).
+  const AutoDecisions decided = session.auto_decisions();
+  if (decided.refine.basis == "held_out_poses")
+    std::fprintf(stderr, "fresco run: refinement %s\n", decided.refine.Describe().c_str());
+  if (decided.background.basis == "held_out_without_model")
+    std::fprintf(stderr, "fresco run: background %s\n", decided.background.Describe().c_str());
   std::fprintf(stderr,
                "fresco run: %d frames (%d painted) in %.2fs = %.1f fps; %.2fs end to end = %.1f "
                "fps; coverage %.1f%% of %lld texels in %zu buffers -> %s\n",

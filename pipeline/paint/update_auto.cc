@@ -165,10 +165,17 @@ void PaintSession::DecideUpdate() {
   options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
   if (best == 2) TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
   // What every frame painted, the chosen way.
-  for (PaintedBuffer& p : painted_) {
+  for (size_t b = 0; b < painted_.size(); ++b) {
+    PaintedBuffer& p = painted_[b];
     if (mean) {
       p.bgra = MeanTexels(p.bgra, p.mean_sum);
       cv::absdiff(p.quality, 0, p.quality);  // none provisional: every view counts
+      // The mean paints texels the sharpest view had not (samples the model kept out): counted.
+      const BaseBuffer& buffer = set_.buffers[b];
+      int painted = 0;
+      for (size_t k = 0; k < buffer.texel_index.size(); ++k)
+        painted += buffer.on_surface[k] && p.bgra.ptr<cv::Vec4b>()[buffer.texel_index[k]][3] > 0;
+      p.painted_surface_texels = painted;
     } else {
       p.mean_sum.release();
     }

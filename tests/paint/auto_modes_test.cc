@@ -176,6 +176,43 @@ TEST(AutoBackground, CapturesFromFilesDecideBeforePaintingFromMoversAcrossViews)
   EXPECT_TRUE(as_off);
 }
 
+// The share of the surface's texels the painted buffers show (alpha > 0).
+double PaintedShare(const PaintSession& session) {
+  long long painted = 0, surface = 0;
+  for (size_t b = 0; b < session.buffers().size(); ++b) {
+    const BaseBuffer& buffer = session.buffers()[b];
+    const cv::Mat& bgra = session.painted()[b].bgra;
+    for (size_t k = 0; k < buffer.texel_index.size(); ++k) {
+      if (!buffer.on_surface[k]) continue;
+      ++surface;
+      painted += bgra.ptr<cv::Vec4b>()[buffer.texel_index[k]][3] > 0;
+    }
+  }
+  return surface > 0 ? static_cast<double>(painted) / surface : 0.0;
+}
+
+// With the model on and the mean chosen, the coverage counts what the mean paints: the texels
+// the model kept out of the sharpest view too.
+TEST(AutoBackground, TheMeanChosenWithTheModelOnCountsEveryTexelItPaints) {
+  const Scene scene = RoomScene();
+  SynthCapture capture;
+  ASSERT_TRUE(SynthesizeCapture(scene, RoomWithMovers(true), &capture).ok());
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kAuto;
+  options.update = UpdatePolicy::kAuto;
+  std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
+  session->DecideBackgroundAcrossViews(4 * kBackgroundAcrossViewsThreshold, 40);
+  FrameReport report;
+  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
+    PaintCaptureFrame(session.get(), capture, i, &report);
+  std::printf("update %s; coverage %.6f, painted %.6f\n",
+              session->auto_decisions().update.Describe().c_str(), session->Coverage(),
+              PaintedShare(*session));
+  ASSERT_EQ(session->auto_decisions().update.state, State::kOn);
+  EXPECT_DOUBLE_EQ(session->Coverage(), PaintedShare(*session));
+}
+
 // Where the movers found across views turned the model on but the capture has none, the frames
 // held out of `update: auto` turn it off on their first half (kModelHeldOutFrames), not at the
 // update's decision near the end: what the model would cost for the rest is saved, and the mean
@@ -217,6 +254,7 @@ TEST(AutoBackground, FramesHeldOutTurnAModelWithoutMoversOffOnTheirFirstHalf) {
   for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
     PaintCaptureFrame(off.get(), capture, i, &report);
   EXPECT_EQ(off->auto_decisions().update.state, State::kOn);
+  EXPECT_DOUBLE_EQ(session->Coverage(), PaintedShare(*session));
   for (size_t b = 0; b < off->painted().size(); ++b)
     EXPECT_LE(cv::norm(session->painted()[b].bgra, off->painted()[b].bgra, cv::NORM_INF), 1.0)
         << "buffer " << b;
