@@ -176,6 +176,15 @@ TEST(AutoBackground, CapturesFromFilesDecideBeforePaintingFromMoversAcrossViews)
   EXPECT_TRUE(as_off);
 }
 
+// Background and update `auto`, refinement off.
+PipelineOptions ModelAndUpdateAuto() {
+  PipelineOptions options;
+  options.refine.mode = RefineMode::kOff;
+  options.background.mode = BackgroundMode::kAuto;
+  options.update = UpdatePolicy::kAuto;
+  return options;
+}
+
 // The share of the surface's texels the painted buffers show (alpha > 0).
 double PaintedShare(const PaintSession& session) {
   long long painted = 0, surface = 0;
@@ -197,10 +206,7 @@ TEST(AutoBackground, TheMeanChosenWithTheModelOnCountsEveryTexelItPaints) {
   const Scene scene = RoomScene();
   SynthCapture capture;
   ASSERT_TRUE(SynthesizeCapture(scene, RoomWithMovers(true), &capture).ok());
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kAuto;
-  options.update = UpdatePolicy::kAuto;
+  PipelineOptions options = ModelAndUpdateAuto();
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
   session->DecideBackgroundAcrossViews(4 * kBackgroundAcrossViewsThreshold, 40);
   FrameReport report;
@@ -223,10 +229,7 @@ TEST(AutoBackground, FramesHeldOutTurnAModelWithoutMoversOffOnTheirFirstHalf) {
   SynthOptions o = RoomCaptureWithMovers(40, 0.1);  // exposure changes, no movers
   o.movers.clear();
   ASSERT_TRUE(SynthesizeCapture(scene, o, &capture).ok());
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kAuto;
-  options.update = UpdatePolicy::kAuto;
+  PipelineOptions options = ModelAndUpdateAuto();
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
   session->DecideBackgroundAcrossViews(4 * kBackgroundAcrossViewsThreshold, 40);  // fooled
   ASSERT_EQ(session->auto_decisions().background.state, State::kOn);
