@@ -61,17 +61,7 @@ double Quantile(std::vector<double>* values, double q) {
   return (*values)[k];
 }
 
-// The edge from `from` towards `to` near `from`, as a point on it and its direction; false
-// when too few points show an edge.
-//
-// Each cut across the edge is first placed where its grey crosses halfway between its own
-// darkest and lightest samples, then sampled again centred there and placed where it crosses
-// halfway between the edge's dark and light levels: the darkest quarter of the cuts' inner
-// ends and the lightest quarter of their outer ends, kPlateauPx or more from the edge. A cut's
-// own ends are not the levels on a small blurred tag: centred on a chord pulled into the tag,
-// or reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
-// border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
-// 1 px); the border's black shows where the bits behind it are black too.
+// The cuts across one edge of a tag (EdgeCutsOf) and the edge's levels.
 struct EdgeCuts {
   struct Cut {
     Eigen::Vector2d base;
@@ -136,12 +126,11 @@ bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::V
 }
 
 // The edge as a point on it and its direction: each cut placed where it crosses halfway
-// between `dark` and `light`; false when too few do.
-bool EdgeLine(const EdgeCuts& edge, double dark, double light, Eigen::Vector2d* point,
-              Eigen::Vector2d* direction) {
+// between the edge's dark and light levels; false when too few do.
+bool EdgeLine(const EdgeCuts& edge, Eigen::Vector2d* point, Eigen::Vector2d* direction) {
   std::vector<Eigen::Vector2d> points;
   for (const EdgeCuts::Cut& cut : edge.cuts) {
-    const double second = Crossing(cut.grey, edge.half, 0.5 * (dark + light));
+    const double second = Crossing(cut.grey, edge.half, 0.5 * (edge.dark + edge.light));
     if (second != kNone) points.push_back(cut.base + (cut.first + second) * edge.normal);
   }
   if (static_cast<int>(points.size()) < kMinPoints) return false;
@@ -205,9 +194,7 @@ bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& 
     return false;
   }
   Eigen::Vector2d a, da, b, db;
-  if (!EdgeLine(cuts_a, cuts_a.dark, cuts_a.light, &a, &da) ||
-      !EdgeLine(cuts_b, cuts_b.dark, cuts_b.light, &b, &db))
-    return false;
+  if (!EdgeLine(cuts_a, &a, &da) || !EdgeLine(cuts_b, &b, &db)) return false;
   // a + s da = b + u db
   Eigen::Matrix2d m;
   m << da, -db;

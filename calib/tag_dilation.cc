@@ -103,8 +103,9 @@ void ShiftTagEdges(double shift_px, const std::vector<bool>& from_edges,
       // of 20 px or more: the shift, under 1 px, moves a few hundredths of a pixel less
       // or more). Before, such corners kept the whole shift (the inner corners of the outer
       // tags beside a narrow margin on a dark surround: 0.07-0.15 px out of the tag).
-      if (outlines == nullptr || outlines->count(tag) == 0) continue;
+      if (outlines == nullptr) continue;
       const auto it = outlines->find(tag);
+      if (it == outlines->end()) continue;
       const std::array<Eigen::Vector2d, 4>& q = it->second.p;
       d1 = (q[(k + 1) % 4] - q[k]).normalized(), d2 = (q[(k + 3) % 4] - q[k]).normalized();
     }

@@ -132,7 +132,7 @@ void PaintSession::DecideModelEarly() {
   if (!DecidingModelOnHeldOut() || model_decided_early_) return;
   model_decided_early_ = true;
   std::vector<double> psnr_sum;
-  const int measured = ScoreHeldOut(3, &psnr_sum);
+  const int measured = ScoreHeldOut(/*candidates=*/3, &psnr_sum);
   if (measured > 0 && psnr_sum[2] > std::max(psnr_sum[0], psnr_sum[1]))
     TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
 }
