@@ -89,8 +89,17 @@ Status PackAtlas(const std::vector<cv::Size>& buffer_sizes, const AtlasOptions& 
 }
 
 cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images) {
+  cv::Mat out;
+  ComposeAtlasPageInto(atlas, page, images, &out);
+  return out;
+}
+
+void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          cv::Mat* page_image) {
   const int type = images.empty() ? CV_8UC4 : images.front().type();
-  cv::Mat out = cv::Mat::zeros(atlas.pages[page], type);
+  page_image->create(atlas.pages[page], type);
+  page_image->setTo(cv::Scalar::all(0));
+  cv::Mat& out = *page_image;
   const int pad = atlas.padding;
   for (size_t b = 0; b < images.size() && b < atlas.placements.size(); ++b) {
     const AtlasPlacement& p = atlas.placements[b];
@@ -99,7 +108,6 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
     const cv::Rect with_padding(p.x - pad, p.y - pad, image.cols + 2 * pad, image.rows + 2 * pad);
     cv::copyMakeBorder(image, out(with_padding), pad, pad, pad, pad, cv::BORDER_REPLICATE);
   }
-  return out;
 }
 
 }  // namespace fresco

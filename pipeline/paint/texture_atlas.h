@@ -42,5 +42,8 @@ Status PackAtlas(const std::vector<cv::Size>& buffer_sizes, const AtlasOptions& 
 // Page `page` as an image of `type` (e.g. CV_8UC4), each buffer image copied to its
 // placement with its padding; texels of no buffer are zero.
 cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images);
+// The same into `out`, whose memory is reused when it already has the page's size and type.
+void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          cv::Mat* out);
 
 }  // namespace fresco

@@ -4,11 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/texture_atlas.h"
 #include "pipeline/render/renderer.h"
 
 namespace fresco {
@@ -33,14 +35,14 @@ cv::Mat MeanTexels(const cv::Mat& base, const cv::Mat& sums, const cv::Mat& held
   return bgra;
 }
 
-// PSNR of each rendering against `frame` over the pixels all of them paint, less `movers`
-// (kMoverPixel, any size); false when there is none.
-bool ComparedPsnr(const std::vector<RenderOutput>& rendered, const cv::Mat& frame,
-                  const cv::Mat& movers, std::vector<double>* psnr) {
+// PSNR of each rendering (RGBA) against `frame` over the pixels all of them paint, less
+// `movers` (kMoverPixel, any size); false when there is none.
+bool ComparedPsnr(const std::vector<cv::Mat>& rendered, const cv::Mat& frame, const cv::Mat& movers,
+                  std::vector<double>* psnr) {
   cv::Mat compared(frame.size(), CV_8U, cv::Scalar(255));
-  for (const RenderOutput& r : rendered) {
+  for (const cv::Mat& rgba : rendered) {
     cv::Mat alpha;
-    cv::extractChannel(r.rgba, alpha, 3);
+    cv::extractChannel(rgba, alpha, 3);
     compared &= alpha == 255;
   }
   if (!movers.empty()) {
@@ -51,13 +53,24 @@ bool ComparedPsnr(const std::vector<RenderOutput>& rendered, const cv::Mat& fram
   const int pixels = cv::countNonZero(compared);
   if (pixels == 0) return false;
   psnr->clear();
-  for (const RenderOutput& r : rendered) {
+  for (const cv::Mat& rgba : rendered) {
     cv::Mat bgr;
-    cv::cvtColor(r.rgba, bgr, cv::COLOR_RGBA2BGR);
+    cv::cvtColor(rgba, bgr, cv::COLOR_RGBA2BGR);
     const double mse = cv::norm(bgr, frame, cv::NORM_L2SQR, compared) / (3.0 * pixels);
     psnr->push_back(10 * std::log10(255.0 * 255.0 / std::max(mse, 1e-10)));
   }
   return true;
+}
+
+// The texture of each of `scene`'s atlas pages (PaintSession::PaintedScene: textures 0..pages-1)
+// composed again from `buffer_bgra`, in the memory it has.
+void ComposePagesInto(const TextureAtlas& atlas, const std::vector<cv::Mat>& buffer_bgra,
+                      Scene* scene) {
+  for (size_t page = 0; page < atlas.pages.size(); ++page) {
+    cv::Mat& rgba = scene->textures[page].rgba;
+    ComposeAtlasPageInto(atlas, static_cast<int>(page), buffer_bgra, &rgba);
+    cv::cvtColor(rgba, rgba, cv::COLOR_BGRA2RGBA);
+  }
 }
 
 }  // namespace
@@ -78,8 +91,9 @@ void PaintSession::KeepSharpestViews(const char* why) {
 // The candidates painted without the frames held out, rendered at those frames' poses:
 // `psnr_sum[c]` over the frames measured (the return value).
 int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const {
-  std::vector<Scene> scenes;
-  for (size_t c = 0; c < n; ++c) {
+  // One scene (the mesh with its atlas UVs), its pages composed again for each candidate; each
+  // frame rasterized once and shaded with each.
+  const auto candidate = [&](size_t c) {
     std::vector<cv::Mat> texels;
     for (const PaintedBuffer& p : painted_) {
       const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
@@ -88,17 +102,27 @@ int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const {
                                                : MeanTexels(base, p.unmasked_sum,
                                                             p.held_unmasked_sum)));
     }
-    scenes.push_back(PaintedScene(texels));
+    return texels;
+  };
+  Scene scene = PaintedScene(candidate(0));
+  std::vector<std::unique_ptr<Renderer>> renderers;
+  std::vector<RasterOutput> rasters(update_held_out_.size());
+  std::vector<std::vector<cv::Mat>> rendered(update_held_out_.size(), std::vector<cv::Mat>(n));
+  for (size_t f = 0; f < update_held_out_.size(); ++f) {
+    renderers.push_back(std::make_unique<Renderer>(update_held_out_[f].camera, RenderOptions()));
+    renderers[f]->RasterizeScene(scene, update_held_out_[f].cam_from_world, &rasters[f]);
+  }
+  for (size_t c = 0; c < n; ++c) {
+    if (c > 0) ComposePagesInto(atlas_, candidate(c), &scene);
+    for (size_t f = 0; f < update_held_out_.size(); ++f)
+      renderers[f]->ShadeScene(scene, rasters[f], &rendered[f][c]);
   }
   psnr_sum->assign(n, 0.0);
   std::vector<double> psnr;
   int measured = 0;
-  for (const HeldOutFrame& frame : update_held_out_) {
-    const Renderer renderer(frame.camera, RenderOptions());
-    std::vector<RenderOutput> rendered(n);
-    for (size_t c = 0; c < n; ++c)
-      renderer.Render(scenes[c], frame.cam_from_world, &rendered[c]);
-    if (!ComparedPsnr(rendered, frame.bgr, frame.movers, &psnr)) continue;
+  for (size_t f = 0; f < update_held_out_.size(); ++f) {
+    const HeldOutFrame& frame = update_held_out_[f];
+    if (!ComparedPsnr(rendered[f], frame.bgr, frame.movers, &psnr)) continue;
     for (size_t c = 0; c < n; ++c) (*psnr_sum)[c] += psnr[c];
     ++measured;
   }

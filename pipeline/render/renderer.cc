@@ -269,9 +269,18 @@ void Renderer::Render(const Scene& scene, const Rigid3d& cam_from_world,
   } else {
     CentreDepth(raster, n, nullptr, size, output);
   }
-  const TriangleShades shading = ShadesOf(scene);
-  output->rgba.create(size, CV_8UC4);
-  ShadePixels(raster, mesh, shading, options_, &output->rgba);
+  ShadeScene(scene, raster, &output->rgba);
+}
+
+void Renderer::RasterizeScene(const Scene& scene, const Rigid3d& cam_from_world,
+                              RasterOutput* raster) const {
+  rasterizer_.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world), raster);
+}
+
+void Renderer::ShadeScene(const Scene& scene, const RasterOutput& raster, cv::Mat* rgba) const {
+  const Camera& camera = rasterizer_.camera();
+  rgba->create(cv::Size(camera.width, camera.height), CV_8UC4);
+  ShadePixels(raster, scene.mesh, ShadesOf(scene), options_, rgba);
 }
 
 }  // namespace fresco

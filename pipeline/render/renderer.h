@@ -42,6 +42,12 @@ class Renderer {
   ~Renderer();
   // Thread-safe (const): several threads may render with one Renderer.
   void Render(const Scene& scene, const Rigid3d& cam_from_world, RenderOutput* output) const;
+  // Render's two halves, for scenes that differ only in their textures' pixels (one
+  // rasterization shaded with each): the samples `scene` shows at `cam_from_world`, then
+  // their colours (`rgba`: CV_8UC4, camera size), as Render's `rgba` to the bit.
+  void RasterizeScene(const Scene& scene, const Rigid3d& cam_from_world,
+                      RasterOutput* raster) const;
+  void ShadeScene(const Scene& scene, const RasterOutput& raster, cv::Mat* rgba) const;
   const Rasterizer& rasterizer() const { return rasterizer_; }
   const RenderOptions& options() const { return options_; }
 

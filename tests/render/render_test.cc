@@ -765,6 +765,40 @@ TEST(RendererTest, HeadOnTexturedPlaneReproducesTexture) {
   }
 }
 
+TEST(RendererTest, OneRasterShadedWithEachTextureMatchesRenderingEach) {
+  // A tilted textured quad, shaded from one rasterization with two textures in turn: each as
+  // Render with that texture to the bit (how the `update: auto` decision scores candidates).
+  const int width = 80, height = 60;
+  const double f = 90.0;
+  const Camera camera = PinholeCamera(width, height, f);
+  Scene scene;
+  scene.textures.push_back(MakeTexture(40, 30, 5));
+  Material material;
+  material.base_color_texture = 0;
+  scene.materials.push_back(material);
+  const Eigen::Vector3d corners[4] = {
+      {-1.2, -0.8, 2.5}, {-1.0, 0.9, 3.5}, {1.1, 0.8, 4.0}, {1.0, -0.9, 2.8}};
+  const Eigen::Vector2f uvs[4] = {{0, 0}, {0, 1}, {1, 1}, {1, 0}};
+  AddQuad(&scene.mesh, corners, uvs);
+  for (const int n : {1, 2}) {
+    RenderOptions options;
+    options.raster.supersample = n;
+    const Renderer renderer(camera, options);
+    RasterOutput raster;
+    renderer.RasterizeScene(scene, Rigid3d(), &raster);
+    for (const int seed : {5, 9}) {
+      scene.textures[0] = MakeTexture(40, 30, seed);
+      RenderOutput whole;
+      renderer.Render(scene, Rigid3d(), &whole);
+      cv::Mat shaded;
+      renderer.ShadeScene(scene, raster, &shaded);
+      ASSERT_GT(cv::countNonZero(whole.triangle_id >= 0), width * height / 4) << n;
+      EXPECT_EQ(cv::norm(shaded, whole.rgba, cv::NORM_INF), 0)
+          << "supersample " << n << ", texture " << seed;
+    }
+  }
+}
+
 TEST(RendererTest, AlphaMaterialColourAndNoBleeding) {
   const Camera camera = PinholeCamera(64, 48, 60.0);
   Scene scene;
