@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <future>
 #include <map>
 #include <memory>
@@ -17,6 +18,7 @@
 #include "pipeline/run/live_frame_source.h"
 #include "pipeline/run/merged_frame_source.h"
 #include "pipeline/run/offset_estimator.h"
+#include "pipeline/run/prepass_file.h"
 
 namespace fresco {
 
@@ -64,6 +66,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
   }
   j->mover_masks = all;
+  j->prepass.background_across_views = {all.fraction(), static_cast<int>(where.size())};
   j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
   // No background model, nothing for the masks to join: not kept.
   if (j->session->options().background.mode == BackgroundMode::kOff)
@@ -79,6 +82,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
 // with its capture; the videos open again for painting.
 Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& options,
                                PaintJob* j) {
+  j->prepass.ran = true;
   const bool joint = project.pipeline.refine.joint;
   const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
   PoseAdjustOptions adjust_options;
@@ -155,10 +159,13 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     // Where the check found corrections that frames left out do not agree better with,
     // refinement (a correction of the same kind, per frame) is not switched on either.
     if (adjusted.not_run.empty() && adjust_options.check_min_improvement > 0 &&
-        adjusted.check_one_end_px > 0)
+        adjusted.check_one_end_px > 0) {
+      j->prepass.pose_check = {adjusted.check_before_px / adjusted.check_one_end_px,
+                               adjust_options.check_min_improvement, adjusted.decided_on_frames};
       j->session->SetRefinePoseCheck(adjusted.check_before_px / adjusted.check_one_end_px,
                                      adjust_options.check_min_improvement,
                                      adjusted.decided_on_frames);
+    }
     cam_from_local = adjusted.cam_from_local;
     const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
     for (size_t k = 0; k < where.size(); ++k)
@@ -175,6 +182,23 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t s = 0; s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
+  return Status::Ok();
+}
+
+// The whole-capture pre-pass, when the project needs one: read from options.prepass_file when
+// it exists, else run (and written there when named).
+Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+  if (!NeedsWholeCapturePrepass(project)) return Status::Ok();
+  const auto start = std::chrono::steady_clock::now();
+  if (!options.prepass_file.empty() && std::filesystem::exists(options.prepass_file)) {
+    FRESCO_RETURN_IF_ERROR(ReadPrepassFile(options.prepass_file, project, j));
+  } else {
+    FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, j));
+    if (options.prepass_file.empty()) return Status::Ok();
+    FRESCO_RETURN_IF_ERROR(WritePrepassFile(options.prepass_file, project, *j));
+  }
+  j->open_seconds.prepass_file =
+      SecondsSince(start) - j->open_seconds.read - j->open_seconds.joint - j->open_seconds.movers;
   return Status::Ok();
 }
 
@@ -220,8 +244,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
     return Status::Error(project.file_path +
                          ": --shard paints captures from files (a live stream cannot be split)");
   if (!j.live) {
-    if (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background))
-      FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
+    FRESCO_RETURN_IF_ERROR(PrepareOrReadPrepass(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     FileFrameSource::SkipFrame skip;

@@ -1,6 +1,7 @@
 #include "pipeline/run/shard.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <numeric>
 
@@ -30,6 +31,15 @@ Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpe
   spec->index = static_cast<int>(index);
   spec->count = static_cast<int>(count);
   return Status::Ok();
+}
+
+std::string SettingsHash(const Project& project) {
+  const std::string fingerprint = ProjectToJsonText(project);
+  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a
+  for (unsigned char c : fingerprint) hash = (hash ^ c) * 1099511628211ULL;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", hash);
+  return hex;
 }
 
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers, int count) {

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/project.h"
 #include "pipeline/core/status.h"
 #include "pipeline/paint/base_buffer.h"
 
@@ -24,6 +25,10 @@ struct ShardSpec {
 
 // Reads "I/N" (0 <= I < N, N >= 1): an error naming `what` (e.g. "--shard") and the value.
 Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpec* spec);
+
+// A fingerprint of the project and its settings (16 hex digits, FNV-1a of its JSON text): parts
+// and pre-pass files made for one project and settings carry the same.
+std::string SettingsHash(const Project& project);
 
 // The shard each buffer goes to (size: buffers): the largest buffers first (surface texels,
 // then id), each to the shard holding the fewest texels so far (the lowest index at a tie).
