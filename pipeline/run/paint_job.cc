@@ -202,6 +202,24 @@ Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& optio
   return Status::Ok();
 }
 
+// How many of the capture's poses see each buffer (its bounds in their view), counted over at
+// most kPosesCounted poses spread evenly over the streams' poses in order.
+std::vector<int> FramesSeeingBuffers(const PaintJob& j,
+                                     const std::map<const Camera*, NormalizedBounds>& bounds) {
+  constexpr size_t kPosesCounted = 512;
+  std::vector<std::pair<const Camera*, const Rigid3d*>> views;
+  for (const Capture& capture : j.captures)
+    for (const PosedImage& pose : capture.poses)
+      if (const Camera* camera = capture.CameraFor(pose))
+        views.push_back({camera, &pose.cam_from_world});
+  std::vector<int> counts(j.session->buffers().size(), 0);
+  const size_t step = std::max<size_t>(1, (views.size() + kPosesCounted - 1) / kPosesCounted);
+  for (size_t k = 0; k < views.size(); k += step)
+    if (const auto it = bounds.find(views[k].first); it != bounds.end())
+      j.session->CountBuffersInView(*views[k].first, it->second, *views[k].second, &counts);
+  return counts;
+}
+
 // PaintJobOptions::paint_at_truth_poses: each pose with a true one of its name takes it.
 void TakeTruthPoses(Capture* capture) {
   std::map<std::string, const PosedImage*> truth;
@@ -249,15 +267,16 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     FileFrameSource::SkipFrame skip;
     if (options.shard.sharded()) {
-      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), options.shard.count);
-      std::vector<bool> own(j.buffer_shard.size());
-      for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
-      j.session->SetOwnBuffers(std::move(own));
       // Each camera's frustum bounds, computed here: the skip runs on the reading threads.
       auto bounds = std::make_shared<std::map<const Camera*, NormalizedBounds>>();
       for (const Capture& capture : j.captures)
         for (const auto& [id, camera] : capture.cameras)
           (*bounds)[&camera] = ComputeNormalizedBounds(camera);
+      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), FramesSeeingBuffers(j, *bounds),
+                                             options.shard.count);
+      std::vector<bool> own(j.buffer_shard.size());
+      for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
+      j.session->SetOwnBuffers(std::move(own));
       const PaintSession* session = j.session.get();
       skip = [session, bounds](const SourcedFrame& f) {
         const auto it = bounds->find(f.camera);

@@ -57,7 +57,7 @@ struct PaintJobOptions {
   bool paint_at_truth_poses = false;
   // Paint only shard `shard.index` of `shard.count` (shard.h; captures from files only): the
   // session paints that shard's buffers and the source skips, unread, the frames whose view
-  // meets none of them (folders; a video file's frames are decoded still).
+  // meets none of them (folders: unread; video files: grabbed, not converted to BGR).
   ShardSpec shard;
   // Non-empty (captures from files): the whole-capture pre-pass's outcome is read from this
   // file (prepass_file.h) instead of being found again; when the file does not exist, the
