@@ -3,7 +3,8 @@
 // its .bin, every atlas page; texels and coverage in metrics.json), on the default project
 // (one stream, the defaults: joint pose check, `auto` modes) and on a capture of two streams,
 // for N = 1, 2 and 4; each shard paints only its charts and skips frames; bad shard specs and
-// bad sets of parts are refused with exit 2 naming them, leaving the output folder untouched.
+// bad sets of parts are refused with exit 2 naming them, leaving the output folder untouched;
+// so is a pre-pass file written for other settings.
 #include <filesystem>
 #include <map>
 #include <string>
@@ -128,6 +129,30 @@ TEST(ShardMerge, BadShardSpecsAreRefused) {
     EXPECT_NE(r.err.find("--shard"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out)) << bad;
   }
+}
+
+// A pre-pass file is for its project and settings only: another run refuses it (exit 2,
+// naming the file and the field) and paints nothing; --prepass-only needs the file's name.
+TEST(ShardMerge, PrepassFileOfOtherSettingsIsRefused) {
+  const std::string root = testing::SourceDir() + "/projects/cube-room";
+  ASSERT_EQ(RunFresco({"synth", root + "/synth.json", "--if-changed"}).exit_code, 0);
+  const std::string work = MakeTempDir("shard-prepass");
+  const std::string prepass = work + "/prepass.json";
+  const testing::CommandResult written =
+      RunFresco({"run", root + "/project.json", "--prepass", prepass, "--prepass-only", "--set",
+                 "pipeline.max_frames=6", "--quiet"});
+  ASSERT_EQ(written.exit_code, 0) << written.err;
+  ASSERT_TRUE(fs::exists(prepass));
+  const testing::CommandResult other =
+      RunFresco({"run", root + "/project.json", "--out", work + "/out", "--shard", "0/2",
+                 "--prepass", prepass, "--set", "pipeline.max_frames=8", "--quiet"});
+  EXPECT_EQ(other.exit_code, 2) << other.err;
+  EXPECT_NE(other.err.find(prepass + ": settings_hash"), std::string::npos) << other.err;
+  EXPECT_FALSE(fs::exists(work + "/out/painted.gltf"));
+  const testing::CommandResult unnamed =
+      RunFresco({"run", root + "/project.json", "--prepass-only", "--quiet"});
+  EXPECT_EQ(unnamed.exit_code, 2) << unnamed.err;
+  EXPECT_NE(unnamed.err.find("--prepass"), std::string::npos) << unnamed.err;
 }
 
 TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
