@@ -18,11 +18,12 @@
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
 #include "pipeline/live/live_input.h"
-#include "pipeline/run/live_status.h"
 #include "pipeline/paint/charts.h"
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/run/live_status.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
+#include "pipeline/run/prepass_file.h"
 #include "pipeline/run/shard.h"
 
 namespace fresco {
@@ -32,7 +33,7 @@ ArgSpec RunSpec() {
   ArgSpec spec;
   spec.usage =
       "fresco run PROJECT.json --out DIR [--set KEY=VALUE ...] [--debug-images] [--quiet]\n"
-      "       [--record DIR] [--shard I/N]";
+      "       [--record DIR] [--shard I/N] [--prepass FILE [--prepass-only]]";
   spec.help =
       "Replays the project headless: streams its video, paints every frame into the base\n"
       "buffers, and writes DIR/painted.gltf (+ .bin and one PNG per texture atlas page;\n"
@@ -48,7 +49,12 @@ ArgSpec RunSpec() {
       "  --shard I/N       paint only shard I (0..N-1) of N: its charts (balanced by texels),\n"
       "                    reading only the frames that see them; DIR holds a part that\n"
       "                    `fresco merge` joins with the others into exactly this run's\n"
-      "                    outputs (docs/guide/slurm.md; captures from files)\n\n"
+      "                    outputs (docs/guide/slurm.md; captures from files)\n"
+      "  --prepass FILE    the whole-capture pre-pass (the joint pose check, the movers found\n"
+      "                    across views, the decisions they take) read from FILE; when FILE\n"
+      "                    does not exist, run and written to it: the shards of one project\n"
+      "                    run it once (FILE is for this project and these settings only)\n"
+      "  --prepass-only    write the --prepass FILE and stop, painting nothing (no --out)\n\n"
       "Live sources (docs/guide/live.md): `video` may be device:N or a stream URL\n"
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
       "(tcp://HOST:PORT, udp://HOST:PORT, fifo://PATH) or a TUM file; frames match poses\n"
@@ -62,10 +68,9 @@ ArgSpec RunSpec() {
       "taken in turn (none starves another), and metrics.json has a \"live\" object per\n"
       "live stream in \"streams\". --record needs a project with one stream.";
   spec.min_positional = spec.max_positional = 1;
-  spec.options = {"--out", "--record", "--shard"};
+  spec.options = {"--out", "--record", "--shard", "--prepass"};
   spec.repeatable = {"--set"};
-  spec.switches = {"--debug-images", "--quiet"};
-  spec.required = {"--out"};
+  spec.switches = {"--debug-images", "--quiet", "--prepass-only"};
   return spec;
 }
 
@@ -174,24 +179,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
   // What the `auto` modes decided, with their evidence (null for a mode not auto).
   metrics["auto"] = nlohmann::json::parse(AutoDecisionsJson(session->auto_decisions()));
   if (job.joint_poses) {  // pipeline.refine.joint: the poses adjusted before painting
-    const PoseAdjustResult& a = *job.joint_poses;
-    metrics["joint_poses"] = {{"applied", a.applied},
-                              {"not_run", a.not_run},
-                              {"matches", a.matches},
-                              {"inliers", a.inliers},
-                              {"check_matches", a.check_matches},
-                              {"check_before_px", a.check_before_px},
-                              {"check_after_px", a.check_after_px},
-                              {"check_one_end_px", a.check_one_end_px},
-                              {"check_seconds", a.check_seconds},
-                              {"rms_before_px", a.rms_before_px},
-                              {"rms_after_px", a.rms_after_px},
-                              {"median_rotation_deg", a.median_rotation_deg},
-                              {"median_translation_m", a.median_translation_m},
-                              {"rotation_prior_deg", a.rotation_prior_deg},
-                              {"translation_prior_m", a.translation_prior_m},
-                              {"decided_on_frames", a.decided_on_frames},
-                              {"seconds", a.seconds}};
+    metrics["joint_poses"] = PoseAdjustSummaryJson(*job.joint_poses);
   }
   if (job.mover_masks) {  // background.mode auto: movers found across views before painting
     const MoverMaskResult& m = *job.mover_masks;
@@ -291,15 +279,10 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
         cv::Rect(cv::Point(0, 0), atlas.pages[place.page]);
     rects.push_back({place.page, padded.x, padded.y, padded.width, padded.height});
   }
-  std::string fingerprint = ProjectToJsonText(project);
-  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a
-  for (unsigned char c : fingerprint) hash = (hash ^ c) * 1099511628211ULL;
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", hash);
   return {{"index", shard.index},
           {"count", shard.count},
           {"project", project.file_path},
-          {"settings_hash", hex},
+          {"settings_hash", SettingsHash(project)},
           {"buffers", buffers},
           {"page_rects", rects},
           {"texels", texels},
@@ -331,6 +314,7 @@ nlohmann::json WallJson(const PaintJob& job, const PaintRunStats& stats, double 
             {"prepass_read", o.read},
             {"prepass_joint", o.joint},
             {"prepass_movers", o.movers},
+            {"prepass_file", o.prepass_file},
             {"connect", o.connect}}},
           {"paint_seconds", stats.seconds},
           {"write_seconds", write_s},
@@ -445,6 +429,11 @@ int RunVerbRun(const CommandArgs& argv) {
   const std::string project_path = args.positional[0];
   const std::string out_dir = args.Get("--out");
   const bool quiet = args.Switch("--quiet");
+  const std::string prepass_file = args.Get("--prepass");
+  const bool prepass_only = args.Switch("--prepass-only");
+  if (prepass_only && prepass_file.empty())
+    return Fail(Status::Error("--prepass-only: needs --prepass FILE (the file to write)"));
+  if (!prepass_only && !args.Has("--out")) return UsageError("run", spec, "missing --out");
 
   Project project;
   if (Status s = LoadProject(project_path, args.All("--set"), &project); !s.ok()) return Fail(s);
@@ -462,10 +451,26 @@ int RunVerbRun(const CommandArgs& argv) {
   PaintJobOptions job_options;
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.shard = shard;
+  job_options.prepass_file = prepass_file;
+  if (prepass_only && !NeedsWholeCapturePrepass(project)) {
+    if (!quiet)
+      std::fprintf(stderr,
+                   "fresco run: %s needs no whole-capture pre-pass (refine.joint off, no "
+                   "movers across views): %s not written\n",
+                   project_path.c_str(), prepass_file.c_str());
+    return kExitOk;
+  }
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;
   if (Status s = OpenPaintJob(project, job_options, &job); !s.ok()) return Fail(s);
+  if (prepass_only) {
+    if (!quiet) {
+      PrintJobSummary(*job, specs.size());
+      std::fprintf(stderr, "fresco run: whole-capture pre-pass -> %s\n", prepass_file.c_str());
+    }
+    return kExitOk;
+  }
   const double setup_peak_rss_mb = PeakRssMb();
   PaintSession* session = job->session.get();
   LiveRecording recording;

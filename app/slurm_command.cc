@@ -1,7 +1,8 @@
 // fresco slurm PROJECT.json --out DIR --shards N [--submit] [--sbatch "OPTIONS"]: writes a
 // Slurm array job painting the project in N shards (`fresco run --shard I/N` into
 // DIR/parts/I) and a job merging them into DIR after the array succeeds; --submit submits
-// both with the `sbatch` on PATH (the cluster SLURM_CONF names).
+// both with the `sbatch` on PATH (the cluster SLURM_CONF names); a project that needs the
+// whole-capture pre-pass gets a job running it once first, which the array waits for.
 #include <unistd.h>
 
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/project.h"
 #include "pipeline/core/run_process.h"
+#include "pipeline/run/prepass_file.h"
 
 namespace fresco {
 namespace {
@@ -27,13 +29,17 @@ ArgSpec SlurmSpec() {
       "Paints a project on a Slurm cluster in N shards: writes DIR/paint.sbatch (an array job,\n"
       "task I running `fresco run PROJECT --out DIR/parts/I --shard I/N`) and\n"
       "DIR/merge.sbatch (`fresco merge DIR/parts/0 ... --out DIR`, to run after every task\n"
-      "succeeded: --dependency=afterok). DIR/painted.gltf and DIR/metrics.json appear when the\n"
+      "succeeded: --dependency=afterok). When the project's settings need the whole-capture\n"
+      "pre-pass (the joint pose check, movers found across views), DIR/prepass.sbatch runs it\n"
+      "once first (`fresco run --prepass DIR/prepass.json --prepass-only`) and every task reads\n"
+      "its outcome (--prepass). DIR/painted.gltf and DIR/metrics.json appear when the\n"
       "merge job ends. DIR must be on a file system every node sees; the jobs run this\n"
       "fresco executable by its absolute path. Logs: DIR/logs/. A failed task: resubmit\n"
       "that index (sbatch --array=I DIR/paint.sbatch), then DIR/merge.sbatch.\n\n"
       "  --shards N        shards (array tasks), N >= 1\n"
-      "  --submit          submit both jobs with `sbatch` on PATH and print their ids\n"
-      "  --sbatch OPTIONS  extra sbatch options for both jobs, e.g. \"--partition=big --mem=8G\"\n"
+      "  --submit          submit the jobs with `sbatch` on PATH (each after the one before\n"
+      "                    succeeded) and print their ids\n"
+      "  --sbatch OPTIONS  extra sbatch options for every job, e.g. \"--partition=big --mem=8G\"\n"
       "                    (written as #SBATCH lines)\n"
       "  --set KEY=VALUE   project settings passed to every shard (as `fresco run`'s)";
   spec.min_positional = spec.max_positional = 1;
@@ -110,11 +116,18 @@ int RunVerbSlurm(const CommandArgs& argv) {
   std::string sets;
   for (const std::string& set : args.All("--set")) sets += " --set " + ShellQuote(set);
   const std::string n = std::to_string(shards);
+  // The whole-capture pre-pass, run once before the array (which reads it) when needed.
+  const bool prepass = NeedsWholeCapturePrepass(project);
+  const std::string prepass_file = dir + "/prepass.json";
+  std::string prepass_job = Header("fresco-prepass", dir + "/logs/prepass.out", {}, extra);
+  prepass_job += "exec " + ShellQuote(fresco) + " run " + ShellQuote(project_path) + " --prepass " +
+                 ShellQuote(prepass_file) + " --prepass-only --quiet" + sets + "\n";
   std::string paint = Header("fresco-paint", dir + "/logs/paint-%a.out",
                              {"--array=0-" + std::to_string(shards - 1)}, extra);
   paint += "I=${SLURM_ARRAY_TASK_ID:?run as a Slurm array task}\n";
   paint += "exec " + ShellQuote(fresco) + " run " + ShellQuote(project_path) + " --out " +
-           ShellQuote(dir + "/parts/") + "\"$I\" --shard \"$I/" + n + "\" --quiet" + sets + "\n";
+           ShellQuote(dir + "/parts/") + "\"$I\" --shard \"$I/" + n + "\" --quiet" + sets +
+           (prepass ? " --prepass " + ShellQuote(prepass_file) : std::string()) + "\n";
   // A failed shard cancels the merge (else it would wait forever, DependencyNeverSatisfied).
   std::string merge =
       Header("fresco-merge", dir + "/logs/merge.out", {"--kill-on-invalid-dep=yes"}, extra);
@@ -122,9 +135,12 @@ int RunVerbSlurm(const CommandArgs& argv) {
   for (int i = 0; i < shards; ++i) merge += " " + ShellQuote(dir + "/parts/" + std::to_string(i));
   merge += " --out " + ShellQuote(dir) + " --quiet\n";
   if (Status s = MakeDirectories(dir + "/logs"); !s.ok()) return Fail(s);
+  if (prepass)
+    if (Status s = WriteFileAtomic(dir + "/prepass.sbatch", prepass_job); !s.ok()) return Fail(s);
   if (Status s = WriteFileAtomic(dir + "/paint.sbatch", paint); !s.ok()) return Fail(s);
   if (Status s = WriteFileAtomic(dir + "/merge.sbatch", merge); !s.ok()) return Fail(s);
   if (!args.Switch("--submit")) {
+    if (prepass) std::printf("%s/prepass.sbatch\n", dir.c_str());
     std::printf("%s/paint.sbatch\n%s/merge.sbatch\n", dir.c_str(), dir.c_str());
     return kExitOk;
   }
@@ -134,9 +150,19 @@ int RunVerbSlurm(const CommandArgs& argv) {
         Status::Error("--submit: sbatch not found on PATH (install Slurm's client, or "
                       "submit DIR/paint.sbatch and DIR/merge.sbatch by hand)"));
   const std::string log = dir + "/logs/sbatch.log";
-  std::string paint_id, merge_id;
-  if (Status s = Submit({sbatch, "--parsable", dir + "/paint.sbatch"}, log, &paint_id); !s.ok())
-    return Fail(s);
+  std::string prepass_id, paint_id, merge_id;
+  std::vector<std::string> paint_argv = {sbatch, "--parsable"};
+  if (prepass) {
+    if (Status s = Submit({sbatch, "--parsable", dir + "/prepass.sbatch"}, log, &prepass_id);
+        !s.ok())
+      return Fail(s);
+    std::printf("prepass %s\n", prepass_id.c_str());
+    // A failed pre-pass cancels the array (and so the merge) instead of leaving it waiting.
+    paint_argv.insert(paint_argv.end(),
+                      {"--dependency=afterok:" + prepass_id, "--kill-on-invalid-dep=yes"});
+  }
+  paint_argv.push_back(dir + "/paint.sbatch");
+  if (Status s = Submit(paint_argv, log, &paint_id); !s.ok()) return Fail(s);
   if (Status s =
           Submit({sbatch, "--parsable", "--dependency=afterok:" + paint_id, dir + "/merge.sbatch"},
                  log, &merge_id);

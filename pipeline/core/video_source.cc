@@ -114,7 +114,7 @@ class FolderSource : public VideoSource {
   int FrameCount() const override { return static_cast<int>(names_.size()); }
   std::vector<std::string> FrameNames() const override { return names_; }
   double Fps() const override { return kDefaultFolderFps; }
-  bool PeekNext(Frame* header) const override {
+  bool PeekNext(Frame* header) override {
     if (next_ >= names_.size()) return false;
     header->index = static_cast<int>(next_);
     header->name = names_[next_];
@@ -149,11 +149,34 @@ class CaptureSource : public VideoSource {
     count_ = !live_ && std::isfinite(count) && count > 0 ? static_cast<int>(count) : -1;
   }
 
+  // Video files: the next frame grabbed (demuxed and decoded by FFmpeg, not converted), so
+  // that a frame skipped costs no conversion to BGR; a frame grabbed is Next()'s to retrieve.
+  bool PeekNext(Frame* header) override {
+    if (live_) return false;
+    if (!grabbed_) grabbed_ = capture_.grab();
+    if (!grabbed_) return false;  // the end: Next() says so (and whether it came too early)
+    char name[32];
+    std::snprintf(name, sizeof(name), "%06d.png", index_);
+    header->index = index_;
+    header->name = name;
+    header->timestamp_s = index_ / fps_;
+    header->bgr.release();
+    return true;
+  }
+  void SkipNext() override {
+    if (!grabbed_) return;
+    grabbed_ = false;
+    ++index_;
+  }
+
   bool Next(Frame* frame, Status* status) override {
     cv::Mat image;
     const auto read_start = std::chrono::steady_clock::now();
     timed_out_ = false;
-    const bool read = capture_.read(image) && !image.empty();
+    const bool was_grabbed = grabbed_;
+    grabbed_ = false;
+    const bool read =
+        (was_grabbed ? capture_.retrieve(image) : capture_.read(image)) && !image.empty();
     const double read_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
     const double previous_read_s = last_read_s_;
@@ -243,6 +266,7 @@ class CaptureSource : public VideoSource {
   bool stream_clock_;
   double read_timeout_s_;
   bool timed_out_ = false;
+  bool grabbed_ = false;      // PeekNext grabbed the next frame
   double last_read_s_ = 0.0;  // how long the last read took
   bool use_stream_clock_ = false;
   double first_pts_ms_ = 0.0;

@@ -44,10 +44,12 @@ class VideoSource {
   // Frame names in order when known (folders), else empty.
   virtual std::vector<std::string> FrameNames() const = 0;
   virtual double Fps() const = 0;
-  // The next frame's index, name and timestamp without reading it, where they are known
-  // before decoding (folders); false otherwise (nothing to skip without decoding).
-  virtual bool PeekNext(Frame* /*header*/) const { return false; }
-  // Passes over the next frame without reading it (after PeekNext said true).
+  // The next frame's index, name and timestamp without reading its pixels, where they are
+  // known before (folders: nothing is read; video files: the next frame is grabbed, not yet
+  // converted to BGR); false otherwise (live sources, the end: nothing to skip).
+  virtual bool PeekNext(Frame* /*header*/) { return false; }
+  // Passes over the next frame without reading it (after PeekNext said true; a video file's
+  // grabbed frame is dropped unconverted).
   virtual void SkipNext() {}
   // A camera or a stream (frames arrive on their own clock; reading may time out).
   virtual bool IsLive() const { return false; }

@@ -199,19 +199,35 @@ bool PaintSession::CouplesBuffers() const {
           options_.background.normalize_gain);
 }
 
-bool PaintSession::ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
-                                       const Rigid3d& cam_from_world) const {
+FrameView PaintSession::BoundsView(const Camera& camera, const NormalizedBounds& bounds,
+                                   const Rigid3d& cam_from_world) const {
   FrameView view;
   view.camera = &camera;
   view.cam_from_local = CamFromLocal(*scene_, cam_from_world);
   view.centre_local = view.cam_from_local.Centre();
   view.bounds = bounds;
+  return view;
+}
+
+bool PaintSession::ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
+                                       const Rigid3d& cam_from_world) const {
+  const FrameView view = BoundsView(camera, bounds, cam_from_world);
   const double near_m = WarpOptions().near_m;
   for (size_t b = 0; b < set_.buffers.size(); ++b)
     if ((own_.empty() || own_[b]) &&
         !BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view, near_m))
       return true;
   return false;
+}
+
+void PaintSession::CountBuffersInView(const Camera& camera, const NormalizedBounds& bounds,
+                                      const Rigid3d& cam_from_world,
+                                      std::vector<int>* counts) const {
+  const FrameView view = BoundsView(camera, bounds, cam_from_world);
+  const double near_m = WarpOptions().near_m;
+  for (size_t b = 0; b < set_.buffers.size(); ++b)
+    (*counts)[b] +=
+        !BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view, near_m);
 }
 
 std::vector<BufferBackground>& PaintSession::StreamBackground(int stream) {

@@ -191,6 +191,10 @@ class PaintSession {
   // ComputeNormalizedBounds(camera). Const, for a source reading ahead.
   bool ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
                            const Rigid3d& cam_from_world) const;
+  // Adds 1 to (*counts)[b] for every buffer b whose bounds the view meets (the same test; counts
+  // has one entry per buffer): how many frames see each buffer, which shards balance.
+  void CountBuffersInView(const Camera& camera, const NormalizedBounds& bounds,
+                          const Rigid3d& cam_from_world, std::vector<int>* counts) const;
   // A frame the source skipped (PaintsOwnBuffersOnly, its view meets no own buffer): counted
   // as painted frames are (the frame numbers the stages and `update_every` use) and nothing
   // else; painting it would have changed no own buffer.
@@ -283,6 +287,9 @@ class PaintSession {
   // frame's transform (select_stages.cc). The buffer itself when the stage is off.
   cv::Mat AtMeanExposure(const cv::Mat& bgra) const;
 
+  // The view ViewMeetsOwnBuffers and CountBuffersInView test the buffers' bounds against.
+  FrameView BoundsView(const Camera& camera, const NormalizedBounds& bounds,
+                       const Rigid3d& cam_from_world) const;
   // Sharded painting (SetOwnBuffers): the own buffers, and whether only they are painted.
   void UpdateOwnOnly() { own_only_.store(own_only_.load() || (!own_.empty() && !CouplesBuffers())); }
   std::vector<bool> own_;

@@ -43,10 +43,11 @@ class FileFrameSource : public PosedFrameSource {
  public:
   // `streams[i]`: stream i of `project` (Project::Streams() order) loaded with its video
   // open (LoadCapture); each must outlive the source.
-  // `skip` (optional; folders only, whose frame names are known before decoding): asked, on
+  // `skip` (optional; folders and video files, VideoSource::PeekNext): asked, on
   // the reading thread, with a posed frame's header (pose, camera; no pixels); true: the frame
   // is not read and comes out with `skipped` set.
-  // `read_frames_without_pose` false (folders only): a frame without a pose is not decoded and
+  // `read_frames_without_pose` false (folders and video files): a frame without a pose is not
+  // decoded (a video file's: not converted) and
   // comes out without pixels (nothing paints it; the app shows it, so reads it).
   // `decoded` (optional; folders only): a frame kept there is taken from it, not decoded.
   using SkipFrame = std::function<bool(const SourcedFrame& header)>;

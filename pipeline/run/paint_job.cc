@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <future>
 #include <map>
 #include <memory>
@@ -17,6 +18,7 @@
 #include "pipeline/run/live_frame_source.h"
 #include "pipeline/run/merged_frame_source.h"
 #include "pipeline/run/offset_estimator.h"
+#include "pipeline/run/prepass_file.h"
 
 namespace fresco {
 
@@ -64,6 +66,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
   }
   j->mover_masks = all;
+  j->prepass.background_across_views = {all.fraction(), static_cast<int>(where.size())};
   j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
   // No background model, nothing for the masks to join: not kept.
   if (j->session->options().background.mode == BackgroundMode::kOff)
@@ -79,6 +82,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
 // with its capture; the videos open again for painting.
 Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& options,
                                PaintJob* j) {
+  j->prepass.ran = true;
   const bool joint = project.pipeline.refine.joint;
   const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
   PoseAdjustOptions adjust_options;
@@ -155,10 +159,13 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     // Where the check found corrections that frames left out do not agree better with,
     // refinement (a correction of the same kind, per frame) is not switched on either.
     if (adjusted.not_run.empty() && adjust_options.check_min_improvement > 0 &&
-        adjusted.check_one_end_px > 0)
+        adjusted.check_one_end_px > 0) {
+      j->prepass.pose_check = {adjusted.check_before_px / adjusted.check_one_end_px,
+                               adjust_options.check_min_improvement, adjusted.decided_on_frames};
       j->session->SetRefinePoseCheck(adjusted.check_before_px / adjusted.check_one_end_px,
                                      adjust_options.check_min_improvement,
                                      adjusted.decided_on_frames);
+    }
     cam_from_local = adjusted.cam_from_local;
     const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
     for (size_t k = 0; k < where.size(); ++k)
@@ -176,6 +183,41 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   for (size_t s = 0; s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
   return Status::Ok();
+}
+
+// The whole-capture pre-pass, when the project needs one: read from options.prepass_file when
+// it exists, else run (and written there when named).
+Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+  if (!NeedsWholeCapturePrepass(project)) return Status::Ok();
+  const auto start = std::chrono::steady_clock::now();
+  if (!options.prepass_file.empty() && std::filesystem::exists(options.prepass_file)) {
+    FRESCO_RETURN_IF_ERROR(ReadPrepassFile(options.prepass_file, project, j));
+  } else {
+    FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, j));
+    if (options.prepass_file.empty()) return Status::Ok();
+    FRESCO_RETURN_IF_ERROR(WritePrepassFile(options.prepass_file, project, *j));
+  }
+  j->open_seconds.prepass_file =
+      SecondsSince(start) - j->open_seconds.read - j->open_seconds.joint - j->open_seconds.movers;
+  return Status::Ok();
+}
+
+// How many of the capture's poses see each buffer (its bounds in their view), counted over at
+// most kPosesCounted poses spread evenly over the streams' poses in order.
+std::vector<int> FramesSeeingBuffers(const PaintJob& j,
+                                     const std::map<const Camera*, NormalizedBounds>& bounds) {
+  constexpr size_t kPosesCounted = 512;
+  std::vector<std::pair<const Camera*, const Rigid3d*>> views;
+  for (const Capture& capture : j.captures)
+    for (const PosedImage& pose : capture.poses)
+      if (const Camera* camera = capture.CameraFor(pose))
+        views.push_back({camera, &pose.cam_from_world});
+  std::vector<int> counts(j.session->buffers().size(), 0);
+  const size_t step = std::max<size_t>(1, (views.size() + kPosesCounted - 1) / kPosesCounted);
+  for (size_t k = 0; k < views.size(); k += step)
+    if (const auto it = bounds.find(views[k].first); it != bounds.end())
+      j.session->CountBuffersInView(*views[k].first, it->second, *views[k].second, &counts);
+  return counts;
 }
 
 // PaintJobOptions::paint_at_truth_poses: each pose with a true one of its name takes it.
@@ -220,21 +262,21 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
     return Status::Error(project.file_path +
                          ": --shard paints captures from files (a live stream cannot be split)");
   if (!j.live) {
-    if (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background))
-      FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, &j));
+    FRESCO_RETURN_IF_ERROR(PrepareOrReadPrepass(project, options, &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     FileFrameSource::SkipFrame skip;
     if (options.shard.sharded()) {
-      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), options.shard.count);
-      std::vector<bool> own(j.buffer_shard.size());
-      for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
-      j.session->SetOwnBuffers(std::move(own));
       // Each camera's frustum bounds, computed here: the skip runs on the reading threads.
       auto bounds = std::make_shared<std::map<const Camera*, NormalizedBounds>>();
       for (const Capture& capture : j.captures)
         for (const auto& [id, camera] : capture.cameras)
           (*bounds)[&camera] = ComputeNormalizedBounds(camera);
+      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), FramesSeeingBuffers(j, *bounds),
+                                             options.shard.count);
+      std::vector<bool> own(j.buffer_shard.size());
+      for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
+      j.session->SetOwnBuffers(std::move(own));
       const PaintSession* session = j.session.get();
       skip = [session, bounds](const SourcedFrame& f) {
         const auto it = bounds->find(f.camera);

@@ -10,6 +10,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "pipeline/core/capture.h"
@@ -55,8 +57,12 @@ struct PaintJobOptions {
   bool paint_at_truth_poses = false;
   // Paint only shard `shard.index` of `shard.count` (shard.h; captures from files only): the
   // session paints that shard's buffers and the source skips, unread, the frames whose view
-  // meets none of them (folders; a video file's frames are decoded still).
+  // meets none of them (folders: unread; video files: grabbed, not converted to BGR).
   ShardSpec shard;
+  // Non-empty (captures from files): the whole-capture pre-pass's outcome is read from this
+  // file (prepass_file.h) instead of being found again; when the file does not exist, the
+  // pre-pass runs and writes it. So the shards of one project run it once.
+  std::string prepass_file;
   // Decode the frames without a pose too (the app shows them); false: folders' frames without
   // a pose come out without pixels, undecoded (nothing paints them).
   bool read_frames_without_pose = false;
@@ -74,6 +80,14 @@ struct PaintJob {
   // background.mode auto: the movers found across views before painting, which decided it
   // (`masks` is empty).
   std::optional<MoverMaskResult> mover_masks;
+  // The decisions the whole-capture pre-pass handed the session (what prepass_file.h keeps):
+  // refine.mode auto's pose check (SetRefinePoseCheck: ratio, threshold, frames) and
+  // background.mode auto's movers across views (DecideBackgroundAcrossViews: fraction, frames).
+  struct PrepassDecisions {
+    bool ran = false;  // the pre-pass ran (or was read): poses and movers are its
+    std::optional<std::tuple<double, double, int>> pose_check;
+    std::optional<std::pair<double, int>> background_across_views;
+  } prepass;
   // The frames the whole-capture pre-pass decoded, kept for painting to take (up to
   // 256 MB; folders only; null without a pre-pass).
   std::shared_ptr<DecodedFrames> decoded;
@@ -85,6 +99,7 @@ struct PaintJob {
     double load = 0;      // scene, cameras, poses read; charts and base buffers built
     double cameras = 0;   // each camera's ray table and the mesh's culling clusters
     double read = 0;      // the whole-capture pre-pass: every frame read and decoded once
+    double prepass_file = 0;  // ... or its outcome read from (or written to) prepass_file
     double joint = 0;     // ... the poses adjusted together (refine.joint)
     double movers = 0;    // ... the movers found across views (background auto / across_views)
     double connect = 0;   // live sources connected

@@ -174,6 +174,42 @@ TEST(VideoSourceTest, VideoFileFramesAreNamedByIndex) {
   EXPECT_EQ(n, 8);
 }
 
+// A video file's frames are passed over without converting them (PeekNext grabs, SkipNext
+// drops): the frames read after them are the right ones, named by their index.
+TEST(VideoSourceTest, VideoFileFramesAreSkippedByIndex) {
+  const std::string path = testing::MakeTempDir("video-skip") + "/clip.avi";
+  {
+    cv::VideoWriter writer(path, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 10.0,
+                           cv::Size(64, 48));
+    ASSERT_TRUE(writer.isOpened());
+    for (int i = 0; i < 8; ++i) writer.write(FrameImage(3 * i, cv::Size(64, 48)));
+  }
+  auto source = Open(path);
+  ASSERT_TRUE(source);
+  Frame frame;
+  Status status;
+  std::vector<int> read;
+  for (int i = 0; i < 8; ++i) {
+    ASSERT_TRUE(source->PeekNext(&frame)) << i;
+    EXPECT_EQ(frame.index, i);
+    EXPECT_TRUE(frame.bgr.empty());
+    if (i % 3 != 1) {  // frames 1, 4 and 7 read, the others skipped
+      source->SkipNext();
+      continue;
+    }
+    ASSERT_TRUE(source->Next(&frame, &status)) << status.message();
+    EXPECT_EQ(frame.index, i);
+    EXPECT_LT(cv::norm(frame.bgr, FrameImage(3 * i, cv::Size(64, 48)), cv::NORM_L1) / (64 * 48 * 3),
+              4.0)
+        << "frame " << i << " is another frame's";
+    read.push_back(i);
+  }
+  EXPECT_EQ(read, std::vector<int>({1, 4, 7}));
+  EXPECT_FALSE(source->PeekNext(&frame));
+  EXPECT_FALSE(source->Next(&frame, &status));
+  EXPECT_TRUE(status.ok()) << status.message();
+}
+
 TEST(VideoSourceTest, ReadsARealVideo) {
   FRESCO_REQUIRE_SHARED_DATA();
   auto source = Open(testing::SharedDataDir() + "/video-intel-static-cam/car-detection.mp4");

@@ -3,7 +3,8 @@
 // its .bin, every atlas page; texels and coverage in metrics.json), on the default project
 // (one stream, the defaults: joint pose check, `auto` modes) and on a capture of two streams,
 // for N = 1, 2 and 4; each shard paints only its charts and skips frames; bad shard specs and
-// bad sets of parts are refused with exit 2 naming them, leaving the output folder untouched.
+// bad sets of parts are refused with exit 2 naming them, leaving the output folder untouched;
+// so is a pre-pass file written for other settings.
 #include <filesystem>
 #include <map>
 #include <string>
@@ -53,8 +54,18 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
     int skipped = 0;
     for (int i = n - 1; i >= 0; --i) {  // any order
       const std::string part = work + "/n" + std::to_string(n) + "/part" + std::to_string(i);
-      run({"run", project, "--out", part, "--shard", std::to_string(i) + "/" + std::to_string(n)});
+      std::vector<std::string> args = {
+          "run", project, "--out", part, "--shard", std::to_string(i) + "/" + std::to_string(n)};
+      // N > 1: the whole-capture pre-pass runs in the first shard, which writes it; the others
+      // read it (and the merge must not tell).
+      if (n > 1)
+        args.insert(args.end(), {"--prepass", work + "/n" + std::to_string(n) + ".prepass"});
+      run(args);
       const json m = Metrics(part);
+      if (n > 1 && i < n - 1 && whole_metrics.contains("joint_poses")) {
+        EXPECT_EQ(m["wall"]["open_seconds"]["prepass_read"], 0.0) << "shard " << i << " of " << n;
+        EXPECT_EQ(m["joint_poses"]["check_matches"], whole_metrics["joint_poses"]["check_matches"]);
+      }
       EXPECT_EQ(m["shard"]["index"], i);
       EXPECT_EQ(m["shard"]["count"], n);
       texels_sum += m["shard"]["texels"].get<long long>();
@@ -118,6 +129,30 @@ TEST(ShardMerge, BadShardSpecsAreRefused) {
     EXPECT_NE(r.err.find("--shard"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out)) << bad;
   }
+}
+
+// A pre-pass file is for its project and settings only: another run refuses it (exit 2,
+// naming the file and the field) and paints nothing; --prepass-only needs the file's name.
+TEST(ShardMerge, PrepassFileOfOtherSettingsIsRefused) {
+  const std::string root = testing::SourceDir() + "/projects/cube-room";
+  ASSERT_EQ(RunFresco({"synth", root + "/synth.json", "--if-changed"}).exit_code, 0);
+  const std::string work = MakeTempDir("shard-prepass");
+  const std::string prepass = work + "/prepass.json";
+  const testing::CommandResult written =
+      RunFresco({"run", root + "/project.json", "--prepass", prepass, "--prepass-only", "--set",
+                 "pipeline.max_frames=6", "--quiet"});
+  ASSERT_EQ(written.exit_code, 0) << written.err;
+  ASSERT_TRUE(fs::exists(prepass));
+  const testing::CommandResult other =
+      RunFresco({"run", root + "/project.json", "--out", work + "/out", "--shard", "0/2",
+                 "--prepass", prepass, "--set", "pipeline.max_frames=8", "--quiet"});
+  EXPECT_EQ(other.exit_code, 2) << other.err;
+  EXPECT_NE(other.err.find(prepass + ": settings_hash"), std::string::npos) << other.err;
+  EXPECT_FALSE(fs::exists(work + "/out/painted.gltf"));
+  const testing::CommandResult unnamed =
+      RunFresco({"run", root + "/project.json", "--prepass-only", "--quiet"});
+  EXPECT_EQ(unnamed.exit_code, 2) << unnamed.err;
+  EXPECT_NE(unnamed.err.find("--prepass"), std::string::npos) << unnamed.err;
 }
 
 TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {

@@ -54,9 +54,13 @@ for f in "$work"/whole/*; do
   fi
 done
 [ -f "$work/job/metrics.json" ] || { echo "slurm_test: no merged metrics.json" >&2; status=1; }
+# The defaults need the whole-capture pre-pass: one job ran it, before the array.
+prepass=$(echo "$ids" | awk '$1 == "prepass" {print $2}')
+[ -n "$prepass" ] && [ -f "$work/job/prepass.json" ] ||
+  { echo "slurm_test: no pre-pass job or no DIR/prepass.json" >&2; status=1; }
 for i in 0 1 2; do
   grep -q "\"index\": $i" "$work/job/parts/$i/metrics.json" ||
     { echo "slurm_test: part $i has no shard index" >&2; status=1; }
 done
 if [ $status -ne 0 ]; then tail -n 5 "$work"/job/logs/*.out >&2 || true; exit 1; fi
-echo "slurm_test: 3 shards on Slurm, merged == unsharded"
+echo "slurm_test: a pre-pass and 3 shards on Slurm, merged == unsharded"

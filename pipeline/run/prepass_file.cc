@@ -1,0 +1,226 @@
+#include "pipeline/run/prepass_file.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "pipeline/core/atomic_file.h"
+#include "pipeline/paint/mover_masks.h"
+#include "pipeline/run/shard.h"
+
+namespace fresco {
+namespace {
+
+using nlohmann::json;
+
+constexpr int kPrepassFormat = 1;
+constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+std::string Base64(const std::vector<uchar>& bytes) {
+  std::string text;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);
+    unsigned v = bytes[i] << 16 | (n > 1 ? bytes[i + 1] << 8 : 0) | (n > 2 ? bytes[i + 2] : 0);
+    for (size_t k = 0; k < 4; ++k) text += k <= n ? kBase64[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return text;
+}
+
+bool FromBase64(const std::string& text, std::vector<uchar>* bytes) {
+  if (text.size() % 4 != 0) return false;
+  bytes->clear();
+  for (size_t i = 0; i < text.size(); i += 4) {
+    unsigned v = 0;
+    int pad = 0;
+    for (size_t k = 0; k < 4; ++k) {
+      const char c = text[i + k];
+      const char* at = c == '=' ? nullptr : std::strchr(kBase64, c);
+      if (c == '=')
+        ++pad;
+      else if (!at || !*at || pad > 0)
+        return false;
+      v = v << 6 | (at ? static_cast<unsigned>(at - kBase64) : 0);
+    }
+    if (pad > 2) return false;
+    for (int k = 0; k < 3 - pad; ++k) bytes->push_back(static_cast<uchar>(v >> (16 - 8 * k)));
+  }
+  return true;
+}
+
+json PoseJson(const Rigid3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation;
+  const Eigen::Vector3d& t = pose.translation;
+  return {q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()};
+}
+
+// Bad input naming the file and the field.
+Status Bad(const std::string& path, const std::string& field, const std::string& what) {
+  return Status::Error(path + ": " + field + ": " + what);
+}
+
+}  // namespace
+
+bool NeedsWholeCapturePrepass(const Project& project) {
+  return !IsLiveProject(project) &&
+         (project.pipeline.refine.joint || NeedsMoversAcrossViews(project.pipeline.background));
+}
+
+json PoseAdjustSummaryJson(const PoseAdjustResult& a) {
+  return {{"applied", a.applied},
+          {"not_run", a.not_run},
+          {"matches", a.matches},
+          {"inliers", a.inliers},
+          {"check_matches", a.check_matches},
+          {"check_before_px", a.check_before_px},
+          {"check_after_px", a.check_after_px},
+          {"check_one_end_px", a.check_one_end_px},
+          {"check_seconds", a.check_seconds},
+          {"rms_before_px", a.rms_before_px},
+          {"rms_after_px", a.rms_after_px},
+          {"median_rotation_deg", a.median_rotation_deg},
+          {"median_translation_m", a.median_translation_m},
+          {"rotation_prior_deg", a.rotation_prior_deg},
+          {"translation_prior_m", a.translation_prior_m},
+          {"decided_on_frames", a.decided_on_frames},
+          {"seconds", a.seconds}};
+}
+
+Status WritePrepassFile(const std::string& path, const Project& project, const PaintJob& job) {
+  json file = {{"fresco_prepass", kPrepassFormat},
+               {"project", project.file_path},
+               {"settings_hash", SettingsHash(project)}};
+  const PaintJob::PrepassDecisions& d = job.prepass;
+  if (job.joint_poses) {
+    file["joint_poses"] = PoseAdjustSummaryJson(*job.joint_poses);
+    file["joint_poses"]["frames"] = job.joint_poses->cam_from_local.size();
+  }
+  if (job.mover_masks) {
+    const MoverMaskResult& m = *job.mover_masks;
+    file["movers_across_views"] = {{"not_run", m.not_run},
+                                   {"judged", m.judged},
+                                   {"flagged", m.flagged},
+                                   {"seconds", m.seconds}};
+  }
+  if (d.pose_check) {
+    const auto& [ratio, threshold, frames] = *d.pose_check;
+    file["pose_check"] = {ratio, threshold, frames};
+  }
+  if (d.background_across_views)
+    file["background_across_views"] = {d.background_across_views->first,
+                                       d.background_across_views->second};
+  // Every pose as painting takes it (the joint check writes each frame's, applied or not), and
+  // each frame's movers (PNG: lossless).
+  const bool poses = job.joint_poses && job.joint_poses->not_run.empty();
+  file["streams"] = json::array();
+  for (const Capture& capture : job.captures) {
+    json stream = json::object();
+    if (poses) {
+      stream["poses"] = json::array();
+      for (const PosedImage& pose : capture.poses)
+        stream["poses"].push_back(PoseJson(pose.cam_from_world));
+    }
+    json movers = json::object();
+    for (size_t i = 0; i < capture.movers.size(); ++i) {
+      if (capture.movers[i].empty()) continue;
+      std::vector<uchar> png;
+      if (!cv::imencode(".png", capture.movers[i], png))
+        return Status::Failed(path + ": could not encode the movers of pose " + std::to_string(i));
+      movers[std::to_string(i)] = Base64(png);
+    }
+    stream["movers"] = movers;
+    stream["movers_size"] = capture.movers.size();
+    file["streams"].push_back(stream);
+  }
+  return WriteFileAtomic(path, file.dump() + "\n");
+}
+
+Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob* job) {
+  std::string text;
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &text));
+  const json file = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (file.is_discarded() || !file.is_object())
+    return Status::Error(path + ": not a pre-pass file (fresco run --prepass writes them)");
+  if (file.value("fresco_prepass", 0) != kPrepassFormat)
+    return Bad(path, "fresco_prepass", "not format " + std::to_string(kPrepassFormat));
+  const std::string hash = SettingsHash(project);
+  if (file.value("settings_hash", std::string()) != hash)
+    return Bad(path, "settings_hash",
+               "written for another project or other settings (" +
+                   file.value("settings_hash", std::string("none")) + ", not " + hash + " of " +
+                   project.file_path + ")");
+  try {
+    const json& streams = file.at("streams");
+    if (!streams.is_array() || streams.size() != job->captures.size())
+      return Bad(path, "streams", "not one entry per stream of " + project.file_path);
+    for (size_t s = 0; s < streams.size(); ++s) {
+      Capture& capture = job->captures[s];
+      const std::string at = "streams[" + std::to_string(s) + "]";
+      if (streams[s].contains("poses")) {
+        const json& poses = streams[s]["poses"];
+        if (poses.size() != capture.poses.size())
+          return Bad(path, at + ".poses",
+                     std::to_string(poses.size()) + " poses, the capture has " +
+                         std::to_string(capture.poses.size()));
+        for (size_t i = 0; i < poses.size(); ++i) {
+          const std::vector<double> v = poses[i].get<std::vector<double>>();
+          if (v.size() != 7) return Bad(path, at + ".poses", "a pose is 7 numbers");
+          capture.poses[i].cam_from_world = Rigid3d(Eigen::Quaterniond(v[0], v[1], v[2], v[3]),
+                                                    Eigen::Vector3d(v[4], v[5], v[6]));
+        }
+      }
+      const size_t size = streams[s].value("movers_size", size_t{0});
+      if (size > capture.poses.size())
+        return Bad(path, at + ".movers_size", "more than the capture's poses");
+      capture.movers.assign(size, cv::Mat());
+      for (const auto& [index, base64] : streams[s].at("movers").items()) {
+        const size_t i = std::stoul(index);
+        std::vector<uchar> png;
+        if (i >= size || !FromBase64(base64.get<std::string>(), &png))
+          return Bad(path, at + ".movers." + index, "not a pose's movers");
+        capture.movers[i] = cv::imdecode(png, cv::IMREAD_UNCHANGED);
+        if (capture.movers[i].empty()) return Bad(path, at + ".movers." + index, "not a PNG");
+      }
+    }
+    if (file.contains("joint_poses")) {
+      const json& a = file["joint_poses"];
+      PoseAdjustResult r;
+      r.applied = a.at("applied");
+      r.not_run = a.at("not_run");
+      r.matches = a.at("matches"), r.inliers = a.at("inliers");
+      r.check_matches = a.at("check_matches");
+      r.check_before_px = a.at("check_before_px"), r.check_after_px = a.at("check_after_px");
+      r.check_one_end_px = a.at("check_one_end_px"), r.check_seconds = a.at("check_seconds");
+      r.rms_before_px = a.at("rms_before_px"), r.rms_after_px = a.at("rms_after_px");
+      r.median_rotation_deg = a.at("median_rotation_deg");
+      r.median_translation_m = a.at("median_translation_m");
+      r.rotation_prior_deg = a.at("rotation_prior_deg");
+      r.translation_prior_m = a.at("translation_prior_m");
+      r.decided_on_frames = a.at("decided_on_frames"), r.seconds = a.at("seconds");
+      r.cam_from_local.resize(a.at("frames").get<size_t>());  // the count (poses: the captures')
+      job->joint_poses = r;
+    }
+    if (file.contains("movers_across_views")) {
+      const json& m = file["movers_across_views"];
+      MoverMaskResult r;
+      r.not_run = m.at("not_run");
+      r.judged = m.at("judged"), r.flagged = m.at("flagged"), r.seconds = m.at("seconds");
+      job->mover_masks = r;
+    }
+    // The decisions, in the pre-pass's order.
+    if (file.contains("pose_check")) {
+      const json& c = file["pose_check"];
+      job->prepass.pose_check = {c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<int>()};
+      const auto& [ratio, threshold, frames] = *job->prepass.pose_check;
+      job->session->SetRefinePoseCheck(ratio, threshold, frames);
+    }
+    if (file.contains("background_across_views")) {
+      const json& b = file["background_across_views"];
+      job->prepass.background_across_views = {b.at(0).get<double>(), b.at(1).get<int>()};
+      job->session->DecideBackgroundAcrossViews(b.at(0).get<double>(), b.at(1).get<int>());
+    }
+  } catch (const std::exception& e) {
+    return Bad(path, "content", std::string("not a pre-pass file's (") + e.what() + ")");
+  }
+  job->prepass.ran = true;
+  return Status::Ok();
+}
+
+}  // namespace fresco
