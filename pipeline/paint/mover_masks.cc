@@ -101,11 +101,13 @@ Comparison Compare(const SmallFrame& self, int other_index, const SmallFrame& ot
 // (made here when empty). `joinable`: the surface pixels that may join a mover by
 // their colour (those that differ from a frame that sees them, or are seen by too few);
 // `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed);
-// `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h).
+// `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h);
+// `regions`: the frame's colour regions, kept for the later passes.
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
                    std::vector<Comparison>* comparisons, long long* judged, long long* flagged,
-                   cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions) {
+                   cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions,
+                   ColourRegionLabels* regions) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   if (comparisons->empty())
@@ -175,7 +177,7 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   mask = grown;
   cv::Mat ringed;
   if (options.ringed.share > 0)
-    ringed = RingedRegions(self.bgr, mask, self.surface, options.ringed);
+    ringed = RingedRegions(self.bgr, mask, self.surface, options.ringed, regions);
   if (options.dilate_px > 0)
     cv::dilate(mask, mask,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
@@ -270,6 +272,7 @@ void ReportPass(const MoverMaskOptions& options, const MoverMaskResult& result, 
 // comparisons with the frames near it (kept for the later passes).
 struct Judged {
   std::vector<cv::Mat> joinable, ringed;
+  std::vector<ColourRegionLabels> regions;
   std::vector<std::vector<Comparison>> comparisons;
 };
 
@@ -290,9 +293,9 @@ std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
         for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
       if (!any) continue;
       long long unused = 0;
-      result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f],
-                                    &unused, &unused,
-                                    &judged->joinable[f], &result->agreed[f], &judged->ringed[f]);
+      result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f], &unused,
+                                    &unused, &judged->joinable[f], &result->agreed[f],
+                                    &judged->ringed[f], &judged->regions[f]);
       now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
     }
   });
@@ -365,6 +368,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   judging.joinable.resize(n);
   judging.ringed.resize(n);
   judging.comparisons.resize(n);
+  judging.regions.resize(n);
   result->agreed.resize(n);
   const bool keep_comparisons = options.passes > 1;
   cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
@@ -372,7 +376,8 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       if (frames[f].points.empty()) continue;
       result->masks[f] =
           JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f], &flagged[f],
-                     &judging.joinable[f], &result->agreed[f], &judging.ringed[f]);
+                     &judging.joinable[f], &result->agreed[f], &judging.ringed[f],
+                     keep_comparisons ? &judging.regions[f] : nullptr);
       if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
     }
   });

@@ -45,32 +45,52 @@ cv::Mat ColourRegions(const cv::Mat& bgr, int levels, int* count) {
 }
 
 cv::Mat RingedRegions(const cv::Mat& bgr, const cv::Mat& mask, const cv::Mat& surface,
-                      const RingedRegionOptions& options) {
+                      const RingedRegionOptions& options, ColourRegionLabels* kept) {
   const int w = bgr.cols, h = bgr.rows;
   cv::Mat ringed(bgr.size(), CV_8U, cv::Scalar(0));
   if (options.share <= 0 || cv::countNonZero(mask) == 0) return ringed;
-  int count = 0;
-  const cv::Mat regions = ColourRegions(bgr, options.levels, &count);
+  ColourRegionLabels made;
+  ColourRegionLabels& labelled = kept ? *kept : made;
+  if (labelled.labels.empty()) {
+    labelled.labels = ColourRegions(bgr, options.levels, &labelled.count);
+    const cv::Mat& regions = labelled.labels;
+    labelled.on_boundary = cv::Mat::zeros(bgr.size(), CV_8U);
+    labelled.area.assign(labelled.count, 0);
+    labelled.boundary.assign(labelled.count, 0);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const int r = regions.at<int>(y, x);
+        ++labelled.area[r];
+        // Another region's surface pixel next to it: this pixel is on the region's boundary.
+        const auto other = [&](int u, int v) {
+          return regions.at<int>(v, u) != r && surface.at<uchar>(v, u) != 0;
+        };
+        if ((x > 0 && other(x - 1, y)) || (x + 1 < w && other(x + 1, y)) ||
+            (y > 0 && other(x, y - 1)) || (y + 1 < h && other(x, y + 1))) {
+          labelled.on_boundary.at<uchar>(y, x) = 1;
+          ++labelled.boundary[r];
+        }
+      }
+  }
+  const int count = labelled.count;
+  const cv::Mat& regions = labelled.labels;
+  const std::vector<int>& area = labelled.area;
+  const std::vector<int>& boundary = labelled.boundary;
   // Within two pixels of the mask: the 5 x 5 square without its corners.
   cv::Mat near, reach = cv::Mat::ones(5, 5, CV_8U);
   reach.at<uchar>(0, 0) = reach.at<uchar>(0, 4) = reach.at<uchar>(4, 0) = reach.at<uchar>(4, 4) = 0;
   cv::dilate(mask, near, reach);
-  std::vector<int> area(count, 0), boundary(count, 0), masked_boundary(count, 0), inside(count, 0);
-  for (int y = 0; y < h; ++y)
+  std::vector<int> masked_boundary(count, 0), inside(count, 0);
+  for (int y = 0; y < h; ++y) {
+    const int* region = regions.ptr<int>(y);
+    const uchar* masked = mask.ptr<uchar>(y);
+    const uchar* edge = labelled.on_boundary.ptr<uchar>(y);
+    const uchar* close = near.ptr<uchar>(y);
     for (int x = 0; x < w; ++x) {
-      const int r = regions.at<int>(y, x);
-      ++area[r];
-      inside[r] += mask.at<uchar>(y, x) != 0;
-      // Another region's surface pixel next to it: this pixel is on the region's boundary.
-      const auto other = [&](int u, int v) {
-        return regions.at<int>(v, u) != r && surface.at<uchar>(v, u) != 0;
-      };
-      if (!((x > 0 && other(x - 1, y)) || (x + 1 < w && other(x + 1, y)) ||
-            (y > 0 && other(x, y - 1)) || (y + 1 < h && other(x, y + 1))))
-        continue;
-      ++boundary[r];
-      masked_boundary[r] += near.at<uchar>(y, x) != 0;
+      inside[region[x]] += masked[x] != 0;
+      if (edge[x]) masked_boundary[region[x]] += close[x] != 0;
     }
+  }
   std::vector<uint8_t> joins(count, 0);
   const double max_px = options.max_share * w * h;
   for (int r = 0; r < count; ++r)

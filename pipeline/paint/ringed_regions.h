@@ -5,6 +5,8 @@
 // the masks are made at.
 #pragma once
 
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 namespace fresco {
@@ -24,11 +26,23 @@ struct RingedRegionOptions {
 // Labels (CV_32S, 0 .. *count - 1) of the regions of one colour of `bgr` (CV_8UC3).
 cv::Mat ColourRegions(const cv::Mat& bgr, int levels, int* count);
 
+// A frame's ColourRegions and their boundaries, kept between calls of RingedRegions on the
+// same image and surface (the passes of mover_masks.h judge a frame several times; its
+// regions do not change, only the mask).
+struct ColourRegionLabels {
+  cv::Mat labels;  // empty until made
+  int count = 0;
+  cv::Mat on_boundary;              // CV_8U, 1 where a pixel meets another region's surface pixel
+  std::vector<int> area, boundary;  // per region: pixels, of which on its boundary
+};
+
 // The regions of `bgr` ringed by `mask` (CV_8U, bgr's size): CV_8U, 255 on their pixels.
 // `surface` (CV_8U, the same size): pixels that show the mesh. A region's boundary is where it
 // meets another region's surface pixel; where it meets the image's border or pixels off the
 // surface (the sky), nothing tells what it is, and that part does not count.
+// `regions` (optional): bgr's colour regions at options.levels and their boundaries on
+// `surface`, made here when empty.
 cv::Mat RingedRegions(const cv::Mat& bgr, const cv::Mat& mask, const cv::Mat& surface,
-                      const RingedRegionOptions& options);
+                      const RingedRegionOptions& options, ColourRegionLabels* regions = nullptr);
 
 }  // namespace fresco

@@ -1,7 +1,8 @@
 // Regions of one colour ringed by a mask (ringed_regions.h): a plain square on a textured
 // background whose edges are masked joins the mask whole, shading and all; one masked along too
 // little of its boundary does not, nor does the textured background beside it; the image's
-// border and the pixels off the surface do not count as boundary.
+// border and the pixels off the surface do not count as boundary; a frame's regions kept
+// between masks give what fresh ones give.
 #include "pipeline/paint/ringed_regions.h"
 
 #include <gtest/gtest.h>
@@ -92,6 +93,23 @@ TEST(RingedRegions, TheImageBorderAndPixelsOffTheSurfaceAreNotBoundary) {
   EXPECT_EQ(cv::countNonZero(ringed(cut)), cut.area());
   // Away from the border, the same square masked along one side does not join, sky or not.
   EXPECT_EQ(cv::countNonZero(RingedRegions(frame, EdgeMask(1), sky, {})), 0);
+}
+
+TEST(RingedRegions, RegionsKeptFromAnEarlierMaskGiveWhatFreshOnesGive) {
+  // One frame judged with masks of 1, 3 and 4 sides in turn, its colour regions made by the
+  // first call and kept: each result as with regions made afresh (3 and 4 sides join the
+  // square, 1 does not), with the sky cutting the boundary.
+  const cv::Mat frame = Frame();
+  cv::Mat sky = AllSurface();
+  sky(cv::Rect(0, kSquare.br().y + 3, kSize.width, kSize.height - kSquare.br().y - 3)).setTo(0);
+  ColourRegionLabels kept;
+  for (int sides : {1, 3, 4}) {
+    const cv::Mat fresh = RingedRegions(frame, EdgeMask(sides), sky, {});
+    const cv::Mat again = RingedRegions(frame, EdgeMask(sides), sky, {}, &kept);
+    EXPECT_FALSE(kept.labels.empty());
+    EXPECT_EQ(cv::norm(fresh, again, cv::NORM_INF), 0) << sides << " sides masked";
+    EXPECT_EQ(Covered(again), sides == 1 ? 0.0 : 1.0) << sides << " sides masked";
+  }
 }
 
 }  // namespace
