@@ -199,6 +199,48 @@ TEST(ElsewhereDetectTest, TagsGrownOrShrunkByAToneCurveAreMeasuredAndUndone) {
   }
 }
 
+// Cause 6: the tone curve moves each edge's halfway crossing by an amount that depends on the
+// edge's own ramp (its blur, how the pixels cut it, the print's sharpness where the board is
+// near or far); one shift per image, undone alike at every edge, leaves each edge its own part
+// of it. Each edge is now placed at the level (between its dark and light) at which the tags
+// are neither grown nor shrunk against their pitch, found per image from the shifts at two
+// levels. calib_detect_elsewhere --border-bits 1 --margin 0.1 --gamma 2 --contrast 0.6
+// --vignette 0.5 --solve, seed 3, 40 views: the lens from the truth over the imager / where
+// seen, sharp dark 0.154 / 0.120 -> 0.122 / 0.097 px, blurred dark 0.209 / 0.126 -> 0.123 /
+// 0.071 px (levels 0.40-0.45 sharp, 0.38-0.40 blurred; gamma 2 on a linear ramp: 0.38).
+TEST(ElsewhereDetectTest, EdgesArePlacedAtTheLevelThatKeepsTheTagsPitch) {
+  const BoardSpec spec = Spec("aprilgrid:6x6:0.088:0.3");
+  ElsewhereBoard board;
+  board.border_bits = 1;
+  const ElsewhereRenderer renderer(board, ElsewhereLens());
+  const auto poses = renderer.Poses(2, 1);
+  // The level that crosses the linear grey's halfway after the tone curve (contrast 0.6, the
+  // print's 25 / 235, no vignetting): gamma 2 0.378, gamma 0.5 0.564.
+  for (double gamma : {2.0, 1.0, 0.5}) {
+    for (int i = 0; i < 2; ++i) {
+      ElsewhereShot shot;
+      shot.gamma = gamma, shot.contrast = 0.6, shot.blur_sigma_px = 1, shot.seed = 10 + i;
+      const ElsewhereView view = renderer.Render(poses[i], shot);
+      DetectOptions halfway;
+      halfway.edge_level_from_pitch = false;
+      const BoardDetection before = DetectBoard(view.gray, spec, halfway);
+      const BoardDetection d = DetectBoard(view.gray, spec);
+      std::printf("gamma %.1f view %d: halfway shift %.3f px; level %.3f, shift left %.3f px\n",
+                  gamma, i, before.tag_edge_shift_px, d.tag_edge_level, d.tag_edge_shift_px);
+      SCOPED_TRACE(::testing::Message() << "gamma " << gamma << " view " << i);
+      ASSERT_TRUE(d.found);
+      if (gamma == 1) {  // no tone curve: halfway, nothing to undo
+        EXPECT_LT(std::abs(before.tag_edge_shift_px), 0.04);
+        EXPECT_NEAR(d.tag_edge_level, 0.5, 0.02);
+        continue;
+      }
+      EXPECT_GT(std::abs(before.tag_edge_shift_px), 0.1);  // the tags grown / shrunk halfway
+      EXPECT_NEAR(d.tag_edge_level, gamma > 1 ? 0.378 : 0.564, 0.025);
+      EXPECT_LT(std::abs(d.tag_edge_shift_px), 0.03);
+    }
+  }
+}
+
 // Cause 3: a narrow paper margin (0.1 tag edges, 3-6 px here) on a dark surround. The
 // square probe took the surround beyond the margin for Kalibr's black square at the outer
 // tags' corners and kept cornerSubPix's saddle there, which its window (a quarter of the tag)
