@@ -252,6 +252,78 @@ int BorderBitsOf(const std::map<int, TagQuad>& found) {
   return by_bits[1] > by_bits[2] ? 1 : 2;
 }
 
+// The edge level is looked for (DetectAprilGrid) when the tags at level 0.5 are grown or
+// shrunk by more than kLevelSearchFromPx, from a second level kLevelStep away; it is kept
+// within kMinLevel..kMaxLevel (gamma 2: about 0.38, gamma 0.5: about 0.62).
+constexpr double kLevelSearchFromPx = 0.02, kLevelStep = 0.12;
+constexpr double kMinLevel = 0.2, kMaxLevel = 0.8;
+
+// A tag's corners moved onto the image's saddles (RefineTagCorners), and which settled.
+struct Saddles {
+  std::array<Eigen::Vector2d, 4> p;
+  bool refined[4] = {true, true, true, true};
+};
+
+// The corners of the tags `found`: each the saddle, or where no black square is at it, where the
+// tag's edges through it meet, each edge where its cuts cross `level` between the edge's dark
+// and light levels (calib/tag_corner_edges.h); corners sorted by id, `edged_ids` those from the
+// edges. Returns how many are.
+int PlaceCorners(const cv::Mat& gray, const std::map<int, TagQuad>& found,
+                 const std::map<int, Saddles>& saddles, const DetectOptions& options, double level,
+                 std::vector<CornerObservation>* out_corners, std::set<int>* edged_ids) {
+  out_corners->clear();
+  edged_ids->clear();
+  for (const auto& [id, quad] : found) {
+    const Saddles& saddle = saddles.at(id);
+    std::array<Eigen::Vector2d, 4> corners = saddle.p;
+    bool refined[4];
+    std::copy(saddle.refined, saddle.refined + 4, refined);
+    if (options.refine_tag_corners) {
+      // Where the board has no black square at a corner, cornerSubPix's saddle is not there:
+      // the corner from the tag's edges (calib/tag_corner_edges.h).
+      const std::array<Eigen::Vector2d, 4>& p = saddle.p;
+      std::array<std::array<double, 2>, 4> levels;
+      bool placed[4] = {false, false, false, false};
+      for (int k = 0; k < 4; ++k) {
+        Eigen::Vector2d corner;
+        // No square, and the saddle more than 1 px from the tag's outline as read: near a
+        // narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
+        // paper's edge, and edges looked for from there are the paper's. Then the edges are
+        // looked for from the outline.
+        const bool strayed =
+            options.edges_from_outline_when_strayed && (p[k] - quad.p[k]).norm() > kStrayedPx;
+        const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
+        if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
+        bool left_out = false;
+        if (!CornerFromEdges(gray, from, k, &corner, &left_out, &levels[k], level)) {
+          refined[k] = !strayed && !left_out;  // a stray saddle and no edges: left out
+          continue;
+        }
+        corners[k] = corner;
+        placed[k] = true;
+      }
+      // The board's own corners: both edges beside the paper margin, no gap's white beside
+      // either to tell a margin too narrow for its blur by; the tag's other corners' is.
+      double tag_light = 0;
+      for (int k = 0; k < 4; ++k)
+        if (placed[k]) tag_light = std::max(tag_light, levels[k][1]);
+      for (int k = 0; k < 4; ++k) {
+        if (!placed[k]) continue;
+        if (tag_light - levels[k][1] > kMaxEdgeLightDeficit * (tag_light - levels[k][0])) {
+          refined[k] = false;
+          continue;
+        }
+        edged_ids->insert(id * 4 + k);
+      }
+    }
+    for (int k = 0; k < 4; ++k)
+      if (refined[k]) out_corners->push_back({id * 4 + k, corners[k]});
+  }
+  std::sort(out_corners->begin(), out_corners->end(),
+            [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
+  return static_cast<int>(edged_ids->size());
+}
+
 BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
                                const DetectOptions& options) {
   BoardDetection out;
@@ -294,64 +366,49 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   out.border_bits = BorderBitsOf(found);
   for (const auto& [id, quad] : found)
     out.tag_centres.push_back(0.25 * (quad.p[0] + quad.p[1] + quad.p[2] + quad.p[3]));
-  std::set<int> edged_ids;  // corners taken from the tag's edges
+  // The saddles (cornerSubPix) once; the corners from the tags' edges at an edge level.
+  std::map<int, Saddles> saddles;
   for (const auto& [id, quad] : found) {
+    Saddles& t = saddles[id];
     std::vector<cv::Point2f> corners;
     for (int k = 0; k < 4; ++k)
       corners.emplace_back(static_cast<float>(quad.p[k].x()), static_cast<float>(quad.p[k].y()));
-    bool refined[4] = {true, true, true, true};
-    if (options.refine_tag_corners) {
-      RefineTagCorners(gray, quad, &corners, refined);
-      // Where the board has no black square at a corner, cornerSubPix's saddle is not there:
-      // the corner from the tag's edges (calib/tag_corner_edges.h).
-      std::array<Eigen::Vector2d, 4> p;
-      for (int k = 0; k < 4; ++k) p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
-      std::array<std::array<double, 2>, 4> levels;
-      bool placed[4] = {false, false, false, false};
-      for (int k = 0; k < 4; ++k) {
-        Eigen::Vector2d corner;
-        // No square, and the saddle more than 1 px from the tag's outline as read: near a
-        // narrow paper margin on a dark surround cornerSubPix settles 2-6 px off, on the
-        // paper's edge, and edges looked for from there are the paper's. Then the edges are
-        // looked for from the outline.
-        const bool strayed =
-            options.edges_from_outline_when_strayed && (p[k] - quad.p[k]).norm() > kStrayedPx;
-        const std::array<Eigen::Vector2d, 4>& from = strayed ? quad.p : p;
-        if (!refined[k] || CrossingSquareAt(gray, p, k)) continue;
-        bool left_out = false;
-        if (!CornerFromEdges(gray, from, k, &corner, &left_out, &levels[k])) {
-          refined[k] = !strayed && !left_out;  // a stray saddle and no edges: left out
-          continue;
-        }
-        corners[k] = cv::Point2f(static_cast<float>(corner.x()), static_cast<float>(corner.y()));
-        placed[k] = true;
-      }
-      // The board's own corners: both edges beside the paper margin, no gap's white beside
-      // either to tell a margin too narrow for its blur by; the tag's other corners' is.
-      double tag_light = 0;
-      for (int k = 0; k < 4; ++k)
-        if (placed[k]) tag_light = std::max(tag_light, levels[k][1]);
-      for (int k = 0; k < 4; ++k) {
-        if (!placed[k]) continue;
-        if (tag_light - levels[k][1] > kMaxEdgeLightDeficit * (tag_light - levels[k][0])) {
-          refined[k] = false;
-          continue;
-        }
-        ++out.corners_from_edges;
-        edged_ids.insert(id * 4 + k);
+    if (options.refine_tag_corners) RefineTagCorners(gray, quad, &corners, t.refined);
+    for (int k = 0; k < 4; ++k) t.p[k] = Eigen::Vector2d(corners[k].x, corners[k].y);
+  }
+  std::vector<bool> from_edges;
+  const auto place = [&](double level, std::vector<CornerObservation>* placed_corners) {
+    std::set<int> edged_ids;
+    const int from_edges_count =
+        PlaceCorners(gray, found, saddles, options, level, placed_corners, &edged_ids);
+    from_edges.clear();
+    for (const CornerObservation& c : *placed_corners)
+      from_edges.push_back(edged_ids.count(c.id) > 0);
+    return from_edges_count;
+  };
+  out.corners_from_edges = place(0.5, &out.corners);
+  out.tags = static_cast<int>(found.size());
+  if (out.corners_from_edges > 0) {  // a tone curve grows or shrinks the tags: tag_dilation.h
+    out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
+    // The edge level at which the tags are neither grown nor shrunk, from the shifts at two
+    // levels (the secant); each edge then moves by its own ramp's share of the tone curve.
+    if (options.edge_level_from_pitch && std::abs(out.tag_edge_shift_px) > kLevelSearchFromPx) {
+      const double level_0 = 0.5, shift_0 = out.tag_edge_shift_px;
+      const double level_1 = level_0 + (shift_0 > 0 ? -kLevelStep : kLevelStep);
+      std::vector<CornerObservation> at_1;
+      place(level_1, &at_1);
+      const double shift_1 = TagEdgeShift_px(spec, at_1, from_edges);
+      // A lower level moves the edges into the dark, inwards: the shift must fall with it.
+      if ((shift_1 - shift_0) * (level_1 - level_0) > 0 && shift_1 != 0) {
+        const double level = std::clamp(
+            level_0 - shift_0 * (level_1 - level_0) / (shift_1 - shift_0), kMinLevel, kMaxLevel);
+        out.corners_from_edges = place(level, &out.corners);
+        out.tag_edge_level = level;
+        out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
+      } else {
+        place(level_0, &out.corners);
       }
     }
-    for (int k = 0; k < 4; ++k)
-      if (refined[k])
-        out.corners.push_back({id * 4 + k, Eigen::Vector2d(corners[k].x, corners[k].y)});
-    ++out.tags;
-  }
-  std::sort(out.corners.begin(), out.corners.end(),
-            [](const CornerObservation& a, const CornerObservation& b) { return a.id < b.id; });
-  if (!edged_ids.empty()) {  // a tone curve grows or shrinks the tags: calib/tag_dilation.h
-    std::vector<bool> from_edges;
-    for (const CornerObservation& c : out.corners) from_edges.push_back(edged_ids.count(c.id) > 0);
-    out.tag_edge_shift_px = TagEdgeShift_px(spec, out.corners, from_edges);
     ShiftTagEdges(out.tag_edge_shift_px, from_edges, &out.corners, &found);
   }
   if (options.refine_tag_corners && options.drop_inconsistent_corners)

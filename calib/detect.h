@@ -38,8 +38,12 @@ struct BoardDetection {
   // AprilGrid: corners placed where the tag's edges meet (no black square at the corner:
   // calib/tag_corner_edges.h) instead of on cornerSubPix's saddle.
   int corners_from_edges = 0;
-  // AprilGrid: how far (px, outwards) a tone curve moved the edges those corners were taken
-  // from, undone (calib/tag_dilation.h); 0 when not measured.
+  // AprilGrid: where between the edges' dark (0) and light (1) levels those corners' edges
+  // were placed: 0.5, or the level at which a tone curve leaves the tags neither grown nor
+  // shrunk (calib/tag_dilation.h).
+  double tag_edge_level = 0.5;
+  // AprilGrid: how far (px, outwards) the edges at that level still lay from where the tags'
+  // pitch puts them, undone (calib/tag_dilation.h); 0 when not measured.
   double tag_edge_shift_px = 0;
   double detect_ms = 0;  // wall time of this detection
   // AprilGrid: the centre of every tag read (before corners were left out), for marking
@@ -72,6 +76,10 @@ struct DetectOptions {
   // 1 px from the outline read, its edges are looked for from the outline (the corner left
   // out when none show) instead of from the saddle (on a paper's or a tag's edge).
   bool edges_from_outline_when_strayed = true;
+  // AprilGrid: the tags' edges placed at the level (between each edge's dark and light) that
+  // keeps the tags neither grown nor shrunk against their pitch (BoardDetection::
+  // tag_edge_level); false: halfway, the shift measured there undone alike at every edge.
+  bool edge_level_from_pitch = true;
   // DetectTagsApriltag: keep every tag read, an id read twice too (photos of scattered tags
   // of one id; a board has each id once, so by default both are dropped).
   bool keep_repeated_ids = false;

@@ -6,8 +6,8 @@
 // against the board's pitch, and a solve takes that for lens distortion). There the corner
 // is the meeting point of the tag's two edges: each edge located to sub-pixel along its
 // normal (where the grey crosses halfway between the edge's dark and light levels, taken
-// 2.5 px or more to either side, so that blur moves it neither way) over the part of the edge
-// near the corner, fitted by a line, and the two lines intersected.
+// 2.5 px or more to either side, so that blur moves it neither way) along the whole edge,
+// fitted by a quadratic (a lens bends the edge), and the two curves intersected.
 #pragma once
 
 #include <array>
@@ -31,9 +31,12 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
 // is to be left out, not refined otherwise.
 // `levels`, when given and both edges were found: the edges' dark level and the lighter one's
 // light level.
+// `level`: where between the edge's dark (0) and light (1) levels each cut places the edge;
+// halfway (0.5) is the printed edge when the grey is linear in the light (calib/tag_dilation.h
+// finds the one for a tone curve).
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
                      Eigen::Vector2d* corner, bool* left_out = nullptr,
-                     std::array<double, 2>* levels = nullptr);
+                     std::array<double, 2>* levels = nullptr, double level = 0.5);
 
 // An edge whose light level lies more than this part of the dark-to-light range below that of
 // the other edges of its tag is beside a margin too narrow for its blur: its corner is left out.

@@ -7,7 +7,11 @@
 // distortion (gamma 2, blur 1 px, JPEG 80: tags 0.7 px larger, the lens 0.57 px RMS from the
 // truth). The pitch itself does not move: along a row of two neighbouring tags the four
 // corners' cross ratio (perspective keeps it) gives how far each edge moved, the median over
-// the image's tag pairs one figure for the image; each edge-derived corner is then moved back.
+// the image's tag pairs one figure for the image. The detector (calib/detect.cc) then looks for
+// the edge level (between each edge's dark and light, 0.5 halfway) at which that figure is 0,
+// from the figures at two levels: each edge then moves by its own ramp's share of the tone
+// curve, where one shift undone at every edge leaves each edge its difference from the
+// median; what is left at that level is undone as below.
 #pragma once
 
 #include <map>

@@ -10,14 +10,24 @@
 //                          [--margin TAGS] [--gamma G] [--contrast C] [--vignette V]
 //                          [--solve] [--save DIR] [--verbose] [--no-second-look]
 //                          [--only dark_sharp|dark_blur|light_sharp|light_blur] [--per-view]
+//                          [--truth-corners] [--truth-at found|outline|inner]
+//                          [--truth-above PX] [--truth-noise PX] [--corners-from FILE]
+//                          [--dump FILE] [--halfway]
 // --verbose also lists every corner more than 2 px from the truth; the corners' errors are
 // also given apart for those on the board's outline (an outer tag's outer edge through them);
-// --per-view gives them for each view, with its tag edge shift.
+// --per-view gives them for each view, with its tag edge shift. To tell which corners bias the
+// lens, the solve can take the true pixel instead of the one found: of every corner of the
+// board (--truth-corners: the solve's floor), of the corners found (--truth-at found: what the
+// corners left out cost), of those on the outline or the others found, of those more than PX
+// off (--truth-above); --dump writes every corner found, one a line: variant, view, id, on the
+// outline (1) or not, x, y, then the true pixels of its tag's corners from it on (k, k + 1, ..).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 
@@ -37,7 +47,8 @@ int main(int argc, char** argv) {
   std::vector<unsigned> seeds = {1, 2, 3};
   ElsewhereBoard board;
   bool solve = false, verbose = false, truth_corners = false, per_view = false;
-  std::string save, only;
+  std::string save, only, truth_at, dump, corners_from;
+  double truth_above_px = 1e9, truth_noise_px = 0;
   DetectOptions options;
   ElsewhereShot look;  // the tone curve and vignetting every view gets
   for (int i = 1; i < argc; ++i) {
@@ -66,12 +77,24 @@ int main(int argc, char** argv) {
       solve = true;
     } else if (a == "--truth-corners") {  // solve from the true corners (the solve's floor)
       truth_corners = true;
+    } else if (a == "--truth-at") {  // the true pixel of the corners found: found|outline|inner
+      truth_at = next, ++i;
+    } else if (a == "--truth-above") {  // the true pixel of the corners found more than PX off
+      truth_above_px = std::atof(next), ++i;
+    } else if (a == "--truth-noise") {  // --truth-at's true pixels plus Gaussian noise (px)
+      truth_noise_px = std::atof(next), ++i;
+    } else if (a == "--corners-from") {  // the pixels the solve takes: variant view id x y lines
+      corners_from = next, ++i;
+    } else if (a == "--dump") {  // every corner found: variant view id outline x y, the truth
+      dump = next, ++i;
     } else if (a == "--only") {  // one variant: dark_sharp, dark_blur, light_sharp, light_blur
       only = next, ++i;
     } else if (a == "--per-view") {  // each view's edge shift and corner errors
       per_view = true;
     } else if (a == "--verbose") {
       verbose = true;
+    } else if (a == "--halfway") {  // edges halfway, one shift undone (before the edge level)
+      options.edge_level_from_pitch = false;
     } else if (a == "--no-second-look") {
       options.second_look = false;
     } else {
@@ -79,7 +102,10 @@ int main(int argc, char** argv) {
           stderr,
           "usage: calib_detect_elsewhere [--views N] [--seeds S1,S2] [--border-bits 1|2] "
           "[--margin TAGS] [--gamma G] [--contrast C] [--vignette V] [--solve] "
-          "[--save DIR] [--verbose] [--no-second-look] [--only dark_blur|...] [--per-view]\n");
+          "[--save DIR] [--verbose] [--no-second-look] [--only dark_blur|...] [--per-view] "
+          "[--truth-corners] [--truth-at found|outline|inner] [--truth-above PX] [--truth-noise "
+          "PX] "
+          "[--corners-from FILE] [--dump FILE] [--halfway]\n");
       return 2;
     }
   }
@@ -94,6 +120,18 @@ int main(int argc, char** argv) {
       grid.emplace_back(lens.width * (0.05 + 0.9 * i / 39.0),
                         lens.height * (0.05 + 0.9 * j / 29.0));
   int all_lost = 0;
+  cv::RNG rng(7);
+  std::map<std::string, Eigen::Vector2d> given;  // --corners-from, by "variant view id"
+  if (!corners_from.empty()) {
+    std::ifstream in(corners_from);
+    std::string variant_name;
+    size_t view_index;
+    int id;
+    double x, y;
+    while (in >> variant_name >> view_index >> id >> x >> y)
+      given[variant_name + " " + std::to_string(view_index) + " " + std::to_string(id)] = {x, y};
+  }
+  FILE* dump_file = dump.empty() ? nullptr : std::fopen(dump.c_str(), "w");
   for (unsigned seed : seeds) {
     const auto poses = renderer.Poses(views, seed);
     for (int surround : {20, 225})
@@ -111,13 +149,15 @@ int main(int argc, char** argv) {
         Eigen::Vector2d sum_px = Eigen::Vector2d::Zero();
         double sum_radial_px = 0, sum_outward_px = 0;
         std::vector<BoardView> used_views;
+        const std::string variant = "s" + std::to_string(seed) +
+                                    (surround < 128 ? "_dark" : "_light") +
+                                    (degraded ? "_blur" : "_sharp");
         const std::string name = "seed " + std::to_string(seed) +
                                  (surround < 128 ? " dark " : " light") +
                                  (degraded ? " blur1+jpeg80" : " sharp       ");
         std::string dir;
         if (!save.empty()) {
-          dir = save + "/s" + std::to_string(seed) + (surround < 128 ? "_dark" : "_light") +
-                (degraded ? "_blur" : "_sharp");
+          dir = save + "/" + variant;
           std::filesystem::create_directories(dir);
         }
         for (size_t v = 0; v < poses.size(); ++v) {
@@ -141,6 +181,7 @@ int main(int argc, char** argv) {
           tags_ours += d.tags;
           tags_aruco += static_cast<int>(aruco.size());
           if (!d.found && aruco_reads) ++lost;
+          std::vector<CornerObservation> solved_corners;  // d.corners, or the truth (--truth-at)
           double view_out[2] = {0, 0}, view_sq[2] = {0, 0};
           int view_n[2] = {0, 0};
           for (const CornerObservation& c : d.corners) {
@@ -166,13 +207,35 @@ int main(int argc, char** argv) {
             (outline ? outline_out : inner_out) += out_of_tag;
             ++(outline ? outline_n : inner_n);
             view_out[outline] += out_of_tag, view_sq[outline] += e * e, ++view_n[outline];
+            if (dump_file != nullptr) {
+              std::fprintf(dump_file, "%s %zu %d %d %.4f %.4f", variant.c_str(), v, c.id,
+                           outline ? 1 : 0, c.pixel.x(), c.pixel.y());
+              for (int j = 0; j < 4; ++j)  // the truth of the tag's corners, from this one on
+                std::fprintf(dump_file, " %.4f %.4f", view.truth[t0 + (k + j) % 4].x(),
+                             view.truth[t0 + (k + j) % 4].y());
+              std::fprintf(dump_file, "\n");
+            }
+            const bool to_truth = e > truth_above_px || truth_at == "found" ||
+                                  (truth_at == "outline" && outline) ||
+                                  (truth_at == "inner" && !outline);
+            const auto it =
+                given.find(variant + " " + std::to_string(v) + " " + std::to_string(c.id));
+            if (it != given.end())
+              solved_corners.push_back({c.id, it->second});
+            else if (to_truth)
+              solved_corners.push_back(
+                  {c.id, view.truth[c.id] +
+                             truth_noise_px * Eigen::Vector2d(rng.gaussian(1), rng.gaussian(1))});
+            else
+              solved_corners.push_back(c);
           }
           if (per_view)
             std::printf(
-                "  view %2zu shift %.3f edged %d dropped %d | outline %d rms %.3f out %.3f "
+                "  view %2zu level %.3f shift %.3f edged %d dropped %d | outline %d rms %.3f out "
+                "%.3f "
                 "| others %d rms %.3f out %.3f\n",
-                v, d.tag_edge_shift_px, d.corners_from_edges, d.corners_inconsistent, view_n[1],
-                std::sqrt(view_sq[1] / std::max(1, view_n[1])),
+                v, d.tag_edge_level, d.tag_edge_shift_px, d.corners_from_edges,
+                d.corners_inconsistent, view_n[1], std::sqrt(view_sq[1] / std::max(1, view_n[1])),
                 view_out[1] / std::max(1, view_n[1]), view_n[0],
                 std::sqrt(view_sq[0] / std::max(1, view_n[0])),
                 view_out[0] / std::max(1, view_n[0]));
@@ -181,7 +244,7 @@ int main(int argc, char** argv) {
             for (int id = 0; id < spec.NumCorners(); ++id) truth.push_back({id, view.truth[id]});
             used_views.push_back({"view" + std::to_string(v), truth});
           } else if (d.found) {
-            used_views.push_back({"view" + std::to_string(v), d.corners});
+            used_views.push_back({"view" + std::to_string(v), solved_corners});
           }
           if (verbose || (!d.found && aruco_reads))
             std::printf("  %s view %2zu: ours %2d tags (%s), aruco %2zu, %.0f ms\n", name.c_str(),
@@ -235,6 +298,7 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
   }
+  if (dump_file != nullptr) std::fclose(dump_file);
   std::printf("lost in all: %d\n", all_lost);
   return 0;
 }
