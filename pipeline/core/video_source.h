@@ -49,6 +49,10 @@ class VideoSource {
   virtual bool PeekNext(Frame* /*header*/) const { return false; }
   // Passes over the next frame without reading it (after PeekNext said true).
   virtual void SkipNext() {}
+  // Makes frame `index` (0-based) the next one read: a folder at once, a video file by
+  // reading it again from the start up to there (exact whatever the codec's key frames).
+  // False where the source cannot go back (live sources) or the video has no such frame.
+  virtual bool Seek(int /*index*/) { return false; }
   // A camera or a stream (frames arrive on their own clock; reading may time out).
   virtual bool IsLive() const { return false; }
   // Which clock timestamp_s follows: "index" (folders), "stream" or "arrival".
