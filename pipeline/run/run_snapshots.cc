@@ -8,11 +8,14 @@ RunSnapshots::RunSnapshots(int every, size_t budget_bytes)
     : every_(std::max(1, every)), budget_bytes_(budget_bytes) {}
 
 bool RunSnapshots::Due(int frames_read) const {
-  return frames_read % every_ == 0 && states_.count(frames_read) == 0;
+  if (frames_read % every_ != 0 || states_.count(frames_read) != 0) return false;
+  const size_t first = states_.empty() ? 0 : states_.begin()->second.bytes();
+  return first + last_offered_bytes_ <= budget_bytes_;
 }
 
 void RunSnapshots::Add(int frames_read, PaintRunState state) {
   const size_t bytes = state.bytes();
+  last_offered_bytes_ = bytes;
   if (bytes > budget_bytes_) return;  // one state alone over the budget: none kept
   // Thinned until the new state fits: the spacing doubles, every state off it dropped.
   while (bytes_ + bytes > budget_bytes_ && states_.size() > 1) {

@@ -18,8 +18,9 @@ class RunSnapshots {
  public:
   RunSnapshots(int every, size_t budget_bytes);
 
-  // Whether a state is due before reading frame `frames_read` (0-based): none kept there yet
-  // and `frames_read` on the spacing.
+  // Whether a state is due before reading frame `frames_read` (0-based): none kept there yet,
+  // `frames_read` on the spacing, and the last state offered would fit beside the first (a
+  // state is not saved, a costly copy, only to be dropped).
   bool Due(int frames_read) const;
   // Keeps `state` (saved before reading frame `frames_read`), thinning as the budget asks.
   void Add(int frames_read, PaintRunState state);
@@ -35,6 +36,7 @@ class RunSnapshots {
   int every_;
   size_t budget_bytes_;
   size_t bytes_ = 0;
+  size_t last_offered_bytes_ = 0;
   std::map<int, PaintRunState> states_;  // by frames read before it
 };
 

@@ -178,9 +178,10 @@ TEST(RunSnapshots, OverTheBudgetTheSpacingDoublesAndTheFirstStateStays) {
   EXPECT_EQ(at, 0);
   ASSERT_NE(snapshots.AtOrBefore(12, &at), nullptr);
   EXPECT_EQ(at, 8);
-  // A state alone over the budget is not kept.
+  // A state alone over the budget is not kept, and after it none is due that would not fit.
   snapshots.Add(16, state_of(400));
   EXPECT_EQ(snapshots.count(), 2u);
+  EXPECT_FALSE(snapshots.Due(24));
 }
 
 }  // namespace

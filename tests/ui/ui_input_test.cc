@@ -325,8 +325,40 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
   EXPECT_EQ(app.runner.Snapshot()->frame, 0);
 }
 
-// Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
-// where the seek goes and how far it got, never a bare "frame -1".
+// Step back (the Left key) paints on from the nearest painting state saved on the way (every
+// 10 frames by default), not from frame 0, and paints what painting straight there paints.
+TEST(UiInput, StepBackPaintsOnFromTheNearestSavedState) {
+  App app(11);  // states saved before frames 0 and 10
+  app.Tap(kKeyLeft);
+  app.runner.WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> back = app.runner.Snapshot();
+  EXPECT_EQ(back->frame, 10);
+  EXPECT_EQ(back->seek_from, 10) << "painted again from frame " << back->seek_from;
+  EXPECT_EQ(back->run.frames, 11);
+  AppState state;
+  ASSERT_TRUE(state.Open(app.dir + "/capture/project.json").ok());
+  PipelineRunner straight;
+  straight.Restart(state.project);
+  straight.Seek(10);
+  straight.WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> there = straight.Snapshot();
+  ASSERT_TRUE(back->painted && there->painted);
+  ASSERT_EQ(back->painted->size(), there->painted->size());
+  for (size_t b = 0; b < back->painted->size(); ++b)
+    EXPECT_EQ(cv::norm((*back->painted)[b], (*there->painted)[b], cv::NORM_INF), 0) << b;
+  EXPECT_EQ(back->run.frames_painted, there->run.frames_painted);
+  EXPECT_EQ(back->frames_painted, there->frames_painted) << "the per-frame history";
+  // Once more: frame 9 lies before the state at 10, so from the one before frame 0.
+  app.Frame();
+  app.Tap(kKeyLeft);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 9);
+  EXPECT_EQ(app.runner.Snapshot()->seek_from, 0);
+}
+
+// Seeking back repaints from the nearest saved state (here the one before frame 0): every
+// snapshot the worker publishes meanwhile says where the seek goes and how far it got, never
+// a bare "frame -1".
 // A long step before painting (here the joint adjustment of the poses) says, beside how far
 // it got, how long it has run and, once that can be told, about how long is left.
 TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
