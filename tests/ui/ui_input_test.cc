@@ -376,13 +376,22 @@ TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
   runner.Restart(state.project);
   runner.WaitIdle();
   std::lock_guard<std::mutex> lock(mutex);
-  int adjusting = 0;
+  int adjusting = 0, reading = 0, loading = 0;
   for (const std::string& status : statuses) {
+    loading += status.rfind("loading the scene, poses and buffers", 0) == 0;
+    // The pre-pass's reading of every frame: how far, the time elapsed (and left).
+    if (status.rfind("reading every frame ", 0) == 0) {
+      ++reading;
+      EXPECT_NE(status.find("/12, "), std::string::npos) << status;
+      EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
+    }
     if (status.rfind("adjusting poses ", 0) != 0) continue;
     ++adjusting;
     EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
   }
   EXPECT_GT(adjusting, 0) << "the joint adjustment published its progress";
+  EXPECT_GT(reading, 0) << "the pre-pass's reading published its progress";
+  EXPECT_EQ(loading, 1) << "the load said what it does";
 }
 
 TEST(UiInput, SeekingBackPublishesItsProgress) {

@@ -175,6 +175,26 @@ void PipelineRunner::OpenSession(const Project& project) {
   };
   job_options.joint_progress = progress("adjusting poses");
   job_options.movers_progress = progress("finding movers, pass");
+  // The pre-pass's reading, published at most every publish interval (a frame takes ms).
+  job_options.read_progress = [this, read = progress("reading every frame"),
+                               last = std::make_shared<Clock::time_point>()](
+                                  int done, int total, const std::string& line) {
+    if (done != total &&
+        Clock::now() - *last < std::chrono::milliseconds(options_.publish_interval_ms))
+      return;
+    *last = Clock::now();
+    read(done, total, line);
+  };
+  // The steps without a progress of their own: about as long as they took the last time
+  // this project opened (Apply, Restart and seeks back reopen it).
+  job_options.step_started = [this, &project](const std::string& step) {
+    working_.status = std::string(seek_target_ >= 0 ? "seeking: " : "") + step;
+    const double last_s = project.file_path != last_open_file_ ? -1
+                          : step == kLoadStep                  ? last_open_.load
+                                                               : last_open_.cameras;
+    if (last_s >= 1) working_.status += ", about " + DurationText(last_s) + " (as last time)";
+    Publish(false);
+  };
   if (const Status opened = OpenPaintJob(project, job_options, &s->job); !opened.ok()) {
     working_.status = "error: " + opened.message();
     if (s->live()) {
@@ -183,6 +203,8 @@ void PipelineRunner::OpenSession(const Project& project) {
     }
     return;
   }
+  last_open_file_ = project.file_path;
+  last_open_ = s->job->open_seconds;
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   s->run = std::make_unique<PaintRun>(s->paint(), s->job->source.get(), run_options);

@@ -32,6 +32,7 @@
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/run/live_status.h"
+#include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
 #include "pipeline/run/run_snapshots.h"
 
@@ -194,6 +195,10 @@ class PipelineRunner {
   RunnerSnapshot working_;
   bool playing_ = false;
   int seek_target_ = -1;
+  // The last project opened (its file) and how long its steps took: the estimate of the
+  // steps without a progress of their own when it opens again.
+  std::string last_open_file_;
+  PaintJob::OpenSeconds last_open_;
   std::thread thread_;
 };
 
