@@ -273,6 +273,7 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
   if (request.model != "auto") select.candidates = {request.model};
   select.cross_validate = request.cross_validate;
   select.all_halves = request.all_halves;
+  select.solve.cancelled = request.cancelled;
   if (request.progress)
     select.progress = [&request](int done, int total, const std::string& what) {
       request.progress("solve", done, total, what);

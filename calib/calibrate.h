@@ -29,6 +29,9 @@ struct CalibrateRequest {
   // SolveViews before each solve ("solve", model and data); `done` of `total` finished.
   std::function<void(const std::string& stage, int done, int total, const std::string& what)>
       progress;
+  // Optional: SolveViews asks it about every 0.1 s during each fit; true abandons the fit
+  // under way (SolveOptions::cancelled) and the solve fails with "cancelled".
+  std::function<bool()> cancelled;
 };
 
 struct RejectedImage {

@@ -1,7 +1,12 @@
 #include "calib/mrcal_solve.h"
 
 #include <malloc.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -119,6 +124,86 @@ Status Optimize(Problem* p, std::vector<double>* x) {
   if (stats.rms_reproj_error__pixels < 0 || !std::isfinite(stats.rms_reproj_error__pixels))
     return Status::Error("mrcal_optimize failed (bad arguments or a diverged solve)");
   return Status::Ok();
+}
+
+// The state a fit solves for and returns, as bytes: a child process's fit sent back.
+std::vector<std::pair<void*, size_t>> FitOutputs(Problem* p, std::vector<double>* x) {
+  std::vector<std::pair<void*, size_t>> parts = {
+      {p->intrinsics.data(), p->intrinsics.size() * sizeof(double)},
+      {p->frames.data(), p->frames.size() * sizeof(mrcal_pose_t)},
+      {&p->warp, sizeof(p->warp)},
+      {p->pool.data(), p->pool.size() * sizeof(mrcal_point3_t)}};  // outliers marked
+  if (x) parts.push_back({x->data(), x->size() * sizeof(double)});
+  return parts;
+}
+
+// Optimize in a child process (SolveOptions::cancelled): it writes a status byte and the
+// fit's outputs to a pipe; the parent reads them while asking `cancelled`, and kills the
+// child when it says so.
+Status OptimizeAbandonably(Problem* p, std::vector<double>* x,
+                           const std::function<bool()>& cancelled) {
+  if (x) x->assign(p->NumMeasurements(), 0.0);
+  int fds[2];
+  if (pipe(fds) != 0) return Optimize(p, x);
+  const pid_t child = fork();
+  if (child < 0) {
+    close(fds[0]), close(fds[1]);
+    return Optimize(p, x);
+  }
+  if (child == 0) {  // the fit, and its result down the pipe; no exit handlers
+    close(fds[0]);
+    const char ok = Optimize(p, x).ok() ? 1 : 0;
+    bool written = write(fds[1], &ok, 1) == 1;
+    for (const auto& [data, size] : FitOutputs(p, x))
+      for (size_t done = 0; written && done < size;) {
+        const ssize_t n = write(fds[1], static_cast<const char*>(data) + done, size - done);
+        written = n > 0;
+        done += n > 0 ? static_cast<size_t>(n) : 0;
+      }
+    _exit(written ? 0 : 1);
+  }
+  close(fds[1]);
+  std::vector<char> result;
+  bool abandoned = false;
+  for (;;) {
+    pollfd ready{fds[0], POLLIN, 0};
+    const int polled = poll(&ready, 1, 100);
+    if (polled == 0 || (polled < 0 && errno == EINTR)) {
+      if (cancelled()) {
+        kill(child, SIGKILL);
+        abandoned = true;
+        break;
+      }
+      continue;
+    }
+    char chunk[65536];
+    const ssize_t n = read(fds[0], chunk, sizeof(chunk));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // the end: the child wrote all it had
+    result.insert(result.end(), chunk, chunk + n);
+  }
+  close(fds[0]);
+  while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
+  }
+  if (abandoned) return Status::Error("cancelled");
+  size_t expected = 1;
+  for (const auto& part : FitOutputs(p, x)) expected += part.second;
+  if (result.size() != expected)
+    return Status::Error("mrcal_optimize: the fit's process ended without its result");
+  if (result[0] != 1)
+    return Status::Error("mrcal_optimize failed (bad arguments or a diverged solve)");
+  size_t at = 1;
+  for (const auto& [data, size] : FitOutputs(p, x)) {
+    std::memcpy(data, result.data() + at, size);
+    at += size;
+  }
+  return Status::Ok();
+}
+
+// A fit in this process, or one that can be abandoned when `options` ask.
+Status Optimize(Problem* p, std::vector<double>* x, const SolveOptions& options) {
+  if (options.cancelled && options.cancelled()) return Status::Error("cancelled");
+  return options.cancelled ? OptimizeAbandonably(p, x, options.cancelled) : Optimize(p, x);
 }
 
 // All measurements at the problem's current state (no optimisation), and mrcal's Jacobian
@@ -343,7 +428,7 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   // Stage 1: core and board poses, distortion held (a stereographic core for splined).
   SeedCore(target, splined, seed, &p);
   p.selections = Selections(true, false, false, false, false);
-  FRESCO_RETURN_IF_ERROR(Optimize(&p, nullptr));
+  FRESCO_RETURN_IF_ERROR(Optimize(&p, nullptr, options));
 
   // Stage 2: everything.
   if (splined) {
@@ -356,7 +441,7 @@ Status SolveIntrinsics(const std::vector<BoardView>& views, const BoardSpec& spe
   p.selections =
       Selections(true, has_distortion, options.optimize_board_warp, true, options.reject_outliers);
   std::vector<double> x;
-  FRESCO_RETURN_IF_ERROR(Optimize(&p, &x));
+  FRESCO_RETURN_IF_ERROR(Optimize(&p, &x, options));
 
   SolveResult out;
   char name[512];

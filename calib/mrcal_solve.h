@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,11 @@ struct SolveOptions {
   // Multiplies sigma in the covariance: > 1 when corner errors are positively correlated
   // (AprilTag corners of one tag share one quad fit); calib/noise_correlation.h.
   double noise_inflation = 1.0;
+  // Optional: asked about every 0.1 s while a fit runs; true abandons the fit mid-way and the
+  // solve fails with "cancelled". mrcal_optimize has no hook to stop it, so with this set each
+  // fit runs in a child process (its result sent back whole, byte for byte what it would be
+  // here), which is killed: nothing is left half-written.
+  std::function<bool()> cancelled;
 };
 
 struct ViewFit {

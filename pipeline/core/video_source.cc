@@ -125,6 +125,11 @@ class FolderSource : public VideoSource {
   void SkipNext() override {
     if (next_ < names_.size()) ++next_;
   }
+  bool Seek(int index) override {
+    if (index < 0 || static_cast<size_t>(index) > names_.size()) return false;
+    next_ = static_cast<size_t>(index);
+    return true;
+  }
 
  private:
   std::string folder_;
@@ -220,6 +225,16 @@ class CaptureSource : public VideoSource {
     return true;
   }
   int FrameCount() const override { return count_; }
+  bool Seek(int index) override {
+    if (live_ || index < 0) return false;
+    if (index < index_) {  // opened again: the decoder starts as it did the first time
+      if (!capture_.open(what_, cv::CAP_FFMPEG)) return false;
+      index_ = 0;
+    }
+    for (; index_ < index; ++index_)
+      if (!capture_.grab()) return false;
+    return true;
+  }
   std::vector<std::string> FrameNames() const override { return {}; }
   double Fps() const override { return fps_; }
   bool IsLive() const override { return live_; }

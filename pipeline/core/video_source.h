@@ -51,6 +51,10 @@ class VideoSource {
   // Passes over the next frame without reading it (after PeekNext said true; a video file's
   // grabbed frame is dropped unconverted).
   virtual void SkipNext() {}
+  // Makes frame `index` (0-based) the next one read: a folder at once, a video file by
+  // reading it again from the start up to there (exact whatever the codec's key frames).
+  // False where the source cannot go back (live sources) or the video has no such frame.
+  virtual bool Seek(int /*index*/) { return false; }
   // A camera or a stream (frames arrive on their own clock; reading may time out).
   virtual bool IsLive() const { return false; }
   // Which clock timestamp_s follows: "index" (folders), "stream" or "arrival".

@@ -88,6 +88,10 @@ class BufferBackground {
   // state of the texel nearest to q + field(q - roi.tl()) (CV_32FC2, roi size), when there
   // is one.
   void Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field);
+  // A copy that shares no pixels with this one (a saved painting state), and the bytes the
+  // model holds.
+  BufferBackground Clone() const;
+  size_t Bytes() const;
 
   // Per-texel state of the average model (by texel number k, not buffer index); the robust
   // model's is RobustTexels.

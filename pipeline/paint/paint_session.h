@@ -112,6 +112,15 @@ class PaintSession {
   // the same frames once per candidate offset).
   void ResetPainting();
 
+  // Everything painting changes (painting_state.h: the buffers, the per-texel models, the
+  // layers, the `auto` modes' decisions and evidence so far, the frame counts), saved between
+  // two frames and restored: painting on from a restored state gives, byte for byte, what
+  // painting on from where it was saved gave (the app steps back from its nearest saved state
+  // instead of repainting from the first frame). A state fits the session that saved it.
+  struct State;
+  std::shared_ptr<const State> SaveState() const;
+  void RestoreState(const State& state);
+
   // The scene's geometry with the painted buffers packed into texture atlas pages
   // (texture_atlas.h), one base-colour texture and material per page (alpha 0 where never
   // painted), and new UVs into them: what `fresco run` writes. With view-dependent layers

@@ -52,10 +52,41 @@ FileFrameSource::FileFrameSource(const Project& project, const std::vector<const
         if (f.camera && skip_ && skip_(f)) return true;
         return decoded_ && decoded_->Has(f.stream, f.pose_index);  // Next() takes it
       };
-    readers_.push_back(std::make_unique<ReadAhead>(streams_[s]->video.get(), skip_frame));
+    skip_frame_.push_back(skip_frame);
+    readers_.emplace_back();
+    StartReading(s);
     fps_.push_back(specs[s].fps);
   }
   if (std::any_of(fps_.begin(), fps_.end(), [](double fps) { return !(fps > 0); })) fps_.clear();
+}
+
+void FileFrameSource::StartReading(size_t s) {
+  readers_[s].reset();  // waits for the frame it was reading ahead
+  readers_[s] = std::make_unique<ReadAhead>(streams_[s]->video.get(), skip_frame_[s]);
+}
+
+bool FileFrameSource::Tell(SourcePosition* position) const {
+  position->read = read_;
+  position->ended = ended_;
+  position->next = next_;
+  return true;
+}
+
+Status FileFrameSource::Seek(const SourcePosition& position) {
+  if (position.read.size() != streams_.size() || position.ended.size() != streams_.size())
+    return Status::Error("seek: a position of " + std::to_string(position.read.size()) +
+                         " streams in a source of " + std::to_string(streams_.size()));
+  for (size_t s = 0; s < streams_.size(); ++s) {
+    readers_[s].reset();  // nothing reads the video while it moves
+    if (!streams_[s]->video->Seek(static_cast<int>(position.read[s])))
+      return Status::Error(origins_[s].video + ": cannot go back to frame " +
+                           std::to_string(position.read[s]));
+    StartReading(s);
+  }
+  read_ = position.read;
+  ended_ = position.ended;
+  next_ = position.next;
+  return Status::Ok();
 }
 
 int FileFrameSource::PickStream() {

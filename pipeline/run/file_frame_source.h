@@ -59,10 +59,13 @@ class FileFrameSource : public PosedFrameSource {
   int NumStreams() const override { return static_cast<int>(streams_.size()); }
   const FrameOrigin& Origin(int stream) const override { return origins_[stream]; }
   int FrameCount() const override;
+  bool Tell(SourcePosition* position) const override;
+  Status Seek(const SourcePosition& position) override;
 
  private:
   // Fills the pose, camera and its identity of a frame of stream `s`.
   void MatchPose(int s, SourcedFrame* frame) const;
+  void StartReading(size_t s);  // stream s's reader, from where its video stands
   // The stream to read from next (time order or in turn), -1 when every stream ended.
   int PickStream();
 
@@ -70,6 +73,7 @@ class FileFrameSource : public PosedFrameSource {
   SkipFrame skip_;
   std::shared_ptr<DecodedFrames> decoded_;
   std::vector<FrameOrigin> origins_;
+  std::vector<std::function<bool(const Frame&)>> skip_frame_;  // per stream, for its reader
   std::vector<std::unique_ptr<ReadAhead>> readers_;
   std::vector<bool> ended_;
   std::vector<double> fps_;      // per stream, when every stream has one (else empty)

@@ -120,10 +120,14 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
     for (const Capture* capture : streams) folder.push_back(!capture->video->FrameNames().empty());
     SourcedFrame f;
     Status status;
+    int to_read = source.FrameCount();
+    if (project.pipeline.max_frames > 0 && to_read >= 0)
+      to_read = std::min(to_read, project.pipeline.max_frames);
     for (int read = 0; (project.pipeline.max_frames <= 0 || read < project.pipeline.max_frames) &&
                        source.Next(&f, &status) == FrameRead::kFrame;
          ++read) {
       if (options.stop && options.stop()) return Status::Error(project.file_path + ": interrupted");
+      if (options.read_progress) options.read_progress(read + 1, to_read, f.posed.frame.name);
       const int every = options.joint_holdout_every;
       if (read == options.joint_holdout_counter || (every > 0 && read % every == every / 2))
         continue;
@@ -248,6 +252,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   load_options.open_live_video = false;  // a live video opens after its pose feed connects
   const auto start = std::chrono::steady_clock::now();
   PaintJob::OpenSeconds& seconds = j.open_seconds;
+  if (options.step_started) options.step_started(kLoadStep);
   FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
   if (options.paint_at_truth_poses)
     for (Capture& capture : j.captures) TakeTruthPoses(&capture);
@@ -255,6 +260,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).
+  if (options.step_started) options.step_started(kCamerasStep);
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
   seconds.cameras = SecondsSince(start) - seconds.load;

@@ -27,6 +27,10 @@ namespace fresco {
 
 class DecodedFrames;  // file_frame_source.h
 
+// The steps of opening a project that PaintJobOptions::step_started names.
+inline constexpr const char* kLoadStep = "loading the scene, poses and buffers";
+inline constexpr const char* kCamerasStep = "preparing the cameras";
+
 struct PaintJobOptions {
   // Non-empty: the project must have one stream, else an error naming `streams` and this
   // ("fresco bench").
@@ -42,6 +46,13 @@ struct PaintJobOptions {
   // Captures from files with background `auto` or a model: progress of the search for movers
   // across views before painting, pass by pass (optional).
   std::function<void(int done, int total, const std::string& line)> movers_progress;
+  // The whole-capture pre-pass (refine.joint or the movers' search): its reading of every
+  // frame, called after each frame read with the frames read and the frames to read (-1:
+  // unknown) (optional).
+  std::function<void(int done, int total, const std::string& line)> read_progress;
+  // Before each step of opening without a progress of its own (kLoadStep, kCamerasStep),
+  // naming it (optional).
+  std::function<void(const std::string& step)> step_started;
   // pipeline.refine.joint: frames held out of painting (as PaintRunOptions' holdout_every and
   // holdout_counter, by position in reading order) take no part in the adjustment and keep
   // their given poses: the photos `fresco rephoto` and `fresco bench` score are not used.

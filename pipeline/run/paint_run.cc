@@ -71,6 +71,25 @@ FrameRead PaintRun::Next(RunFrame* frame) {
   return End(FrameRead::kFrame);
 }
 
+bool PaintRun::Save(PaintRunState* state) const {
+  if (!source_->Tell(&state->position)) return false;
+  state->stats = stats_;
+  state->painting = session_->SaveState();
+  return true;
+}
+
+Status PaintRun::Restore(const PaintRunState& state) {
+  status_ = source_->Seek(state.position);
+  ended_ = !status_.ok();
+  if (ended_) return status_;
+  max_frames_reached_ = false;
+  const double seconds = stats_.seconds;  // the clock runs on
+  stats_ = state.stats;
+  stats_.seconds = seconds;
+  session_->RestoreState(*state.painting);
+  return status_;
+}
+
 std::string PaintRun::EndReason() const {
   if (max_frames_reached_)
     return "pipeline.max_frames (" + std::to_string(options_.max_frames) + ") reached";

@@ -19,10 +19,12 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "pipeline/paint/paint_session.h"
+#include "pipeline/paint/painting_state.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/run/frame_policy.h"
 #include "pipeline/run/posed_frame_source.h"
@@ -87,6 +89,15 @@ struct PaintRunStats {
   std::map<std::string, std::map<std::string, double>> MeanStageMetrics() const;
 };
 
+// A run between two frames (PaintRun::Save): the session's painting state, the counts so far
+// and where the source stands; Restore goes back (or on) to it.
+struct PaintRunState {
+  std::shared_ptr<const PaintSession::State> painting;
+  PaintRunStats stats;
+  SourcePosition position;
+  size_t bytes() const { return painting ? painting->bytes : 0; }
+};
+
 class PaintRun {
  public:
   // `session` and `source` must outlive the run.
@@ -98,6 +109,12 @@ class PaintRun {
   FrameRead Next(RunFrame* frame);
   // Paints a frame Next gave with fate kPaint into the session and counts it.
   void Paint(const RunFrame& frame, FrameReport* report);
+
+  // The run as it stands, to come back to; false for a source that cannot go back (live).
+  bool Save(PaintRunState* state) const;
+  // Back (or on) to a state this run saved: painting on gives what it gave from there. An
+  // error (a video that cannot be read again) leaves the run ended with it.
+  Status Restore(const PaintRunState& state);
 
   const Status& status() const { return status_; }
   bool ended() const { return ended_; }

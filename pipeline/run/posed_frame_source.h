@@ -10,6 +10,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "pipeline/core/camera.h"
 #include "pipeline/core/status.h"
@@ -42,6 +43,13 @@ enum class FrameRead {
   kEnded,    // the end of every stream, or an error (then in `status`)
 };
 
+// Where a source of files is in its streams (PosedFrameSource::Tell), to go back to (Seek).
+struct SourcePosition {
+  std::vector<long long> read;  // per stream: frames handed out
+  std::vector<bool> ended;      // per stream: at its end
+  int next = 0;                 // the stream whose turn is next
+};
+
 class PosedFrameSource {
  public:
   virtual ~PosedFrameSource() = default;
@@ -59,6 +67,12 @@ class PosedFrameSource {
   // Frames arrive on a camera's or a stream's clock (and are dropped when the painter is
   // behind); false for files and folders, live pose feeds or not: a replay.
   virtual bool RealTime() const { return false; }
+  // Sources of files: where the next frame comes from; false where a source cannot go back.
+  virtual bool Tell(SourcePosition* /*position*/) const { return false; }
+  // Goes back (or on) to where Tell was: the frames from there are read again, as they were.
+  virtual Status Seek(const SourcePosition& /*position*/) {
+    return Status::Error("this source of frames cannot go back (live)");
+  }
 };
 
 }  // namespace fresco

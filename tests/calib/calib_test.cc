@@ -18,6 +18,8 @@
 #include "calib/board_image.h"
 #include "calib/calibrate.h"
 #include "calib/lens_projection.h"
+#include "calib/mrcal_solve.h"
+#include "calib/seed.h"
 #include "pipeline/core/cameramodel_io.h"
 #include "tests/calib/synthetic_boards.h"
 #include "tests/test_support.h"
@@ -84,6 +86,36 @@ TEST(SyntheticCalibrationTest, PinholeTruthRecoveredAndAutoPicksPinhole) {
   }
   EXPECT_NEAR(fit.noise_sigma_px, 0.2, 0.03);
   EXPECT_EQ(run.choice.trials.size(), 5u);
+}
+
+// A fit that can be cancelled runs in a child process: what it sends back is byte for byte
+// what the same fit gives in this process; cancelled while it runs (asked every 0.1 s), the
+// solve says "cancelled" and fills nothing.
+TEST(SyntheticCalibrationTest, AFitInAChildProcessIsTheSameAndCanBeAbandoned) {
+  const BoardSpec spec = Spec("chessboard:10x7:0.03");
+  SyntheticCapture capture;
+  capture.views = 10;
+  const auto views = SyntheticViews(spec, capture);
+  CalibrationSeed seed;
+  ASSERT_TRUE(SeedCalibration(views, spec, 640, 480, &seed).ok());
+  SolveOptions options;
+  options.lensmodel = "LENSMODEL_OPENCV4";
+  SolveResult here, child;
+  ASSERT_TRUE(SolveIntrinsics(views, spec, 640, 480, seed, options, &here).ok());
+  options.cancelled = [] { return false; };
+  ASSERT_TRUE(SolveIntrinsics(views, spec, 640, 480, seed, options, &child).ok());
+  ASSERT_EQ(here.intrinsics.size(), child.intrinsics.size());
+  for (size_t i = 0; i < here.intrinsics.size(); ++i)
+    EXPECT_EQ(here.intrinsics[i], child.intrinsics[i]) << i;  // to the bit
+  EXPECT_EQ(here.rms_px, child.rms_px);
+  EXPECT_EQ(here.intrinsics_stdev, child.intrinsics_stdev);
+  int asked = 0;
+  options.cancelled = [&asked] { return ++asked >= 2; };  // first before the fit, then during
+  SolveResult abandoned;
+  const Status status = SolveIntrinsics(views, spec, 640, 480, seed, options, &abandoned);
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.message(), "cancelled");
+  EXPECT_TRUE(abandoned.intrinsics.empty());
 }
 
 TEST(SyntheticCalibrationTest, StrongDistortionPicksARicherModel) {

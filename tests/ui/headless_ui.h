@@ -177,8 +177,10 @@ struct HeadlessApp {
     const auto it = report.find(key);
     return it == report.end() ? "" : it->second;
   }
+  // A panel's window by its title, or another window by its name ("##Menu_00").
   static ImGuiWindow* Window(const std::string& title) {
-    ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
+    ImGuiWindow* w = ImGui::FindWindowByName(PanelWindowId(title).c_str());
+    if (!w) w = ImGui::FindWindowByName(title.c_str());
     EXPECT_NE(w, nullptr) << title;
     return w;
   }

@@ -27,7 +27,7 @@ using testing::Capture;
 using testing::HeadlessApp;
 
 bool Shown(const std::string& title) {
-  ImGuiWindow* w = ImGui::FindWindowByName(title.c_str());
+  ImGuiWindow* w = ImGui::FindWindowByName(PanelWindowId(title).c_str());
   return w && w->Active;
 }
 
@@ -35,7 +35,8 @@ bool Shown(const std::string& title) {
 std::string Overlaps(HeadlessApp& app) {
   std::vector<ImGuiWindow*> shown;
   for (const auto& p : app.panels)
-    if (Shown(p->Title())) shown.push_back(ImGui::FindWindowByName(p->Title()));
+    if (Shown(p->Title()))
+      shown.push_back(ImGui::FindWindowByName(PanelWindowId(p->Title()).c_str()));
   std::string overlaps;
   for (size_t i = 0; i < shown.size(); ++i)
     for (size_t j = i + 1; j < shown.size(); ++j) {

@@ -325,8 +325,40 @@ TEST(UiInput, ArrowsStepBackAndForwardAndF5KeepsTheFrame) {
   EXPECT_EQ(app.runner.Snapshot()->frame, 0);
 }
 
-// Seeking back repaints from frame 0: every snapshot the worker publishes meanwhile says
-// where the seek goes and how far it got, never a bare "frame -1".
+// Step back (the Left key) paints on from the nearest painting state saved on the way (every
+// 10 frames by default), not from frame 0, and paints what painting straight there paints.
+TEST(UiInput, StepBackPaintsOnFromTheNearestSavedState) {
+  App app(11);  // states saved before frames 0 and 10
+  app.Tap(kKeyLeft);
+  app.runner.WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> back = app.runner.Snapshot();
+  EXPECT_EQ(back->frame, 10);
+  EXPECT_EQ(back->seek_from, 10) << "painted again from frame " << back->seek_from;
+  EXPECT_EQ(back->run.frames, 11);
+  AppState state;
+  ASSERT_TRUE(state.Open(app.dir + "/capture/project.json").ok());
+  PipelineRunner straight;
+  straight.Restart(state.project);
+  straight.Seek(10);
+  straight.WaitIdle();
+  std::shared_ptr<const RunnerSnapshot> there = straight.Snapshot();
+  ASSERT_TRUE(back->painted && there->painted);
+  ASSERT_EQ(back->painted->size(), there->painted->size());
+  for (size_t b = 0; b < back->painted->size(); ++b)
+    EXPECT_EQ(cv::norm((*back->painted)[b], (*there->painted)[b], cv::NORM_INF), 0) << b;
+  EXPECT_EQ(back->run.frames_painted, there->run.frames_painted);
+  EXPECT_EQ(back->frames_painted, there->frames_painted) << "the per-frame history";
+  // Once more: frame 9 lies before the state at 10, so from the one before frame 0.
+  app.Frame();
+  app.Tap(kKeyLeft);
+  app.runner.WaitIdle();
+  EXPECT_EQ(app.runner.Snapshot()->frame, 9);
+  EXPECT_EQ(app.runner.Snapshot()->seek_from, 0);
+}
+
+// Seeking back repaints from the nearest saved state (here the one before frame 0): every
+// snapshot the worker publishes meanwhile says where the seek goes and how far it got, never
+// a bare "frame -1".
 // A long step before painting (here the joint adjustment of the poses) says, beside how far
 // it got, how long it has run and, once that can be told, about how long is left.
 TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
@@ -344,13 +376,22 @@ TEST(UiInput, TheStepsBeforePaintingSayTheTimeElapsedAndLeft) {
   runner.Restart(state.project);
   runner.WaitIdle();
   std::lock_guard<std::mutex> lock(mutex);
-  int adjusting = 0;
+  int adjusting = 0, reading = 0, loading = 0;
   for (const std::string& status : statuses) {
+    loading += status.rfind("loading the scene, poses and buffers", 0) == 0;
+    // The pre-pass's reading of every frame: how far, the time elapsed (and left).
+    if (status.rfind("reading every frame ", 0) == 0) {
+      ++reading;
+      EXPECT_NE(status.find("/12, "), std::string::npos) << status;
+      EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
+    }
     if (status.rfind("adjusting poses ", 0) != 0) continue;
     ++adjusting;
     EXPECT_NE(status.find(" elapsed"), std::string::npos) << status;
   }
   EXPECT_GT(adjusting, 0) << "the joint adjustment published its progress";
+  EXPECT_GT(reading, 0) << "the pre-pass's reading published its progress";
+  EXPECT_EQ(loading, 1) << "the load said what it does";
 }
 
 TEST(UiInput, SeekingBackPublishesItsProgress) {

@@ -20,7 +20,7 @@ using testing::Capture;
 struct LayoutApp : testing::HeadlessApp {
   explicit LayoutApp(ImVec2 display) : HeadlessApp(Capture() + "/project.json", 2, display) {}
   static bool Shown(const char* title) {
-    ImGuiWindow* w = ImGui::FindWindowByName(title);
+    ImGuiWindow* w = ImGui::FindWindowByName(PanelWindowId(title).c_str());
     return w && w->Active;
   }
 };
@@ -82,6 +82,31 @@ void ExpectUsable(ImVec2 display, float content_scale = 1) {
 
 TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1600x1000) { ExpectUsable({1600, 1000}); }
 TEST(UiLayout, The3DViewIsLargeAndEveryTileUsableAt1280x800) { ExpectUsable({1280, 800}); }
+// At 1280 x 800 every title bar shows its panel's title whole or shortened, never cut in the
+// middle of a word ("Stage: depth and vi"), the tool panels' tabs too; and a panel's window
+// stays the same ImGui window whatever its title bar shows.
+TEST(UiLayout, EveryTitleFitsItsTitleBarAt1280x800) {
+  LayoutApp app({1280, 800});
+  for (const char* tool : {kPosesPanelTitle, kCalibrationPanelTitle, kNewProjectTitle})
+    app.Find(tool).open = true;
+  app.Frames(3);
+  const ImGuiStyle& style = ImGui::GetStyle();
+  for (const auto& p : app.panels) {
+    if (!p->open || !LayoutApp::Shown(p->Title())) continue;
+    ImGuiWindow* w = LayoutApp::Window(p->Title());
+    const std::string name = w->Name;
+    const std::string shown = name.substr(0, name.find("###"));
+    EXPECT_EQ(name.substr(shown.size()), PanelWindowId(p->Title())) << name;
+    const float room = w->Size.x - 2 * style.FramePadding.x - ImGui::GetFontSize();
+    EXPECT_LE(ImGui::CalcTextSize(shown.c_str()).x, room)
+        << p->Title() << " shows '" << shown << "'";
+    EXPECT_TRUE(shown == p->Title() || shown == p->ShortTitle())
+        << p->Title() << " shows '" << shown << "'";
+  }
+  EXPECT_EQ(std::string(LayoutApp::Window("Stage: depth and visibility")->Name),
+            "Depth###Stage: depth and visibility");
+}
+
 // A 4K monitor at 192 dpi (content scale 2): the same layout at twice the size, the text
 // drawn from a font built at 26 pixels (crisp, not a 13-pixel font magnified), the status bar
 // as tall as its text needs.

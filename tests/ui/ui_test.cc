@@ -81,7 +81,7 @@ TEST(UiHeadless, EveryPanelDrawsTheWorkersSnapshot) {
   // share the stage row's place), and images went through the texture backend.
   for (const auto& panel : panels) {
     if (ui.layout.ShowTab(panel->Title())) imgui.Frame(ui, panels);
-    ImGuiWindow* window = ImGui::FindWindowByName(panel->Title());
+    ImGuiWindow* window = ImGui::FindWindowByName(PanelWindowId(panel->Title()).c_str());
     ASSERT_NE(window, nullptr) << panel->Title();
     EXPECT_TRUE(window->Active || window->WasActive) << panel->Title();
     EXPECT_GT(window->Size.x, 100) << panel->Title();
@@ -395,7 +395,8 @@ TEST(CalibrationRunner, DetectsSolvesAndSavesTheChessboard) {
     ASSERT_TRUE(form);
     ImGuiHeadless::DrawPanel(ui, *form, ImVec2(760, 300));
     const std::string button = "Use the camera just calibrated: " + out;
-    ImGui::ActivateItem(ImGui::FindWindowByName(kNewProjectTitle)->GetID(button.c_str()));
+    ImGui::ActivateItem(
+        ImGui::FindWindowByName(PanelWindowId(kNewProjectTitle).c_str())->GetID(button.c_str()));
     ImGuiHeadless::DrawPanel(ui, *form, ImVec2(760, 300));
     EXPECT_EQ(form->Report().at("camera"), out);
   }

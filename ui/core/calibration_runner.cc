@@ -232,12 +232,15 @@ void CalibrationRunner::RunSolve() {
         "solving " + std::to_string(done + 1) + "/" + std::to_string(total) + ": " + what;
     Publish();
   };
+  // A fit under way is abandoned too (it runs in a child process that Cancel kills).
+  request.cancelled = [this] { return cancel_.load(); };
   working_.solving = true;
   working_.solves_done = working_.solves_total = 0;
   working_.solve_started = std::chrono::steady_clock::now();
   Status solved;
   try {
     solved = calib::SolveViews(request, &run);
+    if (cancel_) throw Cancelled{};  // the last fit abandoned: its model failed, not chosen
   } catch (const Cancelled&) {
     working_.solving = false;
     working_.status = "cancelled: the solve stopped after " + std::to_string(working_.solves_done) +

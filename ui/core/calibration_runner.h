@@ -61,9 +61,9 @@ class CalibrationRunner {
   // Starts over on this folder and board (a detection under way stops after its image).
   void Detect(const calib::CalibrateRequest& request);
   void Solve();  // on the views detected so far, with the request's model
-  // Stops a detection or solve under way: a detection after its image, a solve before its
-  // next fit (one lens model's fit runs to its end). The detections are kept, an earlier
-  // solve's results too; nothing is written. Status "cancelled: ...".
+  // Stops a detection or solve under way: a detection after its image, a solve within about
+  // 0.1 s, mid-fit too (each fit runs in a child process, killed). The detections are kept,
+  // an earlier solve's results too; nothing is written. Status "cancelled: ...".
   void Cancel();
   // Leaves image `name` out of (or puts it back into) the views; an earlier solve is stale.
   void Exclude(const std::string& name, bool excluded);

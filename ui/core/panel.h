@@ -99,7 +99,11 @@ struct UiContext {
 class Panel {
  public:
   virtual ~Panel() = default;
+  // The panel's name: in the View menu, the tiled layout, layout files, and its ImGui
+  // window's ID (PanelWindowId), whatever its title bar shows.
   virtual const char* Title() const = 0;
+  // A shorter title for a title bar too narrow for Title() (FittedTitle); Title() if none.
+  virtual const char* ShortTitle() const { return Title(); }
   virtual void Draw(UiContext& ui) = 0;
   // What the panel shows, for `fresco gui --screenshot`'s FILE.json (name -> value).
   virtual std::map<std::string, std::string> Report() const { return {}; }
@@ -136,6 +140,12 @@ inline float StatusBarHeight() { return std::round(ImGui::GetFrameHeight() + 5);
 // maximise or restore it); else at its default place the first time (scaled to the
 // display), its title bar kept below the menu bar and on screen.
 bool BeginPanel(Panel& panel);
+// A panel's ImGui window is named "shown title###Title()": its ID is this, whatever the
+// title bar shows (ImGui::FindWindowByName(PanelWindowId(title)) finds it).
+inline std::string PanelWindowId(const std::string& title) { return "###" + title; }
+// What a title bar `width` pixels wide shows of the panel's title: Title() where it fits,
+// else ShortTitle(), else that cut short with ".." (the title bar's tooltip shows it whole).
+std::string FittedTitle(const Panel& panel, float width);
 // The same for a tool panel that shows a worker (Poses, Calibration; tiled as a tab below the
 // 3D view): false, with the window already ended, when there is no worker (it says so).
 bool BeginOverlayPanel(Panel& panel, bool has_worker, const char* worker);

@@ -25,13 +25,29 @@ void PushPanelTextWrap() {
 
 }  // namespace
 
+std::string FittedTitle(const Panel& panel, float width) {
+  const auto fits = [width](const std::string& text) {
+    return ImGui::CalcTextSize(text.c_str()).x <= width;
+  };
+  if (fits(panel.Title())) return panel.Title();
+  std::string shown = panel.ShortTitle();
+  if (fits(shown)) return shown;
+  while (shown.size() > 1 && !fits(shown + "..")) shown.pop_back();
+  return shown + "..";
+}
+
 bool BeginPanel(Panel& panel) {
   const ImVec2 display = ImGui::GetIO().DisplaySize;
   if (panel.tiled) {
     ImGui::SetNextWindowPos(panel.tile_pos, ImGuiCond_Always);
     ImGui::SetNextWindowSize(panel.tile_size, ImGuiCond_Always);
+    // The title bar holds the title between its paddings, beside the close button.
+    const ImGuiStyle& style = ImGui::GetStyle();
+    const float title_width = panel.tile_size.x - 2 * style.FramePadding.x - ImGui::GetFontSize() -
+                              style.ItemInnerSpacing.x;
+    const std::string name = FittedTitle(panel, title_width) + PanelWindowId(panel.Title());
     const bool visible =
-        ImGui::Begin(panel.Title(), &panel.open,
+        ImGui::Begin(name.c_str(), &panel.open,
                      ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
                          ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
     // Text wraps at the panel's edge instead of running out of a narrow tile (ImGui resets
@@ -52,7 +68,8 @@ bool BeginPanel(Panel& panel) {
                           ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(panel.default_size.x * sx, panel.default_size.y * sy),
                            ImGuiCond_FirstUseEver);
-  const bool visible = ImGui::Begin(panel.Title(), &panel.open);
+  const bool visible =
+      ImGui::Begin((panel.Title() + PanelWindowId(panel.Title())).c_str(), &panel.open);
   PushPanelTextWrap();
   // However it was dragged, the title bar stays below the menu bar and on screen.
   const ImVec2 pos = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();

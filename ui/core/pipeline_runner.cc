@@ -28,6 +28,8 @@ struct PipelineRunner::Session {
   // The painting job's frame loop (reads `job`: after it), judged and counted as `fresco run`
   // does.
   std::unique_ptr<PaintRun> run;
+  // Painting states to step back to (files only; RunnerOptions::snapshot_every).
+  std::unique_ptr<RunSnapshots> snapshots;
   // The first live stream, whose state the Pipeline panel shows (-1: none); its state as
   // read, its recording, and the pose time of its last frame taken (-1: none yet).
   int live_stream = -1;
@@ -173,6 +175,26 @@ void PipelineRunner::OpenSession(const Project& project) {
   };
   job_options.joint_progress = progress("adjusting poses");
   job_options.movers_progress = progress("finding movers, pass");
+  // The pre-pass's reading, published at most every publish interval (a frame takes ms).
+  job_options.read_progress = [this, read = progress("reading every frame"),
+                               last = std::make_shared<Clock::time_point>()](
+                                  int done, int total, const std::string& line) {
+    if (done != total &&
+        Clock::now() - *last < std::chrono::milliseconds(options_.publish_interval_ms))
+      return;
+    *last = Clock::now();
+    read(done, total, line);
+  };
+  // The steps without a progress of their own: about as long as they took the last time
+  // this project opened (Apply, Restart and seeks back reopen it).
+  job_options.step_started = [this, &project](const std::string& step) {
+    working_.status = std::string(seek_target_ >= 0 ? "seeking: " : "") + step;
+    const double last_s = project.file_path != last_open_file_ ? -1
+                          : step == kLoadStep                  ? last_open_.load
+                                                               : last_open_.cameras;
+    if (last_s >= 1) working_.status += ", about " + DurationText(last_s) + " (as last time)";
+    Publish(false);
+  };
   if (const Status opened = OpenPaintJob(project, job_options, &s->job); !opened.ok()) {
     working_.status = "error: " + opened.message();
     if (s->live()) {
@@ -181,9 +203,13 @@ void PipelineRunner::OpenSession(const Project& project) {
     }
     return;
   }
+  last_open_file_ = project.file_path;
+  last_open_ = s->job->open_seconds;
   PaintRunOptions run_options;
   run_options.max_frames = project.pipeline.max_frames;
   s->run = std::make_unique<PaintRun>(s->paint(), s->job->source.get(), run_options);
+  s->snapshots = std::make_unique<RunSnapshots>(
+      options_.snapshot_every, static_cast<size_t>(std::max(0, options_.snapshot_budget_mb)) << 20);
   working_.geometry = MakeGeometry(*s->job);
   working_.stream_frames.assign(s->captures().size(), cv::Mat());
   for (const Camera& camera : working_.geometry->stream_cameras) {
@@ -202,6 +228,10 @@ void PipelineRunner::OpenSession(const Project& project) {
 PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   if (!session_ || session_->ended) return Painted::kEnded;
   Session& s = *session_;
+  if (!s.live() && options_.snapshot_budget_mb > 0 && s.snapshots->Due(s.next_frame)) {
+    PaintRunState state;  // the state before this frame, to step back to
+    if (s.run->Save(&state)) s.snapshots->Add(s.next_frame, std::move(state));
+  }
   RunFrame f;
   const FrameRead read = s.run->Next(&f);  // the frame policy of `fresco run` and bench
   s.next_frame = s.run->stats().frames;
@@ -275,7 +305,7 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   s.run->Paint(f, &working_.report);
   working_.report_has_images = show && options_.debug_images;
   if (working_.report.painted) {
-    working_.frames_painted.push_back(frame.index);
+    working_.frames_painted.push_back(working_.frame);  // several streams: the counter
     for (const StageReport& st : working_.report.stages)
       working_.stage_ms[st.name].push_back(static_cast<float>(st.wall_ms));
     working_.misalignment.push_back(static_cast<float>(working_.report.paint.difference_to_buffer));
@@ -294,6 +324,31 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   }
   working_.coverage = s.paint()->Coverage();
   return Painted::kFrame;
+}
+
+bool PipelineRunner::SeekBackFromSnapshot(int frame) {
+  Session& s = *session_;
+  int from = -1;
+  const PaintRunState* state = s.snapshots->AtOrBefore(frame, &from);
+  if (!state || !s.run->Restore(*state).ok()) return false;
+  s.next_frame = from;
+  s.ended = false;
+  s.end_message.clear();
+  // The histories forget the frames painted from there on (painted again).
+  size_t keep = working_.frames_painted.size();
+  while (keep > 0 && working_.frames_painted[keep - 1] >= from) --keep;
+  const size_t drop = working_.frames_painted.size() - keep;
+  const auto forget = [drop](auto* history) {
+    history->resize(history->size() - std::min(drop, history->size()));
+  };
+  forget(&working_.frames_painted);
+  forget(&working_.misalignment);
+  for (auto& [stage, ms] : working_.stage_ms) forget(&ms);
+  // Refinement's figures run from the first frame painted while it ran on: as many as kept.
+  for (std::vector<float>* refine : {&working_.refine_before_px, &working_.refine_after_px})
+    refine->resize(std::min(refine->size(), keep));
+  working_.coverage = s.paint()->Coverage();
+  return true;
 }
 
 void PipelineRunner::SetRecording(const std::string& dir) {
@@ -403,14 +458,18 @@ bool PipelineRunner::Handle(Command command, Clock::time_point* last_publish) {
       playing_ = false;
       // A live source cannot go back: only forward seeks (paint N more frames) apply.
       if (session_ && !session_->live() && command.frame < session_->next_frame) {
-        // Back: reopen and repaint from frame 0. Say so at once (reopening can take
-        // seconds on large buffers); progress follows as frames are painted.
+        // Back: from the nearest saved painting state at or before the frame, else reopen
+        // and repaint from frame 0. Say so at once (going back can take seconds on large
+        // buffers); progress follows as frames are painted.
         seek_target_ = command.frame;
         working_.frame = -1;
         Publish(false);
-        const Project project = session_->project;
-        OpenSession(project);
+        if (!SeekBackFromSnapshot(command.frame)) {
+          const Project project = session_->project;
+          OpenSession(project);
+        }
       }
+      if (session_) working_.seek_from = session_->next_frame;
       seek_target_ = session_ ? command.frame : -1;
       if (session_ && seek_target_ < session_->next_frame) seek_target_ = -1;
       // Either the result, or that a seek is under way (the UI shows its progress).

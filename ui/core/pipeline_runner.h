@@ -32,7 +32,9 @@
 #include "pipeline/core/scene.h"
 #include "pipeline/paint/stage_report.h"
 #include "pipeline/run/live_status.h"
+#include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
+#include "pipeline/run/run_snapshots.h"
 
 namespace fresco {
 
@@ -64,8 +66,11 @@ struct RunnerSnapshot {
   bool playing = false;
   int frame = -1;  // index of the frame last painted
   // A seek under way: the frame it paints up to (`frame` says how far it got; -1 while a
-  // seek back reopens the video); -1 when none.
+  // seek back goes back); -1 when none.
   int seek_target = -1;
+  // The frame the last seek painted from: forward, the one after the frame shown; back, the
+  // frame of the saved state it went back to (RunSnapshots; 0 when it reopened the project).
+  int seek_from = -1;
   std::string frame_name;
   bool has_pose = false;
   Rigid3d cam_from_world;
@@ -127,6 +132,13 @@ struct RunnerOptions {
   // Live sources: the worker waits at most this long for a frame before it looks at its
   // commands again (and publishes the sources' state at least every publish_interval_ms).
   int live_poll_ms = 50;
+  // Stepping back (a seek behind the frame shown): the painting state is saved every
+  // snapshot_every frames (before the first frame too), and a seek back paints on from the
+  // nearest saved state at or before its frame instead of from the first frame. The states
+  // hold at most snapshot_budget_mb; past it they are thinned (every other one dropped), so
+  // they stay spread over the capture. 0: none kept (a seek back reopens the project).
+  int snapshot_every = 10;
+  int snapshot_budget_mb = 1024;
   // Tests: called on the worker thread with every snapshot it publishes, in order.
   std::function<void(const RunnerSnapshot&)> on_publish;
 };
@@ -167,6 +179,8 @@ class PipelineRunner {
   // kWaiting: a live source has no frame yet; kEnded: the end of the video, or an error.
   Painted PaintNext(bool show);
   void OpenSession(const Project& project);
+  // A seek back to `frame` from the nearest saved state; false when none (reopen instead).
+  bool SeekBackFromSnapshot(int frame);
   void SetRecording(const std::string& dir);
   void Publish(bool with_painted);
 
@@ -181,6 +195,10 @@ class PipelineRunner {
   RunnerSnapshot working_;
   bool playing_ = false;
   int seek_target_ = -1;
+  // The last project opened (its file) and how long its steps took: the estimate of the
+  // steps without a progress of their own when it opens again.
+  std::string last_open_file_;
+  PaintJob::OpenSeconds last_open_;
   std::thread thread_;
 };
 

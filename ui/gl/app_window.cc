@@ -55,7 +55,7 @@ cv::Mat ReadWindow(int width, int height) {
 Status WritePanelList(const std::string& path, const std::vector<std::unique_ptr<Panel>>& panels) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& panel : panels) {
-    ImGuiWindow* window = ImGui::FindWindowByName(panel->Title());
+    ImGuiWindow* window = ImGui::FindWindowByName(PanelWindowId(panel->Title()).c_str());
     nlohmann::json entry = {{"title", panel->Title()}, {"open", panel->open}};
     if (const auto report = panel->Report(); !report.empty()) entry["state"] = report;
     if (window && panel->open) {

@@ -37,11 +37,13 @@ class PipelinePanel : public Panel {
       ui.runner->Play();
     }
     ImGui::SameLine();
-    // A file source can go back (repainting from the start up to the previous frame).
+    // A file source can go back (painting on from the nearest state saved on the way).
     ImGui::BeginDisabled(snap.live.active || snap.frame < 1);
     if (ImGui::Button("<")) PostSeek(ui, snap, std::max(0, ShownFrame(snap) - 1));
     if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
-      ImGui::SetTooltip("step back one frame (repaints from the start)");
+      ImGui::SetTooltip(
+          "step back one frame (paints on from the nearest of the states saved "
+          "every few frames)");
     ImGui::EndDisabled();
     ImGui::SameLine();
     if (ImGui::Button("Step")) ui.runner->Step();
@@ -72,10 +74,11 @@ class PipelinePanel : public Panel {
       ImGui::TextUnformatted(of_last);
     }
     ImGui::EndDisabled();
-    if (snap.seek_target >= 0) {  // a seek (back: from the start) under way
-      const float done = snap.frame < 0 ? 0.0f
-                                        : static_cast<float>(snap.frame + 1) /
-                                              static_cast<float>(snap.seek_target + 1);
+    if (snap.seek_target >= 0) {  // a seek (back: from the nearest saved state) under way
+      const int from = std::max(0, snap.seek_from);  // painted on from there
+      const float done = snap.frame < from ? 0.0f
+                                           : static_cast<float>(snap.frame + 1 - from) /
+                                                 static_cast<float>(snap.seek_target + 1 - from);
       // Elapsed and remaining time, from when this panel first saw the seek.
       if (seek_seen_ != snap.seek_target) {
         seek_seen_ = snap.seek_target;

@@ -2,6 +2,7 @@
 // frame (any stage that reports images gets its panel with one registration line), plus the
 // input frame and the painted buffers.
 #include <algorithm>
+#include <cctype>
 
 #include "ui/core/image_view.h"
 #include "ui/core/natural_sort.h"
@@ -45,8 +46,11 @@ namespace {
 class StagePanel : public Panel {
  public:
   StagePanel(std::string stage, std::string title)
-      : stage_(std::move(stage)), title_(std::move(title)) {}
+      : stage_(std::move(stage)), title_(std::move(title)), short_title_(stage_) {
+    short_title_[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(stage_[0])));
+  }
   const char* Title() const override { return title_.c_str(); }
+  const char* ShortTitle() const override { return short_title_.c_str(); }  // "Depth", ...
 
   void Draw(UiContext& ui) override {
     if (!BeginPanel(*this)) {
@@ -113,7 +117,7 @@ class StagePanel : public Panel {
   }
 
  private:
-  std::string stage_, title_, selected_;
+  std::string stage_, title_, short_title_, selected_;
   std::string note_;  // why no debug image is shown ("" when one is)
   ImageView view_;
 };

@@ -1,0 +1,43 @@
+// Saved states of one painting run (PaintRun::Save), every `every` frames read, to step back
+// from: going back to frame M restores the nearest state at or before M and paints on from
+// there, instead of painting again from the first frame (the app's step back and seek back).
+// The memory they hold is bounded: past the budget the spacing doubles (every other state
+// dropped), so the states stay spread over the whole capture; the first (before any frame:
+// going back to it spares reopening the project and its whole-capture pre-pass) is kept
+// while it fits.
+#pragma once
+
+#include <cstddef>
+#include <map>
+
+#include "pipeline/run/paint_run.h"
+
+namespace fresco {
+
+class RunSnapshots {
+ public:
+  RunSnapshots(int every, size_t budget_bytes);
+
+  // Whether a state is due before reading frame `frames_read` (0-based): none kept there yet,
+  // `frames_read` on the spacing, and the last state offered would fit beside the first (a
+  // state is not saved, a costly copy, only to be dropped).
+  bool Due(int frames_read) const;
+  // Keeps `state` (saved before reading frame `frames_read`), thinning as the budget asks.
+  void Add(int frames_read, PaintRunState state);
+  // The state with the most frames read at most `frames_read`, or null.
+  const PaintRunState* AtOrBefore(int frames_read, int* its_frames_read) const;
+  void Clear() { states_.clear(), bytes_ = 0; }
+
+  int every() const { return every_; }
+  size_t bytes() const { return bytes_; }
+  size_t count() const { return states_.size(); }
+
+ private:
+  int every_;
+  size_t budget_bytes_;
+  size_t bytes_ = 0;
+  size_t last_offered_bytes_ = 0;
+  std::map<int, PaintRunState> states_;  // by frames read before it
+};
+
+}  // namespace fresco
