@@ -55,6 +55,10 @@ struct PaintSessionInputs {
   // automatic texel size (about one texel per pixel at the typical distance).
   std::vector<Rigid3d> expected_poses;
   const Camera* typical_camera = nullptr;
+  // Non-null: the buffers laid out as this layout says (its texel size and charts, as another
+  // session over the same scene and settings laid them out: PaintSession::Layout), built
+  // hollow, without texels: SetOwnBuffers builds those the session will paint.
+  const BufferLayout* layout = nullptr;
 };
 
 // One frame on its way through the stages (paint_stages.h): what they hand each other.
@@ -175,7 +179,16 @@ class PaintSession {
   // session still paints every buffer a frame sees while a frame's outcome in one buffer
   // depends on the others (CouplesBuffers): so the shards' buffers come out exactly as one
   // session over every buffer paints them.
+  // A session made from a layout (PaintSessionInputs::layout) builds here the texels and
+  // painted images of the buffers it will paint: the own ones when no buffer is coupled
+  // (PaintsOwnBuffersOnly), else every buffer; the others stay hollow (no texels, nothing
+  // painted, left out of the atlas pages).
   void SetOwnBuffers(std::vector<bool> own);
+  // The buffers' layout (texel size, charts, each buffer's recipe): what a session made with
+  // PaintSessionInputs::layout takes to lay out the same buffers without building them.
+  BufferLayout Layout() const;
+  // Whether buffer b has its texels (false: hollow, PaintSessionInputs::layout).
+  bool BufferBuilt(size_t b) const { return hollow_.empty() || !hollow_[b]; }
   // True while painting one buffer depends on the frame's other buffers: an `auto` mode
   // deciding (its evidence spans the frame), refinement on (one pose correction from every
   // buffer's matches), view selection (one exposure gain per frame), view-dependent layers
@@ -294,6 +307,10 @@ class PaintSession {
   void UpdateOwnOnly() { own_only_.store(own_only_.load() || (!own_.empty() && !CouplesBuffers())); }
   std::vector<bool> own_;
   std::atomic<bool> own_only_{false};
+  std::vector<bool> hollow_;  // buffers without texels (empty: none)
+  BaseBufferOptions buffer_options_;
+  // Builds the hollow buffers the session paints (SetOwnBuffers).
+  void BuildPaintedBuffers();
   int frames_painted_whole_ = 0;
   const Scene* scene_ = nullptr;
   PipelineOptions options_;

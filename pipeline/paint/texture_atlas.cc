@@ -96,7 +96,12 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
 
 void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
                           cv::Mat* page_image) {
-  const int type = images.empty() ? CV_8UC4 : images.front().type();
+  int type = CV_8UC4;  // an empty image (a buffer left out) says nothing of the type
+  for (const cv::Mat& image : images)
+    if (!image.empty()) {
+      type = image.type();
+      break;
+    }
   page_image->create(atlas.pages[page], type);
   page_image->setTo(cv::Scalar::all(0));
   cv::Mat& out = *page_image;

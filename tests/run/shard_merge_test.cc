@@ -36,8 +36,11 @@ std::map<std::string, std::string> Files(const std::string& dir) {
 json Metrics(const std::string& dir) { return json::parse(ReadText(dir + "/metrics.json")); }
 
 // Runs `project` unsharded and in 1, 2 and 4 shards, merges each set, and compares.
+// `own_charts_only`: settings that couple no charts, so a shard that reads the charts' layout
+// from the pre-pass file builds only its own charts' texels.
 void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& tag,
-                                 const std::vector<std::string>& sets = {}) {
+                                 const std::vector<std::string>& sets = {},
+                                 bool own_charts_only = false) {
   const std::string work = MakeTempDir(tag);
   auto run = [&](std::vector<std::string> args) {
     for (const std::string& set : sets) args.insert(args.end(), {"--set", set});
@@ -66,6 +69,11 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
         EXPECT_EQ(m["wall"]["open_seconds"]["prepass_read"], 0.0) << "shard " << i << " of " << n;
         EXPECT_EQ(m["joint_poses"]["check_matches"], whole_metrics["joint_poses"]["check_matches"]);
       }
+      const int all = whole_metrics["base_buffers"].get<int>();
+      const int own = static_cast<int>(m["shard"]["buffers"].size());
+      const bool read_layout = n > 1 && i < n - 1;  // the last shard wrote the file
+      EXPECT_EQ(m["shard"]["buffers_built"], own_charts_only && read_layout ? own : all)
+          << "shard " << i << " of " << n;
       EXPECT_EQ(m["shard"]["index"], i);
       EXPECT_EQ(m["shard"]["count"], n);
       texels_sum += m["shard"]["texels"].get<long long>();
@@ -105,6 +113,19 @@ TEST(ShardMerge, DefaultProjectMergedEqualsUnsharded) {
   // 6th frame held out, every 6th of the 48).
   ExpectMergedEqualsUnsharded(root + "/project.json", "shard-cube-room",
                               {"pipeline.max_frames=48"});
+}
+
+// The decisions off (no frame couples the charts): shards build, hold and paint only their
+// own charts, and the parts still join into the unsharded run's bytes.
+TEST(ShardMerge, DecisionsOffShardsBuildOnlyTheirChartsAndMergeEqualsUnsharded) {
+  const std::string root = testing::SourceDir() + "/projects/cube-room";
+  const testing::CommandResult synth = RunFresco({"synth", root + "/synth.json", "--if-changed"});
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  ExpectMergedEqualsUnsharded(
+      root + "/project.json", "shard-decisions-off",
+      {"pipeline.max_frames=16", "pipeline.update=quality", "pipeline.refine.mode=off",
+       "pipeline.refine.joint=false", "pipeline.background.mode=off"},
+      /*own_charts_only=*/true);
 }
 
 TEST(ShardMerge, TwoStreamsMergedEqualsUnsharded) {
