@@ -275,13 +275,10 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
     buffers.push_back(b);
     texels += buffer.num_surface_texels;
     painted += session.painted()[b].painted_surface_texels;
-    const AtlasPlacement& place = atlas.placements[b];
-    if (place.page < 0) continue;
-    const cv::Rect padded =
-        cv::Rect(place.x - atlas.padding, place.y - atlas.padding,
-                 buffer.width + 2 * atlas.padding, buffer.height + 2 * atlas.padding) &
-        cv::Rect(cv::Point(0, 0), atlas.pages[place.page]);
-    rects.push_back({place.page, padded.x, padded.y, padded.width, padded.height});
+    const int page = atlas.placements[b].page;
+    if (page < 0) continue;
+    const cv::Rect padded = PaddedPlacement(atlas, b, cv::Size(buffer.width, buffer.height));
+    rects.push_back({page, padded.x, padded.y, padded.width, padded.height});
   }
   return {{"index", shard.index},
           {"count", shard.count},
@@ -334,8 +331,11 @@ Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job, const Pa
   const auto writing = Clock::now();
   StagedFolder outputs;
   FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
-  FRESCO_RETURN_IF_ERROR(
-      SaveGltfScene(job.session->PaintedScene(), outputs.path() + "/painted.gltf"));
+  // A shard's part: its pages hold only its own buffers' placements (fresco merge).
+  FRESCO_RETURN_IF_ERROR(SaveGltfScene(job.buffer_shard.empty()
+                                           ? job.session->PaintedScene()
+                                           : job.session->PaintedSceneOfOwnBuffers(),
+                                       outputs.path() + "/painted.gltf"));
   metrics["wall"] = WallJson(job, stats, SecondsSince(start), SecondsSince(writing));
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
   return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});

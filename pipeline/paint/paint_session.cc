@@ -443,21 +443,38 @@ static Scene UnpaintedCopy(const Scene& scene) {
   return out;
 }
 
-Scene PaintSession::PaintedScene() const {
+Scene PaintSession::PaintedScene() const { return PaintedScene(false); }
+
+Scene PaintSession::PaintedSceneOfOwnBuffers() const { return PaintedScene(true); }
+
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
+  return PaintedScene(buffer_bgra, false);
+}
+
+cv::Mat PaintSession::PageImage(int page, const std::vector<cv::Mat>& images, bool own_only) const {
+  if (!own_only) return ComposeAtlasPage(atlas_, page, images);
+  std::vector<bool> own = own_;
+  if (own.empty()) own.assign(images.size(), true);
+  return ComposeAtlasStrip(atlas_, page, images, own);
+}
+
+Scene PaintSession::PaintedScene(bool own_only) const {
   std::vector<cv::Mat> images(painted_.size());
-  for (size_t b = 0; b < painted_.size(); ++b) images[b] = AtMeanExposure(painted_[b].bgra);
-  Scene scene = PaintedScene(images);
+  for (size_t b = 0; b < painted_.size(); ++b)
+    if (!own_only || own_.empty() || own_[b]) images[b] = AtMeanExposure(painted_[b].bgra);
+  Scene scene = PaintedScene(images, own_only);
   // Each layer's pages after the base pages; material page + 1 shows page `page`.
   for (const ViewLayer& layer : layers_) {
     ViewLayerTextures textures;
     textures.centre_world = scene_->WorldFromLocal(layer.Centre());
     textures.material_texture.assign(scene.materials.size(), -1);
-    for (size_t b = 0; b < images.size(); ++b) images[b] = AtMeanExposure(layer.painted[b].bgra);
+    for (size_t b = 0; b < images.size(); ++b)
+      if (!own_only || own_.empty() || own_[b]) images[b] = AtMeanExposure(layer.painted[b].bgra);
     for (size_t page = 0; page < atlas_.pages.size(); ++page) {
       Texture texture;
       texture.name =
           "layer_" + std::to_string(scene.view_layers.size()) + "_page_" + std::to_string(page);
-      cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), images), texture.rgba,
+      cv::cvtColor(PageImage(static_cast<int>(page), images, own_only), texture.rgba,
                    cv::COLOR_BGRA2RGBA);
       texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
       textures.material_texture[page + 1] = static_cast<int>(scene.textures.size());
@@ -468,13 +485,13 @@ Scene PaintSession::PaintedScene() const {
   return scene;
 }
 
-Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const {
   Scene out = UnpaintedCopy(*scene_);
   const TriangleMesh& mesh = scene_->mesh;
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
     texture.name = "page_" + std::to_string(page);
-    cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), buffer_bgra), texture.rgba,
+    cv::cvtColor(PageImage(static_cast<int>(page), buffer_bgra, own_only), texture.rgba,
                  cv::COLOR_BGRA2RGBA);
     texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
     out.textures.push_back(texture);

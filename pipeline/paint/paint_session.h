@@ -127,6 +127,10 @@ class PaintSession {
   // The same with one texture and material per buffer (material b + 1 = buffer b, material 0
   // for triangles in no buffer): the per-buffer view the app and debug images use.
   Scene PaintedSceneByBuffer() const;
+  // PaintedScene() as a shard's part holds it (SetOwnBuffers): each texture holds, instead of
+  // its page, the own buffers' padded placements on that page (ComposeAtlasStrip), which
+  // `fresco merge` puts back in place; the rest (mesh, UVs, materials) as PaintedScene()'s.
+  Scene PaintedSceneOfOwnBuffers() const;
   const TextureAtlas& atlas() const { return atlas_; }
   // The view-dependent layers (pipeline.layers; view_layers.h) as they are painted; in
   // PaintedScene() they follow the base pages as textures of their own (Scene::view_layers).
@@ -234,7 +238,12 @@ class PaintSession {
   cv::Mat BackgroundImage(size_t b, int stream = 0) const;
 
  private:
-  void KeepSharpestViews(const char* why);  // DecideUpdate: `quality`, for the reason given
+  void KeepSharpestViews(const char* why);
+  // PaintedScene(), its pages whole or (own_only) the own buffers' placements only.
+  Scene PaintedScene(bool own_only) const;
+  Scene PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const;
+  cv::Mat PageImage(int page, const std::vector<cv::Mat>& images,
+                    bool own_only) const;  // DecideUpdate: `quality`, for the reason given
   PaintSession() = default;
   // The stages, one member each (paint_stages.h): `void DepthStage(FrameWork*)`, ...
 #define FRESCO_DECLARE_STAGE(Name) void Name##Stage(FrameWork* work);

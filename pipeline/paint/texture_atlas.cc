@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 #include <opencv2/core.hpp>
 #include <stb/stb_rect_pack.h>  // implementation in Debian's libstb
@@ -94,14 +95,57 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
   return out;
 }
 
+namespace {
+
+// The images' type (an empty image, a buffer left out, says nothing of it; none: CV_8UC4).
+int ImagesType(const std::vector<cv::Mat>& images) {
+  for (const cv::Mat& image : images)
+    if (!image.empty()) return image.type();
+  return CV_8UC4;
+}
+
+}  // namespace
+
+cv::Rect PaddedPlacement(const TextureAtlas& atlas, size_t b, cv::Size buffer_size) {
+  const AtlasPlacement& p = atlas.placements[b];
+  if (p.page < 0) return cv::Rect();
+  const int pad = atlas.padding;
+  return cv::Rect(p.x - pad, p.y - pad, buffer_size.width + 2 * pad, buffer_size.height + 2 * pad) &
+         cv::Rect(cv::Point(0, 0), atlas.pages[p.page]);
+}
+
+cv::Mat ComposeAtlasStrip(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          const std::vector<bool>& which) {
+  std::vector<std::pair<size_t, cv::Rect>> rects;
+  cv::Size strip(1, 0);
+  for (size_t b = 0; b < images.size() && b < atlas.placements.size() && b < which.size(); ++b) {
+    if (!which[b] || atlas.placements[b].page != page) continue;
+    const cv::Rect rect = PaddedPlacement(atlas, b, images[b].size());
+    rects.push_back({b, rect});
+    strip.width = std::max(strip.width, rect.width);
+    strip.height += rect.height;
+  }
+  cv::Mat out = cv::Mat::zeros(std::max(strip.height, 1), strip.width, ImagesType(images));
+  const int pad = atlas.padding;
+  int y = 0;
+  for (const auto& [b, rect] : rects) {
+    const cv::Mat& image = images[b];
+    const AtlasPlacement& p = atlas.placements[b];
+    if (!image.empty()) {
+      cv::Mat padded;
+      cv::copyMakeBorder(image, padded, pad, pad, pad, pad, cv::BORDER_REPLICATE);
+      // The padded image's texel at the rectangle's corner (the page may clip it).
+      const cv::Point from(rect.x - (p.x - pad), rect.y - (p.y - pad));
+      padded(cv::Rect(from, rect.size())).copyTo(out(cv::Rect(cv::Point(0, y), rect.size())));
+    }
+    y += rect.height;
+  }
+  return out;
+}
+
 void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
                           cv::Mat* page_image) {
-  int type = CV_8UC4;  // an empty image (a buffer left out) says nothing of the type
-  for (const cv::Mat& image : images)
-    if (!image.empty()) {
-      type = image.type();
-      break;
-    }
+  const int type = ImagesType(images);
   page_image->create(atlas.pages[page], type);
   page_image->setTo(cv::Scalar::all(0));
   cv::Mat& out = *page_image;

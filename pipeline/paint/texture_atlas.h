@@ -46,4 +46,15 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
 void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
                           cv::Mat* out);
 
+// Buffer b's placement with its padding (b of size `buffer_size`), within its page: the
+// rectangle of the page that ComposeAtlasPage fills from it.
+cv::Rect PaddedPlacement(const TextureAtlas& atlas, size_t b, cv::Size buffer_size);
+// What ComposeAtlasPage puts in the padded placements (PaddedPlacement) of the buffers
+// `which` (one flag per buffer) on page `page`, without the rest of the page: those
+// rectangles stacked top to bottom in buffer order, left-aligned, in one image as wide as the
+// widest (zero elsewhere; 1 x 1 when none). A shard's part holds its pages so (the painted
+// buffers' placements never overlap).
+cv::Mat ComposeAtlasStrip(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          const std::vector<bool>& which);
+
 }  // namespace fresco
