@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/paint/texture_atlas.h"
 
 namespace fresco {
 namespace {
@@ -167,8 +168,8 @@ Status CheckSameLayout(const std::vector<Part>& parts) {
 }
 
 // Texture file `name` (painted_textureT.png): each part holds in it its rectangles on that
-// page stacked top to bottom in the order of its page_rects (ComposeAtlasStrip); they go back
-// in place on a page of zeros (a texel of no buffer is zero).
+// page at StripPositions (ComposeAtlasStrip); they go back in place on a page of zeros (a
+// texel of no buffer is zero).
 Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int num_pages,
                    const std::string& out_path) {
   const size_t end = name.size() - 4;  // before ".png"
@@ -184,17 +185,22 @@ Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int 
     if (strip.empty()) return Status::Error(path + ": cannot read the PNG");
     if (strip.type() != joined.type())
       return Status::Error(path + ": not 8-bit RGBA, as a part's page is");
-    int y = 0;
+    std::vector<cv::Rect> rects;
+    std::vector<cv::Size> sizes;
     for (const Json& r : part.metrics["shard"]["page_rects"]) {
       if (r[0].get<int>() != page) continue;
-      const cv::Rect rect(r[1].get<int>(), r[2].get<int>(), r[3].get<int>(), r[4].get<int>());
-      const cv::Rect from(0, y, rect.width, rect.height);
-      if ((rect & cv::Rect(cv::Point(), joined.size())) != rect ||
-          (from & cv::Rect(cv::Point(), strip.size())) != from)
-        return Status::Error(part.dir + "/metrics.json: shard.page_rects: a rectangle outside " +
-                             name + " or its page");
-      strip(from).copyTo(joined(rect));
-      y += rect.height;
+      rects.emplace_back(r[1].get<int>(), r[2].get<int>(), r[3].get<int>(), r[4].get<int>());
+      sizes.push_back(rects.back().size());
+    }
+    cv::Size strip_size;
+    const std::vector<cv::Point> at = StripPositions(sizes, joined.cols, &strip_size);
+    for (size_t k = 0; k < rects.size(); ++k) {
+      const cv::Rect from(at[k], rects[k].size());
+      if ((rects[k] & cv::Rect(cv::Point(), joined.size())) != rects[k] ||
+          strip.size() != strip_size)
+        return Status::Error(part.dir + "/metrics.json: shard.page_rects: not the rectangles " +
+                             name + " holds");
+      strip(from).copyTo(joined(rects[k]));
     }
   }
   std::vector<unsigned char> png;
