@@ -457,6 +457,7 @@ int RunVerbRun(const CommandArgs& argv) {
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.shard = shard;
   job_options.prepass_file = prepass_file;
+  job_options.prepass_only = prepass_only;
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;

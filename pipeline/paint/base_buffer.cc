@@ -448,6 +448,10 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   }
   std::vector<uint8_t> surface(owner.size(), 0);
   for (size_t idx = 0; idx < owner.size(); ++idx) surface[idx] = owner[idx] >= 0;
+  if (options.layout_only) {
+    buffer.num_surface_texels = static_cast<int>(std::count(surface.begin(), surface.end(), 1));
+    return buffer;
+  }
 
   GrowGutter(mesh, buffer, options.gutter_texels, &texels);
   const int tile = BaseBuffer::kTileTexels;
@@ -564,6 +568,7 @@ BaseBufferSet HollowBaseBuffers(const TriangleMesh& mesh, const BufferLayout& la
 
 BaseBuffer BuildLaidOutBuffer(const TriangleMesh& mesh, const BaseBufferSet& set, size_t b,
                               BaseBufferOptions options) {
+  options.layout_only = false;
   const BufferRecipe& recipe = set.recipes.at(b);
   const double s = recipe.group_texel_size_m > 0 ? recipe.group_texel_size_m : options.texel_size_m;
   std::vector<int> folded;

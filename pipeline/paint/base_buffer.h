@@ -119,6 +119,9 @@ struct BaseBufferOptions {
   int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels
   int max_side_texels = 1 << 30;    // so does one wider or higher (an atlas page's limit)
   int gutter_texels = 2;
+  // Lay the buffers out only (the fold test and the surface texels counted): no texel arrays,
+  // the buffers hollow as HollowBaseBuffers makes them (what a layout needs, for less).
+  bool layout_only = false;
 };
 
 // How BuildBaseBuffers made one buffer, enough to make it again alone: the triangles it

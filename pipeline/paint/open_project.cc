@@ -7,7 +7,8 @@ namespace {
 
 // The session over the scene of streams[0], its texel size chosen for every stream.
 Status CreateSession(const Project& project, const std::vector<const Capture*>& streams,
-                     const BufferLayout* layout, std::unique_ptr<PaintSession>* session) {
+                     const BufferLayout* layout, bool layout_only,
+                     std::unique_ptr<PaintSession>* session) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t i = 0; i < streams.size(); ++i) {
     if (streams[i]->cameras.empty())
@@ -18,6 +19,7 @@ Status CreateSession(const Project& project, const std::vector<const Capture*>& 
   inputs.pipeline = project.pipeline;
   inputs.grouping = project.grouping;
   inputs.layout = layout;
+  inputs.layout_only = layout_only;
   const auto expected_poses = [](const Capture& capture) {
     std::vector<Rigid3d> poses;
     for (const PosedImage& p : capture.poses) poses.push_back(p.cam_from_world);
@@ -50,7 +52,7 @@ Status OpenPaintSession(const Project& project, Capture* capture,
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
                         Capture* capture, std::unique_ptr<PaintSession>* session) {
   FRESCO_RETURN_IF_ERROR(LoadCapture(project, load_options, capture));
-  return CreateSession(project, {capture}, nullptr, session);
+  return CreateSession(project, {capture}, nullptr, false, session);
 }
 
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
@@ -60,10 +62,11 @@ Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_o
 }
 
 Status CreatePaintSession(const Project& project, const std::vector<Capture>& streams,
-                          const BufferLayout* layout, std::unique_ptr<PaintSession>* session) {
+                          const BufferLayout* layout, std::unique_ptr<PaintSession>* session,
+                          bool layout_only) {
   std::vector<const Capture*> views;
   for (const Capture& stream : streams) views.push_back(&stream);
-  return CreateSession(project, views, layout, session);
+  return CreateSession(project, views, layout, layout_only, session);
 }
 
 }  // namespace fresco

@@ -94,7 +94,10 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
     chart_scale.texel_size_m = s->texel_size_m_;
     chart_scale.max_chart_texels = inputs.pipeline.max_buffer_texels;
     FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, chart_scale, &grouping));
+    buffer_options.layout_only = inputs.layout_only;
     s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
+    buffer_options.layout_only = false;
+    if (inputs.layout_only) s->hollow_.assign(s->set_.buffers.size(), true);
   }
   std::vector<cv::Size> sizes;
   for (const BaseBuffer& b : s->set_.buffers) sizes.emplace_back(b.width, b.height);

@@ -59,6 +59,9 @@ struct PaintSessionInputs {
   // session over the same scene and settings laid them out: PaintSession::Layout), built
   // hollow, without texels: SetOwnBuffers builds those the session will paint.
   const BufferLayout* layout = nullptr;
+  // True: the buffers are laid out only (BaseBufferOptions::layout_only), hollow: a session
+  // that only finds the layout (PaintSession::Layout) and paints nothing.
+  bool layout_only = false;
 };
 
 // One frame on its way through the stages (paint_stages.h): what they hand each other.

@@ -260,8 +260,9 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
       std::filesystem::exists(options.prepass_file))
     FRESCO_RETURN_IF_ERROR(
         ReadPrepassLayout(options.prepass_file, project, j.scene().mesh.NumTriangles(), &layout));
-  FRESCO_RETURN_IF_ERROR(
-      CreatePaintSession(project, j.captures, layout ? &*layout : nullptr, &j.session));
+  FRESCO_RETURN_IF_ERROR(CreatePaintSession(project, j.captures, layout ? &*layout : nullptr,
+                                            &j.session,
+                                            /*layout_only=*/options.prepass_only && !layout));
   if (options.paint_at_truth_poses)
     for (Capture& capture : j.captures) TakeTruthPoses(&capture);
   seconds.load = SecondsSince(start);

@@ -155,10 +155,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
   json file = {{"fresco_prepass", kPrepassFormat},
                {"project", project.file_path},
                {"settings_hash", SettingsHash(project)}};
-  // The layout, from a session that built every buffer (a shard's has hollow ones).
-  if (std::all_of(job.session->buffers().begin(), job.session->buffers().end(),
-                  [&](const BaseBuffer& b) { return job.session->BufferBuilt(b.id); }))
-    file["layout"] = LayoutJson(job.session->Layout());
+  file["layout"] = LayoutJson(job.session->Layout());
   const PaintJob::PrepassDecisions& d = job.prepass;
   if (job.joint_poses) {
     file["joint_poses"] = PoseAdjustSummaryJson(*job.joint_poses);

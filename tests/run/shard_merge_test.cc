@@ -37,7 +37,8 @@ json Metrics(const std::string& dir) { return json::parse(ReadText(dir + "/metri
 
 // Runs `project` unsharded and in 1, 2 and 4 shards, merges each set, and compares.
 // `own_charts_only`: settings that couple no charts, so a shard that reads the charts' layout
-// from the pre-pass file builds only its own charts' texels.
+// from the pre-pass file builds only its own charts' texels; the pre-pass job (--prepass-only,
+// which lays the charts out without building them) writes the file first.
 void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& tag,
                                  const std::vector<std::string>& sets = {},
                                  bool own_charts_only = false) {
@@ -53,6 +54,9 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
   const json whole_metrics = Metrics(work + "/whole");
   for (int n : {1, 2, 4}) {
     std::vector<std::string> merge = {"merge"};
+    // own_charts_only: the pre-pass job writes the file (its charts laid out, not built).
+    const std::string prepass = work + "/n" + std::to_string(n) + ".prepass";
+    if (n > 1 && own_charts_only) run({"run", project, "--prepass", prepass, "--prepass-only"});
     long long texels_sum = 0;
     int skipped = 0;
     for (int i = n - 1; i >= 0; --i) {  // any order
@@ -61,8 +65,7 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
           "run", project, "--out", part, "--shard", std::to_string(i) + "/" + std::to_string(n)};
       // N > 1: the whole-capture pre-pass runs in the first shard, which writes it; the others
       // read it (and the merge must not tell).
-      if (n > 1)
-        args.insert(args.end(), {"--prepass", work + "/n" + std::to_string(n) + ".prepass"});
+      if (n > 1) args.insert(args.end(), {"--prepass", prepass});
       run(args);
       const json m = Metrics(part);
       if (n > 1 && i < n - 1 && whole_metrics.contains("joint_poses")) {
@@ -71,7 +74,8 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
       }
       const int all = whole_metrics["base_buffers"].get<int>();
       const int own = static_cast<int>(m["shard"]["buffers"].size());
-      const bool read_layout = n > 1 && i < n - 1;  // the last shard wrote the file
+      // The file's writer: the pre-pass job, else the first shard to run (the last).
+      const bool read_layout = n > 1 && (own_charts_only || i < n - 1);
       EXPECT_EQ(m["shard"]["buffers_built"], own_charts_only && read_layout ? own : all)
           << "shard " << i << " of " << n;
       EXPECT_EQ(m["shard"]["index"], i);
