@@ -51,9 +51,11 @@ ArgSpec RunSpec() {
       "                    `fresco merge` joins with the others into exactly this run's\n"
       "                    outputs (docs/guide/slurm.md; captures from files)\n"
       "  --prepass FILE    the whole-capture pre-pass (the joint pose check, the movers found\n"
-      "                    across views, the decisions they take) read from FILE; when FILE\n"
-      "                    does not exist, run and written to it: the shards of one project\n"
-      "                    run it once (FILE is for this project and these settings only)\n"
+      "                    across views, the decisions they take) and the charts' layout read\n"
+      "                    from FILE; when FILE does not exist, run and written to it: the\n"
+      "                    shards of one project run it once, and a shard that reads it\n"
+      "                    builds only its own charts (FILE is for this project and these\n"
+      "                    settings only)\n"
       "  --prepass-only    write the --prepass FILE and stop, painting nothing (no --out)\n\n"
       "Live sources (docs/guide/live.md): `video` may be device:N or a stream URL\n"
       "(udp://127.0.0.1:5000, rtsp://..., http://...), `poses` a feed of TUM lines\n"
@@ -265,19 +267,18 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
   const TextureAtlas& atlas = session.atlas();
   nlohmann::json buffers = nlohmann::json::array(), rects = nlohmann::json::array();
   long long texels = 0, painted = 0;
+  int built = 0;  // buffers with texels: its own, or every one (PaintSession::SetOwnBuffers)
   for (size_t b = 0; b < job.buffer_shard.size(); ++b) {
+    built += session.BufferBuilt(b);
     if (job.buffer_shard[b] != shard.index) continue;
     const BaseBuffer& buffer = session.buffers()[b];
     buffers.push_back(b);
     texels += buffer.num_surface_texels;
     painted += session.painted()[b].painted_surface_texels;
-    const AtlasPlacement& place = atlas.placements[b];
-    if (place.page < 0) continue;
-    const cv::Rect padded =
-        cv::Rect(place.x - atlas.padding, place.y - atlas.padding,
-                 buffer.width + 2 * atlas.padding, buffer.height + 2 * atlas.padding) &
-        cv::Rect(cv::Point(0, 0), atlas.pages[place.page]);
-    rects.push_back({place.page, padded.x, padded.y, padded.width, padded.height});
+    const int page = atlas.placements[b].page;
+    if (page < 0) continue;
+    const cv::Rect padded = PaddedPlacement(atlas, b, cv::Size(buffer.width, buffer.height));
+    rects.push_back({page, padded.x, padded.y, padded.width, padded.height});
   }
   return {{"index", shard.index},
           {"count", shard.count},
@@ -289,6 +290,7 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
           {"texels_painted", painted},
           {"frames_skipped", stats.frames_skipped},
           {"frames_painted_whole", session.frames_painted_whole()},
+          {"buffers_built", built},
           {"cpu_seconds", CpuSeconds()}};
 }
 
@@ -329,8 +331,11 @@ Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job, const Pa
   const auto writing = Clock::now();
   StagedFolder outputs;
   FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
-  FRESCO_RETURN_IF_ERROR(
-      SaveGltfScene(job.session->PaintedScene(), outputs.path() + "/painted.gltf"));
+  // A shard's part: its pages hold only its own buffers' placements (fresco merge).
+  FRESCO_RETURN_IF_ERROR(SaveGltfScene(job.buffer_shard.empty()
+                                           ? job.session->PaintedScene()
+                                           : job.session->PaintedSceneOfOwnBuffers(),
+                                       outputs.path() + "/painted.gltf"));
   metrics["wall"] = WallJson(job, stats, SecondsSince(start), SecondsSince(writing));
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
   return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
@@ -452,14 +457,7 @@ int RunVerbRun(const CommandArgs& argv) {
   job_options.keep_tracker_poses = !record_dir.empty();
   job_options.shard = shard;
   job_options.prepass_file = prepass_file;
-  if (prepass_only && !NeedsWholeCapturePrepass(project)) {
-    if (!quiet)
-      std::fprintf(stderr,
-                   "fresco run: %s needs no whole-capture pre-pass (refine.joint off, no "
-                   "movers across views): %s not written\n",
-                   project_path.c_str(), prepass_file.c_str());
-    return kExitOk;
-  }
+  job_options.prepass_only = prepass_only;
   job_options.joint_progress = ProgressLines("adjusting poses", quiet);
   job_options.movers_progress = ProgressLines("finding movers, pass", quiet);
   std::unique_ptr<PaintJob> job;

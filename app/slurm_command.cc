@@ -29,10 +29,11 @@ ArgSpec SlurmSpec() {
       "Paints a project on a Slurm cluster in N shards: writes DIR/paint.sbatch (an array job,\n"
       "task I running `fresco run PROJECT --out DIR/parts/I --shard I/N`) and\n"
       "DIR/merge.sbatch (`fresco merge DIR/parts/0 ... --out DIR`, to run after every task\n"
-      "succeeded: --dependency=afterok). When the project's settings need the whole-capture\n"
-      "pre-pass (the joint pose check, movers found across views), DIR/prepass.sbatch runs it\n"
-      "once first (`fresco run --prepass DIR/prepass.json --prepass-only`) and every task reads\n"
-      "its outcome (--prepass). DIR/painted.gltf and DIR/metrics.json appear when the\n"
+      "succeeded: --dependency=afterok). With more than one shard, or when the project's\n"
+      "settings need the whole-capture pre-pass (the joint pose check, movers found across\n"
+      "views), DIR/prepass.sbatch runs it once first (`fresco run --prepass DIR/prepass.json\n"
+      "--prepass-only`: the pre-pass and the charts' layout) and every task reads its outcome\n"
+      "(--prepass). DIR/painted.gltf and DIR/metrics.json appear when the\n"
       "merge job ends. DIR must be on a file system every node sees; the jobs run this\n"
       "fresco executable by its absolute path. Logs: DIR/logs/. A failed task: resubmit\n"
       "that index (sbatch --array=I DIR/paint.sbatch), then DIR/merge.sbatch.\n\n"
@@ -116,8 +117,10 @@ int RunVerbSlurm(const CommandArgs& argv) {
   std::string sets;
   for (const std::string& set : args.All("--set")) sets += " --set " + ShellQuote(set);
   const std::string n = std::to_string(shards);
-  // The whole-capture pre-pass, run once before the array (which reads it) when needed.
-  const bool prepass = NeedsWholeCapturePrepass(project);
+  // The whole-capture pre-pass and the charts' layout, found once before the array (which
+  // reads them): when the settings need the pre-pass, or there is more than one shard (each
+  // then builds only its own charts, where no chart is coupled).
+  const bool prepass = NeedsWholeCapturePrepass(project) || shards > 1;
   const std::string prepass_file = dir + "/prepass.json";
   std::string prepass_job = Header("fresco-prepass", dir + "/logs/prepass.out", {}, extra);
   prepass_job += "exec " + ShellQuote(fresco) + " run " + ShellQuote(project_path) + " --prepass " +

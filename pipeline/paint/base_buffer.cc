@@ -4,6 +4,8 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <unordered_set>
 
 namespace fresco {
@@ -397,18 +399,34 @@ void GroupChunks(BaseBuffer* buffer) {
   }
 }
 
+// The buffer's plane frame, bounds and size for `triangles` (no texels).
+void FrameBuffer(const TriangleMesh& mesh, const std::vector<int>& triangles, double texel_size_m,
+                 const BaseBufferOptions& options, BaseBuffer* buffer) {
+  BaseBufferGroup group;
+  group.triangles = triangles;
+  ChooseAxes(GroupNormal(mesh, group), buffer);
+  const Eigen::Vector3d anchor = mesh.Corner(triangles[0], 0);
+  const PlaneCoords pc = PlaneExtent(mesh, triangles, anchor, buffer);
+  SizeTexels(pc, anchor, texel_size_m, options, buffer);
+}
+
+// The triangles a recipe's buffer keeps (placed less folded, in order).
+std::vector<int> KeptTriangles(const BufferRecipe& recipe) {
+  if (recipe.folded.empty()) return recipe.placed;
+  const std::unordered_set<int> folded(recipe.folded.begin(), recipe.folded.end());
+  std::vector<int> kept;
+  for (int t : recipe.placed)
+    if (!folded.count(t)) kept.push_back(t);
+  return kept;
+}
+
 // Builds one buffer; triangles whose projection folds over others are returned in `folded`.
 BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
                     double texel_size_m, const BaseBufferOptions& options,
                     std::vector<int>* folded) {
   BaseBuffer buffer;
   buffer.triangles = triangles;
-  BaseBufferGroup tmp;
-  tmp.triangles = triangles;
-  ChooseAxes(GroupNormal(mesh, tmp), &buffer);
-  const Eigen::Vector3d anchor = mesh.Corner(triangles[0], 0);
-  const PlaneCoords pc = PlaneExtent(mesh, triangles, anchor, &buffer);
-  SizeTexels(pc, anchor, texel_size_m, options, &buffer);
+  FrameBuffer(mesh, triangles, texel_size_m, options, &buffer);
   const int w = buffer.width, h = buffer.height;
 
   const int num_local = static_cast<int>(triangles.size());
@@ -430,6 +448,10 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   }
   std::vector<uint8_t> surface(owner.size(), 0);
   for (size_t idx = 0; idx < owner.size(); ++idx) surface[idx] = owner[idx] >= 0;
+  if (options.layout_only) {
+    buffer.num_surface_texels = static_cast<int>(std::count(surface.begin(), surface.end(), 1));
+    return buffer;
+  }
 
   GrowGutter(mesh, buffer, options.gutter_texels, &texels);
   const int tile = BaseBuffer::kTileTexels;
@@ -480,7 +502,7 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
     pending.pop_front();
     if (group.triangles.empty()) continue;
     const double s = group.texel_size_m > 0 ? group.texel_size_m : options.texel_size_m;
-    std::vector<int> folded;
+    std::vector<int> folded, placed = group.triangles;
     BaseBuffer buffer = BuildOne(mesh, group.triangles, s, options, &folded);
     if (!folded.empty()) {
       if (folded.size() == group.triangles.size()) {
@@ -507,11 +529,56 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
       ++set.folds_split;
     }
     buffer.id = static_cast<int>(set.buffers.size());
+    BufferRecipe recipe;
+    recipe.placed = std::move(placed);
+    recipe.folded = std::move(folded);
+    recipe.group_texel_size_m = group.texel_size_m;
+    recipe.num_surface_texels = buffer.num_surface_texels;
+    set.recipes.push_back(std::move(recipe));
     set.grouping.groups.push_back(group);
     set.buffers.push_back(std::move(buffer));
   }
   set.grouping.RebuildIndex(mesh.NumTriangles());
   return set;
+}
+
+BaseBufferSet HollowBaseBuffers(const TriangleMesh& mesh, const BufferLayout& layout,
+                                BaseBufferOptions options) {
+  options.texel_size_m = layout.texel_size_m;
+  BaseBufferSet set;
+  set.folds_split = layout.folds_split;
+  set.recipes = layout.recipes;
+  for (const BufferRecipe& recipe : layout.recipes) {
+    BaseBuffer buffer;
+    buffer.id = static_cast<int>(set.buffers.size());
+    buffer.triangles = KeptTriangles(recipe);
+    const double s =
+        recipe.group_texel_size_m > 0 ? recipe.group_texel_size_m : options.texel_size_m;
+    FrameBuffer(mesh, recipe.placed, s, options, &buffer);
+    buffer.num_surface_texels = recipe.num_surface_texels;
+    GroupSpec group;
+    group.triangles = buffer.triangles;
+    group.texel_size_m = recipe.group_texel_size_m;
+    set.grouping.groups.push_back(std::move(group));
+    set.buffers.push_back(std::move(buffer));
+  }
+  set.grouping.RebuildIndex(mesh.NumTriangles());
+  return set;
+}
+
+BaseBuffer BuildLaidOutBuffer(const TriangleMesh& mesh, const BaseBufferSet& set, size_t b,
+                              BaseBufferOptions options) {
+  options.layout_only = false;
+  const BufferRecipe& recipe = set.recipes.at(b);
+  const double s = recipe.group_texel_size_m > 0 ? recipe.group_texel_size_m : options.texel_size_m;
+  std::vector<int> folded;
+  BaseBuffer buffer = BuildOne(mesh, recipe.placed, s, options, &folded);
+  if (folded != recipe.folded || buffer.num_surface_texels != recipe.num_surface_texels)
+    throw std::runtime_error("BuildLaidOutBuffer: buffer " + std::to_string(b) +
+                             " is not the one its recipe describes (another mesh?)");
+  buffer.id = static_cast<int>(b);
+  buffer.triangles = KeptTriangles(recipe);
+  return buffer;
 }
 
 }  // namespace fresco

@@ -119,15 +119,49 @@ struct BaseBufferOptions {
   int max_buffer_texels = 1 << 20;  // a bigger buffer gets coarser texels
   int max_side_texels = 1 << 30;    // so does one wider or higher (an atlas page's limit)
   int gutter_texels = 2;
+  // Lay the buffers out only (the fold test and the surface texels counted): no texel arrays,
+  // the buffers hollow as HollowBaseBuffers makes them (what a layout needs, for less).
+  bool layout_only = false;
+};
+
+// How BuildBaseBuffers made one buffer, enough to make it again alone: the triangles it
+// placed (in order; their mean plane, extent and bounds are the buffer's), those it moved out
+// (their projection folded: they went to later buffers), the texel size its group asked for.
+struct BufferRecipe {
+  std::vector<int> placed;
+  std::vector<int> folded;
+  double group_texel_size_m = 0;  // GroupSpec::texel_size_m (0: the default)
+  int num_surface_texels = 0;
+};
+
+// The buffers' layout without their texels (a shard builds only its own: pipeline/run/shard.h).
+struct BufferLayout {
+  double texel_size_m = 0;  // the session's default texel size
+  int folds_split = 0;
+  std::vector<BufferRecipe> recipes;  // one per buffer
 };
 
 struct BaseBufferSet {
   std::vector<BaseBuffer> buffers;
   Grouping grouping;    // after fold-over splits: buffers[g] serves grouping.groups[g]
   int folds_split = 0;  // groups split because their projection folded
+  std::vector<BufferRecipe> recipes;  // buffers[b] is made by recipes[b]
 };
 
 BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& grouping,
                                const BaseBufferOptions& options);
+
+// The buffers of `layout` without texels ("hollow": triangles, plane frame, size, bounds and
+// num_surface_texels as BuildBaseBuffers makes them; no texel arrays), with the grouping and
+// recipes. Cheap: only the triangles' corners are read. `options.texel_size_m` is ignored
+// (the layout's).
+BaseBufferSet HollowBaseBuffers(const TriangleMesh& mesh, const BufferLayout& layout,
+                                BaseBufferOptions options);
+// Buffer `b` of a set made by either, with its texels: the same as BuildBaseBuffers made it
+// (`options.texel_size_m`: the layout's default texel size).
+// Throws std::runtime_error when the recipe does not make the buffer it describes (another
+// mesh).
+BaseBuffer BuildLaidOutBuffer(const TriangleMesh& mesh, const BaseBufferSet& set, size_t b,
+                              BaseBufferOptions options);
 
 }  // namespace fresco

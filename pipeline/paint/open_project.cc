@@ -7,6 +7,7 @@ namespace {
 
 // The session over the scene of streams[0], its texel size chosen for every stream.
 Status CreateSession(const Project& project, const std::vector<const Capture*>& streams,
+                     const BufferLayout* layout, bool layout_only,
                      std::unique_ptr<PaintSession>* session) {
   const std::vector<StreamSpec> specs = project.Streams();
   for (size_t i = 0; i < streams.size(); ++i) {
@@ -17,6 +18,8 @@ Status CreateSession(const Project& project, const std::vector<const Capture*>& 
   inputs.scene = &streams[0]->scene;
   inputs.pipeline = project.pipeline;
   inputs.grouping = project.grouping;
+  inputs.layout = layout;
+  inputs.layout_only = layout_only;
   const auto expected_poses = [](const Capture& capture) {
     std::vector<Rigid3d> poses;
     for (const PosedImage& p : capture.poses) poses.push_back(p.cam_from_world);
@@ -25,7 +28,7 @@ Status CreateSession(const Project& project, const std::vector<const Capture*>& 
   if (streams.size() == 1) {
     inputs.typical_camera = &streams[0]->cameras.begin()->second;
     inputs.expected_poses = expected_poses(*streams[0]);
-  } else if (inputs.pipeline.texel_size_m <= 0) {
+  } else if (inputs.pipeline.texel_size_m <= 0 && !layout) {  // a layout holds its own
     double texel_size_m = 0;
     for (const Capture* stream : streams) {
       const double t = AutomaticTexelSize(*inputs.scene, stream->cameras.begin()->second,
@@ -49,15 +52,21 @@ Status OpenPaintSession(const Project& project, Capture* capture,
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
                         Capture* capture, std::unique_ptr<PaintSession>* session) {
   FRESCO_RETURN_IF_ERROR(LoadCapture(project, load_options, capture));
-  return CreateSession(project, {capture}, session);
+  return CreateSession(project, {capture}, nullptr, false, session);
 }
 
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
                         std::vector<Capture>* streams, std::unique_ptr<PaintSession>* session) {
   FRESCO_RETURN_IF_ERROR(LoadStreamCaptures(project, load_options, streams));
+  return CreatePaintSession(project, *streams, nullptr, session);
+}
+
+Status CreatePaintSession(const Project& project, const std::vector<Capture>& streams,
+                          const BufferLayout* layout, std::unique_ptr<PaintSession>* session,
+                          bool layout_only) {
   std::vector<const Capture*> views;
-  for (const Capture& stream : *streams) views.push_back(&stream);
-  return CreateSession(project, views, session);
+  for (const Capture& stream : streams) views.push_back(&stream);
+  return CreateSession(project, views, layout, layout_only, session);
 }
 
 }  // namespace fresco

@@ -25,5 +25,11 @@ Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_o
 // stream's first camera at its own poses).
 Status OpenPaintSession(const Project& project, const CaptureLoadOptions& load_options,
                         std::vector<Capture>* streams, std::unique_ptr<PaintSession>* session);
+// The session over streams loaded already (LoadStreamCaptures), its buffers laid out as
+// `layout` says when given (PaintSessionInputs::layout: hollow until SetOwnBuffers).
+// `layout_only`: PaintSessionInputs::layout_only.
+Status CreatePaintSession(const Project& project, const std::vector<Capture>& streams,
+                          const BufferLayout* layout, std::unique_ptr<PaintSession>* session,
+                          bool layout_only = false);
 
 }  // namespace fresco

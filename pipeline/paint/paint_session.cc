@@ -75,31 +75,41 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
   const TriangleMesh& mesh = inputs.scene->mesh;
   if (mesh.NumTriangles() == 0) return Status::Error(inputs.scene->source_path + ": no triangles");
   s->texel_size_m_ =
-      inputs.pipeline.texel_size_m > 0
+      inputs.layout ? inputs.layout->texel_size_m
+      : inputs.pipeline.texel_size_m > 0
           ? inputs.pipeline.texel_size_m
           : (inputs.typical_camera
                  ? AutomaticTexelSize(*inputs.scene, *inputs.typical_camera, inputs.expected_poses)
                  : 0.01);
-  Grouping grouping;
-  ChartScale chart_scale;
-  chart_scale.texel_size_m = s->texel_size_m_;
-  chart_scale.max_chart_texels = inputs.pipeline.max_buffer_texels;
-  FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, chart_scale, &grouping));
-  BaseBufferOptions buffer_options;
+  BaseBufferOptions& buffer_options = s->buffer_options_;
   buffer_options.texel_size_m = s->texel_size_m_;
   buffer_options.max_buffer_texels = inputs.pipeline.max_buffer_texels;
   buffer_options.max_side_texels = MaxBufferSide(inputs.pipeline.atlas);
-  s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
+  if (inputs.layout) {
+    s->set_ = HollowBaseBuffers(mesh, *inputs.layout, buffer_options);
+    s->hollow_.assign(s->set_.buffers.size(), true);
+  } else {
+    Grouping grouping;
+    ChartScale chart_scale;
+    chart_scale.texel_size_m = s->texel_size_m_;
+    chart_scale.max_chart_texels = inputs.pipeline.max_buffer_texels;
+    FRESCO_RETURN_IF_ERROR(MakeGrouping(mesh, inputs.grouping, chart_scale, &grouping));
+    buffer_options.layout_only = inputs.layout_only;
+    s->set_ = BuildBaseBuffers(mesh, grouping, buffer_options);
+    buffer_options.layout_only = false;
+    if (inputs.layout_only) s->hollow_.assign(s->set_.buffers.size(), true);
+  }
   std::vector<cv::Size> sizes;
   for (const BaseBuffer& b : s->set_.buffers) sizes.emplace_back(b.width, b.height);
   FRESCO_RETURN_IF_ERROR(PackAtlas(sizes, inputs.pipeline.atlas, &s->atlas_));
   s->painted_.resize(s->set_.buffers.size());
   s->anchors_.resize(s->set_.buffers.size());
-  for (size_t b = 0; b < s->set_.buffers.size(); ++b)
-    InitRefineAnchor(s->set_.buffers[b], &s->anchors_[b]);
   s->warped_.resize(s->set_.buffers.size());
-  for (size_t b = 0; b < s->set_.buffers.size(); ++b)
+  for (size_t b = 0; b < s->set_.buffers.size(); ++b) {
+    if (!s->BufferBuilt(b)) continue;
+    InitRefineAnchor(s->set_.buffers[b], &s->anchors_[b]);
     InitPaintedBuffer(s->set_.buffers[b], &s->painted_[b]);
+  }
   Eigen::Vector3d lo, hi;
   inputs.scene->Bounds(&lo, &hi);
   s->scene_centre_ = 0.5 * (lo + hi);
@@ -110,6 +120,7 @@ Status PaintSession::Create(const PaintSessionInputs& inputs,
 
 void PaintSession::ResetPainting() {
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!BufferBuilt(b)) continue;
     InitPaintedBuffer(set_.buffers[b], &painted_[b]);
     InitRefineAnchor(set_.buffers[b], &anchors_[b]);
   }
@@ -189,6 +200,27 @@ void PaintSession::SetOwnBuffers(std::vector<bool> own) {
   own_ = std::move(own);
   own_only_.store(false);
   UpdateOwnOnly();
+  BuildPaintedBuffers();
+}
+
+void PaintSession::BuildPaintedBuffers() {
+  for (size_t b = 0; b < hollow_.size(); ++b) {
+    if (!hollow_[b] || (own_only_.load() && !own_.empty() && !own_[b])) continue;
+    set_.buffers[b] = BuildLaidOutBuffer(scene_->mesh, set_, b, buffer_options_);
+    hollow_[b] = false;
+    InitRefineAnchor(set_.buffers[b], &anchors_[b]);
+    InitPaintedBuffer(set_.buffers[b], &painted_[b]);
+    for (std::vector<BufferBackground>& models : background_)
+      if (b < models.size()) models[b].Init(set_.buffers[b], options_.background);
+  }
+}
+
+BufferLayout PaintSession::Layout() const {
+  BufferLayout layout;
+  layout.texel_size_m = texel_size_m_;
+  layout.folds_split = set_.folds_split;
+  layout.recipes = set_.recipes;
+  return layout;
 }
 
 bool PaintSession::CouplesBuffers() const {
@@ -414,21 +446,38 @@ static Scene UnpaintedCopy(const Scene& scene) {
   return out;
 }
 
-Scene PaintSession::PaintedScene() const {
+Scene PaintSession::PaintedScene() const { return PaintedScene(false); }
+
+Scene PaintSession::PaintedSceneOfOwnBuffers() const { return PaintedScene(true); }
+
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
+  return PaintedScene(buffer_bgra, false);
+}
+
+cv::Mat PaintSession::PageImage(int page, const std::vector<cv::Mat>& images, bool own_only) const {
+  if (!own_only) return ComposeAtlasPage(atlas_, page, images);
+  std::vector<bool> own = own_;
+  if (own.empty()) own.assign(images.size(), true);
+  return ComposeAtlasStrip(atlas_, page, images, own);
+}
+
+Scene PaintSession::PaintedScene(bool own_only) const {
   std::vector<cv::Mat> images(painted_.size());
-  for (size_t b = 0; b < painted_.size(); ++b) images[b] = AtMeanExposure(painted_[b].bgra);
-  Scene scene = PaintedScene(images);
+  for (size_t b = 0; b < painted_.size(); ++b)
+    if (!own_only || own_.empty() || own_[b]) images[b] = AtMeanExposure(painted_[b].bgra);
+  Scene scene = PaintedScene(images, own_only);
   // Each layer's pages after the base pages; material page + 1 shows page `page`.
   for (const ViewLayer& layer : layers_) {
     ViewLayerTextures textures;
     textures.centre_world = scene_->WorldFromLocal(layer.Centre());
     textures.material_texture.assign(scene.materials.size(), -1);
-    for (size_t b = 0; b < images.size(); ++b) images[b] = AtMeanExposure(layer.painted[b].bgra);
+    for (size_t b = 0; b < images.size(); ++b)
+      if (!own_only || own_.empty() || own_[b]) images[b] = AtMeanExposure(layer.painted[b].bgra);
     for (size_t page = 0; page < atlas_.pages.size(); ++page) {
       Texture texture;
       texture.name =
           "layer_" + std::to_string(scene.view_layers.size()) + "_page_" + std::to_string(page);
-      cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), images), texture.rgba,
+      cv::cvtColor(PageImage(static_cast<int>(page), images, own_only), texture.rgba,
                    cv::COLOR_BGRA2RGBA);
       texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
       textures.material_texture[page + 1] = static_cast<int>(scene.textures.size());
@@ -439,13 +488,13 @@ Scene PaintSession::PaintedScene() const {
   return scene;
 }
 
-Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const {
   Scene out = UnpaintedCopy(*scene_);
   const TriangleMesh& mesh = scene_->mesh;
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
     texture.name = "page_" + std::to_string(page);
-    cv::cvtColor(ComposeAtlasPage(atlas_, static_cast<int>(page), buffer_bgra), texture.rgba,
+    cv::cvtColor(PageImage(static_cast<int>(page), buffer_bgra, own_only), texture.rgba,
                  cv::COLOR_BGRA2RGBA);
     texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
     out.textures.push_back(texture);

@@ -55,6 +55,13 @@ struct PaintSessionInputs {
   // automatic texel size (about one texel per pixel at the typical distance).
   std::vector<Rigid3d> expected_poses;
   const Camera* typical_camera = nullptr;
+  // Non-null: the buffers laid out as this layout says (its texel size and charts, as another
+  // session over the same scene and settings laid them out: PaintSession::Layout), built
+  // hollow, without texels: SetOwnBuffers builds those the session will paint.
+  const BufferLayout* layout = nullptr;
+  // True: the buffers are laid out only (BaseBufferOptions::layout_only), hollow: a session
+  // that only finds the layout (PaintSession::Layout) and paints nothing.
+  bool layout_only = false;
 };
 
 // One frame on its way through the stages (paint_stages.h): what they hand each other.
@@ -132,6 +139,10 @@ class PaintSession {
   // The same with one texture and material per buffer (material b + 1 = buffer b, material 0
   // for triangles in no buffer): the per-buffer view the app and debug images use.
   Scene PaintedSceneByBuffer() const;
+  // PaintedScene() as a shard's part holds it (SetOwnBuffers): each texture holds, instead of
+  // its page, the own buffers' padded placements on that page (ComposeAtlasStrip), which
+  // `fresco merge` puts back in place; the rest (mesh, UVs, materials) as PaintedScene()'s.
+  Scene PaintedSceneOfOwnBuffers() const;
   const TextureAtlas& atlas() const { return atlas_; }
   // The view-dependent layers (pipeline.layers; view_layers.h) as they are painted; in
   // PaintedScene() they follow the base pages as textures of their own (Scene::view_layers).
@@ -184,7 +195,16 @@ class PaintSession {
   // session still paints every buffer a frame sees while a frame's outcome in one buffer
   // depends on the others (CouplesBuffers): so the shards' buffers come out exactly as one
   // session over every buffer paints them.
+  // A session made from a layout (PaintSessionInputs::layout) builds here the texels and
+  // painted images of the buffers it will paint: the own ones when no buffer is coupled
+  // (PaintsOwnBuffersOnly), else every buffer; the others stay hollow (no texels, nothing
+  // painted, left out of the atlas pages).
   void SetOwnBuffers(std::vector<bool> own);
+  // The buffers' layout (texel size, charts, each buffer's recipe): what a session made with
+  // PaintSessionInputs::layout takes to lay out the same buffers without building them.
+  BufferLayout Layout() const;
+  // Whether buffer b has its texels (false: hollow, PaintSessionInputs::layout).
+  bool BufferBuilt(size_t b) const { return hollow_.empty() || !hollow_[b]; }
   // True while painting one buffer depends on the frame's other buffers: an `auto` mode
   // deciding (its evidence spans the frame), refinement on (one pose correction from every
   // buffer's matches), view selection (one exposure gain per frame), view-dependent layers
@@ -230,7 +250,12 @@ class PaintSession {
   cv::Mat BackgroundImage(size_t b, int stream = 0) const;
 
  private:
-  void KeepSharpestViews(const char* why);  // DecideUpdate: `quality`, for the reason given
+  void KeepSharpestViews(const char* why);
+  // PaintedScene(), its pages whole or (own_only) the own buffers' placements only.
+  Scene PaintedScene(bool own_only) const;
+  Scene PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const;
+  cv::Mat PageImage(int page, const std::vector<cv::Mat>& images,
+                    bool own_only) const;  // DecideUpdate: `quality`, for the reason given
   PaintSession() = default;
   // The stages, one member each (paint_stages.h): `void DepthStage(FrameWork*)`, ...
 #define FRESCO_DECLARE_STAGE(Name) void Name##Stage(FrameWork* work);
@@ -303,6 +328,10 @@ class PaintSession {
   void UpdateOwnOnly() { own_only_.store(own_only_.load() || (!own_.empty() && !CouplesBuffers())); }
   std::vector<bool> own_;
   std::atomic<bool> own_only_{false};
+  std::vector<bool> hollow_;  // buffers without texels (empty: none)
+  BaseBufferOptions buffer_options_;
+  // Builds the hollow buffers the session paints (SetOwnBuffers).
+  void BuildPaintedBuffers();
   int frames_painted_whole_ = 0;
   const Scene* scene_ = nullptr;
   PipelineOptions options_;

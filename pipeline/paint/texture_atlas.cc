@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 
 #include <opencv2/core.hpp>
 #include <stb/stb_rect_pack.h>  // implementation in Debian's libstb
@@ -94,9 +95,74 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
   return out;
 }
 
+namespace {
+
+// The images' type (an empty image, a buffer left out, says nothing of it; none: CV_8UC4).
+int ImagesType(const std::vector<cv::Mat>& images) {
+  for (const cv::Mat& image : images)
+    if (!image.empty()) return image.type();
+  return CV_8UC4;
+}
+
+}  // namespace
+
+cv::Rect PaddedPlacement(const TextureAtlas& atlas, size_t b, cv::Size buffer_size) {
+  const AtlasPlacement& p = atlas.placements[b];
+  if (p.page < 0) return cv::Rect();
+  const int pad = atlas.padding;
+  return cv::Rect(p.x - pad, p.y - pad, buffer_size.width + 2 * pad, buffer_size.height + 2 * pad) &
+         cv::Rect(cv::Point(0, 0), atlas.pages[p.page]);
+}
+
+std::vector<cv::Point> StripPositions(const std::vector<cv::Size>& sizes, int width,
+                                      cv::Size* strip) {
+  for (const cv::Size& size : sizes) width = std::max(width, size.width);
+  std::vector<size_t> order(sizes.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](size_t a, size_t b) { return sizes[a].height > sizes[b].height; });
+  std::vector<cv::Point> at(sizes.size());
+  int x = 0, y = 0, shelf = 0;  // the shelf's top is y, its height the first (tallest) one's
+  for (size_t k : order) {
+    if (x + sizes[k].width > width) y += shelf, x = 0, shelf = 0;
+    at[k] = cv::Point(x, y);
+    x += sizes[k].width;
+    shelf = std::max(shelf, sizes[k].height);
+  }
+  *strip = cv::Size(std::max(width, 1), std::max(y + shelf, 1));
+  return at;
+}
+
+cv::Mat ComposeAtlasStrip(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          const std::vector<bool>& which) {
+  std::vector<size_t> buffers;
+  std::vector<cv::Size> sizes;
+  for (size_t b = 0; b < images.size() && b < atlas.placements.size() && b < which.size(); ++b) {
+    if (!which[b] || atlas.placements[b].page != page) continue;
+    buffers.push_back(b);
+    sizes.push_back(PaddedPlacement(atlas, b, images[b].size()).size());
+  }
+  cv::Size strip;
+  const std::vector<cv::Point> at = StripPositions(sizes, atlas.pages[page].width, &strip);
+  cv::Mat out = cv::Mat::zeros(strip, ImagesType(images));
+  const int pad = atlas.padding;
+  for (size_t k = 0; k < buffers.size(); ++k) {
+    const cv::Mat& image = images[buffers[k]];
+    const AtlasPlacement& p = atlas.placements[buffers[k]];
+    if (image.empty()) continue;
+    const cv::Rect rect = PaddedPlacement(atlas, buffers[k], image.size());
+    cv::Mat padded;
+    cv::copyMakeBorder(image, padded, pad, pad, pad, pad, cv::BORDER_REPLICATE);
+    // The padded image's texel at the rectangle's corner (the page may clip it).
+    const cv::Point from(rect.x - (p.x - pad), rect.y - (p.y - pad));
+    padded(cv::Rect(from, rect.size())).copyTo(out(cv::Rect(at[k], rect.size())));
+  }
+  return out;
+}
+
 void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
                           cv::Mat* page_image) {
-  const int type = images.empty() ? CV_8UC4 : images.front().type();
+  const int type = ImagesType(images);
   page_image->create(atlas.pages[page], type);
   page_image->setTo(cv::Scalar::all(0));
   cv::Mat& out = *page_image;

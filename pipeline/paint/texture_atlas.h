@@ -46,4 +46,18 @@ cv::Mat ComposeAtlasPage(const TextureAtlas& atlas, int page, const std::vector<
 void ComposeAtlasPageInto(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
                           cv::Mat* out);
 
+// Buffer b's placement with its padding (b of size `buffer_size`), within its page: the
+// rectangle of the page that ComposeAtlasPage fills from it.
+cv::Rect PaddedPlacement(const TextureAtlas& atlas, size_t b, cv::Size buffer_size);
+// Where rectangles of `sizes` go in a strip `width` wide (at least the widest): in shelves,
+// the tallest first (ties in order), left to right; `strip` gets its size (at least 1 x 1).
+std::vector<cv::Point> StripPositions(const std::vector<cv::Size>& sizes, int width,
+                                      cv::Size* strip);
+// What ComposeAtlasPage puts in the padded placements (PaddedPlacement) of the buffers
+// `which` (one flag per buffer) on page `page`, without the rest of the page: those
+// rectangles, in buffer order, at StripPositions in a strip as wide as the page (zero
+// elsewhere). A shard's part holds its pages so (the buffers' placements never overlap).
+cv::Mat ComposeAtlasStrip(const TextureAtlas& atlas, int page, const std::vector<cv::Mat>& images,
+                          const std::vector<bool>& which);
+
 }  // namespace fresco

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/paint/texture_atlas.h"
 
 namespace fresco {
 namespace {
@@ -62,6 +63,12 @@ Status CheckFieldsMergeReads(const std::string& path, const Json& m) {
     if (!is_count(Member(m, key))) return wrong(key, "a count");
   const Json* atlas = Member(m, "atlas");
   if (!atlas || !is_count(Member(*atlas, "pages"))) return wrong("atlas.pages", "a count");
+  const Json* sizes = Member(*atlas, "page_sizes");
+  bool sizes_ok = sizes && sizes->is_array() && sizes->size() == (*atlas)["pages"].get<size_t>();
+  for (size_t p = 0; sizes_ok && p < sizes->size(); ++p)
+    sizes_ok = (*sizes)[p].is_array() && (*sizes)[p].size() == 2 && is_count(&(*sizes)[p][0]) &&
+               is_count(&(*sizes)[p][1]);
+  if (!sizes_ok) return wrong("atlas.page_sizes", "a width and height per page");
   const Json* streams = Member(m, "streams");
   if (!streams || !streams->is_array()) return wrong("streams", "an array");
   for (size_t s = 0; s < streams->size(); ++s)
@@ -160,7 +167,9 @@ Status CheckSameLayout(const std::vector<Part>& parts) {
   return Status::Ok();
 }
 
-// Texture file `name` (painted_textureT.png): each shard's rectangles on its page.
+// Texture file `name` (painted_textureT.png): each part holds in it its rectangles on that
+// page at StripPositions (ComposeAtlasStrip); they go back in place on a page of zeros (a
+// texel of no buffer is zero).
 Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int num_pages,
                    const std::string& out_path) {
   const size_t end = name.size() - 4;  // before ".png"
@@ -168,21 +177,30 @@ Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int 
   if (first >= end) return Status::Error(parts.front().dir + "/" + name + ": not a page's name");
   const int texture = std::stoi(name.substr(first, end - first));
   const int page = num_pages > 0 ? texture % num_pages : 0;
-  cv::Mat joined;
+  const Json& size = parts.front().metrics["atlas"]["page_sizes"][page];
+  cv::Mat joined = cv::Mat::zeros(size[1].get<int>(), size[0].get<int>(), CV_8UC4);
   for (const Part& part : parts) {
     const std::string path = part.dir + "/" + name;
-    cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (image.empty()) return Status::Error(path + ": cannot read the PNG");
-    if (joined.empty()) joined = image;
-    if (image.size() != joined.size() || image.type() != joined.type())
-      return Status::Error(path + ": page size differs from " + parts.front().dir + "'s");
+    const cv::Mat strip = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (strip.empty()) return Status::Error(path + ": cannot read the PNG");
+    if (strip.type() != joined.type())
+      return Status::Error(path + ": not 8-bit RGBA, as a part's page is");
+    std::vector<cv::Rect> rects;
+    std::vector<cv::Size> sizes;
     for (const Json& r : part.metrics["shard"]["page_rects"]) {
       if (r[0].get<int>() != page) continue;
-      const cv::Rect rect(r[1].get<int>(), r[2].get<int>(), r[3].get<int>(), r[4].get<int>());
-      if ((rect & cv::Rect(cv::Point(), image.size())) != rect)
-        return Status::Error(part.dir + "/metrics.json: shard.page_rects: a rectangle outside " +
-                             name);
-      image(rect).copyTo(joined(rect));
+      rects.emplace_back(r[1].get<int>(), r[2].get<int>(), r[3].get<int>(), r[4].get<int>());
+      sizes.push_back(rects.back().size());
+    }
+    cv::Size strip_size;
+    const std::vector<cv::Point> at = StripPositions(sizes, joined.cols, &strip_size);
+    for (size_t k = 0; k < rects.size(); ++k) {
+      const cv::Rect from(at[k], rects[k].size());
+      if ((rects[k] & cv::Rect(cv::Point(), joined.size())) != rects[k] ||
+          strip.size() != strip_size)
+        return Status::Error(part.dir + "/metrics.json: shard.page_rects: not the rectangles " +
+                             name + " holds");
+      strip(from).copyTo(joined(rects[k]));
     }
   }
   std::vector<unsigned char> png;

@@ -1,7 +1,8 @@
 // `fresco merge PART_DIR... --out DIR`: the parts that `fresco run --shard I/N` wrote (shard.h)
 // joined into the outputs one `fresco run` writes: painted.gltf and its .bin as every part has
 // them (the atlas is laid out once from the whole mesh), each atlas page (and each view layer's
-// page) made of every shard's own charts with their padding, and metrics.json with the run's
+// page) made of every shard's own charts with their padding (a part's page file holds only
+// those: PaintSession::PaintedSceneOfOwnBuffers), and metrics.json with the run's
 // figures joined (texels painted summed from the buffers' owners; wall time the slowest
 // shard's; stage times per frame summed) and each shard's in "shards".
 #pragma once

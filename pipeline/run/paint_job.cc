@@ -6,6 +6,8 @@
 #include <future>
 #include <map>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -192,12 +194,14 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
 // The whole-capture pre-pass, when the project needs one: read from options.prepass_file when
 // it exists, else run (and written there when named).
 Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& options, PaintJob* j) {
-  if (!NeedsWholeCapturePrepass(project)) return Status::Ok();
+  const bool whole_capture = NeedsWholeCapturePrepass(project);
+  // Without a pre-pass the file still carries the charts' layout for the shards.
+  if (!whole_capture && options.prepass_file.empty()) return Status::Ok();
   const auto start = std::chrono::steady_clock::now();
   if (!options.prepass_file.empty() && std::filesystem::exists(options.prepass_file)) {
     FRESCO_RETURN_IF_ERROR(ReadPrepassFile(options.prepass_file, project, j));
   } else {
-    FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, j));
+    if (whole_capture) FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, j));
     if (options.prepass_file.empty()) return Status::Ok();
     FRESCO_RETURN_IF_ERROR(WritePrepassFile(options.prepass_file, project, *j));
   }
@@ -253,7 +257,17 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
   const auto start = std::chrono::steady_clock::now();
   PaintJob::OpenSeconds& seconds = j.open_seconds;
   if (options.step_started) options.step_started(kLoadStep);
-  FRESCO_RETURN_IF_ERROR(OpenPaintSession(project, load_options, &j.captures, &j.session));
+  FRESCO_RETURN_IF_ERROR(LoadStreamCaptures(project, load_options, &j.captures));
+  // A shard whose pre-pass file holds the charts' layout lays them out from it, hollow: it
+  // builds only the texels it paints (SetOwnBuffers, below).
+  std::optional<BufferLayout> layout;
+  if (options.shard.sharded() && !options.prepass_file.empty() &&
+      std::filesystem::exists(options.prepass_file))
+    FRESCO_RETURN_IF_ERROR(
+        ReadPrepassLayout(options.prepass_file, project, j.scene().mesh.NumTriangles(), &layout));
+  FRESCO_RETURN_IF_ERROR(CreatePaintSession(project, j.captures, layout ? &*layout : nullptr,
+                                            &j.session,
+                                            /*layout_only=*/options.prepass_only && !layout));
   if (options.paint_at_truth_poses)
     for (Capture& capture : j.captures) TakeTruthPoses(&capture);
   seconds.load = SecondsSince(start);
@@ -282,7 +296,13 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                                              options.shard.count);
       std::vector<bool> own(j.buffer_shard.size());
       for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
-      j.session->SetOwnBuffers(std::move(own));
+      const auto build = std::chrono::steady_clock::now();
+      try {
+        j.session->SetOwnBuffers(std::move(own));
+      } catch (const std::runtime_error& e) {
+        return Status::Error(options.prepass_file + ": layout: " + e.what());
+      }
+      seconds.load += SecondsSince(build);
       const PaintSession* session = j.session.get();
       skip = [session, bounds](const SourcedFrame& f) {
         const auto it = bounds->find(f.camera);

@@ -74,6 +74,9 @@ struct PaintJobOptions {
   // file (prepass_file.h) instead of being found again; when the file does not exist, the
   // pre-pass runs and writes it. So the shards of one project run it once.
   std::string prepass_file;
+  // Only the pre-pass file is wanted (`fresco run --prepass-only`): the charts are laid out,
+  // not built (PaintSessionInputs::layout_only); the job paints nothing.
+  bool prepass_only = false;
   // Decode the frames without a pose too (the app shows them); false: folders' frames without
   // a pose come out without pixels, undecoded (nothing paints them).
   bool read_frames_without_pose = false;

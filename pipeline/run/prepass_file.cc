@@ -1,5 +1,7 @@
 #include "pipeline/run/prepass_file.h"
 
+#include <algorithm>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
@@ -56,7 +58,73 @@ Status Bad(const std::string& path, const std::string& field, const std::string&
   return Status::Error(path + ": " + field + ": " + what);
 }
 
+// The buffers' layout (PaintSession::Layout): exact, the texel size's double as written.
+json LayoutJson(const BufferLayout& layout) {
+  json buffers = json::array();
+  for (const BufferRecipe& r : layout.recipes)
+    buffers.push_back({{"placed", r.placed},
+                       {"folded", r.folded},
+                       {"group_texel_size_m", r.group_texel_size_m},
+                       {"surface_texels", r.num_surface_texels}});
+  return {{"texel_size_m", layout.texel_size_m},
+          {"folds_split", layout.folds_split},
+          {"buffers", buffers}};
+}
+
+// Parses the file's header and checks it was written for `project` and its settings.
+Status ReadHeader(const std::string& path, const Project& project, json* file) {
+  std::string text;
+  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &text));
+  *file = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (file->is_discarded() || !file->is_object())
+    return Status::Error(path + ": not a pre-pass file (fresco run --prepass writes them)");
+  if (file->value("fresco_prepass", 0) != kPrepassFormat)
+    return Bad(path, "fresco_prepass", "not format " + std::to_string(kPrepassFormat));
+  const std::string hash = SettingsHash(project);
+  if (file->value("settings_hash", std::string()) != hash)
+    return Bad(path, "settings_hash",
+               "written for another project or other settings (" +
+                   file->value("settings_hash", std::string("none")) + ", not " + hash + " of " +
+                   project.file_path + ")");
+  return Status::Ok();
+}
+
 }  // namespace
+
+Status ReadPrepassLayout(const std::string& path, const Project& project, int num_triangles,
+                         std::optional<BufferLayout>* layout) {
+  layout->reset();
+  json file;
+  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, &file));
+  if (!file.contains("layout")) return Status::Ok();
+  BufferLayout out;
+  try {
+    const json& l = file["layout"];
+    out.texel_size_m = l.at("texel_size_m").get<double>();
+    out.folds_split = l.at("folds_split").get<int>();
+    for (const json& b : l.at("buffers")) {
+      BufferRecipe r;
+      r.placed = b.at("placed").get<std::vector<int>>();
+      r.folded = b.at("folded").get<std::vector<int>>();
+      r.group_texel_size_m = b.at("group_texel_size_m").get<double>();
+      r.num_surface_texels = b.at("surface_texels").get<int>();
+      out.recipes.push_back(std::move(r));
+    }
+  } catch (const std::exception& e) {
+    return Bad(path, "layout", std::string("not a layout of charts (") + e.what() + ")");
+  }
+  if (!(out.texel_size_m > 0)) return Bad(path, "layout.texel_size_m", "not positive");
+  for (size_t b = 0; b < out.recipes.size(); ++b) {
+    const BufferRecipe& r = out.recipes[b];
+    bool ok = !r.placed.empty();
+    for (int t : r.placed) ok = ok && t >= 0 && t < num_triangles;
+    if (!ok)
+      return Bad(path, "layout.buffers[" + std::to_string(b) + "].placed",
+                 "not triangles of the mesh (" + std::to_string(num_triangles) + ")");
+  }
+  *layout = std::move(out);
+  return Status::Ok();
+}
 
 bool NeedsWholeCapturePrepass(const Project& project) {
   return !IsLiveProject(project) &&
@@ -87,6 +155,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
   json file = {{"fresco_prepass", kPrepassFormat},
                {"project", project.file_path},
                {"settings_hash", SettingsHash(project)}};
+  file["layout"] = LayoutJson(job.session->Layout());
   const PaintJob::PrepassDecisions& d = job.prepass;
   if (job.joint_poses) {
     file["joint_poses"] = PoseAdjustSummaryJson(*job.joint_poses);
@@ -133,19 +202,8 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
 }
 
 Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob* job) {
-  std::string text;
-  FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &text));
-  const json file = json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (file.is_discarded() || !file.is_object())
-    return Status::Error(path + ": not a pre-pass file (fresco run --prepass writes them)");
-  if (file.value("fresco_prepass", 0) != kPrepassFormat)
-    return Bad(path, "fresco_prepass", "not format " + std::to_string(kPrepassFormat));
-  const std::string hash = SettingsHash(project);
-  if (file.value("settings_hash", std::string()) != hash)
-    return Bad(path, "settings_hash",
-               "written for another project or other settings (" +
-                   file.value("settings_hash", std::string("none")) + ", not " + hash + " of " +
-                   project.file_path + ")");
+  json file;
+  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, &file));
   try {
     const json& streams = file.at("streams");
     if (!streams.is_array() || streams.size() != job->captures.size())
@@ -219,7 +277,7 @@ Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob
   } catch (const std::exception& e) {
     return Bad(path, "content", std::string("not a pre-pass file's (") + e.what() + ")");
   }
-  job->prepass.ran = true;
+  job->prepass.ran = NeedsWholeCapturePrepass(project);
   return Status::Ok();
 }
 

@@ -165,6 +165,32 @@ TEST(BaseBuffers, FoldedGroupIsSplit) {
   const BaseBufferSet set = BuildBaseBuffers(scene.mesh, g, options);
   EXPECT_EQ(set.buffers.size(), 2u);
   EXPECT_GE(set.folds_split, 1);
+  // Laid out again from the recipes (as a shard does from the pre-pass file's layout): the
+  // same buffers, hollow, then each built alone with the same texels.
+  BufferLayout layout;
+  layout.texel_size_m = options.texel_size_m;
+  layout.folds_split = set.folds_split;
+  layout.recipes = set.recipes;
+  const BaseBufferSet hollow = HollowBaseBuffers(scene.mesh, layout, options);
+  ASSERT_EQ(hollow.buffers.size(), set.buffers.size());
+  EXPECT_TRUE(hollow.grouping.groups == set.grouping.groups);
+  for (size_t b = 0; b < set.buffers.size(); ++b) {
+    const BaseBuffer& want = set.buffers[b];
+    for (const BaseBuffer& got :
+         {hollow.buffers[b], BuildLaidOutBuffer(scene.mesh, hollow, b, options)}) {
+      EXPECT_EQ(got.triangles, want.triangles) << b;
+      EXPECT_EQ(got.width, want.width) << b;
+      EXPECT_EQ(got.height, want.height) << b;
+      EXPECT_EQ(got.origin, want.origin) << b;
+      EXPECT_EQ(got.bounds_min, want.bounds_min) << b;
+      EXPECT_EQ(got.num_surface_texels, want.num_surface_texels) << b;
+    }
+    EXPECT_EQ(hollow.buffers[b].NumTexels(), 0);
+    const BaseBuffer built = BuildLaidOutBuffer(scene.mesh, hollow, b, options);
+    EXPECT_EQ(built.texel_index, want.texel_index) << b;
+    EXPECT_EQ(built.point_qx, want.point_qx) << b;
+    EXPECT_EQ(built.normal_qz, want.normal_qz) << b;
+  }
 }
 
 TEST(Painting, PerfectPosesReproduceTheSceneAtFramePosesAndNovelPoses) {

@@ -56,6 +56,49 @@ TEST(TextureAtlas, PacksWithoutOverlapAlignedAndWithinPages) {
   EXPECT_GT(atlas.Occupancy(), 0.4);
 }
 
+// A shard's part holds some buffers' placements in strips (ComposeAtlasStrip); put back at
+// StripPositions, every part's strip makes the page ComposeAtlasPage makes.
+TEST(TextureAtlas, StripsOfEveryBufferPutBackMakeThePage) {
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> side(1, 120), value(0, 255);
+  std::vector<cv::Mat> images;
+  std::vector<cv::Size> sizes;
+  for (int i = 0; i < 60; ++i) {
+    images.emplace_back(side(rng), side(rng), CV_8UC4);
+    cv::randu(images.back(), 0, 256);
+    sizes.push_back(images.back().size());
+  }
+  AtlasOptions options;
+  options.page_size = 512;
+  options.padding_texels = 2;
+  TextureAtlas atlas;
+  ASSERT_TRUE(PackAtlas(sizes, options, &atlas).ok());
+  ASSERT_GE(atlas.pages.size(), 2u);
+  for (int page = 0; page < static_cast<int>(atlas.pages.size()); ++page) {
+    cv::Mat joined = cv::Mat::zeros(atlas.pages[page], CV_8UC4);
+    for (int part = 0; part < 3; ++part) {  // buffer b in part b % 3
+      std::vector<bool> which(images.size());
+      std::vector<cv::Rect> rects;
+      std::vector<cv::Size> rect_sizes;
+      for (size_t b = 0; b < images.size(); ++b) {
+        which[b] = static_cast<int>(b % 3) == part;
+        if (!which[b] || atlas.placements[b].page != page) continue;
+        rects.push_back(PaddedPlacement(atlas, b, sizes[b]));
+        rect_sizes.push_back(rects.back().size());
+      }
+      const cv::Mat strip = ComposeAtlasStrip(atlas, page, images, which);
+      cv::Size strip_size;
+      const std::vector<cv::Point> at =
+          StripPositions(rect_sizes, atlas.pages[page].width, &strip_size);
+      ASSERT_EQ(strip.size(), strip_size);
+      for (size_t k = 0; k < rects.size(); ++k)
+        strip(cv::Rect(at[k], rects[k].size())).copyTo(joined(rects[k]));
+    }
+    const cv::Mat whole = ComposeAtlasPage(atlas, page, images);
+    EXPECT_EQ(cv::norm(joined, whole, cv::NORM_INF), 0.0) << "page " << page;
+  }
+}
+
 TEST(TextureAtlas, RefusesABufferLargerThanAPage) {
   AtlasOptions options;
   options.page_size = 256;

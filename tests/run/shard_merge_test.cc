@@ -36,8 +36,12 @@ std::map<std::string, std::string> Files(const std::string& dir) {
 json Metrics(const std::string& dir) { return json::parse(ReadText(dir + "/metrics.json")); }
 
 // Runs `project` unsharded and in 1, 2 and 4 shards, merges each set, and compares.
+// `own_charts_only`: settings that couple no charts, so a shard that reads the charts' layout
+// from the pre-pass file builds only its own charts' texels; the pre-pass job (--prepass-only,
+// which lays the charts out without building them) writes the file first.
 void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& tag,
-                                 const std::vector<std::string>& sets = {}) {
+                                 const std::vector<std::string>& sets = {},
+                                 bool own_charts_only = false) {
   const std::string work = MakeTempDir(tag);
   auto run = [&](std::vector<std::string> args) {
     for (const std::string& set : sets) args.insert(args.end(), {"--set", set});
@@ -50,6 +54,9 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
   const json whole_metrics = Metrics(work + "/whole");
   for (int n : {1, 2, 4}) {
     std::vector<std::string> merge = {"merge"};
+    // own_charts_only: the pre-pass job writes the file (its charts laid out, not built).
+    const std::string prepass = work + "/n" + std::to_string(n) + ".prepass";
+    if (n > 1 && own_charts_only) run({"run", project, "--prepass", prepass, "--prepass-only"});
     long long texels_sum = 0;
     int skipped = 0;
     for (int i = n - 1; i >= 0; --i) {  // any order
@@ -58,14 +65,19 @@ void ExpectMergedEqualsUnsharded(const std::string& project, const std::string& 
           "run", project, "--out", part, "--shard", std::to_string(i) + "/" + std::to_string(n)};
       // N > 1: the whole-capture pre-pass runs in the first shard, which writes it; the others
       // read it (and the merge must not tell).
-      if (n > 1)
-        args.insert(args.end(), {"--prepass", work + "/n" + std::to_string(n) + ".prepass"});
+      if (n > 1) args.insert(args.end(), {"--prepass", prepass});
       run(args);
       const json m = Metrics(part);
       if (n > 1 && i < n - 1 && whole_metrics.contains("joint_poses")) {
         EXPECT_EQ(m["wall"]["open_seconds"]["prepass_read"], 0.0) << "shard " << i << " of " << n;
         EXPECT_EQ(m["joint_poses"]["check_matches"], whole_metrics["joint_poses"]["check_matches"]);
       }
+      const int all = whole_metrics["base_buffers"].get<int>();
+      const int own = static_cast<int>(m["shard"]["buffers"].size());
+      // The file's writer: the pre-pass job, else the first shard to run (the last).
+      const bool read_layout = n > 1 && (own_charts_only || i < n - 1);
+      EXPECT_EQ(m["shard"]["buffers_built"], own_charts_only && read_layout ? own : all)
+          << "shard " << i << " of " << n;
       EXPECT_EQ(m["shard"]["index"], i);
       EXPECT_EQ(m["shard"]["count"], n);
       texels_sum += m["shard"]["texels"].get<long long>();
@@ -105,6 +117,19 @@ TEST(ShardMerge, DefaultProjectMergedEqualsUnsharded) {
   // 6th frame held out, every 6th of the 48).
   ExpectMergedEqualsUnsharded(root + "/project.json", "shard-cube-room",
                               {"pipeline.max_frames=48"});
+}
+
+// The decisions off (no frame couples the charts): shards build, hold and paint only their
+// own charts, and the parts still join into the unsharded run's bytes.
+TEST(ShardMerge, DecisionsOffShardsBuildOnlyTheirChartsAndMergeEqualsUnsharded) {
+  const std::string root = testing::SourceDir() + "/projects/cube-room";
+  const testing::CommandResult synth = RunFresco({"synth", root + "/synth.json", "--if-changed"});
+  ASSERT_EQ(synth.exit_code, 0) << synth.err;
+  ExpectMergedEqualsUnsharded(
+      root + "/project.json", "shard-decisions-off",
+      {"pipeline.max_frames=16", "pipeline.update=quality", "pipeline.refine.mode=off",
+       "pipeline.refine.joint=false", "pipeline.background.mode=off"},
+      /*own_charts_only=*/true);
 }
 
 TEST(ShardMerge, TwoStreamsMergedEqualsUnsharded) {
