@@ -119,18 +119,26 @@ std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, doub
     runs.emplace(key_of[order[r]], std::make_pair(r, end));
     r = end;
   }
-  for (int i : order) {
-    const Eigen::Vector3d& p = vertices[i];
-    const CellKey& key = key_of[i];
-    for (int64_t dx = -1; dx <= 1; ++dx) {
-      for (int64_t dy = -1; dy <= 1; ++dy) {
-        for (int64_t dz = -1; dz <= 1; ++dz) {
-          auto it = runs.find({key.x + dx, key.y + dy, key.z + dz});
-          if (it == runs.end()) continue;
-          for (int r = it->second.first; r < it->second.second; ++r) {
-            const int j = order[r];
-            if (j != i && (vertices[j] - p).squaredNorm() <= tolerance2) sets.Union(i, j);
-          }
+  // Each pair of vertices in the same or neighbouring cells is tested once: within a cell, and
+  // against the 13 neighbouring cells that come after it (the union is symmetric).
+  const auto test_pairs = [&](int a_begin, int a_end, int b_begin, int b_end, bool same_cell) {
+    for (int ra = a_begin; ra < a_end; ++ra) {
+      const int i = order[ra];
+      const Eigen::Vector3d& p = vertices[i];
+      for (int rb = same_cell ? ra + 1 : b_begin; rb < b_end; ++rb) {
+        const int j = order[rb];
+        if ((vertices[j] - p).squaredNorm() <= tolerance2) sets.Union(i, j);
+      }
+    }
+  };
+  for (const auto& [key, run] : runs) {
+    test_pairs(run.first, run.second, run.first, run.second, /*same_cell=*/true);
+    for (int64_t dx = 0; dx <= 1; ++dx) {
+      for (int64_t dy = dx == 0 ? 0 : -1; dy <= 1; ++dy) {
+        for (int64_t dz = dx == 0 && dy == 0 ? 1 : -1; dz <= 1; ++dz) {
+          const auto it = runs.find({key.x + dx, key.y + dy, key.z + dz});
+          if (it != runs.end())
+            test_pairs(run.first, run.second, it->second.first, it->second.second, false);
         }
       }
     }

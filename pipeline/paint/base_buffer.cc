@@ -8,6 +8,8 @@
 #include <string>
 #include <unordered_set>
 
+#include <opencv2/core.hpp>
+
 namespace fresco {
 namespace {
 
@@ -497,13 +499,34 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
                                const BaseBufferOptions& options) {
   BaseBufferSet set;
   std::deque<BaseBufferGroup> pending(grouping.groups.begin(), grouping.groups.end());
+  // The groups pending are built in waves, in parallel, then taken in order: the groups split
+  // off go to the back, so the order is the one building them one by one gives.
+  std::deque<BaseBuffer> built;
+  std::deque<std::vector<int>> built_folded;
   while (!pending.empty()) {
+    if (built.empty()) {
+      const int wave = static_cast<int>(pending.size());
+      built.resize(wave);
+      built_folded.resize(wave);
+      cv::parallel_for_(
+          cv::Range(0, wave),
+          [&](const cv::Range& range) {
+            for (int g = range.start; g < range.end; ++g) {
+              const BaseBufferGroup& group = pending[g];
+              if (group.triangles.empty()) continue;
+              const double s = group.texel_size_m > 0 ? group.texel_size_m : options.texel_size_m;
+              built[g] = BuildOne(mesh, group.triangles, s, options, &built_folded[g]);
+            }
+          },
+          wave);
+    }
     BaseBufferGroup group = pending.front();
     pending.pop_front();
+    BaseBuffer buffer = std::move(built.front());
+    std::vector<int> folded = std::move(built_folded.front()), placed = group.triangles;
+    built.pop_front();
+    built_folded.pop_front();
     if (group.triangles.empty()) continue;
-    const double s = group.texel_size_m > 0 ? group.texel_size_m : options.texel_size_m;
-    std::vector<int> folded, placed = group.triangles;
-    BaseBuffer buffer = BuildOne(mesh, group.triangles, s, options, &folded);
     if (!folded.empty()) {
       if (folded.size() == group.triangles.size()) {
         // Nothing in this group can be served by its own mean plane (e.g. opposite

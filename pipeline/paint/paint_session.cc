@@ -39,14 +39,26 @@ double AutomaticTexelSize(const Scene& scene, const Camera& camera,
   std::vector<float> depths;
   try {
     const Rasterizer raster(small, RasterOptions());
-    RasterOutput out;
     const size_t step = std::max<size_t>(1, cam_from_world.size() / 16);
-    for (size_t i = 0; i < cam_from_world.size(); i += step) {
-      raster.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world[i]), &out);
-      for (int y = 0; y < out.depth.rows; ++y)
-        for (int x = 0; x < out.depth.cols; ++x)
-          if (const float z = out.depth.at<float>(y, x); std::isfinite(z)) depths.push_back(z);
-    }
+    const int poses = static_cast<int>((cam_from_world.size() + step - 1) / step);
+    // The poses at once (a small image's rasterizing is mostly on one core); the median does
+    // not depend on the order the depths come in.
+    std::vector<std::vector<float>> seen(poses);
+    cv::parallel_for_(
+        cv::Range(0, poses),
+        [&](const cv::Range& range) {
+          RasterOutput out;
+          for (int k = range.start; k < range.end; ++k) {
+            raster.Rasterize(scene.mesh, CamFromLocal(scene, cam_from_world[k * step]), &out);
+            for (int y = 0; y < out.depth.rows; ++y)
+              for (int x = 0; x < out.depth.cols; ++x)
+                if (const float z = out.depth.at<float>(y, x); std::isfinite(z))
+                  seen[k].push_back(z);
+          }
+          Rasterizer::ReleaseThreadScratch();  // see below
+        },
+        std::min(poses, cv::getNumThreads()));
+    for (const std::vector<float>& d : seen) depths.insert(depths.end(), d.begin(), d.end());
   } catch (const std::invalid_argument&) {
   }
   // Seeing the whole mesh, the rasterizer's set-ups would hold ~110 bytes per triangle for

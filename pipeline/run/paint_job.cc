@@ -34,15 +34,24 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// What the whole-capture pre-pass found that goes into the captures and the session once it
+// is built (ApplyWholeCapturePrepass): the pre-pass runs while the session is built.
+struct PrepassFound {
+  std::vector<std::pair<std::pair<int, int>, Rigid3d>> poses;  // (stream, pose index), adjusted
+  std::vector<std::vector<cv::Mat>> movers;  // per stream, per pose (background.across_views)
+  bool read = false;                         // the frames were read: the videos open again
+};
+
 // The movers found across views (each stream's frames compared with that stream's frames
-// near them), which decide the background; the masks kept with the captures when the model
+// near them), which decide the background; the masks kept for the captures when the model
 // joins them. `small[k]`, `frames[k]`, `cam_from_local[k]`: frame k of the pre-pass, at
 // stream and pose index `where[k]`.
 Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mover_options,
                              const std::vector<cv::Mat>& small,
                              const std::vector<PoseAdjustFrame>& frames,
                              const std::vector<Rigid3d>& cam_from_local,
-                             const std::vector<std::pair<int, int>>& where, PaintJob* j) {
+                             const std::vector<std::pair<int, int>>& where, PaintJob* j,
+                             PrepassFound* found_for_captures) {
   // Each stream's frames are compared with that stream's frames near them.
   MoverMaskResult all;
   for (size_t s = 0; s < j->captures.size(); ++s) {
@@ -61,18 +70,13 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
     all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
     if (project.pipeline.background.across_views) {
-      Capture& capture = j->captures[s];
-      capture.movers.resize(capture.poses.size());
-      for (size_t k = 0; k < pose_index.size(); ++k)
-        capture.movers[pose_index[k]] = found.Packed(k);
+      std::vector<cv::Mat>& movers = found_for_captures->movers[s];
+      movers.resize(j->captures[s].poses.size());
+      for (size_t k = 0; k < pose_index.size(); ++k) movers[pose_index[k]] = found.Packed(k);
     }
   }
   j->mover_masks = all;
   j->prepass.background_across_views = {all.fraction(), static_cast<int>(where.size())};
-  j->session->DecideBackgroundAcrossViews(all.fraction(), static_cast<int>(where.size()));
-  // No background model, nothing for the masks to join: not kept.
-  if (j->session->options().background.mode == BackgroundMode::kOff)
-    for (Capture& capture : j->captures) capture.movers.clear();
   return Status::Ok();
 }
 
@@ -81,9 +85,11 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
 // for the movers found across views that background.mode auto decides on and, with
 // background.across_views, the model's foreground joins: mover_masks.h), the poses are
 // adjusted and written into the captures, the background decided, each frame's movers kept
-// with its capture; the videos open again for painting.
-Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& options,
-                               PaintJob* j) {
+// with its capture; the videos open again for painting. It needs the scene and the captures,
+// not the session: what goes into them waits in `found` (ApplyWholeCapturePrepass), and it
+// may run while the session is built.
+Status RunWholeCapturePrepass(const Project& project, const PaintJobOptions& options, PaintJob* j,
+                              PrepassFound* found) {
   j->prepass.ran = true;
   const bool joint = project.pipeline.refine.joint;
   const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
@@ -110,6 +116,8 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
   }
   std::vector<const Capture*> streams;
   for (const Capture& capture : j->captures) streams.push_back(&capture);
+  found->read = true;
+  found->movers.resize(j->captures.size());
   std::vector<PoseAdjustFrame> frames;
   std::vector<cv::Mat> small;              // colour, at the movers' size
   std::vector<std::pair<int, int>> where;  // stream, pose index
@@ -168,45 +176,79 @@ Status PrepareFromWholeCapture(const Project& project, const PaintJobOptions& op
         adjusted.check_one_end_px > 0) {
       j->prepass.pose_check = {adjusted.check_before_px / adjusted.check_one_end_px,
                                adjust_options.check_min_improvement, adjusted.decided_on_frames};
-      j->session->SetRefinePoseCheck(adjusted.check_before_px / adjusted.check_one_end_px,
-                                     adjust_options.check_min_improvement,
-                                     adjusted.decided_on_frames);
     }
     cam_from_local = adjusted.cam_from_local;
     const Rigid3d local_from_world(Eigen::Quaterniond::Identity(), -j->scene().origin_in_world);
     for (size_t k = 0; k < where.size(); ++k)
-      j->captures[where[k].first].poses[where[k].second].cam_from_world =
-          adjusted.cam_from_local[k] * local_from_world;
+      found->poses.push_back({where[k], adjusted.cam_from_local[k] * local_from_world});
   }
   seconds.joint = SecondsSince(step);
   step = std::chrono::steady_clock::now();
   for (PoseAdjustFrame& frame : frames) frame.bgr.release();  // only their cameras are left
   if (movers)
-    FRESCO_RETURN_IF_ERROR(
-        FindMoversAcrossViews(project, mover_options, small, frames, cam_from_local, where, j));
+    FRESCO_RETURN_IF_ERROR(FindMoversAcrossViews(project, mover_options, small, frames,
+                                                 cam_from_local, where, j, found));
   seconds.movers = SecondsSince(step);
+  return Status::Ok();
+}
+
+// What the pre-pass found, into the captures (the poses adjusted, each frame's movers) and the
+// session (its decisions, in the pre-pass's order); the videos open again for painting.
+Status ApplyWholeCapturePrepass(const Project& project, PrepassFound found, PaintJob* j) {
+  for (const auto& [where, cam_from_world] : found.poses)
+    j->captures[where.first].poses[where.second].cam_from_world = cam_from_world;
+  for (size_t s = 0; s < j->captures.size() && s < found.movers.size(); ++s)
+    if (!found.movers[s].empty()) j->captures[s].movers = std::move(found.movers[s]);
+  if (j->prepass.pose_check) {
+    const auto& [ratio, threshold, frames] = *j->prepass.pose_check;
+    j->session->SetRefinePoseCheck(ratio, threshold, frames);
+  }
+  if (j->prepass.background_across_views) {
+    const auto& [fraction, frames] = *j->prepass.background_across_views;
+    j->session->DecideBackgroundAcrossViews(fraction, frames);
+    // No background model, nothing for the masks to join: not kept.
+    if (j->session->options().background.mode == BackgroundMode::kOff)
+      for (Capture& capture : j->captures) capture.movers.clear();
+  }
   const std::vector<StreamSpec> specs = project.Streams();
-  for (size_t s = 0; s < j->captures.size(); ++s)
+  for (size_t s = 0; found.read && s < j->captures.size(); ++s)
     FRESCO_RETURN_IF_ERROR(OpenVideoSource(project.Resolve(specs[s].video), &j->captures[s].video));
   return Status::Ok();
 }
 
+// The whole-capture pre-pass runs (RunWholeCapturePrepass) rather than being read from
+// options.prepass_file.
+bool RunsWholeCapturePrepass(const Project& project, const PaintJobOptions& options) {
+  return NeedsWholeCapturePrepass(project) &&
+         (options.prepass_file.empty() || !std::filesystem::exists(options.prepass_file));
+}
+
 // The whole-capture pre-pass, when the project needs one: read from options.prepass_file when
-// it exists, else run (and written there when named).
-Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& options, PaintJob* j) {
+// it exists, else run (or `ran`: run while the session was built) and written there when named.
+Status PrepareOrReadPrepass(const Project& project, const PaintJobOptions& options,
+                            std::optional<PrepassFound> ran, PaintJob* j) {
   const bool whole_capture = NeedsWholeCapturePrepass(project);
   // Without a pre-pass the file still carries the charts' layout for the shards.
   if (!whole_capture && options.prepass_file.empty()) return Status::Ok();
   const auto start = std::chrono::steady_clock::now();
+  bool ran_here = false;
   if (!options.prepass_file.empty() && std::filesystem::exists(options.prepass_file)) {
     FRESCO_RETURN_IF_ERROR(ReadPrepassFile(options.prepass_file, project, j));
   } else {
-    if (whole_capture) FRESCO_RETURN_IF_ERROR(PrepareFromWholeCapture(project, options, j));
+    if (whole_capture) {
+      if (!ran) {
+        ran.emplace();
+        ran_here = true;
+        FRESCO_RETURN_IF_ERROR(RunWholeCapturePrepass(project, options, j, &*ran));
+      }
+      FRESCO_RETURN_IF_ERROR(ApplyWholeCapturePrepass(project, std::move(*ran), j));
+    }
     if (options.prepass_file.empty()) return Status::Ok();
     FRESCO_RETURN_IF_ERROR(WritePrepassFile(options.prepass_file, project, *j));
   }
+  const PaintJob::OpenSeconds& seconds = j->open_seconds;
   j->open_seconds.prepass_file =
-      SecondsSince(start) - j->open_seconds.read - j->open_seconds.joint - j->open_seconds.movers;
+      SecondsSince(start) - (ran_here ? seconds.read + seconds.joint + seconds.movers : 0.0);
   return Status::Ok();
 }
 
@@ -265,24 +307,43 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
       std::filesystem::exists(options.prepass_file))
     FRESCO_RETURN_IF_ERROR(
         ReadPrepassLayout(options.prepass_file, project, j.scene().mesh.NumTriangles(), &layout));
-  FRESCO_RETURN_IF_ERROR(CreatePaintSession(project, j.captures, layout ? &*layout : nullptr,
-                                            &j.session,
-                                            /*layout_only=*/options.prepass_only && !layout));
+  // The whole-capture pre-pass needs the scene and the frames, not the session: it runs while
+  // the session's charts and buffers are built (most of that on one core). Only it reports
+  // progress meanwhile.
+  std::optional<PrepassFound> ran;
+  std::future<Status> prepass;
+  if (!j.live && !options.paint_at_truth_poses && RunsWholeCapturePrepass(project, options)) {
+    ran.emplace();
+    prepass = std::async(std::launch::async, [&] {
+      try {
+        return RunWholeCapturePrepass(project, options, &j, &*ran);
+      } catch (const std::exception& e) {
+        return Status::Internal(project.file_path + ": pre-pass: " + e.what());
+      }
+    });
+  }
+  const Status created =
+      CreatePaintSession(project, j.captures, layout ? &*layout : nullptr, &j.session,
+                         /*layout_only=*/options.prepass_only && !layout);
+  seconds.load = SecondsSince(start);  // the pre-pass's steps have their own times
+  const Status prepassed = prepass.valid() ? prepass.get() : Status::Ok();
+  FRESCO_RETURN_IF_ERROR(created);
+  FRESCO_RETURN_IF_ERROR(prepassed);
   if (options.paint_at_truth_poses)
     for (Capture& capture : j.captures) TakeTruthPoses(&capture);
-  seconds.load = SecondsSince(start);
+  const double loaded = SecondsSince(start);
   // Each camera's ray table and the mesh's culling clusters are set-up, not painting: built
   // here, the first frame costs what the others do (a few photos of a large mesh would
   // otherwise show a painting rate set by the first frame).
   if (options.step_started) options.step_started(kCamerasStep);
   for (const Capture& capture : j.captures)
     for (const auto& [id, camera] : capture.cameras) j.session->PrepareCamera(camera);
-  seconds.cameras = SecondsSince(start) - seconds.load;
+  seconds.cameras = SecondsSince(start) - loaded;
   if (options.shard.sharded() && j.live)
     return Status::Error(project.file_path +
                          ": --shard paints captures from files (a live stream cannot be split)");
   if (!j.live) {
-    FRESCO_RETURN_IF_ERROR(PrepareOrReadPrepass(project, options, &j));
+    FRESCO_RETURN_IF_ERROR(PrepareOrReadPrepass(project, options, std::move(ran), &j));
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     FileFrameSource::SkipFrame skip;
@@ -342,7 +403,7 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                                                      std::to_string(s) + "]: " + status.message());
   }
   if (!first_error.ok()) return first_error;
-  seconds.connect = SecondsSince(start) - seconds.load - seconds.cameras;
+  seconds.connect = SecondsSince(start) - loaded - seconds.cameras;
   std::vector<std::unique_ptr<PosedFrameSource>> sources;
   for (int s = 0; s < num_streams; ++s) {
     const Project one = project.ForStream(s);

@@ -112,6 +112,8 @@ struct PaintJob {
   struct OpenSeconds {
     double load = 0;      // scene, cameras, poses read; charts and base buffers built
     double cameras = 0;   // each camera's ray table and the mesh's culling clusters
+    // The whole-capture pre-pass runs while the charts and buffers are built: its steps overlap
+    // `load`.
     double read = 0;      // the whole-capture pre-pass: every frame read and decoded once
     double prepass_file = 0;  // ... or its outcome read from (or written to) prepass_file
     double joint = 0;     // ... the poses adjusted together (refine.joint)
