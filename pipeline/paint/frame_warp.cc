@@ -80,7 +80,33 @@ struct KernelContext {
   uint8_t* paint_bgra = nullptr;
   float* paint_quality = nullptr;
   TexelUpdateRule rule;
+  // ... and the sums of `update: mean` and `auto` (PaintedBuffer; null when not kept).
+  float* mean_sum = nullptr;
+  float* held_sum = nullptr;
+  uint8_t* shadow_bgra = nullptr;
+  float* shadow_quality = nullptr;
 };
+
+// One visible sample (BGR) into the painted texel `idx` by `k.rule`: what PaintBuffer paints
+// for it without a mask or a background model (paint_update.cc's PaintTexel).
+inline void PaintSample(const KernelContext& k, size_t idx, const uint8_t* sample, float quality,
+                        bool on_surface, PaintUpdateStats* stats) {
+  uint8_t* const texel = k.paint_bgra + 4 * idx;
+  if (k.mean_sum && !k.rule.mean_too) {
+    MeanTexel(sample, quality, /*provisional=*/false, on_surface, texel, k.paint_quality + idx,
+              k.mean_sum + 4 * idx, stats);
+    return;
+  }
+  if (k.rule.mean_too) {  // `auto` deciding: the means beside the sharpest
+    AddToMean(sample, quality, /*provisional=*/false, k.mean_sum + 4 * idx,
+              k.held_sum ? k.held_sum + 4 * idx : nullptr, k.rule.held_out);
+    PaintUpdateStats ignored;
+    if (!k.rule.held_out && k.shadow_bgra)
+      UpdateTexel(k.rule, sample, quality, on_surface, k.shadow_bgra + 4 * idx,
+                  k.shadow_quality + idx, &ignored);
+  }
+  UpdateTexel(k.rule, sample, quality, on_surface, texel, k.paint_quality + idx, stats);
+}
 
 // True when the box lies wholly behind the near plane or outside one side of the view
 // frustum (all eight corners outside the same plane); R, t map the box's frame to the camera.
@@ -561,6 +587,33 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   counts->paint.Add(stats);
 }
 
+// Painting with the sums of `update: mean` or `auto` (KernelContext::mean_sum): the batch's
+// depth test and bilinear sample, then each visible texel painted (PaintSample).
+template <bool kDepth>
+void PaintSumsChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
+                           const ChunkProjection& proj, int in_view, int grazing, Counts* counts) {
+  PaintBatch batch;
+  const int n = chunk.end - chunk.begin;
+  GatherBatch<kDepth>(k, proj, n, &batch);
+  const int visible = !kDepth         ? SampleBatchNoDepth(n, &proj, &batch)
+                      : k.depth_range ? SampleBatchDepthRange(n, &proj, &batch)
+                                      : SampleBatchDepth(n, &proj, &batch);
+  const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
+  const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
+  PaintUpdateStats stats;
+  for (int i = 0; i < n; ++i) {
+    if (!batch.write[i]) continue;
+    const uint32_t bgr = batch.out[i];
+    const uint8_t sample[3] = {static_cast<uint8_t>(bgr), static_cast<uint8_t>(bgr >> 8),
+                               static_cast<uint8_t>(bgr >> 16)};
+    PaintSample(k, static_cast<size_t>(texel_index[i]), sample, proj.quality[i], on_surface[i] != 0,
+                &stats);
+  }
+  counts->in_view += in_view, counts->visible += visible;
+  counts->occluded += in_view - visible, counts->grazing += grazing;
+  counts->paint.Add(stats);
+}
+
 // Pass 2 when later stages read the warped samples (no painting here): the batch's depth
 // test and bilinear sample, then each visible texel's sample, quality and valid flag stored.
 // The same samples, to the bit, as the texel-by-texel loop.
@@ -623,6 +676,15 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
   if constexpr (kPaint && kMode == SamplingMode::kBilinear) {
     // The whole chunk as a batch, texels out of view masked (a chunk with none in view
     // is only counted).
+    if (k.mean_sum) {
+      int in_view, grazing;
+      CountCodes(proj, n, &in_view, &grazing);
+      if (in_view == 0) {
+        counts->grazing += grazing;
+        return;
+      }
+      return PaintSumsChunkBatched<kDepth>(k, chunk, proj, in_view, grazing, counts);
+    }
     if (k.rule.weight == 256) {
       int in_view, grazing;
       CountCodes(proj, n, &in_view, &grazing);
@@ -709,8 +771,8 @@ void WarpChunk(const KernelContext& context, const BaseBuffer::Chunk& chunk, Cou
                      (v + 0.5f) * scale - 0.5f, sample);
     }
     if constexpr (kPaint) {
-      UpdateTexel(k.rule, sample, proj.quality[i], on_surface[i] != 0,
-                  k.paint_bgra + 4 * static_cast<size_t>(idx), k.paint_quality + idx, &paint_stats);
+      PaintSample(k, static_cast<size_t>(idx), sample, proj.quality[i], on_surface[i] != 0,
+                  &paint_stats);
     } else {
       uint8_t* out = k.out_bgr + 3 * static_cast<size_t>(idx);
       out[0] = sample[0], out[1] = sample[1], out[2] = sample[2];
@@ -967,12 +1029,28 @@ PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& v
   k.paint_bgra = painted->bgra.data;
   k.paint_quality = painted->quality.ptr<float>();
   k.rule = rule;
+  const bool sums = rule.policy == UpdatePolicy::kMean || rule.mean_too;
+  const bool fresh_sums = sums && painted->mean_sum.empty();
+  if (sums) {
+    AllocateSums(rule, painted);
+    k.mean_sum = painted->mean_sum.ptr<float>();
+    if (rule.mean_too) {
+      k.held_sum = painted->held_sum.ptr<float>();
+      k.shadow_bgra = painted->shadow_bgra.data;
+      k.shadow_quality = painted->shadow_quality.ptr<float>();
+    }
+  }
   cv::Rect visible_box;
   const Counts n =
       RunChunks(k, SelectKernel<true>(view.camera->HasDistortion(), use_depth, options.sampling),
                 &visible_box);
   SetCounts(n, counts);
   painted->painted_surface_texels += n.paint.newly_painted;
+  if (fresh_sums && n.visible == 0) {  // as PaintBuffer, which paints only buffers seen
+    for (cv::Mat* m :
+         {&painted->mean_sum, &painted->shadow_bgra, &painted->shadow_quality, &painted->held_sum})
+      m->release();
+  }
   return n.paint;
 }
 

@@ -40,9 +40,7 @@ inline bool StagesReadWarpedSamples(const PipelineOptions& options) {
   return options.refine.mode != RefineMode::kOff ||          // Refine
          SelectActive(options) ||                            // Exposure and Select
          options.background.mode != BackgroundMode::kOff ||  // Background
-         options.layers.count > 0 ||                         // Layers
-         options.update == UpdatePolicy::kMean ||            // Paint's sums per texel
-         options.update == UpdatePolicy::kAuto;
+         options.layers.count > 0;                           // Layers
 }
 
 }  // namespace fresco

@@ -27,6 +27,21 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
     painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
 }
 
+void AllocateSums(const TexelUpdateRule& rule, PaintedBuffer* painted) {
+  if ((rule.policy == UpdatePolicy::kMean || rule.mean_too) && painted->mean_sum.empty())
+    painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  if (rule.unmasked_too && painted->unmasked_sum.empty())
+    painted->unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  if (rule.mean_too && painted->shadow_bgra.empty()) {
+    // The shadows start from what the texels hold (the frames before `auto` began deciding).
+    painted->shadow_bgra = painted->bgra.clone();
+    painted->shadow_quality = painted->quality.clone();
+    painted->held_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  }
+  if (rule.unmasked_too && painted->held_unmasked_sum.empty())
+    painted->held_unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+}
+
 namespace {
 
 // The arrays one frame's update reads and writes, all in the rectangle's layout.
@@ -158,17 +173,7 @@ PaintUpdateStats PaintBuffer(const BaseBuffer& buffer, const WarpedBuffer& warpe
                              PaintedBuffer* painted, const cv::Mat& warming, bool held_out) {
   TexelUpdateRule rule = TexelUpdateRule::From(options);
   rule.held_out = held_out && rule.mean_too;
-  if ((rule.policy == UpdatePolicy::kMean || rule.mean_too) && painted->mean_sum.empty())
-    painted->mean_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
-  if (rule.unmasked_too && painted->unmasked_sum.empty())
-    painted->unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
-  if (rule.mean_too && painted->shadow_bgra.empty()) {
-    painted->shadow_bgra = painted->bgra.clone();  // the fused warp paints none while deciding
-    painted->shadow_quality = painted->quality.clone();
-    painted->held_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
-  }
-  if (rule.unmasked_too && painted->held_unmasked_sum.empty())
-    painted->held_unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+  AllocateSums(rule, painted);
   PaintUpdateStats stats;
   if (buffer.chunks.empty()) {  // a hand-made buffer: all texels, no culling
     stats = PaintTexels(buffer, warped, mask, warming, rule, 0, buffer.NumTexels(), painted);

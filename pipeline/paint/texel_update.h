@@ -74,6 +74,10 @@ struct TexelUpdateRule {
   }
 };
 
+// The sums `rule` paints into (PaintedBuffer::mean_sum and, for `update: auto` deciding, the
+// shadows and held-out parts), made where missing (paint_update.cc).
+void AllocateSums(const TexelUpdateRule& rule, PaintedBuffer* painted);
+
 // The misalignment signal: a sample against what a painted texel holds (BT.601 luma, integer
 // weights), into `stats`.
 inline void CompareWithStored(const uint8_t* sample, const uint8_t* texel,

@@ -52,7 +52,8 @@ void PaintSession::WarpStage(FrameWork* work) {
   // debug images are wanted, the warp paints them directly: the same texels, without writing
   // and reading back the warped images.
   work->paint_in_warp = !StagesReadWarpedSamples(options_) && !work->debug;
-  const TexelUpdateRule rule = TexelUpdateRule::From(options_);
+  TexelUpdateRule rule = TexelUpdateRule::From(options_);
+  rule.held_out = work->held_out && rule.mean_too;  // as PaintBuffer takes it
   if (work->paint_in_warp && view.depth && !in_frustum.empty() &&
       options_.sampling == SamplingMode::kBilinear) {
     DepthRange2x2(depth_, &depth_range_);  // one pair per texel instead of four depths

@@ -1,5 +1,6 @@
 #include "pipeline/run/paint_job.h"
 
+#include <malloc.h>
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
@@ -344,6 +345,10 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
                          ": --shard paints captures from files (a live stream cannot be split)");
   if (!j.live) {
     FRESCO_RETURN_IF_ERROR(PrepareOrReadPrepass(project, options, std::move(ran), &j));
+    // What the pre-pass and the set-up freed goes back to the system before painting: freed
+    // on several threads, it stays in their allocators' pools otherwise (the teddy's peak
+    // memory 680 -> 880 MB).
+    malloc_trim(0);
     std::vector<const Capture*> streams;
     for (const Capture& capture : j.captures) streams.push_back(&capture);
     FileFrameSource::SkipFrame skip;

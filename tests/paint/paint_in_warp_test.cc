@@ -1,7 +1,8 @@
 // Painting during the warp (frame_warp.h WarpAndPaintBuffer, taken when no stage looks at the
 // warped samples before the paint stage) paints exactly what the two stages paint one after
 // the other: the same texels, colours, stored qualities and figures, bit for bit, for every
-// sampling mode, both update policies, a running average and a distorted lens.
+// sampling mode, every update policy (with the sums `mean` and `auto` keep), a running average
+// and a distorted lens.
 #include <gtest/gtest.h>
 #include <algorithm>
 #include <limits>
@@ -57,6 +58,15 @@ void ExpectSame(const Painted& a, const Painted& b, const std::string& what) {
     EXPECT_EQ(cv::norm(a.buffers[k].quality, b.buffers[k].quality, cv::NORM_INF), 0)
         << what << " b" << k;
     EXPECT_EQ(a.buffers[k].painted_surface_texels, b.buffers[k].painted_surface_texels) << what;
+    const auto same_or_both_empty = [&](const cv::Mat& x, const cv::Mat& y, const char* name) {
+      ASSERT_EQ(x.empty(), y.empty()) << what << " b" << k << " " << name;
+      if (!x.empty())
+        EXPECT_EQ(cv::norm(x, y, cv::NORM_INF), 0) << what << " b" << k << " " << name;
+    };
+    same_or_both_empty(a.buffers[k].mean_sum, b.buffers[k].mean_sum, "mean_sum");
+    same_or_both_empty(a.buffers[k].shadow_bgra, b.buffers[k].shadow_bgra, "shadow_bgra");
+    same_or_both_empty(a.buffers[k].shadow_quality, b.buffers[k].shadow_quality, "shadow_quality");
+    same_or_both_empty(a.buffers[k].held_sum, b.buffers[k].held_sum, "held_sum");
     painted_texels += a.buffers[k].painted_surface_texels;
   }
   EXPECT_GT(painted_texels, 10000) << what;  // the capture paints the room
@@ -91,7 +101,8 @@ TEST(PaintInWarp, PaintsWhatTheTwoStagesPaint) {
     for (const SamplingMode sampling :
          {SamplingMode::kNearest, SamplingMode::kBilinear, SamplingMode::kArea}) {
       options.sampling = sampling;
-      for (const UpdatePolicy policy : {UpdatePolicy::kQuality, UpdatePolicy::kLatest}) {
+      for (const UpdatePolicy policy : {UpdatePolicy::kQuality, UpdatePolicy::kLatest,
+                                        UpdatePolicy::kMean, UpdatePolicy::kAuto}) {
         options.update = policy;
         for (const double weight : {1.0, 0.3}) {
           options.update_weight = weight;
