@@ -587,6 +587,16 @@ void PaintChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
   counts->paint.Add(stats);
 }
 
+// The batch's depth test and bilinear sample (b->out, b->write: SampleBatchBody); returns how
+// many texels are visible.
+template <bool kDepth>
+int SampleChunk(const KernelContext& k, const ChunkProjection& proj, int n, PaintBatch* b) {
+  GatherBatch<kDepth>(k, proj, n, b);
+  return !kDepth         ? SampleBatchNoDepth(n, &proj, b)
+         : k.depth_range ? SampleBatchDepthRange(n, &proj, b)
+                         : SampleBatchDepth(n, &proj, b);
+}
+
 // Painting with the sums of `update: mean` or `auto` (KernelContext::mean_sum): the batch's
 // depth test and bilinear sample, then each visible texel painted (PaintSample).
 template <bool kDepth>
@@ -594,10 +604,7 @@ void PaintSumsChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chun
                            const ChunkProjection& proj, int in_view, int grazing, Counts* counts) {
   PaintBatch batch;
   const int n = chunk.end - chunk.begin;
-  GatherBatch<kDepth>(k, proj, n, &batch);
-  const int visible = !kDepth         ? SampleBatchNoDepth(n, &proj, &batch)
-                      : k.depth_range ? SampleBatchDepthRange(n, &proj, &batch)
-                                      : SampleBatchDepth(n, &proj, &batch);
+  const int visible = SampleChunk<kDepth>(k, proj, n, &batch);
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   const uint8_t* const on_surface = k.buffer->on_surface.data() + chunk.begin;
   PaintUpdateStats stats;
@@ -622,10 +629,7 @@ void SampleChunkBatched(const KernelContext& k, const BaseBuffer::Chunk& chunk,
                         const ChunkProjection& proj, int in_view, int grazing, Counts* counts) {
   PaintBatch batch;
   const int n = chunk.end - chunk.begin;
-  GatherBatch<kDepth>(k, proj, n, &batch);
-  const int visible = !kDepth         ? SampleBatchNoDepth(n, &proj, &batch)
-                      : k.depth_range ? SampleBatchDepthRange(n, &proj, &batch)
-                                      : SampleBatchDepth(n, &proj, &batch);
+  const int visible = SampleChunk<kDepth>(k, proj, n, &batch);
   const int32_t* const texel_index = k.buffer->texel_index.data() + chunk.begin;
   for (int i = 0; i < n; ++i) {
     if (!batch.write[i]) continue;
