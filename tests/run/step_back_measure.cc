@@ -137,6 +137,9 @@ int main(int argc, char** argv) {
   PaintUpTo(&run, back_to, nullptr, &unused, &none);
   const double step_back_seconds = Since(start), step_back_cpu = CpuSeconds() - cpu;
 
+  const size_t kept = snapshots.count(), kept_bytes = snapshots.bytes();
+  const int spacing = snapshots.every();
+
   // The same frames painted again from the first: from the state before it when kept, else
   // (the app's only way then) the project opened again, its pre-pass too.
   start = Clock::now();
@@ -166,9 +169,9 @@ int main(int argc, char** argv) {
       "(%d saves, %.0f ms each)\n",
       frames, paint_seconds, paint_cpu, save_seconds, saves,
       1000 * save_seconds / std::max(1, saves));
-  std::printf("states kept    %zu, every %d frames, %.0f MB (%.1f MB each; budget %d MB)\n",
-              snapshots.count(), snapshots.every(), snapshots.bytes() / 1048576.0,
-              snapshots.bytes() / 1048576.0 / std::max<size_t>(1, snapshots.count()), budget_mb);
+  std::printf("states kept    %zu, every %d frames, %.0f MB (%.1f MB each; budget %d MB)\n", kept,
+              spacing, kept_bytes / 1048576.0, kept_bytes / 1048576.0 / std::max<size_t>(1, kept),
+              budget_mb);
   std::printf(
       "step back      frame %d -> %d: %.3f s, %.3f s CPU (restore %.3f s, %d frames "
       "painted from the state at %d)\n",
