@@ -10,8 +10,9 @@
 # once as Slurm jobs (WORK/job: the pre-pass job, an array of SHARDS shards, default 16, the
 # merge), every process niced and timed with /usr/bin/time. The array runs with --exclusive:
 # one shard at a time has the node, as each would have its own node on a cluster of SHARDS
-# nodes; so the makespan there is projected as the pre-pass job's wall time + the slowest
-# shard's + the merge's, each measured here. Prints the figures (also in WORK/figures.txt),
+# nodes; so the makespan there is projected as the pre-pass job's time + the slowest
+# shard's + the merge's, each measured here (in wall time, and in CPU time, which the
+# machine's other load sways less). Prints the figures (also in WORK/figures.txt),
 # compares the merged outputs with the one-process run's (byte for byte, then the largest
 # difference of any atlas page's texel with ImageMagick's `compare`), stops the daemons it
 # started and removes the generated data (KEEP=1 keeps it). FRESCO: the binary (default
@@ -124,6 +125,8 @@ figures() {
       printf "one node, the jobs one after another: %.0f s from submitting to the merge done\n", el
       printf "projected on %d nodes: pre-pass %.1f + slowest shard %.1f + merge %.1f = %.1f s wall (one process: %.1f s, %.1fx faster)\n",
              n, pw, wmax, mw, pw + wmax + mw, w, w / (pw + wmax + mw)
+      printf "the same in CPU time (an idle node, one core): %.1f + %.1f + %.1f = %.1f s (one process: %.1f s, %.2fx faster)\n",
+             pc, cmax, mc, pc + cmax + mc, c, c / (pc + cmax + mc)
     }' "$work/shards.txt"
   same=1
   maxdiff=0
