@@ -6,8 +6,10 @@
 // against the board's pitch, and a solve takes that for lens distortion). There the corner
 // is the meeting point of the tag's two edges: each edge located to sub-pixel along its
 // normal (where the grey crosses halfway between the edge's dark and light levels, taken
-// 2.5 px or more to either side, so that blur moves it neither way) along the whole edge,
-// fitted by a quadratic (a lens bends the edge), and the two curves intersected.
+// 2.5 px or more to either side, so that blur moves it neither way; then moved to where a
+// step has the grey's area about that crossing, which a sharp edge's crossing interpolated
+// between pixels is not) along the whole edge, fitted by a quadratic (a lens bends the
+// edge), and the two curves intersected.
 #pragma once
 
 #include <array>

@@ -4,7 +4,8 @@
 // The memory they hold is bounded: past the budget the spacing doubles (every other state
 // dropped), so the states stay spread over the whole capture; the first (before any frame:
 // going back to it spares reopening the project and its whole-capture pre-pass) is kept
-// while it fits.
+// while a later state fits beside it. Where the budget holds one state only (a large model),
+// the newest on the spacing replaces it, the spacing doubling each time.
 #pragma once
 
 #include <cstddef>
@@ -19,8 +20,8 @@ class RunSnapshots {
   RunSnapshots(int every, size_t budget_bytes);
 
   // Whether a state is due before reading frame `frames_read` (0-based): none kept there yet,
-  // `frames_read` on the spacing, and the last state offered would fit beside the first (a
-  // state is not saved, a costly copy, only to be dropped).
+  // `frames_read` on the spacing, and the last state offered fits the budget (a state is not
+  // saved, a costly copy, only to be dropped).
   bool Due(int frames_read) const;
   // Keeps `state` (saved before reading frame `frames_read`), thinning as the budget asks.
   void Add(int frames_read, PaintRunState state);
@@ -38,6 +39,8 @@ class RunSnapshots {
   size_t bytes_ = 0;
   size_t last_offered_bytes_ = 0;
   std::map<int, PaintRunState> states_;  // by frames read before it
+
+  void DoubleTheSpacing();  // every state off the new spacing dropped
 };
 
 }  // namespace fresco

@@ -44,19 +44,51 @@ std::string SettingsHash(const Project& project) {
   return hex;
 }
 
+void BufferViews::Mark(size_t buffers, size_t b, int v) {
+  const size_t words = (static_cast<size_t>(num_views) + 63) / 64;
+  if (seen.size() != buffers) seen.assign(buffers, std::vector<unsigned long long>(words, 0));
+  seen[b][v / 64] |= 1ULL << (v % 64);
+}
+
+int BufferViews::Count(size_t b) const {
+  int n = 0;
+  if (b < seen.size())
+    for (unsigned long long w : seen[b]) n += __builtin_popcountll(w);
+  return n;
+}
+
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
-                                       const std::vector<int>& frames_seeing, int count) {
+                                       const BufferViews& views, double view_work, int count) {
   std::vector<int> shard(buffers.size(), 0);
   if (count <= 1) return shard;
+  const bool with_views = views.num_views > 0 && views.seen.size() == buffers.size();
+  const size_t words = with_views ? views.seen[0].size() : 0;
   std::vector<double> work(buffers.size());
   std::vector<Eigen::Vector3d> centre(buffers.size());
   for (size_t b = 0; b < buffers.size(); ++b) {
-    const int frames = frames_seeing.empty() ? 1 : std::max(frames_seeing[b], 1);
-    work[b] = static_cast<double>(std::max<long long>(buffers[b].num_surface_texels, 1)) * frames;
+    const double texels =
+        static_cast<double>(std::max<long long>(buffers[b].num_surface_texels, 1));
+    work[b] = with_views ? texels * views.Count(b) : texels;
     centre[b] = 0.5 * (buffers[b].bounds_min + buffers[b].bounds_max);
   }
   std::vector<size_t> ids(buffers.size());
   std::iota(ids.begin(), ids.end(), 0);
+  // The work of ids [begin, k) for every k in (begin, end] (from_end: of ids [k, end) for k in
+  // [begin, end)), at index k - begin - 1 (from_end: k - begin).
+  const auto side_work = [&](size_t begin, size_t end, bool from_end) {
+    std::vector<double> out(end - begin);
+    std::vector<unsigned long long> seen(words, 0);
+    double sum = 0;
+    for (size_t step = 0; step < end - begin; ++step) {
+      const size_t id = ids[from_end ? end - 1 - step : begin + step];
+      sum += work[id];
+      int frames = 0;
+      for (size_t w = 0; w < words; ++w)
+        frames += __builtin_popcountll(seen[w] |= views.seen[id][w]);
+      out[from_end ? end - begin - 1 - step : step] = sum + view_work * frames;
+    }
+    return out;
+  };
   // Shards [first, first + n) take ids [begin, end).
   const std::function<void(size_t, size_t, int, int)> split = [&](size_t begin, size_t end,
                                                                   int first, int n) {
@@ -65,24 +97,23 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
       return;
     }
     Eigen::Vector3d low = centre[ids[begin]], high = low;
-    double total = 0;
-    for (size_t k = begin; k < end; ++k) {
+    for (size_t k = begin; k < end; ++k)
       low = low.cwiseMin(centre[ids[k]]), high = high.cwiseMax(centre[ids[k]]);
-      total += work[ids[k]];
-    }
     int axis = 0;
     (high - low).maxCoeff(&axis);
     std::sort(ids.begin() + begin, ids.begin() + end, [&](size_t a, size_t b) {
       return centre[a][axis] != centre[b][axis] ? centre[a][axis] < centre[b][axis] : a < b;
     });
-    // The cut whose first side's work is nearest its shards' share (each side keeps a buffer).
+    // The cut (each side keeps a buffer) whose larger side's work per shard is least.
     const int left = n / 2;
-    const double target = total * left / n;
+    const std::vector<double> first_side = side_work(begin, end, false);
+    const std::vector<double> second_side = side_work(begin, end, true);
     size_t cut = begin + 1;
-    double sum = work[ids[begin]], best = std::abs(sum - target);
-    for (size_t k = begin + 1; k + 1 < end; ++k) {
-      sum += work[ids[k]];
-      if (std::abs(sum - target) < best) best = std::abs(sum - target), cut = k + 1;
+    double best = -1;
+    for (size_t k = begin + 1; k < end; ++k) {
+      const double larger =
+          std::max(first_side[k - begin - 1] / left, second_side[k - begin] / (n - left));
+      if (best < 0 || larger < best) best = larger, cut = k;
     }
     split(begin, cut, first, left);
     split(cut, end, first + left, n - left);

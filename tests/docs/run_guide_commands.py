@@ -34,6 +34,7 @@ Usage: run_guide_commands.py FRESCO [--list]
 """
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -203,11 +204,16 @@ def main():
                 script = (("set -e\n" if kind in ("run", "given") else "") +
                           (setup + "\n" if setup else "") + code + "\n")
                 start = time.time()
+                cpu_before = resource.getrusage(resource.RUSAGE_CHILDREN)
                 r = subprocess.run(["bash", "-c", script], cwd=scratch, capture_output=True,
                                    text=True, timeout=600)
                 output = r.stdout + r.stderr
                 ran += 1
-                print(f"run  {where}: exit {r.returncode} in {time.time() - start:.1f} s")
+                cpu_after = resource.getrusage(resource.RUSAGE_CHILDREN)
+                cpu = (cpu_after.ru_utime + cpu_after.ru_stime -
+                       cpu_before.ru_utime - cpu_before.ru_stime)
+                print(f"run  {where}: exit {r.returncode} in {time.time() - start:.1f} s "
+                      f"({cpu:.1f} s CPU)")
                 if kind in ("run", "given") and r.returncode != 0:
                     errors.append(f"{where}: exit {r.returncode}\n{code}\n--- output:\n{output[-2000:]}")
                 if kind == "output" and arg not in output:

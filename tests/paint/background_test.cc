@@ -428,13 +428,17 @@ BackgroundScore Score(const cv::Mat& estimate_grey, const cv::Mat& truth_grey) {
   return s;
 }
 
-// Paints a clip onto the plane with `mode`; returns the painted plane rendered through the
+// Paints a clip onto the plane once per mode in `modes` (the clip decoded once, each frame
+// painted by every mode's session); returns each mode's painted plane rendered through the
 // camera (grey) and keeps the grey frames listed in `keep`.
-cv::Mat LearnBackground(const std::string& video, BackgroundMode mode, const std::vector<int>& keep,
-                        std::map<int, cv::Mat>* kept) {
+std::map<BackgroundMode, cv::Mat> LearnBackgrounds(const std::string& video,
+                                                   const std::vector<BackgroundMode>& modes,
+                                                   const std::vector<int>& keep,
+                                                   std::map<int, cv::Mat>* kept) {
+  std::map<BackgroundMode, cv::Mat> learned;
   std::unique_ptr<VideoSource> source;
   EXPECT_TRUE(OpenVideoSource(video, &source).ok()) << video;
-  if (!source) return cv::Mat();
+  if (!source) return learned;
   Frame frame;
   Status status;
   EXPECT_TRUE(source->Next(&frame, &status)) << video;
@@ -447,27 +451,33 @@ cv::Mat LearnBackground(const std::string& video, BackgroundMode mode, const std
   const Rigid3d cam_from_world(
       Eigen::Quaterniond(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX())),
       Eigen::Vector3d(0, 0, kPlaneDistanceM));
-  PaintSessionInputs inputs;
-  inputs.scene = &scene;
-  inputs.pipeline.texel_size_m = s;
-  inputs.pipeline.background.mode = mode;
-  inputs.pipeline.refine.mode = RefineMode::kOff;  // a static camera: nothing to align
-  std::unique_ptr<PaintSession> session;
-  EXPECT_TRUE(PaintSession::Create(inputs, &session).ok());
+  std::map<BackgroundMode, std::unique_ptr<PaintSession>> sessions;
+  for (BackgroundMode mode : modes) {
+    PaintSessionInputs inputs;
+    inputs.scene = &scene;
+    inputs.pipeline.texel_size_m = s;
+    inputs.pipeline.background.mode = mode;
+    inputs.pipeline.refine.mode = RefineMode::kOff;  // a static camera: nothing to align
+    EXPECT_TRUE(PaintSession::Create(inputs, &sessions[mode]).ok());
+    if (!sessions[mode]) return learned;
+  }
   FrameReport report;
   do {
     for (int k : keep)
       if (frame.index == k) cv::cvtColor(frame.bgr, (*kept)[k], cv::COLOR_BGR2GRAY);
-    session->PaintFrame(frame, camera, cam_from_world, &report);
+    for (auto& [mode, session] : sessions)
+      session->PaintFrame(frame, camera, cam_from_world, &report);
   } while (source->Next(&frame, &status));
   EXPECT_TRUE(status.ok()) << status.message();
   RenderOptions render_options;
   render_options.filter = TextureFilter::kNearest;
-  RenderOutput out;
-  Renderer(camera, render_options).Render(session->PaintedScene(), cam_from_world, &out);
-  cv::Mat grey;
-  cv::cvtColor(out.rgba, grey, cv::COLOR_RGBA2GRAY);
-  return grey;
+  const Renderer renderer(camera, render_options);
+  for (auto& [mode, session] : sessions) {
+    RenderOutput out;
+    renderer.Render(session->PaintedScene(), cam_from_world, &out);
+    cv::cvtColor(out.rgba, learned[mode], cv::COLOR_RGBA2GRAY);
+  }
+  return learned;
 }
 
 struct ClipCase {
@@ -480,10 +490,14 @@ struct ClipCase {
 std::map<BackgroundMode, BackgroundScore> ScoreClip(const ClipCase& clip) {
   const std::string video = testing::SharedDataDir() + "/video-intel-static-cam/" + clip.file;
   std::map<BackgroundMode, BackgroundScore> result;
-  for (BackgroundMode mode :
-       {BackgroundMode::kOff, BackgroundMode::kAverage, BackgroundMode::kRobust}) {
-    std::map<int, cv::Mat> truth;
-    const cv::Mat estimate = LearnBackground(video, mode, clip.empty_frames, &truth);
+  std::map<int, cv::Mat> truth;
+  const std::vector<BackgroundMode> modes = {BackgroundMode::kOff, BackgroundMode::kAverage,
+                                             BackgroundMode::kRobust};
+  std::map<BackgroundMode, cv::Mat> learned =
+      LearnBackgrounds(video, modes, clip.empty_frames, &truth);
+  for (BackgroundMode mode : modes) {
+    const cv::Mat& estimate = learned[mode];
+    EXPECT_FALSE(estimate.empty()) << BackgroundModeName(mode);
     BackgroundScore mean;
     for (int k : clip.empty_frames) {
       EXPECT_TRUE(truth.count(k)) << clip.file << " frame " << k;

@@ -157,18 +157,20 @@ TEST(StepBack, ViewLayersAndViewSelectionRepaintAsStraightPainting) {
 // Back to the very first frame: from the state saved before any (no reopening).
 TEST(StepBack, BackToTheFirstFrameFromTheStateBeforeAny) { StepBackAndCompare({}, 10, 14, 0); }
 
+// A state that says it holds `bytes` (the budget's arithmetic only).
+PaintRunState StateOf(size_t bytes) {
+  auto painting = std::make_shared<PaintSession::State>();
+  painting->bytes = bytes;
+  PaintRunState state;
+  state.painting = painting;
+  return state;
+}
+
 // The budget: past it the spacing doubles (states off it dropped) and the first state stays.
 TEST(RunSnapshots, OverTheBudgetTheSpacingDoublesAndTheFirstStateStays) {
-  const auto state_of = [](size_t bytes) {
-    auto painting = std::make_shared<PaintSession::State>();
-    painting->bytes = bytes;
-    PaintRunState state;
-    state.painting = painting;
-    return state;
-  };
   RunSnapshots snapshots(2, 350);  // room for three states of 100 bytes
   for (int frames = 0; frames <= 12; ++frames)
-    if (snapshots.Due(frames)) snapshots.Add(frames, state_of(100));
+    if (snapshots.Due(frames)) snapshots.Add(frames, StateOf(100));
   // 0, 2, 4; at 6 the spacing becomes 4 (0, 4; 6 off it); 8; at 12 it becomes 8 (0, 8).
   EXPECT_EQ(snapshots.every(), 8);
   EXPECT_EQ(snapshots.count(), 2u);
@@ -179,9 +181,26 @@ TEST(RunSnapshots, OverTheBudgetTheSpacingDoublesAndTheFirstStateStays) {
   ASSERT_NE(snapshots.AtOrBefore(12, &at), nullptr);
   EXPECT_EQ(at, 8);
   // A state alone over the budget is not kept, and after it none is due that would not fit.
-  snapshots.Add(16, state_of(400));
+  snapshots.Add(16, StateOf(400));
   EXPECT_EQ(snapshots.count(), 2u);
   EXPECT_FALSE(snapshots.Due(24));
+}
+
+// A budget with room for one state (a large model): the first gives way to a later one, the
+// newest on the spacing replaces the one kept and the spacing doubles each time, so a step
+// back far into the capture paints from a recent state, not from the first frame.
+TEST(RunSnapshots, WhereOneStateFitsTheNewestReplacesItAndTheSpacingDoubles) {
+  RunSnapshots snapshots(2, 150);
+  for (int frames = 0; frames <= 17; ++frames)
+    if (snapshots.Due(frames)) snapshots.Add(frames, StateOf(100));
+  // 0; at 2 the spacing becomes 4 (none kept); 4; at 8 it becomes 8 (8); at 16, 16 (16).
+  EXPECT_EQ(snapshots.every(), 16);
+  EXPECT_EQ(snapshots.count(), 1u);
+  EXPECT_EQ(snapshots.bytes(), 100u);
+  int at = -1;
+  ASSERT_NE(snapshots.AtOrBefore(17, &at), nullptr);
+  EXPECT_EQ(at, 16);
+  EXPECT_EQ(snapshots.AtOrBefore(15, &at), nullptr);
 }
 
 }  // namespace

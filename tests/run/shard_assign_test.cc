@@ -1,0 +1,61 @@
+// Which shard paints each chart (AssignBuffersToShards): a shard pays every frame that sees any
+// of its charts once (the frame read, the whole mesh's depth rendered), so charts seen by the
+// same frames go to the same shard where texels alone would split them.
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/run/shard.h"
+
+namespace fresco {
+namespace {
+
+// Buffer b of `texels` surface texels centred at x = b along a street.
+std::vector<BaseBuffer> BuffersAlongX(const std::vector<int>& texels) {
+  std::vector<BaseBuffer> buffers(texels.size());
+  for (size_t b = 0; b < texels.size(); ++b) {
+    buffers[b].num_surface_texels = texels[b];
+    buffers[b].bounds_min = Eigen::Vector3d(b - 0.4, 0, 0);
+    buffers[b].bounds_max = Eigen::Vector3d(b + 0.4, 1, 0);
+  }
+  return buffers;
+}
+
+// Buffers 0 and 1 seen by views 0-9, buffers 2 and 3 by views 10-19.
+BufferViews TwoGroupsOfViews() {
+  BufferViews views;
+  views.num_views = 20;
+  for (int v = 0; v < 20; ++v)
+    for (size_t b = v < 10 ? 0 : 2; b < (v < 10 ? 2u : 4u); ++b) views.Mark(4, b, v);
+  return views;
+}
+
+TEST(ShardAssign, TexelsAloneBalanceTexelsTimesViews) {
+  // Work 1000, 1000, 3000, 3000: the cut nearest half of 8000 is after the third.
+  const std::vector<int> shard =
+      AssignBuffersToShards(BuffersAlongX({100, 100, 300, 300}), TwoGroupsOfViews(), 0.0, 2);
+  EXPECT_EQ(shard, (std::vector<int>{0, 0, 0, 1}));
+}
+
+TEST(ShardAssign, AFrameCostsOnceAShardSoChartsSeenTogetherStayTogether) {
+  // Each view costs 1000 texels' work in every shard it meets: {0, 1, 2} | {3} reads 20 + 10
+  // views (25000 and 13000), {0, 1} | {2, 3} reads 10 + 10 (12000 and 16000).
+  const BufferViews views = TwoGroupsOfViews();
+  const std::vector<int> shard =
+      AssignBuffersToShards(BuffersAlongX({100, 100, 300, 300}), views, 1000.0, 2);
+  EXPECT_EQ(shard, (std::vector<int>{0, 0, 1, 1}));
+  EXPECT_EQ(views.Count(0), 10);
+  EXPECT_EQ(views.Count(3), 10);
+}
+
+TEST(ShardAssign, WithoutViewsTexelsAreTheWork) {
+  const std::vector<int> shard =
+      AssignBuffersToShards(BuffersAlongX({100, 100, 100, 100, 100, 300}), BufferViews(), 0.0, 2);
+  EXPECT_EQ(shard, (std::vector<int>{0, 0, 0, 0, 1, 1}));
+  // One shard: every buffer in it.
+  EXPECT_EQ(AssignBuffersToShards(BuffersAlongX({5, 6}), BufferViews(), 0.0, 1),
+            (std::vector<int>{0, 0}));
+}
+
+}  // namespace
+}  // namespace fresco
