@@ -1,6 +1,8 @@
 // The depth stage (paint_stages.h): the model's depth map seen from the frame's camera, which
 // the warp's occlusion test compares each texel with (§3.3). Off with occlusion.enabled false.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
@@ -29,12 +31,44 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
 
 }  // namespace
 
+// A shard painting only its own buffers (SetOwnBuffers) reads the depth only where they
+// project: the box of their bounds' corners in the image, with the pixels the occlusion test
+// reads beside each texel's. Empty (the whole image) when a corner is not in front of the
+// camera or the lens has distortion (a box's image is then not bounded by its corners').
+cv::Rect PaintSession::OwnBuffersWindow(const Camera& camera, const Rigid3d& cam_from_local) const {
+  if (!own_only_.load() || camera.HasDistortion()) return cv::Rect();
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    if (!own_[b]) continue;
+    const Eigen::Vector3d& lo = set_.buffers[b].bounds_min;
+    const Eigen::Vector3d& hi = set_.buffers[b].bounds_max;
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                                   (c & 4) ? hi.z() : lo.z());
+      const Eigen::Vector3d in_cam = cam_from_local * corner;
+      Eigen::Vector2d pixel;
+      if (!(in_cam.z() > 1e-6) || !camera.Project(in_cam, &pixel)) return cv::Rect();
+      x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
+      y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
+    }
+  }
+  if (!(x0 <= x1)) return cv::Rect(-4, -4, 1, 1);  // none: a window outside the image
+  constexpr int kMargin = 4;                       // the 2x2 depths about a sample, and rounding
+  const cv::Rect box(cv::Point(static_cast<int>(std::floor(std::max(x0, -1e6))) - kMargin,
+                               static_cast<int>(std::floor(std::max(y0, -1e6))) - kMargin),
+                     cv::Point(static_cast<int>(std::ceil(std::min(x1, 1e6))) + kMargin + 1,
+                               static_cast<int>(std::ceil(std::min(y1, 1e6))) + kMargin + 1));
+  return box;
+}
+
 void PaintSession::DepthStage(FrameWork* work) {
   const auto start = std::chrono::steady_clock::now();
   StageReport report;
   report.name = "depth";
   if (options_.occlusion.enabled) {
-    CacheFor(*work->camera).rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_);
+    CacheFor(*work->camera)
+        .rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_,
+                                    OwnBuffersWindow(*work->camera, work->cam_from_local));
     if (work->debug) {
       report.metrics["surface_pixels"] =
           cv::countNonZero(depth_ < std::numeric_limits<float>::infinity());

@@ -261,6 +261,8 @@ class PaintSession {
 #define FRESCO_DECLARE_STAGE(Name) void Name##Stage(FrameWork* work);
   FRESCO_PAINT_STAGES(FRESCO_DECLARE_STAGE)
 #undef FRESCO_DECLARE_STAGE
+  // Where the depth stage's map is read (depth_stage.cc); empty: the whole image.
+  cv::Rect OwnBuffersWindow(const Camera& camera, const Rigid3d& cam_from_local) const;
   // Per distinct camera: its depth rasterizer and its frustum bounds (built once).
   struct CameraCache {
     Camera camera;

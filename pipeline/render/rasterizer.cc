@@ -654,8 +654,8 @@ namespace {
 template <class Table, class Clusters>
 std::vector<int> SlotsInView(const Table& t, const Clusters& clusters, int num_triangles,
                              const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
-                             double near_m) {
-  const double grid_x1 = t.x0 + t.cell_w * t.cols, grid_y1 = t.y0 + t.cell_h * t.rows;
+                             double near_m, const double view[4]) {
+  const double x0 = view[0], y0 = view[1], grid_x1 = view[2], grid_y1 = view[3];
   const int num_clusters = static_cast<int>(clusters.bounds_min.size());
   std::vector<int> slot_start(num_clusters + 1, 0);
   cv::parallel_for_(cv::Range(0, num_clusters), [&](const cv::Range& range) {
@@ -671,9 +671,9 @@ std::vector<int> SlotsInView(const Table& t, const Clusters& clusters, int num_t
                                        (k & 4) ? hi.z() : lo.z()) +
             translation;
         out[0] += p.z() < near_m;
-        out[1] += p.x() < t.x0 * p.z();
+        out[1] += p.x() < x0 * p.z();
         out[2] += p.x() > grid_x1 * p.z();
-        out[3] += p.y() < t.y0 * p.z();
+        out[3] += p.y() < y0 * p.z();
         out[4] += p.y() > grid_y1 * p.z();
       }
       const bool culled = !lo.allFinite() || !hi.allFinite() ||
@@ -693,9 +693,10 @@ std::vector<int> SlotsInView(const Table& t, const Clusters& clusters, int num_t
 template <class Table, class Clusters>
 inline bool SetUpTriangle(const Table& t, const Clusters& clusters, int tri,
                           const Eigen::Matrix3d& rotation, const Eigen::Vector3d& translation,
-                          double near_m, bool cull, TriangleSetup* setup, double poly[4][2]) {
+                          double near_m, bool cull, const double view[4], TriangleSetup* setup,
+                          double poly[4][2]) {
   TriangleSetup& s = *setup;
-  const double grid_x1 = t.x0 + t.cell_w * t.cols, grid_y1 = t.y0 + t.cell_h * t.rows;
+  const double view_x0 = view[0], view_y0 = view[1], grid_x1 = view[2], grid_y1 = view[3];
   s.num_poly = 0;
   const Eigen::Vector3i& idx = clusters.triangles[tri];
   if ((idx.array() < 0).any()) return false;
@@ -721,7 +722,7 @@ inline bool SetUpTriangle(const Table& t, const Clusters& clusters, int tri,
   const double margin = 1e-6 + 1e-7 * std::max({std::abs(xmin), std::abs(xmax),
                                                 std::abs(ymin), std::abs(ymax)});
   xmin -= margin, ymin -= margin, xmax += margin, ymax += margin;
-  if (!(xmax >= t.x0 && xmin <= grid_x1 && ymax >= t.y0 && ymin <= grid_y1)) return false;
+  if (!(xmax >= view_x0 && xmin <= grid_x1 && ymax >= view_y0 && ymin <= grid_y1)) return false;
   const double sign = det > 0 ? 1.0 : -1.0;
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d e = sign * v[(i + 1) % 3].cross(v[(i + 2) % 3]);
@@ -855,8 +856,11 @@ void ScanBucketRows(const Table& t, int row_lo, int row_hi, const TriangleSetup*
 
 template <bool kDirect, class Record, class BandRecord>
 void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                          const Record& record, const BandRecord* band_record) const {
+                          const Record& record, const BandRecord* band_record,
+                          const double* view) const {
   const RayTable& t = *rays_;
+  const double whole[4] = {t.x0, t.y0, t.x0 + t.cell_w * t.cols, t.y0 + t.cell_h * t.rows};
+  if (!view) view = whole;
   const double near_m = options_.near_m;
   const bool cull = options_.cull_back_faces;
   const std::shared_ptr<const TriangleClusters> clusters = ClustersFor(mesh);
@@ -865,7 +869,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
   const Eigen::Vector3d translation = cam_from_local.translation;
   const int num_clusters = static_cast<int>(clusters->bounds_min.size());
   const std::vector<int> slot_start =
-      SlotsInView(t, *clusters, num_triangles, rotation, translation, near_m);
+      SlotsInView(t, *clusters, num_triangles, rotation, translation, near_m, view);
   const int num_slots = slot_start[num_clusters];
 
   // Triangle set-up (independent per triangle, so parallel and deterministic), in the camera
@@ -902,7 +906,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
         TriangleSetup& s = kDirect ? direct_setup : setups[slot];
         if constexpr (!kDirect) triangle_of_slot[slot] = tri;
         double poly[4][2];
-        if (!SetUpTriangle(t, *clusters, tri, rotation, translation, near_m, cull, &s, poly))
+        if (!SetUpTriangle(t, *clusters, tri, rotation, translation, near_m, cull, view, &s, poly))
           continue;
         if constexpr (!kDirect)
           if (!t.grid) std::copy(&poly[0][0], &poly[0][0] + 8, &polygons[slot].corner[0][0]);
@@ -1023,7 +1027,32 @@ void Rasterizer::ReleaseThreadScratch() {
 
 void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                                 cv::Mat* depth) const {
+  RasterizeDepth(mesh, cam_from_local, depth, cv::Rect());
+}
+
+void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
+                                cv::Mat* depth, const cv::Rect& window) const {
   const RayTable& t = *rays_;
+  // The window's part of the view: its samples' rays (a grid: x by column, y by row) and one
+  // more sample all round, so that rounding never leaves out a triangle that covers one.
+  double window_view[4];
+  const double* view = nullptr;
+  const int n = options_.supersample;
+  const cv::Rect samples(window.x * n - 1, window.y * n - 1, window.width * n + 2,
+                         window.height * n + 2);
+  const cv::Rect in_grid = samples & cv::Rect(0, 0, t.width, t.height);
+  if (t.grid && !window.empty() && in_grid != cv::Rect(0, 0, t.width, t.height)) {
+    if (in_grid.empty()) {  // nothing of the window is in the image: no triangle needed
+      depth->create(t.height, t.width, CV_32F);
+      depth->setTo(std::numeric_limits<float>::infinity());
+      return;
+    }
+    window_view[0] = t.col_x[in_grid.x];
+    window_view[1] = t.row_y[in_grid.y];
+    window_view[2] = t.col_x[in_grid.br().x - 1];
+    window_view[3] = t.row_y[in_grid.br().y - 1];
+    view = window_view;
+  }
   if (!depth->isContinuous()) depth->release();  // rays index the samples as one array
   depth->create(t.height, t.width, CV_32F);
   // Inverse depth in place (0: no hit), then depth. The nearest hit is the largest float
@@ -1037,12 +1066,12 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   // The nearest hit so far, where one thread owns the sample.
   const NearestInverseDepth exclusive_record{inv, inv_near};
   if (!rays_->grid) {
-    Traverse<false>(mesh, cam_from_local, exclusive_record);
+    Traverse<false>(mesh, cam_from_local, exclusive_record, &exclusive_record, view);
   } else {
     // Triangles scanned by whichever thread set them up, each task into a buffer of its own;
     // the large triangles after, one thread per band of rows, into the output.
     const InverseDepthShards shards(inv, t.by_sample.size(), inv_near, &depth_shard_spares);
-    Traverse<true>(mesh, cam_from_local, shards, &exclusive_record);
+    Traverse<true>(mesh, cam_from_local, shards, &exclusive_record, view);
     spares = shards.Spares();
   }
   cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {

@@ -58,6 +58,11 @@ class Rasterizer {
   // output images: 1.25 against 3.00 ms at 1280x720, paint_bench BM_DepthRaster).
   void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                       cv::Mat* depth) const;
+  // ... exact within `window` (the camera's pixels; empty: the whole image) and anything
+  // outside it: only the triangles whose bounds meet the window's part of the view are set up
+  // (a lens with distortion: the whole image).
+  void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local, cv::Mat* depth,
+                      const cv::Rect& window) const;
   // Builds what rasterizing `mesh` needs once (the culling clusters of its triangles), which
   // the first Rasterize or RasterizeDepth would otherwise build.
   void Prepare(const TriangleMesh& mesh) const { ClustersFor(mesh); }
@@ -84,9 +89,11 @@ class Rasterizer {
   // triangle is scanned by the thread that set it up, so record must be thread-safe; the
   // large triangles are scanned afterwards by bands of rows, one thread a band, through
   // band_record (which need not be: no other thread writes the band's samples then).
+  // `view` (x0, y0, x1, y1 of the normalized rays; null: the ray table's bounds): triangles
+  // wholly outside it are not set up.
   template <bool kDirect, class Record, class BandRecord = Record>
   void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local, const Record& record,
-                const BandRecord* band_record = nullptr) const;
+                const BandRecord* band_record = nullptr, const double* view = nullptr) const;
   Camera camera_;
   RasterOptions options_;
   std::unique_ptr<RayTable> rays_;

@@ -470,6 +470,48 @@ TEST(RasterizerTest, DepthOnlyMatchesFullRaster) {
   ExpectDepthOnlyMatchesFull(DistortedCamera(), grid, 1e-3);
 }
 
+// Depth for a window of the image only (what a shard's charts read): bit for bit the whole
+// image's inside the window, for windows inside, across the image's edges and outside it,
+// with and without supersampling; fewer triangles are set up (the rest of the image may stay
+// empty). Many small triangles, so that most lie beside a window.
+TEST(RasterizerTest, DepthInAWindowIsTheWholeImagesThere) {
+  TriangleMesh mesh;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> xy(-3.0, 3.0), z(1.5, 6.0), d(-0.08, 0.08);
+  for (int i = 0; i < 4000; ++i) {
+    const Eigen::Vector3d a(xy(rng), xy(rng), z(rng));
+    AddTriangle(&mesh, a, a + Eigen::Vector3d(d(rng), d(rng), d(rng)),
+                a + Eigen::Vector3d(d(rng), d(rng), d(rng)));
+  }
+  const Camera camera = PinholeCamera(160, 120, 100.0);
+  for (const int supersample : {1, 2}) {
+    RasterOptions options;
+    options.supersample = supersample;
+    const Rasterizer rasterizer(camera, options);
+    cv::Mat whole;
+    rasterizer.RasterizeDepth(mesh, Rigid3d(), &whole);
+    for (const cv::Rect window : {cv::Rect(40, 30, 50, 40), cv::Rect(-20, 100, 60, 50),
+                                  cv::Rect(150, -5, 30, 20), cv::Rect(0, 0, 160, 120)}) {
+      cv::Mat part;
+      rasterizer.RasterizeDepth(mesh, Rigid3d(), &part, window);
+      const cv::Rect inside = cv::Rect(window.x * supersample, window.y * supersample,
+                                       window.width * supersample, window.height * supersample) &
+                              cv::Rect(0, 0, whole.cols, whole.rows);
+      ASSERT_FALSE(inside.empty());
+      EXPECT_EQ(cv::norm(part(inside), whole(inside), cv::NORM_INF), 0)
+          << "window " << window << " supersample " << supersample;
+      EXPECT_GT(cv::countNonZero(whole(inside) < 1e30f), 0) << window;  // some surface
+      if (window.width < 100) {  // triangles far from the window were not set up
+        cv::Mat left_empty = (part >= 1e30f) & (whole < 1e30f);
+        EXPECT_GT(cv::countNonZero(left_empty), whole.total() / 10) << window;
+      }
+    }
+    cv::Mat none;
+    rasterizer.RasterizeDepth(mesh, Rigid3d(), &none, cv::Rect(-50, -50, 10, 10));
+    EXPECT_EQ(cv::countNonZero(none < 1e30f), 0);  // a window outside the image: no surface
+  }
+}
+
 // A large mesh in runs of nearby triangles all around the camera (in view, behind it,
 // beside the frustum): runs outside the view are culled whole, and the result is still
 // exactly the brute force's; moving the vertices in place is noticed (no stale culling).
