@@ -35,13 +35,21 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
 // project: the box of their bounds' corners in the image, with the pixels the occlusion test
 // reads beside each texel's. Empty (the whole image) when a corner is not in front of the
 // camera or the lens has distortion (a box's image is then not bounded by its corners').
-cv::Rect PaintSession::OwnBuffersWindow(const Camera& camera, const Rigid3d& cam_from_local) const {
+cv::Rect PaintSession::OwnBuffersWindow(const Camera& camera, const NormalizedBounds& bounds,
+                                        const Rigid3d& cam_from_local) const {
   if (!own_only_.load() || camera.HasDistortion()) return cv::Rect();
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+  // Buffers the warp leaves out whole (outside the view) are not read: as warp_stage.cc.
+  FrameView view;
+  view.camera = &camera;
+  view.cam_from_local = cam_from_local;
+  view.bounds = bounds;
+  const double near_m = WarpOptions().near_m;
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!own_[b]) continue;
     const Eigen::Vector3d& lo = set_.buffers[b].bounds_min;
     const Eigen::Vector3d& hi = set_.buffers[b].bounds_max;
+    if (BoundsOutsideView(lo, hi, view, near_m)) continue;
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
                                    (c & 4) ? hi.z() : lo.z());
@@ -66,9 +74,10 @@ void PaintSession::DepthStage(FrameWork* work) {
   StageReport report;
   report.name = "depth";
   if (options_.occlusion.enabled) {
-    CacheFor(*work->camera)
-        .rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_,
-                                    OwnBuffersWindow(*work->camera, work->cam_from_local));
+    const CameraCache& cache = CacheFor(*work->camera);
+    cache.rasterizer->RasterizeDepth(
+        scene_->mesh, work->cam_from_local, &depth_,
+        OwnBuffersWindow(*work->camera, cache.bounds, work->cam_from_local));
     if (work->debug) {
       report.metrics["surface_pixels"] =
           cv::countNonZero(depth_ < std::numeric_limits<float>::infinity());

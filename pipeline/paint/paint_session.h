@@ -262,7 +262,8 @@ class PaintSession {
   FRESCO_PAINT_STAGES(FRESCO_DECLARE_STAGE)
 #undef FRESCO_DECLARE_STAGE
   // Where the depth stage's map is read (depth_stage.cc); empty: the whole image.
-  cv::Rect OwnBuffersWindow(const Camera& camera, const Rigid3d& cam_from_local) const;
+  cv::Rect OwnBuffersWindow(const Camera& camera, const NormalizedBounds& bounds,
+                            const Rigid3d& cam_from_local) const;
   // Per distinct camera: its depth rasterizer and its frustum bounds (built once).
   struct CameraCache {
     Camera camera;
