@@ -189,6 +189,8 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                                       {"pixels_judged", m.judged},
                                       {"pixels_masked", m.flagged},
                                       {"fraction", m.fraction()},
+                                      {"pixels_in_regions", m.compact},
+                                      {"fraction_in_regions", m.compact_fraction()},
                                       {"seconds", m.seconds}};
   }
   metrics["texels"] = session->NumSurfaceTexels();

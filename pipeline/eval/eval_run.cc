@@ -134,7 +134,7 @@ Status PaintCapture(const Project& project, const GeneratedCapture& g, const Eva
   result->paint_fps = paint_seconds > 0 ? result->painted_frames / paint_seconds : 0.0;
   result->coverage = session.Coverage();
   result->decisions = session.auto_decisions();
-  if (job->mover_masks) result->movers_across_views = job->mover_masks->fraction();
+  if (job->mover_masks) result->movers_across_views = job->mover_masks->compact_fraction();
   if (const auto& joint = job->joint_poses; joint && joint->not_run.empty()) {
     const auto ratio = [](double before, double after) { return after > 0 ? before / after : 0; };
     result->joint_ran = true;

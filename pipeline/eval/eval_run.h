@@ -63,8 +63,8 @@ struct CaptureEval {
   double mover_never_open = 0, mover_open_masked = 0, mover_open_passed = 0,
          mover_open_replaced = 0;
   double coverage = 0;  // on-surface texels painted
-  // background.mode auto: the share of the surface pixels judged that were masked (NaN
-  // when not run).
+  // background.mode auto: the share of the surface pixels judged that were found in compact
+  // regions (MoverMaskResult::compact: the evidence decided on; NaN when not run).
   double movers_across_views = std::numeric_limits<double>::quiet_NaN();
   bool noisy_poses = false;  // the given poses differ from the true ones
   // refine.joint: whether the poses' joint adjustment ran and was applied, on how many frames

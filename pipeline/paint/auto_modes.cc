@@ -41,7 +41,7 @@ std::string AutoDecision::Describe() const {
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
                   "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
-                  "(decided before painting)",
+                  "in regions (decided before painting)",
                   StateName(), evidence, relation, threshold, frames_measured);
   else
     std::snprintf(line, sizeof line, "%s: %.3g %s %.3g over %d frames (decided at frame %d)",

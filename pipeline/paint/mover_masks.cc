@@ -106,7 +106,7 @@ Comparison Compare(const SmallFrame& self, int other_index, const SmallFrame& ot
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
                    std::vector<Comparison>* comparisons, long long* judged, long long* flagged,
-                   cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions,
+                   long long* compact, cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions,
                    ColourRegionLabels* regions) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
@@ -141,6 +141,11 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
       ++seen_pixels;
       if (d >= options.min_differing && d >= options.share * s) mask.at<uchar>(y, x) = 255;
     }
+  // What differs in regions, not along lines (MoverMaskResult::compact).
+  cv::Mat regions_only;
+  cv::morphologyEx(mask, regions_only, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  *compact = cv::countNonZero(regions_only);
   // Cleaning: small blobs are noise. A mover's pixels that match the frames near it (its
   // inside, where they show it too: it is large or slow) join it: within each blob's box,
   // the pixels of its colours. Not pixels that agree with every frame that sees them: the
@@ -294,7 +299,7 @@ std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
       if (!any) continue;
       long long unused = 0;
       result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f], &unused,
-                                    &unused, &judged->joinable[f], &result->agreed[f],
+                                    &unused, &unused, &judged->joinable[f], &result->agreed[f],
                                     &judged->ringed[f], &judged->regions[f]);
       now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
     }
@@ -363,7 +368,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   result->masks.resize(n);
   std::map<const Camera*, SmallCamera> small;
   const std::vector<SmallFrame> frames = SmallFrames(mesh, given, options, &small);
-  std::vector<long long> judged(n, 0), flagged(n, 0);
+  std::vector<long long> judged(n, 0), flagged(n, 0), compact(n, 0);
   Judged judging;
   judging.joinable.resize(n);
   judging.ringed.resize(n);
@@ -376,15 +381,16 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       if (frames[f].points.empty()) continue;
       result->masks[f] =
           JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f], &flagged[f],
-                     &judging.joinable[f], &result->agreed[f], &judging.ringed[f],
+                     &compact[f], &judging.joinable[f], &result->agreed[f], &judging.ringed[f],
                      keep_comparisons ? &judging.regions[f] : nullptr);
       if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
     }
   });
-  for (int f = 0; f < n; ++f) result->judged += judged[f], result->flagged += flagged[f];
+  for (int f = 0; f < n; ++f)
+    result->judged += judged[f], result->flagged += flagged[f], result->compact += compact[f];
   // A later pass judges a frame again only where a frame it is compared with had its mask
   // changed by the pass before (the first pass: any masked pixel); none once nothing changes.
-  const bool later_passes = result->fraction() > options.later_passes_min_fraction;
+  const bool later_passes = result->compact_fraction() > options.later_passes_min_fraction;
   const int passes = later_passes ? std::max(1, options.passes) : 1;
   std::vector<uint8_t> changed(n, 0);
   for (int f = 0; f < n; ++f)

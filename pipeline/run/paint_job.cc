@@ -69,7 +69,8 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
     MoverMaskResult found;
     FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
-    all.judged += found.judged, all.flagged += found.flagged, all.seconds += found.seconds;
+    all.judged += found.judged, all.flagged += found.flagged, all.compact += found.compact;
+    all.seconds += found.seconds;
     if (project.pipeline.background.across_views) {
       std::vector<cv::Mat>& movers = found_for_captures->movers[s];
       movers.resize(j->captures[s].poses.size());
@@ -77,7 +78,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
   }
   j->mover_masks = all;
-  j->prepass.background_across_views = {all.fraction(), static_cast<int>(where.size())};
+  j->prepass.background_across_views = {all.compact_fraction(), static_cast<int>(where.size())};
   return Status::Ok();
 }
 

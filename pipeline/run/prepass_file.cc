@@ -166,6 +166,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
     file["movers_across_views"] = {{"not_run", m.not_run},
                                    {"judged", m.judged},
                                    {"flagged", m.flagged},
+                                   {"compact", m.compact},
                                    {"seconds", m.seconds}};
   }
   if (d.pose_check) {
@@ -260,6 +261,7 @@ Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob
       MoverMaskResult r;
       r.not_run = m.at("not_run");
       r.judged = m.at("judged"), r.flagged = m.at("flagged"), r.seconds = m.at("seconds");
+      r.compact = m.value("compact", 0LL);
       job->mover_masks = r;
     }
     // The decisions, in the pre-pass's order.

@@ -111,7 +111,9 @@ void Fields(BackgroundOptions& o, V& v) {
          "`average` is the paper's (§3.4); `robust` follows changes and exposure; `auto` (the "
          "default): `robust` where the capture shows moving objects, else `off`. Captures from "
          "files decide before painting (every frame compared with the frames near it through "
-         "the mesh: more than 0.8 % of the pixels differing from most of them); the app and "
+         "the mesh: more than 0.4 % of the pixels differing from most of them in regions, not "
+         "lines along the image's edges, which blur, a pose slightly off or the mesh's error "
+         "make); the app and "
          "live captures decide once warmed up (`robust` learns from the start and stays when "
          "the texels it trusts show enough foreground). The decision and its evidence are in "
          "the background stage's report and `metrics.json`");

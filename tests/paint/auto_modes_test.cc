@@ -143,7 +143,8 @@ AutoDecision DecideAcrossViews(bool movers, bool* paints_as_off) {
   options.refine.mode = RefineMode::kOff;
   options.background.mode = BackgroundMode::kAuto;
   std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
-  session->DecideBackgroundAcrossViews(found.fraction(), static_cast<int>(found.masks.size()));
+  session->DecideBackgroundAcrossViews(found.compact_fraction(),
+                                       static_cast<int>(found.masks.size()));
   const AutoDecision decided = session->auto_decisions().background;
   std::printf("%s: background auto %s\n", movers ? "movers" : "no movers",
               decided.Describe().c_str());
