@@ -409,8 +409,10 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
   std::cout << "matched " << distances.size() << " of " << reference
             << " reference corners; median " << median << " px, p90 " << p90 << " px\n";
   EXPECT_GT(distances.size(), 0.8 * reference);
-  EXPECT_LT(median, 0.2);
-  EXPECT_LT(p90, 0.4);
+  // 0.0962 px before the saddles beside Kalibr's squares were found with the wider window and
+  // the board's outermost corners whose saddle strayed were left out (calib/detect.cc): 0.0882.
+  EXPECT_LT(median, 0.092);
+  EXPECT_LT(p90, 0.25);
 }
 
 // All 30 aprilgrid-yac-mocap images, opencv4 (auto on them takes minutes: README): every
