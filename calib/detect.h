@@ -52,6 +52,9 @@ struct BoardDetection {
   // AprilGrid: corners dropped because the corners near them on the board place them more
   // than 1.5 px (or 4 % of a tag pitch) elsewhere (settled on a tag's edge, not its corner).
   int corners_inconsistent = 0;
+  // AprilGrid: the board prints Kalibr's black squares where the gaps cross (most tag corners
+  // show one), so every tag corner is a saddle: DetectOptions::saddles_for_crossing_squares.
+  bool crossing_squares = false;
 };
 
 struct DetectOptions {
@@ -76,6 +79,12 @@ struct DetectOptions {
   // 1 px from the outline read, its edges are looked for from the outline (the corner left
   // out when none show) instead of from the saddle (on a paper's or a tag's edge).
   bool edges_from_outline_when_strayed = true;
+  // AprilGrid: on a board with crossing squares (BoardDetection::crossing_squares), the
+  // saddles found again with a window up to the square's middle (a corner the two windows
+  // place more than 0.5 px apart left out), and a corner whose saddle strayed more than 1 px
+  // from the outline where the square shows at the outline left out (false: every board
+  // alike, a window a quarter of the tag's edge, such corners from the edges).
+  bool saddles_for_crossing_squares = true;
   // AprilGrid: the tags' edges placed at the level (between each edge's dark and light) that
   // keeps the tags neither grown nor shrunk against their pitch (BoardDetection::
   // tag_edge_level); false: halfway, the shift measured there undone alike at every edge.

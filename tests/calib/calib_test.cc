@@ -378,6 +378,9 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
   int reference = 0, off_2px = 0, off_2px_unchecked = 0;
   DetectOptions unchecked;
   unchecked.drop_inconsistent_corners = false;
+  // The saddles as on a board without squares: the wider window's check (two windows more
+  // than 0.5 px apart) drops 5 of these corners too (7 -> 2 over 2 px without either).
+  unchecked.saddles_for_crossing_squares = false;
   for (size_t i = 0; i < images.size(); i += 3) {  // every third image: 10 of 30
     const cv::Mat gray = cv::imread(images[i], cv::IMREAD_GRAYSCALE);
     const BoardDetection det = DetectBoard(gray, spec);
@@ -409,8 +412,10 @@ TEST(RealDataTest, AprilGridDetectionsAgreeWithYacReference) {
   std::cout << "matched " << distances.size() << " of " << reference
             << " reference corners; median " << median << " px, p90 " << p90 << " px\n";
   EXPECT_GT(distances.size(), 0.8 * reference);
-  EXPECT_LT(median, 0.2);
-  EXPECT_LT(p90, 0.4);
+  // 0.0962 px before the saddles beside Kalibr's squares were found with the wider window and
+  // the board's outermost corners whose saddle strayed were left out (calib/detect.cc): 0.0882.
+  EXPECT_LT(median, 0.092);
+  EXPECT_LT(p90, 0.25);
 }
 
 // All 30 aprilgrid-yac-mocap images, opencv4 (auto on them takes minutes: README): every

@@ -2,13 +2,17 @@
 // AprilGrid detector (calib/detect.h) against OpenCV's aruco on synthetic views of a whole
 // board through a strong barrel lens (tests/calib/synthetic_images.h).
 //   calib_detect_recall [--views N] [--blur SIGMA_PX] [--noise GREY] [--seed S]
-//                       [--single] [--no-refine] [--save DIR] [--verbose]
+//                       [--single] [--no-refine] [--quarter-window] [--save DIR] [--verbose]
 // --single: the apriltag library alone (the detector before retries and aruco were added).
+// --quarter-window: saddles found as on boards without crossing squares
+// (DetectOptions::saddles_for_crossing_squares off).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -21,7 +25,7 @@ using namespace fresco::calib;
 int main(int argc, char** argv) {
   int views = 40;
   unsigned seed = 11;
-  bool single = false, verbose = false, no_refine = false;
+  bool single = false, verbose = false, no_refine = false, quarter_window = false;
   SyntheticImageOptions image_options;
   std::string save;
   for (int i = 1; i < argc; ++i) {
@@ -43,10 +47,13 @@ int main(int argc, char** argv) {
       verbose = true;
     else if (a == "--no-refine")
       no_refine = true;
+    else if (a == "--quarter-window")
+      quarter_window = true;
     else {
       std::fprintf(stderr,
                    "usage: calib_detect_recall [--views N] [--blur SIGMA_PX] "
-                   "[--noise GREY] [--seed S] [--single] [--no-refine] [--save DIR] [--verbose]\n");
+                   "[--noise GREY] [--seed S] [--single] [--no-refine] [--quarter-window] "
+                   "[--save DIR] [--verbose]\n");
       return 2;
     }
   }
@@ -57,9 +64,11 @@ int main(int argc, char** argv) {
   DetectOptions options;
   if (single) options.second_look = false;
   options.refine_tag_corners = !no_refine;
+  options.saddles_for_crossing_squares = !quarter_window;
   int in_view = 0, ours = 0, aruco = 0, views_ok = 0, views_aruco_ok = 0;
   double sq_error = 0, max_error = 0, aruco_sq_error = 0;
   int corners = 0, aruco_corners = 0, over_2px = 0, inconsistent = 0;
+  std::vector<double> errors;
   const auto poses = WholeBoardPoses(spec, lens, views, seed);
   for (size_t v = 0; v < poses.size(); ++v) {
     image_options.seed = seed * 1000 + static_cast<unsigned>(v);
@@ -72,6 +81,7 @@ int main(int argc, char** argv) {
     for (const CornerObservation& c : d.corners) {
       const double e = (c.pixel - image.truth[c.id]).norm();
       sq_error += e * e;
+      errors.push_back(e);
       max_error = std::max(max_error, e);
       over_2px += e > 2;
       if (verbose && e > 1.5)
@@ -100,11 +110,14 @@ int main(int argc, char** argv) {
   }
   std::printf("%zu views (blur %.2f px, noise %.1f): tags in view %d\n", poses.size(),
               image_options.blur_sigma_px, image_options.noise_px, in_view);
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
   std::printf(
       "%-10s recall %.3f (%d tags, %d corners), views with a board %d, corner error rms %.3f "
-      "px, max %.3f px, %d over 2 px (%d dropped: their neighbours place them elsewhere)\n",
+      "px, median %.4f px, max %.3f px, %d over 2 px (%d dropped: their neighbours place them "
+      "elsewhere)\n",
       single ? "apriltag" : "fresco", ours / double(in_view), ours, corners, views_ok,
-      std::sqrt(sq_error / std::max(1, corners)), max_error, over_2px, inconsistent);
+      std::sqrt(sq_error / std::max(1, corners)), errors.empty() ? 0.0 : errors[errors.size() / 2],
+      max_error, over_2px, inconsistent);
   std::printf(
       "%-10s recall %.3f (%d tags), views with >= 2 tags %d, corner error rms %.3f px "
       "(unrefined)\n",
