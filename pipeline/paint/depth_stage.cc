@@ -32,9 +32,11 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
 }  // namespace
 
 // A shard painting only its own buffers (SetOwnBuffers) reads the depth only where they
-// project: the box of their bounds' corners in the image, with the pixels the occlusion test
-// reads beside each texel's. Empty (the whole image) when a corner is not in front of the
-// camera or the lens has distortion (a box's image is then not bounded by its corners').
+// project: the box of the image of their bounds' part in front of the camera (the warp tests
+// no texel nearer than its near plane: the bounds are cut at half of it, their corners there
+// and where their edges cross it), with the pixels the occlusion test reads beside each
+// texel's. Empty (the whole image) when the lens has distortion (a box's image is then not
+// bounded by its corners').
 cv::Rect PaintSession::OwnBuffersWindow(const Camera& camera, const NormalizedBounds& bounds,
                                         const Rigid3d& cam_from_local) const {
   if (!own_only_.load() || camera.HasDistortion()) return cv::Rect();
@@ -45,19 +47,36 @@ cv::Rect PaintSession::OwnBuffersWindow(const Camera& camera, const NormalizedBo
   view.cam_from_local = cam_from_local;
   view.bounds = bounds;
   const double near_m = WarpOptions().near_m;
+  const double cut_z = 0.5 * near_m;
+  const auto add = [&](const Eigen::Vector3d& in_cam) {
+    Eigen::Vector2d pixel;
+    if (!camera.Project(in_cam, &pixel)) return false;
+    x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
+    y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
+    return true;
+  };
   for (size_t b = 0; b < set_.buffers.size(); ++b) {
     if (!own_[b]) continue;
     const Eigen::Vector3d& lo = set_.buffers[b].bounds_min;
     const Eigen::Vector3d& hi = set_.buffers[b].bounds_max;
     if (BoundsOutsideView(lo, hi, view, near_m)) continue;
+    Eigen::Vector3d corner[8];
+    for (int c = 0; c < 8; ++c)
+      corner[c] =
+          cam_from_local * Eigen::Vector3d((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
+                                           (c & 4) ? hi.z() : lo.z());
     for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(),
-                                   (c & 4) ? hi.z() : lo.z());
-      const Eigen::Vector3d in_cam = cam_from_local * corner;
-      Eigen::Vector2d pixel;
-      if (!(in_cam.z() > 1e-6) || !camera.Project(in_cam, &pixel)) return cv::Rect();
-      x0 = std::min(x0, pixel.x()), x1 = std::max(x1, pixel.x());
-      y0 = std::min(y0, pixel.y()), y1 = std::max(y1, pixel.y());
+      if (corner[c].z() >= cut_z && !add(corner[c])) return cv::Rect();
+      for (int bit = 1; bit < 8; bit <<= 1) {  // each edge once: from its corner without `bit`
+        if (c & bit) continue;
+        const Eigen::Vector3d& p = corner[c];
+        const Eigen::Vector3d& q = corner[c | bit];
+        if ((p.z() < cut_z) == (q.z() < cut_z)) continue;
+        const double s = (cut_z - p.z()) / (q.z() - p.z());
+        Eigen::Vector3d crossing = p + s * (q - p);
+        crossing.z() = cut_z;
+        if (!add(crossing)) return cv::Rect();
+      }
     }
   }
   if (!(x0 <= x1)) return cv::Rect(-4, -4, 1, 1);  // none: a window outside the image
@@ -75,9 +94,12 @@ void PaintSession::DepthStage(FrameWork* work) {
   report.name = "depth";
   if (options_.occlusion.enabled) {
     const CameraCache& cache = CacheFor(*work->camera);
-    cache.rasterizer->RasterizeDepth(
-        scene_->mesh, work->cam_from_local, &depth_,
-        OwnBuffersWindow(*work->camera, cache.bounds, work->cam_from_local));
+    cv::Rect window = OwnBuffersWindow(*work->camera, cache.bounds, work->cam_from_local);
+    cache.rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_, window);
+    // The share of the image the depth was rasterized in (1: the whole image).
+    const cv::Rect image(0, 0, work->camera->width, work->camera->height);
+    report.metrics["window_fraction"] =
+        window.empty() ? 1.0 : static_cast<double>((window & image).area()) / image.area();
     if (work->debug) {
       report.metrics["surface_pixels"] =
           cv::countNonZero(depth_ < std::numeric_limits<float>::infinity());

@@ -58,17 +58,21 @@ int BufferViews::Count(size_t b) const {
 }
 
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
-                                       const BufferViews& views, double view_work, int count) {
+                                       const BufferViews& views, const ShardCosts& costs,
+                                       int count) {
   std::vector<int> shard(buffers.size(), 0);
   if (count <= 1) return shard;
   const bool with_views = views.num_views > 0 && views.seen.size() == buffers.size();
   const size_t words = with_views ? views.seen[0].size() : 0;
+  const double frame_work = costs.per_frame * views.frames_per_view;
   std::vector<double> work(buffers.size());
   std::vector<Eigen::Vector3d> centre(buffers.size());
   for (size_t b = 0; b < buffers.size(); ++b) {
     const double texels =
         static_cast<double>(std::max<long long>(buffers[b].num_surface_texels, 1));
-    work[b] = with_views ? texels * views.Count(b) : texels;
+    work[b] = with_views ? texels * (costs.per_texel +
+                                     costs.per_texel_frame * views.Count(b) * views.frames_per_view)
+                         : texels;
     centre[b] = 0.5 * (buffers[b].bounds_min + buffers[b].bounds_max);
   }
   std::vector<size_t> ids(buffers.size());
@@ -85,7 +89,7 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
       int frames = 0;
       for (size_t w = 0; w < words; ++w)
         frames += __builtin_popcountll(seen[w] |= views.seen[id][w]);
-      out[from_end ? end - begin - 1 - step : step] = sum + view_work * frames;
+      out[from_end ? end - begin - 1 - step : step] = sum + frame_work * frames;
     }
     return out;
   };
