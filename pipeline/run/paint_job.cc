@@ -270,35 +270,41 @@ BufferViews ViewsSeeingBuffers(const PaintJob& j,
   if (seeing.num_views > 0)
     seeing.frames_per_view = static_cast<double>(views.size()) / seeing.num_views;
   seeing.seen.assign(buffers, std::vector<unsigned long long>((seeing.num_views + 63) / 64, 0));
-  std::vector<int> in_view(buffers);
+  seeing.boxes.assign(buffers, {});
+  std::vector<std::optional<std::array<float, 4>>> boxes(buffers);
   for (size_t k = 0; k < views.size(); k += step) {
     const auto it = bounds.find(views[k].first);
     if (it == bounds.end()) continue;
-    std::fill(in_view.begin(), in_view.end(), 0);
-    j.session->CountBuffersInView(*views[k].first, it->second, *views[k].second, &in_view);
+    j.session->BufferBoxesInView(*views[k].first, it->second, *views[k].second, &boxes);
+    const int v = static_cast<int>(k / step);
     for (size_t b = 0; b < buffers; ++b)
-      if (in_view[b]) seeing.Mark(buffers, b, static_cast<int>(k / step));
+      if (boxes[b]) {
+        seeing.Mark(buffers, b, v);
+        seeing.boxes[b].push_back({v, *boxes[b]});
+      }
   }
   return seeing;
 }
 
 // What a shard's work is made of, in nanoseconds of a core, as measured in the shards of a
-// city street (2.09 M triangles, 8 streams at 1280x720, 160 frames, 134 M texels; a fit of the
-// CPU of 20 shards, at 4 and 16, within 0.6 s): a texel held costs ~130 ns (built, written);
-// the warp ~0.2 ns a texel of a buffer for each frame that sees it (~1 ns a texel tested, a
-// sixth of them in view); a frame ~16 ns a triangle (the whole mesh's depth) and ~10 ns a pixel
-// (read, decoded), in every shard it meets.
+// city street (2.09 M triangles, 8 streams at 1280x720, 160 and 240 frames, 134 M texels; a
+// fit of the CPU of 32 shards of 16 within 0.6 s): a texel held costs ~100 ns (built,
+// written); the warp ~2 ns a texel of a buffer for each frame that sees it (~13 ns a texel
+// tested, a sixth of them in view); a frame ~10 ns a pixel (read, decoded) and ~4 ns a
+// triangle (the mesh culled), and ~12 ns a triangle times the share of the image its depth is
+// rendered in, in every shard it meets.
 ShardCosts ShardCostsFor(const PaintJob& j) {
   double pixels = 0, frames = 0;
   for (const Capture& capture : j.captures)
     for (const PosedImage& pose : capture.poses)
       if (const Camera* camera = capture.CameraFor(pose))
         pixels += static_cast<double>(camera->width) * camera->height, ++frames;
+  const double triangles = static_cast<double>(j.scene().mesh.NumTriangles());
   ShardCosts costs;
-  costs.per_texel = 130;
-  costs.per_texel_frame = 0.2;
-  costs.per_frame =
-      16.0 * j.scene().mesh.NumTriangles() + 10.0 * (frames > 0 ? pixels / frames : 0);
+  costs.per_texel = 100;
+  costs.per_texel_frame = 2;
+  costs.per_frame = 10.0 * (frames > 0 ? pixels / frames : 0) + 4.0 * triangles;
+  costs.per_frame_window = 12.0 * triangles;
   return costs;
 }
 

@@ -77,19 +77,36 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
   }
   std::vector<size_t> ids(buffers.size());
   std::iota(ids.begin(), ids.end(), 0);
+  const bool with_boxes = with_views && views.boxes.size() == buffers.size();
+  const double window_work = costs.per_frame_window * views.frames_per_view;
   // The work of ids [begin, k) for every k in (begin, end] (from_end: of ids [k, end) for k in
   // [begin, end)), at index k - begin - 1 (from_end: k - begin).
   const auto side_work = [&](size_t begin, size_t end, bool from_end) {
     std::vector<double> out(end - begin);
     std::vector<unsigned long long> seen(words, 0);
-    double sum = 0;
+    // Per view, the box of the buffers' boxes so far (empty: x0 > x1), and the sum of their areas.
+    std::vector<std::array<float, 4>> window(with_boxes ? views.num_views : 0,
+                                             std::array<float, 4>{1, 1, 0, 0});
+    const auto area = [](const std::array<float, 4>& w) {
+      return w[0] < w[2] && w[1] < w[3] ? static_cast<double>(w[2] - w[0]) * (w[3] - w[1]) : 0.0;
+    };
+    double sum = 0, windows = 0;
     for (size_t step = 0; step < end - begin; ++step) {
       const size_t id = ids[from_end ? end - 1 - step : begin + step];
       sum += work[id];
       int frames = 0;
       for (size_t w = 0; w < words; ++w)
         frames += __builtin_popcountll(seen[w] |= views.seen[id][w]);
-      out[from_end ? end - begin - 1 - step : step] = sum + frame_work * frames;
+      if (with_boxes)
+        for (const auto& [v, box] : views.boxes[id]) {
+          std::array<float, 4>& w = window[v];
+          windows -= area(w);
+          w = {std::min(w[0], box[0]), std::min(w[1], box[1]), std::max(w[2], box[2]),
+               std::max(w[3], box[3])};
+          windows += area(w);
+        }
+      out[from_end ? end - begin - 1 - step : step] =
+          sum + frame_work * frames + window_work * (with_boxes ? windows : frames);
     }
     return out;
   };

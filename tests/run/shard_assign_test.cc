@@ -2,6 +2,7 @@
 // of its charts once (the frame read, the whole mesh's depth rendered), so charts seen by the
 // same frames go to the same shard where texels alone would split them; and every texel it
 // holds, however few frames see it.
+#include <array>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -79,6 +80,27 @@ TEST(ShardAssign, ATexelHeldCostsHoweverFewFramesSeeIt) {
   views.frames_per_view = 10;
   EXPECT_EQ(AssignBuffersToShards(buffers, views, Costs(10, 1, 0), 2),
             (std::vector<int>{0, 0, 1, 1}));
+}
+
+TEST(ShardAssign, AFramesDepthCostsTheShareOfTheImageItsChartsTakeIn) {
+  // Buffers of 100, 100, 300 texels, all seen by 10 views: buffer 0 in the left half of the
+  // image, 1 in the right half, 2 in a speck of it.
+  BufferViews views;
+  views.num_views = 10;
+  const std::array<float, 4> box[3] = {{0, 0, 0.5, 1}, {0.5, 0, 1, 1}, {0.5, 0.5, 0.51, 0.51}};
+  for (int v = 0; v < 10; ++v)
+    for (size_t b = 0; b < 3; ++b) views.Mark(3, b, v);
+  const std::vector<BaseBuffer> buffers = BuffersAlongX({100, 100, 300});
+  ShardCosts costs = Costs(0, 1, 0);
+  costs.per_frame_window = 3000;
+  // Without boxes each frame's depth is the whole image's: {0} 31000 | {1, 2} 34000, or
+  // {0, 1} 32000 | {2} 33000.
+  EXPECT_EQ(AssignBuffersToShards(buffers, views, costs, 2), (std::vector<int>{0, 0, 1}));
+  // With them: {0} 16000 | {1, 2} 19000, or {0, 1} 32000 | {2} 3003.
+  views.boxes.resize(3);
+  for (int v = 0; v < 10; ++v)
+    for (size_t b = 0; b < 3; ++b) views.boxes[b].push_back({v, box[b]});
+  EXPECT_EQ(AssignBuffersToShards(buffers, views, costs, 2), (std::vector<int>{0, 1, 1}));
 }
 
 TEST(ShardAssign, WithoutViewsTexelsAreTheWork) {
