@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <opencv2/core/utility.hpp>
@@ -264,14 +265,24 @@ bool PaintSession::ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBou
   return false;
 }
 
-void PaintSession::CountBuffersInView(const Camera& camera, const NormalizedBounds& bounds,
-                                      const Rigid3d& cam_from_world,
-                                      std::vector<int>* counts) const {
+void PaintSession::BufferBoxesInView(
+    const Camera& camera, const NormalizedBounds& bounds, const Rigid3d& cam_from_world,
+    std::vector<std::optional<std::array<float, 4>>>* boxes) const {
   const FrameView view = BoundsView(camera, bounds, cam_from_world);
   const double near_m = WarpOptions().near_m;
-  for (size_t b = 0; b < set_.buffers.size(); ++b)
-    (*counts)[b] +=
-        !BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view, near_m);
+  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+    (*boxes)[b].reset();
+    if (BoundsOutsideView(set_.buffers[b].bounds_min, set_.buffers[b].bounds_max, view, near_m))
+      continue;
+    const double inf = std::numeric_limits<double>::infinity();
+    double box[4] = {inf, inf, -inf, -inf};
+    std::array<float, 4> share = {0, 0, 1, 1};
+    if (BufferImageBox(b, view, box) && box[0] <= box[2])
+      for (int i = 0; i < 4; ++i)
+        share[i] = static_cast<float>(
+            std::clamp(box[i] / (i % 2 ? camera.height : camera.width), 0.0, 1.0));
+    (*boxes)[b] = share;
+  }
 }
 
 std::vector<BufferBackground>& PaintSession::StreamBackground(int stream) {

@@ -18,10 +18,12 @@
 // FrameReport that the CLI and the GUI both consume.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -220,10 +222,18 @@ class PaintSession {
   // ComputeNormalizedBounds(camera). Const, for a source reading ahead.
   bool ViewMeetsOwnBuffers(const Camera& camera, const NormalizedBounds& bounds,
                            const Rigid3d& cam_from_world) const;
-  // Adds 1 to (*counts)[b] for every buffer b whose bounds the view meets (the same test; counts
-  // has one entry per buffer): how many frames see each buffer, which shards balance.
-  void CountBuffersInView(const Camera& camera, const NormalizedBounds& bounds,
-                          const Rigid3d& cam_from_world, std::vector<int>* counts) const;
+  // For every buffer b whose bounds the view meets (the same test; boxes has one entry per
+  // buffer; the others get none): its BufferImageBox as a share of the image, clipped to it
+  // ({x0, y0, x1, y1} in 0..1; the whole image when not bounded by it), in (*boxes)[b]. How
+  // many frames see each buffer, and where, which shards balance.
+  void BufferBoxesInView(const Camera& camera, const NormalizedBounds& bounds,
+                         const Rigid3d& cam_from_world,
+                         std::vector<std::optional<std::array<float, 4>>>* boxes) const;
+  // Widens `box` ({x0, y0, x1, y1} in pixels) by the image of buffer b's bounds' part in front
+  // of the camera (the warp tests no texel nearer than its near plane: the bounds are cut at
+  // half of it, their corners there and where their edges cross it); false when that image is
+  // not bounded by it (a lens with distortion).
+  bool BufferImageBox(size_t b, const FrameView& view, double box[4]) const;
   // A frame the source skipped (PaintsOwnBuffersOnly, its view meets no own buffer): counted
   // as painted frames are (the frame numbers the stages and `update_every` use) and nothing
   // else; painting it would have changed no own buffer.
@@ -324,7 +334,7 @@ class PaintSession {
   // frame's transform (select_stages.cc). The buffer itself when the stage is off.
   cv::Mat AtMeanExposure(const cv::Mat& bgra) const;
 
-  // The view ViewMeetsOwnBuffers and CountBuffersInView test the buffers' bounds against.
+  // The view ViewMeetsOwnBuffers and BufferBoxesInView test the buffers' bounds against.
   FrameView BoundsView(const Camera& camera, const NormalizedBounds& bounds,
                        const Rigid3d& cam_from_world) const;
   // Sharded painting (SetOwnBuffers): the own buffers, and whether only they are painted.

@@ -58,34 +58,55 @@ int BufferViews::Count(size_t b) const {
 }
 
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
-                                       const BufferViews& views, double view_work, int count) {
+                                       const BufferViews& views, const ShardCosts& costs,
+                                       int count) {
   std::vector<int> shard(buffers.size(), 0);
   if (count <= 1) return shard;
   const bool with_views = views.num_views > 0 && views.seen.size() == buffers.size();
   const size_t words = with_views ? views.seen[0].size() : 0;
+  const double frame_work = costs.per_frame * views.frames_per_view;
   std::vector<double> work(buffers.size());
   std::vector<Eigen::Vector3d> centre(buffers.size());
   for (size_t b = 0; b < buffers.size(); ++b) {
     const double texels =
         static_cast<double>(std::max<long long>(buffers[b].num_surface_texels, 1));
-    work[b] = with_views ? texels * views.Count(b) : texels;
+    work[b] = with_views ? texels * (costs.per_texel +
+                                     costs.per_texel_frame * views.Count(b) * views.frames_per_view)
+                         : texels;
     centre[b] = 0.5 * (buffers[b].bounds_min + buffers[b].bounds_max);
   }
   std::vector<size_t> ids(buffers.size());
   std::iota(ids.begin(), ids.end(), 0);
+  const bool with_boxes = with_views && views.boxes.size() == buffers.size();
+  const double window_work = costs.per_frame_window * views.frames_per_view;
   // The work of ids [begin, k) for every k in (begin, end] (from_end: of ids [k, end) for k in
   // [begin, end)), at index k - begin - 1 (from_end: k - begin).
   const auto side_work = [&](size_t begin, size_t end, bool from_end) {
     std::vector<double> out(end - begin);
     std::vector<unsigned long long> seen(words, 0);
-    double sum = 0;
+    // Per view, the box of the buffers' boxes so far (empty: x0 > x1), and the sum of their areas.
+    std::vector<std::array<float, 4>> window(with_boxes ? views.num_views : 0,
+                                             std::array<float, 4>{1, 1, 0, 0});
+    const auto area = [](const std::array<float, 4>& w) {
+      return w[0] < w[2] && w[1] < w[3] ? static_cast<double>(w[2] - w[0]) * (w[3] - w[1]) : 0.0;
+    };
+    double sum = 0, windows = 0;
     for (size_t step = 0; step < end - begin; ++step) {
       const size_t id = ids[from_end ? end - 1 - step : begin + step];
       sum += work[id];
       int frames = 0;
       for (size_t w = 0; w < words; ++w)
         frames += __builtin_popcountll(seen[w] |= views.seen[id][w]);
-      out[from_end ? end - begin - 1 - step : step] = sum + view_work * frames;
+      if (with_boxes)
+        for (const auto& [v, box] : views.boxes[id]) {
+          std::array<float, 4>& w = window[v];
+          windows -= area(w);
+          w = {std::min(w[0], box[0]), std::min(w[1], box[1]), std::max(w[2], box[2]),
+               std::max(w[3], box[3])};
+          windows += area(w);
+        }
+      out[from_end ? end - begin - 1 - step : step] =
+          sum + frame_work * frames + window_work * (with_boxes ? windows : frames);
     }
     return out;
   };

@@ -9,7 +9,9 @@
 // joined, are exactly those of one run.
 #pragma once
 
+#include <array>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pipeline/core/project.h"
@@ -32,27 +34,43 @@ Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpe
 std::string SettingsHash(const Project& project);
 
 // Which views (poses of the capture, a sample of them) see each buffer (its bounds in their
-// view): seen[b] holds one bit per view, (num_views + 63) / 64 words.
+// view): seen[b] holds one bit per view, (num_views + 63) / 64 words; each view stands for
+// frames_per_view frames of the capture. Optionally boxes[b]: for each view that sees buffer b,
+// the box its bounds project into, as a share of the image ({x0, y0, x1, y1} in 0..1).
 struct BufferViews {
   int num_views = 0;
+  double frames_per_view = 1;
   std::vector<std::vector<unsigned long long>> seen;
+  std::vector<std::vector<std::pair<int, std::array<float, 4>>>> boxes;
   // Sets that view `v` sees buffer `b` (sizes `seen` for `buffers` buffers on first use).
   void Mark(size_t buffers, size_t b, int v);
   int Count(size_t b) const;  // how many views see buffer b
 };
 
+// What a shard's work is made of (in any one unit, e.g. nanoseconds of a core): each texel it
+// holds (built, written), each texel of a buffer for each frame that sees the buffer (the warp
+// tests the part of it in view), each frame that sees any of its buffers (the frame read, the
+// whole mesh's depth rendered at it: paid once per frame however many of its buffers it sees),
+// and per_frame_window more times the share of the image the box of its buffers' boxes in the
+// frame covers (the depth rendered there; the whole image without BufferViews::boxes).
+struct ShardCosts {
+  double per_texel = 0;
+  double per_texel_frame = 1;
+  double per_frame = 0;
+  double per_frame_window = 0;
+};
+
 // The shard each buffer goes to (size: buffers), by space: the buffers are cut in two across
 // the longest side of the box of their centres (the centres of their bounds), recursively, each
 // cut giving either side count / 2 and the rest of the count's shards. A set of buffers' work
-// is what a shard painting them does: its texels tested, each buffer's surface texels times
-// the views that see it, plus `view_work` for every view that sees any of them (the frame read
-// and the whole mesh's depth rendered at it: a shard pays it once per frame however many of its
-// buffers the frame sees). A cut is the one whose larger side's work per shard is least. So a
+// is that of `costs`: a buffer's surface texels, times the frames that see it, and the frames
+// that see any of them. A cut is the one whose larger side's work per shard is least. So a
 // shard's charts lie together, a frame that looks elsewhere is skipped, and a shard of few
 // texels seen by most frames (a long road) holds fewer frames' worth of other charts.
 // Without views (num_views 0) a buffer's work is its texels. Deterministic: every shard
 // computes the same.
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
-                                       const BufferViews& views, double view_work, int count);
+                                       const BufferViews& views, const ShardCosts& costs,
+                                       int count);
 
 }  // namespace fresco
