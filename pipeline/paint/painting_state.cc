@@ -59,9 +59,9 @@ void Fill(const PackedImage& packed, std::vector<T>& array, const cv::Mat*) {
   packed.CopyTo(array.data());
 }
 
-// Packs the images (and models' arrays) of a state's lists (SaveState), each against the same image
-// of the state saved before (`earlier`, null: none), releasing them in the lists; and unpacks them
-// back (RestoreState), in the same order.
+// Packs the images (and the models' arrays) of a state's lists (SaveState), each against the
+// same image of the state saved before (`earlier`, null: none) to share its blocks, releasing
+// them in the lists; Unpack (RestoreState) fills them back in the same order.
 class ImagePacker {
  public:
   ImagePacker(PaintSession::State* state, const PaintSession::State* earlier)
