@@ -265,9 +265,9 @@ Status SolveViews(const CalibrateRequest& request, CalibrationRun* run) {
     run->warnings.push_back("only " + std::to_string(run->views.size()) +
                             " images with a board: use 20 or more for a trustworthy model");
   // The images were read: a seed or a fit that fails is failed work, not bad input.
-  FRESCO_RETURN_IF_ERROR(
-      SeedCalibration(run->views, request.board, run->width, run->height, &run->seed)
-          .Reclassified(StatusKind::kFailed));
+  FRESCO_RETURN_IF_ERROR(SeedCalibration(run->views, request.board, run->width, run->height,
+                                         &run->seed, request.cancelled)
+                             .Reclassified(StatusKind::kFailed));
   CheckCoverage(run);
   SelectOptions select;
   if (request.model != "auto") select.candidates = {request.model};

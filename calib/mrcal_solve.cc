@@ -1,12 +1,7 @@
 #include "calib/mrcal_solve.h"
 
 #include <malloc.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstring>
@@ -22,6 +17,8 @@ extern "C" {
 // After mrcal.h: _mrcal_num_j_nonzero, the size of the Jacobian mrcal_optimizer_callback fills.
 #include <mrcal/mrcal-internal.h>
 }
+
+#include "calib/abandonable.h"
 
 namespace fresco::calib {
 namespace {
@@ -137,64 +134,27 @@ std::vector<std::pair<void*, size_t>> FitOutputs(Problem* p, std::vector<double>
   return parts;
 }
 
-// Optimize in a child process (SolveOptions::cancelled): it writes a status byte and the
-// fit's outputs to a pipe; the parent reads them while asking `cancelled`, and kills the
-// child when it says so.
+// Optimize in a child process (SolveOptions::cancelled, abandonable.h): the fit's outputs
+// come back as bytes.
 Status OptimizeAbandonably(Problem* p, std::vector<double>* x,
                            const std::function<bool()>& cancelled) {
   if (x) x->assign(p->NumMeasurements(), 0.0);
-  int fds[2];
-  if (pipe(fds) != 0) return Optimize(p, x);
-  const pid_t child = fork();
-  if (child < 0) {
-    close(fds[0]), close(fds[1]);
-    return Optimize(p, x);
-  }
-  if (child == 0) {  // the fit, and its result down the pipe; no exit handlers
-    close(fds[0]);
-    const char ok = Optimize(p, x).ok() ? 1 : 0;
-    bool written = write(fds[1], &ok, 1) == 1;
-    for (const auto& [data, size] : FitOutputs(p, x))
-      for (size_t done = 0; written && done < size;) {
-        const ssize_t n = write(fds[1], static_cast<const char*>(data) + done, size - done);
-        written = n > 0;
-        done += n > 0 ? static_cast<size_t>(n) : 0;
-      }
-    _exit(written ? 0 : 1);
-  }
-  close(fds[1]);
-  std::vector<char> result;
-  bool abandoned = false;
-  for (;;) {
-    pollfd ready{fds[0], POLLIN, 0};
-    const int polled = poll(&ready, 1, 100);
-    if (polled == 0 || (polled < 0 && errno == EINTR)) {
-      if (cancelled()) {
-        kill(child, SIGKILL);
-        abandoned = true;
-        break;
-      }
-      continue;
-    }
-    char chunk[65536];
-    const ssize_t n = read(fds[0], chunk, sizeof(chunk));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;  // the end: the child wrote all it had
-    result.insert(result.end(), chunk, chunk + n);
-  }
-  close(fds[0]);
-  while (waitpid(child, nullptr, 0) < 0 && errno == EINTR) {
-  }
-  if (abandoned) return Status::Error("cancelled");
-  size_t expected = 1;
-  for (const auto& part : FitOutputs(p, x)) expected += part.second;
-  if (result.size() != expected)
-    return Status::Error("mrcal_optimize: the fit's process ended without its result");
-  if (result[0] != 1)
-    return Status::Error("mrcal_optimize failed (bad arguments or a diverged solve)");
-  size_t at = 1;
+  std::string bytes;
+  FRESCO_RETURN_IF_ERROR(RunAbandonably(
+      "mrcal_optimize",
+      [&](std::string* out) {
+        const Status fit = Optimize(p, x);
+        if (!fit.ok()) return *out = fit.message(), false;
+        for (const auto& [data, size] : FitOutputs(p, x))
+          out->append(static_cast<const char*>(data), size);
+        return true;
+      },
+      cancelled, &bytes));
+  size_t at = 0;
   for (const auto& [data, size] : FitOutputs(p, x)) {
-    std::memcpy(data, result.data() + at, size);
+    if (at + size > bytes.size())
+      return Status::Error("mrcal_optimize: the fit's process ended without its result");
+    std::memcpy(data, bytes.data() + at, size);
     at += size;
   }
   return Status::Ok();

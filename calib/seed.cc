@@ -1,13 +1,19 @@
 #include "calib/seed.h"
 
 #include <cmath>
+#include <cstring>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
 
+#include "calib/abandonable.h"
+
 namespace fresco::calib {
 
-Status SeedCalibration(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
-                       int height, CalibrationSeed* seed) {
+namespace {
+
+Status SeedHere(const std::vector<BoardView>& views, const BoardSpec& spec, int width, int height,
+                CalibrationSeed* seed) {
   std::vector<std::vector<cv::Point3f>> object_points;
   std::vector<std::vector<cv::Point2f>> image_points;
   for (const BoardView& view : views) {
@@ -52,6 +58,51 @@ Status SeedCalibration(const std::vector<BoardView>& views, const BoardSpec& spe
   if (!(std::isfinite(out.fx) && out.fx > 0 && std::isfinite(out.fy) && out.fy > 0))
     return Status::Error("seeding with OpenCV calibrateCamera gave no usable focal length");
   *seed = out;
+  return Status::Ok();
+}
+
+// A seed as bytes (a child process's sent back) and back.
+std::string SeedBytes(const CalibrationSeed& seed) {
+  std::string bytes;
+  for (double v : {seed.fx, seed.fy, seed.cx, seed.cy, seed.k1, seed.k2, seed.rms_px})
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof(v));
+  for (const std::array<double, 6>& rt : seed.rt_cam_from_board)
+    bytes.append(reinterpret_cast<const char*>(rt.data()), sizeof(rt));
+  return bytes;
+}
+
+bool SeedFromBytes(const std::string& bytes, CalibrationSeed* seed) {
+  constexpr size_t kHead = 7 * sizeof(double);
+  if (bytes.size() < kHead || (bytes.size() - kHead) % sizeof(std::array<double, 6>) != 0)
+    return false;
+  CalibrationSeed out;
+  for (size_t i = 0;
+       double* v : {&out.fx, &out.fy, &out.cx, &out.cy, &out.k1, &out.k2, &out.rms_px})
+    std::memcpy(v, bytes.data() + sizeof(double) * i++, sizeof(double));
+  out.rt_cam_from_board.resize((bytes.size() - kHead) / sizeof(std::array<double, 6>));
+  std::memcpy(out.rt_cam_from_board.data(), bytes.data() + kHead, bytes.size() - kHead);
+  *seed = out;
+  return true;
+}
+
+}  // namespace
+
+Status SeedCalibration(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
+                       int height, CalibrationSeed* seed, const std::function<bool()>& cancelled) {
+  if (!cancelled) return SeedHere(views, spec, width, height, seed);
+  if (cancelled()) return Status::Error("cancelled");
+  std::string bytes;
+  FRESCO_RETURN_IF_ERROR(RunAbandonably(
+      "OpenCV calibrateCamera",
+      [&](std::string* out) {
+        CalibrationSeed here;
+        const Status status = SeedHere(views, spec, width, height, &here);
+        *out = status.ok() ? SeedBytes(here) : status.message();
+        return status.ok();
+      },
+      cancelled, &bytes));
+  if (!SeedFromBytes(bytes, seed))
+    return Status::Error("OpenCV calibrateCamera: the process ended without its result");
   return Status::Ok();
 }
 

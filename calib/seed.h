@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "calib/board.h"
@@ -20,7 +21,11 @@ struct CalibrationSeed {
   double rms_px = 0;                                     // OpenCV's reprojection RMS
 };
 
+// With `cancelled` set, OpenCV's calibration (seconds on many views, with no way to stop it)
+// runs in a child process that a Cancel abandons (abandonable.h): the seed is then, to the
+// bit, the one made in this process, or the call fails with "cancelled".
 Status SeedCalibration(const std::vector<BoardView>& views, const BoardSpec& spec, int width,
-                       int height, CalibrationSeed* seed);
+                       int height, CalibrationSeed* seed,
+                       const std::function<bool()>& cancelled = nullptr);
 
 }  // namespace fresco::calib

@@ -45,22 +45,6 @@ void BufferBackground::Init(const BaseBuffer& buffer, const BackgroundOptions& o
   raw_set_.assign(buffer.chunks.size(), 0);
 }
 
-BufferBackground BufferBackground::Clone() const {
-  BufferBackground copy = *this;  // the models are vectors: copied
-  copy.raw_ = raw_.clone();
-  return copy;
-}
-
-size_t BufferBackground::Bytes() const {
-  size_t bytes = raw_.total() * raw_.elemSize() + raw_set_.size() + texel_at_.size() * sizeof(int) +
-                 average_.size() * sizeof(AverageTexel) + robust_.var4.size() * sizeof(uint16_t) +
-                 robust_.samples.size() * sizeof(uint16_t);
-  for (const auto& mode : robust_.mean)
-    for (const std::vector<uint16_t>& channel : mode) bytes += channel.size() * sizeof(uint16_t);
-  for (const std::vector<float>& w : robust_.weight) bytes += w.size() * sizeof(float);
-  return bytes;
-}
-
 namespace {
 // The texel pairs (k, from) by which a field moves texels: the texel at q (in `roi`) takes
 // the state of the texel nearest to q + field(q - roi.tl()), when there is one.

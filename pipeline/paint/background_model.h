@@ -88,10 +88,15 @@ class BufferBackground {
   // state of the texel nearest to q + field(q - roi.tl()) (CV_32FC2, roi size), when there
   // is one.
   void Move(const BaseBuffer& buffer, const cv::Rect& roi, const cv::Mat& field);
-  // A copy that shares no pixels with this one (a saved painting state), and the bytes the
-  // model holds.
-  BufferBackground Clone() const;
-  size_t Bytes() const;
+  // Each array the model holds (`f` called with the cv::Mat or std::vector): a saved painting
+  // state stores them packed (painting_state.cc).
+  template <typename F>
+  void ForEachArray(F f) {
+    f(raw_), f(raw_set_), f(texel_at_), f(average_), f(robust_.var4), f(robust_.samples);
+    for (auto& mode : robust_.mean)
+      for (std::vector<uint16_t>& channel : mode) f(channel);
+    for (std::vector<float>& weight : robust_.weight) f(weight);
+  }
 
   // Per-texel state of the average model (by texel number k, not buffer index); the robust
   // model's is RobustTexels.

@@ -126,6 +126,8 @@ class PaintSession {
   // two frames and restored: painting on from a restored state gives, byte for byte, what
   // painting on from where it was saved gave (the app steps back from its nearest saved state
   // instead of repainting from the first frame). A state fits the session that saved it.
+  // A state shares the image blocks it has in common with the one saved before it, while that
+  // is held (painting_state.h).
   struct State;
   std::shared_ptr<const State> SaveState() const;
   void RestoreState(const State& state);
@@ -341,6 +343,7 @@ class PaintSession {
   void UpdateOwnOnly() { own_only_.store(own_only_.load() || (!own_.empty() && !CouplesBuffers())); }
   std::vector<bool> own_;
   std::atomic<bool> own_only_{false};
+  mutable std::weak_ptr<const State> last_saved_;  // SaveState's last, to share blocks with
   std::vector<bool> hollow_;  // buffers without texels (empty: none)
   BaseBufferOptions buffer_options_;
   // Builds the hollow buffers the session paints (SetOwnBuffers).

@@ -3,13 +3,14 @@
 namespace fresco {
 namespace {
 
-// Every image of each kind of per-buffer state, one list per kind: the copy clones them and
-// counts their bytes.
+// Every image of each kind of per-buffer state, one list per kind: the state packs them. An
+// image mostly equal to one before it (a shadow of the texels, the sums without the model)
+// comes with that one, to be packed against (packed_image.h).
 template <typename F>
 void ForEachImage(PaintedBuffer& p, F f) {
-  for (cv::Mat* m : {&p.bgra, &p.quality, &p.texel_kind, &p.mean_sum, &p.unmasked_sum,
-                     &p.shadow_bgra, &p.shadow_quality, &p.held_sum, &p.held_unmasked_sum})
-    f(*m);
+  for (cv::Mat* m : {&p.bgra, &p.quality, &p.texel_kind, &p.mean_sum, &p.held_sum}) f(*m);
+  f(p.unmasked_sum, &p.mean_sum), f(p.shadow_bgra, &p.bgra), f(p.shadow_quality, &p.quality);
+  f(p.held_unmasked_sum, &p.held_sum);
 }
 template <typename F>
 void ForEachImage(WarpedBuffer& w, F f) {
@@ -31,26 +32,76 @@ template <typename F>
 void ForEachImage(ViewLayer& layer, F f) {
   for (PaintedBuffer& p : layer.painted) ForEachImage(p, f);
 }
-
-// Copies `from` into `to` with every image cloned; adds the images' bytes to `bytes`.
-template <typename T>
-void DeepCopy(const std::vector<T>& from, std::vector<T>* to, size_t* bytes) {
-  *to = from;  // the images still shared
-  for (T& item : *to)
-    ForEachImage(item, [bytes](cv::Mat& m) {
-      m = m.clone();
-      *bytes += m.total() * m.elemSize();
-    });
+template <typename F>
+void ForEachImage(std::vector<BufferBackground>& models, F f) {
+  for (BufferBackground& model : models) model.ForEachArray(f);
 }
 
-void DeepCopy(const std::vector<std::vector<BufferBackground>>& from,
-              std::vector<std::vector<BufferBackground>>* to, size_t* bytes) {
-  to->assign(from.size(), {});
-  for (size_t s = 0; s < from.size(); ++s)
-    for (const BufferBackground& model : from[s]) {
-      (*to)[s].push_back(model.Clone());
-      *bytes += model.Bytes();
+// The arrays of a model as bytes to pack (a view, no copy), released once packed and filled
+// back from their packing; images as they are.
+cv::Mat BytesOf(const cv::Mat& image) { return image; }
+template <typename T>
+cv::Mat BytesOf(std::vector<T>& array) {
+  if (array.empty()) return cv::Mat();
+  return cv::Mat(1, static_cast<int>(array.size() * sizeof(T)), CV_8U, array.data());
+}
+void Release(cv::Mat& image) { image.release(); }
+template <typename T>
+void Release(std::vector<T>& array) {
+  std::vector<T>().swap(array);
+}
+void Fill(const PackedImage& packed, cv::Mat& image, const cv::Mat* reference) {
+  image = packed.Unpacked(reference);
+}
+template <typename T>
+void Fill(const PackedImage& packed, std::vector<T>& array, const cv::Mat*) {
+  array.resize(packed.raw_bytes() / sizeof(T));
+  packed.CopyTo(array.data());
+}
+
+// Packs the images (and the models' arrays) of a state's lists (SaveState), each against the
+// same image of the state saved before (`earlier`, null: none) to share its blocks, releasing
+// them in the lists; Unpack (RestoreState) fills them back in the same order.
+class ImagePacker {
+ public:
+  ImagePacker(PaintSession::State* state, const PaintSession::State* earlier)
+      : state_(state), earlier_(earlier) {}
+
+  // `to` = `from` with its images packed into the state, as the part `what`.
+  template <typename T>
+  void Pack(const char* what, const std::vector<T>& from, std::vector<T>* to) {
+    *to = from;  // the images still shared
+    PaintSession::State::Part part{what};
+    for (T& item : *to) {
+      ForEachImage(item, [&](auto& array, const cv::Mat* reference = nullptr) {
+        const size_t i = state_->images.size();
+        const bool has_earlier = earlier_ && i < earlier_->images.size();
+        state_->images.emplace_back(BytesOf(array), has_earlier ? &earlier_->images[i] : nullptr,
+                                    reference);
+        part.raw += state_->images.back().raw_bytes();
+        state_->images.back().ForEachBlock([&](const void*, size_t n) { part.held += n; });
+      });
+      ForEachImage(item, [](auto& array, const cv::Mat* = nullptr) { Release(array); });
     }
+    state_->block_bytes += part.held;
+    state_->bytes += part.held;
+    state_->parts.push_back(part);
+  }
+
+ private:
+  PaintSession::State* state_;
+  const PaintSession::State* earlier_;
+};
+
+// `to` = `from` with its images unpacked from `state`, from its image `*next` on.
+template <typename T>
+void Unpack(const PaintSession::State& state, const std::vector<T>& from, std::vector<T>* to,
+            size_t* next) {
+  *to = from;
+  for (T& item : *to)
+    ForEachImage(item, [&](auto& array, const cv::Mat* reference = nullptr) {
+      Fill(state.images[(*next)++], array, reference);
+    });
 }
 
 }  // namespace
@@ -73,23 +124,27 @@ std::shared_ptr<const PaintSession::State> PaintSession::SaveState() const {
   s.background_across_views = background_across_views_;
   s.own_only = own_only_.load();
   s.frames_painted_whole = frames_painted_whole_;
-  DeepCopy(painted_, &s.painted, &bytes);
-  DeepCopy(warped_, &s.warped, &bytes);
-  DeepCopy(movers_warped_, &s.movers_warped, &bytes);
-  DeepCopy(mover_texels_, &s.mover_texels, &bytes);
-  DeepCopy(agreed_texels_, &s.agreed_texels, &bytes);
-  DeepCopy(near_mover_texels_, &s.near_mover_texels, &bytes);
-  DeepCopy(anchors_, &s.anchors, &bytes);
-  DeepCopy(layers_, &s.layers, &bytes);
-  DeepCopy(background_, &s.background, &bytes);
-  DeepCopy(background_frame_, &s.background_frame, &bytes);
+  const std::shared_ptr<const State> earlier = last_saved_.lock();
+  ImagePacker packer(&s, earlier.get());
+  packer.Pack("painted buffers", painted_, &s.painted);
+  packer.Pack("warped images", warped_, &s.warped);
+  packer.Pack("movers warped", movers_warped_, &s.movers_warped);
+  packer.Pack("mover texels", mover_texels_, &s.mover_texels);
+  packer.Pack("agreed texels", agreed_texels_, &s.agreed_texels);
+  packer.Pack("near-mover texels", near_mover_texels_, &s.near_mover_texels);
+  packer.Pack("refine anchors", anchors_, &s.anchors);
+  packer.Pack("view layers", layers_, &s.layers);
+  packer.Pack("background frames", background_frame_, &s.background_frame);
+  packer.Pack("background models", background_, &s.background);
+  s.parts.push_back({"frames held out", bytes, bytes});
   s.frames_seen = frames_seen_;
   s.exposure_gain_sum = exposure_gain_sum_;
   s.exposure_offset_sum = exposure_offset_sum_;
   s.exposure_frames = exposure_frames_;
   s.frame_misalignment_px = frame_misalignment_px_;
   s.frame_explained_px = frame_explained_px_;
-  s.bytes = bytes;
+  s.bytes += bytes;
+  last_saved_ = state;
   return state;
 }
 
@@ -107,17 +162,17 @@ void PaintSession::RestoreState(const State& s) {
   background_across_views_ = s.background_across_views;
   own_only_.store(s.own_only);
   frames_painted_whole_ = s.frames_painted_whole;
-  size_t bytes = 0;  // the state is restored from again: painting must not write into it
-  DeepCopy(s.painted, &painted_, &bytes);
-  DeepCopy(s.warped, &warped_, &bytes);
-  DeepCopy(s.movers_warped, &movers_warped_, &bytes);
-  DeepCopy(s.mover_texels, &mover_texels_, &bytes);
-  DeepCopy(s.agreed_texels, &agreed_texels_, &bytes);
-  DeepCopy(s.near_mover_texels, &near_mover_texels_, &bytes);
-  DeepCopy(s.anchors, &anchors_, &bytes);
-  DeepCopy(s.layers, &layers_, &bytes);
-  DeepCopy(s.background, &background_, &bytes);
-  DeepCopy(s.background_frame, &background_frame_, &bytes);
+  size_t next = 0;  // the state is restored from again: painting must not write into it
+  Unpack(s, s.painted, &painted_, &next);
+  Unpack(s, s.warped, &warped_, &next);
+  Unpack(s, s.movers_warped, &movers_warped_, &next);
+  Unpack(s, s.mover_texels, &mover_texels_, &next);
+  Unpack(s, s.agreed_texels, &agreed_texels_, &next);
+  Unpack(s, s.near_mover_texels, &near_mover_texels_, &next);
+  Unpack(s, s.anchors, &anchors_, &next);
+  Unpack(s, s.layers, &layers_, &next);
+  Unpack(s, s.background_frame, &background_frame_, &next);
+  Unpack(s, s.background, &background_, &next);
   frames_seen_ = s.frames_seen;
   exposure_gain_sum_ = s.exposure_gain_sum;
   exposure_offset_sum_ = s.exposure_offset_sum;

@@ -1,15 +1,17 @@
-// A PaintSession's painting state (PaintSession::SaveState / RestoreState): a deep copy of
-// every member that painting a frame changes, pixels included (cv::Mat copies share pixels,
-// so each is cloned). What stays put while a session paints (the grouping, the buffers'
-// layout, the atlas, the camera caches) is not in it. The current frame's work images
-// (warped samples, masks) are: a stage may read what an earlier frame left outside the texels
-// it sampled.
+// A PaintSession's painting state (PaintSession::SaveState / RestoreState): a copy of every
+// member that painting a frame changes, pixels included. Its images are packed (packed_image.h):
+// the blocks all zero are not stored (a large model's texels never painted, the sums not made)
+// and the blocks equal to the state saved before it are shared with it. What stays put while a
+// session paints (the grouping, the buffers' layout, the atlas, the camera caches) is not in
+// it. The current frame's work images (warped samples, masks) are: a stage may read what an
+// earlier frame left outside the texels it sampled.
 #pragma once
 
 #include <cstddef>
 #include <utility>
 #include <vector>
 
+#include "pipeline/paint/packed_image.h"
 #include "pipeline/paint/paint_session.h"
 
 namespace fresco {
@@ -35,7 +37,23 @@ struct PaintSession::State {
   cv::Vec3d exposure_gain_sum, exposure_offset_sum;
   int exposure_frames = 0;
   double frame_misalignment_px = -1, frame_explained_px = -1;
-  size_t bytes = 0;  // the pixels and models held
+  // Every image of the lists above, packed, in the order painting_state.cc walks them (the
+  // lists hold them released).
+  std::vector<PackedImage> images;
+  size_t bytes = 0;  // held: the images' blocks stored (shared ones too), the models, the frames
+  size_t block_bytes = 0;  // ... of which the images' blocks
+  // Where the bytes go: each kind's images before packing and as held, and the models.
+  struct Part {
+    const char* what;
+    size_t raw = 0, held = 0;
+  };
+  std::vector<Part> parts;
+
+  // Each image block held (its identity, its bytes): blocks shared between states count once.
+  template <typename F>
+  void ForEachBlock(F f) const {
+    for (const PackedImage& image : images) image.ForEachBlock(f);
+  }
 };
 
 }  // namespace fresco

@@ -1,6 +1,9 @@
 #include "pipeline/run/run_snapshots.h"
 
 #include <algorithm>
+#include <unordered_set>
+
+#include "pipeline/paint/painting_state.h"
 
 namespace fresco {
 
@@ -15,31 +18,41 @@ bool RunSnapshots::Due(int frames_read) const {
 void RunSnapshots::DoubleTheSpacing() {
   every_ *= 2;
   for (auto it = states_.begin(); it != states_.end();)
-    if (it->first % every_ != 0) {
-      bytes_ -= it->second.bytes();
-      it = states_.erase(it);
-    } else {
-      ++it;
-    }
+    it = it->first % every_ != 0 ? states_.erase(it) : std::next(it);
+}
+
+size_t RunSnapshots::HeldBytes(const PaintRunState* adding) const {
+  std::unordered_set<const void*> blocks;
+  size_t bytes = 0;
+  auto count = [&](const PaintRunState& state) {
+    if (!state.painting) return;
+    bytes += state.painting->bytes - state.painting->block_bytes;
+    state.painting->ForEachBlock([&](const void* block, size_t n) {
+      if (blocks.insert(block).second) bytes += n;
+    });
+  };
+  for (const auto& [frames_read, state] : states_) count(state);
+  if (adding) count(*adding);
+  return bytes;
 }
 
 void RunSnapshots::Add(int frames_read, PaintRunState state) {
-  const size_t bytes = state.bytes();
-  last_offered_bytes_ = bytes;
-  if (bytes > budget_bytes_) return;  // one state alone over the budget: none kept
+  last_offered_bytes_ = state.bytes();
+  if (last_offered_bytes_ > budget_bytes_) return;  // one state alone over the budget: none kept
   // Thinned until the new state fits: the spacing doubles, every state off it dropped.
-  while (bytes_ + bytes > budget_bytes_ && states_.size() > 1) DoubleTheSpacing();
-  // Room for one state only: the newest on the spacing replaces the one kept (the first too),
-  // the spacing doubling each time (saves stay few); a step back then paints at most the
-  // frames since the state kept, not every frame from the first.
-  if (bytes_ + bytes > budget_bytes_) {
-    bytes_ = 0;
+  while (HeldBytes(&state) > budget_bytes_ && states_.size() > 1) DoubleTheSpacing();
+  // Room for one state only: the newest replaces the one kept (the first too), the spacing
+  // doubling each time (saves stay few); a step back then paints at most the frames since the
+  // state kept, not every frame from the first.
+  if (HeldBytes(&state) > budget_bytes_) {
     states_.clear();
     every_ *= 2;
+  } else if (frames_read % every_ != 0) {
+    bytes_ = HeldBytes(nullptr);
+    return;
   }
-  if (frames_read % every_ != 0) return;
-  bytes_ += bytes;
   states_[frames_read] = std::move(state);
+  bytes_ = HeldBytes(nullptr);
 }
 
 const PaintRunState* RunSnapshots::AtOrBefore(int frames_read, int* its_frames_read) const {

@@ -5,7 +5,8 @@
 // dropped), so the states stay spread over the whole capture; the first (before any frame:
 // going back to it spares reopening the project and its whole-capture pre-pass) is kept
 // while a later state fits beside it. Where the budget holds one state only (a large model),
-// the newest on the spacing replaces it, the spacing doubling each time.
+// the newest replaces it, the spacing doubling each time. The image blocks two
+// states share (painting_state.h) count once.
 #pragma once
 
 #include <cstddef>
@@ -30,7 +31,7 @@ class RunSnapshots {
   void Clear() { states_.clear(), bytes_ = 0; }
 
   int every() const { return every_; }
-  size_t bytes() const { return bytes_; }
+  size_t bytes() const { return bytes_; }  // held, shared blocks once
   size_t count() const { return states_.size(); }
 
  private:
@@ -41,6 +42,8 @@ class RunSnapshots {
   std::map<int, PaintRunState> states_;  // by frames read before it
 
   void DoubleTheSpacing();  // every state off the new spacing dropped
+  // The bytes the states kept hold, with `adding` (null: none) among them.
+  size_t HeldBytes(const PaintRunState* adding) const;
 };
 
 }  // namespace fresco

@@ -5,10 +5,12 @@
 // again from the state before the first frame (what a step back cost without the states, the
 // project's opening and pre-pass aside, which it would have repeated too).
 //   step_back_measure PROJECT.json [--frames N] [--every K] [--budget-mb MB] [--set K=V]...
-// Prints the opening, painting and saving times, the states' count and memory, the step back
-// and the repaint from the first frame, and the peak resident memory.
+// Prints the opening, painting and saving times, the states' count and memory, where the last
+// state saved holds its bytes, the step back and the repaint from the first frame, and the
+// peak resident memory.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "pipeline/core/project.h"
+#include "pipeline/paint/painting_state.h"
 #include "pipeline/run/paint_job.h"
 #include "pipeline/run/paint_run.h"
 #include "pipeline/run/run_snapshots.h"
@@ -44,16 +47,30 @@ double PeakRssMb() {
   return usage.ru_maxrss / 1024.0;
 }
 
+// The last state saved: its frame, bytes held alone and where they go; the largest saved.
+struct LastSaved {
+  int frames_read = -1;
+  size_t bytes = 0;
+  std::vector<fresco::PaintSession::State::Part> parts;
+  size_t largest = 0;  // the largest state saved, alone
+};
+
 // Reads and paints until `frames` frames were read (or the capture ends); keeps states in
 // `snapshots` when given, adding the time spent saving to `save_seconds` and the saves to
 // `saves`.
 bool PaintUpTo(fresco::PaintRun* run, int frames, fresco::RunSnapshots* snapshots,
-               double* save_seconds, int* saves) {
+               double* save_seconds, int* saves, LastSaved* last = nullptr) {
   while (run->stats().frames < frames) {
     if (snapshots && snapshots->Due(run->stats().frames)) {
       const Clock::time_point start = Clock::now();
       fresco::PaintRunState state;
-      if (run->Save(&state)) snapshots->Add(run->stats().frames, std::move(state)), ++*saves;
+      if (run->Save(&state)) {
+        if (last) {
+          *last = {run->stats().frames, state.bytes(), state.painting->parts, last->largest};
+          last->largest = std::max(last->largest, state.bytes());
+        }
+        snapshots->Add(run->stats().frames, std::move(state)), ++*saves;
+      }
       *save_seconds += Since(start);
     }
     fresco::RunFrame frame;
@@ -118,7 +135,9 @@ int main(int argc, char** argv) {
   cpu = CpuSeconds();
   double save_seconds = 0;
   int saves = 0;
-  if (!PaintUpTo(&run, frames, &snapshots, &save_seconds, &saves)) frames = run.stats().frames;
+  LastSaved last;
+  if (!PaintUpTo(&run, frames, &snapshots, &save_seconds, &saves, &last))
+    frames = run.stats().frames;
   const double paint_seconds = Since(start), paint_cpu = CpuSeconds() - cpu;
 
   // A step back from the last frame read: the nearest state at or before it, painted on.
@@ -172,6 +191,14 @@ int main(int argc, char** argv) {
   std::printf("states kept    %zu, every %d frames, %.0f MB (%.1f MB each; budget %d MB)\n", kept,
               spacing, kept_bytes / 1048576.0, kept_bytes / 1048576.0 / std::max<size_t>(1, kept),
               budget_mb);
+  std::printf(
+      "last state     before frame %d: %.0f MB alone, the largest saved %.0f MB (as held / "
+      "before packing):\n",
+      last.frames_read, last.bytes / 1048576.0, last.largest / 1048576.0);
+  for (const fresco::PaintSession::State::Part& part : last.parts)
+    if (part.raw > 0)
+      std::printf("  %-18s %7.1f / %7.1f MB\n", part.what, part.held / 1048576.0,
+                  part.raw / 1048576.0);
   std::printf(
       "step back      frame %d -> %d: %.3f s, %.3f s CPU (restore %.3f s, %d frames "
       "painted from the state at %d)\n",

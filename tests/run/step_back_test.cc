@@ -157,6 +157,27 @@ TEST(StepBack, ViewLayersAndViewSelectionRepaintAsStraightPainting) {
 // Back to the very first frame: from the state saved before any (no reopening).
 TEST(StepBack, BackToTheFirstFrameFromTheStateBeforeAny) { StepBackAndCompare({}, 10, 14, 0); }
 
+// A state stores what painting made, not the texels never painted nor the shadows equal to
+// the texels they shadow (a large model's state then fits the budget), and two states share
+// what did not change between them; stepping back to either still paints on as straight
+// painting (the tests above). Before, a state held a whole copy of every image.
+TEST(StepBack, AStateHoldsThePaintedTexelsAndSharesWithTheOneBefore) {
+  Job j = Open({});
+  PaintUpTo(&j, 3);
+  PaintRunState a, b;
+  ASSERT_TRUE(j.run->Save(&a));
+  ASSERT_TRUE(j.run->Save(&b));  // nothing painted between: the images' blocks all shared
+  const size_t one = a.bytes();
+  size_t raw = 0;  // the images' bytes (a whole copy of each, as a state held them before)
+  for (const PaintSession::State::Part& part : a.painting->parts) raw += part.raw;
+  EXPECT_LT(one, raw * 3 / 4);  // 160x120 frames of a small room: most of it painted already
+  RunSnapshots snapshots(1, size_t{1} << 30);
+  snapshots.Add(3, std::move(a));
+  snapshots.Add(4, std::move(b));
+  EXPECT_EQ(snapshots.count(), 2u);
+  EXPECT_LT(snapshots.bytes(), one + one / 50);  // the frames held out, copied, aside
+}
+
 // A state that says it holds `bytes` (the budget's arithmetic only).
 PaintRunState StateOf(size_t bytes) {
   auto painting = std::make_shared<PaintSession::State>();
@@ -193,8 +214,9 @@ TEST(RunSnapshots, WhereOneStateFitsTheNewestReplacesItAndTheSpacingDoubles) {
   RunSnapshots snapshots(2, 150);
   for (int frames = 0; frames <= 17; ++frames)
     if (snapshots.Due(frames)) snapshots.Add(frames, StateOf(100));
-  // 0; at 2 the spacing becomes 4 (none kept); 4; at 8 it becomes 8 (8); at 16, 16 (16).
-  EXPECT_EQ(snapshots.every(), 16);
+  // 0; 2 replaces it (the spacing 4); 4 (8); 8 (16); 16 (32). Before, a state off the new
+  // spacing dropped the one kept without taking its place: none was left.
+  EXPECT_EQ(snapshots.every(), 32);
   EXPECT_EQ(snapshots.count(), 1u);
   EXPECT_EQ(snapshots.bytes(), 100u);
   int at = -1;
