@@ -191,6 +191,7 @@ nlohmann::json RunMetrics(const Project& project, const PaintJob& job, const Pai
                                       {"fraction", m.fraction()},
                                       {"pixels_in_regions", m.compact},
                                       {"fraction_in_regions", m.compact_fraction()},
+                                      {"frames_judged", m.frames_judged},
                                       {"seconds", m.seconds}};
   }
   metrics["texels"] = session->NumSurfaceTexels();

@@ -333,6 +333,20 @@ void FollowAcrossFrames(const std::vector<SmallFrame>& frames, const Judged& jud
   FollowMovers(follow, options.follow_frames, &result->masks);
 }
 
+// Whether the first half judged (the even frames) is enough: the caller drops the masks below
+// a share (later_passes_min_fraction) and they show well under it in regions.
+bool JudgedHalfIsEnough(const MoverMaskOptions& options, const std::vector<long long>& judged,
+                        const std::vector<long long>& compact) {
+  const int n = static_cast<int>(judged.size());
+  if (options.later_passes_min_fraction <= 0 || options.half_enough_below <= 0 ||
+      n < 2 * options.half_min_frames)
+    return false;
+  long long judged_half = 0, compact_half = 0;
+  for (int f = 0; f < n; f += 2) judged_half += judged[f], compact_half += compact[f];
+  return judged_half > 0 &&
+         compact_half < options.half_enough_below * options.later_passes_min_fraction * judged_half;
+}
+
 }  // namespace
 
 cv::Mat MoverMaskResult::Packed(size_t k) const {
@@ -376,18 +390,28 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   judging.regions.resize(n);
   result->agreed.resize(n);
   const bool keep_comparisons = options.passes > 1;
-  cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
-    for (int f = range.start; f < range.end; ++f) {
-      if (frames[f].points.empty()) continue;
-      result->masks[f] =
-          JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f], &flagged[f],
-                     &compact[f], &judging.joinable[f], &result->agreed[f], &judging.ringed[f],
-                     keep_comparisons ? &judging.regions[f] : nullptr);
-      if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
-    }
-  });
-  for (int f = 0; f < n; ++f)
+  // The first pass judges every second frame (f % 2 == parity); a frame's judging reads only
+  // the frames, so the halves in turn judge as all at once.
+  const auto judge_half = [&](int parity) {
+    const int count = (n - parity + 1) / 2;
+    cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
+      for (int k = range.start; k < range.end; ++k) {
+        const int f = 2 * k + parity;
+        if (frames[f].points.empty()) continue;
+        result->masks[f] =
+            JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f],
+                       &flagged[f], &compact[f], &judging.joinable[f], &result->agreed[f],
+                       &judging.ringed[f], keep_comparisons ? &judging.regions[f] : nullptr);
+        if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
+      }
+    });
+  };
+  judge_half(0);
+  if (!JudgedHalfIsEnough(options, judged, compact)) judge_half(1);
+  for (int f = 0; f < n; ++f) {
     result->judged += judged[f], result->flagged += flagged[f], result->compact += compact[f];
+    result->frames_judged += judged[f] > 0 ? 1 : 0;
+  }
   // A later pass judges a frame again only where a frame it is compared with had its mask
   // changed by the pass before (the first pass: any masked pixel); none once nothing changes.
   const bool later_passes = result->compact_fraction() > options.later_passes_min_fraction;

@@ -69,6 +69,12 @@ struct MoverMaskOptions {
   // agrees with the frames near it, and where its ring is missed in a frame, so is its inside.
   // 0: not followed that way.
   int ringed_follow_frames = 2;
+  // The first pass judges every second frame first; with later_passes_min_fraction set, where
+  // those show in regions less than this share of it (and the capture has at least twice
+  // half_min_frames frames), the others are not judged (their masks stay empty): the caller
+  // drops the masks anyway. 0: every frame judged.
+  double half_enough_below = 0.75;
+  int half_min_frames = 12;
   // Called after each pass (optional): passes done, passes at most, a line for people.
   std::function<void(int done, int total, const std::string& line)> progress;
 };
@@ -102,6 +108,7 @@ struct MoverMaskResult {
   // TUM's teddy: 1.6 % of the pixels differ, 0.2 % in regions; the suites' captures without
   // movers 0.2 % and 0.00 %). The evidence background `auto` decides on.
   long long compact = 0;
+  int frames_judged = 0;  // frames with a pixel judged (MoverMaskOptions::half_enough_below)
   double seconds = 0;
 
   double fraction() const { return judged > 0 ? static_cast<double>(flagged) / judged : 0.0; }

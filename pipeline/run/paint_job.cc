@@ -70,6 +70,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     MoverMaskResult found;
     FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
     all.judged += found.judged, all.flagged += found.flagged, all.compact += found.compact;
+    all.frames_judged += found.frames_judged;
     all.seconds += found.seconds;
     if (project.pipeline.background.across_views) {
       std::vector<cv::Mat>& movers = found_for_captures->movers[s];
@@ -78,7 +79,7 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
   }
   j->mover_masks = all;
-  j->prepass.background_across_views = {all.compact_fraction(), static_cast<int>(where.size())};
+  j->prepass.background_across_views = {all.compact_fraction(), all.frames_judged};
   return Status::Ok();
 }
 

@@ -167,6 +167,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
                                    {"judged", m.judged},
                                    {"flagged", m.flagged},
                                    {"compact", m.compact},
+                                   {"frames_judged", m.frames_judged},
                                    {"seconds", m.seconds}};
   }
   if (d.pose_check) {
@@ -262,6 +263,7 @@ Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob
       r.not_run = m.at("not_run");
       r.judged = m.at("judged"), r.flagged = m.at("flagged"), r.seconds = m.at("seconds");
       r.compact = m.value("compact", 0LL);
+      r.frames_judged = m.value("frames_judged", 0);
       job->mover_masks = r;
     }
     // The decisions, in the pre-pass's order.

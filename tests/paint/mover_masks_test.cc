@@ -130,6 +130,21 @@ TEST(MoverMasks, BlurredAndShiftedFramesOfAStaticSceneAreNotMovers) {
   EXPECT_LT(o.found.compact_fraction(), kBackgroundAcrossViewsThreshold / 4);
 }
 
+// Where the masks are dropped below a share (background `auto`), a capture whose every second
+// frame shows well under it in regions is not judged further: half the comparisons.
+TEST(MoverMasks, AStaticSceneIsJudgedOnEverySecondFrameWhereTheMasksWouldBeDropped) {
+  MoverMaskOptions options;
+  options.later_passes_min_fraction = kBackgroundAcrossViewsThreshold;
+  const Orbit still = FindMovers(0, options);
+  EXPECT_EQ(still.found.frames_judged, 20);
+  for (size_t f = 0; f < still.found.masks.size(); ++f)
+    EXPECT_EQ(still.found.masks[f].empty(), f % 2 == 1) << f;
+  EXPECT_LT(still.found.compact_fraction(), kBackgroundAcrossViewsThreshold / 4);
+  const Orbit moving = FindMovers(2, options);
+  EXPECT_EQ(moving.found.frames_judged, 40);
+  EXPECT_GT(moving.found.compact_fraction(), 2 * kBackgroundAcrossViewsThreshold);
+}
+
 // The later passes run only where their masks are used: with the model kept (across_views)
 // and, with `auto`, when the first pass decides it on.
 TEST(MoverMasks, LaterPassesOnlyWhereTheMasksAreUsed) {
