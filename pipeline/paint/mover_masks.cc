@@ -102,7 +102,8 @@ Comparison Compare(const SmallFrame& self, int other_index, const SmallFrame& ot
 // their colour (those that differ from a frame that sees them, or are seen by too few);
 // `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed);
 // `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h);
-// `regions`: the frame's colour regions, kept for the later passes.
+// `regions`: the frame's colour regions, kept for the later passes; `compact` (null: not
+// counted): its masked pixels in regions (MoverMaskResult::compact).
 cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
                    const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
                    std::vector<Comparison>* comparisons, long long* judged, long long* flagged,
@@ -141,11 +142,13 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
       ++seen_pixels;
       if (d >= options.min_differing && d >= options.share * s) mask.at<uchar>(y, x) = 255;
     }
-  // What differs in regions, not along lines (MoverMaskResult::compact).
-  cv::Mat regions_only;
-  cv::morphologyEx(mask, regions_only, cv::MORPH_OPEN,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-  *compact = cv::countNonZero(regions_only);
+  // What differs in regions, not along lines (MoverMaskResult::compact; the first pass's).
+  if (compact) {
+    cv::Mat regions_only;
+    cv::morphologyEx(mask, regions_only, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+    *compact = cv::countNonZero(regions_only);
+  }
   // Cleaning: small blobs are noise. A mover's pixels that match the frames near it (its
   // inside, where they show it too: it is large or slow) join it: within each blob's box,
   // the pixels of its colours. Not pixels that agree with every frame that sees them: the
@@ -299,7 +302,7 @@ std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
       if (!any) continue;
       long long unused = 0;
       result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f], &unused,
-                                    &unused, &unused, &judged->joinable[f], &result->agreed[f],
+                                    &unused, nullptr, &judged->joinable[f], &result->agreed[f],
                                     &judged->ringed[f], &judged->regions[f]);
       now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
     }

@@ -21,7 +21,9 @@ bool AllZero(const uint8_t* bytes, size_t n) {
 // `n` bytes XOR the reference's into `out` (no reference: the bytes).
 const uint8_t* Xored(const uint8_t* bytes, const uint8_t* reference, size_t n, uint8_t* out) {
   if (!reference) return bytes;
-  for (size_t i = 0; i < n; ++i) out[i] = bytes[i] ^ reference[i];
+  cv::Mat into(1, static_cast<int>(n), CV_8U, out);
+  cv::bitwise_xor(cv::Mat(1, static_cast<int>(n), CV_8U, const_cast<uint8_t*>(bytes)),
+                  cv::Mat(1, static_cast<int>(n), CV_8U, const_cast<uint8_t*>(reference)), into);
   return out;
 }
 
@@ -63,8 +65,7 @@ cv::Mat PackedImage::Unpacked(const cv::Mat* reference) const {
   CopyTo(image.data);
   if (against_reference_) {
     CV_Assert(reference && reference->size() == image.size() && reference->type() == type_);
-    const cv::Mat against = reference->isContinuous() ? *reference : reference->clone();
-    for (size_t i = 0; i < raw_bytes_; ++i) image.data[i] ^= against.data[i];
+    cv::bitwise_xor(image, *reference, image);  // bit for bit, whatever the type
   }
   return image;
 }
