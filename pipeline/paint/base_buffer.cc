@@ -10,6 +10,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/paint/scattered_groups.h"
+
 namespace fresco {
 namespace {
 
@@ -112,19 +114,6 @@ Eigen::Vector3d ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
     return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
   const double denom = 1.0 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
-}
-
-void ChooseAxes(const Eigen::Vector3d& normal, BaseBuffer* buffer) {
-  // Image "down" follows world down (glTF +Y up) on walls; on floors and ceilings +Z.
-  Eigen::Vector3d down(0, -1, 0);
-  Eigen::Vector3d v = down - normal * normal.dot(down);
-  if (v.norm() < 0.3) {
-    const Eigen::Vector3d z(0, 0, 1);
-    v = z - normal * normal.dot(z);
-  }
-  buffer->normal = normal;
-  buffer->axis_v = v.normalized();
-  buffer->axis_u = normal.cross(buffer->axis_v).normalized();
 }
 
 struct PlaneCoords {
@@ -465,6 +454,19 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
 
 }  // namespace
 
+void ChooseAxes(const Eigen::Vector3d& normal, BaseBuffer* buffer) {
+  // Image "down" follows world down (glTF +Y up) on walls; on floors and ceilings +Z.
+  Eigen::Vector3d down(0, -1, 0);
+  Eigen::Vector3d v = down - normal * normal.dot(down);
+  if (v.norm() < 0.3) {
+    const Eigen::Vector3d z(0, 0, 1);
+    v = z - normal * normal.dot(z);
+  }
+  buffer->normal = normal;
+  buffer->axis_v = v.normalized();
+  buffer->axis_u = normal.cross(buffer->axis_v).normalized();
+}
+
 // For a normal n within the chunk's cone (axis a, half-angle h) and d = c - p from a point p
 // in the box, n.d <= cos(h) a.d + sin(h) |d|, whose maximum over the box is at most the sum
 // of the two terms' maxima over its corners (a.d is linear in p, |d| convex).
@@ -498,7 +500,16 @@ Eigen::Vector2d BaseBuffer::TexelCoords(const Eigen::Vector3d& local_point) cons
 BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& grouping,
                                const BaseBufferOptions& options) {
   BaseBufferSet set;
-  std::deque<BaseBufferGroup> pending(grouping.groups.begin(), grouping.groups.end());
+  // Each group, and each part a fold splits off, in compact pieces (scattered_groups.h).
+  std::deque<BaseBufferGroup> pending;
+  const auto add_pending = [&](const BaseBufferGroup& group) {
+    const double s = group.texel_size_m > 0 ? group.texel_size_m : options.texel_size_m;
+    std::vector<BaseBufferGroup> pieces =
+        SplitScatteredGroup(mesh, group, s, options.gutter_texels);
+    if (pieces.size() > 1) ++set.scattered_split;
+    for (BaseBufferGroup& piece : pieces) pending.push_back(std::move(piece));
+  };
+  for (const BaseBufferGroup& group : grouping.groups) add_pending(group);
   // The groups pending are built in waves, in parallel, then taken in order: the groups split
   // off go to the back, so the order is the one building them one by one gives.
   std::deque<BaseBuffer> built;
@@ -535,8 +546,8 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
         BaseBufferGroup a = group, b = group;
         a.triangles.assign(folded.begin(), folded.begin() + folded.size() / 2);
         b.triangles.assign(folded.begin() + folded.size() / 2, folded.end());
-        pending.push_back(a);
-        pending.push_back(b);
+        add_pending(a);
+        add_pending(b);
         ++set.folds_split;
         continue;
       }
@@ -548,7 +559,7 @@ BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& groupin
       buffer.triangles = kept;
       BaseBufferGroup rest = group;
       rest.triangles = folded;
-      pending.push_back(rest);
+      add_pending(rest);
       ++set.folds_split;
     }
     buffer.id = static_cast<int>(set.buffers.size());

@@ -145,8 +145,13 @@ struct BaseBufferSet {
   std::vector<BaseBuffer> buffers;
   Grouping grouping;    // after fold-over splits: buffers[g] serves grouping.groups[g]
   int folds_split = 0;  // groups split because their projection folded
+  int scattered_split = 0;            // groups cut into compact pieces (SplitScatteredGroup)
   std::vector<BufferRecipe> recipes;  // buffers[b] is made by recipes[b]
 };
+
+// The buffer's plane axes for a group's mean `normal`: axis_v follows world down on walls,
+// +z on floors and ceilings (sets normal, axis_u, axis_v).
+void ChooseAxes(const Eigen::Vector3d& normal, BaseBuffer* buffer);
 
 BaseBufferSet BuildBaseBuffers(const TriangleMesh& mesh, const Grouping& grouping,
                                const BaseBufferOptions& options);
