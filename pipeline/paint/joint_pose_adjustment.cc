@@ -701,6 +701,7 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
   if (const int first = options.decide_on_first_frames; first >= 2 && 2 * n > 3 * first) {
     PoseAdjustOptions on_first = options;
     on_first.decide_on_first_frames = 0;
+    if (options.decide_max_side_px > 0) on_first.max_side_px = options.decide_max_side_px;
     if (options.progress)  // the first frames' steps, then the whole capture's
       on_first.progress = [&options](int done, int total, const std::string& line) {
         options.progress(done, total, "first frames: " + line);
