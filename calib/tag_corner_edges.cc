@@ -137,7 +137,8 @@ struct EdgeCuts {
 // Each cut across the edge is first placed where its grey crosses halfway between its own
 // darkest and lightest samples, then sampled again centred there; the edge's levels are the
 // darkest quarter of the inner ends and the lightest quarter of the outer ends of the cuts
-// near `from` (kFirst..kLast of the edge), kPlateauPx or more from the edge. A cut's own ends
+// near `from` (kFirst..kLast of the edge, or the first kMinPoints cuts where fewer are there: a
+// tag seen at a slant, its edge under 17.5 px), kPlateauPx or more from the edge. A cut's own ends
 // are not the levels on a small blurred tag: centred on a chord pulled into the tag, or
 // reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
 // border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
@@ -155,6 +156,7 @@ bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::V
   cuts.clear();
   std::vector<double> dark_ends, light_ends, grey;
   const double first_t = std::max(kFirst, (reach + 1.5) / length);
+  const double last_t = std::max(kLast, first_t + (kMinPoints - 0.5) / length);
   for (double t = first_t; t <= 1 - first_t; t += 1.0 / length) {
     EdgeCuts::Cut cut;
     cut.base = from + t * length * along;
@@ -166,7 +168,7 @@ bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::V
     if (cut.first == kNone || !Profile(gray, cut.base, normal, cut.first, half, &cut.grey))
       continue;
     cut.light_last = grey.back() > grey.front();  // from the first, shorter cut
-    if (t <= kLast) {
+    if (t <= last_t) {
       const int n = static_cast<int>(cut.grey.size()), ends = std::max(1, n / 6);
       double a = 0, b = 0;
       for (int i = 0; i < ends; ++i) a += cut.grey[i], b += cut.grey[n - 1 - i];
