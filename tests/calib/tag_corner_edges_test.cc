@@ -139,7 +139,8 @@ Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 
         const Eigen::Vector2d out = (tag.corner[k] - centre).normalized();
         Eigen::Vector2d corner;
         e.crossing_squares += CrossingSquareAt(tag.gray, saddle, k);
-        if (!CornerFromEdges(tag.gray, saddle, k, &corner)) continue;
+        if (!CornerFromEdges(tag.gray, saddle, k, &corner, nullptr, nullptr, 0.5, border_bits))
+          continue;
         ++e.corners, ++e.from_edges;
         e.saddle_rms_px += (saddle[k] - tag.corner[k]).squaredNorm();
         e.edges_rms_px += (corner - tag.corner[k]).squaredNorm();
@@ -195,16 +196,18 @@ TEST(TagCornerEdgesTest, SmallBlurredTagCornerNotPulledIn) {
   EXPECT_LT(std::abs(e.edges_out_px), 0.05);
 }
 
-// A tag seen at a slant, 28-32 px tall and half as wide, blurred 1 px: the edges' levels are
-// read from the cuts near the corner, kFirst..kLast of the edge and 1.5 px past the cut's reach
-// from it, and on an edge under 17.5 px fewer than five cuts were there: no edge, and the
-// detector kept cornerSubPix's saddle, 0.3-0.8 px into the tag (calib_detect_elsewhere
+// A tag seen at a slant (Kalibr's 2-bit border), 32-34 px tall and half as wide, blurred 1 px: the
+// edges' levels are read from the cuts near the corner, kFirst..kLast of the edge and 1.5 px past
+// the cut's reach from it, and on an edge under 17.5 px fewer than five cuts were there: no edge,
+// and the detector kept cornerSubPix's saddle, 0.3-0.8 px into the tag (calib_detect_elsewhere
 // --border-bits 2 --margin 0.1 --gamma 0.5 --contrast 0.6 --vignette 0.5 --seeds 3 --only
 // light_blur: view 6's right-hand tags, 14.7-17.8 px wide; the lens 0.103 px RMS from the
-// truth where the boards were seen). Now the levels are read from five cuts at least: 4 -> 32
-// corners, 0.066 px rms (cornerSubPix 0.38 px, 0.33 px into the tag).
+// truth where the boards were seen). Now the levels are read from five cuts at least where the
+// border along the edge is 2.5 px thick or more: 4 -> 32 corners, 0.058 px rms (cornerSubPix
+// 0.365 px, 0.328 px into the tag). With OpenCV's 1-bit border (under 2.5 px on these tags)
+// such corners lay 0.13 px out of the tag (0.23 px rms) and are not placed so.
 TEST(TagCornerEdgesTest, NarrowTagsCornersFromTheirEdges) {
-  const Errors e = Measure(1, {28, 32}, 0, 0.5, 2);
+  const Errors e = Measure(1, {32, 34}, 0, 0.5, 2);
   EXPECT_EQ(e.corners, 32);  // before: 4
   EXPECT_LT(e.saddle_out_px, -0.1);
   EXPECT_LT(e.edges_rms_px, 0.15);
