@@ -145,11 +145,11 @@ struct EdgeCuts {
 // darkest quarter of the inner ends and the lightest quarter of the outer ends of the cuts
 // near `from` (kFirst..kLast of the edge, or the first kMinPoints cuts where fewer are there: a
 // tag seen at a slant, its edge under 17.5 px, where its border is kMinBorderPx thick or more),
-// kPlateauPx or more from the edge. A cut's own ends
-// are not the levels on a small blurred tag: centred on a chord pulled into the tag, or
-// reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
-// border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
-// 1 px); the border's black shows where the bits behind it are black too. The cuts go on along
+// kPlateauPx or more from the edge. A cut's own ends are not the levels on a small blurred
+// tag: centred on a chord pulled into the tag, or reaching the tag's bits behind a thin border,
+// the dark end is darker or lighter than the border's black and the halfway crossing moves
+// (0.1-0.17 px into a 24-32 px tag blurred 1 px); the border's black shows where the bits
+// behind it are black too. The cuts go on along
 // the whole edge, as far from `to` as the first is from `from`: they give the edge's curve.
 bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
                 int border_bits, EdgeCuts* edge) {
