@@ -280,14 +280,14 @@ struct Saddles {
 // The corners of the tags `found`: each the saddle, or where no black square is at it, where the
 // tag's edges through it meet, each edge where its cuts cross `level` between the edge's dark
 // and light levels (calib/tag_corner_edges.h); corners sorted by id, `edged_ids` those from the
-// edges. Returns how many are.
+// edges. Returns how many are. `border_bits`: the board's (BorderBitsOf).
 // On a board with crossing squares (`squares`), a saddle that strayed where the square shows
 // at the outline is left out: cornerSubPix failed at a real saddle (the board's outermost
 // corners on the yac photos: the square's contact with the tag blurred to grey), and the
 // tag's edges run on into the square's there, so they do not give the corner either.
 int PlaceCorners(const cv::Mat& gray, const std::map<int, TagQuad>& found,
                  const std::map<int, Saddles>& saddles, const DetectOptions& options, double level,
-                 bool squares, std::vector<CornerObservation>* out_corners,
+                 bool squares, int border_bits, std::vector<CornerObservation>* out_corners,
                  std::set<int>* edged_ids) {
   out_corners->clear();
   edged_ids->clear();
@@ -317,7 +317,7 @@ int PlaceCorners(const cv::Mat& gray, const std::map<int, TagQuad>& found,
           continue;
         }
         bool left_out = false;
-        if (!CornerFromEdges(gray, from, k, &corner, &left_out, &levels[k], level)) {
+        if (!CornerFromEdges(gray, from, k, &corner, &left_out, &levels[k], level, border_bits)) {
           refined[k] = !strayed && !left_out;  // a stray saddle and no edges: left out
           continue;
         }
@@ -443,8 +443,9 @@ BoardDetection DetectAprilGrid(const cv::Mat& gray, const BoardSpec& spec,
   std::vector<bool> from_edges;
   const auto place = [&](double level, std::vector<CornerObservation>* placed_corners) {
     std::set<int> edged_ids;
-    const int from_edges_count = PlaceCorners(gray, found, saddles, options, level,
-                                              out.crossing_squares, placed_corners, &edged_ids);
+    const int from_edges_count =
+        PlaceCorners(gray, found, saddles, options, level, out.crossing_squares, out.border_bits,
+                     placed_corners, &edged_ids);
     from_edges.clear();
     for (const CornerObservation& c : *placed_corners)
       from_edges.push_back(edged_ids.count(c.id) > 0);

@@ -16,6 +16,12 @@ constexpr int kMinPoints = 5;
 constexpr double kNone = 1e9;  // no crossing
 // The second sampling reaches this far to each side of the edge: past a 1 px blur's ramp.
 constexpr double kPlateauPx = 3;
+// The tag's border along an edge (the edge's length times its share of black bits: 1 of 8, or
+// 2 of 10) as thick as this or more: the other edge's cuts across it reach the border's black.
+// Thinner, a corner from the edges lies 0.1 px out of the tag (OpenCV's 1-bit border on a tag
+// under 20 px: TagCornerEdgesTest's half-wide tags, 0.13 px); an edge that short whose levels
+// fewer than kMinPoints cuts near the corner give is then not placed.
+constexpr double kMinBorderPx = 2.5;
 
 // Bilinear grey at (x, y); -1 outside the image.
 double Grey(const cv::Mat& gray, double x, double y) {
@@ -137,14 +143,16 @@ struct EdgeCuts {
 // Each cut across the edge is first placed where its grey crosses halfway between its own
 // darkest and lightest samples, then sampled again centred there; the edge's levels are the
 // darkest quarter of the inner ends and the lightest quarter of the outer ends of the cuts
-// near `from` (kFirst..kLast of the edge), kPlateauPx or more from the edge. A cut's own ends
-// are not the levels on a small blurred tag: centred on a chord pulled into the tag, or
-// reaching the tag's bits behind a thin border, the dark end is darker or lighter than the
-// border's black and the halfway crossing moves (0.1-0.17 px into a 24-32 px tag blurred
-// 1 px); the border's black shows where the bits behind it are black too. The cuts go on along
+// near `from` (kFirst..kLast of the edge, or the first kMinPoints cuts where fewer are there: a
+// tag seen at a slant, its edge under 17.5 px, where its border is kMinBorderPx thick or more),
+// kPlateauPx or more from the edge. A cut's own ends are not the levels on a small blurred
+// tag: centred on a chord pulled into the tag, or reaching the tag's bits behind a thin border,
+// the dark end is darker or lighter than the border's black and the halfway crossing moves
+// (0.1-0.17 px into a 24-32 px tag blurred 1 px); the border's black shows where the bits
+// behind it are black too. The cuts go on along
 // the whole edge, as far from `to` as the first is from `from`: they give the edge's curve.
 bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::Vector2d& to,
-                EdgeCuts* edge) {
+                int border_bits, EdgeCuts* edge) {
   const double length = (to - from).norm();
   if (length < 8) return false;
   const Eigen::Vector2d along = (to - from) / length, normal(-along.y(), along.x());
@@ -155,6 +163,9 @@ bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::V
   cuts.clear();
   std::vector<double> dark_ends, light_ends, grey;
   const double first_t = std::max(kFirst, (reach + 1.5) / length);
+  const bool border_holds = length * border_bits / (6 + 2 * border_bits) >= kMinBorderPx;
+  const double last_t =
+      border_holds ? std::max(kLast, first_t + (kMinPoints - 0.5) / length) : kLast;
   for (double t = first_t; t <= 1 - first_t; t += 1.0 / length) {
     EdgeCuts::Cut cut;
     cut.base = from + t * length * along;
@@ -166,7 +177,7 @@ bool EdgeCutsOf(const cv::Mat& gray, const Eigen::Vector2d& from, const Eigen::V
     if (cut.first == kNone || !Profile(gray, cut.base, normal, cut.first, half, &cut.grey))
       continue;
     cut.light_last = grey.back() > grey.front();  // from the first, shorter cut
-    if (t <= kLast) {
+    if (t <= last_t) {
       const int n = static_cast<int>(cut.grey.size()), ends = std::max(1, n / 6);
       double a = 0, b = 0;
       for (int i = 0; i < ends; ++i) a += cut.grey[i], b += cut.grey[n - 1 - i];
@@ -251,11 +262,11 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
 
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
                      Eigen::Vector2d* corner, bool* left_out, std::array<double, 2>* levels,
-                     double level) {
+                     double level, int border_bits) {
   if (left_out != nullptr) *left_out = false;
   EdgeCuts cuts_a, cuts_b;
-  if (!EdgeCutsOf(gray, p[k], p[(k + 1) % 4], &cuts_a) ||
-      !EdgeCutsOf(gray, p[k], p[(k + 3) % 4], &cuts_b))
+  if (!EdgeCutsOf(gray, p[k], p[(k + 1) % 4], border_bits, &cuts_a) ||
+      !EdgeCutsOf(gray, p[k], p[(k + 3) % 4], border_bits, &cuts_b))
     return false;
   // The two edges' light levels differ: beside the lighter one is the gap's white, beside the
   // other a paper margin of a few pixels blurred onto a dark surround, whose white is never

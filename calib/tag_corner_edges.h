@@ -36,9 +36,13 @@ bool CrossingSquareAt(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>&
 // `level`: where between the edge's dark (0) and light (1) levels each cut places the edge;
 // halfway (0.5) is the printed edge when the grey is linear in the light (calib/tag_dilation.h
 // finds the one for a tone curve).
+// `border_bits`: the tag's black border (1 or 2 bits of its 8 or 10): an edge too short for its
+// levels to be read near the corner is placed only where the border along it is 2.5 px thick
+// or more.
 bool CornerFromEdges(const cv::Mat& gray, const std::array<Eigen::Vector2d, 4>& p, int k,
                      Eigen::Vector2d* corner, bool* left_out = nullptr,
-                     std::array<double, 2>* levels = nullptr, double level = 0.5);
+                     std::array<double, 2>* levels = nullptr, double level = 0.5,
+                     int border_bits = 1);
 
 // An edge whose light level lies more than this part of the dark-to-light range below that of
 // the other edges of its tag is beside a margin too narrow for its blur: its corner is left out.

@@ -32,9 +32,12 @@ struct Tag {
 // (perspective), blurred by `blur_sigma_px` (0: sharp), grey noise sigma 2. `bend` > 0 bends
 // the tag's edges as a barrel lens does near the imager's corner: each point moved towards a
 // centre kBendCentrePx away up and to the left by bend * (its distance from there)^3 / 1e6
-// (bend 1: a 96 px edge bows about 0.5 px).
+// (bend 1: a 96 px edge bows about 0.5 px). `width` < 1 narrows the tag across (a board seen
+// at a slant): its width is `width` times its height before the turn. `border_bits`: the tag's
+// black border, 1 (OpenCV's) or 2 (Kalibr's).
 constexpr double kBendCentrePx = 250;
-Tag Render(double edge_px, double turn_rad, double blur_sigma_px, unsigned seed, double bend = 0) {
+Tag Render(double edge_px, double turn_rad, double blur_sigma_px, unsigned seed, double bend = 0,
+           double width = 1, int border_bits = 1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> jitter(-0.08 * edge_px, 0.08 * edge_px);
   Tag tag;
@@ -43,7 +46,7 @@ Tag Render(double edge_px, double turn_rad, double blur_sigma_px, unsigned seed,
   const double unit[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
   std::vector<cv::Point2f> from, to;
   for (int k = 0; k < 4; ++k) {
-    const Eigen::Vector2d u(0.5 * edge_px * unit[k][0], 0.5 * edge_px * unit[k][1]);
+    const Eigen::Vector2d u(0.5 * width * edge_px * unit[k][0], 0.5 * edge_px * unit[k][1]);
     tag.corner[k] = centre + Eigen::Vector2d(c * u.x() - s * u.y(), s * u.x() + c * u.y()) +
                     Eigen::Vector2d(jitter(rng), jitter(rng));
     // The marker's outer corners (pixel centres at integers) and where they land in the
@@ -55,7 +58,7 @@ Tag Render(double edge_px, double turn_rad, double blur_sigma_px, unsigned seed,
   }
   cv::Mat marker, fine;
   cv::aruco::drawMarker(cv::aruco::getPredefinedDictionary(cv::aruco::DICT_APRILTAG_36h11), 7,
-                        kMarkerPx, marker, 1);
+                        kMarkerPx, marker, border_bits);
   marker.convertTo(marker, CV_32F, (kWhite - kBlack) / 255.0, kBlack);
   cv::warpPerspective(marker, fine, cv::getPerspectiveTransform(from, to),
                       cv::Size(kSamples * kImagePx, kSamples * kImagePx), cv::INTER_LINEAR,
@@ -121,14 +124,14 @@ struct Errors {
 };
 
 // Over tags of `sizes_px` at several turns: cornerSubPix's corners, and the edges' meeting
-// point started from them (as the detector does).
+// point started from them (as the detector does). `width`, `border_bits`: Render's.
 Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 64, 96},
-               double bend = 0) {
+               double bend = 0, double width = 1, int border_bits = 1) {
   Errors e;
   unsigned seed = 1;
   for (double edge_px : sizes_px)
     for (double turn_rad : {0.05, 0.4, 0.9, 1.3}) {
-      const Tag tag = Render(edge_px, turn_rad, blur_sigma_px, seed++, bend);
+      const Tag tag = Render(edge_px, turn_rad, blur_sigma_px, seed++, bend, width, border_bits);
       const std::array<Eigen::Vector2d, 4> saddle = CornerSubPix(tag);
       const Eigen::Vector2d centre =
           0.25 * (tag.corner[0] + tag.corner[1] + tag.corner[2] + tag.corner[3]);
@@ -136,7 +139,8 @@ Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 
         const Eigen::Vector2d out = (tag.corner[k] - centre).normalized();
         Eigen::Vector2d corner;
         e.crossing_squares += CrossingSquareAt(tag.gray, saddle, k);
-        if (!CornerFromEdges(tag.gray, saddle, k, &corner)) continue;
+        if (!CornerFromEdges(tag.gray, saddle, k, &corner, nullptr, nullptr, 0.5, border_bits))
+          continue;
         ++e.corners, ++e.from_edges;
         e.saddle_rms_px += (saddle[k] - tag.corner[k]).squaredNorm();
         e.edges_rms_px += (corner - tag.corner[k]).squaredNorm();
@@ -148,11 +152,9 @@ Errors Measure(double blur_sigma_px, const std::vector<double>& sizes_px = {40, 
   e.saddle_rms_px = std::sqrt(e.saddle_rms_px / n), e.edges_rms_px = std::sqrt(e.edges_rms_px / n);
   e.saddle_out_px /= n, e.edges_out_px /= n;
   std::printf(
-      "bend %.1f, blur %.1f px, tags %.0f-%.0f px: %d corners, cornerSubPix %.3f px rms (out "
-      "%.3f), edges "
-      "%.3f px rms "
-      "(out %.3f)\n",
-      bend, blur_sigma_px, sizes_px.front(), sizes_px.back(), e.corners, e.saddle_rms_px,
+      "bend %.1f, width %.2f, blur %.1f px, tags %.0f-%.0f px: %d corners, cornerSubPix %.3f px "
+      "rms (out %.3f), edges %.3f px rms (out %.3f)\n",
+      bend, width, blur_sigma_px, sizes_px.front(), sizes_px.back(), e.corners, e.saddle_rms_px,
       e.saddle_out_px, e.edges_rms_px, e.edges_out_px);
   return e;
 }
@@ -191,6 +193,24 @@ TEST(TagCornerEdgesTest, SmallBlurredTagCornerNotPulledIn) {
   EXPECT_EQ(e.crossing_squares, 0);
   EXPECT_EQ(e.corners, 32);
   EXPECT_LT(e.edges_rms_px, 0.1);
+  EXPECT_LT(std::abs(e.edges_out_px), 0.05);
+}
+
+// A tag seen at a slant (Kalibr's 2-bit border), 32-34 px tall and half as wide, blurred 1 px: the
+// edges' levels are read from the cuts near the corner, kFirst..kLast of the edge and 1.5 px past
+// the cut's reach from it, and on an edge under 17.5 px fewer than five cuts were there: no edge,
+// and the detector kept cornerSubPix's saddle, 0.3-0.8 px into the tag (calib_detect_elsewhere
+// --border-bits 2 --margin 0.1 --gamma 0.5 --contrast 0.6 --vignette 0.5 --seeds 3 --only
+// light_blur: view 6's right-hand tags, 14.7-17.8 px wide; the lens 0.103 px RMS from the
+// truth where the boards were seen). Now the levels are read from five cuts at least where the
+// border along the edge is 2.5 px thick or more: 4 -> 32 corners, 0.058 px rms (cornerSubPix
+// 0.365 px, 0.328 px into the tag). With OpenCV's 1-bit border (under 2.5 px on these tags)
+// such corners lay 0.13 px out of the tag (0.23 px rms) and are not placed so.
+TEST(TagCornerEdgesTest, NarrowTagsCornersFromTheirEdges) {
+  const Errors e = Measure(1, {32, 34}, 0, 0.5, 2);
+  EXPECT_EQ(e.corners, 32);  // before: 4
+  EXPECT_LT(e.saddle_out_px, -0.1);
+  EXPECT_LT(e.edges_rms_px, 0.15);
   EXPECT_LT(std::abs(e.edges_out_px), 0.05);
 }
 
