@@ -78,7 +78,7 @@ class Rasterizer {
 
  private:
   struct RayTable;
-  // Bounds of runs of consecutive triangles, for culling whole runs per frame (computed once
+  // Bounds of runs of triangles near in space, for culling whole runs per frame (computed once
   // per mesh and cached; see ClustersFor).
   struct TriangleClusters;
   struct ClusterCache;
