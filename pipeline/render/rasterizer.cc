@@ -498,9 +498,15 @@ struct NearestInverseDepth {
 // buffer, as a maximum does not depend on the order, and the rows scan vectorized.
 class InverseDepthShards {
  public:
-  InverseDepthShards(float* output, size_t samples, double inv_near,
+  // Only samples [first, end) are scanned (the rest of each spare is never read).
+  InverseDepthShards(float* output, size_t samples, size_t first, size_t end, double inv_near,
                      std::deque<std::vector<float>>* spares)
-      : output_(output), samples_(samples), inv_near_(inv_near), spares_(spares) {}
+      : output_(output),
+        samples_(samples),
+        first_(first),
+        end_(end),
+        inv_near_(inv_near),
+        spares_(spares) {}
   // A buffer no other task writes until it is released.
   NearestInverseDepth Acquire() const {
     std::vector<float>* spare = nullptr;
@@ -518,7 +524,9 @@ class InverseDepthShards {
       if (used_spares_ == spares_->size()) spares_->emplace_back();
       spare = &(*spares_)[used_spares_++];  // a deque: stays put while others are added
     }
-    spare->assign(samples_, 0.0f);  // outside the lock: the other tasks go on
+    // Outside the lock: the other tasks go on.
+    if (spare->size() != samples_) spare->assign(samples_, 0.0f);
+    std::fill(spare->begin() + first_, spare->begin() + end_, 0.0f);
     std::lock_guard<std::mutex> lock(mutex_);
     used_.push_back(spare->data());
     return {spare->data(), inv_near_};
@@ -532,7 +540,7 @@ class InverseDepthShards {
 
  private:
   float* output_;
-  size_t samples_;
+  size_t samples_, first_, end_;
   double inv_near_;
   std::deque<std::vector<float>>* spares_;
   mutable std::mutex mutex_;
@@ -912,9 +920,10 @@ void ScanBucketRows(const Table& t, int row_lo, int row_hi, const TriangleSetup*
 
 template <bool kDirect, class Record, class BandRecord>
 void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
-                          const Record& record, const BandRecord* band_record,
-                          const double* view) const {
+                          const Record& record, const BandRecord* band_record, const double* view,
+                          const int* rows) const {
   const RayTable& t = *rays_;
+  const int row_lo = rows ? rows[0] : 0, row_hi = rows ? rows[1] : t.height;
   const double whole[4] = {t.x0, t.y0, t.x0 + t.cell_w * t.cols, t.y0 + t.cell_h * t.rows};
   if (!view) view = whole;
   const double near_m = options_.near_m;
@@ -973,7 +982,7 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
           if (samples > kLargeTriangleSamples)
             large[c].emplace_back(tri, s);
           else
-            ScanGridTriangle(t, s, tri, 0, t.height, task->Get());
+            ScanGridTriangle(t, s, tri, row_lo, row_hi, task->Get());
         }
       }
     }
@@ -985,7 +994,9 @@ void Rasterizer::Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_loca
     const int num_bands = (t.height + kBandRows - 1) / kBandRows;
     cv::parallel_for_(cv::Range(0, num_bands), [&](const cv::Range& range) {
       for (int band = range.start; band < range.end; ++band) {
-        const int band_lo = band * kBandRows, band_hi = std::min(t.height, band_lo + kBandRows);
+        const int band_lo = std::max(row_lo, band * kBandRows);
+        const int band_hi = std::min({t.height, row_hi, band * kBandRows + kBandRows});
+        if (band_lo >= band_hi) continue;
         for (const auto& [tri, setup] : all) {
           if (setup.row0 >= band_hi || setup.row1 < band_lo) continue;
           if (band_record)
@@ -1094,6 +1105,7 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   // more sample all round, so that rounding never leaves out a triangle that covers one.
   double window_view[4];
   const double* view = nullptr;
+  int rows[2] = {0, t.height};  // the grid's rows scanned
   const int n = options_.supersample;
   const cv::Rect samples(window.x * n - 1, window.y * n - 1, window.width * n + 2,
                          window.height * n + 2);
@@ -1109,13 +1121,16 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
     window_view[2] = t.col_x[in_grid.br().x - 1];
     window_view[3] = t.row_y[in_grid.br().y - 1];
     view = window_view;
+    rows[0] = in_grid.y, rows[1] = in_grid.br().y;
   }
   if (!depth->isContinuous()) depth->release();  // rays index the samples as one array
   depth->create(t.height, t.width, CV_32F);
   // Inverse depth in place (0: no hit), then depth. The nearest hit is the largest float
   // inverse depth: a maximum, so the result does not depend on the visiting order.
   cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
-    for (int r = range.start; r < range.end; ++r) std::fill_n(depth->ptr<float>(r), t.width, 0.0f);
+    for (int r = range.start; r < range.end; ++r)
+      std::fill_n(depth->ptr<float>(r), t.width,
+                  r >= rows[0] && r < rows[1] ? 0.0f : std::numeric_limits<float>::infinity());
   });
   float* inv = depth->ptr<float>();
   const double inv_near = 1.0 / options_.near_m;
@@ -1127,11 +1142,13 @@ void Rasterizer::RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_fro
   } else {
     // Triangles scanned by whichever thread set them up, each task into a buffer of its own;
     // the large triangles after, one thread per band of rows, into the output.
-    const InverseDepthShards shards(inv, t.by_sample.size(), inv_near, &depth_shard_spares);
-    Traverse<true>(mesh, cam_from_local, shards, &exclusive_record, view);
+    const size_t width = static_cast<size_t>(t.width);
+    const InverseDepthShards shards(inv, t.by_sample.size(), rows[0] * width, rows[1] * width,
+                                    inv_near, &depth_shard_spares);
+    Traverse<true>(mesh, cam_from_local, shards, &exclusive_record, view, rows);
     spares = shards.Spares();
   }
-  cv::parallel_for_(cv::Range(0, t.height), [&](const cv::Range& range) {
+  cv::parallel_for_(cv::Range(rows[0], rows[1]), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       float* d = depth->ptr<float>(r);
       const size_t row = static_cast<size_t>(r) * t.width;
