@@ -187,7 +187,30 @@ Eigen::Vector3d PlanePoint(const BaseBuffer& buffer, int i, int j) {
 struct TexelOwners {
   std::vector<int32_t> owner;
   std::vector<Eigen::Vector3f> point;
+  // Laying out only (nothing but the folds and the count is kept): `point` holds only the
+  // slivers' centroids, the texels in `sliver`; any other owned texel's point is worked out
+  // again from its triangle (`corner0` and `normal`, by position in the buffer's list) where
+  // another triangle covers its centre, the same in every bit.
+  bool points_on_demand = false;
+  std::unordered_set<size_t> sliver;
+  std::vector<Eigen::Vector3d> corner0, normal;
 };
+
+// Texel (i, j)'s centre on the buffer's plane moved along the buffer's normal onto the plane
+// of the triangle through `corner` with normal `normal`.
+Eigen::Vector3d PointOver(const BaseBuffer& buffer, int i, int j, const Eigen::Vector3d& corner,
+                          const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d pp = PlanePoint(buffer, i, j);
+  return pp + buffer.normal * ((corner - pp).dot(normal) / buffer.normal.dot(normal));
+}
+
+// The point texel `idx` = (i, j) holds (it has an owner).
+Eigen::Vector3f HeldPoint(const BaseBuffer& buffer, const TexelOwners& texels, size_t idx, int i,
+                          int j) {
+  if (!texels.points_on_demand || texels.sliver.count(idx)) return texels.point[idx];
+  const int li = texels.owner[idx];
+  return PointOver(buffer, i, j, texels.corner0[li], texels.normal[li]).cast<float>();
+}
 
 // One triangle as placed on the buffer: its position in the buffer's list, its corners in
 // texel coordinates and in the mesh, and its normal.
@@ -207,7 +230,6 @@ bool CoverCentres(const BaseBuffer& buffer, const PlacedTriangle& tri, TexelOwne
   const Eigen::Vector2d* q = tri.q;
   const int w = buffer.width, h = buffer.height;
   const double s = buffer.texel_size_m;
-  const Eigen::Vector3d& n = buffer.normal;
   const int i0 =
       std::max(0, static_cast<int>(std::floor(std::min({q[0].x(), q[1].x(), q[2].x()}) - 0.5)));
   const int i1 =
@@ -216,9 +238,6 @@ bool CoverCentres(const BaseBuffer& buffer, const PlacedTriangle& tri, TexelOwne
       std::max(0, static_cast<int>(std::floor(std::min({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
   const int j1 =
       std::min(h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
-  const Eigen::Vector3d& A = tri.corner[0];
-  const Eigen::Vector3d& nt = tri.normal;
-  const double denom = n.dot(nt);
   bool covers_a_centre = false;
   for (int j = j0; j <= j1; ++j) {
     for (int i = i0; i <= i1; ++i) {
@@ -230,16 +249,17 @@ bool CoverCentres(const BaseBuffer& buffer, const PlacedTriangle& tri, TexelOwne
       }
       if (!inside) continue;
       covers_a_centre = true;
-      const Eigen::Vector3d pp = PlanePoint(buffer, i, j);
-      const Eigen::Vector3d m = pp + n * ((A - pp).dot(nt) / denom);
       const size_t idx = static_cast<size_t>(j) * w + i;
       if (texels->owner[idx] >= 0) {
         // Shared edge: same point. Different point: the projection folds here.
-        if ((texels->point[idx].cast<double>() - m).norm() > 0.5 * s) *folded = 1;
+        const Eigen::Vector3d m = PointOver(buffer, i, j, tri.corner[0], tri.normal);
+        if ((HeldPoint(buffer, *texels, idx, i, j).cast<double>() - m).norm() > 0.5 * s)
+          *folded = 1;
         continue;
       }
       texels->owner[idx] = tri.li;
-      texels->point[idx] = m.cast<float>();
+      if (!texels->points_on_demand)
+        texels->point[idx] = PointOver(buffer, i, j, tri.corner[0], tri.normal).cast<float>();
     }
   }
   return covers_a_centre;
@@ -276,6 +296,7 @@ void PlaceTriangle(const TriangleMesh& mesh, const BaseBuffer& buffer, int li,
     texels->owner[idx] = li;
     texels->point[idx] =
         ((mesh.Corner(t, 0) + mesh.Corner(t, 1) + mesh.Corner(t, 2)) / 3.0).cast<float>();
+    if (texels->points_on_demand) texels->sliver.insert(idx);
   }
 }
 
@@ -427,6 +448,12 @@ BaseBuffer BuildOne(const TriangleMesh& mesh, const std::vector<int>& triangles,
   std::vector<uint8_t> is_folded(num_local, 0);
   std::vector<Eigen::Vector3d> normal_of(num_local);
   for (int li = 0; li < num_local; ++li) normal_of[li] = mesh.Normal(triangles[li]);
+  if (options.layout_only) {
+    texels.points_on_demand = true;
+    texels.normal = normal_of;
+    texels.corner0.resize(num_local);
+    for (int li = 0; li < num_local; ++li) texels.corner0[li] = mesh.Corner(triangles[li], 0);
+  }
   for (int li = 0; li < num_local; ++li)
     PlaceTriangle(mesh, buffer, li, normal_of[li], &texels, &is_folded[li]);
   for (int li = 0; li < num_local; ++li)

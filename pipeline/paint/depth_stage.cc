@@ -102,6 +102,12 @@ void PaintSession::DepthStage(FrameWork* work) {
     cache.rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_, window);
     // The share of the image the depth was rasterized in (1: the whole image).
     const cv::Rect image(0, 0, work->camera->width, work->camera->height);
+    depth_rows_[0] = 0, depth_rows_[1] = -1;
+    if (!window.empty()) {
+      // Exact there and a pixel about it (RasterizeDepth): so is each row's 2x2 range.
+      const int n = cache.rasterizer->options().supersample;
+      depth_rows_[0] = std::max(0, window.y * n), depth_rows_[1] = std::max(0, window.br().y * n);
+    }
     report.metrics["window_fraction"] =
         window.empty() ? 1.0 : static_cast<double>((window & image).area()) / image.area();
     if (work->debug) {

@@ -863,10 +863,11 @@ __attribute__((target_clones("arch=x86-64-v4", "avx2", "default"))) void DepthRa
 
 }  // namespace
 
-void DepthRange2x2(const cv::Mat& depth, cv::Mat* range) {
+void DepthRange2x2(const cv::Mat& depth, cv::Mat* range, int row0, int row1) {
   const int w = depth.cols, h = depth.rows;
   range->create(h, w, CV_32FC2);
-  cv::parallel_for_(cv::Range(0, h), [&](const cv::Range& rows) {
+  row0 = std::clamp(row0, 0, h), row1 = row1 < 0 ? h : std::clamp(row1, row0, h);
+  cv::parallel_for_(cv::Range(row0, row1), [&](const cv::Range& rows) {
     for (int y = rows.start; y < rows.end; ++y)
       DepthRangeRow(depth.ptr<float>(y), depth.ptr<float>(std::min(y + 1, h - 1)), w,
                     range->ptr<float>(y));

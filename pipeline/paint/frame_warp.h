@@ -33,8 +33,9 @@ NormalizedBounds ComputeNormalizedBounds(const Camera& camera);
 // Per pixel (x, y) of a continuous CV_32F depth map, the least and greatest depth of its 2x2
 // block (x..x+1, y..y+1), as CV_32FC2 of the same size (the last row and column: their own
 // depth). The bilinear occlusion test (every one of the four depths within tolerance of the
-// texel's) is the same test on the pair.
-void DepthRange2x2(const cv::Mat& depth, cv::Mat* range);
+// texel's) is the same test on the pair. Only rows [row0, row1) when given (row1 -1: to the
+// last; the other rows left as they were).
+void DepthRange2x2(const cv::Mat& depth, cv::Mat* range, int row0 = 0, int row1 = -1);
 
 // What every buffer of one frame shares.
 struct FrameView {

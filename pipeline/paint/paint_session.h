@@ -389,6 +389,7 @@ class PaintSession {
   std::vector<BackgroundFrame> background_frame_;  // per buffer, this frame's mask
   std::vector<CameraCache> cameras_;
   cv::Mat depth_;        // the current frame's depth map from the video camera (reused)
+  int depth_rows_[2] = {0, -1};  // the rows of its window (DepthStage; -1: to the last)
   cv::Mat depth_range_;  // its 2x2 least and greatest depths, when the warp paints (reused)
   const Camera* frame_camera_ = nullptr;  // the current frame's camera and pose
   Rigid3d frame_cam_from_local_;

@@ -56,7 +56,9 @@ void PaintSession::WarpStage(FrameWork* work) {
   rule.held_out = work->held_out && rule.mean_too;  // as PaintBuffer takes it
   if (work->paint_in_warp && view.depth && !in_frustum.empty() &&
       options_.sampling == SamplingMode::kBilinear) {
-    DepthRange2x2(depth_, &depth_range_);  // one pair per texel instead of four depths
+    // One pair per texel instead of four depths; only in the depth's window's rows (the warp
+    // reads no other: OwnBuffersWindow).
+    DepthRange2x2(depth_, &depth_range_, depth_rows_[0], depth_rows_[1]);
     view.depth_range = &depth_range_;
   }
   work->paint_stats.assign(set_.buffers.size(), PaintUpdateStats());

@@ -58,8 +58,9 @@ class Rasterizer {
   // output images: 1.25 against 3.00 ms at 1280x720, paint_bench BM_DepthRaster).
   void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local,
                       cv::Mat* depth) const;
-  // ... exact within `window` (the camera's pixels; empty: the whole image) and anything
-  // outside it: only the triangles whose bounds meet the window's part of the view are set up
+  // ... exact within `window` (the camera's pixels; empty: the whole image) and one sample
+  // about it, anything elsewhere: only the triangles whose bounds meet the window's part of
+  // the view are set up, and only its rows are scanned (the rows above and below it infinite)
   // (a lens with distortion: the whole image).
   void RasterizeDepth(const TriangleMesh& mesh, const Rigid3d& cam_from_local, cv::Mat* depth,
                       const cv::Rect& window) const;
@@ -78,7 +79,7 @@ class Rasterizer {
 
  private:
   struct RayTable;
-  // Bounds of runs of consecutive triangles, for culling whole runs per frame (computed once
+  // Bounds of runs of triangles near in space, for culling whole runs per frame (computed once
   // per mesh and cached; see ClustersFor).
   struct TriangleClusters;
   struct ClusterCache;
@@ -90,10 +91,12 @@ class Rasterizer {
   // large triangles are scanned afterwards by bands of rows, one thread a band, through
   // band_record (which need not be: no other thread writes the band's samples then).
   // `view` (x0, y0, x1, y1 of the normalized rays; null: the ray table's bounds): triangles
-  // wholly outside it are not set up.
+  // wholly outside it are not set up. `rows` (direct only; null: all): only the grid's rows
+  // rows[0] <= row < rows[1] are scanned.
   template <bool kDirect, class Record, class BandRecord = Record>
   void Traverse(const TriangleMesh& mesh, const Rigid3d& cam_from_local, const Record& record,
-                const BandRecord* band_record = nullptr, const double* view = nullptr) const;
+                const BandRecord* band_record = nullptr, const double* view = nullptr,
+                const int* rows = nullptr) const;
   Camera camera_;
   RasterOptions options_;
   std::unique_ptr<RayTable> rays_;

@@ -377,8 +377,9 @@ TEST(RasterizerTest, ReleaseThreadScratchGivesTheSetUpsBack) {
   const int cells = 550;
   for (int j = 0; j < cells; ++j)
     for (int i = 0; i < cells; ++i) {
-      const double x = -2.0 + 4.0 * i / cells, y = -1.5 + 3.0 * j / cells;
-      const double dx = 4.0 / cells, dy = 3.0 / cells;
+      // Just inside the view (+-1.33 m by +-1 m at 2 m): none of it is culled.
+      const double x = -1.3 + 2.6 * i / cells, y = -0.975 + 1.95 * j / cells;
+      const double dx = 2.6 / cells, dy = 1.95 / cells;
       AddTriangle(&mesh, {x, y, 2.0}, {x + dx, y, 2.0}, {x, y + dy, 2.0});
       AddTriangle(&mesh, {x + dx, y, 2.0}, {x + dx, y + dy, 2.0}, {x, y + dy, 2.0});
     }
