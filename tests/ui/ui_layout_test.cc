@@ -274,6 +274,30 @@ TEST(UiLayout, ThePaintedBufferCaptionStaysOnALineAtALargerFont) {
   }
 }
 
+// A status message longer than the status bar at a larger font: it is cut short of the
+// font-scale steps at the right, not drawn over them (every glyph of the red message that
+// shows lies left of the steps' first glyph).
+TEST(UiLayout, ALongStatusMessageStopsShortOfTheFontScaleSteps) {
+  LayoutApp app({1280, 800});
+  app.ui.scale.user = 1.5f;
+  app.state.message = "error: " + std::string(200, 'x') + ": not attached";
+  app.Frames(3);
+  const ImDrawList* list = LayoutApp::Window("##status")->DrawList;
+  const ImU32 red = ImGui::ColorConvertFloat4ToU32(ImVec4(1.0f, 0.4f, 0.4f, 1.0f));  // errors
+  float red_right = 0, steps_left = 1e9f;
+  for (const ImDrawCmd& cmd : list->CmdBuffer)
+    for (unsigned i = 0; i < cmd.ElemCount; ++i) {
+      const ImDrawVert& v = list->VtxBuffer[cmd.VtxOffset + list->IdxBuffer[cmd.IdxOffset + i]];
+      if (v.col == red)
+        red_right = std::max(red_right, std::min(v.pos.x, cmd.ClipRect.z));
+      else if (v.col == ImGui::GetColorU32(ImGuiCol_Text))
+        steps_left = std::min(steps_left, v.pos.x);
+    }
+  ASSERT_GT(red_right, 0) << "no message drawn";
+  ASSERT_LT(steps_left, 1280) << "no font-scale steps drawn";
+  EXPECT_LT(red_right, steps_left) << "the message runs over the font-scale steps";
+}
+
 // A path field at the largest font scale: the field starts past its label, never over it
 // (the mouse on the label's last letter is not over the field), as at the default scale.
 struct PathFieldPanel : Panel {
