@@ -80,5 +80,25 @@ TEST(PackedImage, AgainstAReferenceOnlyTheBlocksThatDifferAreStored) {
   EXPECT_EQ(HeldBytes(PackedImage(shadow, nullptr), &alone), shadow.total() * shadow.elemSize());
 }
 
+TEST(PackedImage, ALargeImageUnpacksByteForByteInStripes) {
+  // 3 MB and a short last block: unpacked in stripes on the threads, alone and against a
+  // reference, blocks all zero (or equal to the reference's) between blocks stored.
+  cv::Mat store(513, 383, CV_32FC4);
+  cv::randu(store, -1000.0f, 1000.0f);
+  cv::Mat image = store.clone();
+  image.rowRange(100, 300).setTo(cv::Scalar::all(0));
+  image.at<cv::Vec4f>(512, 382)[3] = -0.0f;  // the last byte's sign bit
+  const PackedImage alone(image, nullptr);
+  EXPECT_TRUE(SameBytes(alone.Unpacked(), image));
+  cv::Mat shadow = store.clone();
+  shadow.at<cv::Vec4f>(7, 5)[1] = 3.0f;
+  shadow.at<cv::Vec4f>(400, 200)[0] = -2.0f;
+  shadow.at<cv::Vec4f>(512, 382)[3] = 9.0f;
+  const PackedImage against(shadow, nullptr, &store);
+  std::set<const void*> blocks;
+  EXPECT_EQ(HeldBytes(against, &blocks), 2 * kBlock + (shadow.total() * 16) % kBlock);
+  EXPECT_TRUE(SameBytes(against.Unpacked(&store), shadow));
+}
+
 }  // namespace
 }  // namespace fresco

@@ -4,10 +4,11 @@
 // at or before it restored, painted on from there) and, to compare, paints the same frames
 // again from the state before the first frame (what a step back cost without the states, the
 // project's opening and pre-pass aside, which it would have repeated too).
-//   step_back_measure PROJECT.json [--frames N] [--every K] [--budget-mb MB] [--set K=V]...
+//   step_back_measure PROJECT.json [--frames N] [--every K] [--budget-mb MB] [--restores R]
+//                     [--set K=V]...
 // Prints the opening, painting and saving times, the states' count and memory, where the last
-// state saved holds its bytes, the step back and the repaint from the first frame, and the
-// peak resident memory.
+// state saved holds its bytes, the step back, the restore alone (the step back's state restored
+// R times more, the median), the repaint from the first frame, and the peak resident memory.
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -87,10 +88,10 @@ int main(int argc, char** argv) {
   if (argc < 2) {
     std::fprintf(stderr,
                  "usage: step_back_measure PROJECT.json [--frames N] [--every K] "
-                 "[--budget-mb MB] [--set KEY=VALUE]...\n");
+                 "[--budget-mb MB] [--restores R] [--set KEY=VALUE]...\n");
     return 2;
   }
-  int frames = 200, every = 10, budget_mb = 1024;
+  int frames = 200, every = 10, budget_mb = 1024, restores = 5;
   std::vector<std::string> overrides;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
@@ -100,6 +101,8 @@ int main(int argc, char** argv) {
       every = std::atoi(argv[i + 1]);
     } else if (flag == "--budget-mb") {
       budget_mb = std::atoi(argv[i + 1]);
+    } else if (flag == "--restores") {
+      restores = std::max(1, std::atoi(argv[i + 1]));
     } else if (flag == "--set") {
       overrides.push_back(argv[i + 1]);
     } else {
@@ -156,6 +159,19 @@ int main(int argc, char** argv) {
   PaintUpTo(&run, back_to, nullptr, &unused, &none);
   const double step_back_seconds = Since(start), step_back_cpu = CpuSeconds() - cpu;
 
+  // The restore alone, again and again (the median: the machine may be shared).
+  std::vector<double> restore_walls, restore_cpus;
+  for (int i = 0; i < restores; ++i) {
+    start = Clock::now();
+    cpu = CpuSeconds();
+    if (!run.Restore(*state).ok()) return 1;
+    restore_walls.push_back(Since(start)), restore_cpus.push_back(CpuSeconds() - cpu);
+  }
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+
   const size_t kept = snapshots.count(), kept_bytes = snapshots.bytes();
   const int spacing = snapshots.every();
 
@@ -203,6 +219,9 @@ int main(int argc, char** argv) {
       "step back      frame %d -> %d: %.3f s, %.3f s CPU (restore %.3f s, %d frames "
       "painted from the state at %d)\n",
       frames, back_to, step_back_seconds, step_back_cpu, restore_seconds, back_to - from, from);
+  std::printf("restore alone  %.3f s, %.3f s CPU (median of %d; the state at %d, %.0f MB held)\n",
+              median(restore_walls), median(restore_cpus), restores, from,
+              state->bytes() / 1048576.0);
   std::printf(
       "from frame 0   %.2f s, %.2f s CPU to paint frames 0-%d again %s(%.1fx the step "
       "back's CPU)\n",

@@ -437,6 +437,38 @@ TEST(UiInput, SeekingBackPublishesItsProgress) {
   EXPECT_EQ(seen.back().status, "paused");
 }
 
+// A step back says where it goes back from as it starts: the saved state it restores, not
+// "reopening" (which it says only where no state is kept, as with no memory for them).
+TEST(UiInput, AStepBackNamesTheSavedStateItGoesBackToNotAReopening) {
+  std::mutex mutex;
+  std::vector<std::string> labels;
+  RunnerOptions options;
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (s.seek_target >= 0) labels.push_back(FrameLabel(s));
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(Capture() + "/project.json").ok());
+  for (const int budget_mb : {1024, 0}) {
+    options.snapshot_budget_mb = budget_mb;
+    PipelineRunner runner(options);
+    runner.Restart(state.project);
+    runner.Seek(11);  // states saved before frames 0 and 10
+    runner.WaitIdle();
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      labels.clear();
+    }
+    runner.Seek(10);  // a step back from frame 11
+    runner.WaitIdle();
+    std::lock_guard<std::mutex> lock(mutex);
+    ASSERT_FALSE(labels.empty());
+    EXPECT_EQ(labels.front(), budget_mb > 0
+                                  ? "seeking to frame 10: from the state saved before frame 10"
+                                  : "seeking to frame 10: reopening");
+  }
+}
+
 // A seek can be stopped (Pause, the panel's Stop): it ends at the last frame it painted,
 // paused, with no seek under way.
 TEST(SeekProgress, PauseStopsASeekWhereItGotTo) {
@@ -467,6 +499,8 @@ TEST(UiInput, SeekProgressIsNamedNotFrameMinusOne) {
   RunnerSnapshot snap;
   snap.seek_target = 40;
   EXPECT_EQ(FrameLabel(snap), "seeking to frame 40: reopening");
+  snap.seek_state = 30;
+  EXPECT_EQ(FrameLabel(snap), "seeking to frame 40: from the state saved before frame 30");
   snap.frame = 17;
   EXPECT_EQ(FrameLabel(snap), "seeking to frame 40: at 17");
   snap.seek_target = -1;
@@ -827,6 +861,7 @@ TEST(UiInput, ThePathFieldBrowsesFoldersUpAndDownAndPicksAFile) {
   const std::string browse = app.dir + "/browse/";
   fs::create_directories(browse + "sub");
   std::ofstream(browse + "mesh.ply") << "ply\n";
+  std::ofstream(browse + "other.ply") << "ply\n";
   std::ofstream(browse + "notes.md") << "not a mesh\n";
   std::ofstream(browse + "sub/inner.obj") << "v 0 0 0\n";
   Activate(app, "Project", "New");
@@ -855,10 +890,16 @@ TEST(UiInput, ThePathFieldBrowsesFoldersUpAndDownAndPicksAFile) {
   EXPECT_EQ(scene(), browse);
   EXPECT_EQ(ParentFolder(browse + "mesh"), app.dir + "/");
   EXPECT_EQ(BrowseEntries(browse, {".ply"}),
-            (std::vector<std::string>{browse + "mesh.ply", browse + "sub/"}));
+            (std::vector<std::string>{browse + "mesh.ply", browse + "other.ply", browse + "sub/"}));
+  EXPECT_EQ(BrowseEntries(browse + "m", {".ply"}), (std::vector<std::string>{browse + "mesh.ply"}));
   pick("mesh.ply");
   EXPECT_EQ(scene(), browse + "mesh.ply");
   EXPECT_EQ(list(), nullptr) << "a file picked closes the list";
+  // Browsing again from the file picked lists its whole folder, to pick another.
+  ImGui::ActivateItem(ImHashStr("...", 0, form->GetID("##scene")));
+  app.Frames(2);
+  pick("other.ply");
+  EXPECT_EQ(scene(), browse + "other.ply") << "the list held only the file picked before";
   EXPECT_EQ(ParentFolder("/"), "");
   EXPECT_EQ(ParentFolder("/usr/"), "/");
   EXPECT_EQ(ParentFolder("mesh.ply"), "../");

@@ -11,6 +11,7 @@
 #include "ui/core/calibration_runner.h"
 #include "ui/core/tile_layout.h"
 #include "ui/panels/panels.h"
+#include "ui/panels/path_field.h"
 
 namespace fresco {
 namespace {
@@ -256,6 +257,82 @@ TEST(UiLayout, ANarrowPanelKeepsItsCaptionsOnAFewLines) {
   };
   EXPECT_LE(caption_lines(60), 4) << "a 60-pixel tile stacks its caption letter by letter";
   EXPECT_LT(caption_lines(600), 1.5f) << "one line where it fits";
+}
+
+// The Painted buffers panel at 1280 x 800 and a larger font: the buffer's caption goes below
+// its slider where it does not fit beside it, instead of wrapping a few letters a line in
+// the room left beside the slider.
+TEST(UiLayout, ThePaintedBufferCaptionStaysOnALineAtALargerFont) {
+  LayoutApp app({1280, 800});
+  for (const float scale : {1.0f, 1.5f, 2.0f}) {
+    app.ui.scale.user = scale;
+    app.Frames(4);
+    const float lines = std::stof(app.ReportOf("Painted buffers", "caption lines"));
+    EXPECT_GE(lines, 0.9f) << "no caption at font scale " << scale;
+    // On a line of its own it may wrap once, at a space (the panel is narrower than it).
+    EXPECT_LT(lines, 2.5f) << "the caption wraps a few letters a line at font scale " << scale;
+  }
+}
+
+// A status message longer than the status bar at a larger font: it is cut short of the
+// font-scale steps at the right, not drawn over them (every glyph of the red message that
+// shows lies left of the steps' first glyph).
+TEST(UiLayout, ALongStatusMessageStopsShortOfTheFontScaleSteps) {
+  LayoutApp app({1280, 800});
+  app.ui.scale.user = 1.5f;
+  app.state.message = "error: " + std::string(200, 'x') + ": not attached";
+  app.Frames(3);
+  const ImDrawList* list = LayoutApp::Window("##status")->DrawList;
+  const ImU32 red = ImGui::ColorConvertFloat4ToU32(ImVec4(1.0f, 0.4f, 0.4f, 1.0f));  // errors
+  float red_right = 0, steps_left = 1e9f;
+  for (const ImDrawCmd& cmd : list->CmdBuffer)
+    for (unsigned i = 0; i < cmd.ElemCount; ++i) {
+      const ImDrawVert& v = list->VtxBuffer[cmd.VtxOffset + list->IdxBuffer[cmd.IdxOffset + i]];
+      if (v.col == red)
+        red_right = std::max(red_right, std::min(v.pos.x, cmd.ClipRect.z));
+      else if (v.col == ImGui::GetColorU32(ImGuiCol_Text))
+        steps_left = std::min(steps_left, v.pos.x);
+    }
+  ASSERT_GT(red_right, 0) << "no message drawn";
+  ASSERT_LT(steps_left, 1280) << "no font-scale steps drawn";
+  EXPECT_LT(red_right, steps_left) << "the message runs over the font-scale steps";
+}
+
+// A path field at the largest font scale: the field starts past its label, never over it
+// (the mouse on the label's last letter is not over the field), as at the default scale.
+struct PathFieldPanel : Panel {
+  const char* Title() const override { return "Path"; }
+  void Draw(UiContext&) override {
+    if (BeginPanel(*this)) {
+      label_at = ImGui::GetCursorScreenPos();
+      PathField("Folder", "##folder", "the pictures' folder/", &folder, {});
+    }
+    ImGui::End();
+  }
+  std::string folder;
+  ImVec2 label_at;
+};
+
+TEST(UiLayout, APathFieldStartsPastItsLabelAtEveryFontScale) {
+  LayoutApp app({1280, 800});
+  PathFieldPanel panel;
+  panel.tiled = true;
+  panel.tile_pos = ImVec2(0, 40);
+  panel.tile_size = ImVec2(500, 200);
+  for (const float scale : {1.0f, kFontScaleSteps[std::size(kFontScaleSteps) - 1]}) {
+    float applied = 0;
+    ApplyUiScale(scale, &applied);
+    testing::ImGuiHeadless::DrawPanel(app.ui, panel, {500, 200});  // where the label is
+    const auto hovered_at = [&](float x) {
+      ImGui::GetIO().MousePos =
+          ImVec2(panel.label_at.x + x, panel.label_at.y + 0.5f * ImGui::GetFontSize());
+      for (int i = 0; i < 2; ++i) testing::ImGuiHeadless::DrawPanel(app.ui, panel, {500, 200});
+      return GImGui->HoveredId == LayoutApp::Window("Path")->GetID("##folder");
+    };
+    const float label = ImGui::CalcTextSize("Folder").x;
+    EXPECT_FALSE(hovered_at(label - 2)) << "the field over its label at font scale " << scale;
+    EXPECT_TRUE(hovered_at(label + 4 * ImGui::GetFontSize())) << "the field, at " << scale;
+  }
 }
 
 // The font scale steps (issue 58, item 8): A+ and A- in the status bar and Ctrl+= / Ctrl+-

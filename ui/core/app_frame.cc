@@ -201,14 +201,16 @@ void HandleShortcuts(UiContext& ui) {
 
 // The font scale at the status bar's right end: A- and A+ step it (kFontScaleSteps). Drawn
 // first, the message then starts at the left.
-void DrawFontScaleSteps(UiContext& ui) {
+// Returns where the steps start (screen x): the status message is cut short of them.
+float DrawFontScaleSteps(UiContext& ui) {
   const ImGuiStyle& style = ImGui::GetStyle();
   const std::string label = std::to_string(static_cast<int>(ui.scale.user * 100 + 0.5f)) + " %";
   const float width = ImGui::CalcTextSize("A-").x + ImGui::CalcTextSize("A+").x +
                       ImGui::CalcTextSize(label.c_str()).x + 4 * style.FramePadding.x +
                       2 * style.ItemSpacing.x;
   const ImVec2 start = ImGui::GetCursorPos();
-  ImGui::SetCursorPosX(ImGui::GetWindowContentRegionMax().x - width);
+  const float left = ImGui::GetWindowContentRegionMax().x - width;
+  ImGui::SetCursorPosX(left);
   const float smallest = kFontScaleSteps[0];
   const float largest = kFontScaleSteps[std::size(kFontScaleSteps) - 1];
   ImGui::BeginDisabled(ui.scale.user <= smallest);
@@ -225,6 +227,7 @@ void DrawFontScaleSteps(UiContext& ui) {
   if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled))
     ImGui::SetTooltip("larger text (Ctrl+=; Ctrl+0: 100 %%)");
   ImGui::SetCursorPos(start);
+  return ImGui::GetWindowPos().x + left;
 }
 
 void DrawStatusBar(UiContext& ui) {
@@ -234,7 +237,12 @@ void DrawStatusBar(UiContext& ui) {
   ImGui::Begin("##status", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoScrollWithMouse |
                    ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus);
-  DrawFontScaleSteps(ui);
+  const float steps_x = DrawFontScaleSteps(ui);
+  // The messages stop short of the font-scale steps (a long one is cut, not drawn over them).
+  const ImVec2 pos = ImGui::GetWindowPos();
+  ImGui::PushClipRect(
+      pos, ImVec2(steps_x - ImGui::GetStyle().ItemSpacing.x, pos.y + ImGui::GetWindowSize().y),
+      true);
   // One message: the worker's error replaces "opened ..." (the project named a file it
   // could not read); other messages (saved, grouping edited) stay beside it.
   const std::string& message = ui.state->message;
@@ -253,6 +261,7 @@ void DrawStatusBar(UiContext& ui) {
     ImGui::SameLine();  // a live source that stalled, dropped or ended
     ImGui::TextColored(kErrorColour, "  live: %s", problem.c_str());
   }
+  ImGui::PopClipRect();
   ImGui::End();
 }
 

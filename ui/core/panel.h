@@ -154,13 +154,18 @@ void ShowImage(UiContext& ui, const std::string& key, const cv::Mat& image, uint
                float max_width = 0);
 // The frame the user is looking at: a seek's target while it runs, else the last painted.
 int ShownFrame(const RunnerSnapshot& snap);
-// "frame 12", "seeking to frame 40: at 17", "no frame painted yet".
+// "frame 12", "seeking to frame 40: at 17", "no frame painted yet"; going back, "seeking to
+// frame 13: from the state saved before frame 10" (or ": reopening" without one).
 std::string FrameLabel(const RunnerSnapshot& snap);
 // Layout in narrow panels: the next item's width so that `following` (a button's label on
 // the same line after it, or a widget's own label) still fits, at least `min_px`; and
 // SameLine only when an item `next_width` wide fits after the last one (else a new line).
 void FitNextItem(const char* following = nullptr, float min_px = 40);
 void SameLineIfFits(float next_width);
+// After a form's label (a path field's "Folder", "Save to"): the field on the same line, in
+// the form's column (80 pixels at the default font, growing with the font scale), or just past
+// the label where it is wider, never over it.
+void SameLineInFieldColumn();
 // A labelled widget (slider, drag, combo) that keeps its value readable in a narrow panel or
 // at a large font scale: when the width it has beside its label (CalcItemWidth) is less than
 // kMinFieldEm font sizes, `label` goes on a line of its own above and the widget takes the

@@ -1,6 +1,9 @@
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+
+#include <imgui_internal.h>
 
 #include "pipeline/poses/colmap_log_progress.h"
 #include "ui/core/job_estimate.h"
@@ -131,12 +134,24 @@ void SameLineIfFits(float next_width) {
     ImGui::SameLine();
 }
 
+void SameLineInFieldColumn() {
+  constexpr float kColumnPx = 80, kDefaultFontPx = 13;
+  const ImGuiWindow* w = ImGui::GetCurrentWindow();
+  // SameLine's offsets count from here (the window's left, or the table column's).
+  const float origin = w->Pos.x - w->Scroll.x + w->DC.GroupOffset.x + w->DC.ColumnsOffset.x;
+  const float past_label = ImGui::GetItemRectMax().x - origin + ImGui::GetStyle().ItemSpacing.x;
+  ImGui::SameLine(std::max(kColumnPx / kDefaultFontPx * ImGui::GetFontSize(), past_label));
+}
+
 int ShownFrame(const RunnerSnapshot& snap) {
   return snap.seek_target >= 0 ? snap.seek_target : snap.frame;
 }
 
 std::string FrameLabel(const RunnerSnapshot& snap) {
   const std::string target = std::to_string(snap.seek_target);
+  if (snap.seek_target >= 0 && snap.frame < 0 && snap.seek_state >= 0)
+    return "seeking to frame " + target + ": from the state saved before frame " +
+           std::to_string(snap.seek_state);
   if (snap.seek_target >= 0 && snap.frame < 0) return "seeking to frame " + target + ": reopening";
   if (snap.seek_target >= 0)
     return "seeking to frame " + target + ": at " + std::to_string(snap.frame);

@@ -463,6 +463,9 @@ bool PipelineRunner::Handle(Command command, Clock::time_point* last_publish) {
         // buffers); progress follows as frames are painted.
         seek_target_ = command.frame;
         working_.frame = -1;
+        int state_frame = -1;
+        working_.seek_state =
+            session_->snapshots->AtOrBefore(command.frame, &state_frame) ? state_frame : -1;
         Publish(false);
         if (!SeekBackFromSnapshot(command.frame)) {
           const Project project = session_->project;

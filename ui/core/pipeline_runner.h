@@ -71,6 +71,9 @@ struct RunnerSnapshot {
   // The frame the last seek painted from: forward, the one after the frame shown; back, the
   // frame of the saved state it went back to (RunSnapshots; 0 when it reopened the project).
   int seek_from = -1;
+  // A seek back under way, while it goes back (`frame` -1): the frame of the saved state it
+  // restores (the state before that frame), -1 when it reopens the project instead.
+  int seek_state = -1;
   std::string frame_name;
   bool has_pose = false;
   Rigid3d cam_from_world;

@@ -121,9 +121,12 @@ std::vector<std::string> BrowseEntries(const std::string& typed,
                                        const std::vector<std::string>& extensions) {
   const std::string::size_type slash = typed.rfind('/');
   const std::string folder = slash == std::string::npos ? "." : typed.substr(0, slash + 1);
-  const std::string prefix = slash == std::string::npos ? typed : typed.substr(slash + 1);
+  std::string prefix = slash == std::string::npos ? typed : typed.substr(slash + 1);
   std::vector<std::string> entries;
   std::error_code ec;
+  // A field holding a file's whole name (picked before) lists its whole folder, to pick
+  // another: the name filters the list only while it is being typed.
+  if (!prefix.empty() && fs::is_regular_file(typed, ec)) prefix.clear();
   for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
     const std::string name = it->path().filename().string();
     if (name.rfind(prefix, 0) != 0 || name.front() == '.') continue;

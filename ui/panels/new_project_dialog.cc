@@ -119,7 +119,7 @@ class NewProjectDialog : public Panel {
   // (or rough poses) that place them on the mesh and COLMAP's speed options.
   void DrawPosesChoice(std::string* last_folder) {
     ImGui::TextUnformatted("Poses from");
-    ImGui::SameLine(80);
+    SameLineInFieldColumn();
     int choice = form_.bootstrap ? 1 : 0;
     ImGui::RadioButton("a file or live feed", &choice, 0);
     ImGui::SameLine();

@@ -61,7 +61,7 @@ std::string BrowseNote(const std::string& value, const PathFieldOptions& options
 bool PathField(const char* label, const char* id, const char* hint, std::string* value,
                const PathFieldOptions& options) {
   ImGui::TextUnformatted(label);
-  ImGui::SameLine(80);
+  SameLineInFieldColumn();
   FitNextItem("...", options.min_width_px);
   bool changed = ImGui::InputTextWithHint(id, hint, value);
   if (ImGui::IsItemDeactivatedAfterEdit()) Remember(*value, options.last_folder);

@@ -194,23 +194,30 @@ class PaintedBuffersPanel : public Panel {
     buffer_ = std::clamp(buffer_, 0, n - 1);
     ImGui::SetNextItemWidth(120);
     ImGui::SliderInt("buffer", &buffer_, 0, n - 1);
+    caption_lines_ = 0;
     if (snap.geometry && buffer_ < static_cast<int>(snap.geometry->groups.size())) {
-      ImGui::SameLine();
-      ImGui::Text("%zu triangles, %d texels", snap.geometry->groups[buffer_].triangles.size(),
-                  snap.geometry->buffer_texels[buffer_]);
+      // Beside the slider where it fits, else below it (not wrapped a few letters a line).
+      const std::string caption = std::to_string(snap.geometry->groups[buffer_].triangles.size()) +
+                                  " triangles, " +
+                                  std::to_string(snap.geometry->buffer_texels[buffer_]) + " texels";
+      SameLineIfFits(ImGui::CalcTextSize(caption.c_str()).x);
+      ImGui::TextUnformatted(caption.c_str());
+      caption_lines_ = ImGui::GetItemRectSize().y / ImGui::GetTextLineHeight();
     }
     view_.Draw(ui, "painted/" + std::to_string(buffer_), (*snap.painted)[buffer_],
                snap.painted_version);
     ImGui::End();
   }
   std::map<std::string, std::string> Report() const override {
-    std::map<std::string, std::string> report{{"buffer", std::to_string(buffer_)}};
+    std::map<std::string, std::string> report{{"buffer", std::to_string(buffer_)},
+                                              {"caption lines", std::to_string(caption_lines_)}};
     view_.ReportInto(&report);
     return report;
   }
 
  private:
   int buffer_ = 0;
+  float caption_lines_ = 0;  // the buffer's caption, in lines of text
   uint64_t shown_geometry_ = 0;
   ImageView view_;
 };
