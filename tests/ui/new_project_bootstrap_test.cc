@@ -125,8 +125,9 @@ TEST(UiInputBootstrap, NewProjectBootstrappedWithColmapOpensWithPosesCloseToTheT
   std::cout << "bootstrap from the form: " << seconds << " s, " << app.frames_while_running
             << " frames drawn meanwhile (longest " << longest_ms << " ms); " << summary << "\n";
   EXPECT_GT(app.frames_while_running, 20);
-  // A frame that waited for COLMAP would take its whole run (15 s and more).
-  EXPECT_LT(longest_ms, 1000) << "the app kept drawing while COLMAP ran";
+  // A frame that waited for COLMAP would take most of its run: measured against the run
+  // itself, not a clock limit (a loaded machine slows both alike).
+  EXPECT_LT(longest_ms, 1000.0 * seconds / 3) << "the app kept drawing while COLMAP ran";
   const std::string all = std::to_string(kFrames) + " of " + std::to_string(kFrames);
   EXPECT_EQ(summary.rfind(all + " frames posed by COLMAP in ", 0), 0u) << summary;
   EXPECT_FALSE(fs::exists(workspace)) << "COLMAP's workspace is removed";
