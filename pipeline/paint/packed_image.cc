@@ -20,15 +20,6 @@ bool AllZero(const uint8_t* bytes, size_t n) {
   return true;
 }
 
-// `n` bytes XOR the reference's into `out` (no reference: the bytes).
-const uint8_t* Xored(const uint8_t* bytes, const uint8_t* reference, size_t n, uint8_t* out) {
-  if (!reference) return bytes;
-  cv::Mat into(1, static_cast<int>(n), CV_8U, out);
-  cv::bitwise_xor(cv::Mat(1, static_cast<int>(n), CV_8U, const_cast<uint8_t*>(bytes)),
-                  cv::Mat(1, static_cast<int>(n), CV_8U, const_cast<uint8_t*>(reference)), into);
-  return out;
-}
-
 // `n` bytes of a block XOR the reference's into `out`, a word at a time (a call of
 // cv::bitwise_xor per 4 KB block costs more than the XOR itself).
 void XorInto(const uint8_t* bytes, const uint8_t* reference, size_t n, uint8_t* out) {
@@ -41,6 +32,13 @@ void XorInto(const uint8_t* bytes, const uint8_t* reference, size_t n, uint8_t* 
     std::memcpy(out + i, &a, 8);
   }
   for (; i < n; ++i) out[i] = bytes[i] ^ reference[i];
+}
+
+// `n` bytes XOR the reference's into `out` (no reference: the bytes).
+const uint8_t* Xored(const uint8_t* bytes, const uint8_t* reference, size_t n, uint8_t* out) {
+  if (!reference) return bytes;
+  XorInto(bytes, reference, n, out);
+  return out;
 }
 
 }  // namespace

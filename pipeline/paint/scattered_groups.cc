@@ -1,11 +1,11 @@
 #include "pipeline/paint/scattered_groups.h"
 
-#include "pipeline/paint/base_buffer.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numeric>
+
+#include "pipeline/paint/base_buffer.h"
 
 namespace fresco {
 namespace {
@@ -81,7 +81,7 @@ class Splitter {
         if (texels < best) best = texels, best_axis = axis, best_at = k;
       }
     }
-    sort_along(best_axis);
+    if (best_axis != 1) sort_along(best_axis);  // `order` is along the last axis sorted
     std::vector<char> goes_left(n, 0);
     for (size_t k = 0; k < best_at; ++k) goes_left[order[k]] = 1;
     for (size_t k = 0; k < n; ++k) (goes_left[k] ? left : right)->push_back(items[k]);
