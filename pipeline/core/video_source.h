@@ -10,6 +10,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "pipeline/core/rigid3.h"
 #include "pipeline/core/status.h"
 
 namespace fresco {
@@ -31,6 +32,12 @@ struct Frame {
   // 128: pixels the frames near it agree with (the background model's growth does not start
   // from them).
   cv::Mat movers;
+  // Optional: the mesh's depth seen from the frame's camera at `depth_cam_from_local` (CV_32F
+  // camera z, +inf off the surface: Rasterizer::RasterizeDepth), kept by the whole-capture
+  // pre-pass; painting's depth stage takes it instead of rasterizing when it paints the frame
+  // at that pose exactly.
+  cv::Mat depth;
+  Rigid3d depth_cam_from_local;
 };
 
 class VideoSource {

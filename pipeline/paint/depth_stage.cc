@@ -29,6 +29,11 @@ cv::Mat DepthDebugImage(const cv::Mat& depth) {
   return colour;
 }
 
+// Exactly the same pose (the depth kept was rasterized at it).
+bool SamePose(const Rigid3d& a, const Rigid3d& b) {
+  return a.rotation.coeffs() == b.rotation.coeffs() && a.translation == b.translation;
+}
+
 }  // namespace
 
 bool PaintSession::BufferImageBox(size_t b, const FrameView& view, double box[4]) const {
@@ -99,7 +104,16 @@ void PaintSession::DepthStage(FrameWork* work) {
   if (options_.occlusion.enabled) {
     const CameraCache& cache = CacheFor(*work->camera);
     cv::Rect window = OwnBuffersWindow(*work->camera, cache.bounds, work->cam_from_local);
-    cache.rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_, window);
+    const Frame& frame = *work->frame;
+    if (!frame.depth.empty() && frame.depth.type() == CV_32F &&
+        frame.depth.size() == cv::Size(work->camera->width, work->camera->height) &&
+        cache.rasterizer->options().supersample == 1 &&
+        SamePose(frame.depth_cam_from_local, work->cam_from_local)) {
+      frame.depth.copyTo(depth_);  // rasterized by the pre-pass: the same as below, whole
+      window = cv::Rect();
+    } else {
+      cache.rasterizer->RasterizeDepth(scene_->mesh, work->cam_from_local, &depth_, window);
+    }
     // The share of the image the depth was rasterized in (1: the whole image).
     const cv::Rect image(0, 0, work->camera->width, work->camera->height);
     depth_rows_[0] = 0, depth_rows_[1] = -1;

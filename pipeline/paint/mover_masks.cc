@@ -37,22 +37,30 @@ void Correspond(const SmallFrame& self, const SmallFrame& other, double depth_to
                 std::vector<int>* where, std::array<float, 3>* gain) {
   where->assign(self.points.total(), -1);
   std::array<double, 3> sum_self{}, sum_other{};
-  for (int y = 0; y < self.points.rows; ++y)
-    for (int x = 0; x < self.points.cols; ++x) {
-      const cv::Vec3f p = self.points.at<cv::Vec3f>(y, x);
-      if (!std::isfinite(p[0])) continue;
-      const Eigen::Vector3d in_other = other.cam_from_local * Eigen::Vector3d(p[0], p[1], p[2]);
-      Eigen::Vector2d pixel;
-      if (!other.camera->Project(in_other, &pixel)) continue;
-      const int u = static_cast<int>(std::lround(pixel.x()));
-      const int v = static_cast<int>(std::lround(pixel.y()));
-      if (u < 0 || v < 0 || u >= other.depth.cols || v >= other.depth.rows) continue;
-      const float seen = other.depth.at<float>(v, u);
-      if (!(std::abs(seen - in_other.z()) <= depth_tolerance * in_other.z())) continue;
-      (*where)[y * self.points.cols + x] = v * other.depth.cols + u;
-      const cv::Vec3b a = self.bgr.at<cv::Vec3b>(y, x), b = other.bgr.at<cv::Vec3b>(v, u);
-      for (int c = 0; c < 3; ++c) sum_self[c] += a[c], sum_other[c] += b[c];
-    }
+  const Eigen::Matrix3d rotation = other.cam_from_local.rotation.toRotationMatrix();
+  const Eigen::Vector3d& translation = other.cam_from_local.translation;
+  const cv::Vec3f* points = self.points.ptr<cv::Vec3f>();
+  const cv::Vec3b* self_bgr = self.bgr.ptr<cv::Vec3b>();
+  const cv::Vec3b* other_bgr = other.bgr.ptr<cv::Vec3b>();
+  const float* other_depth = other.depth.ptr<float>();
+  const int cols = other.depth.cols, rows = other.depth.rows;
+  for (const int i : self.surface_pixels) {
+    const cv::Vec3f& p = points[i];
+    const Eigen::Vector3d in_other = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+    Eigen::Vector2d pixel;
+    if (!other.camera->Project(in_other, &pixel)) continue;
+    // The nearest pixel (rounded half up), inside the image.
+    if (!(pixel.x() >= -0.5 && pixel.y() >= -0.5 && pixel.x() < cols - 0.5 &&
+          pixel.y() < rows - 0.5))
+      continue;
+    const int u = static_cast<int>(pixel.x() + 0.5), v = static_cast<int>(pixel.y() + 0.5);
+    const int k = v * cols + u;
+    const float seen = other_depth[k];
+    if (!(std::abs(seen - in_other.z()) <= depth_tolerance * in_other.z())) continue;
+    (*where)[i] = k;
+    const cv::Vec3b a = self_bgr[i], b = other_bgr[k];
+    for (int c = 0; c < 3; ++c) sum_self[c] += a[c], sum_other[c] += b[c];
+  }
   for (int c = 0; c < 3; ++c)
     (*gain)[c] = sum_other[c] > 0 ? static_cast<float>(sum_self[c] / sum_other[c]) : 1.0f;
 }
@@ -96,19 +104,20 @@ Comparison Compare(const SmallFrame& self, int other_index, const SmallFrame& ot
   return comparison;
 }
 
-// Frame `self`'s mask from its neighbours; `previous` (optional): the masks of the pass before,
-// whose masked pixels do not judge. `comparisons`: its comparisons with the frames near it
-// (made here when empty). `joinable`: the surface pixels that may join a mover by
-// their colour (those that differ from a frame that sees them, or are seen by too few);
-// `agreed`: the surface pixels the frames that see them agree with (MoverMaskResult::agreed);
-// `ringed_regions`: the regions of one colour the mask rings (joined to it; ringed_regions.h);
-// `regions`: the frame's colour regions, kept for the later passes; `compact` (null: not
-// counted): its masked pixels in regions (MoverMaskResult::compact).
-cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
-                   const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
-                   std::vector<Comparison>* comparisons, long long* judged, long long* flagged,
-                   long long* compact, cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions,
-                   ColourRegionLabels* regions) {
+// What frame `self`'s comparisons with its neighbours found, before cleaning: per pixel, the
+// frames that see its surface point and those that differ from it; the pixels that differ
+// from most of them (`mask`), how many were judged, how many of those differ in regions.
+struct FirstLook {
+  cv::Mat seeing, differing, mask;  // CV_8U
+  long long judged = 0, compact = 0;
+};
+
+// Frame `self`'s first look from its neighbours; `previous` (optional): the masks of the pass
+// before, whose masked pixels do not judge. `comparisons`: its comparisons with the frames
+// near it (made here when empty).
+FirstLook LookAtFrame(const std::vector<SmallFrame>& frames, int self_index,
+                      const MoverMaskOptions& options, const std::vector<cv::Mat>* previous,
+                      std::vector<Comparison>* comparisons) {
   const SmallFrame& self = frames[self_index];
   const int n = static_cast<int>(frames.size());
   if (comparisons->empty())
@@ -118,10 +127,11 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
         if (o < 0 || o >= n || frames[o].points.empty()) continue;
         comparisons->push_back(Compare(self, o, frames[o], options));
       }
-  cv::Mat seeing(self.bgr.size(), CV_8U, cv::Scalar(0)),
-      differing(self.bgr.size(), CV_8U, cv::Scalar(0));
-  uchar* seeing_data = seeing.data;
-  uchar* differing_data = differing.data;
+  FirstLook look;
+  look.seeing = cv::Mat(self.bgr.size(), CV_8U, cv::Scalar(0));
+  look.differing = cv::Mat(self.bgr.size(), CV_8U, cv::Scalar(0));
+  uchar* seeing_data = look.seeing.data;
+  uchar* differing_data = look.differing.data;
   for (const Comparison& comparison : *comparisons) {
     const int o = comparison.other;
     const uchar* other_masked = previous && !(*previous)[o].empty() ? (*previous)[o].data : nullptr;
@@ -133,22 +143,33 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
       if (seen & 1) ++differing_data[p];
     }
   }
-  cv::Mat mask(self.bgr.size(), CV_8U, cv::Scalar(0));
-  long long seen_pixels = 0;
-  for (int y = 0; y < mask.rows; ++y)
-    for (int x = 0; x < mask.cols; ++x) {
-      const int s = seeing.at<uchar>(y, x), d = differing.at<uchar>(y, x);
-      if (s < options.min_differing) continue;
-      ++seen_pixels;
-      if (d >= options.min_differing && d >= options.share * s) mask.at<uchar>(y, x) = 255;
-    }
-  // What differs in regions, not along lines (MoverMaskResult::compact; the first pass's).
-  if (compact) {
-    cv::Mat regions_only;
-    cv::morphologyEx(mask, regions_only, cv::MORPH_OPEN,
-                     cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-    *compact = cv::countNonZero(regions_only);
+  look.mask = cv::Mat(self.bgr.size(), CV_8U, cv::Scalar(0));
+  for (const int p : self.surface_pixels) {
+    const int seen = seeing_data[p], differ = differing_data[p];
+    if (seen < options.min_differing) continue;
+    ++look.judged;
+    if (differ >= options.min_differing && differ >= options.share * seen) look.mask.data[p] = 255;
   }
+  // What differs in regions, not along lines (MoverMaskResult::compact; the first pass's).
+  cv::Mat regions_only;
+  cv::morphologyEx(look.mask, regions_only, cv::MORPH_OPEN,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  look.compact = cv::countNonZero(regions_only);
+  return look;
+}
+
+// Frame `self`'s mask from its first look, cleaned. `joinable`: the surface pixels that may
+// join a mover by their colour (those that differ from a frame that sees them, or are seen by
+// too few); `agreed`: the surface pixels the frames that see them agree with
+// (MoverMaskResult::agreed); `ringed_regions`: the regions of one colour the mask rings (joined
+// to it; ringed_regions.h); `regions`: the frame's colour regions, kept for the later passes;
+// `flagged`: its masked pixels among those judged.
+cv::Mat CleanMask(const SmallFrame& self, const FirstLook& look, const MoverMaskOptions& options,
+                  long long* flagged, cv::Mat* joinable, cv::Mat* agreed, cv::Mat* ringed_regions,
+                  ColourRegionLabels* regions) {
+  const cv::Mat& seeing = look.seeing;
+  const cv::Mat& differing = look.differing;
+  cv::Mat mask = look.mask.clone();
   // Cleaning: small blobs are noise. A mover's pixels that match the frames near it (its
   // inside, where they show it too: it is large or slow) join it: within each blob's box,
   // the pixels of its colours. Not pixels that agree with every frame that sees them: the
@@ -158,10 +179,8 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
   // missed): on the three sets of captures with movers a little more painted of what was seen
   // without a mover and a little less of the movers than with none differing alone.
   *agreed = ((differing == 0) & (seeing >= 1)) | ((differing <= 1) & (seeing >= 4));
-  for (int y = 0; y < mask.rows; ++y)
-    for (int x = 0; x < mask.cols; ++x)
-      if (std::isnan(self.points.at<cv::Vec3f>(y, x)[0]))
-        joinable->at<uchar>(y, x) = agreed->at<uchar>(y, x) = 0;
+  joinable->setTo(0, ~self.surface);
+  agreed->setTo(0, ~self.surface);
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
   cv::Mat grown = mask.clone();
@@ -190,7 +209,6 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
     cv::dilate(mask, mask,
                cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * options.dilate_px + 1,
                                                                      2 * options.dilate_px + 1)));
-  *judged = seen_pixels;
   *flagged = cv::countNonZero(mask & (seeing >= options.min_differing));
   if (!ringed.empty()) mask |= ringed;
   *ringed_regions = ringed;
@@ -198,33 +216,24 @@ cv::Mat JudgeFrame(const std::vector<SmallFrame>& frames, int self_index,
 }
 
 // Per camera: the camera at the reduced size and its rasterizer (which holds each pixel's
-// ray).
+// ray); with MoverMaskOptions::full_size_depth, the rasterizer of the camera itself.
 struct SmallCamera {
   std::unique_ptr<Camera> camera;
   std::unique_ptr<Rasterizer> rasterizer;
+  std::unique_ptr<Rasterizer> full;
 };
 
-// One frame at the reduced size (SmallFrame) through its small camera.
-void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const SmallCamera& s,
-                    SmallFrame* d) {
-  d->camera = s.camera.get();
-  d->cam_from_local = in.cam_from_local;
-  const cv::Size size(s.camera->width, s.camera->height);
-  if (in.bgr.size() == size)
-    d->bgr = in.bgr.isContinuous() ? in.bgr : in.bgr.clone();
-  else
-    cv::resize(in.bgr, d->bgr, size, 0, 0, cv::INTER_AREA);
-  const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
-  cv::erode(d->bgr, d->low, box);
-  cv::dilate(d->bgr, d->high, box);
-  s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d->depth);
+// The frame's surface points (local) and which pixels show the surface, from its depth and
+// the ray of each pixel: `ray_of(x, y, &z)` gives the ray of pixel (x, y) and its depth.
+template <class RayOf>
+void SurfacePoints(const Rigid3d& cam_from_local, const RayOf& ray_of, SmallFrame* d) {
   d->points.create(d->depth.size(), CV_32FC3);
   d->surface = cv::Mat::zeros(d->depth.size(), CV_8U);
-  const Rigid3d local_from_cam = in.cam_from_local.Inverse();
+  const Rigid3d local_from_cam = cam_from_local.Inverse();
   for (int y = 0; y < d->depth.rows; ++y)
     for (int x = 0; x < d->depth.cols; ++x) {
-      const float z = d->depth.at<float>(y, x);
-      const Eigen::Vector2f ray = s.rasterizer->Ray(x, y);
+      float z = 0;
+      const Eigen::Vector2f ray = ray_of(x, y, &z);
       if (!std::isfinite(z) || !ray.allFinite()) {
         d->points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
         continue;
@@ -236,12 +245,61 @@ void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const Sm
     }
 }
 
+// One frame at the reduced size (SmallFrame) through its small camera; `full_depth` (with
+// MoverMaskOptions::full_size_depth): the depth at the camera's full size, rasterized here.
+void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const SmallCamera& s,
+                    SmallFrame* d, cv::Mat* full_depth) {
+  d->camera = s.camera.get();
+  d->cam_from_local = in.cam_from_local;
+  const cv::Size size(s.camera->width, s.camera->height);
+  if (in.bgr.size() == size)
+    d->bgr = in.bgr.isContinuous() ? in.bgr : in.bgr.clone();
+  else
+    cv::resize(in.bgr, d->bgr, size, 0, 0, cv::INTER_AREA);
+  const cv::Mat box = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3));
+  cv::erode(d->bgr, d->low, box);
+  cv::dilate(d->bgr, d->high, box);
+  if (!s.full) {
+    s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d->depth);
+    SurfacePoints(
+        in.cam_from_local,
+        [&](int x, int y, float* z) {
+          *z = d->depth.at<float>(y, x);
+          return s.rasterizer->Ray(x, y);
+        },
+        d);
+    return;
+  }
+  // Each small pixel: the full-size sample nearest its centre, its depth and its ray.
+  s.full->RasterizeDepth(mesh, in.cam_from_local, full_depth);
+  const double sx = static_cast<double>(full_depth->cols) / size.width;
+  const double sy = static_cast<double>(full_depth->rows) / size.height;
+  std::vector<int> col(size.width), row(size.height);
+  for (int x = 0; x < size.width; ++x)
+    col[x] = std::clamp(static_cast<int>(std::floor((x + 0.5) * sx)), 0, full_depth->cols - 1);
+  for (int y = 0; y < size.height; ++y)
+    row[y] = std::clamp(static_cast<int>(std::floor((y + 0.5) * sy)), 0, full_depth->rows - 1);
+  d->depth.create(size, CV_32F);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x)
+      d->depth.at<float>(y, x) = full_depth->at<float>(row[y], col[x]);
+  SurfacePoints(
+      in.cam_from_local,
+      [&](int x, int y, float* z) {
+        *z = d->depth.at<float>(y, x);
+        return s.full->Ray(col[x], row[y]);
+      },
+      d);
+}
+
 // The frames at the reduced size (empty where a frame has no camera or colour image); the
-// small cameras they point to are kept in `small`.
+// small cameras they point to are kept in `small`; `full_depths` (with
+// MoverMaskOptions::full_size_depth): each frame's depth at its camera's full size.
 std::vector<SmallFrame> SmallFrames(const TriangleMesh& mesh,
                                     const std::vector<MoverMaskFrame>& given,
                                     const MoverMaskOptions& options,
-                                    std::map<const Camera*, SmallCamera>* small) {
+                                    std::map<const Camera*, SmallCamera>* small,
+                                    std::vector<cv::Mat>* full_depths) {
   const auto usable = [](const MoverMaskFrame& in) {
     return in.camera && !in.bgr.empty() && in.bgr.type() == CV_8UC3;
   };
@@ -251,13 +309,19 @@ std::vector<SmallFrame> SmallFrames(const TriangleMesh& mesh,
     if (s.camera) continue;
     const cv::Size size = MoverMaskSize(*in.camera, options);
     s.camera = std::make_unique<Camera>(ScaledCamera(*in.camera, size.width, size.height));
-    s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
+    if (options.full_size_depth)
+      s.full = std::make_unique<Rasterizer>(*in.camera, RasterOptions());
+    else
+      s.rasterizer = std::make_unique<Rasterizer>(*s.camera, RasterOptions());
   }
   // Frames at once (a frame's rasterizing is mostly on one core).
   std::vector<SmallFrame> frames(given.size());
+  full_depths->assign(options.full_size_depth ? given.size() : 0, cv::Mat());
   cv::parallel_for_(cv::Range(0, static_cast<int>(given.size())), [&](const cv::Range& range) {
     for (int f = range.start; f < range.end; ++f)
-      if (usable(given[f])) MakeSmallFrame(mesh, given[f], small->at(given[f].camera), &frames[f]);
+      if (usable(given[f]))
+        MakeSmallFrame(mesh, given[f], small->at(given[f].camera), &frames[f],
+                       options.full_size_depth ? &(*full_depths)[f] : nullptr);
   });
   return frames;
 }
@@ -301,9 +365,9 @@ std::vector<uint8_t> JudgeAgain(const std::vector<SmallFrame>& frames,
         for (int o : {f - offset, f + offset}) any = any || (o >= 0 && o < n && changed[o]);
       if (!any) continue;
       long long unused = 0;
-      result->masks[f] = JudgeFrame(frames, f, options, &previous, &judged->comparisons[f], &unused,
-                                    &unused, nullptr, &judged->joinable[f], &result->agreed[f],
-                                    &judged->ringed[f], &judged->regions[f]);
+      const FirstLook look = LookAtFrame(frames, f, options, &previous, &judged->comparisons[f]);
+      result->masks[f] = CleanMask(frames[f], look, options, &unused, &judged->joinable[f],
+                                   &result->agreed[f], &judged->ringed[f], &judged->regions[f]);
       now_changed[f] = cv::norm(result->masks[f], previous[f], cv::NORM_INF) > 0;
     }
   });
@@ -384,7 +448,7 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   const int n = static_cast<int>(given.size());
   result->masks.resize(n);
   std::map<const Camera*, SmallCamera> small;
-  const std::vector<SmallFrame> frames = SmallFrames(mesh, given, options, &small);
+  const std::vector<SmallFrame> frames = SmallFrames(mesh, given, options, &small, &result->depths);
   std::vector<long long> judged(n, 0), flagged(n, 0), compact(n, 0);
   Judged judging;
   judging.joinable.resize(n);
@@ -395,22 +459,36 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   const bool keep_comparisons = options.passes > 1;
   // The first pass judges every second frame (f % 2 == parity); a frame's judging reads only
   // the frames, so the halves in turn judge as all at once.
+  std::vector<FirstLook> looks(n);
   const auto judge_half = [&](int parity) {
     const int count = (n - parity + 1) / 2;
     cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
       for (int k = range.start; k < range.end; ++k) {
         const int f = 2 * k + parity;
         if (frames[f].points.empty()) continue;
-        result->masks[f] =
-            JudgeFrame(frames, f, options, nullptr, &judging.comparisons[f], &judged[f],
-                       &flagged[f], &compact[f], &judging.joinable[f], &result->agreed[f],
-                       &judging.ringed[f], keep_comparisons ? &judging.regions[f] : nullptr);
+        looks[f] = LookAtFrame(frames, f, options, nullptr, &judging.comparisons[f]);
+        judged[f] = looks[f].judged, compact[f] = looks[f].compact;
         if (!keep_comparisons) std::vector<Comparison>().swap(judging.comparisons[f]);
       }
     });
   };
   judge_half(0);
-  if (!JudgedHalfIsEnough(options, judged, compact)) judge_half(1);
+  if (JudgedHalfIsEnough(options, judged, compact)) {
+    // The caller drops the masks: they are left as the comparisons found them, not cleaned.
+    for (int f = 0; f < n; ++f)
+      if (!looks[f].mask.empty())
+        result->masks[f] = looks[f].mask, flagged[f] = cv::countNonZero(looks[f].mask);
+  } else {
+    judge_half(1);
+    cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
+      for (int f = range.start; f < range.end; ++f)
+        if (!looks[f].mask.empty())
+          result->masks[f] = CleanMask(frames[f], looks[f], options, &flagged[f],
+                                       &judging.joinable[f], &result->agreed[f], &judging.ringed[f],
+                                       keep_comparisons ? &judging.regions[f] : nullptr);
+    });
+  }
+  looks.clear();
   for (int f = 0; f < n; ++f) {
     result->judged += judged[f], result->flagged += flagged[f], result->compact += compact[f];
     result->frames_judged += judged[f] > 0 ? 1 : 0;

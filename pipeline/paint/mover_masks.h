@@ -71,10 +71,17 @@ struct MoverMaskOptions {
   int ringed_follow_frames = 2;
   // The first pass judges every second frame first; with later_passes_min_fraction set, where
   // those show in regions less than this share of it (and the capture has at least twice
-  // half_min_frames frames), the others are not judged (their masks stay empty): the caller
-  // drops the masks anyway. 0: every frame judged.
+  // half_min_frames frames), the others are not judged (their masks stay empty) and the masks
+  // are not cleaned (left as the comparisons found them): the caller drops the masks anyway.
+  // 0: every frame judged.
   double half_enough_below = 0.75;
   int half_min_frames = 12;
+  // Each frame's depth rasterized at the camera's full size (sampled down to the reduced size:
+  // each pixel takes the full-size sample nearest its centre, unprojected by that sample's
+  // ray) and kept (MoverMaskResult::depths) for painting, whose depth stage takes it instead
+  // of rasterizing the frame again: the mesh is rasterized once a frame, not twice (the cost
+  // is mostly the triangles', whatever the size). Else rasterized at the reduced size.
+  bool full_size_depth = false;
   // Called after each pass (optional): passes done, passes at most, a line for people.
   std::function<void(int done, int total, const std::string& line)> progress;
 };
@@ -100,7 +107,7 @@ struct MoverMaskResult {
   std::vector<cv::Mat> agreed;
   std::string not_run;    // why nothing was looked for ("" when it ran)
   long long judged = 0;   // surface pixels seen by enough other frames to be judged
-  long long flagged = 0;  // ... of which masked (after cleaning)
+  long long flagged = 0;  // ... of which masked (after cleaning; see half_enough_below)
   // ... of which the comparison found in compact regions (first pass): what differs from most
   // of the frames near it, less every line narrower than 3 pixels (an opening by 3 x 3). A
   // mover is a region; a blurred frame, a slightly misaligned one, or the mesh's error at its
@@ -109,6 +116,10 @@ struct MoverMaskResult {
   // movers 0.2 % and 0.00 %). The evidence background `auto` decides on.
   long long compact = 0;
   int frames_judged = 0;  // frames with a pixel judged (MoverMaskOptions::half_enough_below)
+  // With MoverMaskOptions::full_size_depth: each frame's depth at its camera's full size
+  // (CV_32F camera z, +inf off the surface, as Rasterizer::RasterizeDepth; empty where the
+  // frame was not usable).
+  std::vector<cv::Mat> depths;
   double seconds = 0;
 
   double fraction() const { return judged > 0 ? static_cast<double>(flagged) / judged : 0.0; }

@@ -30,6 +30,22 @@ size_t DecodedFrames::bytes() const {
   return bytes_;
 }
 
+void DecodedFrames::KeepDepth(int stream, int pose_index, cv::Mat depth,
+                              const Rigid3d& cam_from_local) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  depths_[stream][pose_index] = {std::move(depth), cam_from_local};
+}
+
+bool DecodedFrames::TakeDepth(int stream, int pose_index, cv::Mat* depth, Rigid3d* cam_from_local) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  auto found = depths_[stream].find(pose_index);
+  if (found == depths_[stream].end()) return false;
+  *depth = std::move(found->second.first);
+  *cam_from_local = found->second.second;
+  depths_[stream].erase(found);
+  return true;
+}
+
 FileFrameSource::FileFrameSource(const Project& project, const std::vector<const Capture*>& streams,
                                  SkipFrame skip, bool read_frames_without_pose,
                                  std::shared_ptr<DecodedFrames> decoded)
@@ -126,6 +142,10 @@ FrameRead FileFrameSource::Next(SourcedFrame* frame, Status* status) {
     frame->stream = s;
     MatchPose(s, frame);
     if (!frame->posed.has_pose) frame->skipped = false;  // not decoded: a frame without a pose
+    frame->posed.frame.depth.release();
+    if (decoded_ && frame->posed.has_pose)
+      decoded_->TakeDepth(s, frame->pose_index, &frame->posed.frame.depth,
+                          &frame->posed.frame.depth_cam_from_local);
     // Passed over because it was decoded before (unless `skip` passes it over too).
     if (frame->skipped && decoded_ && frame->posed.has_pose)
       if (cv::Mat bgr = decoded_->Take(s, frame->pose_index);

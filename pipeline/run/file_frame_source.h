@@ -27,15 +27,20 @@ namespace fresco {
 // threads while the painting thread takes.
 class DecodedFrames {
  public:
-  explicit DecodedFrames(size_t streams) : frames_(streams) {}
+  explicit DecodedFrames(size_t streams) : frames_(streams), depths_(streams) {}
   void Keep(int stream, int pose_index, cv::Mat bgr);
   bool Has(int stream, int pose_index) const;
   cv::Mat Take(int stream, int pose_index);  // empty when not kept (or taken)
   size_t bytes() const;
+  // The mesh's depth from the frame's camera at `cam_from_local` (Frame::depth), each handed
+  // out once, with the frame however it is read.
+  void KeepDepth(int stream, int pose_index, cv::Mat depth, const Rigid3d& cam_from_local);
+  bool TakeDepth(int stream, int pose_index, cv::Mat* depth, Rigid3d* cam_from_local);
 
  private:
   mutable std::mutex mutex_;
   std::vector<std::map<int, cv::Mat>> frames_;
+  std::vector<std::map<int, std::pair<cv::Mat, Rigid3d>>> depths_;
   size_t bytes_ = 0;
 };
 

@@ -30,6 +30,10 @@ namespace {
 // The most the pre-pass keeps of the frames it decoded, for painting to take (bytes; 98
 // frames of 640 x 480 are 90 MB).
 constexpr size_t kKeepDecodedBytes = size_t{256} << 20;
+// The most the movers' search keeps of the frames' depth at full size, for painting to take
+// (mover_masks.h, full_size_depth; 98 frames of 640 x 480 are 120 MB): when the whole
+// capture's do not fit, none is kept and frames are rasterized at the reduced size.
+constexpr size_t kKeepDepthBytes = size_t{256} << 20;
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -69,6 +73,10 @@ Status FindMoversAcrossViews(const Project& project, const MoverMaskOptions& mov
     }
     MoverMaskResult found;
     FRESCO_RETURN_IF_ERROR(FindMoverMasks(j->scene().mesh, stream_frames, mover_options, &found));
+    for (size_t k = 0; k < found.depths.size() && j->decoded; ++k)
+      if (!found.depths[k].empty())
+        j->decoded->KeepDepth(static_cast<int>(s), pose_index[k], std::move(found.depths[k]),
+                              stream_frames[k].cam_from_local);
     all.judged += found.judged, all.flagged += found.flagged, all.compact += found.compact;
     all.frames_judged += found.frames_judged;
     all.seconds += found.seconds;
@@ -188,6 +196,13 @@ Status RunWholeCapturePrepass(const Project& project, const PaintJobOptions& opt
   seconds.joint = SecondsSince(step);
   step = std::chrono::steady_clock::now();
   for (PoseAdjustFrame& frame : frames) frame.bgr.release();  // only their cameras are left
+  // The depth at full size when the whole capture's fits (painting takes it), and painting
+  // looks at the depth.
+  size_t depth_bytes = 0;
+  for (const PoseAdjustFrame& frame : frames)
+    depth_bytes += sizeof(float) * frame.camera->width * frame.camera->height;
+  mover_options.full_size_depth =
+      project.pipeline.occlusion.enabled && depth_bytes <= kKeepDepthBytes;
   if (movers)
     FRESCO_RETURN_IF_ERROR(FindMoversAcrossViews(project, mover_options, small, frames,
                                                  cam_from_local, where, j, found));
