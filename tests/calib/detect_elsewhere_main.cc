@@ -140,6 +140,9 @@ int main(int argc, char** argv) {
                                          (degraded ? "blur" : "sharp"))
           continue;
         int used = 0, lost = 0, aruco_ok = 0, tags_ours = 0, tags_aruco = 0;
+        // Views whose border was read other than drawn, and whose tags came mostly from the
+        // second look (the border is the most of the tags').
+        int border_misread = 0, mostly_second_look = 0;
         // Corners on the board's outline (an outer tag's outer edge through them) and the
         // others: squared error, count, mean out of the tag.
         double outline_sq = 0, outline_out = 0, inner_sq = 0, inner_out = 0;
@@ -181,6 +184,8 @@ int main(int argc, char** argv) {
           tags_ours += d.tags;
           tags_aruco += static_cast<int>(aruco.size());
           if (!d.found && aruco_reads) ++lost;
+          border_misread += d.tags > 0 && d.border_bits != board.border_bits;
+          mostly_second_look += 2 * d.tags_second_look >= d.tags && d.tags > 0;
           std::vector<CornerObservation> solved_corners;  // d.corners, or the truth (--truth-at)
           double view_out[2] = {0, 0}, view_sq[2] = {0, 0};
           int view_n[2] = {0, 0};
@@ -263,6 +268,8 @@ int main(int argc, char** argv) {
                     outline_n, std::sqrt(outline_sq / std::max(1, outline_n)),
                     outline_out / std::max(1, outline_n), inner_n,
                     std::sqrt(inner_sq / std::max(1, inner_n)), inner_out / std::max(1, inner_n));
+        std::printf(", border misread in %d views, mostly second look in %d", border_misread,
+                    mostly_second_look);
         if (solve && used >= kMinViews) {
           CalibrateRequest request;
           request.board = spec;
