@@ -57,6 +57,7 @@ bool LookForTag(const cv::Mat& gray, const BoardSpec& spec, const TagDetector& d
     if (q.id != id) continue;
     TagQuad out;
     out.id = id;
+    out.border_bits = q.border_bits;  // the board's border (BorderBitsOf) counts every tag's
     // A tag cut by the patch's edge has false corners there: only whole tags count (a wider
     // patch is tried next).
     bool near = true;

@@ -12,7 +12,7 @@
 //                          [--only dark_sharp|dark_blur|light_sharp|light_blur] [--per-view]
 //                          [--truth-corners] [--truth-at found|outline|inner]
 //                          [--truth-above PX] [--truth-noise PX] [--corners-from FILE]
-//                          [--dump FILE] [--halfway]
+//                          [--dump FILE] [--halfway] [--solve-lock FILE]
 // --verbose also lists every corner more than 2 px from the truth; the corners' errors are
 // also given apart for those on the board's outline (an outer tag's outer edge through them);
 // --per-view gives them for each view, with its tag edge shift. To tell which corners bias the
@@ -21,6 +21,8 @@
 // corners left out cost), of those on the outline or the others found, of those more than PX
 // off (--truth-above); --dump writes every corner found, one a line: variant, view, id, on the
 // outline (1) or not, x, y, then the true pixels of its tag's corners from it on (k, k + 1, ..).
+#include <sys/file.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -47,7 +49,7 @@ int main(int argc, char** argv) {
   std::vector<unsigned> seeds = {1, 2, 3};
   ElsewhereBoard board;
   bool solve = false, verbose = false, truth_corners = false, per_view = false;
-  std::string save, only, truth_at, dump, corners_from;
+  std::string save, only, truth_at, dump, corners_from, solve_lock;
   double truth_above_px = 1e9, truth_noise_px = 0;
   DetectOptions options;
   ElsewhereShot look;  // the tone curve and vignetting every view gets
@@ -95,6 +97,8 @@ int main(int argc, char** argv) {
       verbose = true;
     } else if (a == "--halfway") {  // edges halfway, one shift undone (before the edge level)
       options.edge_level_from_pitch = false;
+    } else if (a == "--solve-lock") {  // one solve at a time among processes sharing FILE
+      solve_lock = next, ++i;
     } else if (a == "--no-second-look") {
       options.second_look = false;
     } else {
@@ -105,7 +109,7 @@ int main(int argc, char** argv) {
           "[--save DIR] [--verbose] [--no-second-look] [--only dark_blur|...] [--per-view] "
           "[--truth-corners] [--truth-at found|outline|inner] [--truth-above PX] [--truth-noise "
           "PX] "
-          "[--corners-from FILE] [--dump FILE] [--halfway]\n");
+          "[--corners-from FILE] [--dump FILE] [--halfway] [--solve-lock FILE]\n");
       return 2;
     }
   }
@@ -140,6 +144,9 @@ int main(int argc, char** argv) {
                                          (degraded ? "blur" : "sharp"))
           continue;
         int used = 0, lost = 0, aruco_ok = 0, tags_ours = 0, tags_aruco = 0;
+        // Views whose border was read other than drawn, and whose tags came mostly from the
+        // second look (the border is the most of the tags').
+        int border_misread = 0, mostly_second_look = 0;
         // Corners on the board's outline (an outer tag's outer edge through them) and the
         // others: squared error, count, mean out of the tag.
         double outline_sq = 0, outline_out = 0, inner_sq = 0, inner_out = 0;
@@ -181,6 +188,8 @@ int main(int argc, char** argv) {
           tags_ours += d.tags;
           tags_aruco += static_cast<int>(aruco.size());
           if (!d.found && aruco_reads) ++lost;
+          border_misread += d.tags > 0 && d.border_bits != board.border_bits;
+          mostly_second_look += 2 * d.tags_second_look >= d.tags && d.tags > 0;
           std::vector<CornerObservation> solved_corners;  // d.corners, or the truth (--truth-at)
           double view_out[2] = {0, 0}, view_sq[2] = {0, 0};
           int view_n[2] = {0, 0};
@@ -263,6 +272,8 @@ int main(int argc, char** argv) {
                     outline_n, std::sqrt(outline_sq / std::max(1, outline_n)),
                     outline_out / std::max(1, outline_n), inner_n,
                     std::sqrt(inner_sq / std::max(1, inner_n)), inner_out / std::max(1, inner_n));
+        std::printf(", border misread in %d views, mostly second look in %d", border_misread,
+                    mostly_second_look);
         if (solve && used >= kMinViews) {
           CalibrateRequest request;
           request.board = spec;
@@ -270,6 +281,9 @@ int main(int argc, char** argv) {
           request.cross_validate = false;
           CalibrationRun run;
           run.width = lens.width, run.height = lens.height, run.views = used_views;
+          // A solve holds GBs (40 views of 144 corners): runs side by side take turns.
+          FILE* lock = solve_lock.empty() ? nullptr : std::fopen(solve_lock.c_str(), "a");
+          if (lock != nullptr) flock(fileno(lock), LOCK_EX);
           const fresco::Status s = SolveViews(request, &run);
           if (s.ok()) {
             const double rms =
@@ -293,6 +307,7 @@ int main(int argc, char** argv) {
           } else {
             std::printf(", solve failed: %s", s.message().c_str());
           }
+          if (lock != nullptr) std::fclose(lock);  // and its lock
         }
         std::printf("\n");
         std::fflush(stdout);
