@@ -228,7 +228,8 @@ int RunVerify(const Args& args, const ArgSpec& spec, const Project& project,
                         (fs::path(out_dir) / "verify.png").string());
   if (!written.ok()) return Fail(written);
   std::cout << "verify: " << result.compared << " frames compared (" << result.registered
-            << " registered by COLMAP), " << result.flagged << " flagged\n"
+            << " registered by COLMAP), " << result.flagged << " flagged, " << result.borderline
+            << " borderline\n"
             << VerifyAgreementText(result) << "\n";
   for (const std::string& note : VerifyNotes(result)) std::cout << "note: " << note << "\n";
   std::cout << "wrote " << (fs::path(out_dir) / "verify.json").string() << "\n";

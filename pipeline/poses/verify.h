@@ -59,8 +59,18 @@ struct FrameVerdict {
   double fit_position_error_m = 0.0;
   bool judged_locally = false;
   bool flagged = false;
-  // Beyond the thresholds under its window's fit (or within a widened tolerance locally),
-  // but as its neighbours: not flagged.
+  // Where judged against the drift: how far the local alignment itself may be off (1.5
+  // standard errors of it, from how its neighbours scatter about their line), and whether the
+  // frame's error is within that of the threshold (neither surely beyond nor surely within:
+  // not flagged, not counted as agreeing).
+  double rotation_uncertainty_deg = 0.0;
+  double position_uncertainty_m = 0.0;
+  bool borderline = false;
+  // Where judged against the drift: the drift itself (its neighbours' line where it is)
+  // carries it beyond the thresholds under its window's fit.
+  bool in_drift = false;
+  // In the drift, within the thresholds (or a widened tolerance) after the local alignment:
+  // beyond them only as its neighbours are. Not flagged.
   bool follows_drift = false;
   // Where judged against the drift: how far the frame's given rotation turns from what its
   // neighbours' given rotations and COLMAP's rotations between them imply (alignment-free;
@@ -104,15 +114,18 @@ struct VerifyResult {
   // How the frames beyond the thresholds disagree with the global alignment: smoothly along
   // the sequence (a drift, pose_alignment.h), or frame by frame.
   Disagreement disagreement;
-  // Where the drift is followed: the first and last frame following it (the stretch where
+  // Where the drift is followed: the first and last frame in it (`in_drift`: the stretch where
   // only a local alignment agrees); else the first and last smooth frame of `disagreement`.
   std::string drift_first, drift_last;
   // The frames were judged against the drift (VerifyOptions::drift_neighbours): each after
   // the local alignment its neighbours give (`judged_locally`, how many), and of the compared
-  // frames `flagged` + `following_drift` + `weak_support` + `unflagged` = `compared`.
+  // frames `flagged` + `borderline` + `following_drift` + `weak_support` + `unflagged` =
+  // `compared`.
   bool drift_followed = false;
   int judged_locally = 0;
   int following_drift = 0;
+  int borderline = 0;
+  double widest_rotation_uncertainty_deg = 0.0;  // of the borderline frames
   // Of the frames following the drift, those judged with a wider tolerance (their neighbours
   // scatter beyond the thresholds: a reconstruction bending unevenly), and the widest, as a
   // rotation (the tolerance times rotation_threshold_deg): a given pose wrong by less than

@@ -77,6 +77,11 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
     }
     f["flagged"] = v.flagged;
     f["follows_drift"] = v.follows_drift;
+    f["borderline"] = v.borderline;
+    if (v.judged_locally) {
+      f["rotation_uncertainty_deg"] = v.rotation_uncertainty_deg;
+      f["position_uncertainty_m"] = v.position_uncertainty_m;
+    }
     if (v.relative_rotation_deg >= 0) f["relative_rotation_deg"] = v.relative_rotation_deg;
     if (v.observations >= 0) f["observations"] = v.observations;
     f["weak_support"] = v.weak_support;
@@ -93,6 +98,7 @@ std::string VerifyJsonText(const VerifyResult& result, const ColmapRunResult& ru
       {"registered", result.registered},
       {"compared", result.compared},
       {"flagged", result.flagged},
+      {"borderline", result.borderline},
       {"scene_size_m", result.scene_size_m},
       {"thresholds",
        {{"rotation_deg", result.rotation_threshold_deg},

@@ -55,6 +55,10 @@ void RunSnapshots::Add(int frames_read, PaintRunState state) {
   bytes_ = HeldBytes(nullptr);
 }
 
+void RunSnapshots::Costs(double save_seconds, double painting_seconds) {
+  if (painting_seconds > 0 && save_seconds > kMaxSaveShare * painting_seconds) every_ *= 2;
+}
+
 const PaintRunState* RunSnapshots::AtOrBefore(int frames_read, int* its_frames_read) const {
   auto it = states_.upper_bound(frames_read);
   if (it == states_.begin()) return nullptr;

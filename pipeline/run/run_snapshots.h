@@ -26,6 +26,13 @@ class RunSnapshots {
   bool Due(int frames_read) const;
   // Keeps `state` (saved before reading frame `frames_read`), thinning as the budget asks.
   void Add(int frames_read, PaintRunState state);
+  // What the state just offered cost to save, against the painting since the state before
+  // (seconds, one clock for both): where saving took more than kMaxSaveShare of that, the
+  // spacing doubles for the states to come (those kept stay), so that keeping states never
+  // costs more than about that share of the painting. A painting whose states grow as it
+  // goes (a large model) then saves a few, not one every `every` frames only to drop most.
+  static constexpr double kMaxSaveShare = 0.25;
+  void Costs(double save_seconds, double painting_seconds);
   // The state with the most frames read at most `frames_read`, or null.
   const PaintRunState* AtOrBefore(int frames_read, int* its_frames_read) const;
   void Clear() { states_.clear(), bytes_ = 0; }

@@ -58,12 +58,15 @@ struct LastSaved {
 
 // Reads and paints until `frames` frames were read (or the capture ends); keeps states in
 // `snapshots` when given, adding the time spent saving to `save_seconds` and the saves to
-// `saves`.
+// `saves`, and each save's wall and CPU seconds to `save_walls` and `save_cpus` when given.
 bool PaintUpTo(fresco::PaintRun* run, int frames, fresco::RunSnapshots* snapshots,
-               double* save_seconds, int* saves, LastSaved* last = nullptr) {
+               double* save_seconds, int* saves, LastSaved* last = nullptr,
+               std::vector<double>* save_walls = nullptr,
+               std::vector<double>* save_cpus = nullptr) {
   while (run->stats().frames < frames) {
     if (snapshots && snapshots->Due(run->stats().frames)) {
       const Clock::time_point start = Clock::now();
+      const double cpu = CpuSeconds();
       fresco::PaintRunState state;
       if (run->Save(&state)) {
         if (last) {
@@ -73,6 +76,13 @@ bool PaintUpTo(fresco::PaintRun* run, int frames, fresco::RunSnapshots* snapshot
         snapshots->Add(run->stats().frames, std::move(state)), ++*saves;
       }
       *save_seconds += Since(start);
+      // The cost against the painting since the state before, as the app gives it (CPU).
+      static double painted_since = -1;
+      const double now = CpuSeconds();
+      snapshots->Costs(now - cpu, painted_since < 0 ? 0 : cpu - painted_since);
+      painted_since = now;
+      if (save_walls) save_walls->push_back(Since(start));
+      if (save_cpus) save_cpus->push_back(CpuSeconds() - cpu);
     }
     fresco::RunFrame frame;
     if (run->Next(&frame) != fresco::FrameRead::kFrame) return false;
@@ -139,7 +149,8 @@ int main(int argc, char** argv) {
   double save_seconds = 0;
   int saves = 0;
   LastSaved last;
-  if (!PaintUpTo(&run, frames, &snapshots, &save_seconds, &saves, &last))
+  std::vector<double> save_walls, save_cpus;
+  if (!PaintUpTo(&run, frames, &snapshots, &save_seconds, &saves, &last, &save_walls, &save_cpus))
     frames = run.stats().frames;
   const double paint_seconds = Since(start), paint_cpu = CpuSeconds() - cpu;
 
@@ -204,6 +215,10 @@ int main(int argc, char** argv) {
       "(%d saves, %.0f ms each)\n",
       frames, paint_seconds, paint_cpu, save_seconds, saves,
       1000 * save_seconds / std::max(1, saves));
+  std::printf("each save      ");
+  for (size_t i = 0; i < save_walls.size(); ++i)
+    std::printf("%s%.2f s (%.2f s CPU)", i ? ", " : "", save_walls[i], save_cpus[i]);
+  std::printf("\n");
   std::printf("states kept    %zu, every %d frames, %.0f MB (%.1f MB each; budget %d MB)\n", kept,
               spacing, kept_bytes / 1048576.0, kept_bytes / 1048576.0 / std::max<size_t>(1, kept),
               budget_mb);

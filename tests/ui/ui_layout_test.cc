@@ -460,3 +460,84 @@ TEST(UiLayout, AtTheLargestFontScaleTheGroupingTableAndSlidersKeepTheirText) {
 
 }  // namespace
 }  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// Draws `title`'s panel alone as a tile `width` pixels wide at font scale 1.5, a few frames.
+Panel& DrawNarrowAtLargerFont(LayoutApp& app, const std::string& title, float width) {
+  Panel* panel = nullptr;
+  for (auto& p : app.panels)
+    if (title == p->Title()) panel = p.get();
+  EXPECT_NE(panel, nullptr) << title;
+  float applied = 0;
+  ApplyUiScale(1.5f, &applied);
+  panel->open = true;
+  panel->tiled = true;
+  panel->tile_pos = ImVec2(0, 40);
+  panel->tile_size = ImVec2(width, 700);
+  for (int i = 0; i < 3; ++i) testing::ImGuiHeadless::DrawPanel(app.ui, *panel, {width, 700});
+  return *panel;
+}
+
+// The calibration light's words in a narrow panel at font scale 1.5: whole (every glyph of
+// "NOT ENOUGH DATA" inside the panel), on at most two lines, not a few letters a line. Before:
+// squeezed into the controls' column (27 % of the panel: 60 pixels of 240), 4 lines of
+// 3-4 letters each.
+TEST(UiLayout, TheCalibrationLightsWordsStayWholeInANarrowPanelAtALargerFont) {
+  LayoutApp app({1280, 800});
+  for (const float width : {240.0f, 300.0f, 600.0f, 1100.0f}) {
+    DrawNarrowAtLargerFont(app, kCalibrationPanelTitle, width);
+    ImGuiWindow* window = LayoutApp::Window(kCalibrationPanelTitle);
+    ASSERT_NE(window, nullptr);
+    const ImDrawList* list = window->DrawList;
+    const ImU32 red = ImGui::ColorConvertFloat4ToU32(ImVec4(0.9f, 0.2f, 0.2f, 1));  // the light
+    float left = 1e9f, right = 0, top = 1e9f, bottom = 0, clip_right = 0;
+    for (const ImDrawCmd& cmd : list->CmdBuffer)
+      for (unsigned i = 0; i < cmd.ElemCount; ++i) {
+        const ImDrawVert& v = list->VtxBuffer[cmd.VtxOffset + list->IdxBuffer[cmd.IdxOffset + i]];
+        if (v.col != red || v.uv.x == ImGui::GetIO().Fonts->TexUvWhitePixel.x) continue;
+        left = std::min(left, v.pos.x), right = std::max(right, v.pos.x);
+        top = std::min(top, v.pos.y), bottom = std::max(bottom, v.pos.y);
+        clip_right = cmd.ClipRect.z;
+      }
+    ASSERT_GT(right, 0) << "the words not drawn at all (beside the lights, past the edge of the "
+                           "controls' column), width "
+                        << width;
+    EXPECT_LE(right, clip_right) << "the words cut at the panel's edge, width " << width;
+    EXPECT_LE(bottom - top, 2.2f * ImGui::GetTextLineHeight()) << "width " << width;
+    EXPECT_GE(right - left, ImGui::CalcTextSize("NOT ENOUGH").x) << "a few letters a line";
+  }
+}
+
+// A seek under way in a narrow Pipeline panel at font scale 1.5: Stop stays inside the panel,
+// and the progress text is shown whole, in the bar where it fits, else on its own lines below
+// it. Before: the bar was the panel less 60 pixels (159 of a 260-pixel panel, 239 of 340)
+// and cut its 410-pixel text.
+TEST(UiLayout, TheSeekProgressTextIsWholeInANarrowPanelAtALargerFont) {
+  LayoutApp app({1280, 800});
+  auto seeking = std::make_shared<RunnerSnapshot>(*app.runner.Snapshot());
+  seeking->seek_target = 90;
+  seeking->seek_from = 0;
+  seeking->frame = 30;
+  app.ui.snapshot = seeking;
+  for (const float width : {260.0f, 340.0f, 700.0f}) {
+    Panel& panel = DrawNarrowAtLargerFont(app, "Pipeline", width);
+    std::map<std::string, std::string> report = panel.Report();
+    const std::string text = report["seek text"];
+    ASSERT_NE(text.find("frame"), std::string::npos) << text;
+    const float bar = std::stof(report["seek bar width"]);
+    const float lines = std::stof(report["seek text lines"]);
+    const float needed = ImGui::CalcTextSize(text.c_str()).x;
+    if (lines == 0) {
+      EXPECT_LE(needed, bar) << "the text cut in a " << bar << "-pixel bar, width " << width;
+    } else {
+      EXPECT_LE(lines, 3.2f) << "width " << width;
+    }
+    EXPECT_LE(std::stof(report["seek stop right"]), std::stof(report["panel right"]) + 0.5f)
+        << "Stop runs out of the panel, width " << width;
+  }
+}
+
+}  // namespace
+}  // namespace fresco

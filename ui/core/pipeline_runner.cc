@@ -1,5 +1,7 @@
 #include "ui/core/pipeline_runner.h"
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -30,6 +32,8 @@ struct PipelineRunner::Session {
   std::unique_ptr<PaintRun> run;
   // Painting states to step back to (files only; RunnerOptions::snapshot_every).
   std::unique_ptr<RunSnapshots> snapshots;
+  // The process's CPU seconds when the last state was saved (-1: none yet).
+  double painting_since_state = -1;
   // The first live stream, whose state the Pipeline panel shows (-1: none); its state as
   // read, its recording, and the pose time of its last frame taken (-1: none yet).
   int live_stream = -1;
@@ -49,6 +53,13 @@ struct PipelineRunner::Session {
 };
 
 namespace {
+
+// The process's CPU seconds so far, every thread (painting and saving use several).
+double ProcessCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec + 1e-9 * t.tv_nsec;
+}
 
 // Drops the oldest half of a per-frame history once it holds 2 * keep entries (amortized
 // O(1) a frame).
@@ -230,7 +241,14 @@ PipelineRunner::Painted PipelineRunner::PaintNext(bool show) {
   Session& s = *session_;
   if (!s.live() && options_.snapshot_budget_mb > 0 && s.snapshots->Due(s.next_frame)) {
     PaintRunState state;  // the state before this frame, to step back to
+    const double started = ProcessCpuSeconds();
     if (s.run->Save(&state)) s.snapshots->Add(s.next_frame, std::move(state));
+    // Its cost against the painting since the state before (CPU: the machine may be shared,
+    // and a pause does not count): keeping states stays a small share of the painting.
+    const double saved = ProcessCpuSeconds();
+    s.snapshots->Costs(saved - started,
+                       s.painting_since_state < 0 ? 0 : started - s.painting_since_state);
+    s.painting_since_state = saved;
   }
   RunFrame f;
   const FrameRead read = s.run->Next(&f);  // the frame policy of `fresco run` and bench

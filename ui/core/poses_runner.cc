@@ -190,7 +190,8 @@ void PosesRunner::RunOnce(const PosesRequest& request) {
   std::snprintf(line, sizeof(line), " in %.1f s", working_.colmap_seconds);
   working_.status += request.colmap.existing_model.empty() ? line : " (earlier model)";
   if (working_.verified) {
-    working_.status += ", " + std::to_string(working_.verify.flagged) + " flagged";
+    working_.status += ", " + std::to_string(working_.verify.flagged) + " flagged, " +
+                       std::to_string(working_.verify.borderline) + " borderline";
   }
 }
 

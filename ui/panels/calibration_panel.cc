@@ -24,6 +24,7 @@ namespace {
 using calib::DataReadiness;
 
 constexpr const char* kAttachPopup = "Attach camera?";
+constexpr float kControlsShare = 0.27f;  // of the panel's width, in three columns
 
 std::string Format(const char* format, double value) {
   char buffer[64];
@@ -46,8 +47,15 @@ void TrafficLight(const DataReadiness& r) {
                           ImGui::ColorConvertFloat4ToU32(c));
   }
   ImGui::Dummy(ImVec2(7 * radius, 2 * radius));
-  ImGui::SameLine();
-  ImGui::TextColored(kColours[level], "%s", kWords[level]);
+  // The words beside the lights where they fit, else below them (wrapped at spaces there, in
+  // a panel narrower still): never cut at the panel's edge.
+  const float words = ImGui::CalcTextSize(kWords[level]).x;
+  const float beside =
+      ImGui::GetContentRegionAvail().x - 7 * radius - ImGui::GetStyle().ItemSpacing.x;
+  if (words <= beside) ImGui::SameLine();
+  ImGui::PushStyleColor(ImGuiCol_Text, kColours[level]);
+  ImGui::TextWrapped("%s", kWords[level]);
+  ImGui::PopStyleColor();
   ImGui::Text("%d views (min %d, want %d+)", r.views, calib::kMinViews, calib::kFewViews);
   ImGui::Text("coverage %.0f %% (want %.0f %%), tilt %s (want %.0f)", 100 * r.coverage_fraction,
               100 * calib::kMinCoverage,
@@ -70,9 +78,17 @@ class CalibrationPanel : public Panel {
     if (!BeginOverlayPanel(*this, ui.calibration != nullptr, "calibration worker")) return;
     const auto snap = ui.calibration->Snapshot();
     if (snap->has_request && folder_.empty()) TakeInputs(snap->request);
-    if (ImGui::BeginTable("calibration", 3,
-                          ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
-      ImGui::TableSetupColumn("controls", ImGuiTableColumnFlags_WidthStretch, 0.27f);
+    // A panel too narrow for three columns (the controls' would be under 15 characters wide)
+    // shows them one under another instead of squeezing their words a few letters a line.
+    if (ImGui::GetContentRegionAvail().x * kControlsShare < 15 * ImGui::GetFontSize()) {
+      DrawControls(ui, *snap);
+      ImGui::Separator();
+      DrawPictures(ui, *snap);
+      ImGui::Separator();
+      DrawResults(ui, *snap);
+    } else if (ImGui::BeginTable("calibration", 3,
+                                 ImGuiTableFlags_Resizable | ImGuiTableFlags_BordersInnerV)) {
+      ImGui::TableSetupColumn("controls", ImGuiTableColumnFlags_WidthStretch, kControlsShare);
       ImGui::TableSetupColumn("pictures", ImGuiTableColumnFlags_WidthStretch, 0.35f);
       ImGui::TableSetupColumn("results", ImGuiTableColumnFlags_WidthStretch, 0.38f);
       ImGui::TableNextRow();

@@ -86,11 +86,26 @@ class PipelinePanel : public Panel {
       }
       const double elapsed_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - seek_started_).count();
-      ImGui::ProgressBar(
-          done, ImVec2(-60, 0),
-          (FrameLabel(snap) + ", " + ElapsedAndRemainingText(elapsed_s, done)).c_str());
+      // The bar leaves room for Stop at any font scale; its text goes on a line of its own
+      // below (wrapped at spaces) where the bar is narrower than it, instead of being cut.
+      const ImGuiStyle& style = ImGui::GetStyle();
+      const float stop = ImGui::CalcTextSize("Stop").x + 2 * style.FramePadding.x;
+      const float bar = ImGui::GetContentRegionAvail().x - stop - style.ItemSpacing.x;
+      seek_text_ = FrameLabel(snap) + ", " + ElapsedAndRemainingText(elapsed_s, done);
+      const bool fits = ImGui::CalcTextSize(seek_text_.c_str()).x + 2 * style.FramePadding.x <= bar;
+      char percent[16];
+      std::snprintf(percent, sizeof(percent), "%.0f %%", 100.0f * done);
+      ImGui::ProgressBar(done, ImVec2(bar, 0), fits ? seek_text_.c_str() : percent);
+      seek_bar_width_ = bar;
       ImGui::SameLine();
       if (ImGui::Button("Stop")) ui.runner->Pause();  // keeps the frames painted so far
+      stop_right_ = ImGui::GetItemRectMax().x;
+      window_right_ = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+      seek_text_lines_ = 0;
+      if (!fits) {
+        ImGui::TextWrapped("%s", seek_text_.c_str());
+        seek_text_lines_ = ImGui::GetItemRectSize().y / ImGui::GetTextLineHeight();
+      }
     } else {
       seek_seen_ = -1;
     }
@@ -145,6 +160,13 @@ class PipelinePanel : public Panel {
     std::snprintf(rect, sizeof(rect), "%.0f %.0f %.0f %.0f", slider_rect_[0], slider_rect_[1],
                   slider_rect_[2], slider_rect_[3]);
     report["seek slider"] = rect;
+    // The seek's progress: its text, the bar's width, the lines the text takes below it (0:
+    // in the bar), and the right edges of Stop and of the panel's content.
+    report["seek text"] = seek_text_;
+    report["seek bar width"] = std::to_string(seek_bar_width_);
+    report["seek text lines"] = std::to_string(seek_text_lines_);
+    report["seek stop right"] = std::to_string(stop_right_);
+    report["panel right"] = std::to_string(window_right_);
     return report;
   }
 
@@ -156,6 +178,8 @@ class PipelinePanel : public Panel {
   }
 
   int seek_ = 0;
+  std::string seek_text_;
+  float seek_bar_width_ = 0, seek_text_lines_ = 0, stop_right_ = 0, window_right_ = 0;
   int seek_seen_ = -1;  // the seek target whose progress is shown, and when it was first seen
   std::chrono::steady_clock::time_point seek_started_;
   int posted_seek_ = -1;         // a seek posted, not yet in a snapshot

@@ -23,6 +23,7 @@ const ImU32 kFlaggedColour = IM_COL32(235, 70, 60, 255);
 const ImU32 kOkColour = IM_COL32(120, 200, 120, 255);
 const ImU32 kMissingColour = IM_COL32(130, 130, 130, 255);
 const ImU32 kDriftColour = IM_COL32(240, 180, 60, 255);
+const ImU32 kBorderlineColour = IM_COL32(230, 140, 230, 255);
 
 std::string Format(const char* format, double value) {
   char buffer[64];
@@ -30,10 +31,10 @@ std::string Format(const char* format, double value) {
   return buffer;
 }
 
-// One error along the sequence: a point per frame (red when flagged, amber when following a
-// drift, grey when not judged; grey ticks where COLMAP registered nothing or there is no
-// given pose), the threshold dashed, the selected frame
-// and the pipeline's current frame as vertical lines. Returns the frame clicked, else -1.
+// One error along the sequence: a point per frame (red when flagged, pink when borderline,
+// amber when following a drift, grey when not judged; grey ticks where COLMAP registered nothing or
+// there is no given pose), the threshold dashed, the selected frame and the pipeline's current
+// frame as vertical lines. Returns the frame clicked, else -1.
 int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool rotation,
               double scale, const char* unit, int selected, int current_row) {
   const VerifyResult& v = snap.verify;
@@ -89,6 +90,7 @@ int ErrorPlot(const char* id, const char* label, const PosesSnapshot& snap, bool
     const ImVec2 p(x_of(i), y_of((rotation ? f.rotation_error_deg : f.position_error_m) * scale));
     const ImU32 colour = f.flagged         ? kFlaggedColour
                          : f.weak_support  ? kMissingColour
+                         : f.borderline    ? kBorderlineColour
                          : f.follows_drift ? kDriftColour
                                            : kOkColour;
     draw->AddCircleFilled(p, f.flagged ? 4.5f : 3.0f, colour);
@@ -316,8 +318,8 @@ class PosesPanel : public Panel {
       return;
     }
     const VerifyResult& v = snap.verify;
-    ImGui::Text("%d frames: %d registered by COLMAP, %d compared, %d flagged", snap.frames,
-                v.registered, v.compared, v.flagged);
+    ImGui::Text("%d frames: %d registered by COLMAP, %d compared, %d flagged, %d borderline",
+                snap.frames, v.registered, v.compared, v.flagged, v.borderline);
     ImGui::TextWrapped("%s", VerifyAgreementText(v).c_str());
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.75f, 0.3f, 1));
     for (const std::string& note : VerifyNotes(v)) ImGui::TextWrapped("%s", note.c_str());
@@ -398,6 +400,8 @@ class PosesPanel : public Panel {
         ImGui::TextDisabled("%s", verdict.c_str());
       else if (f.flagged)
         ImGui::TextColored(ImVec4(1, 0.75f, 0.7f, 1), "%s", verdict.c_str());
+      else if (f.borderline)
+        ImGui::TextColored(ImVec4(0.95f, 0.6f, 0.95f, 1), "%s", verdict.c_str());
       else if (f.follows_drift)
         ImGui::TextColored(ImVec4(1, 0.85f, 0.5f, 1), "%s", verdict.c_str());
       else
