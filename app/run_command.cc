@@ -294,6 +294,12 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
           {"frames_skipped", stats.frames_skipped},
           {"frames_painted_whole", session.frames_painted_whole()},
           {"buffers_built", built},
+          {"work",
+           {{"texels", job.shard_work.texels},
+            {"texel_frames", job.shard_work.texel_frames},
+            {"frames", job.shard_work.frames},
+            {"window_frames", job.shard_work.window_frames},
+            {"estimated_cpu_seconds", job.shard_estimated_s}}},
           {"cpu_seconds", CpuSeconds()}};
 }
 

@@ -303,13 +303,13 @@ BufferViews ViewsSeeingBuffers(const PaintJob& j,
   return seeing;
 }
 
-// What a shard's work is made of, in nanoseconds of a core, as measured in the shards of a
-// city street (2.09 M triangles, 8 streams at 1280x720, 160 and 240 frames, 134 M texels; a
-// fit of the CPU of 32 shards of 16 within 0.6 s): a texel held costs ~100 ns (built,
-// written); the warp ~2 ns a texel of a buffer for each frame that sees it (~13 ns a texel
-// tested, a sixth of them in view); a frame ~10 ns a pixel (read, decoded) and ~4 ns a
-// triangle (the mesh culled), and ~12 ns a triangle times the share of the image its depth is
-// rendered in, in every shard it meets.
+// What a shard's work is made of, in nanoseconds of a core, as measured in the 16 shards of a
+// city street (2.09 M triangles, 8 streams at 1280x720, 240 frames, 134 M texels; a fit of
+// each shard's CPU to the four terms of its ShardWork, within 0.5 s rms, shards of 4.5-10 s):
+// a texel held costs ~120 ns (built, written); the warp ~5 ns a texel of a buffer for each
+// frame that sees it; a frame ~10 ns a pixel (read, decoded) and ~4 ns a triangle (the mesh
+// culled), and ~12 ns a triangle times the share of the image its depth is rendered in, in
+// every shard it meets.
 ShardCosts ShardCostsFor(const PaintJob& j) {
   double pixels = 0, frames = 0;
   for (const Capture& capture : j.captures)
@@ -318,8 +318,8 @@ ShardCosts ShardCostsFor(const PaintJob& j) {
         pixels += static_cast<double>(camera->width) * camera->height, ++frames;
   const double triangles = static_cast<double>(j.scene().mesh.NumTriangles());
   ShardCosts costs;
-  costs.per_texel = 100;
-  costs.per_texel_frame = 2;
+  costs.per_texel = 120;
+  costs.per_texel_frame = 5;
   costs.per_frame = 10.0 * (frames > 0 ? pixels / frames : 0) + 4.0 * triangles;
   costs.per_frame_window = 12.0 * triangles;
   return costs;
@@ -412,8 +412,12 @@ Status OpenPaintJob(const Project& project, const PaintJobOptions& options,
       for (const Capture& capture : j.captures)
         for (const auto& [id, camera] : capture.cameras)
           (*bounds)[&camera] = ComputeNormalizedBounds(camera);
-      j.buffer_shard = AssignBuffersToShards(j.session->buffers(), ViewsSeeingBuffers(j, *bounds),
-                                             ShardCostsFor(j), options.shard.count);
+      const BufferViews views = ViewsSeeingBuffers(j, *bounds);
+      j.buffer_shard =
+          AssignBuffersToShards(j.session->buffers(), views, ShardCostsFor(j), options.shard.count);
+      j.shard_work = ShardWorks(j.session->buffers(), views, j.buffer_shard,
+                                options.shard.count)[options.shard.index];
+      j.shard_estimated_s = j.shard_work.Cost(ShardCostsFor(j)) * 1e-9;
       std::vector<bool> own(j.buffer_shard.size());
       for (size_t b = 0; b < own.size(); ++b) own[b] = j.buffer_shard[b] == options.shard.index;
       const auto build = std::chrono::steady_clock::now();

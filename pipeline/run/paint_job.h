@@ -107,6 +107,9 @@ struct PaintJob {
   std::shared_ptr<DecodedFrames> decoded;
   // Sharded (PaintJobOptions::shard): the shard of every buffer (AssignBuffersToShards).
   std::vector<int> buffer_shard;
+  // Sharded: this shard's work as the assignment counted it, and its CPU seconds as estimated.
+  ShardWork shard_work;
+  double shard_estimated_s = 0;
   // Where opening the job spent its wall time, seconds (what a user waits for before the
   // first frame paints; `fresco run` reports them in metrics.json's "wall").
   struct OpenSeconds {

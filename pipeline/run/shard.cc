@@ -57,6 +57,210 @@ int BufferViews::Count(size_t b) const {
   return n;
 }
 
+namespace {
+
+using Box = std::array<float, 4>;  // {x0, y0, x1, y1}, empty when x0 > x1
+
+double BoxArea(const Box& w) {
+  return w[0] < w[2] && w[1] < w[3] ? static_cast<double>(w[2] - w[0]) * (w[3] - w[1]) : 0.0;
+}
+
+Box JoinBoxes(const Box& a, const Box& b) {
+  return {std::min(a[0], b[0]), std::min(a[1], b[1]), std::max(a[2], b[2]), std::max(a[3], b[3])};
+}
+
+// The work of every shard (ShardWork), kept as buffers move between shards: per shard and view,
+// how many of its buffers the view sees, which, and the box of their boxes.
+class ShardLoads {
+ public:
+  ShardLoads(const std::vector<BaseBuffer>& buffers, const BufferViews& views,
+             const std::vector<int>& shard, int count)
+      : views_(views),
+        with_views_(views.num_views > 0 && views.seen.size() == buffers.size()),
+        with_boxes_(with_views_ && views.boxes.size() == buffers.size()),
+        shard_(shard),
+        texels_(buffers.size()),
+        views_of_(buffers.size()),
+        shards_(count) {
+    for (Shard& one : shards_) {
+      one.seen_by.assign(with_views_ ? views.num_views : 0, 0);
+      one.members.assign(with_boxes_ ? views.num_views : 0, {});
+      one.window.assign(with_boxes_ ? views.num_views : 0, Box{1, 1, 0, 0});
+    }
+    for (size_t b = 0; b < buffers.size(); ++b) {
+      texels_[b] = static_cast<double>(std::max<long long>(buffers[b].num_surface_texels, 1));
+      if (with_views_)
+        for (int v = 0; v < views.num_views; ++v)
+          if (views.seen[b][v / 64] >> (v % 64) & 1) views_of_[b].push_back(v);
+      Add(b, shard[b]);
+    }
+  }
+
+  ShardWork Work(int s) const {
+    const Shard& one = shards_[s];
+    ShardWork work;
+    work.texels = one.texels;
+    work.texel_frames = one.texel_views * views_.frames_per_view;
+    work.frames = one.views * views_.frames_per_view;
+    work.window_frames = (with_boxes_ ? one.window_area : one.views) * views_.frames_per_view;
+    return work;
+  }
+
+  // Shard s's work without buffer b (one of its own).
+  ShardWork WorkWithout(int s, size_t b) const {
+    const Shard& one = shards_[s];
+    ShardWork work = Work(s);
+    const double per_view = views_.frames_per_view;
+    work.texels -= texels_[b];
+    work.texel_frames -= texels_[b] * views_of_[b].size() * per_view;
+    for (int v : views_of_[b])
+      if (one.seen_by[v] == 1) work.frames -= per_view;
+    if (!with_boxes_) {
+      work.window_frames = work.frames;
+      return work;
+    }
+    for (const auto& [v, box] : views_.boxes[b]) {
+      const Box& w = one.window[v];
+      if (box[0] > w[0] && box[1] > w[1] && box[2] < w[2] && box[3] < w[3]) continue;  // inside
+      Box rest{1, 1, 0, 0};
+      for (size_t other : one.members[v])
+        if (other != b) rest = JoinBoxes(rest, BoxOf(other, v));
+      work.window_frames += (BoxArea(rest) - BoxArea(w)) * per_view;
+    }
+    return work;
+  }
+
+  // Shard s's work with buffer b (another shard's) added.
+  ShardWork WorkWith(int s, size_t b) const {
+    const Shard& one = shards_[s];
+    ShardWork work = Work(s);
+    const double per_view = views_.frames_per_view;
+    work.texels += texels_[b];
+    work.texel_frames += texels_[b] * views_of_[b].size() * per_view;
+    for (int v : views_of_[b])
+      if (one.seen_by[v] == 0) work.frames += per_view;
+    if (!with_boxes_) {
+      work.window_frames = work.frames;
+      return work;
+    }
+    for (const auto& [v, box] : views_.boxes[b])
+      work.window_frames +=
+          (BoxArea(JoinBoxes(one.window[v], box)) - BoxArea(one.window[v])) * per_view;
+    return work;
+  }
+
+  void Move(size_t b, int to) {
+    Remove(b, shard_[b]);
+    Add(b, to);
+    shard_[b] = to;
+  }
+
+  const std::vector<int>& shard() const { return shard_; }
+
+ private:
+  struct Shard {
+    double texels = 0;
+    double texel_views = 0;    // texels times the views that see them
+    int views = 0;             // views that see any of its buffers
+    double window_area = 0;    // the sum over views of its window's share of the image
+    std::vector<int> seen_by;  // per view: how many of its buffers it sees
+    std::vector<std::vector<size_t>> members;  // per view: which (with boxes)
+    std::vector<Box> window;                   // per view: the box of their boxes
+  };
+
+  const Box& BoxOf(size_t b, int v) const {
+    const auto& boxes = views_.boxes[b];
+    const auto it =
+        std::lower_bound(boxes.begin(), boxes.end(), v,
+                         [](const auto& entry, int view) { return entry.first < view; });
+    return it->second;
+  }
+
+  void Add(size_t b, int s) {
+    Shard& one = shards_[s];
+    one.texels += texels_[b];
+    one.texel_views += texels_[b] * views_of_[b].size();
+    for (int v : views_of_[b]) one.views += one.seen_by[v]++ == 0;
+    if (!with_boxes_) return;
+    for (const auto& [v, box] : views_.boxes[b]) {
+      one.members[v].push_back(b);
+      one.window_area -= BoxArea(one.window[v]);
+      one.window[v] = JoinBoxes(one.window[v], box);
+      one.window_area += BoxArea(one.window[v]);
+    }
+  }
+
+  void Remove(size_t b, int s) {
+    Shard& one = shards_[s];
+    one.texels -= texels_[b];
+    one.texel_views -= texels_[b] * views_of_[b].size();
+    for (int v : views_of_[b]) one.views -= --one.seen_by[v] == 0;
+    if (!with_boxes_) return;
+    for (const auto& [v, box] : views_.boxes[b]) {
+      auto& members = one.members[v];
+      members.erase(std::find(members.begin(), members.end(), b));
+      Box rest{1, 1, 0, 0};
+      for (size_t other : members) rest = JoinBoxes(rest, BoxOf(other, v));
+      one.window_area += BoxArea(rest) - BoxArea(one.window[v]);
+      one.window[v] = rest;
+    }
+  }
+
+  const BufferViews& views_;
+  const bool with_views_, with_boxes_;
+  std::vector<int> shard_;
+  std::vector<double> texels_;
+  std::vector<std::vector<int>> views_of_;  // per buffer: the views that see it, in order
+  std::vector<Shard> shards_;
+};
+
+// AssignBuffersToShards' last step: buffers move off the shard of most work while that lowers
+// it (up to kMaxMoves moves).
+std::vector<int> BalanceMoves(const std::vector<BaseBuffer>& buffers, const BufferViews& views,
+                              const ShardCosts& costs, const std::vector<int>& shard, int count) {
+  constexpr int kMaxMoves = 256;
+  const bool with_views = views.num_views > 0 && views.seen.size() == buffers.size();
+  const auto cost = [&](const ShardWork& w) { return with_views ? w.Cost(costs) : w.texels; };
+  ShardLoads loads(buffers, views, shard, count);
+  std::vector<double> now(count);
+  std::vector<std::vector<size_t>> members(count);
+  for (int s = 0; s < count; ++s) now[s] = cost(loads.Work(s));
+  for (size_t b = 0; b < shard.size(); ++b) members[shard[b]].push_back(b);
+  for (int move = 0; move < kMaxMoves; ++move) {
+    const int from = static_cast<int>(std::max_element(now.begin(), now.end()) - now.begin());
+    if (members[from].size() <= 1) break;
+    double best = now[from] * (1 - 1e-9), best_from = 0, best_to = 0;
+    size_t moved = buffers.size();
+    int to = -1;
+    for (size_t b : members[from]) {
+      const double without = cost(loads.WorkWithout(from, b));
+      if (without >= best) continue;
+      for (int d = 0; d < count; ++d) {
+        if (d == from) continue;
+        const double with = cost(loads.WorkWith(d, b));
+        if (std::max(without, with) < best)
+          best = std::max(without, with), best_from = without, best_to = with, moved = b, to = d;
+      }
+    }
+    if (to < 0) break;
+    loads.Move(moved, to);
+    now[from] = best_from, now[to] = best_to;
+    members[from].erase(std::find(members[from].begin(), members[from].end(), moved));
+    members[to].insert(std::upper_bound(members[to].begin(), members[to].end(), moved), moved);
+  }
+  return loads.shard();
+}
+
+}  // namespace
+
+std::vector<ShardWork> ShardWorks(const std::vector<BaseBuffer>& buffers, const BufferViews& views,
+                                  const std::vector<int>& shard, int count) {
+  const ShardLoads loads(buffers, views, shard, count);
+  std::vector<ShardWork> works;
+  for (int s = 0; s < count; ++s) works.push_back(loads.Work(s));
+  return works;
+}
+
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
                                        const BufferViews& views, const ShardCosts& costs,
                                        int count) {
@@ -87,9 +291,6 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
     // Per view, the box of the buffers' boxes so far (empty: x0 > x1), and the sum of their areas.
     std::vector<std::array<float, 4>> window(with_boxes ? views.num_views : 0,
                                              std::array<float, 4>{1, 1, 0, 0});
-    const auto area = [](const std::array<float, 4>& w) {
-      return w[0] < w[2] && w[1] < w[3] ? static_cast<double>(w[2] - w[0]) * (w[3] - w[1]) : 0.0;
-    };
     double sum = 0, windows = 0;
     for (size_t step = 0; step < end - begin; ++step) {
       const size_t id = ids[from_end ? end - 1 - step : begin + step];
@@ -100,10 +301,9 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
       if (with_boxes)
         for (const auto& [v, box] : views.boxes[id]) {
           std::array<float, 4>& w = window[v];
-          windows -= area(w);
-          w = {std::min(w[0], box[0]), std::min(w[1], box[1]), std::max(w[2], box[2]),
-               std::max(w[3], box[3])};
-          windows += area(w);
+          windows -= BoxArea(w);
+          w = JoinBoxes(w, box);
+          windows += BoxArea(w);
         }
       out[from_end ? end - begin - 1 - step : step] =
           sum + frame_work * frames + window_work * (with_boxes ? windows : frames);
@@ -140,7 +340,7 @@ std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
     split(cut, end, first + left, n - left);
   };
   split(0, ids.size(), 0, count);
-  return shard;
+  return BalanceMoves(buffers, views, costs, shard, count);
 }
 
 }  // namespace fresco

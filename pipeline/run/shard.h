@@ -60,15 +60,32 @@ struct ShardCosts {
   double per_frame_window = 0;
 };
 
+// What one shard's buffers amount to, in the terms of ShardCosts.
+struct ShardWork {
+  double texels = 0;         // surface texels held
+  double texel_frames = 0;   // each buffer's texels times the frames that see it
+  double frames = 0;         // the frames that see any of its buffers
+  double window_frames = 0;  // those frames times the share of the image their boxes' box takes
+  double Cost(const ShardCosts& costs) const {
+    return costs.per_texel * texels + costs.per_texel_frame * texel_frames +
+           costs.per_frame * frames + costs.per_frame_window * window_frames;
+  }
+};
+
+// The work of each of `count` shards given the shard of each buffer (AssignBuffersToShards).
+std::vector<ShardWork> ShardWorks(const std::vector<BaseBuffer>& buffers, const BufferViews& views,
+                                  const std::vector<int>& shard, int count);
+
 // The shard each buffer goes to (size: buffers), by space: the buffers are cut in two across
 // the longest side of the box of their centres (the centres of their bounds), recursively, each
 // cut giving either side count / 2 and the rest of the count's shards. A set of buffers' work
-// is that of `costs`: a buffer's surface texels, times the frames that see it, and the frames
-// that see any of them. A cut is the one whose larger side's work per shard is least. So a
-// shard's charts lie together, a frame that looks elsewhere is skipped, and a shard of few
-// texels seen by most frames (a long road) holds fewer frames' worth of other charts.
-// Without views (num_views 0) a buffer's work is its texels. Deterministic: every shard
-// computes the same.
+// is that of `costs` (ShardWork). A cut is the one whose larger side's work per shard is least.
+// Then, while it lowers the most work of any shard, a buffer moves from that shard to the one
+// where the larger of the two shards' work is least: halving evenly leaves a shard whose
+// charts many frames see (a long road) with more than its share. So a shard's charts lie
+// together (mostly), a frame that looks elsewhere is skipped, and a shard of few texels seen
+// by most frames holds fewer frames' worth of other charts. Without views (num_views 0) a
+// buffer's work is its texels. Deterministic: every shard computes the same.
 std::vector<int> AssignBuffersToShards(const std::vector<BaseBuffer>& buffers,
                                        const BufferViews& views, const ShardCosts& costs,
                                        int count);
