@@ -8,6 +8,7 @@
 
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/poses/pose_alignment.h"
+#include "pipeline/poses/verify.h"
 
 namespace fresco {
 namespace {
@@ -51,14 +52,38 @@ nlohmann::json ReportJson(const ProjectColmap& colmap, const BootstrapResult& re
                                    {"max_position_m", c.max_position_m},
                                    {"collinear_centres", c.collinear},
                                    {"drifts", c.drifts},
+                                   {"drift_first", c.drift_first},
+                                   {"drift_last", c.drift_last},
                                    {"better", c.better},
                                    {"summary", c.summary}};
   report["project"] = project_path;
   return report;
 }
 
-PosesComparison Compare(const std::vector<PosePair>& pairs, const Sim3d& world_from_colmap,
-                        const PoseAlignmentOptions& thresholds, bool aligned_with_poses) {
+// Where the drift itself carries frames beyond the agreement thresholds, named as `fresco poses
+// verify` names it (VerifyResult::drift_first, drift_last): not every frame that differs
+// smoothly (a reconstruction that bends at its end, aligned by one fit, differs smoothly along
+// the whole walk). Counts those frames in `frames`; false when the verification finds none.
+bool DriftStretch(const ProjectColmap& colmap, const BootstrapOptions& options, std::string* first,
+                  std::string* last, int* frames) {
+  VerifyOptions verify;
+  verify.rotation_threshold_deg = options.agree_rotation_deg;
+  verify.position_threshold_rel = options.agree_position_rel;
+  VerifyResult r;
+  if (!VerifyPoses(VerifyInputs(colmap), colmap.scene_size_m, verify, &r).ok() ||
+      !r.drift_followed || r.drift_first.empty()) {
+    return false;
+  }
+  *first = r.drift_first;
+  *last = r.drift_last;
+  *frames = static_cast<int>(std::count_if(r.frames.begin(), r.frames.end(),
+                                           [](const FrameVerdict& v) { return v.in_drift; }));
+  return true;
+}
+
+PosesComparison Compare(const std::vector<PosePair>& pairs, const ProjectColmap& colmap,
+                        const Sim3d& world_from_colmap, const PoseAlignmentOptions& thresholds,
+                        const BootstrapOptions& options, bool aligned_with_poses) {
   PosesComparison c;
   c.compared = static_cast<int>(pairs.size());
   std::vector<double> rotation, position;
@@ -95,10 +120,17 @@ PosesComparison Compare(const std::vector<PosePair>& pairs, const Sim3d& world_f
   c.drifts = d.Drifts();
   if (c.drifts) {
     c.better = "unknown";
-    c.summary = "The bootstrapped poses agree with " + agree + ", and differ from " +
-                std::to_string(d.smooth) + " smoothly along the sequence (" + pairs[d.first].name +
-                " to " + pairs[d.last].name +
-                "): COLMAP's reconstruction or the given poses drift there, and nothing here "
+    c.drift_first = pairs[d.first].name;
+    c.drift_last = pairs[d.last].name;
+    int in_drift = d.smooth;
+    const bool named = DriftStretch(colmap, options, &c.drift_first, &c.drift_last, &in_drift);
+    c.summary = "The bootstrapped poses agree with " + agree +
+                (named ? "; a drift carries the " + std::to_string(in_drift) + " frames from " +
+                             c.drift_first + " to " + c.drift_last + " beyond the thresholds"
+                       : ", and differ from " + std::to_string(in_drift) +
+                             " smoothly along the sequence (" + c.drift_first + " to " +
+                             c.drift_last + ")") +
+                ": COLMAP's reconstruction or the given poses drift there, and nothing here "
                 "says which (" +
                 figures + "). Check those frames before applying.";
   } else if (2 * c.agreeing >= c.compared && c.agreeing >= 3) {
@@ -173,8 +205,8 @@ Status BootstrapFromColmap(const Project& project, const ProjectColmap& colmap,
   PoseAlignmentOptions agree = align;
   agree.inlier_rotation_deg = options.agree_rotation_deg;
   agree.inlier_position_m = options.agree_position_rel * colmap.scene_size_m;
-  result->comparison =
-      Compare(pairs, result->world_from_colmap, agree, result->aligned_with == "given_poses");
+  result->comparison = Compare(pairs, colmap, result->world_from_colmap, agree, options,
+                               result->aligned_with == "given_poses");
   result->model = TransformModel(colmap.run.model, result->world_from_colmap);
   result->model.cameras = {{1, colmap.camera}};
   for (PosedImage& image : result->model.images) image.camera_id = 1;

@@ -46,6 +46,10 @@ struct PosesComparison {
   // The two differ smoothly along the sequence (a drift of one of them: which is better is
   // then "unknown").
   bool drifts = false;
+  // Where it drifts: the first and last frame of the stretch where the drift itself carries
+  // frames beyond the thresholds, as `fresco poses verify` names it (VerifyResult::drift_first,
+  // drift_last; else the first and last frame that differs smoothly).
+  std::string drift_first, drift_last;
   // "bootstrapped", "given" (the bootstrapped are likely worse), "unknown" (one of the two
   // drifts, or control points disagree with the given poses), "none" (no frame to compare).
   std::string better;

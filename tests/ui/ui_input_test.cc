@@ -669,6 +669,27 @@ TEST(UiInput, AFailedOpenSaysWhichProjectTheOtherPanelsShow) {
   EXPECT_EQ(testing::ReadText(bad).find("frames-moved"), std::string::npos) << "nothing written";
 }
 
+// "Discard" in the unsaved-changes prompt lets the edits go only with a project that opens:
+// when the other one does not open, the open project keeps its edits, still unsaved (the menu
+// bar says so and quitting asks again).
+TEST(UiInput, DiscardBeforeAFailedOpenLeavesTheEditsUnsaved) {
+  App app(0);
+  const std::string bad = BrokenCopy(app), good = app.dir + "/capture/project.json";
+  app.state.BeginEdit();  // an unsaved settings edit
+  app.state.project.pipeline.update_every = 5;
+  RequestOpen(app.ui, bad);
+  app.Frame();  // the prompt
+  Activate(app, "Unsaved changes", "Discard");
+  app.Frames(2);
+  ASSERT_TRUE(app.state.has_unopened) << app.state.message;
+  EXPECT_EQ(app.state.project.file_path, good);
+  EXPECT_EQ(app.state.project.pipeline.update_every, 5) << "the edit is still painted";
+  EXPECT_TRUE(app.state.dirty) << "the edit is not in the file";
+  app.state.pending_quit = true;
+  app.Frames(2);
+  EXPECT_FALSE(app.ui.request_quit) << "quitting asks about the edit again";
+}
+
 TEST(UiInput, APathEditOfTheOpenProjectIsSavedRepaintedAndUndone) {
   App app(2);
   const std::string file = app.dir + "/capture/project.json";

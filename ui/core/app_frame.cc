@@ -75,10 +75,9 @@ void DrawUnsavedPrompt(UiContext& ui) {
         go_on = true;
     }
     ImGui::SameLine();
-    if (ImGui::Button("Discard")) {
-      state.dirty = false;
-      go_on = true;
-    }
+    // The edits go with the project only once another opens (AppState::Open): when it does
+    // not, they are still the open project's, and still unsaved.
+    if (ImGui::Button("Discard")) go_on = true;
     ImGui::SameLine();
     if (ImGui::Button("Cancel")) {
       state.pending_open.clear();
