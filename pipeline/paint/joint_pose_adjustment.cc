@@ -109,6 +109,13 @@ std::vector<PoseAdjustFrame> TrackedFrames(
   return frames;
 }
 
+// The longer side `camera`'s frames are tracked at (TrackedFrames).
+int TrackedLongSide(const Camera& camera, int max_side_px) {
+  int side = std::max(camera.width, camera.height);
+  while (max_side_px > 0 && side > max_side_px) side >>= 1;
+  return side;
+}
+
 // Per camera: each pixel's normalised ray (x, y; NaN where the lens model has none).
 std::map<const Camera*, cv::Mat> RayTables(const std::vector<PoseAdjustFrame>& frames) {
   std::map<const Camera*, cv::Mat> rays;
@@ -698,17 +705,26 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   };
   result->decided_on_frames = n;
-  if (const int first = options.decide_on_first_frames; first >= 2 && 2 * n > 3 * first) {
+  // A long capture is decided on its first frames; a short one whose frames are tracked
+  // smaller to decide is decided on all of them at that size first.
+  const int first_frames = options.decide_on_first_frames;
+  const bool long_capture = first_frames >= 2 && 2 * n > 3 * first_frames;
+  const bool smaller_to_decide = options.decide_max_side_px > 0 &&
+                                 TrackedLongSide(*given[0].camera, options.decide_max_side_px) <
+                                     TrackedLongSide(*given[0].camera, options.max_side_px);
+  if (long_capture || smaller_to_decide) {
     PoseAdjustOptions on_first = options;
     on_first.decide_on_first_frames = 0;
+    on_first.decide_max_side_px = 0;
     if (options.decide_max_side_px > 0) on_first.max_side_px = options.decide_max_side_px;
     if (options.progress)  // the first frames' steps, then the whole capture's
-      on_first.progress = [&options](int done, int total, const std::string& line) {
-        options.progress(done, total, "first frames: " + line);
+      on_first.progress = [&options, long_capture](int done, int total, const std::string& line) {
+        options.progress(done, total, (long_capture ? "first frames: " : "deciding: ") + line);
       };
     PoseAdjustResult trial;
-    const std::vector<PoseAdjustFrame> first_frames(given.begin(), given.begin() + first);
-    FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(mesh, first_frames, on_first, &trial));
+    const std::vector<PoseAdjustFrame> deciding(given.begin(),
+                                                given.begin() + (long_capture ? first_frames : n));
+    FRESCO_RETURN_IF_ERROR(AdjustPosesOnMesh(mesh, deciding, on_first, &trial));
     if (!trial.applied && trial.not_run.empty()) {
       const std::vector<Rigid3d> poses = result->cam_from_local;
       std::vector<int> frame_matches = trial.frame_matches;
@@ -717,7 +733,10 @@ Status AdjustPosesOnMesh(const TriangleMesh& mesh, const std::vector<PoseAdjustF
       result->cam_from_local = poses;
       result->frame_matches = frame_matches;
       result->seconds = seconds();
-      if (options.progress) options.progress(1, 1, "decided on the first frames: not adjusted");
+      if (options.progress)
+        options.progress(1, 1,
+                         long_capture ? "decided on the first frames: not adjusted"
+                                      : "decided on smaller frames: not adjusted");
       return Status::Ok();
     }
   }

@@ -85,9 +85,10 @@ struct PoseAdjustOptions {
   // corrected); when it is, the whole capture is adjusted and decided as above. 0: the whole
   // capture at once.
   int decide_on_first_frames = 32;
-  // Those first frames are tracked for the decision at this size (as max_side_px; 0: as the
-  // whole capture): where they pass, the whole capture is tracked, checked and adjusted at
-  // max_side_px.
+  // Those first frames (a shorter capture: all of its frames, where they are tracked smaller
+  // at this size than at max_side_px) are tracked for the decision at this size (as
+  // max_side_px; 0: as the whole capture): where they pass, the whole capture is tracked,
+  // checked and adjusted at max_side_px.
   int decide_max_side_px = 360;
   // Captures with more frames are not adjusted (not_run says so): every frame is held in
   // memory, with its depth and triangle maps (a few MB a frame).

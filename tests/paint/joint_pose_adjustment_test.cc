@@ -1,6 +1,7 @@
 // Joint adjustment of all poses against the mesh (joint_pose_adjustment.h) on a synthetic
 // orbit: the adjusted poses put the scene's points on the image much closer to where the
 // true poses put them than the given ones do; at exact poses nothing moves.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -268,6 +269,43 @@ TEST(JointPoseAdjustment, ALongCaptureIsDecidedOnItsFirstFrames) {
   EXPECT_EQ(decided_first.matches, at_once.matches);
   for (size_t i = 0; i < at_once.cam_from_local.size(); ++i)
     EXPECT_EQ(decided_first.cam_from_local[i].translation, at_once.cam_from_local[i].translation);
+  EXPECT_LT(after, 0.1 * before);
+}
+
+// A short capture whose frames are tracked smaller to decide (decide_max_side_px, here 160 px
+// for 320x240 frames tracked whole) is decided on all its frames at that size first: at exact
+// poses nothing more is tracked; with noisy poses the check there passes and the capture is
+// adjusted at full size exactly as without the smaller decision.
+TEST(JointPoseAdjustment, AShortCaptureIsDecidedOnSmallerFramesFirst) {
+  std::vector<std::string> lines;
+  PoseAdjustOptions smaller;
+  smaller.max_side_px = 0;
+  smaller.decide_max_side_px = 160;
+  smaller.progress = [&lines](int, int, const std::string& line) { lines.push_back(line); };
+  PoseAdjustOptions whole = smaller;
+  whole.decide_max_side_px = 0;
+  const Orbit exact = MakeOrbit(0, 0);
+  PoseAdjustResult kept;
+  ASSERT_TRUE(AdjustPosesOnMesh(exact.scene.mesh, Frames(exact), smaller, &kept).ok());
+  EXPECT_FALSE(kept.applied);
+  EXPECT_EQ(kept.decided_on_frames, 40);
+  EXPECT_EQ(kept.matches, 0);
+  ASSERT_FALSE(lines.empty());
+  for (const std::string& line : lines)  // every step was the decision's, at the smaller size
+    EXPECT_TRUE(line.rfind("deciding: ", 0) == 0 || line.rfind("decided", 0) == 0) << line;
+  lines.clear();
+  const Orbit noisy = MakeOrbit(0.5, 0.01);
+  PoseAdjustResult decided_smaller, at_once;
+  double before = 0, after = 0;
+  ASSERT_NO_FATAL_FAILURE(AdjustOrbit(noisy, smaller, &decided_smaller, &before, &after));
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(), [](const std::string& line) {
+    return line.rfind("deciding: ", 0) == 0;
+  }));
+  ASSERT_NO_FATAL_FAILURE(AdjustOrbit(noisy, whole, &at_once, &before, &after));
+  EXPECT_TRUE(decided_smaller.applied);
+  EXPECT_EQ(decided_smaller.matches, at_once.matches);
+  for (size_t i = 0; i < at_once.cam_from_local.size(); ++i)
+    EXPECT_EQ(decided_smaller.cam_from_local[i].translation, at_once.cam_from_local[i].translation);
   EXPECT_LT(after, 0.1 * before);
 }
 
