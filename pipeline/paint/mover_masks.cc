@@ -224,7 +224,7 @@ struct SmallCamera {
 };
 
 // The frame's surface points (local) and which pixels show the surface, from its depth and
-// the ray of each pixel: `ray_of(x, y, &z)` gives the ray of pixel (x, y) and its depth.
+// the ray of each pixel: `ray_of(x, y)`.
 template <class RayOf>
 void SurfacePoints(const Rigid3d& cam_from_local, const RayOf& ray_of, SmallFrame* d) {
   d->points.create(d->depth.size(), CV_32FC3);
@@ -232,8 +232,8 @@ void SurfacePoints(const Rigid3d& cam_from_local, const RayOf& ray_of, SmallFram
   const Rigid3d local_from_cam = cam_from_local.Inverse();
   for (int y = 0; y < d->depth.rows; ++y)
     for (int x = 0; x < d->depth.cols; ++x) {
-      float z = 0;
-      const Eigen::Vector2f ray = ray_of(x, y, &z);
+      const float z = d->depth.at<float>(y, x);
+      const Eigen::Vector2f ray = ray_of(x, y);
       if (!std::isfinite(z) || !ray.allFinite()) {
         d->points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
         continue;
@@ -262,12 +262,7 @@ void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const Sm
   if (!s.full) {
     s.rasterizer->RasterizeDepth(mesh, in.cam_from_local, &d->depth);
     SurfacePoints(
-        in.cam_from_local,
-        [&](int x, int y, float* z) {
-          *z = d->depth.at<float>(y, x);
-          return s.rasterizer->Ray(x, y);
-        },
-        d);
+        in.cam_from_local, [&](int x, int y) { return s.rasterizer->Ray(x, y); }, d);
     return;
   }
   // Each small pixel: the full-size sample nearest its centre, its depth and its ray.
@@ -284,12 +279,7 @@ void MakeSmallFrame(const TriangleMesh& mesh, const MoverMaskFrame& in, const Sm
     for (int x = 0; x < size.width; ++x)
       d->depth.at<float>(y, x) = full_depth->at<float>(row[y], col[x]);
   SurfacePoints(
-      in.cam_from_local,
-      [&](int x, int y, float* z) {
-        *z = d->depth.at<float>(y, x);
-        return s.full->Ray(col[x], row[y]);
-      },
-      d);
+      in.cam_from_local, [&](int x, int y) { return s.full->Ray(col[x], row[y]); }, d);
 }
 
 // The frames at the reduced size (empty where a frame has no camera or colour image); the
