@@ -61,12 +61,13 @@ MoverProvenance::MoverProvenance(const Scene& world_scene, const std::vector<Mov
     n_open_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_16U));
     open_written_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
     open_passed_.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_8U));
-    for (MeanShares* m : {&mean_, &unmasked_})
+    for (MeanShares* m : {&mean_, &unmasked_, &sharp_})
       m->shares.push_back(cv::Mat::zeros(buffer.height, buffer.width, CV_32FC2));
   }
   before_.resize(buffers.size());
   mean_.before.resize(buffers.size());
   unmasked_.before.resize(buffers.size());
+  sharp_.before.resize(buffers.size());
 }
 
 void MoverProvenance::BeforeFrame(const PaintSession& session) {
@@ -75,6 +76,7 @@ void MoverProvenance::BeforeFrame(const PaintSession& session) {
     painted.bgra.copyTo(before_[b]);
     mean_.before[b] = Weights(painted.mean_sum);
     unmasked_.before[b] = Weights(painted.unmasked_sum);
+    sharp_.before[b] = Weights(painted.sharp_sum);
   }
   deciding_before_ = session.DecidingUpdate();
   model_before_ = session.options().background.mode != BackgroundMode::kOff;
@@ -110,6 +112,9 @@ void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
   const bool took_unmasked = deciding_before_ && model_before_ && !session.DecidingUpdate() &&
                              session.options().background.mode == BackgroundMode::kOff &&
                              session.options().update == UpdatePolicy::kMean;
+  // ... or for `sharp_mean`: the texels hold its sums from now on.
+  const bool took_sharp = deciding_before_ && !session.DecidingUpdate() &&
+                          session.options().update == UpdatePolicy::kSharpMean;
   const std::vector<BaseBuffer>& buffers = session.buffers();
   for (size_t b = 0; b < buffers.size(); ++b) {
     WarpedBuffer warped;
@@ -132,17 +137,23 @@ void MoverProvenance::AfterFrame(const PaintSession& session, int frame,
     const PaintedBuffer& painted = session.painted()[b];
     if (took_unmasked) {  // mean_sum holds the unmasked sums now
       TakeShares(unmasked_.before[b], Weights(painted.mean_sum), mover_texel, &unmasked_.shares[b]);
+    } else if (took_sharp) {  // ... or the sharp ones
+      TakeShares(sharp_.before[b], Weights(painted.mean_sum), mover_texel, &sharp_.shares[b]);
     } else {
+      TakeShares(sharp_.before[b], Weights(painted.sharp_sum), mover_texel, &sharp_.shares[b]);
       TakeShares(mean_.before[b], Weights(painted.mean_sum), mover_texel, &mean_.shares[b]);
       TakeShares(unmasked_.before[b], Weights(painted.unmasked_sum), mover_texel,
                  &unmasked_.shares[b]);
     }
   }
   if (took_unmasked) mean_.shares = unmasked_.shares;
+  if (took_sharp) mean_.shares = sharp_.shares;
 }
 
 bool MoverProvenance::ShowsMover(const PaintSession& session, size_t b, int idx) const {
-  if (session.options().update != UpdatePolicy::kMean) return shows_mover_[b].data[idx] != 0;
+  if (session.options().update != UpdatePolicy::kMean &&
+      session.options().update != UpdatePolicy::kSharpMean)
+    return shows_mover_[b].data[idx] != 0;
   const cv::Vec2f share = mean_.shares[b].ptr<cv::Vec2f>()[idx];
   return share[0] > 0 && share[0] >= kMoverShare * share[1];
 }

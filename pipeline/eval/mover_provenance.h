@@ -80,7 +80,7 @@ class MoverProvenance {
   struct MeanShares {
     std::vector<cv::Mat> shares, before;
   };
-  MeanShares mean_, unmasked_;
+  MeanShares mean_, unmasked_, sharp_;  // sharp_: PaintedBuffer::sharp_sum
   bool deciding_before_ = false, model_before_ = false;
   bool ShowsMover(const PaintSession& session, size_t b, int idx) const;
 };

@@ -27,6 +27,11 @@ std::string AutoDecision::Describe() const {
                   "on %d frames held out (decided at frame %d)",
                   state == State::kOn ? "mean" : "quality", evidence, frames_measured,
                   decided_at_frame);
+  else if (basis == "held_out_sharp")
+    std::snprintf(line, sizeof line,
+                  "sharp_mean: the mean weighted by each view's pixels on the texel scores "
+                  "%+.2f dB against the sharpest view on %d frames held out (decided at frame %d)",
+                  evidence, frames_measured, decided_at_frame);
   else if (basis == "held_out_without_model")
     std::snprintf(line, sizeof line,
                   "off: the mean of every view without the model scores %+.2f dB against the "
@@ -66,7 +71,9 @@ nlohmann::json DecisionJson(const AutoDecision& d) {
 std::string AutoDecisionsJson(const AutoDecisions& decisions) {
   nlohmann::json update = DecisionJson(decisions.update);
   if (decisions.update.is_auto() && decisions.update.state != AutoDecision::State::kDeciding)
-    update["decision"] = decisions.update.state == AutoDecision::State::kOn ? "mean" : "quality";
+    update["decision"] = decisions.update.state != AutoDecision::State::kOn ? "quality"
+                         : decisions.update.basis == "held_out_sharp"       ? "sharp_mean"
+                                                                            : "mean";
   const nlohmann::json j = {{"refine", DecisionJson(decisions.refine)},
                             {"background", DecisionJson(decisions.background)},
                             {"update", update}};

@@ -83,23 +83,31 @@ struct KernelContext {
   // ... and the sums of `update: mean` and `auto` (PaintedBuffer; null when not kept).
   float* mean_sum = nullptr;
   float* held_sum = nullptr;
+  float* sharp_sum = nullptr;  // `auto` deciding: PaintedBuffer::sharp_sum, held_sharp_sum
+  float* held_sharp_sum = nullptr;
   uint8_t* shadow_bgra = nullptr;
   float* shadow_quality = nullptr;
 };
 
 // One visible sample (BGR) into the painted texel `idx` by `k.rule`: what PaintBuffer paints
 // for it without a mask or a background model (paint_update.cc's PaintTexel).
-inline void PaintSample(const KernelContext& k, size_t idx, const uint8_t* sample, float quality,
-                        bool on_surface, PaintUpdateStats* stats) {
+// `pixels_per_texel`: the view's (ChunkProjection::quality).
+inline void PaintSample(const KernelContext& k, size_t idx, const uint8_t* sample,
+                        float pixels_per_texel, bool on_surface, PaintUpdateStats* stats) {
   uint8_t* const texel = k.paint_bgra + 4 * idx;
+  const float quality = std::min(1.0f, pixels_per_texel);
   if (k.mean_sum && !k.rule.mean_too) {
-    MeanTexel(sample, quality, /*provisional=*/false, on_surface, texel, k.paint_quality + idx,
-              k.mean_sum + 4 * idx, stats);
+    MeanTexel(sample, k.rule.sharp ? SharpWeight(pixels_per_texel) : quality, quality,
+              /*provisional=*/false, on_surface, texel, k.paint_quality + idx, k.mean_sum + 4 * idx,
+              stats);
     return;
   }
   if (k.rule.mean_too) {  // `auto` deciding: the means beside the sharpest
     AddToMean(sample, quality, /*provisional=*/false, k.mean_sum + 4 * idx,
               k.held_sum ? k.held_sum + 4 * idx : nullptr, k.rule.held_out);
+    if (k.sharp_sum)
+      AddToMean(sample, SharpWeight(pixels_per_texel), /*provisional=*/false, k.sharp_sum + 4 * idx,
+                k.held_sharp_sum + 4 * idx, k.rule.held_out);
     PaintUpdateStats ignored;
     if (!k.rule.held_out && k.shadow_bgra)
       UpdateTexel(k.rule, sample, quality, on_surface, k.shadow_bgra + 4 * idx,
@@ -252,8 +260,8 @@ __attribute__((always_inline)) inline void ProjectChunkBody(const KernelContext&
     const float nd_safe = std::max(nd, 1e-12f);
     const float tan_view = std::sqrt(std::max(0.0f, dd - nd * nd)) / nd_safe;
     tol[i] = pz * (tol_rel + slope_px * tan_view) + tol_abs;
-    // Pixels per texel: f s cos(view) / z.
-    quality[i] = std::min(1.0f, focal_texel * nd_safe / (std::sqrt(dd) * z_safe));
+    // Pixels per texel: f s cos(view) / z (the rules count it up to 1: RuleQuality).
+    quality[i] = focal_texel * nd_safe / (std::sqrt(dd) * z_safe);
   };
   if constexpr (kTile == TileSource::kAffine) {
     // Points from the tile's plane, the normal the tile's own (BaseBuffer::Chunk::affine:
@@ -404,7 +412,7 @@ __attribute__((always_inline)) inline PaintBatchSums PaintBatchBody(
     const int compare = ok & has;
     diff_sum += compare * (d < 0 ? -d : d);
     compared += compare;
-    const float q = quality[j], sq = stored_q[j];
+    const float q = std::min(1.0f, quality[j]), sq = stored_q[j];
     const int reject = ok & by_quality & (q < sq * keep);
     const int write = ok & (1 - reject);
     visible += ok;
@@ -1043,6 +1051,10 @@ PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& v
       k.held_sum = painted->held_sum.ptr<float>();
       k.shadow_bgra = painted->shadow_bgra.data;
       k.shadow_quality = painted->shadow_quality.ptr<float>();
+      if (!painted->sharp_sum.empty()) {
+        k.sharp_sum = painted->sharp_sum.ptr<float>();
+        k.held_sharp_sum = painted->held_sharp_sum.ptr<float>();
+      }
     }
   }
   cv::Rect visible_box;
@@ -1052,8 +1064,8 @@ PaintUpdateStats WarpAndPaintBuffer(const BaseBuffer& buffer, const FrameView& v
   SetCounts(n, counts);
   painted->painted_surface_texels += n.paint.newly_painted;
   if (fresh_sums && n.visible == 0) {  // as PaintBuffer, which paints only buffers seen
-    for (cv::Mat* m :
-         {&painted->mean_sum, &painted->shadow_bgra, &painted->shadow_quality, &painted->held_sum})
+    for (cv::Mat* m : {&painted->mean_sum, &painted->shadow_bgra, &painted->shadow_quality,
+                       &painted->held_sum, &painted->sharp_sum, &painted->held_sharp_sum})
       m->release();
   }
   return n.paint;

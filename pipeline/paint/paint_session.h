@@ -183,6 +183,9 @@ class PaintSession {
   // `quality`, as without frames compared.
   static constexpr int kUpdateHoldOutEvery = 4;
   static constexpr int kUpdateHeldOutFrames = 6;
+  // `update: auto` takes the sharp mean only where it beats the mean by this much a frame held
+  // out (DecideUpdate).
+  static constexpr double kSharpMeanMarginDb = 0.1;
   bool DecidingUpdate() const { return update_auto_.state == AutoDecision::State::kDeciding; }
   void DecideUpdate();
   // With background `auto`'s model on while the update decides, the model is judged first on
@@ -364,7 +367,8 @@ class PaintSession {
   // The candidates (the sharpest view, the mean, the mean without the model: the first `n`)
   // without the frames held out, scored at those frames (PSNR summed into `psnr_sum`);
   // returns the frames measured.
-  int ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const;
+  int ScoreHeldOut(size_t n, std::vector<double>* psnr_sum,
+                   const std::vector<int>& candidates = {}) const;
   void TurnModelOffByFramesHeldOut(double gain_db, int measured);
   BackgroundMode requested_background_ = BackgroundMode::kOff;
   // DecideBackgroundAcrossViews' evidence (fraction, frames); frames < 0: none.

@@ -22,6 +22,8 @@ void InitPaintedBuffer(const BaseBuffer& buffer, PaintedBuffer* painted) {
   painted->shadow_quality.release();
   painted->held_sum.release();
   painted->held_unmasked_sum.release();
+  painted->sharp_sum.release();
+  painted->held_sharp_sum.release();
   painted->texel_kind = cv::Mat::zeros(buffer.height, buffer.width, CV_8U);
   for (int k = 0; k < buffer.NumTexels(); ++k)
     painted->texel_kind.data[buffer.texel_index[k]] = buffer.on_surface[k] ? 2 : 1;
@@ -37,6 +39,10 @@ void AllocateSums(const TexelUpdateRule& rule, PaintedBuffer* painted) {
     painted->shadow_bgra = painted->bgra.clone();
     painted->shadow_quality = painted->quality.clone();
     painted->held_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+    if (rule.sharp_too) {
+      painted->sharp_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+      painted->held_sharp_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
+    }
   }
   if (rule.unmasked_too && painted->held_unmasked_sum.empty())
     painted->held_unmasked_sum = cv::Mat::zeros(painted->bgra.size(), CV_32FC4);
@@ -59,6 +65,8 @@ struct PaintArrays {
   float* shadow_quality;
   float* held_sum;
   float* held_unmasked_sum;
+  float* sharp_sum;  // `auto` deciding: the sums of `sharp_mean`, null otherwise
+  float* held_sharp_sum;
 
   PaintArrays(const WarpedBuffer& warped, const cv::Mat& mask, const cv::Mat& warming,
               PaintedBuffer* painted)
@@ -74,7 +82,9 @@ struct PaintArrays {
         shadow_dst(painted->shadow_bgra.empty() ? nullptr : painted->shadow_bgra.data),
         shadow_quality(Floats(painted->shadow_quality)),
         held_sum(Floats(painted->held_sum)),
-        held_unmasked_sum(Floats(painted->held_unmasked_sum)) {}
+        held_unmasked_sum(Floats(painted->held_unmasked_sum)),
+        sharp_sum(Floats(painted->sharp_sum)),
+        held_sharp_sum(Floats(painted->held_sharp_sum)) {}
   static float* Floats(cv::Mat& m) { return m.empty() ? nullptr : m.ptr<float>(); }
 };
 
@@ -88,14 +98,15 @@ struct PaintArrays {
     const float stored = stored_quality[idx];
     uint8_t* texel = dst + 4 * static_cast<size_t>(idx);
     const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
+    const float quality = RuleQuality(rule, a.quality[idx]);
     if (stored >= 0.0f) {
-      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, stored_quality + idx, stats);
+      UpdateTexel(rule, sample, quality, on_surface, texel, stored_quality + idx, stats);
     } else {
       // A provisional stored sample: against a trusted sample it counts as nothing; against
       // another provisional one, by its quality.
       float compared_with = provisional ? -stored : 0.0f;
       const int written_before = stats->written;
-      UpdateTexel(rule, sample, a.quality[idx], on_surface, texel, &compared_with, stats);
+      UpdateTexel(rule, sample, quality, on_surface, texel, &compared_with, stats);
       if (stats->written > written_before) stored_quality[idx] = compared_with;
     }
   }
@@ -109,21 +120,27 @@ struct PaintArrays {
                                               PaintUpdateStats* stats) {
   const bool take = a.valid[idx] && !(a.skip && a.skip[idx]);
   const bool provisional = a.provisional && a.provisional[idx];
+  const float quality = RuleQuality(rule, a.quality[idx]);
   if (a.mean_sum && !rule.mean_too) {
     if (take)
-      MeanTexel(a.src + 3 * static_cast<size_t>(idx), a.quality[idx], provisional, on_surface,
-                a.dst + 4 * static_cast<size_t>(idx), a.stored_quality + idx,
+      MeanTexel(a.src + 3 * static_cast<size_t>(idx),
+                rule.sharp ? SharpWeight(a.quality[idx]) : quality, quality, provisional,
+                on_surface, a.dst + 4 * static_cast<size_t>(idx), a.stored_quality + idx,
                 a.mean_sum + 4 * static_cast<size_t>(idx), stats);
     return;
   }
   if (rule.mean_too) {  // `auto` deciding: the means beside the sharpest
     const uint8_t* sample = a.src + 3 * static_cast<size_t>(idx);
     const size_t at = 4 * static_cast<size_t>(idx);
-    if (take)
-      AddToMean(sample, a.quality[idx], provisional, a.mean_sum + at,
+    if (take) {
+      AddToMean(sample, quality, provisional, a.mean_sum + at,
                 a.held_sum ? a.held_sum + at : nullptr, rule.held_out);
+      if (a.sharp_sum)
+        AddToMean(sample, SharpWeight(a.quality[idx]), provisional, a.sharp_sum + at,
+                  a.held_sharp_sum + at, rule.held_out);
+    }
     if (a.unmasked_sum && a.valid[idx])  // without the model: no sample is provisional
-      AddToMean(sample, a.quality[idx], false, a.unmasked_sum + at,
+      AddToMean(sample, quality, false, a.unmasked_sum + at,
                 a.held_unmasked_sum ? a.held_unmasked_sum + at : nullptr, rule.held_out);
     PaintUpdateStats ignored;
     if (!rule.held_out && a.shadow_dst)

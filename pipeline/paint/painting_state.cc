@@ -10,7 +10,8 @@ template <typename F>
 void ForEachImage(PaintedBuffer& p, F f) {
   for (cv::Mat* m : {&p.bgra, &p.quality, &p.texel_kind, &p.mean_sum, &p.held_sum}) f(*m);
   f(p.unmasked_sum, &p.mean_sum), f(p.shadow_bgra, &p.bgra), f(p.shadow_quality, &p.quality);
-  f(p.held_unmasked_sum, &p.held_sum);
+  f(p.held_unmasked_sum, &p.held_sum), f(p.sharp_sum, &p.mean_sum),
+      f(p.held_sharp_sum, &p.held_sum);
 }
 template <typename F>
 void ForEachImage(WarpedBuffer& w, F f) {

@@ -33,6 +33,10 @@ struct PaintedBuffer {
   // every other frame into the stores above): the texels and qualities `quality` would
   // hold, and the held-out frames' own part of mean_sum and unmasked_sum (subtracted).
   cv::Mat shadow_bgra, shadow_quality, held_sum, held_unmasked_sum;
+  // `update: auto` while deciding: the sums of `sharp_mean` (each sample weighted by the
+  // pixels its view has on the texel, SharpWeight) beside mean_sum, and the held-out frames'
+  // part of them.
+  cv::Mat sharp_sum, held_sharp_sum;
 };
 
 struct PaintUpdateStats {
@@ -59,6 +63,13 @@ struct TexelUpdateRule {
   bool mean_too = false;
   bool unmasked_too = false;  // ... and with the background model on, PaintedBuffer::unmasked_sum
   bool held_out = false;      // ... and this frame is held out of the decision (the shadows)
+  // `sharp_mean` (policy kMean with this set): the sums weigh each sample by SharpWeight.
+  bool sharp = false;
+  // `auto` deciding: PaintedBuffer::sharp_sum too.
+  bool sharp_too = false;
+  // The qualities the rules read are pixels per texel, counted up to 1 (RuleQuality); false
+  // where view selection scored them (its scores are compared as they are).
+  bool cap_quality = true;
 
   static TexelUpdateRule From(const PipelineOptions& options) {
     TexelUpdateRule rule;
@@ -66,8 +77,14 @@ struct TexelUpdateRule {
     if (options.update == UpdatePolicy::kAuto) {
       rule.policy = UpdatePolicy::kQuality;
       rule.mean_too = true;
+      rule.sharp_too = true;
       rule.unmasked_too = options.background.mode != BackgroundMode::kOff;
     }
+    if (options.update == UpdatePolicy::kSharpMean) {
+      rule.policy = UpdatePolicy::kMean;
+      rule.sharp = true;
+    }
+    rule.cap_quality = !options.select.enabled;
     rule.keep = static_cast<float>(1.0 - options.quality_slack);
     rule.weight = std::clamp(static_cast<int>(std::lround(256 * options.update_weight)), 1, 256);
     return rule;
@@ -77,6 +94,17 @@ struct TexelUpdateRule {
 // The sums `rule` paints into (PaintedBuffer::mean_sum and, for `update: auto` deciding, the
 // shadows and held-out parts), made where missing (paint_update.cc).
 void AllocateSums(const TexelUpdateRule& rule, PaintedBuffer* painted);
+
+// A view's pixels per texel as the update rules weigh it (`quality`, `mean`): up to one pixel
+// per texel (a texel seen by a pixel or more counts as seen sharp); view selection's scores
+// as they are.
+inline float RuleQuality(const TexelUpdateRule& rule, float pixels_per_texel) {
+  return rule.cap_quality ? std::min(1.0f, pixels_per_texel) : pixels_per_texel;
+}
+
+// `sharp_mean`'s weight of a sample: the pixels its view has on the texel (pixels per texel
+// squared, not capped), so near and head-on views count more where every view is averaged.
+inline float SharpWeight(float pixels_per_texel) { return pixels_per_texel * pixels_per_texel; }
 
 // The misalignment signal: a sample against what a painted texel holds (BT.601 luma, integer
 // weights), into `stats`.
@@ -112,10 +140,10 @@ inline void UpdateTexel(const TexelUpdateRule& rule, const uint8_t* sample, floa
   ++stats->written;
 }
 
-// Adds the sample, weighted by its quality, to a texel's sums (`sum`: B, G, R, weight). A
-// provisional sample (the background model still learning the texel: it may show a mover)
-// counts only until the texel's first trusted one, which replaces them: the weight of sums
-// of provisional samples only is kept negative. `held` (optional): the part of `sum` taken
+// Adds the sample, weighted by `quality` (RuleQuality, or SharpWeight), to a texel's sums (`sum`:
+// B, G, R, weight). A provisional sample (the background model still learning the texel: it may
+// show a mover) counts only until the texel's first trusted one, which replaces them: the weight of
+// sums of provisional samples only is kept negative. `held` (optional): the part of `sum` taken
 // from frames held out of `update: auto`'s decision; it follows `sum`'s replacements and
 // takes the sample too when `held_out`.
 inline void AddToMean(const uint8_t* sample, float quality, bool provisional, float* sum,
@@ -139,13 +167,14 @@ inline void MeanOfSums(const float* sum, uint8_t* texel) {
   for (int c = 0; c < 3; ++c) texel[c] = cv::saturate_cast<uint8_t>(sum[c] / weight);
 }
 
-// `update: mean`: AddToMean, and the texel their mean; the stored quality is the best seen.
-// Counts into `stats`.
-inline void MeanTexel(const uint8_t* sample, float quality, bool provisional, bool on_surface,
-                      uint8_t* texel, float* stored_quality, float* sum, PaintUpdateStats* stats) {
+// `update: mean` (and `sharp_mean`): AddToMean with `weight`, and the texel their mean; the
+// stored quality is the best seen. Counts into `stats`.
+inline void MeanTexel(const uint8_t* sample, float weight, float quality, bool provisional,
+                      bool on_surface, uint8_t* texel, float* stored_quality, float* sum,
+                      PaintUpdateStats* stats) {
   CompareWithStored(sample, texel, stats);
   if (texel[3] == 0 && on_surface) ++stats->newly_painted;
-  AddToMean(sample, quality, provisional, sum);
+  AddToMean(sample, weight, provisional, sum);
   MeanOfSums(sum, texel);
   texel[3] = 255;
   *stored_quality = std::max(*stored_quality, quality);

@@ -83,24 +83,33 @@ void PaintSession::KeepSharpestViews(const char* why) {
   update_auto_.state = AutoDecision::State::kOff;
   options_.update = UpdatePolicy::kQuality;
   for (PaintedBuffer& p : painted_)
-    for (cv::Mat* m : {&p.mean_sum, &p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality,
-                       &p.held_sum, &p.held_unmasked_sum})
+    for (cv::Mat* m : {&p.mean_sum, &p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum,
+                       &p.held_unmasked_sum, &p.sharp_sum, &p.held_sharp_sum})
       m->release();
 }
 
 // The candidates painted without the frames held out, rendered at those frames' poses:
-// `psnr_sum[c]` over the frames measured (the return value).
-int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const {
+// `psnr_sum[c]` over the frames measured (the return value). Candidate 0 the sharpest view,
+// 1 the mean, 2 the mean without the model, 3 the sharp mean (`candidates`: the first n, or
+// those listed).
+int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum,
+                               const std::vector<int>& candidates) const {
+  std::vector<int> kinds = candidates;
+  if (kinds.empty())
+    for (size_t c = 0; c < n; ++c) kinds.push_back(static_cast<int>(c));
+  n = kinds.size();
   // One scene (the mesh with its atlas UVs), its pages composed again for each candidate; each
   // frame rasterized once and shaded with each.
   const auto candidate = [&](size_t c) {
     std::vector<cv::Mat> texels;
     for (const PaintedBuffer& p : painted_) {
       const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
-      texels.push_back(AtMeanExposure(c == 0   ? base
-                                      : c == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
-                                               : MeanTexels(base, p.unmasked_sum,
-                                                            p.held_unmasked_sum)));
+      const int kind = kinds[c];
+      texels.push_back(AtMeanExposure(kind == 0   ? base
+                                      : kind == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
+                                      : kind == 2
+                                          ? MeanTexels(base, p.unmasked_sum, p.held_unmasked_sum)
+                                          : MeanTexels(base, p.sharp_sum, p.held_sharp_sum)));
     }
     return texels;
   };
@@ -171,26 +180,47 @@ void PaintSession::DecideUpdate() {
   const bool model_on = options_.background.mode != BackgroundMode::kOff;
   const bool without_model = model_on && requested_background_ == BackgroundMode::kAuto;
   if (model_on && !without_model) return KeepSharpestViews("background_model_on");
-  const size_t n = without_model ? 3 : 2;
+  // The sharp mean where its sums were taken from the first frame (every frame painted in
+  // the warp: they are, where nothing is provisional... or beside the model's sums).
+  bool sharp = false;
+  for (const PaintedBuffer& p : painted_) sharp |= !p.sharp_sum.empty();
+  std::vector<int> kinds = {0, 1};
+  if (without_model) kinds.push_back(2);
+  if (sharp) kinds.push_back(3);
+  const size_t n = kinds.size();
   std::vector<double> psnr_sum;
-  const int measured = ScoreHeldOut(n, &psnr_sum);
+  const int measured = ScoreHeldOut(n, &psnr_sum, kinds);
   update_held_out_.clear();
+  // The best of the sharpest view and the means that weigh every view alike; the sharp mean
+  // where it beats them and the mean by kSharpMeanMarginDb a frame (where it hardly differs
+  // from the mean, every view alike is the safer choice: on real photos the frames held out
+  // tell the two apart by less than that, and the sharp one scored lower at views left out).
   size_t best = 0;
   for (size_t c = 1; c < n && measured > 0; ++c)
-    if (psnr_sum[c] > psnr_sum[best]) best = c;
+    if (kinds[c] != 3 && psnr_sum[c] > psnr_sum[best]) best = c;
+  if (sharp && measured > 0 && psnr_sum[n - 1] > psnr_sum[best] &&
+      psnr_sum[n - 1] > psnr_sum[1] + kSharpMeanMarginDb * measured)
+    best = n - 1;
+  const int chosen = kinds[best];
   update_auto_.frames_measured = measured;
   update_auto_.decided_at_frame = frames_seen_;
-  update_auto_.evidence =
-      measured > 0
-          ? (*std::max_element(psnr_sum.begin() + 1, psnr_sum.end()) - psnr_sum[0]) / measured
-          : std::numeric_limits<double>::quiet_NaN();
-  const bool mean = best > 0;
+  update_auto_.evidence = measured > 0 ? (psnr_sum[best > 0 ? best : 1] - psnr_sum[0]) / measured
+                                       : std::numeric_limits<double>::quiet_NaN();
+  if (measured > 0 && best == 0)  // the best mean's shortfall
+    for (size_t c = 1; c < n; ++c)
+      update_auto_.evidence =
+          std::max(update_auto_.evidence, (psnr_sum[c] - psnr_sum[0]) / measured);
+  const bool mean = chosen > 0;
   update_auto_.state = mean ? AutoDecision::State::kOn : AutoDecision::State::kOff;
-  options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
-  if (best == 2) TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
+  if (chosen == 3) update_auto_.basis = "held_out_sharp";
+  options_.update = chosen == 3 ? UpdatePolicy::kSharpMean
+                    : mean      ? UpdatePolicy::kMean
+                                : UpdatePolicy::kQuality;
+  if (chosen == 2) TurnModelOffByFramesHeldOut((psnr_sum[best] - psnr_sum[1]) / measured, measured);
   // What every frame painted, the chosen way.
   for (size_t b = 0; b < painted_.size(); ++b) {
     PaintedBuffer& p = painted_[b];
+    if (chosen == 3) p.mean_sum = p.sharp_sum;
     if (mean) {
       p.bgra = MeanTexels(p.bgra, p.mean_sum);
       cv::absdiff(p.quality, 0, p.quality);  // none provisional: every view counts
@@ -204,7 +234,7 @@ void PaintSession::DecideUpdate() {
       p.mean_sum.release();
     }
     for (cv::Mat* m : {&p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum,
-                       &p.held_unmasked_sum})
+                       &p.held_unmasked_sum, &p.sharp_sum, &p.held_sharp_sum})
       m->release();
   }
 }

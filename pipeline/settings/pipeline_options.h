@@ -20,7 +20,7 @@ enum class SamplingMode { kNearest, kBilinear, kArea };
 // kMean: each texel the mean of every sample it took, weighted by pixels per texel.
 // kAuto: kQuality or kMean, whichever agrees better with frames held out of the decision
 // (PaintSession::DecideUpdate).
-enum class UpdatePolicy { kLatest, kQuality, kMean, kAuto };
+enum class UpdatePolicy { kLatest, kQuality, kMean, kAuto, kSharpMean };
 
 struct PipelineOptions {
   SamplingMode sampling = SamplingMode::kBilinear;
@@ -60,6 +60,7 @@ inline const EnumNames<UpdatePolicy>& UpdatePolicyNames() {
       {UpdatePolicy::kQuality, "quality"},
       {UpdatePolicy::kMean, "mean"},
       {UpdatePolicy::kAuto, "auto"},
+      {UpdatePolicy::kSharpMean, "sharp_mean"},
   };
   return names;
 }
@@ -81,14 +82,17 @@ void Fields(PipelineOptions& o, V& v) {
           {.min = 1, .help = "paint every N-th frame (the paper's §4)"});
   v.Enum("update", o.update, UpdatePolicyNames(),
          "`latest` (the paper: every visible sample overwrites), `quality` (a sample overwrites "
-         "only if at least `1 - quality_slack` as sharp, in pixels per texel), `mean` (each "
-         "texel the mean of every sample it took, weighted by pixels per texel: for views of a "
-         "static scene that disagree in light, noise and by a few pixels; 16 more bytes per "
-         "texel) or `auto`: the capture is painted both ways, and also both ways without 6 "
+         "only if at least `1 - quality_slack` as sharp, in pixels per texel up to 1), `mean` "
+         "(each texel the mean of every sample it took, weighted by pixels per texel up to 1: "
+         "for views of a static scene that disagree in light, noise and by a few pixels; 16 "
+         "more bytes per texel), `sharp_mean` (the same mean with each sample weighted by the "
+         "pixels its view has on the texel, pixels per texel squared: near, head-on views "
+         "count more) or `auto`: the capture is painted each way, and also each way without 6 "
          "frames spread over it (every N / 7-th of N frames; live: 2, 6, ..., 22); after the "
          "6th the model painted each way without them is rendered at their poses, and the way "
-         "that agrees better with them paints on (where "
-         "`background.mode` `auto` turned the model on, the mean without it is a third way, "
+         "that agrees better with them paints on (`sharp_mean` only where it beats `mean` by "
+         "0.1 dB a frame: every view alike is the safer mean; where "
+         "`background.mode` `auto` turned the model on, the mean without it is one more way, "
          "which turns it off; with the model on by hand, refinement on or view selection, "
          "`auto` keeps `quality`). The choice and its evidence (dB gained) are in "
          "metrics.json under `auto.update`");

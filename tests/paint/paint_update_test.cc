@@ -122,6 +122,32 @@ TEST(PaintUpdate, AutoWhileDecidingKeepsTheSharpestAndTheMean) {
   EXPECT_FLOAT_EQ(deciding.painted.mean_sum.at<cv::Vec4f>(0, 1)[3], 2.25f);
 }
 
+// `update: sharp_mean`: the mean with each sample weighted by the pixels its view has on the
+// texel (pixels per texel squared, not capped); `mean` and `quality` count pixels per texel up
+// to 1. `auto` while deciding keeps the sharp sums beside the mean's.
+TEST(PaintUpdate, SharpMeanWeighsSamplesByTheirPixelsOnTheTexel) {
+  PipelineOptions sharp_options, mean_options, auto_options;
+  sharp_options.update = UpdatePolicy::kSharpMean;
+  mean_options.update = UpdatePolicy::kMean;
+  auto_options.update = UpdatePolicy::kAuto;
+  TwoTexels sharp, mean, deciding;
+  for (const auto& [grey, q] : {std::pair{100, 3.0f}, {200, 1.0f}, {40, 0.5f}}) {
+    for (TwoTexels* t : {&sharp, &mean, &deciding}) t->warped.quality.setTo(q);
+    sharp.Paint(grey, sharp_options);
+    mean.Paint(grey, mean_options);
+    deciding.Paint(grey, auto_options);
+  }
+  // (9 * 100 + 200 + 0.25 * 40) / 10.25 = 108.3; the mean: (100 + 200 + 0.5 * 40) / 2.5
+  EXPECT_EQ(sharp.Stored(), 108);
+  EXPECT_EQ(mean.Stored(), 128);
+  EXPECT_FLOAT_EQ(mean.painted.quality.at<float>(0, 1), 1.0f);  // the best seen, counted to 1
+  ASSERT_FALSE(deciding.painted.sharp_sum.empty());
+  const cv::Vec4f s = deciding.painted.sharp_sum.at<cv::Vec4f>(0, 1);
+  EXPECT_NEAR(s[0] / s[3], (900 + 200 + 10) / 10.25, 1e-3);
+  const cv::Vec4f m = deciding.painted.mean_sum.at<cv::Vec4f>(0, 1);
+  EXPECT_NEAR(m[0] / m[3], 128.0, 1e-3);
+}
+
 // While a texel's background model warms up its samples are provisional (PaintBuffer's `warming`):
 // a later provisional sample replaces the stored one only when it is as sharp (the quality
 // rule), a trusted one whatever its quality, even one showing nearly the same (per-texel
