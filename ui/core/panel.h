@@ -175,8 +175,12 @@ std::string FitLabelledItem(const std::string& label);
 float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
-// A COLMAP run under way (PosesRunner): a bar over its steps, with the step's name and
-// elapsed seconds; nothing when the worker is idle.
+// A progress bar `width` wide (<= 0: the available width less that) with `text` in it where
+// the text fits, else the percentage in it and the text whole, wrapped, on the lines below
+// (ImGui's bar would cut the text's start). Returns the lines below (0: the text is in the bar).
+float ProgressBarWithText(float fraction, const std::string& text, float width = 0);
+// A COLMAP run under way (PosesRunner): a bar over its steps, with the step's name, how far
+// COLMAP has got in it, the elapsed time and an estimate; nothing when the worker is idle.
 void ColmapProgressBar(const PosesSnapshot& snap);
 
 }  // namespace fresco
