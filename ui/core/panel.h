@@ -157,6 +157,9 @@ int ShownFrame(const RunnerSnapshot& snap);
 // "frame 12", "seeking to frame 40: at 17", "no frame painted yet"; going back, "seeking to
 // frame 13: from the state saved before frame 10" (or ": reopening" without one).
 std::string FrameLabel(const RunnerSnapshot& snap);
+// The worker's status, with the time of a step of opening still under way counted to now
+// ("adjusting poses 120/246, 40 s elapsed, about 42 s left"; RunnerSnapshot::step_text).
+std::string StatusText(const RunnerSnapshot& snap);
 // Layout in narrow panels: the next item's width so that `following` (a button's label on
 // the same line after it, or a widget's own label) still fits, at least `min_px`; and
 // SameLine only when an item `next_width` wide fits after the last one (else a new line).

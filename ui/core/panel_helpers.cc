@@ -159,6 +159,14 @@ std::string FrameLabel(const RunnerSnapshot& snap) {
   return "frame " + std::to_string(snap.frame);
 }
 
+std::string StatusText(const RunnerSnapshot& snap) {
+  if (snap.step_text.empty() || snap.status.rfind(snap.step_text, 0) != 0) return snap.status;
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - snap.step_started).count();
+  if (snap.step_fraction < 0) return snap.step_text + ", " + DurationText(elapsed_s) + " elapsed";
+  return snap.step_text + ", " + ElapsedAndRemainingText(elapsed_s, snap.step_fraction);
+}
+
 void ShowMetrics(const std::map<std::string, double>& metrics) {
   if (!ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV))
     return;
