@@ -605,3 +605,64 @@ TEST(UiLayout, COLMAPsProgressTextIsWholeInThePosesControlsColumn) {
 
 }  // namespace
 }  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// Two path fields as the Calibration panel has them (Folder, then Attach), drawn in a window
+// with the mouse at `mouse` (button down or not); returns the rectangle of each field's "..."
+// button when its list is closed.
+struct TwoPathFields {
+  std::string folder, attach, last_folder;
+  ImVec4 folder_button, attach_button;
+  void Frame(ImVec2 mouse, bool down) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = mouse;
+    io.MouseDown[0] = down;
+    ImGui::NewFrame();
+    ImGui::SetNextWindowPos(ImVec2(0, 0));
+    ImGui::SetNextWindowSize(ImVec2(600, 400));
+    ImGui::Begin("two path fields");
+    PathField("Folder", "##folder", "", &folder, {.last_folder = &last_folder});
+    folder_button = ItemRect();
+    PathField("Attach", "##attach", "", &attach, {.last_folder = &last_folder});
+    attach_button = ItemRect();
+    ImGui::End();
+    ImGui::Render();
+  }
+  static ImVec4 ItemRect() {
+    return {ImGui::GetItemRectMin().x, ImGui::GetItemRectMin().y, ImGui::GetItemRectMax().x,
+            ImGui::GetItemRectMax().y};
+  }
+  void Click(ImVec2 at) {
+    Frame(at, false);
+    Frame(at, true);
+    Frame(at, false);
+  }
+};
+
+// With the Folder field's "..." list open, a click into the Attach field closes the list and
+// puts the cursor there: what is typed next lands in it. Before: the click only closed the
+// list (ImGui gives a click outside an open list to the list alone), no field was active and
+// the text typed was lost.
+TEST(UiLayout, AClickIntoAnotherFieldWhileAPathListIsOpenTakesTheTyping) {
+  testing::ImGuiHeadless imgui;
+  TwoPathFields fields;
+  fields.last_folder = testing::MakeTempDir("path-list") + "/";
+  fields.Frame(ImVec2(-1, -1), false);
+  fields.Frame(ImVec2(-1, -1), false);
+  const ImVec4 folder = fields.folder_button, attach = fields.attach_button;
+  fields.Click(ImVec2((folder.x + folder.z) / 2, (folder.y + folder.w) / 2));
+  ASSERT_FALSE(GImGui->OpenPopupStack.empty()) << "the Folder field's list opened";
+  // Into the Attach field, just left of its "..." button.
+  fields.Click(ImVec2(attach.x - 30, (attach.y + attach.w) / 2));
+  EXPECT_TRUE(GImGui->OpenPopupStack.empty()) << "the list closed";
+  ImGui::GetIO().AddInputCharacter('x');
+  fields.Frame(ImVec2(attach.x - 30, (attach.y + attach.w) / 2), false);
+  fields.Frame(ImVec2(attach.x - 30, (attach.y + attach.w) / 2), false);
+  EXPECT_EQ(fields.attach, "x") << "the text typed after the click";
+  EXPECT_EQ(fields.folder, fields.last_folder) << "the Folder field as its list left it";
+}
+
+}  // namespace
+}  // namespace fresco

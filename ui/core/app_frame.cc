@@ -420,6 +420,7 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   CheckOpened(ui);
   PlaceDroppedPaths(ui, panels);
   HandleShortcuts(ui);
+  LetAClickOutsideABrowseListThrough();
   DrawMenuBar(ui, panels);
   if (ui.new_project_requested) {
     for (auto& panel : panels)
