@@ -4,7 +4,9 @@
 #include <chrono>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -99,6 +101,46 @@ TEST(StateMessages, TheCalibrationLightIsNotGreenBeforeTheOneCameraCheck) {
   EXPECT_EQ(report["camera_doubts"], "0");
   EXPECT_EQ(report["readiness"], "green") << "after the check";
   std::printf("frames drawn while detecting %d, while checking %d\n", detecting, checking);
+}
+
+// A step of opening that goes quiet keeps counting its time in the window (status bar and
+// Pipeline panel): the worker publishes only when the step says how far it got, and on the
+// street under load the joint pose adjustment stood at "adjusting poses 120/246, 8 s elapsed,
+// about 8 s left" for 34 s between its two passes, as if the app had hung.
+TEST(StateMessages, AQuietStepOfOpeningKeepsCountingItsTime) {
+  std::mutex mutex;
+  std::shared_ptr<RunnerSnapshot> adjusting;  // the first "adjusting poses" published
+  RunnerOptions options;
+  options.publish_interval_ms = 0;
+  options.on_publish = [&](const RunnerSnapshot& s) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!adjusting && s.status.rfind("adjusting poses ", 0) == 0)
+      adjusting = std::make_shared<RunnerSnapshot>(s);
+  };
+  AppState state;
+  ASSERT_TRUE(state.Open(testing::Capture() + "/project.json").ok());
+  state.project.pipeline.refine.joint = true;
+  const auto published = std::chrono::steady_clock::now();
+  {
+    PipelineRunner runner(options);
+    runner.Restart(state.project);
+    runner.WaitIdle();
+  }
+  std::lock_guard<std::mutex> lock(mutex);
+  ASSERT_TRUE(adjusting) << "the joint adjustment published its progress";
+  const std::string stem = adjusting->status.substr(0, adjusting->status.find(','));
+  // The worker says nothing more for 3 s (as if the step were still under way).
+  HeadlessApp app(testing::Capture() + "/project.json", 0);
+  std::this_thread::sleep_until(published + std::chrono::seconds(3));
+  app.ui.snapshot = adjusting;
+  app.imgui.Frame(app.ui, app.panels, &app.input);
+  const std::string line = app.ReportOf("Pipeline", "status");
+  ASSERT_EQ(line.rfind(stem, 0), 0u) << "'" << line << "' for '" << adjusting->status << "'";
+  const size_t seconds = line.find(" s elapsed");
+  ASSERT_NE(seconds, std::string::npos) << line;
+  const size_t number = line.rfind(' ', seconds - 1) + 1;
+  EXPECT_GE(std::stoi(line.substr(number, seconds - number)), 3)
+      << "the time stood still: '" << line << "' (published as '" << adjusting->status << "')";
 }
 
 }  // namespace

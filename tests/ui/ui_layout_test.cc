@@ -3,12 +3,17 @@
 // neighbours; a double-click on a title bar maximises a panel and another restores the
 // layout; closing a panel gives its space to its neighbour; the font scale applies; on a 4K
 // monitor at twice the density the layout and text are twice the size.
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+
 #include <gtest/gtest.h>
 #include <imgui.h>
 #include <imgui_internal.h>
 
 #include "tests/ui/headless_ui.h"
 #include "ui/core/calibration_runner.h"
+#include "ui/core/poses_runner.h"
 #include "ui/core/tile_layout.h"
 #include "ui/panels/panels.h"
 #include "ui/panels/path_field.h"
@@ -537,6 +542,126 @@ TEST(UiLayout, TheSeekProgressTextIsWholeInANarrowPanelAtALargerFont) {
     EXPECT_LE(std::stof(report["seek stop right"]), std::stof(report["panel right"]) + 0.5f)
         << "Stop runs out of the panel, width " << width;
   }
+}
+
+}  // namespace
+}  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// The glyphs drawn in `window` in the text colour (each a quad of four vertices off the font
+// atlas' white pixel), and the leftmost x of any.
+int TextGlyphs(ImGuiWindow* window, float* left) {
+  const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
+  const ImVec2 white = ImGui::GetIO().Fonts->TexUvWhitePixel;
+  int vertices = 0;
+  *left = 1e9f;
+  for (const ImDrawVert& v : window->DrawList->VtxBuffer)
+    if (v.col == text && (v.uv.x != white.x || v.uv.y != white.y)) {
+      ++vertices;
+      *left = std::min(*left, v.pos.x);
+    }
+  return vertices / 4;
+}
+
+// COLMAP's progress in the Poses panel's controls column (360 pixels at 1920 x 1080): every
+// letter of "step 1/8 feature_extractor 30/61 images: 30 s elapsed, about 31 s left in this
+// step" is drawn, in the bar where it fits, else below it. Before: ImGui's bar right-aligned
+// the 470-pixel text and cut its start, showing "images: 30 s elapsed, ..." without the step
+// or the count.
+TEST(UiLayout, COLMAPsProgressTextIsWholeInThePosesControlsColumn) {
+  testing::ImGuiHeadless imgui;
+  const std::string log = testing::MakeTempDir("colmap-progress") + "/feature_extractor.log";
+  std::ofstream(log) << "Processed file [29/61]\nProcessed file [30/61]\n";
+  PosesSnapshot snap;
+  snap.busy = true;
+  snap.step = 1;
+  snap.steps = 8;
+  snap.step_name = "feature_extractor";
+  snap.step_log = log;
+  snap.step_started = snap.started = std::chrono::steady_clock::now() - std::chrono::seconds(30);
+  const std::string expected =
+      "step 1/8 feature_extractor 30/61 images: 30 s elapsed, about 31 s left in this step";
+  const int letters = static_cast<int>(
+      std::count_if(expected.begin(), expected.end(), [](char c) { return c != ' '; }));
+  for (const float width : {360.0f, 900.0f}) {
+    for (int frame = 0; frame < 2; ++frame) {
+      ImGui::NewFrame();
+      ImGui::SetNextWindowPos(ImVec2(100, 100));
+      ImGui::SetNextWindowSize(ImVec2(width, 300));
+      ImGui::Begin("COLMAP progress");
+      ColmapProgressBar(snap);
+      ImGui::End();
+      ImGui::Render();
+    }
+    ImGuiWindow* window = ImGui::FindWindowByName("COLMAP progress");
+    ASSERT_NE(window, nullptr);
+    float left = 0;
+    EXPECT_GE(TextGlyphs(window, &left), letters) << "letters cut off, width " << width;
+    EXPECT_GE(left, window->InnerClipRect.Min.x) << "width " << width;
+  }
+}
+
+}  // namespace
+}  // namespace fresco
+
+namespace fresco {
+namespace {
+
+// Two path fields as the Calibration panel has them (Folder, then Attach), drawn in a window
+// with the mouse at `mouse` (button down or not); returns the rectangle of each field's "..."
+// button when its list is closed.
+struct TwoPathFields {
+  std::string folder, attach, last_folder;
+  ImVec4 folder_button, attach_button;
+  void Frame(ImVec2 mouse, bool down) {
+    ImGuiIO& io = ImGui::GetIO();
+    io.MousePos = mouse;
+    io.MouseDown[0] = down;
+    ImGui::NewFrame();
+    ImGui::SetNextWindowPos(ImVec2(0, 0));
+    ImGui::SetNextWindowSize(ImVec2(600, 400));
+    ImGui::Begin("two path fields");
+    PathField("Folder", "##folder", "", &folder, {.last_folder = &last_folder});
+    folder_button = ItemRect();
+    PathField("Attach", "##attach", "", &attach, {.last_folder = &last_folder});
+    attach_button = ItemRect();
+    ImGui::End();
+    ImGui::Render();
+  }
+  static ImVec4 ItemRect() {
+    return {ImGui::GetItemRectMin().x, ImGui::GetItemRectMin().y, ImGui::GetItemRectMax().x,
+            ImGui::GetItemRectMax().y};
+  }
+  void Click(ImVec2 at) {
+    Frame(at, false);
+    Frame(at, true);
+    Frame(at, false);
+  }
+};
+
+// With the Folder field's "..." list open, a click into the Attach field closes the list and
+// puts the cursor there: what is typed next lands in it. Before: the click only closed the
+// list (ImGui gives a click outside an open list to the list alone), no field was active and
+// the text typed was lost.
+TEST(UiLayout, AClickIntoAnotherFieldWhileAPathListIsOpenTakesTheTyping) {
+  testing::ImGuiHeadless imgui;
+  TwoPathFields fields;
+  fields.last_folder = testing::MakeTempDir("path-list") + "/";
+  fields.Frame(ImVec2(-1, -1), false);
+  fields.Frame(ImVec2(-1, -1), false);
+  const ImVec4 folder = fields.folder_button, attach = fields.attach_button;
+  fields.Click(ImVec2((folder.x + folder.z) / 2, (folder.y + folder.w) / 2));
+  ASSERT_FALSE(GImGui->OpenPopupStack.empty()) << "the Folder field's list opened";
+  // Into the Attach field, just left of its "..." button.
+  fields.Click(ImVec2(attach.x - 30, (attach.y + attach.w) / 2));
+  EXPECT_TRUE(GImGui->OpenPopupStack.empty()) << "the list closed";
+  ImGui::GetIO().AddInputCharacter('x');
+  fields.Frame(ImVec2(attach.x - 30, (attach.y + attach.w) / 2), false);
+  fields.Frame(ImVec2(attach.x - 30, (attach.y + attach.w) / 2), false);
+  EXPECT_EQ(fields.attach, "x") << "the text typed after the click";
+  EXPECT_EQ(fields.folder, fields.last_folder) << "the Folder field as its list left it";
 }
 
 }  // namespace

@@ -161,7 +161,7 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   if (IsError(snap.status)) {  // said once, in the status bar
     ImGui::TextColored(kErrorColour, "error (see the status bar)");
   } else {
-    ImGui::Text("%s  %s  coverage %.1f%%  %s", FrameLabel(snap).c_str(), snap.status.c_str(),
+    ImGui::Text("%s  %s  coverage %.1f%%  %s", FrameLabel(snap).c_str(), StatusText(snap).c_str(),
                 100.0 * snap.coverage, state.dirty ? "[unsaved]" : "");
   }
   ImGui::EndMainMenuBar();
@@ -420,6 +420,7 @@ void DrawAppFrame(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   CheckOpened(ui);
   PlaceDroppedPaths(ui, panels);
   HandleShortcuts(ui);
+  LetAClickOutsideABrowseListThrough();
   DrawMenuBar(ui, panels);
   if (ui.new_project_requested) {
     for (auto& panel : panels)

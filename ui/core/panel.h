@@ -157,6 +157,9 @@ int ShownFrame(const RunnerSnapshot& snap);
 // "frame 12", "seeking to frame 40: at 17", "no frame painted yet"; going back, "seeking to
 // frame 13: from the state saved before frame 10" (or ": reopening" without one).
 std::string FrameLabel(const RunnerSnapshot& snap);
+// The worker's status, with the time of a step of opening still under way counted to now
+// ("adjusting poses 120/246, 40 s elapsed, about 42 s left"; RunnerSnapshot::step_text).
+std::string StatusText(const RunnerSnapshot& snap);
 // Layout in narrow panels: the next item's width so that `following` (a button's label on
 // the same line after it, or a widget's own label) still fits, at least `min_px`; and
 // SameLine only when an item `next_width` wide fits after the last one (else a new line).
@@ -175,8 +178,12 @@ std::string FitLabelledItem(const std::string& label);
 float ButtonWidth(const char* label);
 // A two-column table of metrics.
 void ShowMetrics(const std::map<std::string, double>& metrics);
-// A COLMAP run under way (PosesRunner): a bar over its steps, with the step's name and
-// elapsed seconds; nothing when the worker is idle.
+// A progress bar `width` wide (<= 0: the available width less that) with `text` in it where
+// the text fits, else the percentage in it and the text whole, wrapped, on the lines below
+// (ImGui's bar would cut the text's start). Returns the lines below (0: the text is in the bar).
+float ProgressBarWithText(float fraction, const std::string& text, float width = 0);
+// A COLMAP run under way (PosesRunner): a bar over its steps, with the step's name, how far
+// COLMAP has got in it, the elapsed time and an estimate; nothing when the worker is idle.
 void ColmapProgressBar(const PosesSnapshot& snap);
 
 }  // namespace fresco

@@ -159,6 +159,14 @@ std::string FrameLabel(const RunnerSnapshot& snap) {
   return "frame " + std::to_string(snap.frame);
 }
 
+std::string StatusText(const RunnerSnapshot& snap) {
+  if (snap.step_text.empty() || snap.status.rfind(snap.step_text, 0) != 0) return snap.status;
+  const double elapsed_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - snap.step_started).count();
+  if (snap.step_fraction < 0) return snap.step_text + ", " + DurationText(elapsed_s) + " elapsed";
+  return snap.step_text + ", " + ElapsedAndRemainingText(elapsed_s, snap.step_fraction);
+}
+
 void ShowMetrics(const std::map<std::string, double>& metrics) {
   if (!ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV))
     return;
@@ -180,6 +188,18 @@ void ShowMetrics(const std::map<std::string, double>& metrics) {
   ImGui::EndTable();
 }
 
+float ProgressBarWithText(float fraction, const std::string& text, float width) {
+  const ImGuiStyle& style = ImGui::GetStyle();
+  const float bar = width > 0 ? width : ImGui::GetContentRegionAvail().x + width;
+  const bool fits = ImGui::CalcTextSize(text.c_str()).x + 2 * style.FramePadding.x <= bar;
+  char percent[16];
+  std::snprintf(percent, sizeof(percent), "%.0f %%", 100.0f * std::clamp(fraction, 0.0f, 1.0f));
+  ImGui::ProgressBar(fraction, ImVec2(bar, 0), fits ? text.c_str() : percent);
+  if (fits) return 0;
+  ImGui::TextWrapped("%s", text.c_str());
+  return ImGui::GetItemRectSize().y / ImGui::GetTextLineHeight();
+}
+
 void ColmapProgressBar(const PosesSnapshot& snap) {
   if (!snap.busy) return;
   const auto now = std::chrono::steady_clock::now();
@@ -187,7 +207,7 @@ void ColmapProgressBar(const PosesSnapshot& snap) {
       std::chrono::duration<double>(now - (snap.steps > 0 ? snap.step_started : snap.started))
           .count();
   if (snap.steps == 0) {
-    ImGui::ProgressBar(0.0f, ImVec2(-1, 0), (DurationText(seconds) + " elapsed").c_str());
+    ProgressBarWithText(0.0f, DurationText(seconds) + " elapsed");
     return;
   }
   // How far the step has got, from the progress lines COLMAP writes to its log.
@@ -206,7 +226,7 @@ void ColmapProgressBar(const PosesSnapshot& snap) {
   text.append(": ").append(ElapsedAndRemainingText(seconds, step.Fraction()));
   if (RemainingSeconds(seconds, step.Fraction()) >= 0) text += " in this step";
   const float fraction = (snap.step - 1 + static_cast<float>(step.Fraction())) / snap.steps;
-  ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
+  ProgressBarWithText(fraction, text);
 }
 
 }  // namespace fresco

@@ -178,9 +178,11 @@ void PipelineRunner::OpenSession(const Project& project) {
       const double elapsed_s = std::chrono::duration<double>(Clock::now() - *started).count();
       const double fraction = total > 0 ? static_cast<double>(done) / total : 0;
       // A seek back reopens the project: its progress stays a seek's.
-      working_.status = std::string(seek_target_ >= 0 ? "seeking: " : "") + what + " " +
-                        std::to_string(done) + "/" + std::to_string(total) + ", " +
-                        ElapsedAndRemainingText(elapsed_s, fraction);
+      working_.step_text = std::string(seek_target_ >= 0 ? "seeking: " : "") + what + " " +
+                           std::to_string(done) + "/" + std::to_string(total);
+      working_.step_fraction = fraction;
+      working_.step_started = *started;
+      working_.status = working_.step_text + ", " + ElapsedAndRemainingText(elapsed_s, fraction);
       Publish(false);
     };
   };
@@ -204,6 +206,9 @@ void PipelineRunner::OpenSession(const Project& project) {
                           : step == kLoadStep                  ? last_open_.load
                                                                : last_open_.cameras;
     if (last_s >= 1) working_.status += ", about " + DurationText(last_s) + " (as last time)";
+    working_.step_text = working_.status;
+    working_.step_fraction = -1;
+    working_.step_started = Clock::now();
     Publish(false);
   };
   if (const Status opened = OpenPaintJob(project, job_options, &s->job); !opened.ok()) {

@@ -14,6 +14,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -63,6 +64,13 @@ struct RunnerSnapshot {
   uint64_t geometry_version = 0;
   std::shared_ptr<const SessionGeometry> geometry;  // null until a session opened
   std::string status;                               // "paused", "playing", "error: ..."
+  // A step of opening under way ("adjusting poses 120/246", "loading the scene, ..."): the
+  // status began with `step_text` when it started (at `step_started`) or last said how far it
+  // got (`step_fraction` done, -1 when it does not say). The worker publishes only then, so
+  // the window counts the time itself (StatusText), which would stand still in `status`.
+  std::string step_text;
+  double step_fraction = -1;
+  std::chrono::steady_clock::time_point step_started;
   bool playing = false;
   int frame = -1;  // index of the frame last painted
   // A seek under way: the frame it paints up to (`frame` says how far it got; -1 while a

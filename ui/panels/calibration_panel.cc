@@ -168,7 +168,7 @@ class CalibrationPanel : public Panel {
       const std::string text = std::to_string(snap.solves_done) + "/" +
                                std::to_string(snap.solves_total) + " fits, " +
                                ElapsedAndRemainingText(elapsed_s, fraction);
-      ImGui::ProgressBar(fraction, ImVec2(-1, 0), text.c_str());
+      ProgressBarWithText(fraction, text);
     }
     if (!snap.images.empty())
       ImGui::ProgressBar(

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <set>
 
 #include <imgui.h>
+#include <imgui_internal.h>
 #include <imgui_stdlib.h>
 
 #include "ui/core/panel.h"
@@ -33,7 +35,24 @@ void Remember(const std::string& value, std::string* last_folder) {
   *last_folder = text;
 }
 
+// The ImGui ids of the "..." lists opened so far.
+std::set<ImGuiID>& BrowseLists() {
+  static std::set<ImGuiID> ids;
+  return ids;
+}
+
 }  // namespace
+
+void LetAClickOutsideABrowseListThrough() {
+  ImGuiContext& g = *GImGui;
+  if (g.OpenPopupStack.empty() || !ImGui::IsMouseClicked(0)) return;
+  const ImGuiPopupData& top = g.OpenPopupStack.back();
+  if (!BrowseLists().count(top.PopupId)) return;
+  ImGuiWindow* hovered = g.HoveredWindow;
+  if (hovered && top.Window && hovered->RootWindow == top.Window->RootWindow) return;  // in it
+  ImGui::ClosePopupToLevel(g.OpenPopupStack.Size - 1, false);
+  if (hovered) ImGui::FocusWindow(hovered);
+}
 
 int CountImages(const std::string& folder) {
   static const char* kImages[] = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"};
@@ -60,6 +79,7 @@ std::string BrowseNote(const std::string& value, const PathFieldOptions& options
 
 bool PathField(const char* label, const char* id, const char* hint, std::string* value,
                const PathFieldOptions& options) {
+  LetAClickOutsideABrowseListThrough();
   ImGui::TextUnformatted(label);
   SameLineInFieldColumn();
   FitNextItem("...", options.min_width_px);
@@ -69,6 +89,7 @@ bool PathField(const char* label, const char* id, const char* hint, std::string*
   ImGui::PushID(id);
   if (ImGui::Button("...")) {
     ImGui::OpenPopup("browse");
+    BrowseLists().insert(ImGui::GetID("browse"));
     // An empty field's list starts in the last folder used, not the launch folder.
     if (value->empty() && options.last_folder && !options.last_folder->empty()) {
       *value = *options.last_folder;

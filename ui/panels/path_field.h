@@ -27,6 +27,12 @@ struct PathFieldOptions {
 bool PathField(const char* label, const char* id, const char* hint, std::string* value,
                const PathFieldOptions& options);
 
+// A click outside an open "..." list closes it and reaches what it was on: ImGui alone would
+// only close the list, and a field clicked so stayed inactive (the text typed next was lost).
+// Each PathField calls it; the app calls it once a frame before the panels too, for what is
+// drawn before them.
+void LetAClickOutsideABrowseListThrough();
+
 // The project's four paths as PathField edits them (the hints and "..." extensions of the
 // scene, video, camera and poses). Returns true when one changed.
 struct ProjectPaths;

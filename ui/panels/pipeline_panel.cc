@@ -109,7 +109,8 @@ class PipelinePanel : public Panel {
     } else {
       seek_seen_ = -1;
     }
-    ImGui::TextWrapped("%s", snap.status.c_str());
+    status_ = StatusText(snap);
+    ImGui::TextWrapped("%s", status_.c_str());
     if (snap.geometry)
       ImGui::Text("%zu base buffers, texel %.4f m, coverage %.1f %%", snap.geometry->groups.size(),
                   snap.geometry->texel_size_m, 100.0 * snap.coverage);
@@ -167,6 +168,7 @@ class PipelinePanel : public Panel {
     report["seek text lines"] = std::to_string(seek_text_lines_);
     report["seek stop right"] = std::to_string(stop_right_);
     report["panel right"] = std::to_string(window_right_);
+    report["status"] = status_;  // the worker's status as shown
     return report;
   }
 
@@ -177,6 +179,7 @@ class PipelinePanel : public Panel {
     posted_version_ = snap.version;
   }
 
+  std::string status_;
   int seek_ = 0;
   std::string seek_text_;
   float seek_bar_width_ = 0, seek_text_lines_ = 0, stop_right_ = 0, window_right_ = 0;
