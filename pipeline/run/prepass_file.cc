@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_codecs.h"
 #include "pipeline/paint/mover_masks.h"
 #include "pipeline/run/shard.h"
 
@@ -192,7 +193,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
     for (size_t i = 0; i < capture.movers.size(); ++i) {
       if (capture.movers[i].empty()) continue;
       std::vector<uchar> png;
-      if (!cv::imencode(".png", capture.movers[i], png))
+      if (!EncodeImageBytes(".png", capture.movers[i], &png))
         return Status::Failed(path + ": could not encode the movers of pose " + std::to_string(i));
       movers[std::to_string(i)] = Base64(png);
     }
@@ -235,7 +236,7 @@ Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob
         std::vector<uchar> png;
         if (i >= size || !FromBase64(base64.get<std::string>(), &png))
           return Bad(path, at + ".movers." + index, "not a pose's movers");
-        capture.movers[i] = cv::imdecode(png, cv::IMREAD_UNCHANGED);
+        capture.movers[i] = DecodeImageBytes(png.data(), png.size(), cv::IMREAD_UNCHANGED);
         if (capture.movers[i].empty()) return Bad(path, at + ".movers." + index, "not a PNG");
       }
     }
