@@ -349,6 +349,25 @@ void Rasterizer::RayTable::Unproject(const Camera& camera, int n) {
   by_sample.assign(static_cast<size_t>(width) * height, Eigen::Vector2f(kNaNf, kNaNf));
   // Sample (c, r) of pixel (c/N, r/N) sits at subpixel offset ((c%N) + 0.5)/N - 0.5, with
   // pixel (0,0) centred on the top-left pixel.
+  if (!camera.HasDistortion()) {
+    // Camera::Unproject's arithmetic without distortion, each column's x and each row's y
+    // worked out once: the same rays.
+    std::vector<double> xs(width), ys(height);
+    for (int c = 0; c < width; ++c)
+      xs[c] = (c / n + ((c % n) + 0.5) / n - 0.5 - camera.cx) / camera.fx;
+    for (int r = 0; r < height; ++r)
+      ys[r] = (r / n + ((r % n) + 0.5) / n - 0.5 - camera.cy) / camera.fy;
+    cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+      for (int r = range.start; r < range.end; ++r) {
+        for (int c = 0; c < width; ++c) {
+          const Eigen::Vector2d target(xs[c], ys[r]);
+          if (target.allFinite() && target.squaredNorm() <= camera.fold_r2)
+            by_sample[static_cast<size_t>(r) * width + c] = target.cast<float>();
+        }
+      }
+    });
+    return;
+  }
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       const double py = r / n + ((r % n) + 0.5) / n - 0.5;
