@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "app/commands.h"
 #include "app/progress.h"
 #include "pipeline/core/atomic_file.h"
 #include "pipeline/core/cameramodel_io.h"
+#include "pipeline/core/image_codecs.h"
 #include "pipeline/core/poses.h"
 #include "pipeline/core/scene.h"
 #include "pipeline/render/renderer.h"
@@ -91,7 +91,7 @@ bool OutputName(const std::string& name, const std::string& suffix, std::string*
 
 Status WritePng(const std::string& path, const cv::Mat& image) {
   std::vector<uchar> bytes;
-  if (!cv::imencode(".png", image, bytes))
+  if (!EncodeImageBytes(".png", image, &bytes))
     return Status::Internal(path + ": could not encode the PNG");
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(parent.string()));

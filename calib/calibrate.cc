@@ -200,8 +200,8 @@ bool IsExcluded(const std::string& name, const std::vector<std::string>& pattern
 bool DetectImage(const std::string& path, const CalibrateRequest& request, CalibrationRun* run,
                  BoardDetection* detection_out) {
   const std::string name = fs::path(path).filename().string();
-  cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (gray.empty()) {
+  cv::Mat gray;
+  if (!ReadImage(path, &gray, cv::IMREAD_GRAYSCALE).ok()) {
     run->rejected.push_back({name, "cannot read the image"});
     return false;
   }

@@ -19,10 +19,10 @@
 #include <tiny_gltf.h>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_codecs.h"
 #include "pipeline/core/scene.h"
 
 namespace fresco {
@@ -1350,7 +1350,7 @@ Status WriteTextures(const Scene& scene, const std::string& path, const std::str
     cv::Mat bgra;
     cv::cvtColor(texture.rgba, bgra, cv::COLOR_RGBA2BGRA);
     std::vector<unsigned char> png;
-    if (!cv::imencode(".png", bgra, png)) {
+    if (!EncodeImageBytes(".png", bgra, &png)) {
       return Status::Internal(path + ": texture " + std::to_string(t) + ": PNG encoding failed");
     }
     bgra.release();

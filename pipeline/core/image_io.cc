@@ -7,26 +7,23 @@
 #include <fstream>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "pipeline/core/atomic_file.h"
-#include "pipeline/core/jpeg_decode.h"
+#include "pipeline/core/image_codecs.h"
 
 namespace fresco {
 
 namespace {
+
+std::string InParentheses(const std::string& why) { return why.empty() ? "" : " (" + why + ")"; }
 
 // The image encoded in the format `path`'s extension names (PNG without one).
 Status EncodeImage(const std::string& path, const cv::Mat& image, std::string* encoded) {
   if (image.empty()) return Status::Internal(path + ": empty image");
   const std::string ext = std::filesystem::path(path).extension().string();
   std::vector<uchar> bytes;
-  try {
-    if (!cv::imencode(ext.empty() ? ".png" : ext, image, bytes))
-      return Status::OutputError(path + ": could not encode image");
-  } catch (const cv::Exception& e) {
-    return Status::OutputError(path + ": could not encode image (" + e.msg + ")");
-  }
+  std::string why;
+  if (!EncodeImageBytes(ext.empty() ? ".png" : ext, image, &bytes, &why))
+    return Status::OutputError(path + ": could not encode image" + InParentheses(why));
   encoded->assign(bytes.begin(), bytes.end());
   return Status::Ok();
 }
@@ -90,13 +87,9 @@ Status ReadImage(const std::string& path, cv::Mat* image, int flags) {
   std::string bytes;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &bytes));
   FRESCO_RETURN_IF_ERROR(CheckImageBytes(path, bytes));
-  if (flags == cv::IMREAD_COLOR && DecodeJpegBgr(bytes, image)) return Status::Ok();
-  try {
-    *image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, bytes.data()), flags);
-  } catch (const cv::Exception& e) {
-    return Status::Error(path + ": cannot decode the image (" + e.msg + ")");
-  }
-  if (image->empty()) return Status::Error(path + ": cannot decode the image");
+  std::string why;
+  *image = DecodeImageBytes(bytes.data(), bytes.size(), flags, &why);
+  if (image->empty()) return Status::Error(path + ": cannot decode the image" + InParentheses(why));
   return Status::Ok();
 }
 

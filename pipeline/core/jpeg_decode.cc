@@ -49,10 +49,13 @@ int ExifOrientation(const JOCTET* data, unsigned size) {
 }  // namespace
 
 bool DecodeJpegBgr(const std::string& bytes, cv::Mat* image) {
+  return DecodeJpegBgr(bytes.data(), bytes.size(), image);
+}
+
+bool DecodeJpegBgr(const void* data, size_t size, cv::Mat* image) {
   image->release();
-  if (bytes.size() < 3 || static_cast<unsigned char>(bytes[0]) != 0xff ||
-      static_cast<unsigned char>(bytes[1]) != 0xd8)
-    return false;
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  if (size < 3 || bytes[0] != 0xff || bytes[1] != 0xd8) return false;
   jpeg_decompress_struct info;
   ErrorManager error;
   info.err = jpeg_std_error(&error.pub);
@@ -66,8 +69,7 @@ bool DecodeJpegBgr(const std::string& bytes, cv::Mat* image) {
     return false;
   }
   jpeg_create_decompress(&info);
-  jpeg_mem_src(&info, reinterpret_cast<const unsigned char*>(bytes.data()),
-               static_cast<unsigned long>(bytes.size()));
+  jpeg_mem_src(&info, bytes, static_cast<unsigned long>(size));
   jpeg_save_markers(&info, JPEG_APP0 + 1, 0xffff);
   jpeg_read_header(&info, TRUE);
   for (jpeg_saved_marker_ptr m = info.marker_list; m; m = m->next) {

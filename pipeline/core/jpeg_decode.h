@@ -4,6 +4,7 @@
 // upsampling: the same pixels as cv::imdecode(IMREAD_COLOR).
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include <opencv2/core.hpp>
@@ -14,5 +15,6 @@ namespace fresco {
 // where this path does not apply and cv::imdecode must decide: not a JPEG, not 1 or 3
 // components (CMYK), an EXIF orientation other than upright, or a decoding error.
 bool DecodeJpegBgr(const std::string& bytes, cv::Mat* image);
+bool DecodeJpegBgr(const void* data, size_t size, cv::Mat* image);
 
 }  // namespace fresco

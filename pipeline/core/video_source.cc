@@ -10,10 +10,9 @@
 #include <string>
 #include <vector>
 
-#include <dlfcn.h>
-
 #include <opencv2/imgcodecs.hpp>
 
+#include "pipeline/core/fresco_module.h"
 #include "pipeline/core/image_io.h"
 #include "pipeline/core/project.h"
 #include "pipeline/core/video_capture_source.h"
@@ -112,32 +111,16 @@ Status OpenFolder(const std::string& path, std::unique_ptr<VideoSource>* source)
   return Status::Ok();
 }
 
-// The video module's entry point (video_capture_source.h), loaded once: from the library folder
-// of an installed fresco (bin/../lib/fresco), else from the build tree; null if neither loads
-// (`why` says why).
+// The video module's entry point (video_capture_source.h), loaded once; null if it does not
+// load (`why` says why).
 OpenCaptureSourceFunction VideoModule(std::string* why) {
   static std::once_flag once;
   static OpenCaptureSourceFunction function = nullptr;
   static std::string error;
   std::call_once(once, [] {
-    std::vector<std::string> paths;
-    std::error_code ec;
-    const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-    if (!ec)
-      paths.push_back((self.parent_path() / FRESCO_VIDEO_MODULE_FROM_BINDIR).lexically_normal());
-    paths.push_back(FRESCO_VIDEO_MODULE_BUILD_PATH);
-    for (const std::string& path : paths) {
-      void* module = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-      if (!module) {
-        const char* message = dlerror();
-        error = message ? message : path + ": cannot load";
-        continue;
-      }
-      function =
-          reinterpret_cast<OpenCaptureSourceFunction>(dlsym(module, kOpenCaptureSourceSymbol));
-      if (function) return;
-      error = path + ": no " + kOpenCaptureSourceSymbol;
-    }
+    function = reinterpret_cast<OpenCaptureSourceFunction>(
+        LoadModuleSymbol(FRESCO_VIDEO_MODULE_FROM_BINDIR, FRESCO_VIDEO_MODULE_BUILD_PATH,
+                         kOpenCaptureSourceSymbol, &error));
   });
   *why = error;
   return function;

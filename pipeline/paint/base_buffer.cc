@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "pipeline/paint/scattered_groups.h"
+#include "pipeline/paint/texel_span.h"
 
 namespace fresco {
 namespace {
@@ -240,14 +241,9 @@ bool CoverCentres(const BaseBuffer& buffer, const PlacedTriangle& tri, TexelOwne
       std::min(h - 1, static_cast<int>(std::ceil(std::max({q[0].y(), q[1].y(), q[2].y()}) - 0.5)));
   bool covers_a_centre = false;
   for (int j = j0; j <= j1; ++j) {
-    for (int i = i0; i <= i1; ++i) {
-      const Eigen::Vector2d c(i + 0.5, j + 0.5);
-      bool inside = true;
-      for (int k = 0; k < 3 && inside; ++k) {
-        const Eigen::Vector2d e = q[(k + 1) % 3] - q[k], r = c - q[k];
-        inside = tri.sign * (e.x() * r.y() - e.y() * r.x()) >= 0;
-      }
-      if (!inside) continue;
+    int lo = 0, hi = -1;
+    CentresInsideRow(tri.q, tri.sign, j, i0, i1, &lo, &hi);
+    for (int i = lo; i <= hi; ++i) {
       covers_a_centre = true;
       const size_t idx = static_cast<size_t>(j) * w + i;
       if (texels->owner[idx] >= 0) {

@@ -327,10 +327,11 @@ struct Rasterizer::RayTable {
   void Unproject(const Camera& camera, int n);
   // The bucket grid over the bounding box of the valid rays.
   void PlaceBuckets();
-  // Counting sort of the valid rays into buckets; returns how many there are.
-  int SortIntoBuckets();
+  // Counting sort of the valid rays into buckets (only for rays off a grid: a grid's are
+  // scanned by its rows and columns).
+  void SortIntoBuckets();
   // Whether the rays lie on a grid (grid, col_x, row_y and their fits).
-  void FindGrid(int num_valid);
+  void FindGrid();
 
   int Col(double x) const {
     const double c = std::floor((x - x0) * inv_cell_w);
@@ -348,6 +349,25 @@ void Rasterizer::RayTable::Unproject(const Camera& camera, int n) {
   by_sample.assign(static_cast<size_t>(width) * height, Eigen::Vector2f(kNaNf, kNaNf));
   // Sample (c, r) of pixel (c/N, r/N) sits at subpixel offset ((c%N) + 0.5)/N - 0.5, with
   // pixel (0,0) centred on the top-left pixel.
+  if (!camera.HasDistortion()) {
+    // Camera::Unproject's arithmetic without distortion, each column's x and each row's y
+    // worked out once: the same rays.
+    std::vector<double> xs(width), ys(height);
+    for (int c = 0; c < width; ++c)
+      xs[c] = (c / n + ((c % n) + 0.5) / n - 0.5 - camera.cx) / camera.fx;
+    for (int r = 0; r < height; ++r)
+      ys[r] = (r / n + ((r % n) + 0.5) / n - 0.5 - camera.cy) / camera.fy;
+    cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
+      for (int r = range.start; r < range.end; ++r) {
+        for (int c = 0; c < width; ++c) {
+          const Eigen::Vector2d target(xs[c], ys[r]);
+          if (target.allFinite() && target.squaredNorm() <= camera.fold_r2)
+            by_sample[static_cast<size_t>(r) * width + c] = target.cast<float>();
+        }
+      }
+    });
+    return;
+  }
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& range) {
     for (int r = range.start; r < range.end; ++r) {
       const double py = r / n + ((r % n) + 0.5) / n - 0.5;
@@ -385,7 +405,7 @@ void Rasterizer::RayTable::PlaceBuckets() {
 }
 
 // Stable: sample order within a bucket.
-int Rasterizer::RayTable::SortIntoBuckets() {
+void Rasterizer::RayTable::SortIntoBuckets() {
   const int num_buckets = cols * rows;
   std::vector<int> bucket_of(by_sample.size(), -1);
   bucket_start.assign(num_buckets + 1, 0);
@@ -408,15 +428,15 @@ int Rasterizer::RayTable::SortIntoBuckets() {
     ys[k] = by_sample[i].y();
     sample[k] = static_cast<int>(i);
   }
-  return num_valid;
 }
 
 // Grid of rays? Every ray valid, x a function of the column alone and y of the row alone
 // (bit for bit), both strictly increasing.
-void Rasterizer::RayTable::FindGrid(int num_valid) {
+void Rasterizer::RayTable::FindGrid() {
   col_x.resize(width);
   row_y.resize(height);
-  bool is_grid = num_valid == width * height;
+  bool is_grid = std::all_of(by_sample.begin(), by_sample.end(),
+                             [](const Eigen::Vector2f& ray) { return std::isfinite(ray.x()); });
   for (int c = 0; c < width && is_grid; ++c) col_x[c] = by_sample[c].x();
   for (int r = 0; r < height && is_grid; ++r)
     row_y[r] = by_sample[static_cast<size_t>(r) * width].y();
@@ -452,7 +472,8 @@ Rasterizer::Rasterizer(const Camera& camera, const RasterOptions& options)
   RayTable& t = *rays_;
   t.Unproject(camera_, options.supersample);
   t.PlaceBuckets();
-  t.FindGrid(t.SortIntoBuckets());
+  t.FindGrid();
+  if (!t.grid) t.SortIntoBuckets();
 }
 
 Rasterizer::~Rasterizer() = default;

@@ -8,6 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_codecs.h"
+#include "pipeline/core/image_io.h"
 #include "pipeline/paint/texture_atlas.h"
 
 namespace fresco {
@@ -181,8 +183,9 @@ Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int 
   cv::Mat joined = cv::Mat::zeros(size[1].get<int>(), size[0].get<int>(), CV_8UC4);
   for (const Part& part : parts) {
     const std::string path = part.dir + "/" + name;
-    const cv::Mat strip = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (strip.empty()) return Status::Error(path + ": cannot read the PNG");
+    cv::Mat strip;
+    if (!ReadImage(path, &strip, cv::IMREAD_UNCHANGED).ok())
+      return Status::Error(path + ": cannot read the PNG");
     if (strip.type() != joined.type())
       return Status::Error(path + ": not 8-bit RGBA, as a part's page is");
     std::vector<cv::Rect> rects;
@@ -204,7 +207,8 @@ Status JoinTexture(const std::vector<Part>& parts, const std::string& name, int 
     }
   }
   std::vector<unsigned char> png;
-  if (!cv::imencode(".png", joined, png)) return Status::Internal(out_path + ": PNG encoding failed");
+  if (!EncodeImageBytes(".png", joined, &png))
+    return Status::Internal(out_path + ": PNG encoding failed");
   return WriteFileAtomic(out_path, std::string(png.begin(), png.end()));
 }
 

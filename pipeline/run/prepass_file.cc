@@ -1,10 +1,13 @@
 #include "pipeline/run/prepass_file.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_codecs.h"
 #include "pipeline/paint/mover_masks.h"
 #include "pipeline/run/shard.h"
 
@@ -13,7 +16,7 @@ namespace {
 
 using nlohmann::json;
 
-constexpr int kPrepassFormat = 1;
+constexpr int kPrepassFormat = 2;
 constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
 std::string Base64(const std::vector<uchar>& bytes) {
@@ -27,21 +30,28 @@ std::string Base64(const std::vector<uchar>& bytes) {
 }
 
 bool FromBase64(const std::string& text, std::vector<uchar>* bytes) {
+  static const std::array<int8_t, 256> kValue = [] {
+    std::array<int8_t, 256> value;
+    value.fill(-1);
+    for (int i = 0; i < 64; ++i) value[static_cast<uchar>(kBase64[i])] = static_cast<int8_t>(i);
+    return value;
+  }();
   if (text.size() % 4 != 0) return false;
   bytes->clear();
+  bytes->reserve(text.size() / 4 * 3);
   for (size_t i = 0; i < text.size(); i += 4) {
     unsigned v = 0;
     int pad = 0;
     for (size_t k = 0; k < 4; ++k) {
       const char c = text[i + k];
-      const char* at = c == '=' ? nullptr : std::strchr(kBase64, c);
+      const int value = kValue[static_cast<uchar>(c)];
       if (c == '=')
         ++pad;
-      else if (!at || !*at || pad > 0)
+      else if (value < 0 || pad > 0)
         return false;
-      v = v << 6 | (at ? static_cast<unsigned>(at - kBase64) : 0);
+      v = v << 6 | static_cast<unsigned>(std::max(value, 0));
     }
-    if (pad > 2) return false;
+    if (pad > 2 || (pad > 0 && i + 4 != text.size())) return false;
     for (int k = 0; k < 3 - pad; ++k) bytes->push_back(static_cast<uchar>(v >> (16 - 8 * k)));
   }
   return true;
@@ -58,12 +68,52 @@ Status Bad(const std::string& path, const std::string& field, const std::string&
   return Status::Error(path + ": " + field + ": " + what);
 }
 
+// Triangle numbers as one base64 string of their differences (zigzag LEB128 varints): every
+// shard reads the layout, and a JSON parser takes a character at a time (a chart's triangles
+// mostly follow each other closely: a byte or two each, against 7 characters as numbers).
+std::string PackNumbers(const std::vector<int>& numbers) {
+  std::vector<uchar> bytes;
+  bytes.reserve(numbers.size() * 2);
+  int64_t previous = 0;
+  for (const int n : numbers) {
+    const int64_t delta = n - previous;
+    previous = n;
+    uint64_t v =
+        delta < 0 ? ~(static_cast<uint64_t>(delta) << 1) : static_cast<uint64_t>(delta) << 1;
+    for (; v >= 0x80; v >>= 7) bytes.push_back(static_cast<uchar>(v | 0x80));
+    bytes.push_back(static_cast<uchar>(v));
+  }
+  return Base64(bytes);
+}
+
+// The numbers PackNumbers wrote; false if `text` is not such a list.
+bool UnpackNumbers(const std::string& text, std::vector<int>* numbers) {
+  std::vector<uchar> bytes;
+  if (!FromBase64(text, &bytes)) return false;
+  numbers->clear();
+  int64_t previous = 0;
+  for (size_t at = 0; at < bytes.size();) {
+    uint64_t v = 0;
+    for (int shift = 0;; shift += 7) {
+      if (at == bytes.size() || shift > 35) return false;
+      v |= static_cast<uint64_t>(bytes[at] & 0x7f) << shift;
+      if (!(bytes[at++] & 0x80)) break;
+    }
+    const int64_t n =
+        previous + ((v & 1) ? ~static_cast<int64_t>(v >> 1) : static_cast<int64_t>(v >> 1));
+    if (n < INT32_MIN || n > INT32_MAX) return false;
+    numbers->push_back(static_cast<int>(n));
+    previous = n;
+  }
+  return true;
+}
+
 // The buffers' layout (PaintSession::Layout): exact, the texel size's double as written.
 json LayoutJson(const BufferLayout& layout) {
   json buffers = json::array();
   for (const BufferRecipe& r : layout.recipes)
-    buffers.push_back({{"placed", r.placed},
-                       {"folded", r.folded},
+    buffers.push_back({{"placed", PackNumbers(r.placed)},
+                       {"folded", PackNumbers(r.folded)},
                        {"group_texel_size_m", r.group_texel_size_m},
                        {"surface_texels", r.num_surface_texels}});
   return {{"texel_size_m", layout.texel_size_m},
@@ -71,11 +121,16 @@ json LayoutJson(const BufferLayout& layout) {
           {"buffers", buffers}};
 }
 
-// Parses the file's header and checks it was written for `project` and its settings.
-Status ReadHeader(const std::string& path, const Project& project, json* file) {
+// Parses the file (without its layout unless `with_layout`: most of it, read once) and checks
+// it was written for `project` and its settings.
+Status ReadHeader(const std::string& path, const Project& project, bool with_layout, json* file) {
   std::string text;
   FRESCO_RETURN_IF_ERROR(ReadFileToString(path, &text));
-  *file = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  const json::parser_callback_t skip_layout = [](int depth, json::parse_event_t event,
+                                                 json& parsed) {
+    return !(depth == 1 && event == json::parse_event_t::key && parsed == "layout");
+  };
+  *file = json::parse(text, with_layout ? nullptr : skip_layout, /*allow_exceptions=*/false);
   if (file->is_discarded() || !file->is_object())
     return Status::Error(path + ": not a pre-pass file (fresco run --prepass writes them)");
   if (file->value("fresco_prepass", 0) != kPrepassFormat)
@@ -95,7 +150,7 @@ Status ReadPrepassLayout(const std::string& path, const Project& project, int nu
                          std::optional<BufferLayout>* layout) {
   layout->reset();
   json file;
-  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, &file));
+  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, /*with_layout=*/true, &file));
   if (!file.contains("layout")) return Status::Ok();
   BufferLayout out;
   try {
@@ -104,8 +159,10 @@ Status ReadPrepassLayout(const std::string& path, const Project& project, int nu
     out.folds_split = l.at("folds_split").get<int>();
     for (const json& b : l.at("buffers")) {
       BufferRecipe r;
-      r.placed = b.at("placed").get<std::vector<int>>();
-      r.folded = b.at("folded").get<std::vector<int>>();
+      if (!UnpackNumbers(b.at("placed").get_ref<const std::string&>(), &r.placed) ||
+          !UnpackNumbers(b.at("folded").get_ref<const std::string&>(), &r.folded))
+        return Bad(path, "layout.buffers[" + std::to_string(out.recipes.size()) + "]",
+                   "not lists of triangle numbers");
       r.group_texel_size_m = b.at("group_texel_size_m").get<double>();
       r.num_surface_texels = b.at("surface_texels").get<int>();
       out.recipes.push_back(std::move(r));
@@ -192,7 +249,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
     for (size_t i = 0; i < capture.movers.size(); ++i) {
       if (capture.movers[i].empty()) continue;
       std::vector<uchar> png;
-      if (!cv::imencode(".png", capture.movers[i], png))
+      if (!EncodeImageBytes(".png", capture.movers[i], &png))
         return Status::Failed(path + ": could not encode the movers of pose " + std::to_string(i));
       movers[std::to_string(i)] = Base64(png);
     }
@@ -205,7 +262,7 @@ Status WritePrepassFile(const std::string& path, const Project& project, const P
 
 Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob* job) {
   json file;
-  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, &file));
+  FRESCO_RETURN_IF_ERROR(ReadHeader(path, project, /*with_layout=*/false, &file));
   try {
     const json& streams = file.at("streams");
     if (!streams.is_array() || streams.size() != job->captures.size())
@@ -235,7 +292,7 @@ Status ReadPrepassFile(const std::string& path, const Project& project, PaintJob
         std::vector<uchar> png;
         if (i >= size || !FromBase64(base64.get<std::string>(), &png))
           return Bad(path, at + ".movers." + index, "not a pose's movers");
-        capture.movers[i] = cv::imdecode(png, cv::IMREAD_UNCHANGED);
+        capture.movers[i] = DecodeImageBytes(png.data(), png.size(), cv::IMREAD_UNCHANGED);
         if (capture.movers[i].empty()) return Bad(path, at + ".movers." + index, "not a PNG");
       }
     }

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "pipeline/core/atomic_file.h"
+#include "pipeline/core/image_io.h"
 #include "pipeline/synth/blocks_scene.h"
 #include "pipeline/synth/mesh_refine.h"
 #include "pipeline/synth/procedural_scenes.h"
@@ -142,8 +143,7 @@ struct SceneInfo {
 Status ReadImageFile(const std::string& path, const std::string& what, const ObjectReader& reader,
                      cv::Mat* image) {
   if (!fs::is_regular_file(path)) return reader.Error(what, "no such file: " + path);
-  *image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image->empty() || image->depth() != CV_8U) {
+  if (!ReadImage(path, image, cv::IMREAD_UNCHANGED).ok() || image->depth() != CV_8U) {
     return reader.Error(what, "cannot read an 8-bit image from " + path);
   }
   return Status::Ok();

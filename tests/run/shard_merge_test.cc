@@ -174,6 +174,17 @@ TEST(ShardMerge, PrepassFileOfOtherSettingsIsRefused) {
   EXPECT_EQ(other.exit_code, 2) << other.err;
   EXPECT_NE(other.err.find(prepass + ": settings_hash"), std::string::npos) << other.err;
   EXPECT_FALSE(fs::exists(work + "/out/painted.gltf"));
+  // A layout whose triangle list is damaged is refused the same way.
+  nlohmann::json file = nlohmann::json::parse(testing::ReadText(prepass));
+  file["layout"]["buffers"][0]["placed"] = "not base64!";
+  const std::string damaged = work + "/damaged.json";
+  testing::WriteText(damaged, file.dump());
+  const testing::CommandResult bad =
+      RunFresco({"run", root + "/project.json", "--out", work + "/out", "--shard", "0/2",
+                 "--prepass", damaged, "--set", "pipeline.max_frames=6", "--quiet"});
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find(damaged + ": layout.buffers[0]"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(work + "/out/painted.gltf"));
   const testing::CommandResult unnamed =
       RunFresco({"run", root + "/project.json", "--prepass-only", "--quiet"});
   EXPECT_EQ(unnamed.exit_code, 2) << unnamed.err;

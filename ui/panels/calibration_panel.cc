@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "calib/pictures.h"
+#include "pipeline/core/image_io.h"
 #include "ui/core/camera_attach.h"
 #include "ui/core/job_estimate.h"
 #include "ui/panels/panels.h"
@@ -330,7 +331,8 @@ class CalibrationPanel : public Panel {
     if (shown >= 0 && shown < static_cast<int>(snap.images.size())) {
       const CalibrationImage& image = snap.images[shown];
       if (shown != drawn_image_ || snap.version != drawn_version_) {
-        const cv::Mat pixels = cv::imread(image.path, cv::IMREAD_COLOR);
+        cv::Mat pixels;
+        if (!ReadImage(image.path, &pixels, cv::IMREAD_COLOR).ok()) pixels.release();
         const calib::ViewFit* fit = nullptr;
         if (snap.solved && image.used) fit = &snap.run.Chosen().fit.views[image.view];
         detections_ = pixels.empty() || !image.used
