@@ -3,9 +3,11 @@
 // paint_session.h).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/mover_masks.h"
@@ -73,6 +75,13 @@ void ComposePagesInto(const TextureAtlas& atlas, const std::vector<cv::Mat>& buf
   }
 }
 
+// fn(b) for buffers b = 0 .. count-1, several at once (each reads and writes its own).
+void ForEachBufferOf(size_t count, const std::function<void(size_t)>& fn) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(count)), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) fn(static_cast<size_t>(b));
+  });
+}
+
 }  // namespace
 
 // Decided `quality` (basis `why`) without a comparison: the sums go.
@@ -94,14 +103,14 @@ int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum) const {
   // One scene (the mesh with its atlas UVs), its pages composed again for each candidate; each
   // frame rasterized once and shaded with each.
   const auto candidate = [&](size_t c) {
-    std::vector<cv::Mat> texels;
-    for (const PaintedBuffer& p : painted_) {
+    std::vector<cv::Mat> texels(painted_.size());
+    ForEachBufferOf(painted_.size(), [&](size_t b) {
+      const PaintedBuffer& p = painted_[b];
       const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
-      texels.push_back(AtMeanExposure(c == 0   ? base
-                                      : c == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
-                                               : MeanTexels(base, p.unmasked_sum,
-                                                            p.held_unmasked_sum)));
-    }
+      texels[b] = AtMeanExposure(c == 0   ? base
+                                 : c == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
+                                          : MeanTexels(base, p.unmasked_sum, p.held_unmasked_sum));
+    });
     return texels;
   };
   Scene scene = PaintedScene(candidate(0));
@@ -189,7 +198,7 @@ void PaintSession::DecideUpdate() {
   options_.update = mean ? UpdatePolicy::kMean : UpdatePolicy::kQuality;
   if (best == 2) TurnModelOffByFramesHeldOut((psnr_sum[2] - psnr_sum[1]) / measured, measured);
   // What every frame painted, the chosen way.
-  for (size_t b = 0; b < painted_.size(); ++b) {
+  ForEachBufferOf(painted_.size(), [&](size_t b) {
     PaintedBuffer& p = painted_[b];
     if (mean) {
       p.bgra = MeanTexels(p.bgra, p.mean_sum);
@@ -203,10 +212,10 @@ void PaintSession::DecideUpdate() {
     } else {
       p.mean_sum.release();
     }
-    for (cv::Mat* m : {&p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum,
-                       &p.held_unmasked_sum})
+    for (cv::Mat* m :
+         {&p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum, &p.held_unmasked_sum})
       m->release();
-  }
+  });
 }
 
 }  // namespace fresco
