@@ -5,7 +5,6 @@
 #include <limits>
 #include <numeric>
 #include <tuple>
-#include <unordered_map>
 
 #include <Eigen/Geometry>
 
@@ -72,17 +71,9 @@ struct CellKey {
   int64_t x, y, z;
   bool operator==(const CellKey& o) const { return x == o.x && y == o.y && z == o.z; }
 };
-struct CellKeyHash {
-  size_t operator()(const CellKey& k) const {
-    uint64_t h = static_cast<uint64_t>(k.x) * 0x9E3779B97F4A7C15ull;
-    h ^= static_cast<uint64_t>(k.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
-    h ^= static_cast<uint64_t>(k.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
-    return static_cast<size_t>(h);
-  }
-};
 
 // Canonical vertex per vertex: vertices closer than `tolerance` (transitively) share the
-// smallest index of their group. Hash grid with cell size = tolerance, so only the 27
+// smallest index of their group. A grid with cell size = tolerance, so only the 27
 // neighbouring cells are searched.
 std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, double tolerance) {
   const int n = static_cast<int>(vertices.size());
@@ -111,12 +102,16 @@ std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, doub
     return std::tie(ka.x, ka.y, ka.z, a) < std::tie(kb.x, kb.y, kb.z, b);
   };
   std::sort(order.begin(), order.end(), key_less);
-  std::unordered_map<CellKey, std::pair<int, int>, CellKeyHash> runs;  // [begin, end) in order
-  runs.reserve(order.size());
+  // The occupied cells in key order, each with its run [begin, end) in `order`.
+  struct Run {
+    CellKey key;
+    int begin, end;
+  };
+  std::vector<Run> runs;
   for (int r = 0; r < static_cast<int>(order.size());) {
     int end = r + 1;
     while (end < static_cast<int>(order.size()) && key_of[order[end]] == key_of[order[r]]) ++end;
-    runs.emplace(key_of[order[r]], std::make_pair(r, end));
+    runs.push_back({key_of[order[r]], r, end});
     r = end;
   }
   // Each pair of vertices in the same or neighbouring cells is tested once: within a cell, and
@@ -131,16 +126,26 @@ std::vector<int> WeldVertices(const std::vector<Eigen::Vector3d>& vertices, doub
       }
     }
   };
-  for (const auto& [key, run] : runs) {
-    test_pairs(run.first, run.second, run.first, run.second, /*same_cell=*/true);
-    for (int64_t dx = 0; dx <= 1; ++dx) {
-      for (int64_t dy = dx == 0 ? 0 : -1; dy <= 1; ++dy) {
-        for (int64_t dz = dx == 0 && dy == 0 ? 1 : -1; dz <= 1; ++dz) {
-          const auto it = runs.find({key.x + dx, key.y + dy, key.z + dz});
-          if (it != runs.end())
-            test_pairs(run.first, run.second, it->second.first, it->second.second, false);
-        }
-      }
+  std::vector<CellKey> offsets;
+  for (int64_t dx = 0; dx <= 1; ++dx)
+    for (int64_t dy = dx == 0 ? 0 : -1; dy <= 1; ++dy)
+      for (int64_t dz = dx == 0 && dy == 0 ? 1 : -1; dz <= 1; ++dz) offsets.push_back({dx, dy, dz});
+  // A cell's neighbour at a given offset comes later in key order as the cell does: one cursor
+  // per offset walks the cells once (no lookup per cell; the sets' smallest indices, the
+  // result, do not depend on the order the pairs are tested in).
+  const auto cell_less = [](const CellKey& a, const CellKey& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  };
+  std::vector<size_t> cursor(offsets.size(), 0);
+  for (const Run& run : runs) {
+    test_pairs(run.begin, run.end, run.begin, run.end, /*same_cell=*/true);
+    for (size_t o = 0; o < offsets.size(); ++o) {
+      const CellKey want{run.key.x + offsets[o].x, run.key.y + offsets[o].y,
+                         run.key.z + offsets[o].z};
+      size_t& c = cursor[o];
+      while (c < runs.size() && cell_less(runs[c].key, want)) ++c;
+      if (c < runs.size() && runs[c].key == want)
+        test_pairs(run.begin, run.end, runs[c].begin, runs[c].end, false);
     }
   }
   std::vector<int> canonical(n);

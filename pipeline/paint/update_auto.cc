@@ -3,9 +3,11 @@
 // paint_session.h).
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "pipeline/paint/mover_masks.h"
@@ -73,6 +75,13 @@ void ComposePagesInto(const TextureAtlas& atlas, const std::vector<cv::Mat>& buf
   }
 }
 
+// fn(b) for buffers b = 0 .. count-1, several at once (each reads and writes its own).
+void ForEachBufferOf(size_t count, const std::function<void(size_t)>& fn) {
+  cv::parallel_for_(cv::Range(0, static_cast<int>(count)), [&](const cv::Range& range) {
+    for (int b = range.start; b < range.end; ++b) fn(static_cast<size_t>(b));
+  });
+}
+
 }  // namespace
 
 // Decided `quality` (basis `why`) without a comparison: the sums go.
@@ -101,16 +110,16 @@ int PaintSession::ScoreHeldOut(size_t n, std::vector<double>* psnr_sum,
   // One scene (the mesh with its atlas UVs), its pages composed again for each candidate; each
   // frame rasterized once and shaded with each.
   const auto candidate = [&](size_t c) {
-    std::vector<cv::Mat> texels;
-    for (const PaintedBuffer& p : painted_) {
+    std::vector<cv::Mat> texels(painted_.size());
+    ForEachBufferOf(painted_.size(), [&](size_t b) {
+      const PaintedBuffer& p = painted_[b];
       const cv::Mat& base = p.shadow_bgra.empty() ? p.bgra : p.shadow_bgra;
       const int kind = kinds[c];
-      texels.push_back(AtMeanExposure(kind == 0   ? base
-                                      : kind == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
-                                      : kind == 2
-                                          ? MeanTexels(base, p.unmasked_sum, p.held_unmasked_sum)
-                                          : MeanTexels(base, p.sharp_sum, p.held_sharp_sum)));
-    }
+      texels[b] = AtMeanExposure(kind == 0   ? base
+                                 : kind == 1 ? MeanTexels(base, p.mean_sum, p.held_sum)
+                                 : kind == 2 ? MeanTexels(base, p.unmasked_sum, p.held_unmasked_sum)
+                                             : MeanTexels(base, p.sharp_sum, p.held_sharp_sum));
+    });
     return texels;
   };
   Scene scene = PaintedScene(candidate(0));
@@ -218,7 +227,7 @@ void PaintSession::DecideUpdate() {
                                 : UpdatePolicy::kQuality;
   if (chosen == 2) TurnModelOffByFramesHeldOut((psnr_sum[best] - psnr_sum[1]) / measured, measured);
   // What every frame painted, the chosen way.
-  for (size_t b = 0; b < painted_.size(); ++b) {
+  ForEachBufferOf(painted_.size(), [&](size_t b) {
     PaintedBuffer& p = painted_[b];
     if (chosen == 3) p.mean_sum = p.sharp_sum;
     if (mean) {
@@ -236,7 +245,7 @@ void PaintSession::DecideUpdate() {
     for (cv::Mat* m : {&p.unmasked_sum, &p.shadow_bgra, &p.shadow_quality, &p.held_sum,
                        &p.held_unmasked_sum, &p.sharp_sum, &p.held_sharp_sum})
       m->release();
-  }
+  });
 }
 
 }  // namespace fresco

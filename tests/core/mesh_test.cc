@@ -1,4 +1,6 @@
 // TriangleMesh geometry (normal, area), Scene::Bounds and ComputeAdjacency (welding + edges).
+#include <numeric>
+#include <random>
 #include <set>
 #include <span>
 #include <vector>
@@ -140,6 +142,36 @@ TEST(AdjacencyTest, WeldsAcrossGridCellBoundaries) {
   EXPECT_EQ(Vec(adjacency.EdgeNeighbours(0, 0)), std::vector<int>{1});
   EXPECT_EQ(Vec(adjacency.EdgeNeighbours(1, 2)), std::vector<int>{0});
   EXPECT_TRUE(adjacency.EdgeNeighbours(0, 1).empty());
+}
+
+// Welding against every pair tested by brute force: random points in a box a few cells
+// across, close pairs in every direction (the neighbouring cells before and after a cell on
+// each axis); each vertex's welded index is the smallest of those it is chained to.
+TEST(AdjacencyTest, WeldingMatchesEveryPairTested) {
+  const double tolerance = 0.1;
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> in_box(-0.35, 0.35);
+  TriangleMesh mesh;
+  for (int i = 0; i < 600; ++i)
+    mesh.vertices.emplace_back(in_box(random), in_box(random), in_box(random));
+  for (int i = 0; i + 2 < 600; i += 3) mesh.triangles.emplace_back(i, i + 1, i + 2);
+  const int n = static_cast<int>(mesh.vertices.size());
+  std::vector<int> smallest(n);
+  std::iota(smallest.begin(), smallest.end(), 0);
+  for (bool changed = true; changed;) {  // until every chain carries its smallest index
+    changed = false;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if ((mesh.vertices[i] - mesh.vertices[j]).norm() <= tolerance &&
+            smallest[j] < smallest[i]) {
+          smallest[i] = smallest[j];
+          changed = true;
+        }
+  }
+  const MeshAdjacency adjacency = ComputeAdjacency(mesh, tolerance);
+  EXPECT_EQ(adjacency.welded_vertex, smallest);
+  EXPECT_LT(std::set<int>(smallest.begin(), smallest.end()).size(), 600u);  // some welded
+  EXPECT_GT(std::set<int>(smallest.begin(), smallest.end()).size(), 1u);    // not all
 }
 
 TEST(AdjacencyTest, NonManifoldFanEdgeListsAllOthers) {

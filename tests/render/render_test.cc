@@ -567,6 +567,36 @@ TEST(RasterizerTest, BackFaceCulling) {
   }
 }
 
+// Rasterizers of one camera share its ray table: each rasterizer's rays are still its own
+// camera's (Camera::Unproject of the sample's position), whatever was built before it, for
+// cameras that differ in one distortion term only, and at another supersampling.
+TEST(RasterizerTest, EachRasterizerHasItsOwnCamerasRays) {
+  const Camera a = DistortedCamera();
+  Camera b = a;
+  b.k1 = -0.29;
+  b.UpdateFoldR2();
+  const auto expect_rays_of = [](const Camera& camera, int n, const Rasterizer& rasterizer) {
+    for (const auto& [col, row] : {std::pair{0, 0}, {17, 203}, {160 * n, 120 * n}, {301, 9}}) {
+      Eigen::Vector2d normalized;
+      ASSERT_TRUE(camera.Unproject(Eigen::Vector2d(col / n + ((col % n) + 0.5) / n - 0.5,
+                                                   row / n + ((row % n) + 0.5) / n - 0.5),
+                                   &normalized));
+      const Eigen::Vector2f ray = rasterizer.Ray(col, row);
+      EXPECT_EQ(ray.x(), static_cast<float>(normalized.x())) << col << ", " << row;
+      EXPECT_EQ(ray.y(), static_cast<float>(normalized.y())) << col << ", " << row;
+    }
+  };
+  const Rasterizer first_a(a, RasterOptions());
+  const Rasterizer first_b(b, RasterOptions());
+  const Rasterizer again_a(a, RasterOptions());
+  const Rasterizer a_twice(a, RasterOptions{1e-3, false, 2});
+  expect_rays_of(a, 1, first_a);
+  expect_rays_of(b, 1, first_b);
+  expect_rays_of(a, 1, again_a);
+  expect_rays_of(a, 2, a_twice);
+  EXPECT_NE(first_a.Ray(17, 203), first_b.Ray(17, 203));
+}
+
 // A closed cube seen from outside: with and without culling, the same pixels, and culling
 // never lets the far side show through (watertight, no cracks along shared edges).
 TEST(RasterizerTest, ClosedCubeIsWatertight) {
