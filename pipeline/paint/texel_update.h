@@ -77,7 +77,7 @@ struct TexelUpdateRule {
     if (options.update == UpdatePolicy::kAuto) {
       rule.policy = UpdatePolicy::kQuality;
       rule.mean_too = true;
-      rule.sharp_too = true;
+      rule.sharp_too = options.layers.count == 0;  // layers keep the sharpest or the mean
       rule.unmasked_too = options.background.mode != BackgroundMode::kOff;
     }
     if (options.update == UpdatePolicy::kSharpMean) {

@@ -56,11 +56,9 @@ inline const EnumNames<SamplingMode>& SamplingNames() {
 
 inline const EnumNames<UpdatePolicy>& UpdatePolicyNames() {
   static const EnumNames<UpdatePolicy> names = {
-      {UpdatePolicy::kLatest, "latest"},
-      {UpdatePolicy::kQuality, "quality"},
-      {UpdatePolicy::kMean, "mean"},
+      {UpdatePolicy::kLatest, "latest"}, {UpdatePolicy::kQuality, "quality"},
+      {UpdatePolicy::kMean, "mean"},     {UpdatePolicy::kSharpMean, "sharp_mean"},
       {UpdatePolicy::kAuto, "auto"},
-      {UpdatePolicy::kSharpMean, "sharp_mean"},
   };
   return names;
 }
@@ -91,7 +89,8 @@ void Fields(PipelineOptions& o, V& v) {
          "frames spread over it (every N / 7-th of N frames; live: 2, 6, ..., 22); after the "
          "6th the model painted each way without them is rendered at their poses, and the way "
          "that agrees better with them paints on (`sharp_mean` only where it beats `mean` by "
-         "0.1 dB a frame: every view alike is the safer mean; where "
+         "0.1 dB a frame, every view alike being the safer mean, and not with view layers; "
+         "where "
          "`background.mode` `auto` turned the model on, the mean without it is one more way, "
          "which turns it off; with the model on by hand, refinement on or view selection, "
          "`auto` keeps `quality`). The choice and its evidence (dB gained) are in "

@@ -384,7 +384,7 @@ TEST(ProjectTest, EnumsAndRangesAreChecked) {
             "\"area\"");
   EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"update": "newest"})")),
               StartsWith("p.json: pipeline.update: 'newest' is not one of \"latest\", "
-                         "\"quality\", \"mean\" or \"auto\""));
+                         "\"quality\", \"mean\", \"sharp_mean\" or \"auto\""));
   EXPECT_THAT(ParseError(WithExtra(R"("pipeline": {"quality_slack": 1.5})")),
               StartsWith("p.json: pipeline.quality_slack: must be in [0, 1], got 1.5"));
   EXPECT_EQ(ParseError(WithExtra(R"("pipeline": {"update_every": 0})")),

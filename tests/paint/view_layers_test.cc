@@ -133,7 +133,9 @@ TEST(ViewLayers, EachSideOfAnOrbitKeepsItsOwnLook) {
     // smoothly): within 2 dB of it.
     const int frame = *std::next(c.held_out.begin(), static_cast<long>(k));
     const double ideal = one_look[k] - 20 * std::log10(frame < 18 ? 1.3 : 0.7);
-    EXPECT_GT(views[k], single[k] + 5.0);
+    // The single texture: `update: auto`'s sharp mean (17.44 dB at frame 4; its plain mean
+    // 17.18): layers keep the sharpest view or the mean, and give the same 22.25 dB as before.
+    EXPECT_GT(views[k], single[k] + 4.75);
     EXPECT_GT(views[k], ideal - 2.0);
   }
 }
