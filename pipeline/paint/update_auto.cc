@@ -189,8 +189,7 @@ void PaintSession::DecideUpdate() {
   const bool model_on = options_.background.mode != BackgroundMode::kOff;
   const bool without_model = model_on && requested_background_ == BackgroundMode::kAuto;
   if (model_on && !without_model) return KeepSharpestViews("background_model_on");
-  // The sharp mean where its sums were taken from the first frame (every frame painted in
-  // the warp: they are, where nothing is provisional... or beside the model's sums).
+  // The sharp mean where its sums were kept (TexelUpdateRule::sharp_too: not with layers).
   bool sharp = false;
   for (const PaintedBuffer& p : painted_) sharp |= !p.sharp_sum.empty();
   std::vector<int> kinds = {0, 1};
@@ -213,12 +212,11 @@ void PaintSession::DecideUpdate() {
   const int chosen = kinds[best];
   update_auto_.frames_measured = measured;
   update_auto_.decided_at_frame = frames_seen_;
-  update_auto_.evidence = measured > 0 ? (psnr_sum[best > 0 ? best : 1] - psnr_sum[0]) / measured
-                                       : std::numeric_limits<double>::quiet_NaN();
-  if (measured > 0 && best == 0)  // the best mean's shortfall
-    for (size_t c = 1; c < n; ++c)
-      update_auto_.evidence =
-          std::max(update_auto_.evidence, (psnr_sum[c] - psnr_sum[0]) / measured);
+  // The chosen mean's gain, or where none won, the best one's shortfall.
+  const double top =
+      best > 0 ? psnr_sum[best] : *std::max_element(psnr_sum.begin() + 1, psnr_sum.end());
+  update_auto_.evidence =
+      measured > 0 ? (top - psnr_sum[0]) / measured : std::numeric_limits<double>::quiet_NaN();
   const bool mean = chosen > 0;
   update_auto_.state = mean ? AutoDecision::State::kOn : AutoDecision::State::kOff;
   if (chosen == 3) update_auto_.basis = "held_out_sharp";
