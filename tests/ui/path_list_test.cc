@@ -1,5 +1,5 @@
 // The "..." path lists of the whole app, driven headless: where the Calibration panel's
-// folder list starts in a freshly started app, and Escape on an open list.
+// folder list starts in a freshly started app, and Escape on an open list or menu.
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -88,6 +88,37 @@ TEST(PathList, EscapeClosesAnOpenListLeavingTheField) {
   app.Frames(2);
   EXPECT_EQ(OpenList(), nullptr) << "Escape left the list open";
   EXPECT_EQ(CalibrationFolder(app), folder + "frames/") << "Escape changed the field";
+}
+
+// Escape closes what is open on top, one at a time: in File > Open..., the "..." list (its
+// field as the list left it), then the submenu, then the File menu (before: Escape closed no
+// menu or list at all).
+TEST(PathList, EscapeClosesTheListOrMenuOnTopOneAtATime) {
+  HeadlessApp app(Capture() + "/project.json", 0);
+  const float line = ImGui::GetFrameHeight();
+  app.Click(ImVec2(15, line / 2));  // "File" in the menu bar
+  ImGuiWindow* file = ImGui::FindWindowByName("##Menu_00");
+  ASSERT_NE(file, nullptr);
+  const float item = ImGui::GetTextLineHeight() + ImGui::GetStyle().ItemSpacing.y;
+  app.MouseTo(file->Pos.x + 30, file->DC.CursorStartPos.y + 1.5f * item);  // "Open..."
+  app.Frames(3);
+  ImGuiWindow* open = ImGui::FindWindowByName("##Menu_01");
+  ASSERT_NE(open, nullptr);
+  ImGui::ActivateItem(ImHashStr("...", 0, open->GetID("##menu_open")));
+  app.Frames(2);
+  ASSERT_EQ(GImGui->OpenPopupStack.Size, 3) << "File, Open... and the list";
+  const std::string listed = app.ui.menu_path;
+  EXPECT_EQ(listed, app.state.last_folder);
+  app.MouseTo(800, 600);  // over the 3D view, off the menus
+  app.Frames(2);
+  for (const int left : {2, 1, 0}) {
+    app.input.keys_down[kKeyEscape] = true;
+    app.Frame();
+    app.input.keys_down[kKeyEscape] = false;
+    app.Frames(2);
+    EXPECT_EQ(GImGui->OpenPopupStack.Size, left);
+  }
+  EXPECT_EQ(app.ui.menu_path, listed);
 }
 
 }  // namespace

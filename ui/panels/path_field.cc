@@ -102,9 +102,6 @@ bool PathField(const char* label, const char* id, const char* hint, std::string*
     }
   }
   if (ImGui::BeginPopup("browse")) {
-    // Escape closes the list, the field as it is (ImGui closes a popup on Escape only with
-    // keyboard navigation on, which the app leaves off).
-    if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape), false)) ImGui::CloseCurrentPopup();
     // A folder opens in place (the list stays open); a file is picked and closes the list.
     const std::string folder = ListedFolder(*value);
     std::error_code ec;
