@@ -546,13 +546,33 @@ std::string VerifyAgreementText(const VerifyResult& result) {
     return "No frame agrees within the thresholds (all " + std::to_string(result.compared) +
            " compared frames are flagged).";
   }
-  char text[300];
+  // The unflagged frames that do not count as agreeing, by kind: said, so that the counts
+  // add up to the frames not flagged.
+  std::string others;
+  const auto add = [&](int count, const char* what) {
+    if (count > 0) others += ", " + std::to_string(count) + " " + what;
+  };
+  add(result.borderline, "are borderline");
+  add(result.following_drift, "follow the drift");
+  add(result.weak_support, "were not judged");
+  char text[400];
+  if (others.empty()) {
+    std::snprintf(text, sizeof(text),
+                  "The %d unflagged frames agree within %.3f deg and %.4f m (median %.3f deg, "
+                  "%.4f m).",
+                  result.unflagged, result.max_unflagged_rotation_error_deg,
+                  result.max_unflagged_position_error_m, result.median_rotation_error_deg,
+                  result.median_position_error_m);
+    return text;
+  }
+  const size_t last = others.rfind(", ");
+  if (last != 0) others.replace(last, 2, " and ");
   std::snprintf(text, sizeof(text),
-                "The %d unflagged frames agree within %.3f deg and %.4f m (median %.3f deg, "
-                "%.4f m).",
-                result.unflagged, result.max_unflagged_rotation_error_deg,
-                result.max_unflagged_position_error_m, result.median_rotation_error_deg,
-                result.median_position_error_m);
+                "Of the %d unflagged frames, %d agree within %.3f deg and %.4f m (median %.3f "
+                "deg, %.4f m)%s.",
+                result.compared - result.flagged, result.unflagged,
+                result.max_unflagged_rotation_error_deg, result.max_unflagged_position_error_m,
+                result.median_rotation_error_deg, result.median_position_error_m, others.c_str());
   return text;
 }
 

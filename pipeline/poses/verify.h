@@ -151,7 +151,9 @@ std::vector<std::string> VerifyNotes(const VerifyResult& result);
 // rotation position", "follows the drift (within 2.3 deg)", "not judged: weak COLMAP pose (52
 // points)", "ok" or "ok (not in fit)".
 std::string VerdictText(const FrameVerdict& frame, const VerifyResult& result);
-// "Unflagged frames agree within ..." or, with none unflagged, says so.
+// "The 37 unflagged frames agree within ..."; with frames that are neither flagged nor
+// agreeing, "Of the 118 unflagged frames, 72 agree within ..., 18 are borderline, 25 follow
+// the drift and 3 were not judged." (the counts add up); with none agreeing, says so.
 std::string VerifyAgreementText(const VerifyResult& result);
 
 // One entry per frame of the sequence, in order.

@@ -358,6 +358,30 @@ TEST(Verify, SummarySaysSoWhenNoFrameAgrees) {
   EXPECT_NE(notes[0].find("Only 3 of 19 frames"), std::string::npos) << notes[0];
 }
 
+// The summary's counts add up to the frames not flagged (the street's drift: "The 72
+// unflagged frames agree" read as if 72 of 120 were unflagged, 2 being flagged).
+TEST(Verify, TheSummarysCountsAddUpToTheUnflaggedFrames) {
+  VerifyResult result;
+  result.compared = 120;
+  result.flagged = 2;
+  result.unflagged = 72;
+  result.borderline = 18;
+  result.following_drift = 25;
+  result.weak_support = 3;
+  result.max_unflagged_rotation_error_deg = 0.378;
+  result.max_unflagged_position_error_m = 0.0622;
+  result.median_rotation_error_deg = 0.21;
+  result.median_position_error_m = 0.0275;
+  EXPECT_EQ(VerifyAgreementText(result),
+            "Of the 118 unflagged frames, 72 agree within 0.378 deg and 0.0622 m (median 0.210 "
+            "deg, 0.0275 m), 18 are borderline, 25 follow the drift and 3 were not judged.");
+  result.following_drift = result.weak_support = 0;
+  result.unflagged = 100;
+  EXPECT_EQ(VerifyAgreementText(result).rfind("Of the 118 unflagged frames, 100 agree", 0), 0u);
+  EXPECT_NE(VerifyAgreementText(result).find("), 18 are borderline."), std::string::npos)
+      << VerifyAgreementText(result);
+}
+
 // COLMAP's frames for BootstrapFromColmap: `colmap[i]` (cam_from_colmap) for frame i, whose
 // given pose is `given[i]`.
 struct SyntheticColmap {

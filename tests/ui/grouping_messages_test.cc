@@ -6,6 +6,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <imgui.h>
+#include <imgui_internal.h>
 
 #include "tests/test_support.h"
 #include "tests/ui/headless_ui.h"
@@ -86,6 +88,32 @@ TEST(GroupingMessages, AMergeWhoseTexelsWereCappedSaysSo) {
     EXPECT_NE(app.state.message.find("coarser texels"), std::string::npos) << app.state.message;
   }
   EXPECT_TRUE(capped);
+}
+
+// After a merge split back apart (its message above the table), the Grouping panel of the
+// 1920 x 1080 window shows its six groups and the buttons below them without scrolling: the
+// table is as high as its rows (before: twelve rows high whatever the groups, and the merge
+// and split buttons went out of sight below the messages).
+TEST(GroupingMessages, AFewGroupsLeaveTheButtonsBelowTheTableInSight) {
+  HeadlessApp app(testing::Capture() + "/project.json", 2, ImVec2(1920, 1080));
+  for (int other = 1; other < 6 && app.ReportOf("Grouping", "split").empty(); ++other) {
+    app.state.project.grouping.groups.clear();
+    ApplyProject(app.ui);
+    app.runner.WaitIdle();
+    app.Frames(2);
+    testing::MergeAndApply(app, 0, other);
+  }
+  ASSERT_NE(app.ReportOf("Grouping", "split"), "") << "opposite walls fold over";
+  app.Frames(2);
+  ImGuiWindow* grouping = HeadlessApp::Window("Grouping");
+  ImGuiTable* table = ImGui::TableFindByID(grouping->GetID("groups"));
+  ASSERT_NE(table, nullptr);
+  const size_t groups = app.runner.Snapshot()->geometry->groups.size();
+  ASSERT_EQ(groups, 6u);
+  const float row = ImGui::GetTextLineHeightWithSpacing();
+  EXPECT_LE(table->OuterRect.GetHeight(), (groups + 1) * row + ImGui::GetStyle().ScrollbarSize + 1)
+      << "the table is higher than its " << groups << " groups";
+  EXPECT_EQ(grouping->ScrollMax.y, 0) << "the buttons below the table are out of sight";
 }
 
 }  // namespace

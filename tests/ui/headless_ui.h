@@ -72,6 +72,7 @@ struct ImGuiHeadless {
     io.KeyMap[ImGuiKey_Space] = 32;
     io.KeyMap[ImGuiKey_LeftArrow] = 263;
     io.KeyMap[ImGuiKey_RightArrow] = 262;
+    io.KeyMap[ImGuiKey_Escape] = 256;
     unsigned char* pixels = nullptr;
     int w = 0, h = 0;
     io.Fonts->GetTexDataAsRGBA32(&pixels, &w, &h);  // a font atlas, no texture upload

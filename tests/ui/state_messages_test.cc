@@ -1,4 +1,5 @@
-// Messages true to the state, the app driven headless (issue 58, item 6). Also there: a
+// Messages true to the state, the app driven headless (issue 58, item 6): also "(unsaved)"
+// after Ctrl+Z to the saved state, and a step's estimate at its end. Also there: a
 // fold-over status line goes with its Undo (UiInput.GroupColoursStayAcrossEdits...) and
 // undo says what it changed back (CameraAttach.*).
 #include <chrono>
@@ -7,11 +8,13 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "tests/test_support.h"
 #include "tests/ui/headless_ui.h"
+#include "ui/core/job_estimate.h"
 
 namespace fresco {
 namespace {
@@ -103,31 +106,38 @@ TEST(StateMessages, TheCalibrationLightIsNotGreenBeforeTheOneCameraCheck) {
   std::printf("frames drawn while detecting %d, while checking %d\n", detecting, checking);
 }
 
-// A step of opening that goes quiet keeps counting its time in the window (status bar and
-// Pipeline panel): the worker publishes only when the step says how far it got, and on the
-// street under load the joint pose adjustment stood at "adjusting poses 120/246, 8 s elapsed,
-// about 8 s left" for 34 s between its two passes, as if the app had hung.
-TEST(StateMessages, AQuietStepOfOpeningKeepsCountingItsTime) {
+// The progress the joint pose adjustment publishes while the capture's project opens with
+// it on, first to last.
+std::vector<std::shared_ptr<RunnerSnapshot>> AdjustingPoses() {
   std::mutex mutex;
-  std::shared_ptr<RunnerSnapshot> adjusting;  // the first "adjusting poses" published
+  std::vector<std::shared_ptr<RunnerSnapshot>> published;
   RunnerOptions options;
   options.publish_interval_ms = 0;
   options.on_publish = [&](const RunnerSnapshot& s) {
     std::lock_guard<std::mutex> lock(mutex);
-    if (!adjusting && s.status.rfind("adjusting poses ", 0) == 0)
-      adjusting = std::make_shared<RunnerSnapshot>(s);
+    if (s.status.rfind("adjusting poses ", 0) == 0)
+      published.push_back(std::make_shared<RunnerSnapshot>(s));
   };
   AppState state;
-  ASSERT_TRUE(state.Open(testing::Capture() + "/project.json").ok());
+  EXPECT_TRUE(state.Open(testing::Capture() + "/project.json").ok());
   state.project.pipeline.refine.joint = true;
-  const auto published = std::chrono::steady_clock::now();
   {
     PipelineRunner runner(options);
     runner.Restart(state.project);
     runner.WaitIdle();
   }
-  std::lock_guard<std::mutex> lock(mutex);
-  ASSERT_TRUE(adjusting) << "the joint adjustment published its progress";
+  EXPECT_FALSE(published.empty()) << "the joint adjustment published its progress";
+  if (published.empty()) published.push_back(std::make_shared<RunnerSnapshot>());
+  return published;
+}
+
+// A step of opening that goes quiet keeps counting its time in the window (status bar and
+// Pipeline panel): the worker publishes only when the step says how far it got, and on the
+// street under load the joint pose adjustment stood at "adjusting poses 120/246, 8 s elapsed,
+// about 8 s left" for 34 s between its two passes, as if the app had hung.
+TEST(StateMessages, AQuietStepOfOpeningKeepsCountingItsTime) {
+  const auto published = std::chrono::steady_clock::now();
+  const auto adjusting = AdjustingPoses().front();
   const std::string stem = adjusting->status.substr(0, adjusting->status.find(','));
   // The worker says nothing more for 3 s (as if the step were still under way).
   HeadlessApp app(testing::Capture() + "/project.json", 0);
@@ -141,6 +151,55 @@ TEST(StateMessages, AQuietStepOfOpeningKeepsCountingItsTime) {
   const size_t number = line.rfind(' ', seconds - 1) + 1;
   EXPECT_GE(std::stoi(line.substr(number, seconds - number)), 3)
       << "the time stood still: '" << line << "' (published as '" << adjusting->status << "')";
+}
+
+// Ctrl+Z back to the saved state leaves nothing unsaved (the Project panel's "(unsaved)" and
+// the status bar's "[unsaved]"), and Ctrl+Y away from it is unsaved again; after a Save, the
+// state saved is the one compared with (before: unsaved after any undo or redo).
+TEST(StateMessages, UndoBackToTheSavedStateIsNotUnsaved) {
+  const std::string dir = testing::MakeTempDir("ui-unsaved");
+  fs::copy(testing::Capture(), dir + "/capture", fs::copy_options::recursive);
+  HeadlessApp app(dir + "/capture/project.json", 0);
+  const int every = app.state.project.pipeline.update_every;
+  const auto edit = [&](int update_every) {
+    app.state.BeginEdit();
+    app.state.project.pipeline.update_every = update_every;
+    app.Frames(2);
+  };
+  ASSERT_FALSE(app.state.dirty);
+  edit(every + 1);
+  EXPECT_TRUE(app.state.dirty);
+  app.CtrlTap('Z');
+  EXPECT_EQ(app.state.project.pipeline.update_every, every);
+  EXPECT_FALSE(app.state.dirty) << "back to the file's state, still '(unsaved)'";
+  app.CtrlTap('Y');
+  EXPECT_TRUE(app.state.dirty) << "the edit redone is not in the file";
+  app.CtrlTap('S');
+  EXPECT_FALSE(app.state.dirty);
+  edit(every + 2);
+  app.CtrlTap('Z');
+  EXPECT_EQ(app.state.project.pipeline.update_every, every + 1);
+  EXPECT_FALSE(app.state.dirty) << "back to the state saved with Ctrl+S";
+  app.CtrlTap('Z');
+  EXPECT_EQ(app.state.project.pipeline.update_every, every);
+  EXPECT_TRUE(app.state.dirty) << "the file holds the edit undone";
+}
+
+// The progress line after the last step of the joint pose adjustment (done = total) while
+// what follows it runs: never "about 0 s left" (it said so for as long as the rest took).
+TEST(StateMessages, AStepAtItsEndSaysFinishingNotZeroSecondsLeft) {
+  const auto last = AdjustingPoses().back();
+  ASSERT_EQ(last->step_fraction, 1.0) << last->status;
+  // Shown 5 s after the step began, as if what follows it were still under way.
+  last->step_started = std::chrono::steady_clock::now() - std::chrono::seconds(5);
+  HeadlessApp app(testing::Capture() + "/project.json", 0);
+  app.ui.snapshot = last;
+  app.imgui.Frame(app.ui, app.panels, &app.input);
+  const std::string line = app.ReportOf("Pipeline", "status");
+  EXPECT_EQ(line.find("0 s left"), std::string::npos) << line;
+  EXPECT_NE(line.find("5 s elapsed, finishing"), std::string::npos) << line;
+  EXPECT_EQ(ElapsedAndRemainingText(83.0, 0.999), "1:23 elapsed, finishing");  // 0.08 s left
+  EXPECT_EQ(ElapsedAndRemainingText(83.0, 0.99), "1:23 elapsed, about 1 s left");
 }
 
 }  // namespace

@@ -6,6 +6,8 @@
 #include <set>
 #include <string>
 
+#include <imgui_internal.h>
+
 #include "ui/panels/panels.h"
 #include "ui/panels/path_field.h"
 
@@ -167,9 +169,23 @@ void DrawMenuBar(UiContext& ui, std::vector<std::unique_ptr<Panel>>& panels) {
   ImGui::EndMainMenuBar();
 }
 
+// Escape closes the menu, "..." list or popup on top, one at a time (ImGui 1.86 does so only
+// with keyboard navigation, which the app leaves off); a modal prompt answers it itself, and
+// a field being typed in takes it first (it leaves the field). What a list put in its field
+// stays there.
+void CloseTopPopupOnEscape() {
+  ImGuiContext& g = *GImGui;
+  if (g.OpenPopupStack.empty() || !ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Escape), false))
+    return;
+  const ImGuiWindow* top = g.OpenPopupStack.back().Window;
+  if (top && !(top->Flags & ImGuiWindowFlags_Modal))
+    ImGui::ClosePopupToLevel(g.OpenPopupStack.Size - 1, true);
+}
+
 void HandleShortcuts(UiContext& ui) {
   ImGuiIO& io = ImGui::GetIO();
   if (io.WantTextInput) return;
+  CloseTopPopupOnEscape();
   AppState& state = *ui.state;
   if (io.KeyCtrl && ImGui::IsKeyPressed('S') && state.has_project)
     if (Status s = state.Save(); !s.ok()) state.message = "error: " + s.message();

@@ -68,12 +68,14 @@ Status AppState::Open(const std::string& path) {
     FRESCO_RETURN_IF_ERROR(CheckInputsExist(loaded.ForStream(static_cast<int>(i)),
                                             "streams[" + std::to_string(i) + "]."));
   project = loaded;
+  saved = loaded;
   has_project = true;
   dirty = false;
   undo.clear();
   redo.clear();
   selected_groups.clear();
   selected_triangles.clear();
+  RememberFolderOf(loaded.file_path);
   AddRecent(loaded.file_path);
   message = "opened " + loaded.file_path;
   return Status::Ok();
@@ -84,12 +86,14 @@ Status AppState::Save(const std::string& path) {
   const std::string target = path.empty() ? project.file_path : path;
   FRESCO_RETURN_IF_ERROR(SaveProject(project, target));
   // Re-read what was written, so paths are as they resolve from the new place.
-  Project saved;
-  FRESCO_RETURN_IF_ERROR(LoadProject(target, {}, &saved));
-  project = saved;
+  Project written;
+  FRESCO_RETURN_IF_ERROR(LoadProject(target, {}, &written));
+  project = written;
+  saved = written;
   dirty = false;
-  AddRecent(saved.file_path);
-  message = "saved " + saved.file_path;
+  RememberFolderOf(written.file_path);
+  AddRecent(written.file_path);
+  message = "saved " + written.file_path;
   return Status::Ok();
 }
 
@@ -114,10 +118,12 @@ Status AppState::RepairPaths(const ProjectPaths& typed, std::string* file) {
   const bool had_edits = dirty;  // the file now has these paths: no new unsaved edit
   BeginEdit();
   dirty = had_edits;
-  project.scene = paths.scene;
-  project.video = paths.video;
-  project.camera = paths.camera;
-  project.poses = paths.poses;
+  for (Project* p : {&project, &saved}) {  // the file has these paths, its other keys as before
+    p->scene = paths.scene;
+    p->video = paths.video;
+    p->camera = paths.camera;
+    p->poses = paths.poses;
+  }
   return Status::Ok();
 }
 
@@ -126,7 +132,7 @@ bool AppState::Undo() {
   redo.push_back(project);
   project = undo.back();
   undo.pop_back();
-  dirty = true;
+  dirty = !(project == saved);
   message = "undone: " + DescribeProjectChange(redo.back(), project, "back to");
   return true;
 }
@@ -136,7 +142,7 @@ bool AppState::Redo() {
   undo.push_back(project);
   project = redo.back();
   redo.pop_back();
-  dirty = true;
+  dirty = !(project == saved);
   message = "redone: " + DescribeProjectChange(undo.back(), project, "to");
   return true;
 }
@@ -163,6 +169,11 @@ std::string DescribeProjectChange(const Project& before, const Project& after,
       before.time_offset_s != after.time_offset_s)
     say("settings");
   return said.empty() ? "the last edit" : said;
+}
+
+void AppState::RememberFolderOf(const std::string& file) {
+  last_folder = std::filesystem::path(file).lexically_normal().parent_path().string();
+  if (last_folder.empty() || last_folder.back() != '/') last_folder += '/';
 }
 
 void AppState::LoadRecent() {

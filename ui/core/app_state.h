@@ -16,12 +16,14 @@ namespace fresco {
 struct AppState {
   Project project;  // as edited
   bool has_project = false;
-  bool dirty = false;               // edited since it was opened or saved
+  bool dirty = false;               // differs from the file since it was opened or saved
+  Project saved;                    // the project as its file holds it (Open, Save)
   std::string message;              // the last status or error, shown in the status bar
   std::vector<std::string> recent;  // most recent first
   std::string recent_file;          // where `recent` is kept ("" = not kept)
-  // The folder the path lists ("..." beside a path) were last used in (absolute, ending in
-  // '/'; "" = none yet): an empty field's list starts there. Kept with `recent`.
+  // The folder last used (absolute, ending in '/'; "" = none yet): where a path list ("..."
+  // beside a path) was last used, or the folder of the project last opened or saved. An
+  // empty field's list starts there. Kept with `recent`.
   std::string last_folder;
 
   // Selection (viewport picks and the grouping table).
@@ -56,10 +58,13 @@ struct AppState {
   // edits stay unsaved); a project that did not open is then ready to Open (`*file`).
   Status RepairPaths(const ProjectPaths& typed, std::string* file);
   // Undo and redo say what they changed back in `message` (DescribeProjectChange), so the
-  // status bar never keeps describing an edit that was undone.
+  // status bar never keeps describing an edit that was undone; the project is unsaved after
+  // them only when it differs from `saved` (Ctrl+Z back to the saved state is not an edit).
   bool Undo();
   bool Redo();
 
+  // `last_folder` becomes the folder of `file` (absolute).
+  void RememberFolderOf(const std::string& file);
   void LoadRecent();
   void SaveRecent() const;  // to recent_file (when set)
   void AddRecent(const std::string& path);

@@ -108,13 +108,17 @@ class GroupingPanel : public Panel {
 
     // The groups; click to select (ctrl-click adds).
     // Columns as wide as their headers and values (the table scrolls sideways in a narrow
-    // panel or at a large font scale rather than cutting them to a letter), about twelve
-    // rows high at any font scale.
+    // panel or at a large font scale rather than cutting them to a letter), as high as its
+    // rows up to twelve (with the header) at any font scale: a few groups leave the buttons
+    // below it in sight.
+    const size_t rows = 1 + std::min<size_t>(geo.groups.size(), 11);
+    const float table_height =
+        rows * ImGui::GetTextLineHeightWithSpacing() + ImGui::GetStyle().ScrollbarSize;
     if (ImGui::BeginTable("groups", 4,
                           ImGuiTableFlags_RowBg | ImGuiTableFlags_ScrollY |
                               ImGuiTableFlags_ScrollX | ImGuiTableFlags_SizingFixedFit |
                               ImGuiTableFlags_BordersInnerV,
-                          ImVec2(0, 12 * ImGui::GetTextLineHeightWithSpacing()))) {
+                          ImVec2(0, table_height))) {
       if (table_font_px_ != ImGui::GetFontSize()) {  // the font scale changed: fit again
         ImGui::TableSetColumnWidthAutoAll(ImGui::GetCurrentTable());
         table_font_px_ = ImGui::GetFontSize();

@@ -90,9 +90,14 @@ bool PathField(const char* label, const char* id, const char* hint, std::string*
   if (ImGui::Button("...")) {
     ImGui::OpenPopup("browse");
     BrowseLists().insert(ImGui::GetID("browse"));
-    // An empty field's list starts in the last folder used, not the launch folder.
+    // The list starts in the folder the field names (a folder typed without its '/' lists
+    // what is in it); an empty field's in the last folder used, not the launch folder.
+    std::error_code ec;
     if (value->empty() && options.last_folder && !options.last_folder->empty()) {
       *value = *options.last_folder;
+      changed = true;
+    } else if (!value->empty() && value->back() != '/' && fs::is_directory(*value, ec)) {
+      *value += '/';
       changed = true;
     }
   }

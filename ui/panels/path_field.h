@@ -1,8 +1,10 @@
 // A labelled path input with a "..." button listing the entries of the typed folder that fit
 // (BrowseEntries), shared by the New project form, the Project panel's path editor, the File
 // menu's Open and Save As and the Calibration panel; and the extensions each of a project's
-// paths offers there. Every list starts where the last one was used (`last_folder`, the
-// app's AppState::last_folder) when its field is empty.
+// paths offers there. A list starts in the folder its field names, or, when the field is
+// empty, in the last folder used anywhere in the app (`last_folder`, the app's
+// AppState::last_folder: the last list's, or the project's). Escape closes it (the app's
+// shortcuts close whatever menu or list is on top).
 #pragma once
 
 #include <cstddef>
