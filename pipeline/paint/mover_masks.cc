@@ -390,18 +390,18 @@ void FollowAcrossFrames(const std::vector<SmallFrame>& frames, const Judged& jud
   FollowMovers(follow, options.follow_frames, &result->masks);
 }
 
-// Whether the first half judged (the even frames) is enough: the caller drops the masks below
-// a share (later_passes_min_fraction) and they show well under it in regions.
-bool JudgedHalfIsEnough(const MoverMaskOptions& options, const std::vector<long long>& judged,
-                        const std::vector<long long>& compact) {
+// Whether the frames judged so far (every `stride`-th from the first) are enough: the caller
+// drops the masks below a share (later_passes_min_fraction) and they show in regions under
+// `below` times it.
+bool JudgedAreEnough(const MoverMaskOptions& options, const std::vector<long long>& judged,
+                     const std::vector<long long>& compact, int stride, double below) {
   const int n = static_cast<int>(judged.size());
-  if (options.later_passes_min_fraction <= 0 || options.half_enough_below <= 0 ||
-      n < 2 * options.half_min_frames)
+  if (options.later_passes_min_fraction <= 0 || below <= 0 || n < stride * options.half_min_frames)
     return false;
-  long long judged_half = 0, compact_half = 0;
-  for (int f = 0; f < n; f += 2) judged_half += judged[f], compact_half += compact[f];
-  return judged_half > 0 &&
-         compact_half < options.half_enough_below * options.later_passes_min_fraction * judged_half;
+  long long judged_so_far = 0, compact_so_far = 0;
+  for (int f = 0; f < n; f += stride) judged_so_far += judged[f], compact_so_far += compact[f];
+  return judged_so_far > 0 &&
+         compact_so_far < below * options.later_passes_min_fraction * judged_so_far;
 }
 
 }  // namespace
@@ -447,14 +447,14 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
   judging.regions.resize(n);
   result->agreed.resize(n);
   const bool keep_comparisons = options.passes > 1;
-  // The first pass judges every second frame (f % 2 == parity); a frame's judging reads only
-  // the frames, so the halves in turn judge as all at once.
+  // The first pass judges every fourth frame, then every second, then the rest (f % stride ==
+  // first): a frame's judging reads only the frames, so in turn they judge as all at once.
   std::vector<FirstLook> looks(n);
-  const auto judge_half = [&](int parity) {
-    const int count = (n - parity + 1) / 2;
-    cv::parallel_for_(cv::Range(0, count), [&](const cv::Range& range) {
+  const auto judge = [&](int first, int stride) {
+    const int count = (n - first + stride - 1) / stride;
+    cv::parallel_for_(cv::Range(0, std::max(0, count)), [&](const cv::Range& range) {
       for (int k = range.start; k < range.end; ++k) {
-        const int f = 2 * k + parity;
+        const int f = stride * k + first;
         if (frames[f].points.empty()) continue;
         looks[f] = LookAtFrame(frames, f, options, nullptr, &judging.comparisons[f]);
         judged[f] = looks[f].judged, compact[f] = looks[f].compact;
@@ -462,14 +462,19 @@ Status FindMoverMasks(const TriangleMesh& mesh, const std::vector<MoverMaskFrame
       }
     });
   };
-  judge_half(0);
-  if (JudgedHalfIsEnough(options, judged, compact)) {
+  const bool quarter_first = options.half_enough_below > 0 && options.quarter_enough_below > 0 &&
+                             n >= 4 * options.half_min_frames;
+  judge(0, quarter_first ? 4 : 2);
+  const bool enough =
+      quarter_first && JudgedAreEnough(options, judged, compact, 4, options.quarter_enough_below);
+  if (quarter_first && !enough) judge(2, 4);
+  if (enough || JudgedAreEnough(options, judged, compact, 2, options.half_enough_below)) {
     // The caller drops the masks: they are left as the comparisons found them, not cleaned.
     for (int f = 0; f < n; ++f)
       if (!looks[f].mask.empty())
         result->masks[f] = looks[f].mask, flagged[f] = cv::countNonZero(looks[f].mask);
   } else {
-    judge_half(1);
+    judge(1, 2);
     cv::parallel_for_(cv::Range(0, n), [&](const cv::Range& range) {
       for (int f = range.start; f < range.end; ++f)
         if (!looks[f].mask.empty())

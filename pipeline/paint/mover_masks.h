@@ -76,6 +76,11 @@ struct MoverMaskOptions {
   // 0: every frame judged.
   double half_enough_below = 0.75;
   int half_min_frames = 12;
+  // ... and before that, on a capture of at least four times half_min_frames frames, every
+  // fourth frame: where those show in regions less than this share of it, the others are not
+  // judged either (frames taken at even steps through the capture: a mover in a stretch of it
+  // shows in them as in every second frame). 0: the half first.
+  double quarter_enough_below = 0.5;
   // Each frame's depth rasterized at the camera's full size (sampled down to the reduced size:
   // each pixel takes the full-size sample nearest its centre, unprojected by that sample's
   // ray) and kept (MoverMaskResult::depths) for painting, whose depth stage takes it instead

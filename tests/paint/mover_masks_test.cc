@@ -30,12 +30,13 @@ struct Orbit {
   MoverMaskResult found;
 };
 
-Orbit FindMovers(int random_movers, const MoverMaskOptions& mask_options = MoverMaskOptions()) {
+Orbit FindMovers(int random_movers, const MoverMaskOptions& mask_options = MoverMaskOptions(),
+                 int frames = 40) {
   Orbit o;
   BlocksOptions blocks;
   blocks.seed = 3;
   EXPECT_TRUE(MakeBlocksScene(blocks, &o.scene).ok());
-  SynthOptions options = testing::BlocksHalfOrbit(blocks, 40, 11);
+  SynthOptions options = testing::BlocksHalfOrbit(blocks, frames, 11);
   options.random_movers = random_movers;
   EXPECT_TRUE(SynthesizeCapture(o.scene, options, &o.capture).ok());
   o.found = testing::FindCaptureMovers(o.scene, o.capture, mask_options);
@@ -143,6 +144,23 @@ TEST(MoverMasks, AStaticSceneIsJudgedOnEverySecondFrameWhereTheMasksWouldBeDropp
   const Orbit moving = FindMovers(2, options);
   EXPECT_EQ(moving.found.frames_judged, 40);
   EXPECT_GT(moving.found.compact_fraction(), 2 * kBackgroundAcrossViewsThreshold);
+}
+
+// ... and from 48 frames on, one whose every fourth frame shows well under it is judged on
+// those alone: a quarter of the comparisons. Movers anywhere in the capture show in them too.
+TEST(MoverMasks, ALongCaptureOfAStaticSceneIsJudgedOnEveryFourthFrame) {
+  MoverMaskOptions options;
+  options.later_passes_min_fraction = kBackgroundAcrossViewsThreshold;
+  const Orbit still = FindMovers(0, options, 48);
+  EXPECT_EQ(still.found.frames_judged, 12);
+  for (size_t f = 0; f < still.found.masks.size(); ++f)
+    EXPECT_EQ(still.found.masks[f].empty(), f % 4 != 0) << f;
+  EXPECT_LT(still.found.compact_fraction(), kBackgroundAcrossViewsThreshold / 4);
+  const Orbit moving = FindMovers(2, options, 48);
+  EXPECT_EQ(moving.found.frames_judged, 48);
+  EXPECT_GT(moving.found.compact_fraction(), 2 * kBackgroundAcrossViewsThreshold);
+  options.quarter_enough_below = 0;  // the half first, as on 40 frames
+  EXPECT_EQ(FindMovers(0, options, 48).found.frames_judged, 24);
 }
 
 // The later passes run only where their masks are used: with the model kept (across_views)
