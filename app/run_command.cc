@@ -287,6 +287,7 @@ nlohmann::json ShardMetrics(const Project& project, const PaintJob& job, const S
           {"count", shard.count},
           {"project", project.file_path},
           {"settings_hash", SettingsHash(project)},
+          {"layout", LayoutDigest(job.scene(), session.buffers(), atlas)},
           {"buffers", buffers},
           {"page_rects", rects},
           {"texels", texels},
@@ -332,19 +333,25 @@ nlohmann::json WallJson(const PaintJob& job, const PaintRunStats& stats, double 
           {"other_seconds", std::max(0.0, total_s - o.total - stats.seconds - write_s)}};
 }
 
-// Writes DIR/painted.gltf (+ .bin, PNGs) and DIR/metrics.json: into a staging folder inside
-// DIR first, then moved into DIR with metrics.json last; a failure before that leaves DIR
-// as it was (all or nothing). Errors are not bad input (exit 1).
-Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job, const PaintRunStats& stats,
-                       Clock::time_point start, nlohmann::json metrics) {
+// Writes DIR/painted.gltf (+ .bin, PNGs; a shard but the first, its PNGs only) and
+// DIR/metrics.json: into a staging folder inside DIR first, then moved into DIR with metrics.json
+// last; a failure before that leaves DIR as it was (all or nothing). Errors are not bad input (exit
+// 1).
+Status WriteRunOutputs(const std::string& out_dir, const PaintJob& job, int shard_index,
+                       const PaintRunStats& stats, Clock::time_point start,
+                       nlohmann::json metrics) {
   const auto writing = Clock::now();
   StagedFolder outputs;
   FRESCO_RETURN_IF_ERROR(outputs.Open(out_dir + "/.outputs"));
-  // A shard's part: its pages hold only its own buffers' placements (fresco merge).
-  FRESCO_RETURN_IF_ERROR(SaveGltfScene(job.buffer_shard.empty()
-                                           ? job.session->PaintedScene()
-                                           : job.session->PaintedSceneOfOwnBuffers(),
-                                       outputs.path() + "/painted.gltf"));
+  // A shard's part: its pages hold only its own buffers' placements (fresco merge); the glTF
+  // and its .bin, the same in every part (the layout is), only in shard 0's.
+  const std::string gltf = outputs.path() + "/painted.gltf";
+  if (job.buffer_shard.empty())
+    FRESCO_RETURN_IF_ERROR(SaveGltfScene(job.session->PaintedScene(), gltf));
+  else if (shard_index == 0)
+    FRESCO_RETURN_IF_ERROR(SaveGltfScene(job.session->PaintedSceneOfOwnBuffers(), gltf));
+  else
+    FRESCO_RETURN_IF_ERROR(SaveGltfTextures(job.session->PaintedSceneOfOwnBuffers(false), gltf));
   metrics["wall"] = WallJson(job, stats, SecondsSince(start), SecondsSince(writing));
   FRESCO_RETURN_IF_ERROR(WriteFileAtomic(outputs.path() + "/metrics.json", metrics.dump(2) + "\n"));
   return MoveFilesInto(outputs.path(), out_dir, {"metrics.json"});
@@ -535,7 +542,8 @@ int RunVerbRun(const CommandArgs& argv) {
   // painting; writing the outputs may raise it further (not in here: measure the process).
   metrics["peak_rss_mb"] = {{"setup", setup_peak_rss_mb}, {"painting", PeakRssMb()}};
   if (shard.sharded()) metrics["shard"] = ShardMetrics(project, *job, shard, stats);
-  if (Status s = WriteRunOutputs(out_dir, *job, stats, start, std::move(metrics)); !s.ok()) {
+  if (Status s = WriteRunOutputs(out_dir, *job, shard.index, stats, start, std::move(metrics));
+      !s.ok()) {
     return Fail(s);
   }
   if (project.pipeline.debug_images) {

@@ -1416,4 +1416,11 @@ Status SaveGltfScene(const Scene& scene, const std::string& path) {
   return WriteFileAtomic(path, root.dump(2) + "\n");
 }
 
+Status SaveGltfTextures(const Scene& scene, const std::string& path) {
+  const fs::path dir = fs::path(path).parent_path();
+  if (!dir.empty()) FRESCO_RETURN_IF_ERROR(MakeDirectories(dir.string()));
+  Json unused;
+  return WriteTextures(scene, path, SafeStem(fs::path(path).stem().string()), &unused);
+}
+
 }  // namespace fresco

@@ -9,10 +9,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -263,6 +265,11 @@ class MeshSceneBuilder {
     if (kept.empty()) return Status::Ok();
 
     TriangleMesh& out = scene_.mesh;
+    out.vertices.reserve(out.vertices.size() + mesh.mNumVertices);
+    out.triangles.reserve(out.triangles.size() + kept.size());
+    out.uvs.reserve(out.uvs.size() + kept.size());
+    out.material.reserve(out.material.size() + kept.size());
+    out.has_uv.reserve(out.has_uv.size() + kept.size());
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       if (new_index[v] < 0) continue;
       new_index[v] = static_cast<int>(out.vertices.size());
@@ -340,17 +347,129 @@ class MeshSceneBuilder {
   std::map<std::string, int> texture_of_;  // image path -> Scene::textures index or -1
 };
 
-}  // namespace
+// A plain binary little-endian PLY, the kind OpenMVS and COLMAP write (vertices with scalar
+// properties, float x, y, z among them; one face element of triangles, its only property a
+// list of 8-bit counts and 32-bit indices; no texture), read into the aiScene Assimp's PLY
+// reader makes of it: one mesh, the vertices and faces in the file's order. Without Assimp's
+// parsing of the header and of each value (a third of a run's set-up on a 175k-triangle
+// mesh). False for any other file (or one shorter than its header says): Assimp reads it.
+bool ReadPlainBinaryPly(const std::string& path, aiScene* ai) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || line != "ply") return false;
+  int vertex_bytes = 0, xyz_offset[3] = {-1, -1, -1};
+  unsigned long long num_vertices = 0, num_faces = 0;
+  int element = -1;  // 0 vertex, 1 face
+  bool format = false, face_list = false;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string keyword, a, b, c, d;
+    words >> keyword >> a;
+    if (keyword == "format") {
+      if (a != "binary_little_endian") return false;
+      format = true;
+    } else if (keyword == "comment") {
+      if (line.find("TextureFile") != std::string::npos) return false;
+    } else if (keyword == "element") {
+      words >> b;
+      const unsigned long long count = std::strtoull(b.c_str(), nullptr, 10);
+      if (a == "vertex" && element == -1) {
+        element = 0, num_vertices = count;
+      } else if (a == "face" && element == 0) {
+        element = 1, num_faces = count;
+      } else {
+        return false;
+      }
+    } else if (keyword == "property" && element == 0) {
+      words >> b;
+      const int size = PlyTypeSize(a);
+      if (size == 0 || a == "list") return false;
+      for (int k = 0; k < 3; ++k)
+        if (b == std::string(1, "xyz"[k])) {
+          if (a != "float" && a != "float32") return false;
+          xyz_offset[k] = vertex_bytes;
+        }
+      if (b == "u" || b == "v" || b == "s" || b == "t" || b.rfind("texture", 0) == 0) return false;
+      vertex_bytes += size;
+    } else if (keyword == "property" && element == 1) {
+      words >> b >> c >> d;
+      if (face_list || a != "list" || PlyTypeSize(b) != 1 || PlyTypeSize(c) != 4 ||
+          (c != "int" && c != "int32" && c != "uint" && c != "uint32") ||
+          (d != "vertex_indices" && d != "vertex_index"))
+        return false;
+      face_list = true;
+    } else if (keyword == "end_header") {
+      break;
+    } else if (keyword != "obj_info") {
+      return false;
+    }
+  }
+  if (!format || element != 1 || !face_list || xyz_offset[0] < 0 || xyz_offset[1] < 0 ||
+      xyz_offset[2] < 0 || num_faces == 0)
+    return false;
+  std::error_code ec;
+  const unsigned long long file_bytes = fs::file_size(path, ec);
+  const std::streamoff header = in.tellg();
+  if (ec || header < 0) return false;
+  // Every face a triangle: 13 bytes each.
+  const unsigned long long body = num_vertices * vertex_bytes + num_faces * 13;
+  if (num_vertices > (1ULL << 31) || num_faces > (1ULL << 31) ||
+      file_bytes != static_cast<unsigned long long>(header) + body)
+    return false;
+  std::string bytes(body, '\0');
+  if (!in.read(bytes.data(), static_cast<std::streamsize>(body))) return false;
+  const char* face_bytes = bytes.data() + num_vertices * vertex_bytes;
+  for (unsigned long long f = 0; f < num_faces; ++f)
+    if (static_cast<unsigned char>(face_bytes[13 * f]) != 3) return false;
+  auto mesh = std::make_unique<aiMesh>();
+  mesh->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  mesh->mNumVertices = static_cast<unsigned>(num_vertices);
+  mesh->mVertices = new aiVector3D[num_vertices];
+  for (unsigned long long v = 0; v < num_vertices; ++v) {
+    const char* vertex = bytes.data() + v * vertex_bytes;
+    float xyz[3];
+    for (int k = 0; k < 3; ++k) std::memcpy(&xyz[k], vertex + xyz_offset[k], sizeof(float));
+    mesh->mVertices[v] = aiVector3D(xyz[0], xyz[1], xyz[2]);
+  }
+  mesh->mNumFaces = static_cast<unsigned>(num_faces);
+  mesh->mFaces = new aiFace[num_faces];
+  for (unsigned long long f = 0; f < num_faces; ++f) {
+    aiFace& face = mesh->mFaces[f];
+    face.mNumIndices = 3;
+    face.mIndices = new unsigned[3];
+    std::memcpy(face.mIndices, face_bytes + 13 * f + 1, 3 * sizeof(unsigned));
+  }
+  ai->mNumMeshes = 1;
+  ai->mMeshes = new aiMesh*[1];
+  ai->mMeshes[0] = mesh.release();
+  return true;
+}
 
-Status LoadMeshScene(const std::string& path, const SceneLoadOptions& options, Scene* scene) {
+Status BuildMeshScene(const std::string& path, const SceneLoadOptions& options, const aiScene& ai,
+                      Scene* scene) {
+  Scene loaded;
+  loaded.source_path = path;
+  MeshSceneBuilder builder(path, options, ai, &loaded);
+  FRESCO_RETURN_IF_ERROR(builder.Build());
+  *scene = std::move(loaded);
+  return Status::Ok();
+}
+
+Status LoadMeshScene(const std::string& path, const SceneLoadOptions& options, bool through_assimp,
+                     Scene* scene) {
   if (!(options.min_triangle_area_m2 >= 0.0)) {
     return Status::Error(path + ": min_triangle_area_m2 must be >= 0");
   }
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) return Status::Error(path + ": file not found");
   const std::string ext = LowercaseExtension(path);
+  // A plain binary PLY is read here (its length checked exactly), any other through Assimp.
+  aiScene plain;
+  if (ext == ".ply" && !through_assimp && ReadPlainBinaryPly(path, &plain)) {
+    FRESCO_RETURN_IF_ERROR(CheckFaceIndices(path, plain));
+    return BuildMeshScene(path, options, plain, scene);
+  }
   if (ext == ".ply") FRESCO_RETURN_IF_ERROR(CheckPlyLength(path));
-
   // Face indices are checked before triangulation reads vertices through them (it crashed on
   // a truncated binary PLY before the length check). No other step: none that reorders faces,
   // welds vertices or changes coordinates.
@@ -364,12 +483,18 @@ Status LoadMeshScene(const std::string& path, const SceneLoadOptions& options, S
     return Status::Error(path + ": cannot read " + format + ": " +
                          OneLine(importer.GetErrorString()));
   }
-  Scene loaded;
-  loaded.source_path = path;
-  MeshSceneBuilder builder(path, options, *ai, &loaded);
-  FRESCO_RETURN_IF_ERROR(builder.Build());
-  *scene = std::move(loaded);
-  return Status::Ok();
+  return BuildMeshScene(path, options, *ai, scene);
+}
+
+}  // namespace
+
+Status LoadMeshScene(const std::string& path, const SceneLoadOptions& options, Scene* scene) {
+  return LoadMeshScene(path, options, /*through_assimp=*/false, scene);
+}
+
+Status LoadMeshSceneThroughAssimp(const std::string& path, const SceneLoadOptions& options,
+                                  Scene* scene) {
+  return LoadMeshScene(path, options, /*through_assimp=*/true, scene);
 }
 
 Status LoadScene(const std::string& path, const SceneLoadOptions& options, Scene* scene) {

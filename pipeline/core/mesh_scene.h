@@ -31,5 +31,10 @@ namespace fresco {
 //   decoded to RGBA8; a texture that cannot be read is a warning and its triangles use the
 //   default material.
 Status LoadMeshScene(const std::string& path, const SceneLoadOptions& options, Scene* scene);
+// A plain binary PLY (little-endian, float x, y, z, triangles with 8-bit counts and 32-bit
+// indices, no texture: what OpenMVS writes) is read without Assimp, into what Assimp reads of
+// it. This reads every file through Assimp (tests compare the two).
+Status LoadMeshSceneThroughAssimp(const std::string& path, const SceneLoadOptions& options,
+                                  Scene* scene);
 
 }  // namespace fresco

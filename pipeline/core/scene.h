@@ -142,5 +142,8 @@ Status ParseGltfScene(const std::string& bytes, const std::string& path,
 // Errors: a scene that cannot be saved (not finite, indices out of range) is internal, a
 // failed write is output.
 Status SaveGltfScene(const Scene& scene, const std::string& path);
+// Only the PNG files SaveGltfScene(scene, path) writes beside `path` (the same names and bytes),
+// no .gltf or .bin: e.g. the pages of a shard's part whose glTF another part holds.
+Status SaveGltfTextures(const Scene& scene, const std::string& path);
 
 }  // namespace fresco

@@ -476,7 +476,9 @@ static Scene UnpaintedCopy(const Scene& scene) {
 
 Scene PaintSession::PaintedScene() const { return PaintedScene(false); }
 
-Scene PaintSession::PaintedSceneOfOwnBuffers() const { return PaintedScene(true); }
+Scene PaintSession::PaintedSceneOfOwnBuffers(bool geometry) const {
+  return PaintedScene(true, geometry);
+}
 
 Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra) const {
   return PaintedScene(buffer_bgra, false);
@@ -489,11 +491,11 @@ cv::Mat PaintSession::PageImage(int page, const std::vector<cv::Mat>& images, bo
   return ComposeAtlasStrip(atlas_, page, images, own);
 }
 
-Scene PaintSession::PaintedScene(bool own_only) const {
+Scene PaintSession::PaintedScene(bool own_only, bool geometry) const {
   std::vector<cv::Mat> images(painted_.size());
   for (size_t b = 0; b < painted_.size(); ++b)
     if (!own_only || own_.empty() || own_[b]) images[b] = AtMeanExposure(painted_[b].bgra);
-  Scene scene = PaintedScene(images, own_only);
+  Scene scene = PaintedScene(images, own_only, geometry);
   // Each layer's pages after the base pages; material page + 1 shows page `page`.
   for (const ViewLayer& layer : layers_) {
     ViewLayerTextures textures;
@@ -508,7 +510,7 @@ Scene PaintSession::PaintedScene(bool own_only) const {
       cv::cvtColor(PageImage(static_cast<int>(page), images, own_only), texture.rgba,
                    cv::COLOR_BGRA2RGBA);
       texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
-      textures.material_texture[page + 1] = static_cast<int>(scene.textures.size());
+      if (geometry) textures.material_texture[page + 1] = static_cast<int>(scene.textures.size());
       scene.textures.push_back(std::move(texture));
     }
     scene.view_layers.push_back(std::move(textures));
@@ -516,8 +518,10 @@ Scene PaintSession::PaintedScene(bool own_only) const {
   return scene;
 }
 
-Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const {
-  Scene out = UnpaintedCopy(*scene_);
+Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only,
+                                 bool geometry) const {
+  Scene out;
+  if (geometry) out = UnpaintedCopy(*scene_);
   const TriangleMesh& mesh = scene_->mesh;
   for (size_t page = 0; page < atlas_.pages.size(); ++page) {
     Texture texture;
@@ -526,12 +530,13 @@ Scene PaintSession::PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool o
                  cv::COLOR_BGRA2RGBA);
     texture.wrap_s = texture.wrap_t = TextureWrap::kClampToEdge;
     out.textures.push_back(texture);
+    if (!geometry) continue;
     Material material;
     material.name = texture.name;
     material.base_color_texture = static_cast<int>(page);
     out.materials.push_back(material);
   }
-  for (size_t b = 0; b < set_.buffers.size(); ++b) {
+  for (size_t b = 0; geometry && b < set_.buffers.size(); ++b) {
     const BaseBuffer& buffer = set_.buffers[b];
     const AtlasPlacement& place = atlas_.placements[b];
     if (place.page < 0) continue;

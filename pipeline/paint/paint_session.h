@@ -146,7 +146,9 @@ class PaintSession {
   // PaintedScene() as a shard's part holds it (SetOwnBuffers): each texture holds, instead of
   // its page, the own buffers' padded placements on that page (ComposeAtlasStrip), which
   // `fresco merge` puts back in place; the rest (mesh, UVs, materials) as PaintedScene()'s.
-  Scene PaintedSceneOfOwnBuffers() const;
+  // Without `geometry` only the textures (the mesh empty, no materials): the pages of a part
+  // whose glTF another part writes.
+  Scene PaintedSceneOfOwnBuffers(bool geometry = true) const;
   const TextureAtlas& atlas() const { return atlas_; }
   // The view-dependent layers (pipeline.layers; view_layers.h) as they are painted; in
   // PaintedScene() they follow the base pages as textures of their own (Scene::view_layers).
@@ -266,9 +268,11 @@ class PaintSession {
 
  private:
   void KeepSharpestViews(const char* why);
-  // PaintedScene(), its pages whole or (own_only) the own buffers' placements only.
-  Scene PaintedScene(bool own_only) const;
-  Scene PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only) const;
+  // PaintedScene(), its pages whole or (own_only) the own buffers' placements only; without
+  // `geometry` only its textures.
+  Scene PaintedScene(bool own_only, bool geometry = true) const;
+  Scene PaintedScene(const std::vector<cv::Mat>& buffer_bgra, bool own_only,
+                     bool geometry = true) const;
   cv::Mat PageImage(int page, const std::vector<cv::Mat>& images,
                     bool own_only) const;  // DecideUpdate: `quality`, for the reason given
   PaintSession() = default;

@@ -41,6 +41,8 @@ Status CheckFieldsMergeReads(const std::string& path, const Json& m) {
   const Json& shard = *Member(m, "shard");
   for (const char* key : {"index", "count"})
     if (!is_count(Member(shard, key))) return wrong(std::string("shard.") + key, "a count");
+  const Json* layout = Member(shard, "layout");
+  if (!layout || !layout->is_string()) return wrong("shard.layout", "a string");
   const Json* rects = Member(shard, "page_rects");
   if (!rects || !rects->is_array()) return wrong("shard.page_rects", "an array");
   for (size_t k = 0; k < rects->size(); ++k) {
@@ -146,25 +148,28 @@ bool IsTexture(const std::string& name) {
   return name.size() > 4 && name.compare(name.size() - 4, 4, ".png") == 0;
 }
 
-// The files every part must hold alike (painted.gltf, its .bin: the layout), checked.
+// Every part of one layout: the same fingerprint of it (shard.layout, LayoutDigest) and the
+// same pages; shard 0's part holds the glTF and its .bin, which the others do not write.
 Status CheckSameLayout(const std::vector<Part>& parts) {
   const Part& first = parts.front();
-  std::map<std::string, std::string> contents;
-  for (const std::string& name : first.files) {
-    if (IsTexture(name)) continue;
-    FRESCO_RETURN_IF_ERROR(ReadFileToString(first.dir + "/" + name, &contents[name]));
-  }
+  const auto pages = [](const Part& part) {
+    std::vector<std::string> names;
+    for (const std::string& name : part.files)
+      if (IsTexture(name)) names.push_back(name);
+    return names;
+  };
+  const std::vector<std::string> first_pages = pages(first);
+  if (std::find(first.files.begin(), first.files.end(), "painted.gltf") == first.files.end())
+    return Status::Error(first.dir + ": no painted.gltf (shard 0's part holds it)");
   for (const Part& part : parts) {
-    if (part.files != first.files)
-      return Status::Error(part.dir + ": holds other files than " + first.dir +
+    const Json& layout = part.metrics["shard"]["layout"];
+    if (layout != first.metrics["shard"]["layout"])
+      return Status::Error(part.dir + "/metrics.json: shard.layout: " + layout.dump() + ", but " +
+                           first.dir + " has " + first.metrics["shard"]["layout"].dump() +
+                           " (not parts of one layout)");
+    if (pages(part) != first_pages)
+      return Status::Error(part.dir + ": holds other pages than " + first.dir +
                            " (not parts of one run)");
-    for (const auto& [name, text] : contents) {
-      std::string other;
-      FRESCO_RETURN_IF_ERROR(ReadFileToString(part.dir + "/" + name, &other));
-      if (other != text)
-        return Status::Error(part.dir + "/" + name + ": differs from " + first.dir + "/" + name +
-                             " (not parts of one layout)");
-    }
   }
   return Status::Ok();
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <numeric>
 
@@ -39,6 +40,38 @@ std::string SettingsHash(const Project& project) {
   const std::string fingerprint = ProjectToJsonText(project);
   unsigned long long hash = 1469598103934665603ULL;  // FNV-1a
   for (unsigned char c : fingerprint) hash = (hash ^ c) * 1099511628211ULL;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", hash);
+  return hex;
+}
+
+std::string LayoutDigest(const Scene& scene, const std::vector<BaseBuffer>& buffers,
+                         const TextureAtlas& atlas) {
+  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a over 64-bit words
+  const auto add = [&hash](auto value) {
+    unsigned long long word = 0;
+    static_assert(sizeof(value) <= sizeof(word));
+    std::memcpy(&word, &value, sizeof(value));
+    hash = (hash ^ word) * 1099511628211ULL;
+  };
+  const auto add_vector = [&add](const Eigen::Vector3d& v) { add(v.x()), add(v.y()), add(v.z()); };
+  const TriangleMesh& mesh = scene.mesh;
+  add(mesh.vertices.size()), add(mesh.triangles.size());
+  add_vector(scene.origin_in_world);
+  for (const Eigen::Vector3d& v : mesh.vertices) add_vector(v);
+  for (const Eigen::Vector3i& t : mesh.triangles) add(t.x()), add(t.y()), add(t.z());
+  add(atlas.pages.size());
+  for (const cv::Size& page : atlas.pages) add(page.width), add(page.height);
+  add(buffers.size());
+  for (size_t b = 0; b < buffers.size(); ++b) {
+    const BaseBuffer& buffer = buffers[b];
+    const AtlasPlacement place =
+        b < atlas.placements.size() ? atlas.placements[b] : AtlasPlacement();
+    add(place.page), add(place.x), add(place.y);
+    add_vector(buffer.origin), add_vector(buffer.axis_u), add_vector(buffer.axis_v);
+    add(buffer.texel_size_m), add(buffer.triangles.size());
+    for (int t : buffer.triangles) add(t);
+  }
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", hash);
   return hex;

@@ -15,8 +15,10 @@
 #include <vector>
 
 #include "pipeline/core/project.h"
+#include "pipeline/core/scene.h"
 #include "pipeline/core/status.h"
 #include "pipeline/paint/base_buffer.h"
+#include "pipeline/paint/texture_atlas.h"
 
 namespace fresco {
 
@@ -32,6 +34,13 @@ Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpe
 // A fingerprint of the project and its settings (16 hex digits, FNV-1a of its JSON text): parts
 // and pre-pass files made for one project and settings carry the same.
 std::string SettingsHash(const Project& project);
+
+// A fingerprint of what a painted glTF's geometry is made of (16 hex digits): the scene's mesh
+// and origin, and each buffer's triangles, texel frame and place in the atlas (so its UVs).
+// Parts that hold the same write the same painted.gltf and .bin: only shard 0's part holds
+// them, and `fresco merge` checks the others' fingerprint against it.
+std::string LayoutDigest(const Scene& scene, const std::vector<BaseBuffer>& buffers,
+                         const TextureAtlas& atlas);
 
 // Which views (poses of the capture, a sample of them) see each buffer (its bounds in their
 // view): seen[b] holds one bit per view, (num_views + 63) / 64 words; each view stands for

@@ -457,6 +457,69 @@ TEST(MeshSceneTest, RealSceauxMeshesLoadWithEveryFace) {
   }
 }
 
+// The two scenes alike in everything LoadMeshScene fills.
+void ExpectSameScene(const Scene& a, const Scene& b, const std::string& what) {
+  EXPECT_EQ(a.mesh.vertices, b.mesh.vertices) << what;
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << what;
+  EXPECT_EQ(a.mesh.material, b.mesh.material) << what;
+  EXPECT_EQ(a.mesh.has_uv, b.mesh.has_uv) << what;
+  ASSERT_EQ(a.mesh.uvs.size(), b.mesh.uvs.size()) << what;
+  for (size_t t = 0; t < a.mesh.uvs.size(); ++t)
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(a.mesh.uvs[t][k], b.mesh.uvs[t][k]) << what << " " << t;
+  EXPECT_EQ(a.origin_in_world, b.origin_in_world) << what;
+  EXPECT_EQ(a.materials.size(), b.materials.size()) << what;
+  EXPECT_EQ(a.dropped_degenerate, b.dropped_degenerate) << what;
+  EXPECT_EQ(a.skipped_primitives, b.skipped_primitives) << what;
+}
+
+// A plain binary PLY (OpenMVS's kind) is read without Assimp into exactly the scene Assimp
+// gives: the real Sceaux meshes, and a cube with more vertex properties (normals, colours, a
+// double), an unused vertex and a degenerate triangle. A file of another kind (a polygon, a
+// texture) goes through Assimp as before; a truncated one is still refused, naming where.
+TEST(MeshSceneTest, PlainBinaryPlyIsReadAsAssimpReadsIt) {
+  const std::string dir = MakeTempDir("mesh-scene-plain-ply");
+  FileMesh cube = Cube(Eigen::Vector3d(3.5, -2.25, 1));
+  cube.vertices.push_back(Eigen::Vector3d(9, 9, 9));  // used by no face
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\ncomment OpenMVS\nelement vertex " +
+      std::to_string(cube.vertices.size()) +
+      "\nproperty double confidence\nproperty float x\nproperty float y\nproperty float z\n"
+      "property float nx\nproperty float ny\nproperty float nz\nproperty uchar red\n"
+      "property uchar green\nproperty uchar blue\nelement face " +
+      std::to_string(cube.faces.size()) +
+      "\nproperty list uint8 uint32 vertex_indices\nend_header\n";
+  for (size_t v = 0; v < cube.vertices.size(); ++v) {
+    Append(&ply, 0.25 * v);
+    for (int k = 0; k < 3; ++k) Append(&ply, static_cast<float>(cube.vertices[v][k]));
+    for (int k = 0; k < 3; ++k) Append(&ply, 0.5f);
+    for (int k = 0; k < 3; ++k) Append(&ply, static_cast<uint8_t>(40 * k + v));
+  }
+  for (const auto& face : cube.faces) {
+    Append(&ply, static_cast<uint8_t>(3));
+    for (int v : face) Append(&ply, static_cast<uint32_t>(v));
+  }
+  std::vector<std::string> files = {dir + "/extra.ply"};
+  WriteText(files.back(), ply);
+  files.push_back(dir + "/plain.ply");
+  WriteText(files.back(), BinaryPly(Cube(Eigen::Vector3d(0, 0, 0))));
+  FileMesh polygon = Cube(Eigen::Vector3d(0, 0, 0));
+  polygon.faces.push_back({0, 1, 3, 2});
+  files.push_back(dir + "/polygon.ply");
+  WriteText(files.back(), BinaryPly(polygon));
+  const std::string shared = SharedDataDir() + "/sceaux-castle-openmvs/openmvs_original";
+  for (const char* name : {"scene_mesh_refine.ply", "scene_mesh.ply"})
+    if (fs::exists(shared + "/" + name)) files.push_back(shared + "/" + name);
+  for (const std::string& file : files) {
+    Scene plain, assimp;
+    ASSERT_TRUE(LoadMeshScene(file, SceneLoadOptions(), &plain).ok()) << file;
+    ASSERT_TRUE(LoadMeshSceneThroughAssimp(file, SceneLoadOptions(), &assimp).ok()) << file;
+    EXPECT_GT(plain.mesh.NumTriangles(), 0) << file;
+    ExpectSameScene(plain, assimp, file);
+  }
+  WriteText(dir + "/short.ply", ply.substr(0, ply.size() - 5));
+  EXPECT_THAT(LoadError(dir + "/short.ply"), HasSubstr("truncated PLY: it ends in face 12"));
+}
+
 // ----------------------------------------------------------------------------------------
 // `fresco run` on a project whose scene is a PLY
 

@@ -218,6 +218,11 @@ TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
   json rect = Metrics(work + "/typed-rect");
   rect["shard"]["page_rects"] = json::array({json::array({0, 1, "x", 3, 4})});
   WriteText(work + "/typed-rect/metrics.json", rect.dump());
+  // A part of another layout (the glTF, which only shard 0's part holds, would differ).
+  fs::copy(work + "/p1", work + "/moved", fs::copy_options::recursive);
+  json moved = Metrics(work + "/moved");
+  moved["shard"]["layout"] = "0123456789abcdef";
+  WriteText(work + "/moved/metrics.json", moved.dump());
   const std::string out = work + "/merged";
   struct Case {
     std::vector<std::string> parts;
@@ -231,6 +236,7 @@ TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
       {{work + "/p0", work + "/none"}, "none: not a folder"},
       {{work + "/p0", work + "/typed"},
        "typed/metrics.json: frames_painted: missing or not a count"},
+      {{work + "/p0", work + "/moved"}, "moved/metrics.json: shard.layout"},
       {{work + "/p0", work + "/typed-rect"},
        "typed-rect/metrics.json: shard.page_rects[0]: missing or not 5 counts"},
   };
@@ -247,6 +253,10 @@ TEST(ShardMerge, MergeRefusesMissingRepeatedAndMixedParts) {
       RunFresco({"merge", work + "/p1", work + "/p0", "--out", out, "--quiet"});
   EXPECT_EQ(ok.exit_code, 0) << ok.err;
   EXPECT_TRUE(ReadText(out + "/painted_texture0.png") == ReadText(work + "/whole/painted_texture0.png"));
+  // Only shard 0's part holds the glTF and its .bin; the merge takes them from there.
+  EXPECT_TRUE(fs::exists(work + "/p0/painted.gltf") && fs::exists(work + "/p0/painted.bin"));
+  EXPECT_FALSE(fs::exists(work + "/p1/painted.gltf") || fs::exists(work + "/p1/painted.bin"));
+  EXPECT_TRUE(ReadText(out + "/painted.bin") == ReadText(work + "/whole/painted.bin"));
 }
 
 }  // namespace
