@@ -108,15 +108,18 @@ TEST(StateMessages, TheCalibrationLightIsNotGreenBeforeTheOneCameraCheck) {
 
 // The progress the joint pose adjustment publishes while the capture's project opens with
 // it on, first to last.
-std::vector<std::shared_ptr<RunnerSnapshot>> AdjustingPoses() {
+// `first_at` (optional): when the first of them was published.
+std::vector<std::shared_ptr<RunnerSnapshot>> AdjustingPoses(
+    std::chrono::steady_clock::time_point* first_at = nullptr) {
   std::mutex mutex;
   std::vector<std::shared_ptr<RunnerSnapshot>> published;
   RunnerOptions options;
   options.publish_interval_ms = 0;
   options.on_publish = [&](const RunnerSnapshot& s) {
     std::lock_guard<std::mutex> lock(mutex);
-    if (s.status.rfind("adjusting poses ", 0) == 0)
-      published.push_back(std::make_shared<RunnerSnapshot>(s));
+    if (s.status.rfind("adjusting poses ", 0) != 0) return;
+    if (published.empty() && first_at) *first_at = std::chrono::steady_clock::now();
+    published.push_back(std::make_shared<RunnerSnapshot>(s));
   };
   AppState state;
   EXPECT_TRUE(state.Open(testing::Capture() + "/project.json").ok());
@@ -136,8 +139,8 @@ std::vector<std::shared_ptr<RunnerSnapshot>> AdjustingPoses() {
 // street under load the joint pose adjustment stood at "adjusting poses 120/246, 8 s elapsed,
 // about 8 s left" for 34 s between its two passes, as if the app had hung.
 TEST(StateMessages, AQuietStepOfOpeningKeepsCountingItsTime) {
-  const auto published = std::chrono::steady_clock::now();
-  const auto adjusting = AdjustingPoses().front();
+  auto published = std::chrono::steady_clock::now();
+  const auto adjusting = AdjustingPoses(&published).front();
   const std::string stem = adjusting->status.substr(0, adjusting->status.find(','));
   // The worker says nothing more for 3 s (as if the step were still under way).
   HeadlessApp app(testing::Capture() + "/project.json", 0);
