@@ -172,7 +172,10 @@ std::string DescribeProjectChange(const Project& before, const Project& after,
 }
 
 void AppState::RememberFolderOf(const std::string& file) {
-  last_folder = std::filesystem::path(file).lexically_normal().parent_path().string();
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(file, ec);
+  last_folder =
+      (ec ? std::filesystem::path(file) : absolute).lexically_normal().parent_path().string();
   if (last_folder.empty() || last_folder.back() != '/') last_folder += '/';
 }
 
