@@ -431,14 +431,12 @@ void PrintJobSummary(const PaintJob& job, size_t streams) {
                    a.inliers, a.rms_before_px, a.rms_after_px, a.median_rotation_deg,
                    1000 * a.median_translation_m, a.seconds);
   }
-  const AutoDecision& background = session->auto_decisions().background;
-  if (background.basis == "too_few_frames")
-    std::fprintf(stderr, "fresco run: background %s\n", background.Describe().c_str());
-  else if (job.mover_masks && !job.mover_masks->not_run.empty())
+  if (job.mover_masks && !job.mover_masks->not_run.empty())
     std::fprintf(stderr, "fresco run: background decided frame by frame: %s\n",
                  job.mover_masks->not_run.c_str());
   else if (job.mover_masks)
-    std::fprintf(stderr, "fresco run: background %s (%.1f s)\n", background.Describe().c_str(),
+    std::fprintf(stderr, "fresco run: background %s (%.1f s)\n",
+                 session->auto_decisions().background.Describe().c_str(),
                  job.mover_masks->seconds);
 }
 

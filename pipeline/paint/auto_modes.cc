@@ -43,11 +43,6 @@ std::string AutoDecision::Describe() const {
                   "corrections agree %.2f times better with the corrected frames (%.2f needed; "
                   "%d frames; decided at frame %d)",
                   evidence, threshold, frames_measured, decided_at_frame);
-  else if (basis == "too_few_frames")
-    std::snprintf(line, sizeof line,
-                  "off: %.0f frames, too few to train a background model (%.0f or more: twice "
-                  "its warm-up; decided before painting)",
-                  evidence, threshold);
   else if (basis == "across_views")
     std::snprintf(line, sizeof line,
                   "%s: %.3g %s %.3g of the pixels of %d frames differ from the frames near them "
@@ -166,16 +161,6 @@ void BackgroundAutoDecider::DecideAcrossViews(double fraction, int frames) {
   decision_.decided_at_frame = 0;
   decision_.state =
       fraction > decision_.threshold ? AutoDecision::State::kOn : AutoDecision::State::kOff;
-}
-
-void BackgroundAutoDecider::DecideTooFewFrames(int expected_frames) {
-  if (!deciding()) return;
-  decision_.basis = "too_few_frames";
-  decision_.threshold = kBackgroundAutoMinWarmups * warmup_frames_;
-  decision_.evidence = expected_frames;
-  decision_.frames_measured = 0;
-  decision_.decided_at_frame = 0;
-  decision_.state = AutoDecision::State::kOff;
 }
 
 bool BackgroundAutoDecider::AddFrame(int frame_number, long long observed, long long warming,

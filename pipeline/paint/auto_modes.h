@@ -57,17 +57,6 @@ constexpr double kBackgroundAcrossViewsThreshold = 0.004;
 constexpr int kBackgroundAutoFrames = 8;
 constexpr int kBackgroundAutoMaxFrames = 60;
 
-// A capture of fewer posed frames than this many times the model's warm-up (`warmup_frames`)
-// cannot train it: most texels are seen fewer times than it needs to learn them and then judge
-// (the castle's 10 photos, warm-up 8: 78 % of the texels still warming after the last one, and
-// the frames held out agree 3 dB better without it). Background `auto` decides `off` before
-// painting there, without looking for movers (basis "too_few_frames"). The evaluation suites'
-// captures have 30 frames or more.
-constexpr int kBackgroundAutoMinWarmups = 2;
-inline bool TooFewFramesForBackgroundModel(int expected_frames, int warmup_frames) {
-  return expected_frames > 0 && expected_frames < kBackgroundAutoMinWarmups * warmup_frames;
-}
-
 // {"refine": D, "background": D, "update": D} as JSON text (the update's decision
 // "mean" or "quality"), D = {"decision", "evidence", "threshold",
 // "frames_measured", "decided_at_frame"} or null when that mode is not auto (metrics.json,
@@ -114,10 +103,6 @@ class BackgroundAutoDecider {
   // Decides before the first frame from the movers found across views: `fraction` of the
   // pixels judged over `frames` frames masked.
   void DecideAcrossViews(double fraction, int frames);
-  // Decides off before the first frame: the capture promises `expected_frames`, too few to
-  // train the model (TooFewFramesForBackgroundModel); evidence those frames, threshold the
-  // fewest that can.
-  void DecideTooFewFrames(int expected_frames);
   // Off, whatever was decided, because the frames held out agree better with the mean of
   // every view painted without the model (`gain_db` more PSNR; PaintSession::DecideUpdate).
   void OffByFramesHeldOut(int frame_number, double gain_db, int frames);

@@ -172,11 +172,6 @@ void PaintSession::StartAutoModes() {
   options_.background.mode = background_auto ? BackgroundMode::kRobust : requested_background_;
   refine_auto_.Start(refine_auto);
   background_auto_.Start(background_auto, options_.background.warmup_frames, expected_frames_);
-  if (background_auto &&
-      TooFewFramesForBackgroundModel(expected_frames_, options_.background.warmup_frames)) {
-    background_auto_.DecideTooFewFrames(expected_frames_);
-    options_.background.mode = BackgroundMode::kOff;
-  }
   if (background_auto && background_across_views_.second >= 0) {
     background_auto_.DecideAcrossViews(background_across_views_.first,
                                        background_across_views_.second);

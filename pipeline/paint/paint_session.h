@@ -423,8 +423,6 @@ class PaintSession {
 // least 2): a capture of a few photos would otherwise never end its warm-up, every texel
 // would stay provisional and the latest photo would win everywhere.
 int EffectiveWarmupFrames(const PaintSessionInputs& inputs);
-// The same for `pipeline` and the posed frames a single stream promises (0: unknown).
-int EffectiveWarmupFrames(const PipelineOptions& pipeline, int expected_frames);
 
 // The automatic texel size: the median depth the cameras see (rasterized at a few of the
 // poses) / focal length, i.e. about one texel per pixel at the typical distance. Buffers

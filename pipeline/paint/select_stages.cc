@@ -52,13 +52,10 @@ bool SelectActive(const PipelineOptions& options) {
 }
 
 int EffectiveWarmupFrames(const PaintSessionInputs& inputs) {
-  return EffectiveWarmupFrames(inputs.pipeline, static_cast<int>(inputs.expected_poses.size()));
-}
-
-int EffectiveWarmupFrames(const PipelineOptions& pipeline, int expected_frames) {
-  const int warmup = pipeline.background.warmup_frames;
-  if (!SelectActive(pipeline) || expected_frames == 0) return warmup;
-  return std::min(warmup, std::max(2, expected_frames / 3));
+  const int warmup = inputs.pipeline.background.warmup_frames;
+  const int frames = static_cast<int>(inputs.expected_poses.size());
+  if (!SelectActive(inputs.pipeline) || frames == 0) return warmup;
+  return std::min(warmup, std::max(2, frames / 3));
 }
 
 cv::Mat PaintSession::AtMeanExposure(const cv::Mat& bgra) const {

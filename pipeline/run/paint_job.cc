@@ -13,11 +13,9 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "pipeline/paint/auto_modes.h"
 #include "pipeline/paint/joint_pose_adjustment.h"
 #include "pipeline/paint/mover_masks.h"
 #include "pipeline/paint/open_project.h"
-#include "pipeline/paint/paint_session.h"
 #include "pipeline/render/renderer.h"
 #include "pipeline/run/file_frame_source.h"
 #include "pipeline/run/live_frame_source.h"
@@ -28,12 +26,6 @@
 namespace fresco {
 
 namespace {
-
-// The posed frames a stream promises painting (as PaintSession counts them).
-int ExpectedFrames(const Project& project, const Capture& capture) {
-  const int posed = static_cast<int>(capture.poses.size());
-  return project.pipeline.max_frames > 0 ? std::min(posed, project.pipeline.max_frames) : posed;
-}
 
 // The most the pre-pass keeps of the frames it decoded, for painting to take (bytes; 98
 // frames of 640 x 480 are 90 MB).
@@ -111,18 +103,7 @@ Status RunWholeCapturePrepass(const Project& project, const PaintJobOptions& opt
                               PrepassFound* found) {
   j->prepass.ran = true;
   const bool joint = project.pipeline.refine.joint;
-  // Background auto on a capture too short to train the model decides off without them.
-  const int expected = j->captures.size() == 1 ? ExpectedFrames(project, j->captures[0]) : 0;
-  const bool too_few =
-      project.pipeline.background.mode == BackgroundMode::kAuto &&
-      TooFewFramesForBackgroundModel(expected, EffectiveWarmupFrames(project.pipeline, expected));
-  const bool movers = NeedsMoversAcrossViews(project.pipeline.background) && !too_few;
-  if (too_few) {
-    j->mover_masks = MoverMaskResult();
-    j->mover_masks->not_run = std::to_string(expected) +
-                              " posed frames: too few to train a background model (background "
-                              "auto decides off before painting)";
-  }
+  const bool movers = NeedsMoversAcrossViews(project.pipeline.background);
   PoseAdjustOptions adjust_options;
   adjust_options.progress = options.joint_progress;
   MoverMaskOptions mover_options = MoverMaskOptionsFor(project.pipeline.background);

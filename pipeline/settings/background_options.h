@@ -113,8 +113,7 @@ void Fields(BackgroundOptions& o, V& v) {
          "files decide before painting (every frame compared with the frames near it through "
          "the mesh: more than 0.4 % of the pixels differing from most of them in regions, not "
          "lines along the image's edges, which blur, a pose slightly off or the mesh's error "
-         "make; `off` without comparing when there are fewer frames than twice `warmup_frames`, "
-         "too few to train the model); the app and "
+         "make); the app and "
          "live captures decide once warmed up (`robust` learns from the start and stays when "
          "the texels it trusts show enough foreground). The decision and its evidence are in "
          "the background stage's report and `metrics.json`");

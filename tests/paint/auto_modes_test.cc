@@ -177,45 +177,6 @@ TEST(AutoBackground, CapturesFromFilesDecideBeforePaintingFromMoversAcrossViews)
   EXPECT_TRUE(as_off);
 }
 
-// A capture of fewer frames than twice the model's warm-up (8) cannot train it, movers or not:
-// `auto` decides off before the first frame and paints what `off` paints; at twice the
-// warm-up it decides as before.
-TEST(AutoBackground, ACaptureTooShortToTrainTheModelDecidesOffBeforePainting) {
-  const Scene scene = RoomScene();
-  SynthCapture capture;
-  ASSERT_TRUE(SynthesizeCapture(scene, RoomCaptureWithMovers(15, 0.0), &capture).ok());
-  PipelineOptions options;
-  options.refine.mode = RefineMode::kOff;
-  options.background.mode = BackgroundMode::kAuto;
-  std::unique_ptr<PaintSession> session = SessionForCapture(scene, capture, options);
-  const AutoDecision decided = session->auto_decisions().background;
-  EXPECT_EQ(decided.state, State::kOff);
-  EXPECT_EQ(decided.basis, "too_few_frames");
-  EXPECT_EQ(decided.evidence, 15);
-  EXPECT_EQ(decided.threshold, 16);
-  EXPECT_EQ(decided.decided_at_frame, 0);
-  EXPECT_EQ(session->options().background.mode, BackgroundMode::kOff);
-  // The movers found across views do not turn it on again.
-  session->DecideBackgroundAcrossViews(0.05, 15);
-  EXPECT_EQ(session->auto_decisions().background.basis, "too_few_frames");
-  FrameReport report;
-  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
-    PaintCaptureFrame(session.get(), capture, i, &report);
-  EXPECT_EQ(report.decisions.background.state, State::kOff);
-  options.background.mode = BackgroundMode::kOff;
-  std::unique_ptr<PaintSession> off = SessionForCapture(scene, capture, options);
-  for (size_t i = 0; i < capture.frames_bgr.size(); ++i)
-    PaintCaptureFrame(off.get(), capture, i, &report);
-  EXPECT_TRUE(SameBuffers(*session, *off));
-
-  SynthCapture sixteen;
-  ASSERT_TRUE(SynthesizeCapture(scene, RoomCaptureWithMovers(16, 0.0), &sixteen).ok());
-  options.background.mode = BackgroundMode::kAuto;
-  EXPECT_EQ(SessionForCapture(scene, sixteen, options)->auto_decisions().background.state,
-            State::kDeciding);
-  EXPECT_FALSE(TooFewFramesForBackgroundModel(0, 8));  // frames unknown (live): decided later
-}
-
 // Background and update `auto`, refinement off.
 PipelineOptions ModelAndUpdateAuto() {
   PipelineOptions options;
