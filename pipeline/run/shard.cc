@@ -36,23 +36,35 @@ Status ParseShardSpec(const std::string& text, const std::string& what, ShardSpe
   return Status::Ok();
 }
 
+namespace {
+
+// FNV-1a, fed bytes or 64-bit words; its value as 16 hex digits.
+struct Fnv1a {
+  unsigned long long hash = 1469598103934665603ULL;
+  void Add(unsigned long long value) { hash = (hash ^ value) * 1099511628211ULL; }
+  std::string Hex() const {
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", hash);
+    return hex;
+  }
+};
+
+}  // namespace
+
 std::string SettingsHash(const Project& project) {
-  const std::string fingerprint = ProjectToJsonText(project);
-  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a
-  for (unsigned char c : fingerprint) hash = (hash ^ c) * 1099511628211ULL;
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", hash);
-  return hex;
+  Fnv1a fnv;
+  for (unsigned char c : ProjectToJsonText(project)) fnv.Add(c);
+  return fnv.Hex();
 }
 
 std::string LayoutDigest(const Scene& scene, const std::vector<BaseBuffer>& buffers,
                          const TextureAtlas& atlas) {
-  unsigned long long hash = 1469598103934665603ULL;  // FNV-1a over 64-bit words
-  const auto add = [&hash](auto value) {
+  Fnv1a fnv;  // over 64-bit words
+  const auto add = [&fnv](auto value) {
     unsigned long long word = 0;
     static_assert(sizeof(value) <= sizeof(word));
     std::memcpy(&word, &value, sizeof(value));
-    hash = (hash ^ word) * 1099511628211ULL;
+    fnv.Add(word);
   };
   const auto add_vector = [&add](const Eigen::Vector3d& v) { add(v.x()), add(v.y()), add(v.z()); };
   const TriangleMesh& mesh = scene.mesh;
@@ -72,9 +84,7 @@ std::string LayoutDigest(const Scene& scene, const std::vector<BaseBuffer>& buff
     add(buffer.texel_size_m), add(buffer.triangles.size());
     for (int t : buffer.triangles) add(t);
   }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", hash);
-  return hex;
+  return fnv.Hex();
 }
 
 void BufferViews::Mark(size_t buffers, size_t b, int v) {

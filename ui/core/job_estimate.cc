@@ -28,9 +28,9 @@ double RemainingSeconds(double elapsed_s, double fraction) {
 std::string ElapsedAndRemainingText(double elapsed_s, double fraction) {
   std::string text = DurationText(elapsed_s) + " elapsed";
   const double remaining = RemainingSeconds(elapsed_s, fraction);
-  // At the end (or under half a second from it) "about 0 s left" would stand while what
-  // follows the last step runs: the job is finishing.
-  if (remaining >= 0.5)
+  // At the end "about 0 s left" would stand while what follows the last step runs: the job
+  // is finishing.
+  if (remaining >= kFinishingBelowSeconds)
     text += ", about " + DurationText(remaining) + " left";
   else if (remaining >= 0)
     text += ", finishing";

@@ -15,9 +15,12 @@ std::string DurationText(double seconds);
 // -1 when it cannot be told yet (under 1 % done or under a second elapsed).
 double RemainingSeconds(double elapsed_s, double fraction);
 
+// Under this many seconds left a job is finishing: no estimate is shown (never "about 0 s
+// left").
+inline constexpr double kFinishingBelowSeconds = 0.5;
+
 // "1:23 elapsed, about 2:10 left"; "1:23 elapsed, finishing" at the end (all done, or under
-// half a second left: never "about 0 s left"); "1:23 elapsed" when the remaining time cannot
-// be told yet.
+// kFinishingBelowSeconds left); "1:23 elapsed" when the remaining time cannot be told yet.
 std::string ElapsedAndRemainingText(double elapsed_s, double fraction);
 
 }  // namespace fresco

@@ -224,7 +224,7 @@ void ColmapProgressBar(const PosesSnapshot& snap) {
         .append(std::to_string(step.total))
         .append(" images");
   text.append(": ").append(ElapsedAndRemainingText(seconds, step.Fraction()));
-  if (RemainingSeconds(seconds, step.Fraction()) >= 0.5) text += " in this step";
+  if (RemainingSeconds(seconds, step.Fraction()) >= kFinishingBelowSeconds) text += " in this step";
   const float fraction = (snap.step - 1 + static_cast<float>(step.Fraction())) / snap.steps;
   ProgressBarWithText(fraction, text);
 }
